@@ -1,0 +1,341 @@
+"""The client API: ``AsyncClient`` (asyncio) and ``Client`` (blocking), one set of methods.
+
+    async with AsyncClient("tcp://127.0.0.1:5555") as c:
+        override = await c.read("ch1.mc_command_feed_override_r")
+        await c.write("ch1.mc_command_feed_override_w", 500)
+        async for sample in c.subscribe("ch1.ax1.link_state"):
+            ...
+
+    with Client("tcp://127.0.0.1:5555") as c:
+        c.read_address(551, 0x121301, 0x10018, "UNS32")
+
+Objects are found by name through one browse of the service's catalog, cached for the
+life of the connection. Every failure raises ``AdsError`` naming its ADS code.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+from collections.abc import AsyncIterator, Iterable, Iterator
+from dataclasses import dataclass
+from datetime import UTC, datetime, timedelta
+from typing import Any
+
+from protocol import sum as sums
+from protocol.constants import AdsState, CncPort, TransmissionMode
+from protocol.constants import ReservedIndexGroup as RIG
+from protocol.datatypes import STRING_ENCODING, DataType, parse_type
+from protocol.errors import AdsReturnCode
+from protocol.frames import (
+    AddNotificationRequest,
+    BrowseRequest,
+    DeleteNotificationRequest,
+    ReadDeviceInfoRequest,
+    ReadRequest,
+    ReadStateRequest,
+    ReadWriteRequest,
+    Request,
+    Response,
+    WriteControlRequest,
+    WriteRequest,
+)
+
+from .errors import AdsError
+from .transport import AsyncTransport, SyncTransport, drive
+
+DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
+DEFAULT_TIMEOUT_S = 5.0
+_FILETIME_EPOCH = datetime(1601, 1, 1, tzinfo=UTC)
+_HANDLE_PORT = CncPort.COM  # handles are global in the service; any CNC port serves them
+
+
+@dataclass(frozen=True, slots=True)
+class ObjectInfo:
+    """What the service says about one object (a browse row)."""
+
+    name: str
+    port: int
+    group: int
+    offset: int
+    type: str
+    length: int
+    access: str
+    unit: str
+    description: str
+
+    @property
+    def dtype(self) -> DataType:
+        """The object's data type."""
+        return parse_type(self.type)
+
+
+@dataclass(frozen=True, slots=True)
+class DeviceInfo:
+    """ReadDeviceInfo and ReadState in one."""
+
+    name: str
+    version: str
+    ads_state: AdsState
+    device_state: int
+
+
+@dataclass(frozen=True, slots=True)
+class Sample:
+    """One notification: the object's value, when the kernel sampled it, its sequence."""
+
+    name: str
+    value: Any
+    timestamp: datetime
+    sequence: int
+
+
+def _coerce_type(dtype: DataType | str) -> DataType:
+    if isinstance(dtype, DataType):
+        return dtype
+    try:
+        return parse_type(dtype)
+    except ValueError as exc:
+        raise AdsError(AdsReturnCode.CLIENT_INVALIDPARM, str(exc)) from None
+
+
+def _encode(dtype: DataType, value: Any, what: str) -> bytes:
+    try:
+        return dtype.encode(value)
+    except (TypeError, ValueError) as exc:
+        raise AdsError(AdsReturnCode.DEVICE_INVALIDDATA, f"{what}: {exc} (checked by the client)") from None
+
+
+def _decode(dtype: DataType, data: bytes, what: str) -> Any:
+    try:
+        return dtype.decode(data)
+    except ValueError as exc:
+        raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, f"{what}: {exc}") from None
+
+
+def filetime_to_datetime(filetime: int) -> datetime:
+    """A FILETIME (100 ns since 1601) as an aware UTC datetime."""
+    return _FILETIME_EPOCH + timedelta(microseconds=filetime // 10)
+
+
+class AsyncClient:
+    """Asyncio client of a cnc-objects service. Use with ``async with``."""
+
+    def __init__(
+        self,
+        endpoint: str = DEFAULT_ENDPOINT,
+        *,
+        timeout_s: float = DEFAULT_TIMEOUT_S,
+        _transport: AsyncTransport | SyncTransport | None = None,
+    ) -> None:
+        self.endpoint = endpoint
+        self._t = _transport or AsyncTransport(endpoint, timeout_s)
+        self._objects: dict[str, ObjectInfo] | None = None
+        self._handles: dict[str, int] = {}
+
+    async def __aenter__(self) -> AsyncClient:
+        await self._t.open()
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
+        await self._t.close()
+
+    # ------------------------------------------------------------ plumbing
+
+    async def _call(self, cls: type[Request], port: int, *fields: Any) -> Response:
+        """Send one request; return the reply or raise AdsError with its code."""
+        reply = await self._t.exchange(cls(self._t.next_invoke_id(), port, *fields))
+        if reply.result:
+            raise AdsError(reply.result, reply.message)
+        return reply
+
+    def _payload(self, reply: Response, index: int = 0) -> Any:
+        try:
+            return reply.fields[index]
+        except IndexError:
+            raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, "reply lacks its data") from None
+
+    async def _object(self, name: str) -> ObjectInfo:
+        if self._objects is None:
+            self._objects = {o.name.lower(): o for o in await self.browse("*")}
+        info = self._objects.get(name.lower())
+        if info is None:
+            raise AdsError(AdsReturnCode.DEVICE_SYMBOLNOTFOUND, f"no object is named {name!r}")
+        return info
+
+    # ------------------------------------------------------------ API
+
+    async def info(self) -> DeviceInfo:
+        """Device name and version (ReadDeviceInfo) and ADS state (ReadState)."""
+        dev = await self._call(ReadDeviceInfoRequest, CncPort.COM)
+        state = await self._call(ReadStateRequest, CncPort.COM)
+        major, minor, build, name = dev.fields
+        return DeviceInfo(name, f"{major}.{minor}.{build}", AdsState(state.fields[0]), state.fields[1])
+
+    async def read_state(self) -> tuple[AdsState, int]:
+        """(ADS state, device state)."""
+        reply = await self._call(ReadStateRequest, CncPort.COM)
+        return AdsState(reply.fields[0]), reply.fields[1]
+
+    async def write_control(self, ads_state: AdsState | int, device_state: int = 0) -> None:
+        """Command the kernel's ADS state: RUN, STOP or RESET."""
+        await self._call(WriteControlRequest, CncPort.COM, int(ads_state), device_state, b"")
+
+    async def browse(self, pattern: str = "*") -> list[ObjectInfo]:
+        """Descriptions of the objects whose names match the glob ``pattern``."""
+        reply = await self._call(BrowseRequest, CncPort.COM, pattern)
+        return [ObjectInfo(*row) for row in self._payload(reply)]
+
+    async def read_address(
+        self, port: int, group: int, offset: int, dtype: DataType | str
+    ) -> Any:
+        """Read the value at an ADS address, decoded as ``dtype`` (``"UNS16"``, ...)."""
+        dtype = _coerce_type(dtype)
+        reply = await self._call(ReadRequest, port, group, offset, dtype.size)
+        return _decode(dtype, self._payload(reply), f"0x{group:x}/0x{offset:x}")
+
+    async def read_raw(self, port: int, group: int, offset: int, length: int) -> bytes:
+        """Read ``length`` raw bytes at an ADS address."""
+        return self._payload(await self._call(ReadRequest, port, group, offset, length))
+
+    async def read(self, name: str) -> Any:
+        """Read the object ``name``."""
+        info = await self._object(name)
+        reply = await self._call(ReadRequest, info.port, info.group, info.offset, info.length)
+        return _decode(info.dtype, self._payload(reply), info.name)
+
+    async def write_address(
+        self, port: int, group: int, offset: int, dtype: DataType | str, value: Any
+    ) -> None:
+        """Write ``value`` encoded as ``dtype`` at an ADS address."""
+        dtype = _coerce_type(dtype)
+        data = _encode(dtype, value, f"0x{group:x}/0x{offset:x}")
+        await self._call(WriteRequest, port, group, offset, data)
+
+    async def write_raw(self, port: int, group: int, offset: int, data: bytes) -> None:
+        """Write raw bytes at an ADS address."""
+        await self._call(WriteRequest, port, group, offset, data)
+
+    async def write(self, name: str, value: Any) -> None:
+        """Write the object ``name``; returns once the kernel has applied it."""
+        info = await self._object(name)
+        data = _encode(info.dtype, value, info.name)
+        await self._call(WriteRequest, info.port, info.group, info.offset, data)
+
+    async def read_many(self, names: Iterable[str]) -> dict[str, Any]:
+        """Read several objects in one sum-read round trip (handles cached per name)."""
+        infos = [await self._object(n) for n in names]
+        missing = list(dict.fromkeys(i.name for i in infos if i.name not in self._handles))
+        if missing:
+            await self._acquire_handles(missing)
+        items = [sums.SumItem(RIG.SYM_VALUE_BY_HANDLE, self._handles[i.name], i.length) for i in infos]
+        data, read_length = sums.encode_sum_read(items)
+        reply = await self._call(
+            ReadWriteRequest, _HANDLE_PORT, RIG.SUM_READ, len(items), read_length, data
+        )
+        try:
+            results = sums.decode_sum_read_reply([i.length for i in infos], self._payload(reply))
+        except ValueError as exc:
+            raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, str(exc)) from None
+        values: dict[str, Any] = {}
+        for info, (code, raw) in zip(infos, results):
+            if code:
+                raise AdsError(code, f"{info.name} (in a sum read)")
+            values[info.name] = _decode(info.dtype, raw, info.name)
+        return values
+
+    async def _acquire_handles(self, names: list[str]) -> None:
+        items = [
+            sums.SumItem(RIG.SYM_HANDLE_BY_NAME, 0, 4, n.encode(STRING_ENCODING) + b"\x00")
+            for n in names
+        ]
+        data, read_length = sums.encode_sum_read_write(items)
+        reply = await self._call(
+            ReadWriteRequest, _HANDLE_PORT, RIG.SUM_READ_WRITE, len(items), read_length, data
+        )
+        results = sums.decode_sum_read_write_reply(len(items), self._payload(reply))
+        for name, (code, raw) in zip(names, results):
+            if code:
+                raise AdsError(code, f"handle of {name}")
+            self._handles[name] = int.from_bytes(raw, "little")
+
+    async def subscribe(
+        self, name: str, on_change: bool = True, cycle_ms: int | None = None
+    ) -> AsyncIterator[Sample]:
+        """Samples of ``name`` as the service sends them (server-side notification).
+
+        ``on_change``: a sample when the value changed, checked every ``cycle_ms`` (default:
+        every kernel cycle); otherwise one every ``cycle_ms`` (default 100 ms) of kernel
+        time. The first sample is the current value. Leaving the loop deletes the
+        subscription.
+        """
+        info = await self._object(name)
+        mode = TransmissionMode.SERVER_ON_CHANGE if on_change else TransmissionMode.SERVER_CYCLE
+        cycle = cycle_ms if cycle_ms is not None else (0 if on_change else 100)
+        reply = await self._call(
+            AddNotificationRequest, info.port, info.group, info.offset, info.length,
+            int(mode), 0, int(cycle),
+        )
+        handle = self._payload(reply)
+        self._t.open_samples(handle)
+        try:
+            while True:
+                raw = await self._t.next_sample(handle)
+                yield Sample(
+                    info.name,
+                    _decode(info.dtype, raw.data, info.name),
+                    filetime_to_datetime(raw.timestamp),
+                    raw.sequence,
+                )
+        finally:
+            self._t.close_samples(handle)
+            await self._call(DeleteNotificationRequest, info.port, handle)
+
+
+def _blocking(method: Any) -> Any:
+    """Wrap an AsyncClient method so that it runs to completion on a SyncTransport."""
+    if inspect.isasyncgenfunction(method):
+
+        @functools.wraps(method)
+        def generator(self: Client, *args: Any, **kwargs: Any) -> Iterator[Any]:
+            agen = method(self._core, *args, **kwargs)
+            try:
+                while True:
+                    try:
+                        yield drive(agen.__anext__())
+                    except StopAsyncIteration:
+                        return
+            finally:
+                drive(agen.aclose())
+
+        return generator
+
+    @functools.wraps(method)
+    def call(self: Client, *args: Any, **kwargs: Any) -> Any:
+        return drive(method(self._core, *args, **kwargs))
+
+    return call
+
+
+class Client:
+    """Blocking client: the same methods as ``AsyncClient``. Use with ``with``."""
+
+    def __init__(self, endpoint: str = DEFAULT_ENDPOINT, *, timeout_s: float = DEFAULT_TIMEOUT_S) -> None:
+        self.endpoint = endpoint
+        self._core = AsyncClient(
+            endpoint, _transport=SyncTransport(endpoint, timeout_s)
+        )
+
+    def __enter__(self) -> Client:
+        drive(self._core._t.open())
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        drive(self._core._t.close())
+
+
+for _name, _method in inspect.getmembers(AsyncClient, inspect.isfunction):
+    if not _name.startswith("_"):
+        setattr(Client, _name, _blocking(_method))
+
+__all__ = ["AsyncClient", "Client", "DeviceInfo", "ObjectInfo", "Sample", "filetime_to_datetime"]

@@ -1,0 +1,310 @@
+"""Transports: move frames between a client and the service over a ZeroMQ DEALER socket.
+
+The client's methods are written once, as coroutines that ``await`` only two things of
+their transport: ``exchange(request)`` (a reply) and ``next_sample(handle)`` (a
+notification sample). ``AsyncTransport`` answers them on the event loop, with many
+requests in flight matched by invoke id. ``SyncTransport`` answers them by blocking on
+the socket: its awaitables yield themselves to a small driver (``drive``) that performs
+the I/O and sends the result back into the coroutine, so the blocking client runs the
+same method bodies without an event loop.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import itertools
+import logging
+from collections import deque
+from collections.abc import Coroutine, Generator
+from typing import Any
+
+import zmq
+
+from protocol.constants import AdsCommand
+from protocol.errors import ProtocolError
+from protocol.frames import Notification, Request, Response, Sample, decode_incoming
+
+from .errors import AdsConnectionError, AdsTimeoutError
+
+log = logging.getLogger(__name__)
+
+_NOBLOCK = int(zmq.NOBLOCK)
+SAMPLE_BUFFER = 1000  # samples kept per subscription; a full buffer drops the oldest
+_EARLY_HANDLES = 64  # samples of handles not yet claimed (they can overtake the reply)
+
+
+def _new_socket(context: zmq.Context, endpoint: str) -> zmq.Socket:
+    sock = context.socket(zmq.DEALER)
+    sock.setsockopt(zmq.LINGER, 0)
+    sock.setsockopt(zmq.SNDHWM, 100_000)
+    sock.setsockopt(zmq.RCVHWM, 100_000)
+    try:
+        sock.connect(endpoint)
+    except zmq.ZMQError as exc:
+        sock.close()
+        raise AdsConnectionError(0x748, f"cannot connect to {endpoint}: {exc}") from None
+    return sock
+
+
+class _Transport:
+    """What both transports share: invoke ids and per-subscription sample buffers."""
+
+    def __init__(self, endpoint: str, timeout_s: float) -> None:
+        self.endpoint = endpoint
+        self.timeout_s = timeout_s
+        self._ids = itertools.count(1)
+        self._samples: dict[int, deque[Sample]] = {}
+        self._early: dict[int, deque[Sample]] = {}
+
+    def next_invoke_id(self) -> int:
+        """A fresh invoke id, 1..2**32-1."""
+        invoke_id = next(self._ids)
+        if invoke_id > 0xFFFFFFFF:
+            self._ids = itertools.count(2)
+            invoke_id = 1
+        return invoke_id
+
+    def open_samples(self, handle: int) -> None:
+        """Start buffering samples of ``handle`` (claims any that arrived early)."""
+        self._samples[handle] = self._early.pop(handle, None) or deque(maxlen=SAMPLE_BUFFER)
+
+    def close_samples(self, handle: int) -> None:
+        """Stop buffering samples of ``handle``."""
+        self._samples.pop(handle, None)
+        self._early.pop(handle, None)
+
+    def _route(self, note: Notification) -> None:
+        for sample in note.samples:
+            buffer = self._samples.get(sample.handle)
+            if buffer is None:
+                buffer = self._early.get(sample.handle)
+                if buffer is None:
+                    if len(self._early) >= _EARLY_HANDLES:
+                        continue  # a deleted subscription's last samples: drop
+                    buffer = self._early[sample.handle] = deque(maxlen=SAMPLE_BUFFER)
+            buffer.append(sample)
+
+    def _timeout(self, request: Request) -> AdsTimeoutError:
+        return AdsTimeoutError(
+            f"no reply to {AdsCommand(request.COMMAND).name} within {self.timeout_s:g} s "
+            f"from {self.endpoint} (is cnc-service running?)"
+        )
+
+
+# --------------------------------------------------------------------------- async
+
+
+class AsyncTransport(_Transport):
+    """DEALER socket on the running event loop; replies matched to futures by invoke id.
+
+    Timeouts are enforced by one sweeper task (every quarter of the timeout) rather than
+    a timer per request: with many requests in flight a timer each costs more than the
+    request itself. A request therefore fails between 1 and 1.25 timeouts after it was
+    sent, with ``AdsTimeoutError``.
+    """
+
+    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context | None = None) -> None:
+        super().__init__(endpoint, timeout_s)
+        self._context = context or zmq.Context.instance()
+        self._sock: zmq.Socket | None = None
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._pending: dict[int, tuple[asyncio.Future[Response], float, Request]] = {}
+        self._sample_waiters: dict[int, asyncio.Future[None]] = {}
+        self._drain_scheduled = False
+        self._sweeper: asyncio.Task[None] | None = None
+
+    async def open(self) -> None:
+        """Connect (ZeroMQ connects in the background; requests queue until it has)."""
+        self._loop = asyncio.get_running_loop()
+        self._sock = sock = _new_socket(self._context, self.endpoint)
+        raw = zmq.Socket.__mro__[1]  # the Cython methods, without pyzmq's Python wrappers
+        self._raw_send = raw.send.__get__(sock)
+        self._raw_recv = raw.recv.__get__(sock)
+        self._raw_get = raw.get.__get__(sock)
+        self._loop.add_reader(sock.FD, self._drain)
+        self._sweeper = self._loop.create_task(self._sweep(), name="cnc-client-timeouts")
+
+    async def close(self) -> None:
+        """Disconnect; requests still waiting fail with AdsConnectionError."""
+        if self._sock is None:
+            return
+        if self._sweeper is not None:
+            self._sweeper.cancel()
+        self._loop.remove_reader(self._sock.FD)  # type: ignore[union-attr]
+        self._sock.close(linger=0)
+        self._sock = None
+        closed = AdsConnectionError(0x748, "the client was closed")
+        for fut, _, _ in self._pending.values():
+            if not fut.done():
+                fut.set_exception(closed)
+        for fut in self._sample_waiters.values():
+            if not fut.done():
+                fut.set_exception(closed)
+        self._pending.clear()
+
+    async def exchange(self, request: Request) -> Response:
+        """Send ``request`` and wait for its reply, at most ``timeout_s`` (see class doc)."""
+        if self._sock is None:
+            raise AdsConnectionError(0x748, "the client is not connected; use 'async with'")
+        loop = self._loop
+        fut = loop.create_future()  # type: ignore[union-attr]
+        invoke_id = request.invoke_id
+        self._pending[invoke_id] = (fut, loop.time() + self.timeout_s, request)  # type: ignore[union-attr]
+        try:
+            self._raw_send(request.encode(), _NOBLOCK)
+        except zmq.Again:
+            del self._pending[invoke_id]
+            raise AdsConnectionError(0x748, "send queue full; the service is not reading") from None
+        self._schedule_drain()  # a send can consume the fd's edge: look once per loop pass
+        try:
+            return await fut
+        finally:
+            self._pending.pop(invoke_id, None)
+
+    async def next_sample(self, handle: int) -> Sample:
+        """The next buffered sample of ``handle``, waiting for one if needed."""
+        while True:
+            buffer = self._samples[handle]
+            if buffer:
+                return buffer.popleft()
+            waiter = self._loop.create_future()  # type: ignore[union-attr]
+            self._sample_waiters[handle] = waiter
+            try:
+                await waiter
+            finally:
+                self._sample_waiters.pop(handle, None)
+
+    async def _sweep(self) -> None:
+        period = max(0.001, self.timeout_s / 4)
+        while True:
+            await asyncio.sleep(period)
+            now = self._loop.time()  # type: ignore[union-attr]
+            for fut, deadline, request in list(self._pending.values()):
+                if deadline <= now and not fut.done():
+                    fut.set_exception(self._timeout(request))
+
+    def _schedule_drain(self) -> None:
+        if not self._drain_scheduled:
+            self._drain_scheduled = True
+            self._loop.call_soon(self._drain)  # type: ignore[union-attr]
+
+    def _drain(self) -> None:
+        self._drain_scheduled = False
+        if self._sock is None:
+            return
+        recv = self._raw_recv
+        pending = self._pending
+        while True:
+            try:
+                raw = recv(_NOBLOCK)
+            except zmq.Again:
+                return
+            try:
+                message = decode_incoming(raw)
+            except ProtocolError as exc:
+                log.warning("dropped an unreadable frame from %s: %s", self.endpoint, exc)
+                continue
+            if type(message) is Response:
+                entry = pending.get(message.invoke_id)
+                if entry is not None and not entry[0].done():
+                    entry[0].set_result(message)
+            else:
+                self._route(message)  # type: ignore[arg-type]
+                for sample in message.samples:  # type: ignore[union-attr]
+                    waiter = self._sample_waiters.get(sample.handle)
+                    if waiter is not None and not waiter.done():
+                        waiter.set_result(None)
+
+
+# --------------------------------------------------------------------------- sync
+
+
+class _Pending:
+    """An awaitable that yields itself to ``drive``, which sends back the result."""
+
+    __slots__ = ("transport", "request", "handle")
+
+    def __init__(self, transport: SyncTransport, request: Request | None, handle: int = 0) -> None:
+        self.transport = transport
+        self.request = request
+        self.handle = handle
+
+    def __await__(self) -> Generator[_Pending, Any, Any]:
+        return (yield self)
+
+
+class SyncTransport(_Transport):
+    """DEALER socket used by blocking calls; no event loop, no thread."""
+
+    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context | None = None) -> None:
+        super().__init__(endpoint, timeout_s)
+        self._context = context or zmq.Context.instance()
+        self._sock: zmq.Socket | None = None
+
+    async def open(self) -> None:
+        """Connect."""
+        self._sock = _new_socket(self._context, self.endpoint)
+
+    async def close(self) -> None:
+        """Disconnect."""
+        if self._sock is not None:
+            self._sock.close(linger=0)
+            self._sock = None
+
+    def exchange(self, request: Request) -> _Pending:
+        """Awaitable reply to ``request`` (performed by ``drive``)."""
+        return _Pending(self, request)
+
+    def next_sample(self, handle: int) -> _Pending:
+        """Awaitable next sample of ``handle`` (performed by ``drive``)."""
+        return _Pending(self, None, handle)
+
+    def perform(self, pending: _Pending) -> Response | Sample:
+        """Do the blocking I/O a ``_Pending`` stands for."""
+        sock = self._sock
+        if sock is None:
+            raise AdsConnectionError(0x748, "the client is not connected; use 'with'")
+        request = pending.request
+        if request is None:
+            buffer = self._samples[pending.handle]
+            while not buffer:
+                self._receive(sock, None)
+            return buffer.popleft()
+        try:
+            sock.send(request.encode(), zmq.NOBLOCK)
+        except zmq.Again:
+            raise AdsConnectionError(0x748, "send queue full; the service is not reading") from None
+        timeout_ms = max(1, int(self.timeout_s * 1000))
+        while True:
+            if not sock.poll(timeout_ms, zmq.POLLIN):
+                raise self._timeout(request)
+            message = self._receive(sock, 0)
+            if message is not None and message.invoke_id == request.invoke_id:
+                return message
+
+    def _receive(self, sock: zmq.Socket, flags: int | None) -> Response | None:
+        raw = sock.recv() if flags is None else sock.recv(flags)
+        try:
+            message = decode_incoming(raw)
+        except ProtocolError as exc:
+            log.warning("dropped an unreadable frame from %s: %s", self.endpoint, exc)
+            return None
+        if type(message) is Response:
+            return message  # a late reply to a timed-out request is dropped by the caller
+        self._route(message)  # type: ignore[arg-type]
+        return None
+
+
+def drive(coro: Coroutine[Any, Any, Any]) -> Any:
+    """Run a client coroutine to completion on a ``SyncTransport``, blocking."""
+    send: Any = None
+    error: BaseException | None = None
+    while True:
+        try:
+            pending = coro.throw(error) if error is not None else coro.send(send)
+        except StopIteration as stop:
+            return stop.value
+        try:
+            send, error = pending.transport.perform(pending), None
+        except BaseException as exc:  # noqa: BLE001 - delivered into the coroutine
+            send, error = None, exc

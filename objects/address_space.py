@@ -1,0 +1,212 @@
+"""The address space: find an object by address, name, handle or pattern; read and decode.
+
+Each entry points at live state through a getter and a setter that whoever builds the
+space supplies (the service binds them to the kernel). Reads and write-decoding return
+an ADS code, never raise: ``(0, data)`` on success, ``(code, message)`` otherwise, so
+the message layer answers with the code and a sentence that says why.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import logging
+import re
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from protocol.errors import AdsReturnCode
+
+from .model import CncObject
+
+log = logging.getLogger(__name__)
+
+Getter = Callable[[], Any]
+Setter = Callable[[Any], Any]
+
+_E = AdsReturnCode
+
+
+@dataclass(slots=True)
+class Entry:
+    """An object with its bindings. ``handle`` is stable for the life of the space."""
+
+    obj: CncObject
+    handle: int
+    read: Getter | None
+    write: Setter | None
+
+
+class GroupHandler(Protocol):
+    """A whole index group served by code instead of objects (the COM directory)."""
+
+    def read(self, offset: int, length: int) -> tuple[int, bytes | str]:
+        """ADS read: (0, data) or (code, message)."""
+        ...
+
+
+class AddressSpace:
+    """Objects by (port, group, offset), by case-insensitive name and by handle."""
+
+    def __init__(self) -> None:
+        self._by_address: dict[tuple[int, int, int], Entry] = {}
+        self._by_name: dict[str, Entry] = {}
+        self._entries: list[Entry] = []
+        self._groups: set[tuple[int, int]] = set()
+        self._handlers: dict[tuple[int, int], GroupHandler] = {}
+        self._ports: set[int] = set()
+
+    # ----------------------------------------------------------------- building
+
+    def add(
+        self,
+        obj: CncObject,
+        read: Getter | None = None,
+        write: Setter | None = None,
+        aliases: Iterable[int] = (),
+    ) -> Entry:
+        """Register ``obj``; ``aliases`` are other groups that address it (index-based)."""
+        key = obj.name.lower()
+        if key in self._by_name:
+            raise ValueError(f"object {obj.name} is registered twice")
+        if obj.access.readable and read is None:
+            raise ValueError(f"readable object {obj.name} needs a getter")
+        if obj.access.writable and write is None:
+            raise ValueError(f"writable object {obj.name} needs a setter")
+        entry = Entry(obj, len(self._entries) + 1, read, write)
+        for group in (obj.group, *aliases):
+            address = (obj.port, group, obj.offset)
+            if address in self._by_address:
+                other = self._by_address[address].obj.name
+                raise ValueError(f"{obj.name} and {other} share address {address}")
+            self._by_address[address] = entry
+            self._groups.add((obj.port, group))
+        self._ports.add(obj.port)
+        self._by_name[key] = entry
+        self._entries.append(entry)
+        return entry
+
+    def add_group(self, port: int, group: int, handler: GroupHandler) -> None:
+        """Serve every offset of ``group`` on ``port`` by ``handler``."""
+        self._handlers[(port, group)] = handler
+        self._groups.add((port, group))
+        self._ports.add(port)
+
+    # ----------------------------------------------------------------- lookup
+
+    def __len__(self) -> int:
+        return len(self._entries)
+
+    @property
+    def ports(self) -> frozenset[int]:
+        """Ports that serve at least one object."""
+        return frozenset(self._ports)
+
+    def objects(self) -> list[CncObject]:
+        """Every object, in registration order."""
+        return [e.obj for e in self._entries]
+
+    def by_name(self, name: str) -> Entry | None:
+        """The entry named ``name`` (case-insensitive), or None."""
+        return self._by_name.get(name.lower())
+
+    def by_handle(self, handle: int) -> Entry | None:
+        """The entry whose handle is ``handle``, or None."""
+        if 0 < handle <= len(self._entries):
+            return self._entries[handle - 1]
+        return None
+
+    def find(self, port: int, group: int, offset: int) -> Entry | tuple[int, str]:
+        """The entry at an address, or (code, message): 0x6 port, 0x702 group, 0x703 offset."""
+        entry = self._by_address.get((port, group, offset))
+        if entry is not None:
+            return entry
+        return self._miss(port, group, offset)
+
+    def _miss(self, port: int, group: int, offset: int) -> tuple[int, str]:
+        if port not in self._ports:
+            return _E.TARGETPORTNOTFOUND, f"no CNC task listens on port {port}"
+        if (port, group) not in self._groups:
+            return _E.DEVICE_INVALIDGRP, f"index group 0x{group:x} is unknown on port {port}"
+        return (
+            _E.DEVICE_INVALIDOFFSET,
+            f"index offset 0x{offset:x} is unknown in group 0x{group:x} on port {port}",
+        )
+
+    def match(self, pattern: str) -> list[CncObject]:
+        """Objects whose name matches the glob ``pattern`` (case-insensitive)."""
+        if pattern in ("", "*"):
+            return self.objects()
+        regex = re.compile(fnmatch.translate(pattern.lower()))
+        return [e.obj for e in self._entries if regex.match(e.obj.name.lower())]
+
+    # ----------------------------------------------------------------- values
+
+    def read(self, port: int, group: int, offset: int, length: int) -> tuple[int, bytes | str]:
+        """ADS read at an address: (0, data) or (code, message)."""
+        entry = self._by_address.get((port, group, offset))
+        if entry is None:
+            handler = self._handlers.get((port, group))
+            if handler is not None:
+                return handler.read(offset, length)
+            return self._miss(port, group, offset)
+        return self.read_entry(entry, length)
+
+    @staticmethod
+    def read_entry(entry: Entry, length: int) -> tuple[int, bytes | str]:
+        """Read ``entry`` with a read length of ``length`` bytes."""
+        obj = entry.obj
+        if entry.read is None:
+            return _E.DEVICE_INVALIDACCESS, f"{obj.name} is write-only"
+        if length != obj.dtype.size:
+            return (
+                _E.DEVICE_INVALIDSIZE,
+                f"{obj.name} is {obj.dtype.name}, {obj.dtype.size} bytes; read asked {length}",
+            )
+        try:
+            return 0, obj.dtype.encode(entry.read())
+        except Exception:  # a getter fault must not take the service down
+            log.exception("reading %s failed", obj.name)
+            return _E.DEVICE_ERROR, f"reading {obj.name} failed inside the service"
+
+    def decode_write(
+        self, port: int, group: int, offset: int, data: bytes
+    ) -> tuple[int, Entry | str, Any]:
+        """Check and decode an ADS write: (0, entry, value) or (code, message, None)."""
+        found = self.find(port, group, offset)
+        if isinstance(found, tuple):
+            if (port, group) in self._handlers:
+                return _E.DEVICE_INVALIDACCESS, f"index group 0x{group:x} is read-only", None
+            return found[0], found[1], None
+        return self.decode_entry_write(found, data)
+
+    @staticmethod
+    def decode_entry_write(entry: Entry, data: bytes) -> tuple[int, Entry | str, Any]:
+        """Check and decode a write of ``data`` to ``entry``."""
+        obj = entry.obj
+        dtype = obj.dtype
+        if entry.write is None:
+            return _E.DEVICE_INVALIDACCESS, f"{obj.name} is read-only", None
+        if dtype.kind == "str":
+            # ADS clients commonly send a string without its padding: accept up to the
+            # buffer size, padded with NUL.
+            if len(data) > dtype.size:
+                return (
+                    _E.DEVICE_INVALIDSIZE,
+                    f"{obj.name} is {dtype.name}; {len(data)} bytes do not fit",
+                    None,
+                )
+            data = data.ljust(dtype.size, b"\x00")
+        elif len(data) != dtype.size:
+            return (
+                _E.DEVICE_INVALIDSIZE,
+                f"{obj.name} is {dtype.name}, {dtype.size} bytes; write sent {len(data)}",
+                None,
+            )
+        try:
+            value = dtype.decode(data)
+        except (ValueError, UnicodeDecodeError) as exc:
+            return _E.DEVICE_INVALIDDATA, f"{obj.name}: {exc}", None
+        if dtype.kind == "bool" and data not in (b"\x00", b"\x01"):
+            return _E.DEVICE_INVALIDDATA, f"{obj.name} is BOOLEAN: write 0 or 1", None
+        return 0, entry, value

@@ -1,0 +1,216 @@
+"""The catalog: every CNC object the kernel offers, declared once.
+
+Each ``ObjectTemplate`` is one row of the ISG object tables (reference/cnc-objects.md);
+``build_objects`` expands the rows over a machine layout into object instances. The
+service binds each instance to kernel state by its ``element`` name; this module holds
+no kernel logic.
+
+Objects whose offsets the public ISG documentation does not give (platform statistics,
+feed override names) are marked "project" in their description; their addresses are
+stable and found by name through the COM object directory, as ISG tools do.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+from protocol.constants import CncPort
+from protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16, UNS32, DataType
+
+from .addressing import GroupBase, axis_offset, channel_group
+from .model import Access, CncObject
+
+
+class Scope(Enum):
+    """What one template is instantiated for."""
+
+    PLATFORM = "platform"  # once: name = element
+    PHYSICAL_AXIS = "physical_axis"  # per drive: ax<A>.element, offset 0x<A>00xx
+    CHANNEL = "channel"  # per channel: ch<c>.element, group + CID
+    CHANNEL_AXIS = "channel_axis"  # per axis of a channel: ch<c>.ax<a>.element
+
+
+@dataclass(frozen=True, slots=True)
+class ObjectTemplate:
+    """One object of the tables, before channel and axis are filled in."""
+
+    element: str
+    scope: Scope
+    port: CncPort
+    group_base: int
+    offset: int
+    dtype: DataType
+    access: Access
+    unit: str
+    description: str
+
+
+@dataclass(frozen=True, slots=True)
+class ChannelLayout:
+    """A channel: its logical id and the number of axes it has."""
+
+    channel_id: int
+    axis_count: int
+
+
+@dataclass(frozen=True, slots=True)
+class MachineLayout:
+    """What the catalog is expanded over: channels and physical axis numbers."""
+
+    channels: tuple[ChannelLayout, ...]
+    physical_axes: tuple[int, ...]
+
+
+R, W, RW = Access.READ, Access.WRITE, Access.READ_WRITE
+GEO, COM = CncPort.GEO, CncPort.COM
+IPO = GroupBase.GEO_INTERPOLATOR
+COM_CH = GroupBase.COM_CHANNEL
+COM_AX = GroupBase.COM_PLATFORM_AXIS
+
+TEMPLATES: tuple[ObjectTemplate, ...] = (
+    # --- GEO interpolator, channel axes (FCT-C15 "CNC objects") -------------------------
+    ObjectTemplate(
+        "requested_link_to_physical_axis", Scope.CHANNEL_AXIS, GEO, IPO, 0x16, UNS16, R, "-",
+        "Physical axis this logical axis requests (channel switchover)",
+    ),
+    ObjectTemplate(
+        "actual_link_to_physical_axis", Scope.CHANNEL_AXIS, GEO, IPO, 0x17, UNS16, R, "-",
+        "Physical axis currently linked to this logical axis; 0 = none",
+    ),
+    ObjectTemplate(
+        "link_state", Scope.CHANNEL_AXIS, GEO, IPO, 0x18, UNS32, R, "-",
+        "Axis request state: 0 link exists, 1 physical axis requested, "
+        "2 waiting for acknowledgement",
+    ),
+    # --- GEO interpolator, channel -------------------------------------------------------
+    ObjectTemplate(
+        "dist_prog_start", Scope.CHANNEL, GEO, IPO, 0x56, REAL64, R, "0.1 um",
+        "Path distance from program start on the compensated path",
+    ),
+    # --- COM channel ----------------------------------------------------------------------
+    ObjectTemplate(
+        "mc_command_feed_override_w", Scope.CHANNEL, COM, COM_CH, 0x09, UNS16, W, "0.1 %",
+        "Commanded feed override (project name; offset as TwinSharp)",
+    ),
+    ObjectTemplate(
+        "mc_command_feed_override_r", Scope.CHANNEL, COM, COM_CH, 0x0A, UNS16, R, "0.1 %",
+        "Commanded feed override, read back",
+    ),
+    ObjectTemplate(
+        "mc_active_feed_override_r", Scope.CHANNEL, COM, COM_CH, 0x0C, UNS16, R, "0.1 %",
+        "Feed override in effect in the interpolator",
+    ),
+    ObjectTemplate(
+        "mc_command_execution_mode_w", Scope.CHANNEL, COM, COM_CH, 0x3F, SGN32, W, "-",
+        "Command the channel's execution mode (bit mask; takes effect at program start)",
+    ),
+    ObjectTemplate(
+        "mc_command_execution_mode_r", Scope.CHANNEL, COM, COM_CH, 0x40, SGN32, R, "-",
+        "Commanded execution mode",
+    ),
+    ObjectTemplate(
+        "mc_active_execution_mode_r", Scope.CHANNEL, COM, COM_CH, 0x41, SGN32, R, "-",
+        "Execution mode in effect",
+    ),
+    # --- COM platform (project offsets; found by name through the directory) -------------
+    ObjectTemplate(
+        "cnc_version_r", Scope.PLATFORM, COM, COM_CH, 0x1001, STRING(32), R, "-",
+        "Kernel version (project)",
+    ),
+    ObjectTemplate(
+        "cnc_number_of_channel_r", Scope.PLATFORM, COM, COM_CH, 0x1002, UNS16, R, "-",
+        "Number of configured channels (project)",
+    ),
+    ObjectTemplate(
+        "cnc_number_of_axis_r", Scope.PLATFORM, COM, COM_CH, 0x1003, UNS32, R, "-",
+        "Number of configured physical axes (project)",
+    ),
+    ObjectTemplate(
+        "cnc_cycle_time_r", Scope.PLATFORM, COM, COM_CH, 0x1010, UNS32, R, "us",
+        "Cycle time of the GEO task (project)",
+    ),
+    ObjectTemplate(
+        "cnc_tick_counter_r", Scope.PLATFORM, COM, COM_CH, 0x1011, UNS32, R, "-",
+        "Cycles run by the GEO task since start, modulo 2**32 (project)",
+    ),
+    ObjectTemplate(
+        "cnc_cycle_overruns_r", Scope.PLATFORM, COM, COM_CH, 0x1012, UNS32, R, "-",
+        "Cycles that started later than one cycle after their deadline (project)",
+    ),
+    ObjectTemplate(
+        "cnc_cycle_jitter_max_r", Scope.PLATFORM, COM, COM_CH, 0x1013, UNS32, R, "us",
+        "Largest lateness of a cycle start against its deadline (project)",
+    ),
+    ObjectTemplate(
+        "cnc_cycle_exec_time_max_r", Scope.PLATFORM, COM, COM_CH, 0x1014, UNS32, R, "us",
+        "Longest execution time of one cycle (project)",
+    ),
+    ObjectTemplate(
+        "cnc_kernel_time_r", Scope.PLATFORM, COM, COM_CH, 0x1015, REAL64, R, "s",
+        "Kernel time: cycles run times the cycle time (virtual or real) (project)",
+    ),
+    ObjectTemplate(
+        "cnc_kernel_running_r", Scope.PLATFORM, COM, COM_CH, 0x1016, BOOLEAN, R, "-",
+        "TRUE while the cycle task runs (ADS state RUN), FALSE after STOP (project)",
+    ),
+    # --- COM platform axes (offsets as TwinSharp, 0x120200 / 0x<ANo>00xx) ---------------
+    ObjectTemplate(
+        "command_position_acs", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x02, SGN32, R, "0.1 um",
+        "Command position of the drive in the axis coordinate system",
+    ),
+    ObjectTemplate(
+        "actual_position_acs", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x03, SGN32, R, "0.1 um",
+        "Actual position of the drive in the axis coordinate system",
+    ),
+    ObjectTemplate(
+        "link_to_logical_axis", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x0F, UNS16, R, "-",
+        "Logical axis number that drives this physical axis; 0 = none (project offset)",
+    ),
+)
+
+
+def _instantiate(t: ObjectTemplate, channel: int = 0, axis: int = 0) -> CncObject:
+    match t.scope:
+        case Scope.PLATFORM:
+            name, group, offset = t.element, t.group_base, t.offset
+        case Scope.PHYSICAL_AXIS:
+            name, group, offset = f"ax{axis}.{t.element}", t.group_base, axis_offset(axis, t.offset)
+        case Scope.CHANNEL:
+            name, group, offset = (
+                f"ch{channel}.{t.element}",
+                channel_group(t.group_base, channel),
+                t.offset,
+            )
+        case Scope.CHANNEL_AXIS:
+            name, group, offset = (
+                f"ch{channel}.ax{axis}.{t.element}",
+                channel_group(t.group_base, channel),
+                axis_offset(axis, t.offset),
+            )
+    return CncObject(
+        name, t.element, t.port, group, offset, t.dtype, t.access, t.unit, t.description,
+        channel, axis,
+    )
+
+
+def build_objects(
+    layout: MachineLayout, templates: tuple[ObjectTemplate, ...] = TEMPLATES
+) -> list[CncObject]:
+    """Every object instance of ``layout``: platform, physical axes, channels, their axes."""
+    objects: list[CncObject] = []
+    for t in templates:
+        match t.scope:
+            case Scope.PLATFORM:
+                objects.append(_instantiate(t))
+            case Scope.PHYSICAL_AXIS:
+                objects.extend(_instantiate(t, axis=a) for a in layout.physical_axes)
+            case Scope.CHANNEL:
+                objects.extend(_instantiate(t, c.channel_id) for c in layout.channels)
+            case Scope.CHANNEL_AXIS:
+                objects.extend(
+                    _instantiate(t, c.channel_id, a)
+                    for c in layout.channels
+                    for a in range(1, c.axis_count + 1)
+                )
+    return objects

@@ -1,0 +1,70 @@
+"""The CNC object: a typed value at an ADS address, with a name people read."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+from protocol.datatypes import DataType
+
+
+class Access(str, Enum):
+    """Who may do what with an object, in the ISG tables' spelling."""
+
+    READ = "r"  # read-only: writes get ADS 0x704
+    WRITE = "w"  # write-only: reads get ADS 0x704
+    READ_WRITE = "rw"  # both
+
+    @property
+    def readable(self) -> bool:
+        """True when the object can be read."""
+        return self is not Access.WRITE
+
+    @property
+    def writable(self) -> bool:
+        """True when the object can be written."""
+        return self is not Access.READ
+
+
+@dataclass(frozen=True, slots=True)
+class CncObject:
+    """One CNC object instance.
+
+    ``name`` is the instance name (``ch1.ax2.link_state``), ``element`` the name of the
+    object in the ISG tables (``link_state``). ``group`` is the logical index group (bit
+    0x100000 set); ``channel`` and ``axis`` are the logical channel id and the axis
+    number (axis index in the channel, or physical axis number) the instance belongs to,
+    0 where they do not apply.
+    """
+
+    name: str
+    element: str
+    port: int
+    group: int
+    offset: int
+    dtype: DataType
+    access: Access
+    unit: str
+    description: str
+    channel: int = 0
+    axis: int = 0
+
+    @property
+    def length(self) -> int:
+        """Size of the value in bytes."""
+        return self.dtype.size
+
+    def describe(self) -> list:
+        """The browse descriptor: [name, port, group, offset, type, length, access, unit,
+        description]."""
+        return [
+            self.name,
+            self.port,
+            self.group,
+            self.offset,
+            self.dtype.name,
+            self.length,
+            self.access.value,
+            self.unit,
+            self.description,
+        ]

@@ -1,0 +1,1 @@
+"""The wire and nothing else: ADS vocabulary, return codes, data types, frames. No I/O."""

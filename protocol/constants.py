@@ -1,0 +1,91 @@
+"""ADS vocabulary: command ids, states, transmission modes, ports and reserved index groups.
+
+Numbers and names follow Beckhoff's ADS specification, so that anyone who knows pyads or
+TwinCAT reads them without a table. One comment per member says what it is.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+
+class AdsCommand(IntEnum):
+    """ADS command ids, as carried in the AMS header and in our frames."""
+
+    INVALID = 0  # never sent; a frame with it is refused
+    READ_DEVICE_INFO = 1  # name and version of the device
+    READ = 2  # read data at index group/offset
+    WRITE = 3  # write data at index group/offset
+    READ_STATE = 4  # ADS state and device state
+    WRITE_CONTROL = 5  # change ADS state and device state
+    ADD_DEVICE_NOTIFICATION = 6  # subscribe to a value
+    DELETE_DEVICE_NOTIFICATION = 7  # end a subscription
+    DEVICE_NOTIFICATION = 8  # server to client: subscribed samples
+    READ_WRITE = 9  # write data, then read data, in one request
+    BROWSE = 0x100  # project extension: object descriptions matching a glob pattern
+
+
+class AdsState(IntEnum):
+    """ADS states (ADSSTATE_*), as reported by ReadState and set by WriteControl."""
+
+    INVALID = 0  # not a state
+    IDLE = 1  # idle
+    RESET = 2  # reset requested / resetting
+    INIT = 3  # initialising
+    START = 4  # starting
+    RUN = 5  # running
+    STOP = 6  # stopped
+    SAVECFG = 7  # saving configuration
+    LOADCFG = 8  # loading configuration
+    POWERFAILURE = 9  # power failure
+    POWERGOOD = 10  # power good
+    ERROR = 11  # error
+    SHUTDOWN = 12  # shutting down
+    SUSPEND = 13  # suspended
+    RESUME = 14  # resuming
+    CONFIG = 15  # configuration mode
+    RECONFIG = 16  # reconfiguring
+    STOPPING = 17  # stopping
+    INCOMPATIBLE = 18  # incompatible
+    EXCEPTION = 19  # exception
+
+
+class TransmissionMode(IntEnum):
+    """ADS notification transmission modes (ADSTRANS_*)."""
+
+    NO_TRANS = 0  # no transmission
+    CLIENT_CYCLE = 1  # client polls cyclically (not a server mode)
+    CLIENT_ON_CHANGE = 2  # client polls on change (not a server mode)
+    SERVER_CYCLE = 3  # server sends every cycle time
+    SERVER_ON_CHANGE = 4  # server sends when the value changed, checked every cycle time
+    SERVER_CYCLE2 = 5  # like SERVER_CYCLE (TwinCAT 3 spelling)
+    SERVER_ON_CHANGE2 = 6  # like SERVER_ON_CHANGE (TwinCAT 3 spelling)
+    CLIENT_1_REQ = 7  # one request only
+
+
+class ReservedIndexGroup(IntEnum):
+    """Index groups whose meaning ADS fixes for every port."""
+
+    SYM_HANDLE_BY_NAME = 0xF003  # ReadWrite: name in, UNS32 handle out
+    SYM_VALUE_BY_NAME = 0xF004  # ReadWrite: name in, value out
+    SYM_VALUE_BY_HANDLE = 0xF005  # Read/Write with offset = handle
+    SYM_RELEASE_HANDLE = 0xF006  # Write the UNS32 handle to release it
+    SUM_READ = 0xF080  # ReadWrite: N x (group, offset, length) in, N codes + data out
+    SUM_WRITE = 0xF081  # ReadWrite: N x (group, offset, length) + data in, N codes out
+    SUM_READ_WRITE = 0xF082  # ReadWrite: N x (group, offset, rlen, wlen) + data in
+
+
+class CncPort(IntEnum):
+    """ADS ports of the CNC tasks and of the PLC whose variables we serve."""
+
+    GEO = 551  # interpolator, position controller: path and axis real-time data
+    SDA = 552  # decoder: NC variables
+    COM = 553  # HMI-facing mc_*, cnc_*, ac_* objects
+    PLC = 851  # TwinCAT PLC runtime 1: the HLI elements, served as symbols
+
+
+#: The most sub-requests one sum command may carry (TwinCAT allows 500).
+SUM_COMMAND_MAX_ITEMS = 500
+
+#: Largest data block a single request may carry (bytes). Larger requests get 0x705.
+MAX_DATA_BYTES = 1 << 20

@@ -1,0 +1,363 @@
+"""Frames: one msgpack array per ZeroMQ message, mirroring the ADS command field for field.
+
+Layout (every integer unsigned unless noted; ``data`` is raw bytes)::
+
+    request       [invoke_id, command, port, *fields]
+    response      [invoke_id, command, result, *fields]
+    error reply   [invoke_id, command, result, message]     result != 0
+    notification  [0, 8, port, [[handle, sequence, timestamp, data], ...]]
+
+    command                    request fields                         response fields
+    1 READ_DEVICE_INFO         -                                      major, minor, build, name
+    2 READ                     group, offset, length                  data
+    3 WRITE                    group, offset, data                    -
+    4 READ_STATE               -                                      ads_state, device_state
+    5 WRITE_CONTROL            ads_state, device_state, data          -
+    6 ADD_DEVICE_NOTIFICATION  group, offset, length, transmission_mode,
+                               max_delay_ms, cycle_time_ms            handle
+    7 DELETE_DEVICE_NOTIF.     handle                                 -
+    9 READ_WRITE               group, offset, read_length, data       data
+    0x100 BROWSE (extension)   pattern                                [descriptor, ...]
+
+A descriptor is ``[name, port, group, offset, type, length, access, unit, description]``.
+The ``message`` of an error reply is a project extension: a sentence that says why, next
+to the ADS code. Notification timestamps are Windows FILETIME (100 ns since 1601-01-01),
+as in ADS. Invoke id 0 is reserved for notifications; requests use 1..2**32-1.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import msgpack
+
+from .constants import AdsCommand
+from .errors import AdsReturnCode, ProtocolError
+
+U32_MAX = 0xFFFFFFFF
+_packb = msgpack.Packer(use_bin_type=True, autoreset=True).pack
+
+
+# --------------------------------------------------------------------------- requests
+# Requests are NamedTuples: immutable, and built from a decoded frame in one call (the
+# dispatch hot path). Fields are (invoke_id, port, *command fields); ``FIELDS`` names the
+# command fields with their kind, ``COMMAND`` is the ADS command id.
+
+
+class ReadDeviceInfoRequest(NamedTuple):
+    """Ask for the device name and version."""
+
+    invoke_id: int
+    port: int
+    COMMAND = AdsCommand.READ_DEVICE_INFO
+    FIELDS = ()
+
+    def encode(self) -> bytes:
+        """The frame as msgpack bytes."""
+        return _packb([self[0], self.COMMAND, *self[1:]])
+
+
+class ReadRequest(NamedTuple):
+    """Read ``length`` bytes at ``group``/``offset``."""
+
+    invoke_id: int
+    port: int
+    group: int
+    offset: int
+    length: int
+    COMMAND = AdsCommand.READ
+    FIELDS = (("group", "u32"), ("offset", "u32"), ("length", "u32"))
+    encode = ReadDeviceInfoRequest.encode
+
+
+class WriteRequest(NamedTuple):
+    """Write ``data`` at ``group``/``offset``."""
+
+    invoke_id: int
+    port: int
+    group: int
+    offset: int
+    data: bytes
+    COMMAND = AdsCommand.WRITE
+    FIELDS = (("group", "u32"), ("offset", "u32"), ("data", "bytes"))
+    encode = ReadDeviceInfoRequest.encode
+
+
+class ReadStateRequest(NamedTuple):
+    """Ask for the ADS state and the device state."""
+
+    invoke_id: int
+    port: int
+    COMMAND = AdsCommand.READ_STATE
+    FIELDS = ()
+    encode = ReadDeviceInfoRequest.encode
+
+
+class WriteControlRequest(NamedTuple):
+    """Change the ADS state (RUN, STOP, RESET) and device state."""
+
+    invoke_id: int
+    port: int
+    ads_state: int
+    device_state: int
+    data: bytes
+    COMMAND = AdsCommand.WRITE_CONTROL
+    FIELDS = (("ads_state", "u32"), ("device_state", "u32"), ("data", "bytes"))
+    encode = ReadDeviceInfoRequest.encode
+
+
+class AddNotificationRequest(NamedTuple):
+    """Subscribe to ``length`` bytes at ``group``/``offset``."""
+
+    invoke_id: int
+    port: int
+    group: int
+    offset: int
+    length: int
+    transmission_mode: int
+    max_delay_ms: int
+    cycle_time_ms: int
+    COMMAND = AdsCommand.ADD_DEVICE_NOTIFICATION
+    FIELDS = (
+        ("group", "u32"),
+        ("offset", "u32"),
+        ("length", "u32"),
+        ("transmission_mode", "u32"),
+        ("max_delay_ms", "u32"),
+        ("cycle_time_ms", "u32"),
+    )
+    encode = ReadDeviceInfoRequest.encode
+
+
+class DeleteNotificationRequest(NamedTuple):
+    """End the subscription ``handle``."""
+
+    invoke_id: int
+    port: int
+    handle: int
+    COMMAND = AdsCommand.DELETE_DEVICE_NOTIFICATION
+    FIELDS = (("handle", "u32"),)
+    encode = ReadDeviceInfoRequest.encode
+
+
+class ReadWriteRequest(NamedTuple):
+    """Write ``data``, then read ``read_length`` bytes, at ``group``/``offset``."""
+
+    invoke_id: int
+    port: int
+    group: int
+    offset: int
+    read_length: int
+    data: bytes
+    COMMAND = AdsCommand.READ_WRITE
+    FIELDS = (("group", "u32"), ("offset", "u32"), ("read_length", "u32"), ("data", "bytes"))
+    encode = ReadDeviceInfoRequest.encode
+
+
+class BrowseRequest(NamedTuple):
+    """Project extension: describe every object whose name matches ``pattern`` (glob)."""
+
+    invoke_id: int
+    port: int
+    pattern: str
+    COMMAND = AdsCommand.BROWSE
+    FIELDS = (("pattern", "str"),)
+    encode = ReadDeviceInfoRequest.encode
+
+
+Request = (
+    ReadDeviceInfoRequest
+    | ReadRequest
+    | WriteRequest
+    | ReadStateRequest
+    | WriteControlRequest
+    | AddNotificationRequest
+    | DeleteNotificationRequest
+    | ReadWriteRequest
+    | BrowseRequest
+)
+
+REQUEST_TYPES: dict[int, Any] = {
+    int(cls.COMMAND): cls
+    for cls in (
+        ReadDeviceInfoRequest,
+        ReadRequest,
+        WriteRequest,
+        ReadStateRequest,
+        WriteControlRequest,
+        AddNotificationRequest,
+        DeleteNotificationRequest,
+        ReadWriteRequest,
+        BrowseRequest,
+    )
+}
+_KIND_TYPES = {"u32": int, "bytes": bytes, "str": str, "list": list}
+#: Per command: (frame length, ((python type, is u32), ...)) for the fast shape check.
+_SHAPES: dict[int, tuple[int, tuple[tuple[type, bool], ...]]] = {
+    command: (3 + len(cls.FIELDS), tuple((_KIND_TYPES[k], k == "u32") for _, k in cls.FIELDS))
+    for command, cls in REQUEST_TYPES.items()
+}
+
+
+def _unpack(raw: bytes) -> Any:
+    try:
+        return msgpack.unpackb(raw, raw=False, use_list=True, strict_map_key=True)
+    except (ValueError, msgpack.UnpackException, TypeError) as exc:
+        raise ProtocolError(f"frame is not valid msgpack: {exc}") from None
+
+
+def peek_invoke_id(raw: bytes) -> tuple[int | None, int | None]:
+    """Best effort: the invoke id and command of a frame, or None where unreadable."""
+    try:
+        obj = _unpack(raw)
+    except ProtocolError:
+        return None, None
+    if type(obj) is not list or not obj or type(obj[0]) is not int or not 0 < obj[0] <= U32_MAX:
+        return None, None
+    command = obj[1] if len(obj) > 1 and type(obj[1]) is int else None
+    return obj[0], command
+
+
+def decode_request(raw: bytes) -> Request:
+    """Decode a request frame; raise ``ProtocolError`` (with the invoke id when readable)."""
+    obj = _unpack(raw)
+    if type(obj) is list and len(obj) >= 3:
+        invoke_id, command, port = obj[0], obj[1], obj[2]
+        shape = _SHAPES.get(command) if type(command) is int else None
+        if (
+            shape is not None
+            and len(obj) == shape[0]
+            and type(invoke_id) is int
+            and 0 < invoke_id <= U32_MAX
+            and type(port) is int
+            and 0 <= port <= 0xFFFF
+        ):
+            for (kind, is_u32), value in zip(shape[1], obj[3:]):
+                if type(value) is not kind or (is_u32 and not 0 <= value <= U32_MAX):
+                    break
+            else:
+                return REQUEST_TYPES[command](invoke_id, *obj[2:])
+    raise _explain_bad_request(obj)
+
+
+def _explain_bad_request(obj: Any) -> ProtocolError:
+    """The error for a frame the fast path refused, as precise as the frame allows."""
+    if type(obj) is not list or len(obj) < 3:
+        return ProtocolError("a request is an array [invoke_id, command, port, ...]")
+    invoke_id, command, port = obj[0], obj[1], obj[2]
+    if type(invoke_id) is not int or not 0 < invoke_id <= U32_MAX:
+        return ProtocolError(f"invoke id must be 1..{U32_MAX}, got {invoke_id!r}")
+    if type(command) is not int:
+        return ProtocolError("command id must be an integer", invoke_id=invoke_id)
+    cls = REQUEST_TYPES.get(command)
+    if cls is None:
+        return ProtocolError(
+            f"command id {command} is not supported",
+            invoke_id=invoke_id,
+            command=command,
+            code=AdsReturnCode.DEVICE_SRVNOTSUPP,
+        )
+    if type(port) is not int or not 0 <= port <= 0xFFFF:
+        return ProtocolError(
+            f"port must be 0..65535, got {port!r}", invoke_id=invoke_id, command=command
+        )
+    fields = cls.FIELDS
+    if len(obj) != 3 + len(fields):
+        names = ", ".join(n for n, _ in fields) or "no fields"
+        return ProtocolError(
+            f"{cls.COMMAND.name} takes {len(fields)} fields after the port ({names}), "
+            f"got {len(obj) - 3}",
+            invoke_id=invoke_id,
+            command=command,
+        )
+    for (name, kind), value in zip(fields, obj[3:]):
+        if kind == "u32":
+            if type(value) is not int or not 0 <= value <= U32_MAX:
+                return ProtocolError(
+                    f"field {name} must be an unsigned 32-bit integer, got {value!r}",
+                    invoke_id=invoke_id,
+                    command=command,
+                )
+        elif type(value) is not _KIND_TYPES[kind]:
+            return ProtocolError(
+                f"field {name} must be {kind}, got {type(value).__name__}",
+                invoke_id=invoke_id,
+                command=command,
+            )
+    return ProtocolError("malformed request", invoke_id=invoke_id, command=command)
+
+
+# --------------------------------------------------------------------------- responses
+
+
+@dataclass(frozen=True, slots=True)
+class Response:
+    """A reply: ``result`` is the ADS return code; ``message`` is set on errors only."""
+
+    invoke_id: int
+    command: int
+    result: int
+    fields: tuple[Any, ...] = ()
+    message: str = ""
+
+    def encode(self) -> bytes:
+        """The frame as msgpack bytes."""
+        if self.result:
+            return _packb([self.invoke_id, self.command, self.result, self.message])
+        return _packb([self.invoke_id, self.command, 0, *self.fields])
+
+
+def encode_response(invoke_id: int, command: int, *fields: Any) -> bytes:
+    """Encode a successful reply without building a ``Response`` (the hot path)."""
+    return _packb([invoke_id, command, 0, *fields])
+
+
+def encode_error(invoke_id: int, command: int, code: int, message: str) -> bytes:
+    """Encode an error reply carrying the ADS code and a sentence that says why."""
+    return _packb([invoke_id, command, int(code), message])
+
+
+@dataclass(frozen=True, slots=True)
+class Sample:
+    """One notification sample: handle, sequence number, FILETIME timestamp, raw data."""
+
+    handle: int
+    sequence: int
+    timestamp: int
+    data: bytes
+
+
+def encode_notification(port: int, samples: list[list[Any]]) -> bytes:
+    """Encode samples ``[[handle, sequence, timestamp, data], ...]`` as one frame."""
+    return _packb([0, AdsCommand.DEVICE_NOTIFICATION, port, samples])
+
+
+@dataclass(frozen=True, slots=True)
+class Notification:
+    """An unsolicited server frame with one or more samples."""
+
+    port: int
+    samples: tuple[Sample, ...]
+
+
+def decode_incoming(raw: bytes) -> Response | Notification:
+    """Decode a frame a client receives: a response or a notification."""
+    obj = _unpack(raw)
+    if type(obj) is not list or len(obj) < 3:
+        raise ProtocolError("a reply is an array [invoke_id, command, result, ...]")
+    invoke_id, command = obj[0], obj[1]
+    if invoke_id == 0 and command == AdsCommand.DEVICE_NOTIFICATION:
+        if len(obj) != 4 or type(obj[3]) is not list:
+            raise ProtocolError("a notification is [0, 8, port, [samples]]")
+        try:
+            samples = tuple(Sample(*s) for s in obj[3])
+        except TypeError:
+            raise ProtocolError("a sample is [handle, sequence, timestamp, data]") from None
+        return Notification(obj[2], samples)
+    if type(invoke_id) is not int or type(command) is not int or type(obj[2]) is not int:
+        raise ProtocolError("invoke id, command and result must be integers")
+    if obj[2]:
+        message = obj[3] if len(obj) > 3 and type(obj[3]) is str else ""
+        return Response(invoke_id, command, obj[2], (), message)
+    return Response(invoke_id, command, 0, tuple(obj[3:]))

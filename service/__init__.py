@@ -1,0 +1,3 @@
+"""The running system: configuration, kernel, binding, ZeroMQ server, entry point."""
+
+__version__ = "0.1.0"

@@ -1,0 +1,87 @@
+"""Clocks of the cycle task: real time, or virtual time.
+
+``RealtimeClock`` sleeps to each cycle deadline and counts overruns and jitter.
+``VirtualClock`` does not tie kernel time to the wall: while the kernel has work it runs
+cycles back to back (or paced at ``speed`` times real time); while it is idle it waits
+for the next command, at most one cycle time, so an idle service costs no CPU and a
+command is applied at once. Kernel time is always cycles x cycle time.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Protocol
+
+from .state import CycleStats
+
+
+class Clock(Protocol):
+    """Decides when the next cycle starts."""
+
+    def start(self) -> None:
+        """Called once before the first cycle."""
+
+    def wait(self, busy: bool, stats: CycleStats, wake: WakeSource) -> None:
+        """Block until the next cycle should start; update ``stats``."""
+
+
+class WakeSource(Protocol):
+    """What a clock may wait on instead of sleeping: the command queue."""
+
+    def wait_for_command(self, timeout_s: float) -> None:
+        """Return when a command is queued or ``timeout_s`` has passed."""
+
+
+class RealtimeClock:
+    """Sleep to each deadline; a cycle that ends after the next deadline is an overrun."""
+
+    def __init__(self, cycle_s: float) -> None:
+        self.cycle_s = cycle_s
+        self._deadline = 0.0
+
+    def start(self) -> None:
+        self._deadline = time.perf_counter() + self.cycle_s
+
+    def wait(self, busy: bool, stats: CycleStats, wake: WakeSource) -> None:
+        now = time.perf_counter()
+        if now > self._deadline:
+            # The cycle's work ran past the next deadline: count it and skip the missed
+            # deadlines instead of running a burst of late cycles.
+            stats.overruns += 1
+            missed = int((now - self._deadline) / self.cycle_s) + 1
+            self._deadline += missed * self.cycle_s
+        remaining = self._deadline - time.perf_counter()
+        if remaining > 0:
+            time.sleep(remaining)
+        late_us = int((time.perf_counter() - self._deadline) * 1e6)
+        if late_us > stats.jitter_max_us:
+            stats.jitter_max_us = late_us
+        self._deadline += self.cycle_s
+
+
+class VirtualClock:
+    """Kernel time detached from the wall clock.
+
+    ``speed`` None: as fast as the CPU allows while busy. ``speed`` X: X times real time.
+    """
+
+    def __init__(self, cycle_s: float, speed: float | None = None) -> None:
+        self.cycle_s = cycle_s
+        self.speed = speed
+        self._deadline = 0.0
+
+    def start(self) -> None:
+        self._deadline = time.perf_counter()
+
+    def wait(self, busy: bool, stats: CycleStats, wake: WakeSource) -> None:
+        if self.speed is not None:
+            self._deadline += self.cycle_s / self.speed
+            remaining = self._deadline - time.perf_counter()
+            if remaining > 0:
+                wake.wait_for_command(remaining) if not busy else time.sleep(remaining)
+            else:
+                self._deadline = time.perf_counter()
+        elif busy:
+            time.sleep(0)  # let the service's thread take the GIL between cycles
+        else:
+            wake.wait_for_command(self.cycle_s)

@@ -1,0 +1,86 @@
+"""Commands the service queues for the kernel; the cycle thread applies them.
+
+A command is applied at the start of a cycle and answers None (done) or a ``Refusal``
+that says why not. Kernel code knows nothing of ADS: the binding maps refusal reasons to
+ADS return codes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import IntEnum
+from typing import NamedTuple, Protocol
+
+from .state import ExecutionMode, KernelState
+
+
+class RefusalReason(IntEnum):
+    """Why the kernel did not apply a command."""
+
+    INVALID_VALUE = 1  # the value is outside what the object accepts
+    NOT_READY = 2  # the kernel or channel is not in a state that allows it
+    BUSY = 3  # try again in a later cycle
+
+
+class Refusal(NamedTuple):
+    """A command the kernel did not apply, with a sentence for the user."""
+
+    reason: RefusalReason
+    message: str
+
+
+class Command(Protocol):
+    """Anything the cycle thread can apply to the kernel state."""
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        """Change ``state``; return None when done, a Refusal otherwise."""
+        ...
+
+
+#: Execution mode bits the kernel implements so far. Others are refused, never stored.
+IMPLEMENTED_EXECUTION_MODES = ExecutionMode.ISG_STANDARD
+_KNOWN_MODE_BITS = sum(m for m in ExecutionMode)
+
+
+@dataclass(frozen=True, slots=True)
+class SetFeedOverride:
+    """Command the channel's feed override (0.1 %); in effect from this cycle."""
+
+    channel_index: int
+    value: int
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        channel = state.channels[self.channel_index]
+        if not 0 <= self.value <= channel.feed_override_max:
+            return Refusal(
+                RefusalReason.INVALID_VALUE,
+                f"feed override {self.value / 10:g} % is outside 0..{channel.feed_override_max / 10:g} %",
+            )
+        channel.feed_override_command = self.value
+        channel.feed_override_active = self.value
+        return None
+
+
+@dataclass(frozen=True, slots=True)
+class SetExecutionMode:
+    """Command the channel's execution mode; it takes effect at the next program start."""
+
+    channel_index: int
+    value: int
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        if self.value < 0 or self.value & ~_KNOWN_MODE_BITS:
+            return Refusal(
+                RefusalReason.INVALID_VALUE,
+                f"execution mode 0x{self.value & 0xFFFFFFFF:x} has bits that are not "
+                "execution modes",
+            )
+        missing = self.value & ~IMPLEMENTED_EXECUTION_MODES
+        if missing:
+            names = "|".join(m.name for m in ExecutionMode if m and m & missing)
+            return Refusal(
+                RefusalReason.INVALID_VALUE,
+                f"execution mode {names} is not implemented by this kernel yet",
+            )
+        state.channels[self.channel_index].execution_mode_command = self.value
+        return None

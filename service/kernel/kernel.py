@@ -1,0 +1,202 @@
+"""The kernel: its state and the GEO cycle task in a thread of its own.
+
+Every cycle: apply the queued commands (in arrival order), run the cycle's work, update
+the statistics, publish a snapshot, call the ``on_cycle_end`` hook. The service talks to
+the kernel only through ``submit`` (commands in) and ``snapshot`` (state out); nothing
+here knows about sockets, frames or addresses.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from enum import Enum
+
+from ..config import MachineConfig
+from .clock import Clock
+from .commands import Command, Refusal, RefusalReason
+from .state import CycleStats, KernelState, Snapshot
+
+log = logging.getLogger(__name__)
+
+Done = Callable[[Refusal | None], None]
+
+
+class Control(Enum):
+    """Run control of the whole kernel (ADS WriteControl)."""
+
+    RUN = "run"  # cycles run
+    STOP = "stop"  # cycles pause; reads serve the last snapshot, writes are refused
+    RESET = "reset"  # state re-initialised from the configuration, then RUN
+
+
+@dataclass(frozen=True, slots=True)
+class ControlCommand:
+    """A run-control request, applied by the cycle thread like any command."""
+
+    control: Control
+
+
+_SHUTDOWN = object()
+
+
+class Kernel:
+    """Kernel state plus the cycle thread that owns it."""
+
+    def __init__(self, config: MachineConfig, clock: Clock) -> None:
+        self.config = config
+        self.cycle_s = config.cycle_ms / 1000.0
+        self._cycle_ns = round(config.cycle_ms * 1e6)
+        self._clock = clock
+        self.state = KernelState.from_config(config)
+        self.stats = CycleStats(cycle_us=round(config.cycle_ms * 1000))
+        self.snapshot: Snapshot = self.state.snapshot(0, 0, self.stats)
+        self.on_cycle_end: Callable[[Snapshot], None] | None = None
+        self._queue: queue.SimpleQueue = queue.SimpleQueue()
+        self._waiting: deque = deque()
+        self._channel_index = {c.channel_id: k for k, c in enumerate(self.state.channels)}
+        self._thread: threading.Thread | None = None
+
+    # ------------------------------------------------------------ service side
+
+    @property
+    def running(self) -> bool:
+        """True while cycles run (ADS state RUN)."""
+        return self.stats.running
+
+    def channel_index(self, channel_id: int) -> int:
+        """Position of the channel with logical id ``channel_id`` in the state."""
+        return self._channel_index[channel_id]
+
+    def submit(self, command: Command | ControlCommand, done: Done) -> None:
+        """Queue ``command``; ``done`` is called from the cycle thread once applied."""
+        self._queue.put((command, done))
+
+    def start(self) -> None:
+        """Start the cycle thread."""
+        self._thread = threading.Thread(target=self._run, name="cnc-geo-cycle", daemon=True)
+        self._thread.start()
+
+    def close(self, timeout_s: float = 5.0) -> None:
+        """Stop the cycle thread and wait for it; queued commands are refused."""
+        if self._thread is None:
+            return
+        self._queue.put((_SHUTDOWN, None))
+        self._thread.join(timeout_s)
+        if self._thread.is_alive():
+            log.error("cycle thread did not stop within %.1f s", timeout_s)
+        self._thread = None
+
+    # ------------------------------------------------------------ cycle thread
+
+    def wait_for_command(self, timeout_s: float) -> None:
+        """Block until a command arrives or ``timeout_s`` passes (the idle clock)."""
+        try:
+            self._waiting.append(self._queue.get(timeout=timeout_s))
+        except queue.Empty:
+            pass
+
+    def _run(self) -> None:
+        self._clock.start()
+        try:
+            while True:
+                if not self.stats.running and not self._paused():
+                    return
+                started = time.perf_counter()
+                if not self._cycle():
+                    return
+                exec_us = int((time.perf_counter() - started) * 1e6)
+                if exec_us > self.stats.exec_time_max_us:
+                    self.stats.exec_time_max_us = exec_us
+                self._clock.wait(self.state_has_work(), self.stats, self)
+        except Exception:  # a kernel fault is logged loudly; the service stays up
+            log.exception("cycle thread failed; the kernel is stopped")
+            self.stats.running = False
+            self._publish()
+
+    def _next_command(self, block: bool) -> tuple:
+        if self._waiting:
+            return self._waiting.popleft()
+        return self._queue.get() if block else self._queue.get_nowait()
+
+    def _cycle(self) -> bool:
+        """One cycle; False when the kernel is shutting down."""
+        while True:
+            try:
+                command, done = self._next_command(block=False)
+            except queue.Empty:
+                break
+            if command is _SHUTDOWN:
+                self._refuse_queued()
+                return False
+            self._apply(command, done)
+            if not self.stats.running:
+                return True
+        self.stats.cycles += 1
+        self._publish()
+        return True
+
+    def _paused(self) -> bool:
+        """Wait in STOP until RUN or RESET; False on shutdown."""
+        while not self.stats.running:
+            command, done = self._next_command(block=True)
+            if command is _SHUTDOWN:
+                self._refuse_queued()
+                return False
+            if isinstance(command, ControlCommand):
+                self._apply(command, done)
+            else:
+                done(Refusal(RefusalReason.NOT_READY, "the kernel is stopped (ADS state STOP)"))
+        return True
+
+    def _apply(self, command: Command | ControlCommand, done: Done) -> None:
+        try:
+            if isinstance(command, ControlCommand):
+                result = self._control(command.control)
+            else:
+                result = command.apply(self.state)
+        except Exception:
+            log.exception("command %r failed", command)
+            result = Refusal(RefusalReason.NOT_READY, f"the kernel failed to apply {command!r}")
+        done(result)
+
+    def _control(self, control: Control) -> None:
+        match control:
+            case Control.RUN:
+                self.stats.running = True
+            case Control.STOP:
+                self.stats.running = False
+            case Control.RESET:
+                self.state = KernelState.from_config(self.config)
+                self.stats.running = True
+        self._publish()
+        return None
+
+    def _refuse_queued(self) -> None:
+        while True:
+            try:
+                command, done = self._next_command(block=False)
+            except queue.Empty:
+                return
+            if done is not None:
+                done(Refusal(RefusalReason.NOT_READY, "the kernel is shutting down"))
+
+    def _publish(self) -> None:
+        cycle = self.stats.cycles
+        self.snapshot = self.state.snapshot(cycle, cycle * self._cycle_ns, self.stats)
+        hook = self.on_cycle_end
+        if hook is not None:
+            hook(self.snapshot)
+
+    def state_has_work(self) -> bool:
+        """True while something must be computed every cycle.
+
+        The kernel of this issue has no motion yet: channels hold their axes and wait
+        for commands, so the virtual clock may idle between commands.
+        """
+        return False

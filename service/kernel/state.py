@@ -1,0 +1,203 @@
+"""Kernel state: channels, logical axes, physical axes, cycle statistics.
+
+The cycle thread owns these mutable objects. At the end of every cycle it publishes a
+``Snapshot`` of frozen copies, from which the service answers reads: a read is
+consistent within one cycle and never waits for the kernel.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum
+
+from ..config import ChannelConfig, MachineConfig
+
+
+class LinkState(IntEnum):
+    """State of a logical axis's link to its physical axis (FCT-C15 ``link_state``)."""
+
+    LINKED = 0  # the link exists: this logical axis drives the physical axis
+    REQUESTED = 1  # the physical axis is requested from the position controller
+    WAITING_ACK = 2  # waiting for the position controller's acknowledgement
+
+
+class ExecutionMode(IntEnum):
+    """Execution mode bits of a channel (``mc_command_execution_mode_w``)."""
+
+    ISG_STANDARD = 0x0  # normal machining
+    BLOCK_SEARCH = 0x1  # SV: block search
+    SOLLKON = 0x2  # contour visualisation with output
+    ON_LINE = 0x4  # online
+    SYNCHK = 0x8  # syntax check
+    PROD_TIME = 0x10  # production time calculation
+    ONLINE_PROD_TIME = 0x20  # online production time calculation
+    MACHINE_LOCK = 0x40  # dry run: no axis motion
+    ADD_MDI_BLOCK = 0x80  # additional MDI block
+    KIN_TRAFO_OFF = 0x100  # kinematic transformation off
+    SOLLKON_NO_OUTPUT = 0x800  # with SOLLKON: contour visualisation without output
+    BEARB_MODE_SCENE = 0x1000  # machining scene mode
+    SUPPRESS_TECHNO_OUTPUT = 0x2000  # no M/H/T output
+
+
+@dataclass(slots=True)
+class PhysicalAxis:
+    """A drive: follows the increments of the logical axis linked to it."""
+
+    number: int
+    name: str
+    command_position_incr: int = 0  # 0.1 um
+    actual_position_incr: int = 0  # 0.1 um
+    linked_logical_axis: int = 0  # logical axis number driving it; 0 = none
+
+    def frozen(self) -> PhysicalAxis:
+        """A copy for the snapshot."""
+        return PhysicalAxis(
+            self.number,
+            self.name,
+            self.command_position_incr,
+            self.actual_position_incr,
+            self.linked_logical_axis,
+        )
+
+
+@dataclass(slots=True)
+class LogicalAxis:
+    """An axis of a channel and its link to a physical axis."""
+
+    name: str
+    logical_number: int
+    requested_link: int  # physical axis number the axis asks for
+    actual_link: int = 0  # physical axis number linked now; 0 = none
+    link_state: LinkState = LinkState.LINKED
+
+    def frozen(self) -> LogicalAxis:
+        """A copy for the snapshot."""
+        return LogicalAxis(
+            self.name, self.logical_number, self.requested_link, self.actual_link, self.link_state
+        )
+
+
+@dataclass(slots=True)
+class Channel:
+    """A channel: its axes, override, execution mode and path distance."""
+
+    channel_id: int
+    name: str
+    axes: list[LogicalAxis]
+    feed_override_max: int
+    feed_override_command: int = 1000  # 0.1 %
+    feed_override_active: int = 1000  # 0.1 %
+    execution_mode_command: int = 0
+    execution_mode_active: int = 0
+    dist_prog_start_incr: float = 0.0  # 0.1 um
+    output_suspended: bool = False
+
+    def frozen(self) -> Channel:
+        """A copy for the snapshot, with copies of its axes."""
+        return Channel(
+            self.channel_id,
+            self.name,
+            [a.frozen() for a in self.axes],
+            self.feed_override_max,
+            self.feed_override_command,
+            self.feed_override_active,
+            self.execution_mode_command,
+            self.execution_mode_active,
+            self.dist_prog_start_incr,
+            self.output_suspended,
+        )
+
+
+@dataclass(slots=True)
+class CycleStats:
+    """Statistics of the GEO cycle task."""
+
+    cycle_us: int
+    cycles: int = 0
+    overruns: int = 0
+    jitter_max_us: int = 0
+    exec_time_max_us: int = 0
+    running: bool = True
+
+    def frozen(self) -> CycleStats:
+        """A copy for the snapshot."""
+        return CycleStats(
+            self.cycle_us,
+            self.cycles,
+            self.overruns,
+            self.jitter_max_us,
+            self.exec_time_max_us,
+            self.running,
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class Snapshot:
+    """Everything readable, as it was at the end of one cycle."""
+
+    cycle: int
+    time_ns: int
+    stats: CycleStats
+    channels: tuple[Channel, ...]
+    physical_axes: tuple[PhysicalAxis, ...]
+
+
+@dataclass(slots=True)
+class KernelState:
+    """The live state the cycle thread works on."""
+
+    channels: list[Channel] = field(default_factory=list)
+    physical_axes: list[PhysicalAxis] = field(default_factory=list)
+
+    @classmethod
+    def from_config(cls, config: MachineConfig) -> KernelState:
+        """Initial state: every channel links its axes unless its output is suspended."""
+        state = cls(
+            channels=[_channel_from_config(c) for c in config.channels],
+            physical_axes=[PhysicalAxis(a.number, a.name) for a in config.physical_axes],
+        )
+        by_number = {p.number: p for p in state.physical_axes}
+        for channel in state.channels:
+            if channel.output_suspended:
+                continue
+            for axis in channel.axes:
+                drive = by_number[axis.requested_link]
+                if drive.linked_logical_axis == 0:
+                    drive.linked_logical_axis = axis.logical_number
+                    axis.actual_link = drive.number
+                    axis.link_state = LinkState.LINKED
+                else:  # another channel holds it: the request waits
+                    axis.link_state = LinkState.REQUESTED
+        return state
+
+    def snapshot(self, cycle: int, time_ns: int, stats: CycleStats) -> Snapshot:
+        """Frozen copies of everything readable."""
+        return Snapshot(
+            cycle,
+            time_ns,
+            stats.frozen(),
+            tuple(c.frozen() for c in self.channels),
+            tuple(p.frozen() for p in self.physical_axes),
+        )
+
+
+def _channel_from_config(config: ChannelConfig) -> Channel:
+    suspended = config.suspend_output_at_start
+    axes = [
+        LogicalAxis(
+            a.name,
+            a.logical_number,
+            a.link_to,
+            link_state=LinkState.REQUESTED if suspended else LinkState.LINKED,
+        )
+        for a in config.axes
+    ]
+    return Channel(
+        config.id,
+        config.name,
+        axes,
+        config.feed_override_max,
+        feed_override_command=min(1000, config.feed_override_max),
+        feed_override_active=min(1000, config.feed_override_max),
+        output_suspended=suspended,
+    )

@@ -1,0 +1,180 @@
+"""Device notifications: subscriptions sampled in kernel time, sent on the event loop.
+
+ADS semantics: SERVER_CYCLE sends the value every ``cycle_time_ms`` of kernel time;
+SERVER_ON_CHANGE checks every ``cycle_time_ms`` and sends only when the bytes changed.
+Both send the current value at once after the subscription is acknowledged. Each sample
+carries the handle, a per-subscription sequence number (a gap means a sample was
+dropped because the client did not keep up) and the FILETIME timestamp of the cycle.
+
+The kernel thread only looks at one number per cycle (when the next sample is due) and
+wakes the event loop when it is; all sampling and sending happens on the loop.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from protocol.constants import TransmissionMode
+from protocol.errors import AdsReturnCode
+from protocol.frames import AddNotificationRequest, encode_notification
+
+from .kernel.state import Snapshot
+
+log = logging.getLogger(__name__)
+
+ReadFn = Callable[[int, int, int, int], tuple[int, bytes | str]]
+SendFn = Callable[[tuple[bytes, ...], bytes], bool]
+
+CYCLIC_MODES = {TransmissionMode.SERVER_CYCLE, TransmissionMode.SERVER_CYCLE2}
+ON_CHANGE_MODES = {TransmissionMode.SERVER_ON_CHANGE, TransmissionMode.SERVER_ON_CHANGE2}
+MAX_PER_CLIENT = 1000
+MAX_TOTAL = 20000
+
+#: FILETIME (100 ns since 1601-01-01) of the Unix epoch.
+_FILETIME_UNIX_EPOCH = 116444736000000000
+
+
+@dataclass(slots=True)
+class Subscription:
+    """One client's subscription to one address."""
+
+    handle: int
+    envelope: tuple[bytes, ...]
+    port: int
+    group: int
+    offset: int
+    length: int
+    on_change: bool
+    cycle_ns: int
+    next_due_ns: int
+    last: bytes | None = None
+    sequence: int = 0
+
+
+class NotificationHub:
+    """All subscriptions of the server."""
+
+    def __init__(
+        self, read: ReadFn, send: SendFn, loop: asyncio.AbstractEventLoop, kernel_cycle_ns: int
+    ) -> None:
+        self._read = read
+        self._send = send
+        self._loop = loop
+        self._kernel_cycle_ns = kernel_cycle_ns
+        self._subs: dict[int, Subscription] = {}
+        self._next_handle = 1
+        self._next_due_ns: int | None = None
+        self._scheduled = False
+        self._last_snapshot: Snapshot | None = None
+        # Kernel time 0 is this wall-clock instant; timestamps are kernel time after it.
+        self._base_filetime = _FILETIME_UNIX_EPOCH + time.time_ns() // 100
+        self.dropped = 0
+
+    def __len__(self) -> int:
+        return len(self._subs)
+
+    # ------------------------------------------------------------ requests
+
+    def add(self, envelope: tuple[bytes, ...], req: AddNotificationRequest) -> tuple[int, int | str]:
+        """Subscribe; (0, handle) or (code, message). The first sample follows the reply."""
+        mode = req.transmission_mode
+        if mode not in CYCLIC_MODES and mode not in ON_CHANGE_MODES:
+            return (
+                AdsReturnCode.DEVICE_TRANSMODENOTSUPP,
+                f"transmission mode {mode} is not a server mode (use 3 cyclic or 4 on change)",
+            )
+        code, data = self._read(req.port, req.group, req.offset, req.length)
+        if code:
+            return code, data  # type: ignore[return-value]
+        mine = sum(1 for s in self._subs.values() if s.envelope == envelope)
+        if mine >= MAX_PER_CLIENT or len(self._subs) >= MAX_TOTAL:
+            return AdsReturnCode.DEVICE_NOMOREHDLS, "too many notifications; delete some first"
+        handle = self._next_handle
+        self._next_handle += 1
+        cycle_ns = max(req.cycle_time_ms * 1_000_000, self._kernel_cycle_ns)
+        sub = Subscription(
+            handle, envelope, req.port, req.group, req.offset, req.length,
+            mode in ON_CHANGE_MODES, cycle_ns, 0,
+        )
+        self._subs[handle] = sub
+        self._loop.call_soon(self._first_sample, sub)
+        return 0, handle
+
+    def delete(self, envelope: tuple[bytes, ...], handle: int) -> tuple[int, str]:
+        """End a subscription of this client; 0x714 when it has no such handle."""
+        sub = self._subs.get(handle)
+        if sub is None or sub.envelope != envelope:
+            return AdsReturnCode.DEVICE_NOTIFYHNDINVALID, f"notification handle {handle} is unknown"
+        del self._subs[handle]
+        self._update_due()
+        return 0, ""
+
+    def drop_client(self, envelope: tuple[bytes, ...]) -> None:
+        """Forget every subscription of a client that is gone."""
+        gone = [h for h, s in self._subs.items() if s.envelope == envelope]
+        for handle in gone:
+            del self._subs[handle]
+        if gone:
+            log.info("client gone: dropped %d notifications", len(gone))
+            self._update_due()
+
+    # ------------------------------------------------------------ sampling
+
+    def kernel_cycle_end(self, snapshot: Snapshot) -> None:
+        """Called by the cycle thread after each cycle: wake the loop when a sample is due."""
+        due = self._next_due_ns
+        if due is not None and snapshot.time_ns >= due and not self._scheduled:
+            self._scheduled = True
+            self._last_snapshot = snapshot
+            self._loop.call_soon_threadsafe(self._sample)
+
+    def _first_sample(self, sub: Subscription) -> None:
+        if sub.handle not in self._subs:
+            return
+        snapshot = self._last_snapshot
+        now_ns = snapshot.time_ns if snapshot is not None else 0
+        self._emit({(sub.envelope, sub.port): [self._take(sub, now_ns, force=True)]})
+        self._update_due()
+
+    def _sample(self) -> None:
+        self._scheduled = False
+        snapshot = self._last_snapshot
+        if snapshot is None:
+            return
+        now_ns = snapshot.time_ns
+        batches: dict[tuple[tuple[bytes, ...], int], list] = {}
+        for sub in list(self._subs.values()):
+            if sub.next_due_ns > now_ns:
+                continue
+            sample = self._take(sub, now_ns, force=False)
+            if sample is not None:
+                batches.setdefault((sub.envelope, sub.port), []).append(sample)
+        self._emit(batches)
+        self._update_due()
+
+    def _take(self, sub: Subscription, now_ns: int, force: bool) -> list | None:
+        """Read one subscription; a sample list or None when on-change saw no change."""
+        # Next due time on the subscription's own grid, never in the past.
+        sub.next_due_ns = now_ns - now_ns % sub.cycle_ns + sub.cycle_ns
+        code, data = self._read(sub.port, sub.group, sub.offset, sub.length)
+        if code:
+            return None  # the object went away (cannot happen with a fixed catalog)
+        if sub.on_change and not force and data == sub.last:
+            return None
+        sub.last = data  # type: ignore[assignment]
+        sub.sequence += 1
+        return [sub.handle, sub.sequence, self._base_filetime + now_ns // 100, data]
+
+    def _emit(self, batches: dict[tuple[tuple[bytes, ...], int], list]) -> None:
+        """One frame per client and port with all its samples of this cycle."""
+        for (envelope, port), samples in batches.items():
+            samples = [s for s in samples if s is not None]
+            if samples and not self._send(envelope, encode_notification(port, samples)):
+                self.dropped += len(samples)
+
+    def _update_due(self) -> None:
+        self._next_due_ns = min((s.next_due_ns for s in self._subs.values()), default=None)
