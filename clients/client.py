@@ -15,6 +15,7 @@ life of the connection. Every failure raises ``AdsError`` naming its ADS code.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import inspect
 from collections.abc import AsyncIterator, Iterable, Iterator
@@ -41,7 +42,7 @@ from protocol.frames import (
     WriteRequest,
 )
 
-from .errors import AdsError
+from .errors import AdsConnectionError, AdsError
 from .transport import AsyncTransport, SyncTransport, drive
 
 DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
@@ -154,6 +155,10 @@ class AsyncClient:
             return reply.fields[index]
         except IndexError:
             raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, "reply lacks its data") from None
+
+    async def describe(self, name: str) -> ObjectInfo:
+        """What the service says about the object ``name`` (cached per connection)."""
+        return await self._object(name)
 
     async def _object(self, name: str) -> ObjectInfo:
         if self._objects is None:
@@ -289,7 +294,8 @@ class AsyncClient:
                 )
         finally:
             self._t.close_samples(handle)
-            await self._call(DeleteNotificationRequest, info.port, handle)
+            with contextlib.suppress(AdsConnectionError):  # closed client: nothing to delete
+                await self._call(DeleteNotificationRequest, info.port, handle)
 
 
 def _blocking(method: Any) -> Any:

@@ -59,9 +59,15 @@ class NotificationHub:
     """All subscriptions of the server."""
 
     def __init__(
-        self, read: ReadFn, send: SendFn, loop: asyncio.AbstractEventLoop, kernel_cycle_ns: int
+        self,
+        read: ReadFn,
+        send: SendFn,
+        loop: asyncio.AbstractEventLoop,
+        kernel_cycle_ns: int,
+        current: Callable[[], Snapshot],
     ) -> None:
         self._read = read
+        self._current = current
         self._send = send
         self._loop = loop
         self._kernel_cycle_ns = kernel_cycle_ns
@@ -135,8 +141,7 @@ class NotificationHub:
     def _first_sample(self, sub: Subscription) -> None:
         if sub.handle not in self._subs:
             return
-        snapshot = self._last_snapshot
-        now_ns = snapshot.time_ns if snapshot is not None else 0
+        now_ns = self._current().time_ns
         self._emit({(sub.envelope, sub.port): [self._take(sub, now_ns, force=True)]})
         self._update_due()
 

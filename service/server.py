@@ -102,7 +102,9 @@ class AdsServer:
         self._raw_recv = raw.recv.__get__(sock)
         self._raw_get = raw.get.__get__(sock)
         self.endpoint = sock.getsockopt_string(zmq.LAST_ENDPOINT)
-        self.hub = NotificationHub(self._read_value, self._send, loop, kernel._cycle_ns)
+        self.hub = NotificationHub(
+            self._read_value, self._send, loop, kernel.cycle_ns, lambda: kernel.snapshot
+        )
         kernel.on_cycle_end = self.hub.kernel_cycle_end
         self._drain_scheduled = False
         self._handlers: dict[int, Callable[[Envelope, Any], Reply]] = {

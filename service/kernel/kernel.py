@@ -51,7 +51,7 @@ class Kernel:
     def __init__(self, config: MachineConfig, clock: Clock) -> None:
         self.config = config
         self.cycle_s = config.cycle_ms / 1000.0
-        self._cycle_ns = round(config.cycle_ms * 1e6)
+        self.cycle_ns = round(config.cycle_ms * 1e6)
         self._clock = clock
         self.state = KernelState.from_config(config)
         self.stats = CycleStats(cycle_us=round(config.cycle_ms * 1000))
@@ -188,7 +188,7 @@ class Kernel:
 
     def _publish(self) -> None:
         cycle = self.stats.cycles
-        self.snapshot = self.state.snapshot(cycle, cycle * self._cycle_ns, self.stats)
+        self.snapshot = self.state.snapshot(cycle, cycle * self.cycle_ns, self.stats)
         hook = self.on_cycle_end
         if hook is not None:
             hook(self.snapshot)
