@@ -61,6 +61,7 @@ class Kernel:
         self._waiting: deque = deque()
         self._channel_index = {c.channel_id: k for k, c in enumerate(self.state.channels)}
         self._thread: threading.Thread | None = None
+        self._closed = False
 
     # ------------------------------------------------------------ service side
 
@@ -74,7 +75,11 @@ class Kernel:
         return self._channel_index[channel_id]
 
     def submit(self, command: Command | ControlCommand, done: Done) -> None:
-        """Queue ``command``; ``done`` is called from the cycle thread once applied."""
+        """Queue ``command``; ``done`` is called from the cycle thread once applied
+        (at once, with a refusal, when the kernel is closed)."""
+        if self._closed:
+            done(Refusal(RefusalReason.NOT_READY, "the kernel is shut down"))
+            return
         self._queue.put((command, done))
 
     def start(self) -> None:
@@ -84,6 +89,7 @@ class Kernel:
 
     def close(self, timeout_s: float = 5.0) -> None:
         """Stop the cycle thread and wait for it; queued commands are refused."""
+        self._closed = True
         if self._thread is None:
             return
         self._queue.put((_SHUTDOWN, None))

@@ -1,0 +1,56 @@
+"""Configuration: the embedded default machine, overrides, and errors that name the key."""
+
+from __future__ import annotations
+
+import pytest
+
+from service.config import ConfigError, build_config
+
+
+def test_default_machine() -> None:
+    config = build_config()
+    assert [a.number for a in config.physical_axes] == [1, 2, 3]
+    main, jog = config.channels
+    assert [(a.name, a.logical_number, a.link_to) for a in main.axes] == [
+        ("X", 1, 1), ("Y", 2, 2), ("Z", 3, 3)
+    ]
+    assert jog.jog_of_path_only and jog.suspend_output_at_start
+    assert [(a.logical_number, a.link_to, a.clone_of) for a in jog.axes] == [
+        (11, 1, 1), (12, 2, 2), (13, 3, 3)
+    ]
+    assert main.axes[0].limits.vel_max_mm_s > 0 and main.axes[0].limits.acc_max_mm_s2 > 0
+
+
+def test_tables_merge_and_arrays_replace() -> None:
+    config = build_config({"cycle_ms": 2.0, "name": "lathe"})
+    assert config.cycle_ms == 2.0 and config.name == "lathe" and len(config.channels) == 2
+
+
+@pytest.mark.parametrize(
+    ("overrides", "key"),
+    [
+        ({"cycle_ms": 0}, "cycle_ms"),
+        ({"cycle_ms": "fast"}, "cycle_ms"),
+        ({"unknown_key": 1}, "unknown_key"),
+        ({"physical_axes": [{"number": 1, "name": "X"}, {"number": 1, "name": "Y"}]},
+         "physical axis numbers repeat"),
+        ({"channels": [{"id": 1, "name": "a", "axes": [
+            {"name": "X", "logical_number": 1, "link_to": 9}]}]}, "channels.0.axes.0.link_to"),
+        ({"channels": [{"id": 1, "name": "a", "axes": [
+            {"name": "X", "logical_number": 1, "link_to": 1,
+             "limits": {"sw_limit_min_mm": 5, "sw_limit_max_mm": 1}}]}]},
+         "channels.0.axes.0.limits"),
+        ({"channels": [{"id": 1, "name": "a", "axes": [
+            {"name": "X", "logical_number": 1, "link_to": 1, "limits": {"vel_max_mm_s": -3}}]}]},
+         "channels.0.axes.0.limits.vel_max_mm_s"),
+        ({"channels": [{"id": 1, "name": "a", "axes": [
+            {"name": "X", "logical_number": 1, "link_to": 1},
+            {"name": "X", "logical_number": 2, "link_to": 2}]}]}, "axis names repeat"),
+        ({"channels": []}, "channels"),
+    ],
+)
+def test_bad_configuration_names_the_key(overrides: dict, key: str) -> None:
+    with pytest.raises(ConfigError) as caught:
+        build_config(overrides, "machine.toml")
+    assert key in str(caught.value)
+    assert str(caught.value).startswith("machine.toml: ")
