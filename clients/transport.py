@@ -14,6 +14,7 @@ from __future__ import annotations
 import asyncio
 import itertools
 import logging
+import time
 from collections import deque
 from collections.abc import Coroutine, Generator
 from typing import Any
@@ -242,8 +243,11 @@ class SyncTransport(_Transport):
         self._sock: zmq.Socket | None = None
 
     async def open(self) -> None:
-        """Connect."""
-        self._sock = _new_socket(self._context, self.endpoint)
+        """Connect. Replies are awaited by a blocking receive with a timeout (cheaper
+        than polling first)."""
+        self._sock = sock = _new_socket(self._context, self.endpoint)
+        self._timeout_ms = max(1, int(self.timeout_s * 1000))
+        sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
 
     async def close(self) -> None:
         """Disconnect."""
@@ -267,23 +271,38 @@ class SyncTransport(_Transport):
         request = pending.request
         if request is None:
             buffer = self._samples[pending.handle]
-            while not buffer:
-                self._receive(sock, None)
+            sock.setsockopt(zmq.RCVTIMEO, -1)  # samples come when they come
+            try:
+                while not buffer:
+                    self._receive(sock)
+            finally:
+                sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
             return buffer.popleft()
         try:
             sock.send(request.encode(), zmq.NOBLOCK)
         except zmq.Again:
             raise AdsConnectionError(0x748, "send queue full; the service is not reading") from None
-        timeout_ms = max(1, int(self.timeout_s * 1000))
-        while True:
-            if not sock.poll(timeout_ms, zmq.POLLIN):
-                raise self._timeout(request)
-            message = self._receive(sock, 0)
-            if message is not None and message.invoke_id == request.invoke_id:
-                return message
+        deadline = time.monotonic() + self.timeout_s
+        shortened = False
+        try:
+            message = self._receive(sock)
+            while message is None or message.invoke_id != request.invoke_id:
+                # A notification or a late reply came first: wait only for what is left.
+                left_ms = int((deadline - time.monotonic()) * 1000)
+                if left_ms <= 0:
+                    raise zmq.Again()
+                sock.setsockopt(zmq.RCVTIMEO, left_ms)
+                shortened = True
+                message = self._receive(sock)
+            return message
+        except zmq.Again:
+            raise self._timeout(request) from None
+        finally:
+            if shortened:
+                sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
 
-    def _receive(self, sock: zmq.Socket, flags: int | None) -> Response | None:
-        raw = sock.recv() if flags is None else sock.recv(flags)
+    def _receive(self, sock: zmq.Socket) -> Response | None:
+        raw = sock.recv()
         try:
             message = decode_incoming(raw)
         except ProtocolError as exc:

@@ -1,0 +1,262 @@
+"""``make bench``: request dispatch measured against a raw ZeroMQ echo, in one run.
+
+Baseline: a raw pyzmq ROUTER in a second process that answers each msgpack frame with a
+reply of the same shape as ours (sync sockets, no dispatch), driven by a sync DEALER:
+sequential round trips, and 64 frames in flight. Then the real ``cnc-service``
+(realtime clock, 1 ms cycle, in a second process) driven by:
+
+* ``Client.read_address`` sequentially,
+* ``AsyncClient.read_address`` from 64 coroutines (64 reads in flight),
+* ``AsyncClient.read_many`` of 100 objects (one sum read each).
+
+Every figure is the median over ``--runs`` runs (default 3); ratios compare with the
+baseline measured in the same run. Targets: sequential >= 0.6 of the raw echo, 64 in
+flight >= 0.8 of the raw pipelined echo.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import multiprocessing as mp
+import statistics
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import msgpack
+import zmq
+
+from clients import AsyncClient, Client
+from tests.support.service import start_service
+
+from .raw_echo import serve_echo
+
+ADDRESS = (551, 0x121301, 0x10018, "UNS32")  # ch1.ax1.link_state
+IN_FLIGHT = 64
+
+BENCH_MACHINE = """
+name = "bench"
+physical_axes = [
+  {number = 1, name = "X"}, {number = 2, name = "Y"}, {number = 3, name = "Z"},
+  {number = 4, name = "A"}, {number = 5, name = "B"}, {number = 6, name = "C"},
+]
+""" + "".join(
+    f"""
+[[channels]]
+id = {c}
+name = "ch{c}"
+suspend_output_at_start = {"false" if c == 1 else "true"}
+axes = [{", ".join(
+        f'{{name = "{n}", logical_number = {10 * c + k}, link_to = {k}}}'
+        for k, n in enumerate("XYZABC", start=1))}]
+"""
+    for c in (1, 2, 3)
+)
+
+
+@dataclass
+class Figure:
+    """Throughput and latency of one measurement."""
+
+    reads_s: float
+    median_us: float
+    p99_us: float
+
+
+def _figure(count: int, elapsed_s: float, latencies_s: list[float]) -> Figure:
+    lat = sorted(latencies_s)
+    return Figure(
+        count / elapsed_s,
+        statistics.median(lat) * 1e6,
+        lat[min(len(lat) - 1, int(len(lat) * 0.99))] * 1e6,
+    )
+
+
+def _frame(invoke_id: int) -> bytes:
+    return msgpack.packb([invoke_id, 2, *ADDRESS[:3], 4])
+
+
+def raw_sequential(endpoint: str, count: int) -> Figure:
+    """Sync DEALER, one frame at a time."""
+    ctx = zmq.Context()
+    sock = ctx.socket(zmq.DEALER)
+    sock.connect(endpoint)
+    for k in range(200):  # connect and warm up
+        sock.send(_frame(k + 1))
+        sock.recv()
+    lat = []
+    start = time.perf_counter()
+    for k in range(count):
+        t0 = time.perf_counter()
+        sock.send(_frame(k + 1))
+        msgpack.unpackb(sock.recv())
+        lat.append(time.perf_counter() - t0)
+    elapsed = time.perf_counter() - start
+    sock.close(linger=0)
+    ctx.term()
+    return _figure(count, elapsed, lat)
+
+
+def raw_pipelined(endpoint: str, count: int) -> Figure:
+    """Sync DEALER keeping IN_FLIGHT frames outstanding."""
+    ctx = zmq.Context()
+    sock = ctx.socket(zmq.DEALER)
+    sock.connect(endpoint)
+    for k in range(200):
+        sock.send(_frame(k + 1))
+        sock.recv()
+    sent_at: dict[int, float] = {}
+    lat = []
+    start = time.perf_counter()
+    sent = 0
+    for _ in range(IN_FLIGHT):
+        sent += 1
+        sent_at[sent] = time.perf_counter()
+        sock.send(_frame(sent))
+    for _ in range(count):
+        reply = msgpack.unpackb(sock.recv())
+        lat.append(time.perf_counter() - sent_at.pop(reply[0]))
+        if sent < count:
+            sent += 1
+            sent_at[sent] = time.perf_counter()
+            sock.send(_frame(sent))
+    elapsed = time.perf_counter() - start
+    sock.close(linger=0)
+    ctx.term()
+    return _figure(count, elapsed, lat)
+
+
+def client_sequential(endpoint: str, count: int) -> Figure:
+    """The blocking client, one read at a time."""
+    with Client(endpoint) as c:
+        for _ in range(200):
+            c.read_address(*ADDRESS)
+        lat = []
+        start = time.perf_counter()
+        for _ in range(count):
+            t0 = time.perf_counter()
+            c.read_address(*ADDRESS)
+            lat.append(time.perf_counter() - t0)
+        elapsed = time.perf_counter() - start
+    return _figure(count, elapsed, lat)
+
+
+async def _client_in_flight(endpoint: str, count: int) -> Figure:
+    async with AsyncClient(endpoint) as c:
+        await asyncio.gather(*(c.read_address(*ADDRESS) for _ in range(200)))
+        lat: list[float] = []
+        per_worker = count // IN_FLIGHT
+
+        async def worker() -> None:
+            clock = time.perf_counter
+            for _ in range(per_worker):
+                t0 = clock()
+                await c.read_address(*ADDRESS)
+                lat.append(clock() - t0)
+
+        start = time.perf_counter()
+        await asyncio.gather(*(worker() for _ in range(IN_FLIGHT)))
+        elapsed = time.perf_counter() - start
+    return _figure(per_worker * IN_FLIGHT, elapsed, lat)
+
+
+def client_in_flight(endpoint: str, count: int) -> Figure:
+    """AsyncClient with IN_FLIGHT reads outstanding."""
+    return asyncio.run(_client_in_flight(endpoint, count))
+
+
+async def _client_read_many(endpoint: str, count: int) -> tuple[Figure, int]:
+    async with AsyncClient(endpoint) as c:
+        names = [o.name for o in await c.browse() if o.access != "w"][:100]
+        await c.read_many(names)  # handles acquired once
+        lat = []
+        start = time.perf_counter()
+        for _ in range(count):
+            t0 = time.perf_counter()
+            await c.read_many(names)
+            lat.append(time.perf_counter() - t0)
+        elapsed = time.perf_counter() - start
+    return _figure(count, elapsed, lat), len(names)
+
+
+def median_figure(figures: list[Figure]) -> Figure:
+    """Median of each number over the runs."""
+    return Figure(
+        statistics.median(f.reads_s for f in figures),
+        statistics.median(f.median_us for f in figures),
+        statistics.median(f.p99_us for f in figures),
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmark and print the table."""
+    parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__.split("\n")[0])
+    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
+    args = parser.parse_args(argv)
+
+    ctx = mp.get_context("spawn")
+    ready = ctx.Event()
+    port_queue = ctx.Queue()
+    echo = ctx.Process(target=serve_echo, args=(port_queue, ready), daemon=True)
+    echo.start()
+    echo_endpoint = port_queue.get(timeout=20)
+
+    with tempfile.TemporaryDirectory() as tmp:
+        machine = Path(tmp) / "bench.toml"
+        machine.write_text(BENCH_MACHINE)
+        service = start_service("--clock", "realtime", "--config", str(machine))
+    try:
+        runs: dict[str, list[Figure]] = {k: [] for k in
+                                         ("raw_seq", "raw_pipe", "seq", "flight", "many")}
+        n_objects = 0
+        for run in range(args.runs):
+            runs["raw_seq"].append(raw_sequential(echo_endpoint, args.count // 4))
+            runs["raw_pipe"].append(raw_pipelined(echo_endpoint, args.count * 2))
+            runs["seq"].append(client_sequential(service.endpoint, args.count // 4))
+            runs["flight"].append(client_in_flight(service.endpoint, args.count))
+            many, n_objects = asyncio.run(_client_read_many(service.endpoint, args.count // 20))
+            runs["many"].append(many)
+            print(f"run {run + 1}/{args.runs} done", file=sys.stderr)
+        with Client(service.endpoint) as c:
+            overruns = c.read_many(
+                ["cnc_cycle_overruns_r", "cnc_cycle_jitter_max_r", "cnc_tick_counter_r"]
+            )
+    finally:
+        service.stop()
+        echo.terminate()
+
+    fig = {k: median_figure(v) for k, v in runs.items()}
+    _report(fig, n_objects, args.runs, overruns)
+    return 0
+
+
+def _report(fig: dict[str, Figure], n_objects: int, runs: int, kernel: dict) -> None:
+    rs, rp = fig["raw_seq"], fig["raw_pipe"]
+    rows = [
+        ("raw echo, sequential (baseline)", fig["raw_seq"], rs, None),
+        ("raw echo, 64 in flight (baseline)", fig["raw_pipe"], rp, None),
+        ("Client.read_address, sequential", fig["seq"], rs, 0.6),
+        ("AsyncClient, 64 reads in flight", fig["flight"], rp, 0.8),
+        (f"AsyncClient.read_many({n_objects}) calls", fig["many"], rs, None),
+    ]
+    print(f"\nmedian of {runs} runs; ratios against the raw echo of the same run\n")
+    print(f"{'measurement':38} {'reads/s':>10} {'ratio':>6} {'median us':>10} {'p99 us':>9}  target")
+    for label, f, base, target in rows:
+        ratio = f.reads_s / base.reads_s
+        verdict = "" if target is None else (f">= {target}: " + ("met" if ratio >= target else "NOT met"))
+        print(f"{label:38} {f.reads_s:10.0f} {ratio:6.2f} {f.median_us:10.1f} {f.p99_us:9.1f}  {verdict}")
+    many = fig["many"]
+    print(f"\nread_many: {many.reads_s * n_objects:,.0f} objects/s "
+          f"({n_objects} objects per sum read)")
+    print(f"kernel during the run: {kernel['cnc_tick_counter_r']} cycles, "
+          f"{kernel['cnc_cycle_overruns_r']} overruns, "
+          f"max jitter {kernel['cnc_cycle_jitter_max_r']} us")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
+

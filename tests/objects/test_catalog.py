@@ -1,0 +1,219 @@
+"""The catalog and its address rules (objects/catalog.py, addressing.py, model.py).
+
+``build_objects`` over a two-channel, three-axis machine must give the documented ISG
+addresses: channel in the group (``0x12130<CID>``), axis in the upper 16 bits of the
+offset (``0x<AID>00xx``), the types, access and units of the ISG tables.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from objects.addressing import (
+    LOGICAL_BIT,
+    GroupBase,
+    axis_offset,
+    channel_group,
+    index_based,
+    split_axis_offset,
+)
+from objects.catalog import TEMPLATES, ChannelLayout, MachineLayout, Scope, build_objects
+from objects.model import Access, CncObject
+from protocol.datatypes import REAL64, SGN32, UNS16, UNS32, DataType
+
+LAYOUT = MachineLayout((ChannelLayout(1, 3), ChannelLayout(2, 3)), (1, 2, 3))
+
+
+@pytest.fixture(scope="module")
+def by_name() -> dict[str, CncObject]:
+    return {o.name: o for o in build_objects(LAYOUT)}
+
+
+# (name, port, group, offset, type, access, unit)
+DOCUMENTED = [
+    ("ch2.ax3.actual_link_to_physical_axis", 551, 0x121302, 0x30017, UNS16, Access.READ, "-"),
+    ("ch1.ax1.actual_link_to_physical_axis", 551, 0x121301, 0x10017, UNS16, Access.READ, "-"),
+    ("ch1.ax2.requested_link_to_physical_axis", 551, 0x121301, 0x20016, UNS16, Access.READ, "-"),
+    ("ch1.ax1.link_state", 551, 0x121301, 0x10018, UNS32, Access.READ, "-"),
+    ("ch2.ax2.link_state", 551, 0x121302, 0x20018, UNS32, Access.READ, "-"),
+    ("ch1.dist_prog_start", 551, 0x121301, 0x56, REAL64, Access.READ, "0.1 um"),
+    ("ch2.dist_prog_start", 551, 0x121302, 0x56, REAL64, Access.READ, "0.1 um"),
+    ("ch1.mc_command_execution_mode_w", 553, 0x120101, 0x3F, SGN32, Access.WRITE, "-"),
+    ("ch1.mc_command_execution_mode_r", 553, 0x120101, 0x40, SGN32, Access.READ, "-"),
+    ("ch1.mc_active_execution_mode_r", 553, 0x120101, 0x41, SGN32, Access.READ, "-"),
+    ("ch2.mc_command_execution_mode_w", 553, 0x120102, 0x3F, SGN32, Access.WRITE, "-"),
+    ("ch1.mc_command_feed_override_w", 553, 0x120101, 0x09, UNS16, Access.WRITE, "0.1 %"),
+    ("ch1.mc_command_feed_override_r", 553, 0x120101, 0x0A, UNS16, Access.READ, "0.1 %"),
+    ("ch1.mc_active_feed_override_r", 553, 0x120101, 0x0C, UNS16, Access.READ, "0.1 %"),
+    ("ch2.mc_active_feed_override_r", 553, 0x120102, 0x0C, UNS16, Access.READ, "0.1 %"),
+    ("ax2.command_position_acs", 553, 0x120200, 0x20002, SGN32, Access.READ, "0.1 um"),
+    ("ax3.actual_position_acs", 553, 0x120200, 0x30003, SGN32, Access.READ, "0.1 um"),
+]
+
+
+@pytest.mark.parametrize(
+    ("name", "port", "group", "offset", "dtype", "access", "unit"), DOCUMENTED, ids=[d[0] for d in DOCUMENTED]
+)
+def test_documented_addresses(
+    by_name: dict[str, CncObject],
+    name: str,
+    port: int,
+    group: int,
+    offset: int,
+    dtype: DataType,
+    access: Access,
+    unit: str,
+) -> None:
+    obj = by_name[name]
+    assert (obj.port, obj.group, obj.offset) == (port, group, offset)
+    assert obj.dtype is dtype
+    assert obj.access is access
+    assert obj.unit == unit
+    assert obj.length == dtype.size
+
+
+def test_channel_axis_objects_know_their_channel_and_axis(by_name: dict[str, CncObject]) -> None:
+    obj = by_name["ch2.ax3.actual_link_to_physical_axis"]
+    assert (obj.element, obj.channel, obj.axis) == ("actual_link_to_physical_axis", 2, 3)
+    channel = by_name["ch1.dist_prog_start"]
+    assert (channel.element, channel.channel, channel.axis) == ("dist_prog_start", 1, 0)
+    drive = by_name["ax3.actual_position_acs"]
+    assert (drive.channel, drive.axis) == (0, 3)
+
+
+def test_platform_objects_have_plain_names(by_name: dict[str, CncObject]) -> None:
+    version = by_name["cnc_version_r"]
+    assert (version.port, version.channel, version.axis) == (553, 0, 0)
+    assert version.group == GroupBase.COM_CHANNEL
+
+
+def test_names_are_unique() -> None:
+    names = [o.name for o in build_objects(LAYOUT)]
+    assert len(names) == len(set(names))
+    lowered = [n.lower() for n in names]
+    assert len(lowered) == len(set(lowered))
+
+
+def test_addresses_are_unique() -> None:
+    addresses = [(o.port, o.group, o.offset) for o in build_objects(LAYOUT)]
+    assert len(addresses) == len(set(addresses))
+
+
+def test_every_template_is_instantiated_once_per_scope_member() -> None:
+    objects = build_objects(LAYOUT)
+    expected = {
+        Scope.PLATFORM: 1,
+        Scope.PHYSICAL_AXIS: len(LAYOUT.physical_axes),
+        Scope.CHANNEL: len(LAYOUT.channels),
+        Scope.CHANNEL_AXIS: sum(c.axis_count for c in LAYOUT.channels),
+    }
+    for template in TEMPLATES:
+        count = sum(1 for o in objects if o.element == template.element)
+        assert count == expected[template.scope], template.element
+    assert len(objects) == sum(expected[t.scope] for t in TEMPLATES)
+
+
+def test_every_object_follows_the_address_rules() -> None:
+    templates = {t.element: t for t in TEMPLATES}
+    for obj in build_objects(LAYOUT):
+        t = templates[obj.element]
+        assert obj.group & LOGICAL_BIT, obj.name
+        assert obj.port == t.port and obj.dtype is t.dtype and obj.access is t.access
+        match t.scope:
+            case Scope.PLATFORM:
+                assert obj.name == t.element
+                assert (obj.group, obj.offset) == (t.group_base, t.offset)
+            case Scope.PHYSICAL_AXIS:
+                assert obj.name == f"ax{obj.axis}.{t.element}"
+                assert (obj.group, obj.offset) == (t.group_base, axis_offset(obj.axis, t.offset))
+            case Scope.CHANNEL:
+                assert obj.name == f"ch{obj.channel}.{t.element}"
+                assert (obj.group, obj.offset) == (t.group_base + obj.channel, t.offset)
+            case Scope.CHANNEL_AXIS:
+                assert obj.name == f"ch{obj.channel}.ax{obj.axis}.{t.element}"
+                assert obj.group == t.group_base + obj.channel
+                assert split_axis_offset(obj.offset) == (obj.axis, t.offset)
+
+
+def test_layout_drives_the_instances() -> None:
+    layout = MachineLayout((ChannelLayout(3, 1),), (5,))
+    names = {o.name for o in build_objects(layout)}
+    assert "ch3.ax1.link_state" in names
+    assert "ch3.ax2.link_state" not in names
+    assert "ch1.dist_prog_start" not in names
+    assert "ax5.actual_position_acs" in names
+    assert "ax1.actual_position_acs" not in names
+    by_name = {o.name: o for o in build_objects(layout)}
+    assert by_name["ch3.ax1.link_state"].group == 0x121303
+    assert by_name["ax5.link_to_logical_axis"].offset == 0x5000F
+
+
+def test_empty_layout_keeps_platform_objects_only() -> None:
+    objects = build_objects(MachineLayout((), ()))
+    platform = {t.element for t in TEMPLATES if t.scope is Scope.PLATFORM}
+    assert {o.name for o in objects} == platform
+
+
+# --------------------------------------------------------------------------- addressing
+
+
+def test_channel_group() -> None:
+    assert channel_group(GroupBase.GEO_INTERPOLATOR, 2) == 0x121302
+    assert channel_group(GroupBase.COM_CHANNEL, 1) == 0x120101
+
+
+@pytest.mark.parametrize(
+    ("group", "logical_id", "index", "expected"),
+    [
+        (0x121302, 2, 2, 0x21302),
+        (0x121301, 1, 1, 0x21301),
+        (0x121305, 5, 1, 0x21301),  # logical channel 5 is the first configured channel
+        (0x120102, 2, 1, 0x20101),
+    ],
+)
+def test_index_based(group: int, logical_id: int, index: int, expected: int) -> None:
+    assert index_based(group, logical_id, index) == expected
+    assert not index_based(group, logical_id, index) & LOGICAL_BIT
+
+
+@pytest.mark.parametrize(
+    ("axis", "element", "offset"), [(3, 0x17, 0x30017), (1, 0x18, 0x10018), (0x12, 0x2, 0x120002)]
+)
+def test_axis_offset_and_split(axis: int, element: int, offset: int) -> None:
+    assert axis_offset(axis, element) == offset
+    assert split_axis_offset(offset) == (axis, element)
+
+
+def test_split_axis_offset_of_a_channel_object() -> None:
+    assert split_axis_offset(0x56) == (0, 0x56)
+
+
+# --------------------------------------------------------------------------- model
+
+
+def test_access_flags() -> None:
+    assert (Access.READ.readable, Access.READ.writable) == (True, False)
+    assert (Access.WRITE.readable, Access.WRITE.writable) == (False, True)
+    assert (Access.READ_WRITE.readable, Access.READ_WRITE.writable) == (True, True)
+    assert [a.value for a in Access] == ["r", "w", "rw"]
+
+
+def test_describe_is_the_browse_descriptor(by_name: dict[str, CncObject]) -> None:
+    obj = by_name["ch1.mc_command_feed_override_w"]
+    assert obj.describe() == [
+        "ch1.mc_command_feed_override_w",
+        553,
+        0x120101,
+        0x09,
+        "UNS16",
+        2,
+        "w",
+        "0.1 %",
+        obj.description,
+    ]
+    assert obj.description
+
+
+def test_cnc_objects_are_frozen(by_name: dict[str, CncObject]) -> None:
+    with pytest.raises(AttributeError):
+        by_name["ch1.dist_prog_start"].offset = 0x57  # type: ignore[misc]
