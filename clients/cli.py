@@ -15,7 +15,7 @@ import json
 import os
 import sys
 from dataclasses import asdict
-from typing import Any, NoReturn
+from typing import Annotated, Any, NoReturn, Optional
 
 import typer
 from rich.console import Console
@@ -30,6 +30,18 @@ from .errors import AdsError, AdsTimeoutError
 EXIT_ADS_ERROR = 1
 EXIT_USAGE = 2
 EXIT_UNREACHABLE = 3
+
+# The address options of read and write, declared once.
+PortOption = Annotated[
+    Optional[str], typer.Option("--port", help="ADS port (with --group, --offset, --type).")
+]
+GroupOption = Annotated[Optional[str], typer.Option("--group", help="Index group, decimal or 0x hex.")]
+OffsetOption = Annotated[
+    Optional[str], typer.Option("--offset", help="Index offset, decimal or 0x hex.")
+]
+TypeOption = Annotated[
+    Optional[str], typer.Option("--type", help="Data type: UNS16, REAL64, STRING(84), ...")
+]
 
 app = typer.Typer(
     add_completion=False,
@@ -168,10 +180,10 @@ def browse(
 def read(
     ctx: typer.Context,
     names: list[str] = typer.Argument(None, help="Object names."),
-    port: str = typer.Option(None, help="ADS port (with --group, --offset, --type)."),
-    group: str = typer.Option(None, help="Index group, decimal or 0x hex."),
-    offset: str = typer.Option(None, help="Index offset, decimal or 0x hex."),
-    dtype: str = typer.Option(None, "--type", help="Data type: UNS16, REAL64, STRING(84), ..."),
+    port: PortOption = None,
+    group: GroupOption = None,
+    offset: OffsetOption = None,
+    dtype: TypeOption = None,
 ) -> None:
     """Read objects by name, or one value by address."""
     settings: Settings = ctx.obj
@@ -201,10 +213,10 @@ def read(
 def write(
     ctx: typer.Context,
     args: list[str] = typer.Argument(..., help="NAME VALUE, or VALUE with an address."),
-    port: str = typer.Option(None, help="ADS port (with --group, --offset, --type)."),
-    group: str = typer.Option(None, help="Index group, decimal or 0x hex."),
-    offset: str = typer.Option(None, help="Index offset, decimal or 0x hex."),
-    dtype: str = typer.Option(None, "--type", help="Data type: UNS16, REAL64, STRING(84), ..."),
+    port: PortOption = None,
+    group: GroupOption = None,
+    offset: OffsetOption = None,
+    dtype: TypeOption = None,
 ) -> None:
     """Write an object by name (NAME VALUE) or a value by address (VALUE)."""
     settings: Settings = ctx.obj

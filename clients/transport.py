@@ -248,6 +248,9 @@ class SyncTransport(_Transport):
         self._sock = sock = _new_socket(self._context, self.endpoint)
         self._timeout_ms = max(1, int(self.timeout_s * 1000))
         sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
+        raw = zmq.Socket.__mro__[1]  # the Cython methods, without pyzmq's Python wrappers
+        self._raw_send = raw.send.__get__(sock)
+        self._raw_recv = raw.recv.__get__(sock)
 
     async def close(self) -> None:
         """Disconnect."""
@@ -279,7 +282,7 @@ class SyncTransport(_Transport):
                 sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
             return buffer.popleft()
         try:
-            sock.send(request.encode(), zmq.NOBLOCK)
+            self._raw_send(request.encode(), _NOBLOCK)
         except zmq.Again:
             raise AdsConnectionError(0x748, "send queue full; the service is not reading") from None
         deadline = time.monotonic() + self.timeout_s
@@ -302,7 +305,7 @@ class SyncTransport(_Transport):
                 sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
 
     def _receive(self, sock: zmq.Socket) -> Response | None:
-        raw = sock.recv()
+        raw = self._raw_recv(0)
         try:
             message = decode_incoming(raw)
         except ProtocolError as exc:

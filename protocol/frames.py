@@ -291,14 +291,13 @@ def _explain_bad_request(obj: Any) -> ProtocolError:
 # --------------------------------------------------------------------------- responses
 
 
-@dataclass(frozen=True, slots=True)
-class Response:
+class Response(NamedTuple):
     """A reply: ``result`` is the ADS return code; ``message`` is set on errors only."""
 
     invoke_id: int
     command: int
     result: int
-    fields: tuple[Any, ...] = ()
+    fields: tuple[Any, ...] | list[Any] = ()
     message: str = ""
 
     def encode(self) -> bytes:
@@ -360,4 +359,4 @@ def decode_incoming(raw: bytes) -> Response | Notification:
     if obj[2]:
         message = obj[3] if len(obj) > 3 and type(obj[3]) is str else ""
         return Response(invoke_id, command, obj[2], (), message)
-    return Response(invoke_id, command, 0, tuple(obj[3:]))
+    return Response(invoke_id, command, 0, obj[3:])
