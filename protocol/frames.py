@@ -243,8 +243,13 @@ def decode_request(raw: bytes) -> Request:
 
 def _explain_bad_request(obj: Any) -> ProtocolError:
     """The error for a frame the fast path refused, as precise as the frame allows."""
-    if type(obj) is not list or len(obj) < 3:
-        return ProtocolError("a request is an array [invoke_id, command, port, ...]")
+    shape_error = "a request is an array [invoke_id, command, port, ...]"
+    if type(obj) is not list or not obj:
+        return ProtocolError(shape_error)
+    if len(obj) < 3:
+        invoke_id = obj[0] if type(obj[0]) is int and 0 < obj[0] <= U32_MAX else None
+        command = obj[1] if len(obj) == 2 and type(obj[1]) is int else None
+        return ProtocolError(shape_error, invoke_id=invoke_id, command=command)
     invoke_id, command, port = obj[0], obj[1], obj[2]
     if type(invoke_id) is not int or not 0 < invoke_id <= U32_MAX:
         return ProtocolError(f"invoke id must be 1..{U32_MAX}, got {invoke_id!r}")

@@ -131,20 +131,29 @@ class Kernel:
         return self._queue.get() if block else self._queue.get_nowait()
 
     def _cycle(self) -> bool:
-        """One cycle; False when the kernel is shutting down."""
-        while True:
+        """One cycle; False when the kernel is shutting down.
+
+        Commands are acknowledged only after the snapshot that shows their effect is
+        published, so a read sent after a write's reply always sees the write.
+        """
+        applied: list[tuple[Done, Refusal | None]] = []
+        shutting_down = False
+        while self.stats.running:
             try:
                 command, done = self._next_command(block=False)
             except queue.Empty:
                 break
             if command is _SHUTDOWN:
-                self._refuse_queued()
-                return False
-            self._apply(command, done)
-            if not self.stats.running:
-                return True
+                shutting_down = True
+                break
+            applied.append((done, self._apply(command)))
         self.stats.cycles += 1
         self._publish()
+        for done, result in applied:
+            done(result)
+        if shutting_down:
+            self._refuse_queued()
+            return False
         return True
 
     def _paused(self) -> bool:
@@ -155,21 +164,21 @@ class Kernel:
                 self._refuse_queued()
                 return False
             if isinstance(command, ControlCommand):
-                self._apply(command, done)
+                result = self._apply(command)
+                self._publish()
+                done(result)
             else:
                 done(Refusal(RefusalReason.NOT_READY, "the kernel is stopped (ADS state STOP)"))
         return True
 
-    def _apply(self, command: Command | ControlCommand, done: Done) -> None:
+    def _apply(self, command: Command | ControlCommand) -> Refusal | None:
         try:
             if isinstance(command, ControlCommand):
-                result = self._control(command.control)
-            else:
-                result = command.apply(self.state)
+                return self._control(command.control)
+            return command.apply(self.state)
         except Exception:
             log.exception("command %r failed", command)
-            result = Refusal(RefusalReason.NOT_READY, f"the kernel failed to apply {command!r}")
-        done(result)
+            return Refusal(RefusalReason.NOT_READY, f"the kernel failed to apply {command!r}")
 
     def _control(self, control: Control) -> None:
         match control:
@@ -180,7 +189,6 @@ class Kernel:
             case Control.RESET:
                 self.state = KernelState.from_config(self.config)
                 self.stats.running = True
-        self._publish()
         return None
 
     def _refuse_queued(self) -> None:
