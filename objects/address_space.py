@@ -73,14 +73,15 @@ class AddressSpace:
             raise ValueError(f"readable object {obj.name} needs a getter")
         if obj.access.writable and write is None:
             raise ValueError(f"writable object {obj.name} needs a setter")
-        entry = Entry(obj, len(self._entries) + 1, read, write)
-        for group in (obj.group, *aliases):
-            address = (obj.port, group, obj.offset)
+        addresses = [(obj.port, group, obj.offset) for group in (obj.group, *aliases)]
+        for address in addresses:  # check all before changing anything
             if address in self._by_address:
                 other = self._by_address[address].obj.name
                 raise ValueError(f"{obj.name} and {other} share address {address}")
+        entry = Entry(obj, len(self._entries) + 1, read, write)
+        for address in addresses:
             self._by_address[address] = entry
-            self._groups.add((obj.port, group))
+            self._groups.add(address[:2])
         self._ports.add(obj.port)
         self._by_name[key] = entry
         self._entries.append(entry)
@@ -194,6 +195,12 @@ class AddressSpace:
                 return (
                     _E.DEVICE_INVALIDSIZE,
                     f"{obj.name} is {dtype.name}; {len(data)} bytes do not fit",
+                    None,
+                )
+            if len(data) == dtype.size and b"\x00" not in data:
+                return (
+                    _E.DEVICE_INVALIDSIZE,
+                    f"{obj.name} is {dtype.name}: at most {dtype.size - 1} characters and a NUL",
                     None,
                 )
             data = data.ljust(dtype.size, b"\x00")

@@ -60,7 +60,7 @@ class TransmissionMode(IntEnum):
     SERVER_ON_CHANGE = 4  # server sends when the value changed, checked every cycle time
     SERVER_CYCLE2 = 5  # like SERVER_CYCLE (TwinCAT 3 spelling)
     SERVER_ON_CHANGE2 = 6  # like SERVER_ON_CHANGE (TwinCAT 3 spelling)
-    CLIENT_1_REQ = 7  # one request only
+    CLIENT_1_REQ = 10  # one request only (ADSTRANS_CLIENT1REQ)
 
 
 class ReservedIndexGroup(IntEnum):

@@ -33,8 +33,10 @@ class DataType:
         """Encode ``value`` into exactly ``size`` little-endian bytes."""
         match self.kind:
             case "bool":
-                if not isinstance(value, (bool, int)) or value not in (0, 1):
+                if not isinstance(value, int):
                     raise TypeError(f"{self.name} takes true/false or 0/1, not {value!r}")
+                if value not in (0, 1):
+                    raise ValueError(f"{self.name} takes true/false or 0/1, not {value!r}")
                 return b"\x01" if value else b"\x00"
             case "int":
                 if isinstance(value, bool) or not isinstance(value, int):
@@ -47,9 +49,13 @@ class DataType:
             case "float":
                 if isinstance(value, bool) or not isinstance(value, (int, float)):
                     raise TypeError(f"{self.name} takes a number, not {value!r}")
-                if self.size == 4 and math.isfinite(value) and abs(value) > self.maximum:  # type: ignore[operator]
-                    raise ValueError(f"{value} is outside the range of {self.name}")
-                return self._struct.pack(value)  # type: ignore[union-attr]
+                try:
+                    number = float(value)
+                    if self.size == 4 and math.isfinite(number) and abs(number) > self.maximum:  # type: ignore[operator]
+                        raise OverflowError
+                    return self._struct.pack(number)  # type: ignore[union-attr]
+                except (OverflowError, struct.error):
+                    raise ValueError(f"{value} is outside the range of {self.name}") from None
             case _:
                 return self._encode_string(value)
 
@@ -148,8 +154,13 @@ def parse_value(dtype: DataType, text: str) -> Any:
                 return False
             raise ValueError(f"{text!r} is not a boolean (0/1/true/false)")
         case "int":
+            stripped = text.strip()
             try:
-                return int(text.strip(), 0)
+                return int(stripped, 0)
+            except ValueError:
+                pass
+            try:  # int(x, 0) refuses decimals with leading zeros ("007")
+                return int(stripped, 10)
             except ValueError:
                 raise ValueError(f"{text!r} is not an integer for {dtype.name}") from None
         case "float":

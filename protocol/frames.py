@@ -207,18 +207,6 @@ def _unpack(raw: bytes) -> Any:
         raise ProtocolError(f"frame is not valid msgpack: {exc}") from None
 
 
-def peek_invoke_id(raw: bytes) -> tuple[int | None, int | None]:
-    """Best effort: the invoke id and command of a frame, or None where unreadable."""
-    try:
-        obj = _unpack(raw)
-    except ProtocolError:
-        return None, None
-    if type(obj) is not list or not obj or type(obj[0]) is not int or not 0 < obj[0] <= U32_MAX:
-        return None, None
-    command = obj[1] if len(obj) > 1 and type(obj[1]) is int else None
-    return obj[0], command
-
-
 def decode_request(raw: bytes) -> Request:
     """Decode a request frame; raise ``ProtocolError`` (with the invoke id when readable)."""
     obj = _unpack(raw)
@@ -354,11 +342,19 @@ def decode_incoming(raw: bytes) -> Response | Notification:
     if invoke_id == 0 and command == AdsCommand.DEVICE_NOTIFICATION:
         if len(obj) != 4 or type(obj[3]) is not list:
             raise ProtocolError("a notification is [0, 8, port, [samples]]")
-        try:
-            samples = tuple(Sample(*s) for s in obj[3])
-        except TypeError:
-            raise ProtocolError("a sample is [handle, sequence, timestamp, data]") from None
-        return Notification(obj[2], samples)
+        samples = []
+        for s in obj[3]:
+            if (
+                type(s) is not list
+                or len(s) != 4
+                or type(s[0]) is not int
+                or type(s[1]) is not int
+                or type(s[2]) is not int
+                or type(s[3]) is not bytes
+            ):
+                raise ProtocolError("a sample is [handle, sequence, timestamp, data]")
+            samples.append(Sample(*s))
+        return Notification(obj[2], tuple(samples))
     if type(invoke_id) is not int or type(command) is not int or type(obj[2]) is not int:
         raise ProtocolError("invoke id, command and result must be integers")
     if obj[2]:

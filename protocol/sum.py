@@ -135,6 +135,8 @@ def decode_sum_read_write_reply(count: int, data: bytes) -> list[tuple[int, byte
     out, pos = [], 8 * count
     for k in range(count):
         code, length = struct.unpack_from("<II", data, 8 * k)
+        if pos + length > len(data):
+            raise ValueError("sum read-write reply is shorter than the lengths it announces")
         out.append((code, data[pos : pos + length]))
         pos += length
     return out

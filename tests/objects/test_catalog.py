@@ -52,7 +52,9 @@ DOCUMENTED = [
 
 
 @pytest.mark.parametrize(
-    ("name", "port", "group", "offset", "dtype", "access", "unit"), DOCUMENTED, ids=[d[0] for d in DOCUMENTED]
+    ("name", "port", "group", "offset", "dtype", "access", "unit"),
+    DOCUMENTED,
+    ids=[d[0] for d in DOCUMENTED],
 )
 def test_documented_addresses(
     by_name: dict[str, CncObject],

@@ -156,7 +156,9 @@ def test_integers_are_little_endian(dtype: DataType, value: int, raw: bytes) -> 
 
 
 @pytest.mark.parametrize(("dtype", "size", "iec", "lo", "hi"), INTEGERS, ids=INTEGER_IDS)
-def test_integer_limits_are_accepted(dtype: DataType, size: int, iec: str, lo: int, hi: int) -> None:
+def test_integer_limits_are_accepted(
+    dtype: DataType, size: int, iec: str, lo: int, hi: int
+) -> None:
     assert (dtype.minimum, dtype.maximum) == (lo, hi)
     assert dtype.decode(dtype.encode(lo)) == lo
     assert dtype.decode(dtype.encode(hi)) == hi

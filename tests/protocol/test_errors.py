@@ -174,7 +174,9 @@ def test_cnc_ports() -> None:
     assert (CncPort.GEO, CncPort.SDA, CncPort.COM, CncPort.PLC) == (551, 552, 553, 851)
 
 
-@pytest.mark.parametrize("enum", [AdsCommand, AdsState, TransmissionMode, ReservedIndexGroup, CncPort])
+@pytest.mark.parametrize(
+    "enum", [AdsCommand, AdsState, TransmissionMode, ReservedIndexGroup, CncPort]
+)
 def test_constant_values_are_unique(enum: type) -> None:
     values = [member.value for member in enum]
     assert len(values) == len(set(values))

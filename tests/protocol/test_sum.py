@@ -101,7 +101,10 @@ def test_sum_read_reply_property(results: list[tuple[int, bytes]]) -> None:
 
 
 def test_sum_write_request_layout() -> None:
-    items = [SumItem(0x120101, 0x09, data=b"\xe8\x03"), SumItem(0x120101, 0x3F, data=b"\x01\x00\x00\x00")]
+    items = [
+        SumItem(0x120101, 0x09, data=b"\xe8\x03"),
+        SumItem(0x120101, 0x3F, data=b"\x01\x00\x00\x00"),
+    ]
     payload, read_length = encode_sum_write(items)
     assert payload == le(0x120101, 0x09, 2, 0x120101, 0x3F, 4) + b"\xe8\x03" + b"\x01\x00\x00\x00"
     assert read_length == 8  # one code per item
@@ -224,4 +227,5 @@ def test_sum_read_write_request_property(quads: list[tuple[int, int, int, bytes]
 
 @given(st.lists(st.tuples(u32, st.binary(max_size=16)), max_size=10))
 def test_sum_read_write_reply_property(results: list[tuple[int, bytes]]) -> None:
-    assert decode_sum_read_write_reply(len(results), encode_sum_read_write_reply(results)) == results
+    reply = encode_sum_read_write_reply(results)
+    assert decode_sum_read_write_reply(len(results), reply) == results
