@@ -91,13 +91,20 @@ class Sample:
     sequence: int
 
 
+_TYPES_BY_NAME: dict[str, DataType] = {}
+
+
 def _coerce_type(dtype: DataType | str) -> DataType:
     if isinstance(dtype, DataType):
         return dtype
+    known = _TYPES_BY_NAME.get(dtype)
+    if known is not None:
+        return known
     try:
-        return parse_type(dtype)
+        known = _TYPES_BY_NAME[dtype] = parse_type(dtype)
     except ValueError as exc:
         raise AdsError(AdsReturnCode.CLIENT_INVALIDPARM, str(exc)) from None
+    return known
 
 
 def _encode(dtype: DataType, value: Any, what: str) -> bytes:

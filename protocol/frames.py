@@ -339,6 +339,9 @@ def decode_incoming(raw: bytes) -> Response | Notification:
     if type(obj) is not list or len(obj) < 3:
         raise ProtocolError("a reply is an array [invoke_id, command, result, ...]")
     invoke_id, command = obj[0], obj[1]
+    result = obj[2]
+    if type(result) is int and result == 0 and type(invoke_id) is int and invoke_id > 0 and type(command) is int:
+        return Response(invoke_id, command, 0, obj[3:])  # the common case, checked cheaply
     if invoke_id == 0 and command == AdsCommand.DEVICE_NOTIFICATION:
         if len(obj) != 4 or type(obj[3]) is not list:
             raise ProtocolError("a notification is [0, 8, port, [samples]]")
