@@ -204,7 +204,12 @@ class AsyncClient:
         """Read the value at an ADS address, decoded as ``dtype`` (``"UNS16"``, ...)."""
         dtype = _coerce_type(dtype)
         reply = await self._call(ReadRequest, port, group, offset, dtype.size)
-        return _decode(dtype, self._payload(reply), f"0x{group:x}/0x{offset:x}")
+        try:
+            return dtype.decode(self._payload(reply))
+        except ValueError as exc:  # the message is built only on this rare path
+            raise AdsError(
+                AdsReturnCode.CLIENT_SYNCRESINVALID, f"0x{group:x}/0x{offset:x}: {exc}"
+            ) from None
 
     async def read_raw(self, port: int, group: int, offset: int, length: int) -> bytes:
         """Read ``length`` raw bytes at an ADS address."""

@@ -109,7 +109,9 @@ class AsyncTransport(_Transport):
         self._context = context or zmq.Context.instance()
         self._sock: zmq.Socket | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._pending: dict[int, tuple[asyncio.Future[Response], float, Request]] = {}
+        # invoke id -> (future, sweep generation when sent, request)
+        self._pending: dict[int, tuple[asyncio.Future[Response], int, Request]] = {}
+        self._generation = 0
         self._sample_waiters: dict[int, asyncio.Future[None]] = {}
         self._drain_scheduled = False
         self._sweeper: asyncio.Task[None] | None = None
@@ -147,10 +149,9 @@ class AsyncTransport(_Transport):
         """Send ``request`` and wait for its reply, at most ``timeout_s`` (see class doc)."""
         if self._sock is None:
             raise AdsConnectionError(0x748, "the client is not connected; use 'async with'")
-        loop = self._loop
-        fut = loop.create_future()  # type: ignore[union-attr]
+        fut = self._loop.create_future()  # type: ignore[union-attr]
         invoke_id = request.invoke_id
-        self._pending[invoke_id] = (fut, loop.time() + self.timeout_s, request)  # type: ignore[union-attr]
+        self._pending[invoke_id] = (fut, self._generation, request)
         try:
             self._raw_send(request.encode(), _NOBLOCK)
         except zmq.Again:
@@ -176,12 +177,15 @@ class AsyncTransport(_Transport):
                 self._sample_waiters.pop(handle, None)
 
     async def _sweep(self) -> None:
+        # Requests are stamped with the sweep generation instead of a clock reading; one
+        # sent in generation g has waited at least 4 quarters when generation g + 5 starts.
         period = max(0.001, self.timeout_s / 4)
         while True:
             await asyncio.sleep(period)
-            now = self._loop.time()  # type: ignore[union-attr]
-            for fut, deadline, request in list(self._pending.values()):
-                if deadline <= now and not fut.done():
+            self._generation += 1
+            expired = self._generation - 5
+            for fut, generation, request in list(self._pending.values()):
+                if generation <= expired and not fut.done():
                     fut.set_exception(self._timeout(request))
 
     def _schedule_drain(self) -> None:

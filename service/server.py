@@ -149,10 +149,9 @@ class AdsServer:
             self._loop.call_soon(self._drain)
 
     def _drain(self) -> None:
-        """Handle every waiting frame (up to a batch), then send the replies together."""
+        """Handle every waiting frame (up to a batch) without waiting in between."""
         self._drain_scheduled = False
-        recv = self._raw_recv
-        out: list[tuple[Envelope, bytes]] = []
+        recv, deliver = self._raw_recv, self._deliver
         for _ in range(DRAIN_BATCH):
             try:
                 part = recv(_NOBLOCK, False)  # a zmq.Frame: .more is cheaper than RCVMORE
@@ -165,11 +164,9 @@ class AdsServer:
             envelope = tuple(frames[:-1])
             reply = self._handle(envelope, frames[-1])
             if reply is not None:
-                out.append((envelope, reply))
+                deliver(envelope, reply)  # at once: a pipelining client overlaps with us
         else:
             self._schedule_drain()  # more may wait: come back after other callbacks ran
-        for envelope, reply in out:
-            self._deliver(envelope, reply)
         self._look_for_input()
 
     def _look_for_input(self) -> None:
