@@ -114,6 +114,7 @@ class AsyncTransport(_Transport):
         self._generation = 0
         self._sample_waiters: dict[int, asyncio.Future[None]] = {}
         self._drain_scheduled = False
+        self._outbox: list[tuple[int, bytes]] = []
         self._sweeper: asyncio.Task[None] | None = None
 
     async def open(self) -> None:
@@ -152,12 +153,10 @@ class AsyncTransport(_Transport):
         fut = self._loop.create_future()  # type: ignore[union-attr]
         invoke_id = request.invoke_id
         self._pending[invoke_id] = (fut, self._generation, request)
-        try:
-            self._raw_send(request.encode(), _NOBLOCK)
-        except zmq.Again:
-            del self._pending[invoke_id]
-            raise AdsConnectionError(0x748, "send queue full; the service is not reading") from None
-        self._schedule_drain()  # a send can consume the fd's edge: look once per loop pass
+        # Frames wait in the outbox until the end of this loop pass and then go out back
+        # to back: ZeroMQ's I/O thread is woken once per burst instead of once per frame.
+        self._outbox.append((invoke_id, request.encode()))
+        self._schedule_drain()
         try:
             return await fut
         finally:
@@ -193,10 +192,27 @@ class AsyncTransport(_Transport):
             self._drain_scheduled = True
             self._loop.call_soon(self._drain)  # type: ignore[union-attr]
 
+    def _flush(self) -> None:
+        send, pending = self._raw_send, self._pending
+        outbox, self._outbox = self._outbox, []
+        for k, (invoke_id, frame) in enumerate(outbox):
+            try:
+                send(frame, _NOBLOCK)
+            except zmq.Again:  # the service stopped reading: fail what could not go out
+                full = AdsConnectionError(0x748, "send queue full; the service is not reading")
+                for failed, _ in outbox[k:]:
+                    entry = pending.get(failed)
+                    if entry is not None and not entry[0].done():
+                        entry[0].set_exception(full)
+                return
+
     def _drain(self) -> None:
+        """Send what waits in the outbox, then handle every frame that came in."""
         self._drain_scheduled = False
         if self._sock is None:
             return
+        if self._outbox:
+            self._flush()  # a send can consume the fd's edge: we read right after anyway
         recv = self._raw_recv
         pending = self._pending
         while True:

@@ -156,19 +156,19 @@ class AddressSpace:
     @staticmethod
     def read_entry(entry: Entry, length: int) -> tuple[int, bytes | str]:
         """Read ``entry`` with a read length of ``length`` bytes."""
-        obj = entry.obj
-        if entry.read is None:
-            return _E.DEVICE_INVALIDACCESS, f"{obj.name} is write-only"
-        if length != obj.dtype.size:
-            return (
-                _E.DEVICE_INVALIDSIZE,
-                f"{obj.name} is {obj.dtype.name}, {obj.dtype.size} bytes; read asked {length}",
-            )
-        try:
-            return 0, obj.dtype.encode(entry.read())
-        except Exception:  # a getter fault must not take the service down
-            log.exception("reading %s failed", obj.name)
-            return _E.DEVICE_ERROR, f"reading {obj.name} failed inside the service"
+        getter, dtype = entry.read, entry.obj.dtype
+        if getter is not None and length == dtype.size:
+            try:
+                return 0, dtype.encode(getter())
+            except Exception:  # a getter fault must not take the service down
+                log.exception("reading %s failed", entry.obj.name)
+                return _E.DEVICE_ERROR, f"reading {entry.obj.name} failed inside the service"
+        if getter is None:
+            return _E.DEVICE_INVALIDACCESS, f"{entry.obj.name} is write-only"
+        return (
+            _E.DEVICE_INVALIDSIZE,
+            f"{entry.obj.name} is {dtype.name}, {dtype.size} bytes; read asked {length}",
+        )
 
     def decode_write(
         self, port: int, group: int, offset: int, data: bytes

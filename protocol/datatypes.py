@@ -31,7 +31,10 @@ class DataType:
 
     def encode(self, value: Any) -> bytes:
         """Encode ``value`` into exactly ``size`` little-endian bytes."""
-        match self.kind:
+        kind = self.kind
+        if kind == "int" and type(value) is int and self.minimum <= value <= self.maximum:  # type: ignore[operator]
+            return self._struct.pack(value)  # type: ignore[union-attr]  # the common case
+        match kind:
             case "bool":
                 if not isinstance(value, int):
                     raise TypeError(f"{self.name} takes true/false or 0/1, not {value!r}")

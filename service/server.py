@@ -52,6 +52,7 @@ log = logging.getLogger(__name__)
 
 _E = AdsReturnCode
 _U32 = struct.Struct("<I")
+_RESERVED_GROUPS = 0xF000  # index groups from here on are ADS services, not objects
 DRAIN_BATCH = 256  # frames handled per wake-up before yielding to other callbacks
 DEVICE_NAME = "cnc-objects"
 _CONTROLS = {AdsState.RUN: Control.RUN, AdsState.STOP: Control.STOP, AdsState.RESET: Control.RESET}
@@ -102,6 +103,7 @@ class AdsServer:
         self._raw_recv = raw.recv.__get__(sock)
         self._raw_get = raw.get.__get__(sock)
         self.endpoint = sock.getsockopt_string(zmq.LAST_ENDPOINT)
+        self._space_read = space.read
         self.hub = NotificationHub(
             self._read_value, self._send, loop, kernel.cycle_ns, lambda: kernel.snapshot
         )
@@ -274,7 +276,14 @@ class AdsServer:
         return encode_response(req.invoke_id, req.COMMAND, major, minor, build, DEVICE_NAME)
 
     def _read(self, envelope: Envelope, req: ReadRequest) -> Reply:
-        return self._reply(req, self._read_value(req.port, req.group, req.offset, req.length))
+        # The hot path: an object address goes straight to the address space.
+        if req.group < _RESERVED_GROUPS:
+            code, payload = self._space_read(req.port, req.group, req.offset, req.length)
+        else:
+            code, payload = self._read_value(req.port, req.group, req.offset, req.length)
+        if code:
+            return encode_error(req.invoke_id, AdsCommand.READ, code, payload)
+        return encode_response(req.invoke_id, AdsCommand.READ, payload)
 
     def _write(self, envelope: Envelope, req: WriteRequest) -> Reply:
         code, target, value = self._decode_write(req.port, req.group, req.offset, req.data)
