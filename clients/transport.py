@@ -195,7 +195,7 @@ class AsyncTransport(_Transport):
     def _flush(self) -> None:
         send, pending = self._raw_send, self._pending
         outbox, self._outbox = self._outbox, []
-        for k, (invoke_id, frame) in enumerate(outbox):
+        for k, (_, frame) in enumerate(outbox):
             try:
                 send(frame, _NOBLOCK)
             except zmq.Again:  # the service stopped reading: fail what could not go out

@@ -121,8 +121,6 @@ class AdsServer:
             AdsCommand.BROWSE: self._browse,
         }
         self._read_write_groups: dict[int, Callable[[Envelope, ReadWriteRequest], Reply]] = {
-            RIG.SYM_HANDLE_BY_NAME: self._rw_single,
-            RIG.SYM_VALUE_BY_NAME: self._rw_single,
             RIG.SUM_READ: self._sum_read,
             RIG.SUM_WRITE: self._sum_write,
             RIG.SUM_READ_WRITE: self._sum_read_write,
@@ -353,12 +351,11 @@ class AdsServer:
                 f"read length {req.read_length} exceeds {MAX_DATA_BYTES} bytes",
             )
         handler = self._read_write_groups.get(req.group)
-        if handler is not None:
+        if handler is not None:  # a sum command
             return handler(envelope, req)
-        return self._reply(req, self._rw_value(req.port, req.group, req.offset, req.read_length, req.data))
-
-    def _rw_single(self, envelope: Envelope, req: ReadWriteRequest) -> Reply:
-        return self._reply(req, self._rw_value(req.port, req.group, req.offset, req.read_length, req.data))
+        return self._reply(
+            req, self._rw_value(req.port, req.group, req.offset, req.read_length, req.data)
+        )
 
     def _rw_value(self, port: int, group: int, offset: int, read_length: int, data: bytes) -> ValueResult:
         """ReadWrite at one address: handle by name, value by name; others refused."""

@@ -72,7 +72,9 @@ def start_service(*args: str, timeout_s: float = 20.0) -> RunningService:
             line = lines.get(timeout=timeout_s)
         except queue.Empty:
             proc.kill()
-            raise AssertionError("service did not log 'listening on' in time:\n" + "\n".join(log))
+            raise AssertionError(
+                "service did not log 'listening on' in time:\n" + "\n".join(log)
+            ) from None
         if line is None:
             proc.wait()
             raise AssertionError(
