@@ -152,7 +152,8 @@ class AsyncClient:
 
     async def _call(self, cls: type[Request], port: int, *fields: Any) -> Response:
         """Send one request; return the reply or raise AdsError with its code."""
-        reply = await self._t.exchange(cls(self._t.next_invoke_id(), port, *fields))
+        transport = self._t
+        reply = await transport.exchange(cls(transport.next_invoke_id(), port, *fields))
         if reply.result:
             raise AdsError(reply.result, reply.message)
         return reply
@@ -205,8 +206,8 @@ class AsyncClient:
         dtype = _coerce_type(dtype)
         reply = await self._call(ReadRequest, port, group, offset, dtype.size)
         try:
-            return dtype.decode(self._payload(reply))
-        except ValueError as exc:  # the message is built only on this rare path
+            return dtype.decode(reply.fields[0])
+        except (ValueError, IndexError) as exc:  # the message is built only on this rare path
             raise AdsError(
                 AdsReturnCode.CLIENT_SYNCRESINVALID, f"0x{group:x}/0x{offset:x}: {exc}"
             ) from None

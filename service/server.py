@@ -149,10 +149,10 @@ class AdsServer:
             self._loop.call_soon(self._drain)
 
     def _drain(self) -> None:
-        """Handle every waiting frame (up to a batch), then send the replies together."""
+        """Handle every waiting frame (up to a batch); each reply goes out at once so a
+        pipelining client overlaps its work with ours."""
         self._drain_scheduled = False
-        recv = self._raw_recv
-        out: list[tuple[Envelope, bytes]] = []
+        recv, deliver = self._raw_recv, self._deliver
         for _ in range(DRAIN_BATCH):
             try:
                 part = recv(_NOBLOCK, False)  # a zmq.Frame: .more is cheaper than RCVMORE
@@ -165,13 +165,9 @@ class AdsServer:
             envelope = tuple(frames[:-1])
             reply = self._handle(envelope, frames[-1])
             if reply is not None:
-                out.append((envelope, reply))
+                deliver(envelope, reply)
         else:
             self._schedule_drain()  # more may wait: come back after other callbacks ran
-        # Replies go out back to back: ZeroMQ's I/O thread wakes once per burst.
-        deliver = self._deliver
-        for envelope, reply in out:
-            deliver(envelope, reply)
         self._look_for_input()
 
     def _look_for_input(self) -> None:
