@@ -43,7 +43,8 @@ from protocol.frames import (
 )
 
 from .errors import AdsConnectionError, AdsError
-from .transport import AsyncTransport, SyncTransport, drive
+from .sync_transport import SyncTransport, drive
+from .transport import AsyncTransport
 
 DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
 DEFAULT_TIMEOUT_S = 5.0

@@ -1,0 +1,135 @@
+"""The blocking transport and the driver that runs client coroutines on it.
+
+``SyncTransport``'s awaitables yield themselves to ``drive``, which performs the socket
+I/O and sends the result back into the coroutine, so the blocking client runs the same
+method bodies as the async one, without an event loop or a thread.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Coroutine, Generator
+from typing import Any
+
+import zmq
+
+from protocol.errors import ProtocolError
+from protocol.frames import Request, Response, Sample, decode_incoming
+
+from .errors import AdsConnectionError
+from .transport import _NOBLOCK, _new_socket, _Transport
+
+log = logging.getLogger(__name__)
+
+
+class _Pending:
+    """An awaitable that yields itself to ``drive``, which sends back the result."""
+
+    __slots__ = ("transport", "request", "handle")
+
+    def __init__(self, transport: SyncTransport, request: Request | None, handle: int = 0) -> None:
+        self.transport = transport
+        self.request = request
+        self.handle = handle
+
+    def __await__(self) -> Generator[_Pending, Any, Any]:
+        return (yield self)
+
+
+class SyncTransport(_Transport):
+    """DEALER socket used by blocking calls; no event loop, no thread."""
+
+    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context | None = None) -> None:
+        super().__init__(endpoint, timeout_s)
+        self._context = context or zmq.Context.instance()
+        self._sock: zmq.Socket | None = None
+
+    async def open(self) -> None:
+        """Connect. Replies are awaited by a blocking receive with a timeout (cheaper
+        than polling first)."""
+        self._sock = sock = _new_socket(self._context, self.endpoint)
+        self._timeout_ms = max(1, int(self.timeout_s * 1000))
+        sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
+        raw = zmq.Socket.__mro__[1]  # the Cython methods, without pyzmq's Python wrappers
+        self._raw_send = raw.send.__get__(sock)
+        self._raw_recv = raw.recv.__get__(sock)
+
+    async def close(self) -> None:
+        """Disconnect."""
+        if self._sock is not None:
+            self._sock.close(linger=0)
+            self._sock = None
+
+    def exchange(self, request: Request) -> _Pending:
+        """Awaitable reply to ``request`` (performed by ``drive``)."""
+        return _Pending(self, request)
+
+    def next_sample(self, handle: int) -> _Pending:
+        """Awaitable next sample of ``handle`` (performed by ``drive``)."""
+        return _Pending(self, None, handle)
+
+    def perform(self, pending: _Pending) -> Response | Sample:
+        """Do the blocking I/O a ``_Pending`` stands for."""
+        sock = self._sock
+        if sock is None:
+            raise AdsConnectionError(0x748, "the client is not connected; use 'with'")
+        request = pending.request
+        if request is None:
+            buffer = self._samples[pending.handle]
+            sock.setsockopt(zmq.RCVTIMEO, -1)  # samples come when they come
+            try:
+                while not buffer:
+                    self._receive(sock)
+            finally:
+                sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
+            return buffer.popleft()
+        try:
+            self._raw_send(request.encode(), _NOBLOCK)
+        except zmq.Again:
+            raise AdsConnectionError(0x748, "send queue full; the service is not reading") from None
+        deadline = time.monotonic() + self.timeout_s
+        shortened = False
+        try:
+            message = self._receive(sock)
+            while message is None or message.invoke_id != request.invoke_id:
+                # A notification or a late reply came first: wait only for what is left.
+                left_ms = int((deadline - time.monotonic()) * 1000)
+                if left_ms <= 0:
+                    raise zmq.Again()
+                sock.setsockopt(zmq.RCVTIMEO, left_ms)
+                shortened = True
+                message = self._receive(sock)
+            return message
+        except zmq.Again:
+            raise self._timeout(request) from None
+        finally:
+            if shortened:
+                sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
+
+    def _receive(self, sock: zmq.Socket) -> Response | None:
+        raw = self._raw_recv(0)
+        try:
+            message = decode_incoming(raw)
+        except ProtocolError as exc:
+            log.warning("dropped an unreadable frame from %s: %s", self.endpoint, exc)
+            return None
+        if type(message) is Response:
+            return message  # a late reply to a timed-out request is dropped by the caller
+        self._route(message)  # type: ignore[arg-type]
+        return None
+
+
+def drive(coro: Coroutine[Any, Any, Any]) -> Any:
+    """Run a client coroutine to completion on a ``SyncTransport``, blocking."""
+    send: Any = None
+    error: BaseException | None = None
+    while True:
+        try:
+            pending = coro.throw(error) if error is not None else coro.send(send)
+        except StopIteration as stop:
+            return stop.value
+        try:
+            send, error = pending.transport.perform(pending), None
+        except BaseException as exc:  # noqa: BLE001 - delivered into the coroutine
+            send, error = None, exc
