@@ -153,8 +153,7 @@ class AsyncClient:
 
     async def _call(self, cls: type[Request], port: int, *fields: Any) -> Response:
         """Send one request; return the reply or raise AdsError with its code."""
-        transport = self._t
-        reply = await transport.exchange(cls(transport.next_invoke_id(), port, *fields))
+        reply = await self._t.exchange(cls.COMMAND, port, fields)
         if reply.result:
             raise AdsError(reply.result, reply.message)
         return reply

@@ -15,7 +15,7 @@ from typing import Any
 import zmq
 
 from protocol.errors import ProtocolError
-from protocol.frames import Request, Response, Sample, decode_incoming
+from protocol.frames import Response, Sample, decode_incoming
 
 from .errors import AdsConnectionError
 from .transport import _NOBLOCK, _new_socket, _Transport
@@ -26,11 +26,20 @@ log = logging.getLogger(__name__)
 class _Pending:
     """An awaitable that yields itself to ``drive``, which sends back the result."""
 
-    __slots__ = ("transport", "request", "handle")
+    __slots__ = ("transport", "invoke_id", "frame", "command", "handle")
 
-    def __init__(self, transport: SyncTransport, request: Request | None, handle: int = 0) -> None:
+    def __init__(
+        self,
+        transport: SyncTransport,
+        invoke_id: int = 0,
+        frame: bytes = b"",
+        command: int = 0,
+        handle: int = 0,
+    ) -> None:
         self.transport = transport
-        self.request = request
+        self.invoke_id = invoke_id  # 0: waiting for a sample of ``handle``
+        self.frame = frame
+        self.command = command
         self.handle = handle
 
     def __await__(self) -> Generator[_Pending, Any, Any]:
@@ -61,21 +70,22 @@ class SyncTransport(_Transport):
             self._sock.close(linger=0)
             self._sock = None
 
-    def exchange(self, request: Request) -> _Pending:
-        """Awaitable reply to ``request`` (performed by ``drive``)."""
-        return _Pending(self, request)
+    def exchange(self, command: int, port: int, fields: tuple[Any, ...]) -> _Pending:
+        """Awaitable reply to a request (performed by ``drive``)."""
+        invoke_id, frame = self._frame(command, port, fields)
+        return _Pending(self, invoke_id, frame, command)
 
     def next_sample(self, handle: int) -> _Pending:
         """Awaitable next sample of ``handle`` (performed by ``drive``)."""
-        return _Pending(self, None, handle)
+        return _Pending(self, handle=handle)
 
     def perform(self, pending: _Pending) -> Response | Sample:
         """Do the blocking I/O a ``_Pending`` stands for."""
         sock = self._sock
         if sock is None:
             raise AdsConnectionError(0x748, "the client is not connected; use 'with'")
-        request = pending.request
-        if request is None:
+        invoke_id = pending.invoke_id
+        if not invoke_id:
             buffer = self._samples[pending.handle]
             sock.setsockopt(zmq.RCVTIMEO, -1)  # samples come when they come
             try:
@@ -85,14 +95,14 @@ class SyncTransport(_Transport):
                 sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
             return buffer.popleft()
         try:
-            self._raw_send(request.encode(), _NOBLOCK)
+            self._raw_send(pending.frame, _NOBLOCK)
         except zmq.Again:
             raise AdsConnectionError(0x748, "send queue full; the service is not reading") from None
         deadline = time.monotonic() + self.timeout_s
         shortened = False
         try:
             message = self._receive(sock)
-            while message is None or message.invoke_id != request.invoke_id:
+            while message is None or message.invoke_id != invoke_id:
                 # A notification or a late reply came first: wait only for what is left.
                 left_ms = int((deadline - time.monotonic()) * 1000)
                 if left_ms <= 0:
@@ -102,7 +112,7 @@ class SyncTransport(_Transport):
                 message = self._receive(sock)
             return message
         except zmq.Again:
-            raise self._timeout(request) from None
+            raise self._timeout(pending.command) from None
         finally:
             if shortened:
                 sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)

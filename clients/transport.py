@@ -1,7 +1,7 @@
 """Transports: move frames between a client and the service over a ZeroMQ DEALER socket.
 
 The client's methods are written once, as coroutines that ``await`` only two things of
-their transport: ``exchange(request)`` (a reply) and ``next_sample(handle)`` (a
+their transport: ``exchange(command, port, fields)`` (a reply) and ``next_sample(handle)`` (a
 notification sample). ``AsyncTransport`` (here) answers them on the event loop, with many
 requests in flight matched by invoke id; ``SyncTransport`` (``sync_transport``) answers
 them by blocking on the socket.
@@ -14,11 +14,13 @@ import itertools
 import logging
 from collections import deque
 
+from typing import Any
+
 import zmq
 
 from protocol.constants import AdsCommand
 from protocol.errors import ProtocolError
-from protocol.frames import Notification, Request, Response, Sample, decode_incoming
+from protocol.frames import Notification, Response, Sample, decode_incoming, encode_request
 
 from .errors import AdsConnectionError, AdsTimeoutError
 
@@ -52,13 +54,13 @@ class _Transport:
         self._samples: dict[int, deque[Sample]] = {}
         self._early: dict[int, deque[Sample]] = {}
 
-    def next_invoke_id(self) -> int:
-        """A fresh invoke id, 1..2**32-1."""
+    def _frame(self, command: int, port: int, fields: tuple[Any, ...]) -> tuple[int, bytes]:
+        """A fresh invoke id (1..2**32-1) and the request frame that carries it."""
         invoke_id = next(self._ids)
         if invoke_id > 0xFFFFFFFF:
             self._ids = itertools.count(2)
             invoke_id = 1
-        return invoke_id
+        return invoke_id, encode_request(invoke_id, command, port, fields)
 
     def open_samples(self, handle: int) -> None:
         """Start buffering samples of ``handle`` (claims any that arrived early)."""
@@ -80,9 +82,9 @@ class _Transport:
                     buffer = self._early[sample.handle] = deque(maxlen=SAMPLE_BUFFER)
             buffer.append(sample)
 
-    def _timeout(self, request: Request) -> AdsTimeoutError:
+    def _timeout(self, command: int) -> AdsTimeoutError:
         return AdsTimeoutError(
-            f"no reply to {AdsCommand(request.COMMAND).name} within {self.timeout_s:g} s "
+            f"no reply to {AdsCommand(command).name} within {self.timeout_s:g} s "
             f"from {self.endpoint} (is cnc-service running?)"
         )
 
@@ -104,8 +106,8 @@ class AsyncTransport(_Transport):
         self._context = context or zmq.Context.instance()
         self._sock: zmq.Socket | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
-        # invoke id -> (future, sweep generation when sent, request)
-        self._pending: dict[int, tuple[asyncio.Future[Response], int, Request]] = {}
+        # invoke id -> (future, sweep generation when sent, command id)
+        self._pending: dict[int, tuple[asyncio.Future[Response], int, int]] = {}
         self._generation = 0
         self._sample_waiters: dict[int, asyncio.Future[None]] = {}
         self._drain_scheduled = False
@@ -141,17 +143,17 @@ class AsyncTransport(_Transport):
                 fut.set_exception(closed)
         self._pending.clear()
 
-    def exchange(self, request: Request) -> asyncio.Future[Response]:
-        """Send ``request``; the future is its reply, or fails after ``timeout_s`` (see the
+    def exchange(self, command: int, port: int, fields: tuple[Any, ...]) -> asyncio.Future[Response]:
+        """Send a request; the future is its reply, or fails after ``timeout_s`` (see the
         class doc). A plain function, so that awaiting a reply costs one frame less."""
         if self._sock is None:
             raise AdsConnectionError(0x748, "the client is not connected; use 'async with'")
         fut = self._loop.create_future()  # type: ignore[union-attr]
-        invoke_id = request.invoke_id
-        self._pending[invoke_id] = (fut, self._generation, request)
+        invoke_id, frame = self._frame(command, port, fields)
+        self._pending[invoke_id] = (fut, self._generation, command)
         # Frames wait in the outbox until the end of this loop pass and then go out back
         # to back: ZeroMQ's I/O thread is woken once per burst instead of once per frame.
-        self._outbox.append((invoke_id, request.encode()))
+        self._outbox.append((invoke_id, frame))
         if not self._drain_scheduled:
             self._drain_scheduled = True
             self._loop.call_soon(self._drain)  # type: ignore[union-attr]
@@ -179,12 +181,12 @@ class AsyncTransport(_Transport):
             self._generation += 1
             expired = self._generation - 5
             pending = self._pending
-            for invoke_id, (fut, generation, request) in list(pending.items()):
+            for invoke_id, (fut, generation, command) in list(pending.items()):
                 if fut.done():  # its caller was cancelled: the reply will not be awaited
                     del pending[invoke_id]
                 elif generation <= expired:
                     del pending[invoke_id]
-                    fut.set_exception(self._timeout(request))
+                    fut.set_exception(self._timeout(command))
 
     def _schedule_drain(self) -> None:
         if not self._drain_scheduled:

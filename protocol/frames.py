@@ -300,6 +300,12 @@ class Response(NamedTuple):
         return _packb([self.invoke_id, self.command, 0, *self.fields])
 
 
+def encode_request(invoke_id: int, command: int, port: int, fields: tuple[Any, ...]) -> bytes:
+    """Encode a request without building its NamedTuple (the client's hot path); the
+    bytes are those of ``<Request type>(invoke_id, port, *fields).encode()``."""
+    return _packb([invoke_id, command, port, *fields])
+
+
 def encode_response(invoke_id: int, command: int, *fields: Any) -> bytes:
     """Encode a successful reply without building a ``Response`` (the hot path)."""
     return _packb([invoke_id, command, 0, *fields])

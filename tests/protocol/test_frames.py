@@ -435,3 +435,14 @@ def test_decode_incoming_only_ever_raises_protocol_error(raw: bytes) -> None:
     except ProtocolError:
         return
     assert isinstance(reply, (Response, Notification))
+
+
+def test_encode_request_matches_the_request_types() -> None:
+    from protocol.frames import ReadRequest, WriteRequest, encode_request
+
+    assert encode_request(7, 2, 551, (0x121301, 0x10018, 4)) == ReadRequest(
+        7, 551, 0x121301, 0x10018, 4
+    ).encode()
+    assert encode_request(8, 3, 553, (0x120101, 9, b"\x01\x00")) == WriteRequest(
+        8, 553, 0x120101, 9, b"\x01\x00"
+    ).encode()
