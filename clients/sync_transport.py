@@ -141,5 +141,5 @@ def drive(coro: Coroutine[Any, Any, Any]) -> Any:
             return stop.value
         try:
             send, error = pending.transport.perform(pending), None
-        except BaseException as exc:  # noqa: BLE001 - delivered into the coroutine
+        except BaseException as exc:
             send, error = None, exc

@@ -120,7 +120,7 @@ _STRING_RE = re.compile(r"^STRING\((\d+)\)$")
 _STRING_CACHE: dict[int, DataType] = {}
 
 
-def STRING(size: int) -> DataType:  # noqa: N802 - reads like the ISG type name
+def STRING(size: int) -> DataType:
     """A fixed string buffer of ``size`` bytes including the NUL terminator."""
     if size < 1 or size > 65536:
         raise ValueError(f"STRING size must be 1..65536 bytes, not {size}")

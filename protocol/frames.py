@@ -296,8 +296,8 @@ class Response(NamedTuple):
     def encode(self) -> bytes:
         """The frame as msgpack bytes."""
         if self.result:
-            return _packb([self.invoke_id, self.command, self.result, self.message])
-        return _packb([self.invoke_id, self.command, 0, *self.fields])
+            return encode_error(self.invoke_id, self.command, self.result, self.message)
+        return encode_response(self.invoke_id, self.command, *self.fields)
 
 
 def encode_request(invoke_id: int, command: int, port: int, fields: tuple[Any, ...]) -> bytes:
