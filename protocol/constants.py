@@ -89,3 +89,23 @@ SUM_COMMAND_MAX_ITEMS = 500
 
 #: Largest data block a single request may carry (bytes). Larger requests get 0x705.
 MAX_DATA_BYTES = 1 << 20
+
+
+#: Index group of the program store on the COM port (project-defined: ISG documents no
+#: ADS file service for NC programs). Offsets are ``ProgramStoreOffset``.
+PROGRAM_STORE_GROUP = 0x150000
+
+#: Largest program the store accepts in one upload (bytes); one frame carries it whole.
+PROGRAM_MAX_BYTES = 1_000_000
+
+#: Longest program name (characters): ISG file names are STRING(84) with the NUL.
+PROGRAM_NAME_MAX_CHARS = 83
+
+
+class ProgramStoreOffset(IntEnum):
+    """Operations of the program store (index offsets in ``PROGRAM_STORE_GROUP``)."""
+
+    LIST = 1  # Read: one line per program, "name<TAB>size_bytes<TAB>mtime_unix_s\n" (UTF-8)
+    UPLOAD = 2  # Write: name (CP1252), NUL, content; replaces atomically
+    DOWNLOAD = 3  # ReadWrite: name in, content out (read length >= size)
+    DELETE = 4  # Write: name

@@ -20,7 +20,14 @@ from typing import Any
 
 from objects import AddressSpace, Entry
 from protocol import sum as sums
-from protocol.constants import MAX_DATA_BYTES, SUM_COMMAND_MAX_ITEMS, AdsCommand, AdsState
+from protocol.constants import (
+    MAX_DATA_BYTES,
+    PROGRAM_STORE_GROUP,
+    SUM_COMMAND_MAX_ITEMS,
+    AdsCommand,
+    AdsState,
+    CncPort,
+)
 from protocol.constants import ReservedIndexGroup as RIG
 from protocol.datatypes import STRING_ENCODING
 from protocol.errors import AdsReturnCode, ProtocolError
@@ -43,6 +50,7 @@ from .binding import refusal_code
 from .kernel.commands import Refusal
 from .kernel.kernel import Control, ControlCommand, Kernel
 from .notifications import NotificationHub, SendFn
+from .program_service import ProgramStoreService
 
 log = logging.getLogger(__name__)
 
@@ -66,8 +74,10 @@ class Dispatcher:
         kernel: Kernel,
         loop: asyncio.AbstractEventLoop,
         send: SendFn,
+        programs: ProgramStoreService | None = None,
     ) -> None:
         self.space = space
+        self.programs = programs
         self.kernel = kernel
         self._loop = loop
         self._send = send
@@ -114,6 +124,8 @@ class Dispatcher:
         code, payload = result
         if code:
             return encode_error(request.invoke_id, request.COMMAND, code, payload)
+        if payload is None:  # a write: the reply carries no data
+            return encode_response(request.invoke_id, request.COMMAND)
         return encode_response(request.invoke_id, request.COMMAND, payload)
 
     # ------------------------------------------------------------ values
@@ -172,8 +184,13 @@ class Dispatcher:
         major, minor, build = (int(p) for p in __version__.split("."))
         return encode_response(req.invoke_id, req.COMMAND, major, minor, build, DEVICE_NAME)
 
+    def _is_store(self, port: int, group: int) -> bool:
+        return group == PROGRAM_STORE_GROUP and port == CncPort.COM and self.programs is not None
+
     def _read(self, envelope: Envelope, req: ReadRequest) -> Reply:
         # The hot path: an object address goes straight to the address space.
+        if req.group == PROGRAM_STORE_GROUP and self._is_store(req.port, req.group):
+            return self._reply(req, self.programs.read(req.offset, req.length))
         if req.group < _RESERVED_GROUPS:
             code, payload = self._space_read(req.port, req.group, req.offset, req.length)
         else:
@@ -183,6 +200,8 @@ class Dispatcher:
         return encode_response(req.invoke_id, AdsCommand.READ, payload)
 
     def _write(self, envelope: Envelope, req: WriteRequest) -> Reply:
+        if self._is_store(req.port, req.group):
+            return self._reply(req, self.programs.write(req.offset, req.data))
         code, target, value = self._decode_write(req.port, req.group, req.offset, req.data)
         if code:
             return encode_error(req.invoke_id, req.COMMAND, code, target)
@@ -247,6 +266,8 @@ class Dispatcher:
         handler = self._read_write_groups.get(req.group)
         if handler is not None:  # a sum command
             return handler(envelope, req)
+        if self._is_store(req.port, req.group):
+            return self._reply(req, self.programs.read_write(req.offset, req.data, req.read_length))
         return self._reply(
             req, self._rw_value(req.port, req.group, req.offset, req.read_length, req.data)
         )

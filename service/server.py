@@ -20,6 +20,7 @@ import zmq
 from objects import AddressSpace
 from protocol.constants import MAX_DATA_BYTES
 
+from .program_service import ProgramStoreService
 from .dispatch import Dispatcher, Envelope
 from .kernel.kernel import Kernel
 
@@ -43,6 +44,7 @@ class AdsServer:
         endpoint: str,
         loop: asyncio.AbstractEventLoop,
         context: zmq.Context | None = None,
+        programs: ProgramStoreService | None = None,
     ) -> None:
         self.space = space
         self.kernel = kernel
@@ -69,7 +71,7 @@ class AdsServer:
         self._raw_recv = raw.recv.__get__(sock)
         self._raw_get = raw.get.__get__(sock)
         self.endpoint = sock.getsockopt_string(zmq.LAST_ENDPOINT)
-        self.dispatcher = Dispatcher(space, kernel, loop, self._send)
+        self.dispatcher = Dispatcher(space, kernel, loop, self._send, programs)
         self.hub = self.dispatcher.hub
         kernel.on_cycle_end = self.hub.kernel_cycle_end
         self._handle = self.dispatcher.handle

@@ -1,0 +1,92 @@
+"""The program store on the wire: ADS read, write and read-write at ``PROGRAM_STORE_GROUP``.
+
+Turns the store's operations into ADS replies: (0, payload) or (code, message). Store
+faults map to ADS codes a pyads user knows: a bad name 0x706, a missing program 0x70C,
+an oversized upload or a short read buffer 0x705, a full store 0x70A.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from protocol.constants import ProgramStoreOffset as Op
+from protocol.datatypes import STRING_ENCODING
+from protocol.errors import AdsReturnCode
+
+from .program_store import ProgramStore, StoreError, StoreFault
+
+log = logging.getLogger(__name__)
+
+_E = AdsReturnCode
+Result = tuple[int, bytes | str | None]
+
+FAULT_CODES: dict[StoreFault, AdsReturnCode] = {
+    StoreFault.BAD_NAME: _E.DEVICE_INVALIDDATA,
+    StoreFault.NOT_FOUND: _E.DEVICE_NOTFOUND,
+    StoreFault.TOO_LARGE: _E.DEVICE_INVALIDSIZE,
+    StoreFault.FULL: _E.DEVICE_NOMEMORY,
+    StoreFault.IO: _E.DEVICE_ERROR,
+}
+
+
+def _name(data: bytes) -> str:
+    try:
+        return data.split(b"\x00", 1)[0].decode(STRING_ENCODING)
+    except UnicodeDecodeError:
+        raise StoreError(StoreFault.BAD_NAME, "a program name must be CP1252 text") from None
+
+
+def _unknown(offset: int, what: str) -> Result:
+    ops = ", ".join(f"{o.value} {o.name}" for o in Op)
+    return _E.DEVICE_INVALIDOFFSET, f"program store offset {offset} does not {what}; offsets: {ops}"
+
+
+class ProgramStoreService:
+    """ADS operations on a ``ProgramStore``."""
+
+    def __init__(self, store: ProgramStore) -> None:
+        self.store = store
+
+    def read(self, offset: int, length: int) -> Result:
+        """ADS Read: the program list."""
+        if offset != Op.LIST:
+            return _unknown(offset, "answer a read")
+        listing = "".join(
+            f"{p.name}\t{p.size_bytes}\t{p.mtime_s:.3f}\n" for p in self.store.list()
+        ).encode("utf-8")
+        if len(listing) > length:
+            return _E.DEVICE_INVALIDSIZE, f"the list has {len(listing)} bytes; read asked {length}"
+        return 0, listing
+
+    def write(self, offset: int, data: bytes) -> Result:
+        """ADS Write: upload or delete."""
+        try:
+            match offset:
+                case Op.UPLOAD:
+                    name, sep, content = data.partition(b"\x00")
+                    if not sep:
+                        return _E.DEVICE_INVALIDDATA, "an upload is the name, a NUL, then the content"
+                    self.store.write(_name(name), content)
+                    log.info("program %r uploaded (%d bytes)", _name(name), len(content))
+                case Op.DELETE:
+                    self.store.delete(_name(data))
+                case _:
+                    return _unknown(offset, "take a write")
+        except StoreError as exc:
+            return FAULT_CODES[exc.fault], str(exc)
+        return 0, None
+
+    def read_write(self, offset: int, data: bytes, read_length: int) -> Result:
+        """ADS ReadWrite: download."""
+        if offset != Op.DOWNLOAD:
+            return _unknown(offset, "answer a read-write")
+        try:
+            content = self.store.read(_name(data))
+        except StoreError as exc:
+            return FAULT_CODES[exc.fault], str(exc)
+        if len(content) > read_length:
+            return (
+                _E.DEVICE_INVALIDSIZE,
+                f"the program has {len(content)} bytes; read length was {read_length}",
+            )
+        return 0, content

@@ -1,0 +1,157 @@
+"""The program store: NC programs and the files the kernel writes, in one directory.
+
+Programs reach the controller over the wire (upload, list, download, delete); the kernel
+reads them from here when a program is selected and when a program calls a file
+subprogram. Writes are atomic (a temporary file in the same directory, then
+``os.replace``): a reader sees the old content or the new, never half a file.
+
+Names are plain file names: no path separators, no ``..``, no leading dot, at most
+``PROGRAM_NAME_MAX_CHARS`` characters of letters, digits and ``_ - .``. A bad name or an
+oversized upload raises ``StoreError`` and changes nothing.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+import threading
+from dataclasses import dataclass
+from enum import IntEnum
+from pathlib import Path
+
+from protocol.constants import PROGRAM_MAX_BYTES, PROGRAM_NAME_MAX_CHARS
+
+_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*")
+_TEMP_PREFIX = ".upload-"
+
+
+class StoreFault(IntEnum):
+    """Why the store refused an operation."""
+
+    BAD_NAME = 1  # the name is not a plain file name
+    NOT_FOUND = 2  # no program of that name
+    TOO_LARGE = 3  # the content exceeds the size bound
+    FULL = 4  # the store holds its maximum number of files
+    IO = 5  # the file system refused
+
+
+class StoreError(Exception):
+    """A refused store operation, with a sentence for the user."""
+
+    def __init__(self, fault: StoreFault, message: str) -> None:
+        super().__init__(message)
+        self.fault = fault
+
+
+@dataclass(frozen=True, slots=True)
+class ProgramInfo:
+    """One stored file."""
+
+    name: str
+    size_bytes: int
+    mtime_s: float
+
+
+def check_name(name: str) -> str:
+    """``name`` when it is a valid program name; StoreError otherwise."""
+    if not name:
+        raise StoreError(StoreFault.BAD_NAME, "a program name must not be empty")
+    if len(name) > PROGRAM_NAME_MAX_CHARS:
+        raise StoreError(
+            StoreFault.BAD_NAME,
+            f"program name {name[:20]!r}... has {len(name)} characters; "
+            f"at most {PROGRAM_NAME_MAX_CHARS}",
+        )
+    if "/" in name or "\\" in name or ".." in name or not _NAME.fullmatch(name):
+        raise StoreError(
+            StoreFault.BAD_NAME,
+            f"program name {name!r} is not a plain file name (letters, digits, _ - . ; "
+            "no path separators, no '..', no leading dot)",
+        )
+    return name
+
+
+class ProgramStore:
+    """NC programs in a directory; safe to use from several threads."""
+
+    def __init__(
+        self, root: Path, max_bytes: int = PROGRAM_MAX_BYTES, max_files: int = 1000
+    ) -> None:
+        self.root = Path(root)
+        self.root.mkdir(parents=True, exist_ok=True)
+        self.max_bytes = max_bytes
+        self.max_files = max_files
+        self._lock = threading.Lock()  # serialises writers; readers need no lock
+
+    def _path(self, name: str) -> Path:
+        return self.root / check_name(name)
+
+    def write(self, name: str, data: bytes) -> None:
+        """Store ``data`` under ``name``, replacing any earlier content atomically."""
+        path = self._path(name)
+        if len(data) > self.max_bytes:
+            raise StoreError(
+                StoreFault.TOO_LARGE,
+                f"program {name!r} has {len(data)} bytes; the store takes at most "
+                f"{self.max_bytes}",
+            )
+        with self._lock:
+            if not path.exists() and len(self.list()) >= self.max_files:
+                raise StoreError(
+                    StoreFault.FULL, f"the store holds {self.max_files} files; delete some first"
+                )
+            fd, temp = tempfile.mkstemp(prefix=_TEMP_PREFIX, dir=self.root)
+            try:
+                with os.fdopen(fd, "wb") as f:
+                    f.write(data)
+                os.replace(temp, path)
+            except OSError as exc:
+                Path(temp).unlink(missing_ok=True)
+                raise StoreError(StoreFault.IO, f"cannot store {name!r}: {exc.strerror}") from None
+
+    def read(self, name: str) -> bytes:
+        """The content of ``name``."""
+        path = self._path(name)
+        try:
+            return path.read_bytes()
+        except FileNotFoundError:
+            raise StoreError(StoreFault.NOT_FOUND, f"no program {name!r} in the store") from None
+        except OSError as exc:
+            raise StoreError(StoreFault.IO, f"cannot read {name!r}: {exc.strerror}") from None
+
+    def read_text(self, name: str) -> str:
+        """The content of ``name`` as text: UTF-8, or CP1252 (ISG's encoding) when not."""
+        data = self.read(name)
+        try:
+            return data.decode("utf-8")
+        except UnicodeDecodeError:
+            return data.decode("cp1252", errors="replace")
+
+    def exists(self, name: str) -> bool:
+        """True when ``name`` is a valid name and stored."""
+        try:
+            return self._path(name).is_file()
+        except (StoreError, OSError):
+            return False
+
+    def delete(self, name: str) -> None:
+        """Remove ``name``."""
+        path = self._path(name)
+        with self._lock:
+            try:
+                path.unlink()
+            except FileNotFoundError:
+                raise StoreError(StoreFault.NOT_FOUND, f"no program {name!r} in the store") from None
+            except OSError as exc:
+                raise StoreError(StoreFault.IO, f"cannot delete {name!r}: {exc.strerror}") from None
+
+    def list(self) -> list[ProgramInfo]:
+        """Every stored file, sorted by name (uploads in progress are not listed)."""
+        found = []
+        for entry in os.scandir(self.root):
+            if entry.name.startswith(".") or not entry.is_file():
+                continue
+            st = entry.stat()
+            found.append(ProgramInfo(entry.name, st.st_size, st.st_mtime))
+        return sorted(found, key=lambda p: p.name)
