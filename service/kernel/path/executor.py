@@ -1,0 +1,186 @@
+"""The façade the GEO cycle calls: blocks in (``push``), one cycle out (``step``).
+
+``PathExecutor`` wires path preparation (validation, tool radius compensation,
+software limits), the look-ahead planner and the interpolator together and keeps the
+block accounting of the look-ahead buffer:
+
+* ``buffer_blocks`` is the look-ahead size in blocks (30 / 120 / 190 or any other);
+  a block occupies a slot from ``push`` until it is reported in ``StepResult.finished``
+  (held back by radius compensation included). Every block is reported exactly once.
+* The look-ahead always assumes a stop after the last buffered element, so the path
+  decelerates in time when blocks do not arrive fast enough; ``close`` only releases
+  what radius compensation holds back (end of data).
+* ``idle`` is true when no block is buffered and the path stands, waiting for nothing.
+  After M2/M30 the path waits like after M0 (``stopped_at`` reports it) until
+  ``resume()`` or ``stop_now()``.
+* A ``PathError`` from ``push`` refuses that block only (its motion never starts);
+  everything buffered before keeps running. A software limit or compensation error of
+  a block held back by compensation can surface at the next ``push`` (or ``close``);
+  the error then names the held block.
+* Feedhold during a dwell lets the dwell time run; the motion after it waits.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from ..nc.blocks import Block
+from .errors import PathError, PathErrorId
+from .interpolator import Interpolator, StepResult, Waiting
+from .limits import AxisDynamics
+from .planner import LookAhead, plan_time_optimal
+from .segments import PathPreparation, Segment
+
+__all__ = ["AxisDynamics", "PathError", "PathErrorId", "PathExecutor", "StepResult",
+           "Waiting", "plan_time_optimal"]
+
+
+class PathExecutor:
+    """Path preparation, look-ahead and interpolation of one channel."""
+
+    def __init__(self, dynamics: Sequence[AxisDynamics], start_mm: Sequence[float], *,
+                 cycle_s: float, buffer_blocks: int = 120,
+                 sw_limits_mm: Sequence[tuple[float, float]] | None = None) -> None:
+        dynamics = tuple(dynamics)
+        start = tuple(float(x) for x in start_mm)
+        if not dynamics or len(start) != len(dynamics):
+            raise ValueError("start_mm needs one value per axis of dynamics")
+        if not cycle_s > 0.0:
+            raise ValueError(f"cycle_s must be > 0, not {cycle_s}")
+        if buffer_blocks < 1:
+            raise ValueError(f"buffer_blocks must be >= 1, not {buffer_blocks}")
+        if sw_limits_mm is not None and len(sw_limits_mm) != len(dynamics):
+            raise ValueError("sw_limits_mm needs one (min, max) per axis")
+        self.dynamics = dynamics
+        self.cycle_s = float(cycle_s)
+        self.buffer_blocks = int(buffer_blocks)
+        self._prep = PathPreparation(dynamics, start, sw_limits_mm)
+        self._planner = LookAhead([d.vel_jump_mm_s for d in dynamics])
+        self._ipo = Interpolator(self._planner, self.cycle_s, start)
+        self._single_block = False
+        self._closed = False
+
+    # -- blocks in --------------------------------------------------------------------
+
+    def free_slots(self) -> int:
+        """How many more blocks ``push`` accepts now."""
+        return max(self.buffer_blocks - self._ipo.unfinished, 0)
+
+    def push(self, block: Block) -> None:
+        """Append a block; PathError refuses it (nothing of it will move)."""
+        if self._ipo.unfinished >= self.buffer_blocks:
+            raise PathError(PathErrorId.BUFFER_FULL,
+                            f"look-ahead buffer of {self.buffer_blocks} blocks is full", block)
+        items = self._prep.prepare(block)
+        self._ipo.unfinished += 1
+        self._closed = False
+        self._take(items)
+
+    def close(self) -> None:
+        """End of data: release what compensation holds back; the path stops at the end."""
+        self._closed = True
+        try:
+            items = self._prep.flush()
+        except PathError:
+            dropped = self._prep.holding
+            self._prep.compensator.restore(None)
+            self._ipo.unfinished -= dropped
+            raise
+        self._take(items)
+
+    @property
+    def closed(self) -> bool:
+        """``close`` was called and no block pushed since."""
+        return self._closed
+
+    def _take(self, items: list[Segment | Block]) -> None:
+        planner, ipo = self._planner, self._ipo
+        for item in items:
+            if isinstance(item, Segment):
+                item.single_stop = self._single_block and bool(item.events)
+                planner.append(item)
+                if ipo.seg is None:
+                    ipo.seg = planner.head
+                continue
+            tail = planner.tail
+            if tail is None:  # nothing to move before it: due where the path stands
+                ipo.events.append((item, self._single_block))
+                continue
+            tail.events.append(item)
+            if item.needs_stop:
+                planner.mark_stop(tail)
+            if self._single_block:
+                planner.mark_stop(tail, single=True)
+
+    # -- the cycle --------------------------------------------------------------------
+
+    def step(self, override: float) -> StepResult:
+        """Run one cycle with feed override factor ``override`` (1.0 = 100 %, 0 stands)."""
+        return self._ipo.step(override)
+
+    def hold(self) -> None:
+        """Feedhold: decelerate on the path within the limits and stand."""
+        self._ipo.hold = True
+
+    def resume(self) -> None:
+        """Continue after feedhold, M0/M1/M2/M30 and single-block stops."""
+        self._ipo.resume()
+
+    @property
+    def single_block(self) -> bool:
+        """Stop at the end of every block (from the first block end still reachable)."""
+        return self._single_block
+
+    @single_block.setter
+    def single_block(self, on: bool) -> None:
+        on = bool(on)
+        if on != self._single_block:
+            self._single_block = on
+            self._ipo.set_single_block(on)
+
+    def stop_now(self) -> None:
+        """RESET: drop everything buffered and stand still at the current position."""
+        self._ipo.stop_now()
+        self._prep.reset(self._ipo.position_mm)
+        self._closed = False
+
+    # -- state ------------------------------------------------------------------------
+
+    @property
+    def idle(self) -> bool:
+        """Nothing buffered, standing still, waiting for nothing."""
+        return self._ipo.idle
+
+    @property
+    def position_mm(self) -> tuple[float, ...]:
+        """Command position of every channel axis."""
+        return self._ipo.position_mm
+
+    @property
+    def path_velocity_mm_s(self) -> float:
+        """Current path speed."""
+        return self._ipo.v_mm_s
+
+    @property
+    def distance_mm(self) -> float:
+        """Path length covered since program start (or the last ``clear_distance``)."""
+        return self._ipo.distance_base_mm + self._ipo.s_mm
+
+    def clear_distance(self) -> None:
+        """Restart the path distance at 0 here (#DISTANCE PROG START CLEAR)."""
+        self._ipo.distance_base_mm = -self._ipo.s_mm
+
+    @property
+    def holding(self) -> bool:
+        """Feedhold is active."""
+        return self._ipo.hold
+
+    @property
+    def waiting(self) -> Waiting:
+        """What the path waits for at a block end (dwell, programmed stop, single block)."""
+        return self._ipo.waiting
+
+    @property
+    def override(self) -> float:
+        """Feed override factor of the last cycle."""
+        return self._ipo.override
