@@ -1,0 +1,16 @@
+"""The NC program decoder (SDA task): DIN 66025 with the ISG extensions.
+
+Public API: ``Decoder`` (text -> lazy stream of ``Block``), ``ModalState`` (what
+survives between decoders), ``NcError`` / ``NcErrorId`` (every error with id, file,
+line and column). The output contract is in ``blocks``.
+"""
+
+from .blocks import Block, Compensation, Motion, MotionKind, SourceRef, StopKind
+from .decoder import Decoder
+from .errors import NcError, NcErrorId
+from .modal import DistanceMode, ModalState, Plane
+
+__all__ = [
+    "Block", "Compensation", "Decoder", "DistanceMode", "ModalState", "Motion",
+    "MotionKind", "NcError", "NcErrorId", "Plane", "SourceRef", "StopKind",
+]

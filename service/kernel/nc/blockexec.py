@@ -1,0 +1,325 @@
+"""Executing one parsed NC block against the modal state: the reference semantics.
+
+Items run left to right (an assignment changes the variables the following words
+read). Then, in this order: G functions (at most one per group), D, F, S, T, the
+motion (G0..G3, absolute or incremental, arcs by I/J/K or R), G4 dwell, M functions.
+
+G4 (dwell) takes its time in seconds from the ``X`` or the ``F`` word of its block
+(``G4 X2`` or ``G4 F2``); the block has no motion and F keeps its modal value.
+
+A ``Block`` is produced when the NC block has a motion, a dwell, a stop, M, S or T;
+blocks that only change modal state (``G90``, ``F500``, ``D1``) produce none. A G0/G1
+to the current position gives a block without motion.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from collections.abc import Mapping
+from enum import IntEnum
+from typing import Any
+
+from .blocks import Block, Compensation, MotionKind, StopKind
+from .construct import make_block, make_motion, make_source
+from .errors import NcErrorId
+from .expressions import evaluate_number
+from .geometry import centre_from_offsets, centre_from_radius
+from .modal import G_CODES, PLANE_AXES, DistanceMode, GGroup, MCode, ModalState, Plane
+from .statements import Assign, NcBlock, WordKind
+from .variables import VariableFault
+
+
+class Flow(IntEnum):
+    """What a block does to program flow."""
+
+    NONE = 0  # continue with the next line
+    PROGRAM_END = 1  # M2/M30: the block is the last one
+    SUBPROGRAM_END = 2  # M17/M29: return to the caller
+
+
+# flow-control M functions -> (stop of the block, flow)
+_M_FLOW = {
+    MCode.STOP: (StopKind.PROGRAMMED, Flow.NONE),
+    MCode.OPTIONAL_STOP: (StopKind.OPTIONAL, Flow.NONE),
+    MCode.PROGRAM_END: (StopKind.PROGRAM_END, Flow.PROGRAM_END),
+    MCode.PROGRAM_END_RESET: (StopKind.PROGRAM_END, Flow.PROGRAM_END),
+    MCode.SUBPROGRAM_END: (StopKind.NONE, Flow.SUBPROGRAM_END),
+    MCode.SUBPROGRAM_END_FAST: (StopKind.NONE, Flow.SUBPROGRAM_END),
+}
+
+_OFFSET_LETTER = ("I", "J", "K")
+
+
+def _integer(value: float) -> int | None:
+    """``value`` as a non-negative int, or None when it is not one."""
+    if value < 0 or value != int(value) or value > 0xFFFFFFFF:
+        return None
+    return int(value)
+
+
+class BlockExecutor:
+    """Applies NC blocks to a ``ModalState`` and builds the ``Block`` objects."""
+
+    def __init__(
+        self, axes: tuple[str, ...], tools: Mapping[int, float], modal: ModalState,
+        manual: bool,
+    ) -> None:
+        self.axes = axes
+        self.tools = tools
+        self.modal = modal
+        self.manual = manual
+        index = {name: k for k, name in enumerate(axes)}
+        # plane -> (p, q) channel axis indices, or None when the channel lacks an axis
+        self.plane_axes: dict[Plane, tuple[int, int] | None] = {}
+        self._arc_setup: dict[Plane, tuple] = {}
+        offset_axes = tuple(index.get(name, -1) for name in "XYZ")  # axes of I, J, K
+        for plane, (p, q) in PLANE_AXES.items():
+            both = p in index and q in index
+            pq = (index[p], index[q]) if both else None
+            self.plane_axes[plane] = pq
+            roles = tuple(0 if pq and a == pq[0] else 1 if pq and a == pq[1] else -1
+                          for a in offset_axes)
+            outside = [k for k in range(len(axes)) if pq is None or k not in pq]
+            getter = operator.itemgetter(*outside) if outside else None
+            self._arc_setup[plane] = (pq, pq or (0, 1), roles, getter)
+
+    def arc_setup(self, plane: Plane) -> tuple:
+        """For the hot path: (plane axes or None, plane of line motions, roles of I/J/K
+        (0 = p, 1 = q, -1 = outside), getter of the axes outside the plane or None)."""
+        return self._arc_setup[plane]
+
+    def tool_radius(self, d: int) -> float | None:
+        """Radius of tool entry D (0.0 for D0), None when not in the table."""
+        if d == 0:
+            return float(self.tools.get(0, 0.0))
+        radius = self.tools.get(d)
+        return None if radius is None else float(radius)
+
+    def execute(self, stmt: NcBlock, env: Any) -> tuple[Block | None, Flow, int]:
+        """Run one block: (block or None, flow, position of the flow M word)."""
+        line = stmt.line
+        err = line.error
+        modal = self.modal
+        groups: dict[GGroup, tuple[int, int]] = {}  # group -> (G number, pos)
+        axis_words: list[tuple[int, float, int, str]] = []  # (axis, value, pos, letter)
+        offsets: dict[int, tuple[float, int]] = {}  # axis -> (offset, pos)
+        words: dict[WordKind, tuple[float, int]] = {}  # F S T D R -> (value, pos)
+        m_codes: list[tuple[int, int]] = []
+        for item in stmt.items:
+            if type(item) is Assign:
+                item.target.assign(env, item.value(env))
+                continue
+            value = evaluate_number(item.value, env, line, item.pos)
+            kind = item.kind
+            if kind == WordKind.AXIS:
+                axis_words.append((item.axis, value, item.pos, item.letter))
+            elif kind == WordKind.OFFSET:
+                offsets[item.axis] = (value, item.pos)
+                if item.axis < 0:
+                    raise err(
+                        NcErrorId.ARC_OFFSET_OUT_OF_PLANE,
+                        f"{item.letter}: the channel has no axis "
+                        f"{'XYZ'[_OFFSET_LETTER.index(item.letter)]}", item.pos,
+                    )
+            elif kind == WordKind.G:
+                number = _integer(value)
+                if number is None or number not in G_CODES:
+                    raise err(NcErrorId.UNSUPPORTED_G_CODE, f"G{value:g} is not supported", item.pos)
+                group = G_CODES[number][0]
+                if group in groups:
+                    raise err(
+                        NcErrorId.CONFLICTING_G_CODES,
+                        f"G{groups[group][0]} and G{number} in one block", item.pos,
+                    )
+                groups[group] = (number, item.pos)
+            elif kind == WordKind.M:
+                number = _integer(value)
+                if number is None:
+                    raise err(
+                        NcErrorId.INVALID_M_CODE, f"M{value:g} is not a valid M function", item.pos
+                    )
+                m_codes.append((number, item.pos))
+            else:
+                words[kind] = (value, item.pos)
+        self._modal_groups(groups)
+        self._technology(words, err)
+        dwell = WordKind.FEED in words and GGroup.DWELL in groups
+        if GGroup.DWELL in groups:
+            dwell_s = self._dwell(groups, axis_words, offsets, words, err)
+            motion = None
+        else:
+            dwell_s = 0.0
+            if WordKind.FEED in words and not dwell:
+                self._feed(words[WordKind.FEED], err)
+            motion = self._motion(groups, axis_words, offsets, words, err)
+        stop = StopKind.NONE
+        flow = Flow.NONE
+        flow_pos = -1
+        m_functions = []
+        for number, pos in m_codes:
+            action = _M_FLOW.get(number)
+            if action is None:
+                m_functions.append(number)
+                continue
+            if flow_pos >= 0:
+                raise err(NcErrorId.CONFLICTING_M_CODES, f"M{number} with another program-flow M", pos)
+            stop, flow = action
+            flow_pos = pos
+        spindle = words.get(WordKind.SPINDLE)
+        tool = words.get(WordKind.TOOL)
+        if (motion is None and dwell_s == 0.0 and stop == StopKind.NONE and not m_functions
+                and spindle is None and tool is None and not axis_words and not offsets):
+            return None, flow, flow_pos
+        line_no, column = line.locate(_first(line.text))
+        block = make_block(
+            make_source(line.file, line_no, column, line.offset), stmt.number, motion,
+            dwell_s, stop, tuple(m_functions), None if spindle is None else spindle[0],
+            None if tool is None else int(tool[0]), self.manual,
+        )
+        return block, flow, flow_pos
+
+    # ------------------------------------------------------------ parts
+
+    def _modal_groups(self, groups: dict[GGroup, tuple[int, int]]) -> None:
+        modal = self.modal
+        for group, (number, _pos) in groups.items():
+            value = G_CODES[number][1]
+            if group == GGroup.MOTION:
+                modal.motion = value
+            elif group == GGroup.PLANE:
+                modal.plane = value
+            elif group == GGroup.COMPENSATION:
+                modal.compensation = value
+            elif group == GGroup.DISTANCE:
+                modal.distance = value
+
+    def _technology(self, words: dict, err) -> None:
+        modal = self.modal
+        if WordKind.TOOL_OFFSET in words:
+            value, pos = words[WordKind.TOOL_OFFSET]
+            d = _integer(value)
+            if d is None or self.tool_radius(d) is None:
+                raise err(NcErrorId.TOOL_NOT_IN_TABLE, f"tool D{value:g} is not in the tool table", pos)
+            modal.tool_offset = d
+        if WordKind.SPINDLE in words:
+            value, pos = words[WordKind.SPINDLE]
+            if value < 0:
+                raise err(NcErrorId.INVALID_SPINDLE_SPEED, f"spindle speed S{value:g} is negative", pos)
+            modal.spindle_speed_rpm = value
+        if WordKind.TOOL in words:
+            value, pos = words[WordKind.TOOL]
+            t = _integer(value)
+            if t is None:
+                raise err(NcErrorId.INVALID_TOOL_NUMBER, f"T{value:g} is not a valid tool number", pos)
+            modal.tool = t
+
+    def _feed(self, word: tuple[float, int], err) -> None:
+        value, pos = word
+        if value <= 0:
+            raise err(NcErrorId.INVALID_FEED, f"feed F{value:g} must be greater than 0", pos)
+        self.modal.feed_mm_min = value
+
+    def _dwell(self, groups, axis_words, offsets, words, err) -> float:
+        g_pos = groups[GGroup.DWELL][1]
+        times = [(v, pos) for axis, v, pos, letter in axis_words if letter == "X"]
+        others = [pos for axis, v, pos, letter in axis_words if letter != "X"]
+        if WordKind.FEED in words:
+            times.append(words[WordKind.FEED])
+        if others or offsets or WordKind.RADIUS in words:
+            pos = min(others + [p for _, p in offsets.values()]
+                      + ([words[WordKind.RADIUS][1]] if WordKind.RADIUS in words else []))
+            raise err(NcErrorId.INVALID_DWELL, "a G4 block cannot move axes", pos)
+        if not times:
+            raise err(NcErrorId.INVALID_DWELL, "G4 needs the dwell time in seconds: G4 X.. or G4 F..", g_pos)
+        if len(times) > 1:
+            raise err(NcErrorId.INVALID_DWELL, "G4 takes the time from X or F, not both", times[1][1])
+        value, pos = times[0]
+        if value < 0:
+            raise err(NcErrorId.INVALID_DWELL, f"dwell time {value:g} s is negative", pos)
+        return value
+
+    def _motion(self, groups, axis_words, offsets, words, err):
+        modal = self.modal
+        radius_word = words.get(WordKind.RADIUS)
+        if not axis_words and not offsets and radius_word is None:
+            return None
+        kind = modal.motion
+        positions = [pos for _, _, pos, _ in axis_words] + [pos for _, pos in offsets.values()]
+        if radius_word is not None:
+            positions.append(radius_word[1])
+        if GGroup.MOTION in groups:
+            positions.append(groups[GGroup.MOTION][1])
+        motion_pos = min(positions)
+        start = modal.position_mm
+        end = list(start)
+        incremental = modal.distance == DistanceMode.INCREMENTAL
+        for axis, value, pos, letter in axis_words:
+            if axis < 0:
+                raise err(NcErrorId.UNKNOWN_WORD, f"{letter} is not an axis of this channel", pos)
+            end[axis] = start[axis] + value if incremental else value
+        for axis, value, pos, letter in axis_words:
+            if not math.isfinite(end[axis]):
+                raise err(NcErrorId.VALUE_OUT_OF_RANGE, f"{letter} position is out of range", pos)
+        end_t = tuple(end)
+        arc = kind == MotionKind.ARC_CW or kind == MotionKind.ARC_CCW
+        if not arc and (offsets or radius_word is not None):
+            pos = min([p for _, p in offsets.values()]
+                      + ([radius_word[1]] if radius_word is not None else []))
+            raise err(NcErrorId.ARC_WORDS_WITHOUT_ARC, "I/J/K/R need G2 or G3", pos)
+        if kind == MotionKind.RAPID:
+            feed = math.inf
+        else:
+            if modal.feed_mm_min is None:
+                raise err(NcErrorId.NO_FEED, f"no feed programmed for G{int(kind)}: program F", motion_pos)
+            feed = modal.feed_mm_min / 60.0
+        modal.position_mm = end_t
+        comp = modal.compensation
+        radius = self.tool_radius(modal.tool_offset) or 0.0
+        plane_default = self.plane_axes.get(modal.plane) or (0, 1)
+        if not arc:
+            if end_t == start:
+                return None
+            return make_motion(kind, start, end_t, feed, plane_default, None, comp, radius)
+        plane = self.plane_axes[modal.plane]
+        if plane is None:
+            p, q = PLANE_AXES[modal.plane]
+            raise err(NcErrorId.PLANE_AXIS_MISSING,
+                      f"G{int(modal.plane)} needs the axes {p} and {q}", motion_pos)
+        p, q = plane
+        for axis, value, pos, letter in axis_words:
+            if axis != p and axis != q and end[axis] != start[axis]:
+                raise err(NcErrorId.HELIX_NOT_SUPPORTED,
+                          f"{letter} is outside the G{int(modal.plane)} plane: "
+                          "helical arcs are not supported", pos)
+        for axis, (value, pos) in offsets.items():
+            if axis != p and axis != q:
+                letter = _OFFSET_LETTER["XYZ".index(self.axes[axis])]
+                raise err(NcErrorId.ARC_OFFSET_OUT_OF_PLANE,
+                          f"{letter} is not in the G{int(modal.plane)} plane", pos)
+        try:
+            if radius_word is not None:
+                if offsets:
+                    raise err(NcErrorId.ARC_CENTRE_AND_RADIUS,
+                              "program the arc centre (I/J/K) or the radius (R), not both",
+                              radius_word[1])
+                centre = centre_from_radius(start[p], start[q], end[p], end[q], radius_word[0],
+                                            kind == MotionKind.ARC_CCW)
+            elif offsets:
+                oi = offsets[p][0] if p in offsets else 0.0
+                oj = offsets[q][0] if q in offsets else 0.0
+                centre = centre_from_offsets(start[p], start[q], end[p], end[q], oi, oj)
+            else:
+                raise err(NcErrorId.MISSING_VALUE,
+                          f"G{int(kind)} needs the centre (I/J/K) or the radius (R)", motion_pos)
+        except VariableFault as f:
+            raise err(f.err_id, f.message, motion_pos) from None
+        return make_motion(kind, start, end_t, feed, plane, centre, comp, radius)
+
+
+def _first(text: str) -> int:
+    stripped = text.lstrip()
+    return len(text) - len(stripped) if stripped else 0
+
+
+__all__ = ["BlockExecutor", "Compensation", "Flow"]

@@ -1,0 +1,174 @@
+"""``#VAR ... #ENDVAR``: reading the declaration lines and creating the variables.
+
+Each line of the block declares one variable::
+
+    V.L.COUNT                      REAL64, 0.0
+    V.L.N : UNS32 = 200            typed, with initial value (any expression)
+    V.L.A[3] : REAL64 = [1, 2, 3]  array with initializer list (shorter lists: the rest 0)
+    V.L.M[2][2] = [[1, 2], [3, 4]] two dimensions
+    V.L.B = [3, 212, 213]          a list without size declares an array of that size
+
+An initializer list may continue on the following lines while its ``[`` are open.
+The declarations run when the decoder reaches the block; running the same block again
+(a loop, a second call) re-initialises its variables. Two different declarations of
+one name in one scope are an error.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import TYPE_CHECKING
+
+from .errors import NcErrorId
+from .frames import Frame, FrameKind
+from .source import join_lines
+from .statements import Control, Declaration
+from .variables import (
+    Scope, Value, Variable, VariableFault, VarType, convert, default_value,
+)
+
+if TYPE_CHECKING:
+    from .decoder import Decoder
+
+_ENDVAR = re.compile(r"[ \t]*#[ \t]*ENDVAR\b")
+
+
+def read_block(decoder: Decoder, frame: Frame, stmt: Control, after: int) -> tuple[list, int]:
+    """The declarations of the ``#VAR`` block at ``frame.index`` and the index after it."""
+    program = frame.program
+    cached = program.var_blocks.get(frame.index)
+    if cached is not None:
+        return cached
+    end = frame.section.end
+    declarations: list[Declaration] = []
+    k = after
+    while True:
+        if k >= end:
+            raise stmt.line.error(
+                NcErrorId.VAR_BLOCK_NOT_CLOSED, "#VAR without #ENDVAR", stmt.pos
+            )
+        line, k = program.logical(k, end)
+        if line is None:
+            continue
+        if _ENDVAR.match(line.upper):
+            break
+        while _open_brackets(line.upper) > 0 and k < end:
+            more, k_more = program.logical(k, end)
+            if more is not None and _ENDVAR.match(more.upper):
+                break
+            k = k_more
+            if more is not None:
+                line = join_lines(line, more)
+        declarations.append(decoder.parser.declaration(line))
+    program.var_blocks[frame.index] = (declarations, k)
+    return declarations, k
+
+
+def _open_brackets(text: str) -> int:
+    return text.count("[") - text.count("]")
+
+
+def declare(decoder: Decoder, frame: Frame, decl: Declaration) -> None:
+    """Create (or re-initialise) the variable of one declaration."""
+    modal = decoder.modal
+    line = decl.line
+    full = f"V.{decl.scope.name}.{decl.name}"
+    if decl.scope == Scope.L:
+        table = frame.local_vars
+    elif decl.scope == Scope.CYC:
+        table = frame.cycle_vars
+    elif decl.scope == Scope.P:
+        if frame.kind != FrameKind.MAIN:
+            raise line.error(
+                NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED,
+                f"{full}: V.P. variables can only be declared in the main program", decl.pos,
+            )
+        table = modal.variables_p
+    else:
+        table = modal.variables_g
+    site = (line.file, line.index)
+    existing = table.get(decl.name)
+    if existing is not None:
+        if decl.scope == Scope.G:
+            return  # a global exists once; its value survives
+        earlier_decoder = decl.scope == Scope.P and id(existing) not in decoder.own_variables
+        if existing.site != site and not earlier_decoder:
+            raise line.error(
+                NcErrorId.VARIABLE_DECLARED_TWICE,
+                f"{full} is already declared (line {existing.site[1] + 1})", decl.pos,
+            )
+    variable = _create(decoder, decl, full, site)
+    table[decl.name] = variable
+    decoder.own_variables.add(id(variable))
+
+
+def _create(decoder: Decoder, decl: Declaration, full: str, site) -> Variable:
+    line = decl.line
+    init = decl.init
+    dims = decl.dims
+    values: list
+    if isinstance(init, list) and not dims:
+        if len(init) == 1 and not isinstance(init[0], list):
+            init = init[0]  # "= [expr]" is a bracketed expression
+        else:
+            dims = _shape(init)
+    try:
+        if dims:
+            size = math.prod(dims)
+            values = [default_value(decl.vtype)] * size
+            if init is not None:
+                if not isinstance(init, list):
+                    raise VariableFault(
+                        NcErrorId.INVALID_DECLARATION, f"{full} is an array: initialise it with [..]"
+                    )
+                flat = _flatten(init, dims, full)
+                for n, node in enumerate(flat):
+                    if node is not _DEFAULT_NODE:
+                        values[n] = convert(decl.vtype, node(decoder), full)
+        else:
+            value: Value = default_value(decl.vtype) if init is None else init(decoder)
+            values = [convert(decl.vtype, value, full)]
+    except VariableFault as f:
+        raise line.error(f.err_id, f.message, decl.pos) from None
+    return Variable(full, decl.vtype, tuple(dims), values, site)
+
+
+def _shape(items: list) -> tuple[int, ...]:
+    """Dimensions of a (possibly nested) initializer list."""
+    if items and isinstance(items[0], list):
+        return (len(items), *_shape(items[0]))
+    return (len(items),)
+
+
+def _flatten(items: list, dims: tuple[int, ...], full: str) -> list:
+    """Row-major list of nodes; each level may be shorter than its dimension."""
+    if len(items) > dims[0]:
+        raise VariableFault(
+            NcErrorId.INVALID_DECLARATION, f"{full}: {len(items)} values for {dims[0]} elements"
+        )
+    if len(dims) == 1:
+        if any(isinstance(x, list) for x in items):
+            raise VariableFault(NcErrorId.INVALID_DECLARATION, f"{full}: too many [ levels")
+        return list(items)
+    inner = math.prod(dims[1:])
+    flat: list = []
+    for row in items:
+        if not isinstance(row, list):
+            raise VariableFault(NcErrorId.INVALID_DECLARATION, f"{full}: a row must be a [list]")
+        part = _flatten(row, dims[1:], full)
+        flat.extend(part)
+        flat.extend([_DEFAULT_NODE] * (inner - len(part)))
+    return flat
+
+
+class _Default:
+    """Placeholder for an element without initial value (keeps the type default)."""
+
+    def __call__(self, env) -> Value:
+        raise AssertionError("never evaluated")
+
+
+_DEFAULT_NODE = _Default()
+
+__all__ = ["VarType", "declare", "read_block"]

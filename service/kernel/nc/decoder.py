@@ -1,0 +1,257 @@
+"""The decoder: NC program text -> a lazy stream of ``Block`` objects.
+
+``Decoder.blocks()`` is a generator: it decodes only as far as the caller pulls, so the
+SDA task takes as many blocks as the look-ahead buffer has room for, and an endless
+``$WHILE 1`` with motion never hangs it. Errors are raised at the point where decoding
+reaches them (an error in line 900 comes after the blocks of lines 1..899).
+
+Each line is decoded by the fast path (``fastpath``) when it is a plain motion line,
+otherwise it is parsed (``parser``, cached per line) and executed: NC blocks by the
+``BlockExecutor``, control statements by ``ControlFlow``. Subprograms run in frames of
+their own (``L name`` loads a file through ``loader``, ``LL name`` runs a ``%L``
+section); the frame stack is explicit, so recursion never touches Python's stack.
+
+End of decoding: M2/M30 (the block is yielded with ``stop == PROGRAM_END``, nothing
+after it is decoded); in a manual block also the end of the text. The end of a main
+program without M2/M30 is an error, as is the end of a file subprogram without M17/M29.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterator, Mapping
+
+from .blockexec import BlockExecutor, Flow
+from .blocks import Block
+from .control import ControlFlow
+from .declarations import declare, read_block
+from .errors import NcError, NcErrorId
+from .fastpath import decoding_loop
+from .frames import MAX_CALL_DEPTH, Frame, FrameKind
+from .modal import ModalState
+from .parser import RESERVED_LETTERS, LineParser, word_table
+from .program import Program, Section
+from .source import strip_comments
+from .statements import CLOSER_OF, SPELLING, Control, NcBlock
+from .variables import Scope, Variable
+
+log = logging.getLogger(__name__)
+
+
+class Decoder:
+    """Decodes one NC text (a program, or a manual block) into Blocks.
+
+    ``axes``: the channel's axis names in order, one upper-case letter each (I/J/K are
+    the centre offsets of the axes named X/Y/Z). ``loader(name)`` returns the text of a
+    file subprogram and raises KeyError when there is none. ``tools`` maps D numbers to
+    tool radii in mm (D0 is radius 0). ``modal`` is continued (and changed) when given;
+    otherwise decoding starts from a fresh ``ModalState`` at position 0. Bit n-1 of
+    ``skip_levels`` skips the lines marked ``/n``. ``manual`` marks the blocks as
+    manual and lets the text end without M30.
+    """
+
+    def __init__(
+        self,
+        text: str,
+        file: str,
+        *,
+        axes: tuple[str, ...],
+        loader: Callable[[str], str],
+        tools: Mapping[int, float],
+        modal: ModalState | None = None,
+        skip_levels: int = 1,
+        manual: bool = False,
+    ) -> None:
+        axes = tuple(axes)
+        for name in axes:
+            if len(name) != 1 or not "A" <= name <= "Z" or name in RESERVED_LETTERS:
+                raise ValueError(f"axis name {name!r} must be one letter other than "
+                                 f"{''.join(sorted(RESERVED_LETTERS))}")
+        if len(set(axes)) != len(axes):
+            raise ValueError(f"axis names repeat: {axes}")
+        if modal is None:
+            modal = ModalState()
+        if not modal.position_mm:
+            modal.position_mm = (0.0,) * len(axes)
+        elif len(modal.position_mm) != len(axes):
+            raise ValueError(f"modal position has {len(modal.position_mm)} axes, "
+                             f"the channel {len(axes)}")
+        self.axes = axes
+        self.manual = manual
+        self._loader = loader
+        self._modal = modal
+        self._skip_levels = skip_levels
+        self.parser = LineParser(word_table(axes))
+        self.executor = BlockExecutor(axes, tools, modal, manual)
+        self._main = Program(text, file, self.parser, skip_levels)
+        self._files: dict[str, Program] = {}
+        self.frames: list[Frame] = []
+        self._control = ControlFlow(self)
+        self.finished = False
+        self._started = False
+        self.emitted = 0  # blocks yielded so far
+        self.own_variables: set[int] = set()  # ids of the variables this decoder declared
+
+    @property
+    def modal(self) -> ModalState:
+        """The modal state (the one passed in, changed as decoding goes)."""
+        return self._modal
+
+    def blocks(self) -> Iterator[Block]:
+        """The decoded blocks, lazily; raises NcError where decoding meets an error."""
+        if self._started:
+            raise RuntimeError("Decoder.blocks() can run only once")
+        self._started = True
+        main = self._main
+        self.frames.append(Frame(main, main.main, main.main.start, FrameKind.MAIN))
+        return decoding_loop(self.axes)(self)
+
+    # ------------------------------------------------------------ variables (Env)
+
+    def find_variable(self, scope: Scope, name: str) -> Variable | None:
+        """The variable ``V.<scope>.<name>`` visible in the running frame, or None."""
+        if scope == Scope.L:
+            return self.frames[-1].local_vars.get(name)
+        if scope == Scope.P:
+            return self._modal.variables_p.get(name)
+        if scope == Scope.G:
+            return self._modal.variables_g.get(name)
+        for frame in reversed(self.frames):
+            found = frame.cycle_vars.get(name)
+            if found is not None:
+                return found
+        return None
+
+    def declare_block(self, frame: Frame, stmt: Control, after: int) -> None:
+        """Run the ``#VAR`` block at ``frame.index``."""
+        declarations, next_index = read_block(self, frame, stmt, after)
+        for declaration in declarations:
+            declare(self, frame, declaration)
+        frame.index = next_index
+
+    # ------------------------------------------------------------ the general path
+
+    def slow_step(self, frame: Frame) -> Block | None:
+        """Decode the logical line at ``frame.index`` with the general parser (or end
+        the frame's section); the Block it produces, if any."""
+        try:
+            if frame.index >= frame.section.end:
+                self._end_of_section(frame)
+                return None
+            return self._step(frame)
+        except NcError:
+            raise
+        except RecursionError:
+            raise NcError(NcErrorId.EXPRESSION_TOO_COMPLEX, frame.program.name,
+                          frame.index + 1, 1, "program too deeply nested to decode") from None
+        except Exception as exc:  # a decoder bug must still be the program's error
+            raise self.fault(exc, frame, frame.index) from exc
+
+    def fault(self, exc: Exception, frame: Frame, index: int) -> NcError:
+        """An unexpected exception as the program's error (logged with its traceback)."""
+        if isinstance(exc, NcError):
+            return exc
+        log.error("decoder fault in %s line %d", frame.program.name, index + 1, exc_info=exc)
+        return NcError(NcErrorId.INTERNAL_ERROR, frame.program.name, index + 1, 1,
+                       f"decoder fault: {exc!r}")
+
+    def _step(self, frame: Frame) -> Block | None:
+        stmt, after = frame.program.statement(frame.index, frame.section.end)
+        if stmt is None:
+            frame.index = after
+            return None
+        if type(stmt) is not NcBlock:
+            self._control.run(frame, stmt, after)
+            return None
+        here = frame.index
+        block, flow, flow_pos = self.executor.execute(stmt, self)
+        frame.index = after
+        if flow == Flow.PROGRAM_END:
+            self.finished = True
+            return block
+        if flow == Flow.SUBPROGRAM_END:
+            if frame.kind == FrameKind.MAIN:
+                raise stmt.line.error(
+                    NcErrorId.SUBPROGRAM_END_IN_MAIN,
+                    "M17/M29 ends a subprogram; the main program ends with M30", flow_pos,
+                )
+            self.frames.pop()
+            return block
+        if stmt.call is not None:
+            self._call(frame, stmt)
+        if stmt.goto is not None:
+            self._control.goto(frame, stmt.goto, stmt.line, here)
+        return block
+
+    # ------------------------------------------------------------ subprograms
+
+    def _call(self, frame: Frame, stmt: NcBlock) -> None:
+        call = stmt.call
+        line = stmt.line
+        if len(self.frames) > MAX_CALL_DEPTH:
+            raise line.error(
+                NcErrorId.CALL_DEPTH_EXCEEDED,
+                f"subprogram calls nested deeper than {MAX_CALL_DEPTH}", call.pos,
+            )
+        if call.local:
+            sections = frame.program.local(call.name)
+            if not sections:
+                raise line.error(
+                    NcErrorId.SUBPROGRAM_NOT_FOUND,
+                    f"local subprogram {call.name} not found (no %L {call.name} in "
+                    f"{frame.program.name})", call.pos,
+                )
+            if len(sections) > 1:
+                raise line.error(
+                    NcErrorId.DUPLICATE_SUBPROGRAM,
+                    f"%L {call.name} is defined {len(sections)} times", call.pos,
+                )
+            section = sections[0]
+            self.frames.append(Frame(frame.program, section, section.start, FrameKind.LOCAL))
+            return
+        program = self._files.get(call.name)
+        if program is None:
+            try:
+                text = self._loader(call.name)
+            except KeyError:
+                raise line.error(
+                    NcErrorId.FILE_NOT_FOUND, f"file {call.name} not found", call.pos
+                ) from None
+            except (OSError, ValueError) as exc:
+                raise line.error(
+                    NcErrorId.FILE_NOT_FOUND, f"file {call.name} cannot be read: {exc}", call.pos
+                ) from None
+            program = Program(text, call.name, self.parser, self._skip_levels)
+            self._files[call.name] = program
+        self.frames.append(Frame(program, program.main, program.main.start, FrameKind.FILE))
+
+    def _end_of_section(self, frame: Frame) -> None:
+        if frame.control:
+            entry = frame.control[-1]
+            closer = next(c for c, o in CLOSER_OF.items() if o == entry.kind)
+            raise entry.stmt.line.error(
+                NcErrorId.BLOCK_NOT_CLOSED,
+                f"{SPELLING[entry.kind]} without {SPELLING[closer]}", entry.stmt.pos,
+            )
+        if frame.kind == FrameKind.LOCAL:  # %L ends at the next % line: implicit M17
+            self.frames.pop()
+            return
+        line = _last_code_line(frame.program, frame.section)
+        name = frame.program.name
+        if frame.kind == FrameKind.FILE:
+            raise NcError(NcErrorId.SUBPROGRAM_END_MISSING, name, line, 1,
+                          f"subprogram {name} ends without M17 or M29")
+        if self.manual:
+            self.finished = True
+            return
+        raise NcError(NcErrorId.MISSING_PROGRAM_END, name, line, 1,
+                      f"program {name} ends without M30 (or M2)")
+
+
+def _last_code_line(program: Program, section: Section) -> int:
+    """1-based number of the last line with code in ``section`` (for end errors)."""
+    lines = program.src.lines
+    for k in range(section.end - 1, section.start - 1, -1):
+        if strip_comments(lines[k]).strip():
+            return k + 1
+    return max(section.start, 1)

@@ -1,0 +1,120 @@
+"""Decoder errors: one exception type carrying an ISG-style numeric error id and a place.
+
+Every problem the decoder finds in an NC program is an ``NcError`` with the id of the
+problem, the file (the subprogram file when the error is inside it), the 1-based line
+and column of the offending word or character, and a message a machine operator
+understands. The ids live in 20000..22999 like the decoder errors of the ISG kernel.
+Ids marked "ISG" are the documented ids of the ISG kernel for the same problem; the
+others are this kernel's own and stay stable.
+
+Reserved for later, deliberately not used: 22073 (``#CONTOUR LOOKAHEAD CLEAR`` inside
+``#RT WHILE``) and 21309 (warning: SYNCHK without MACHINE_LOCK).
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+
+class NcErrorId(IntEnum):
+    """Numeric ids of decoder errors."""
+
+    # ---- program selection and faults (also raised by the SDA feed around the decoder)
+    PROGRAM_NOT_FOUND = 20000  # the selected program is not in the program store
+    INTERNAL_ERROR = 20001  # a decoder fault: a bug, reported as the program's error
+
+    # ---- source text
+    COMMENT_BLOCK_NOT_CLOSED = 20101  # #COMMENT BEGIN without #COMMENT END
+    COMMENT_END_WITHOUT_BEGIN = 20102  # #COMMENT END without #COMMENT BEGIN
+    INVALID_SKIP_LEVEL = 20103  # /n with n outside 1..10
+    STRING_NOT_CLOSED = 20104  # "... without the closing quote
+
+    # ---- words of an NC block
+    MISSING_VALUE = 20110  # address letter without a value (e.g. "X" alone)
+    WORD_REPEATED = 20111  # the same address twice in one block (X1 X2)
+    INVALID_BLOCK_NUMBER = 20112  # N not a non-negative integer
+    VALUE_OUT_OF_RANGE = 20113  # a number that is not finite or too large for its word
+    UNSUPPORTED_G_CODE = 20120  # a G function this decoder does not know
+    CONFLICTING_G_CODES = 20121  # two G functions of one group in a block (G0 G1)
+    INVALID_M_CODE = 20122  # M not a non-negative integer
+    CONFLICTING_M_CODES = 20123  # two program-flow M functions in a block (M0 M30)
+    INVALID_FEED = 20130  # F <= 0
+    NO_FEED = 20131  # G1/G2/G3 before any F was programmed
+    INVALID_SPINDLE_SPEED = 20132  # S < 0
+    INVALID_TOOL_NUMBER = 20133  # T not a non-negative integer
+    TOOL_NOT_IN_TABLE = 20134  # D number without an entry in the tool table
+    INVALID_DWELL = 20135  # G4 without a time, negative time, or with axis motion
+    BLOCK_NUMBER_TWICE = 20841  # ISG: N programmed twice in one block (N10 N10:)
+    UNKNOWN_WORD = 21220  # ISG: unknown or incomplete token (unknown address letter)
+
+    # ---- geometry
+    ARC_WORDS_WITHOUT_ARC = 20140  # I/J/K/R in a block that is not G2/G3
+    ARC_OFFSET_OUT_OF_PLANE = 20141  # centre offset of an axis outside the plane (K in G17)
+    HELIX_NOT_SUPPORTED = 20142  # an axis outside the plane moves in an arc block
+    ARC_RADIUS_ZERO = 20143  # centre on the start point
+    ARC_RADIUS_TOO_SMALL = 20144  # R smaller than half the chord
+    ARC_FULL_CIRCLE_WITH_R = 20145  # R with end point == start point (no unique circle)
+    ARC_CENTRE_AND_RADIUS = 20146  # I/J/K and R in the same block
+    PLANE_AXIS_MISSING = 20147  # the plane needs an axis the channel does not have
+    ARC_RADIUS_DIFFERENCE = 21758  # ISG: end point not on the circle (radii differ)
+
+    # ---- expressions
+    EXPRESSION_SYNTAX = 20200  # malformed expression (missing ']', operator without operand)
+    DIVISION_BY_ZERO = 20201  # / or MOD by zero
+    MATH_DOMAIN = 20202  # SQRT of a negative number, LN of 0, overflow, ...
+    TYPE_MISMATCH = 20203  # a string where a number is needed, or the reverse
+    UNKNOWN_FUNCTION = 20204  # NAME[...] that is not a known function
+    EXPRESSION_TOO_COMPLEX = 20205  # nesting deeper than the decoder allows
+
+    # ---- variables
+    UNDECLARED_VARIABLE = 20300  # use of a variable no #VAR declared
+    VARIABLE_DECLARED_TWICE = 20301  # two declarations of one name in one scope
+    VARIABLE_SCOPE_NOT_ALLOWED = 20302  # V.P. outside the main program, V.E. ...
+    UNKNOWN_TYPE = 20303  # ": TYPE" that is not a known type
+    VALUE_OUT_OF_TYPE_RANGE = 20304  # -1 into UNS32, 1e10 into SGN32
+    ARRAY_INDEX_OUT_OF_RANGE = 20305  # V.L.A[5] of a 3-element array
+    ARRAY_INDEX_MISMATCH = 20306  # index on a scalar, or array used without index
+    INVALID_DECLARATION = 20307  # malformed line inside #VAR ... #ENDVAR
+    VAR_BLOCK_NOT_CLOSED = 20308  # #VAR without #ENDVAR
+    ENDVAR_WITHOUT_VAR = 20309  # #ENDVAR without #VAR
+
+    # ---- control flow
+    ENDIF_WITHOUT_IF = 20218  # ISG: $ENDIF that matches no $IF
+    ELSE_WITHOUT_IF = 20219  # $ELSE / $ELSEIF that matches no $IF
+    BLOCK_NOT_CLOSED = 20220  # $IF/$WHILE/$FOR/$SWITCH/$REPEAT/#RT WHILE never closed
+    LOOP_END_WITHOUT_BEGIN = 20221  # $ENDWHILE/$ENDFOR/$UNTIL/#RT ENDWHILE without its start
+    SWITCH_PART_WITHOUT_SWITCH = 20222  # $CASE/$DEFAULT/$ENDSWITCH outside $SWITCH
+    BREAK_OUTSIDE_LOOP = 20223  # $BREAK/$CONTINUE outside a loop or $SWITCH
+    FOR_STEP_ZERO = 20224  # $FOR with step 0 would never end
+    UNKNOWN_CONTROL_KEYWORD = 20225  # $WORD that is not a control statement
+    ENDLESS_LOOP = 20226  # 1,000,000 loop passes without a single block
+    LABEL_NOT_FOUND = 20227  # $GOTO to a label the program does not define
+    BAD_GOTO_TARGET = 20839  # ISG: character after $GOTO not permitted
+
+    # ---- program structure and subprograms
+    MISSING_PROGRAM_END = 20400  # end of a main program without M2/M30
+    SUBPROGRAM_END_IN_MAIN = 20401  # M17/M29 in the main program
+    SUBPROGRAM_END_MISSING = 20402  # end of a file subprogram without M17/M29
+    SUBPROGRAM_NOT_FOUND = 20403  # LL name without %L name in the file
+    FILE_NOT_FOUND = 20404  # L name: the program store has no such file
+    CALL_DEPTH_EXCEEDED = 20405  # subprogram nesting deeper than MAX_CALL_DEPTH
+    DUPLICATE_SUBPROGRAM = 20407  # LL name when the file has two %L sections of that name
+
+    # ---- known but not implemented yet
+    INSTRUCTION_NOT_SUPPORTED = 20500  # a #instruction or keyword of a later issue
+    CYCLE_NOT_SUPPORTED = 20501  # L CYCLE [...]
+
+
+class NcError(Exception):
+    """An error in an NC program, at a place: ``error <id>: <file>:<line>:<column>: <msg>``."""
+
+    def __init__(self, id: int, file: str, line: int, column: int, message: str) -> None:  # noqa: A002
+        self.id = id
+        self.file = file
+        self.line = line
+        self.column = column
+        self.message = message
+        super().__init__(f"error {int(id)}: {file}:{line}:{column}: {message}")
+
+    def __reduce__(self):  # noqa: D105 - keep the five fields when pickled
+        return (type(self), (self.id, self.file, self.line, self.column, self.message))

@@ -1,0 +1,94 @@
+"""Modal state of a channel's decoder and the G functions that change it.
+
+``ModalState`` is what a block leaves behind for the next: the programmed position,
+G90/G91, the plane, the motion mode, F, tool radius compensation and D, S, T, and the
+program-global (V.P.) and global (V.G.) variables. It is mutable and outlives a
+``Decoder``: in the extended manual (MDI) mode every new manual block is decoded with
+the modal state the previous one left.
+
+Defaults after a reset: G90, G17, G01 (a motion block without F is an error until an F
+is programmed, never an accidental rapid), G40, D0, no F, S or T.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum
+
+from .blocks import Compensation, MotionKind
+from .variables import Variable
+
+
+class DistanceMode(IntEnum):
+    """How axis words are read (G90/G91)."""
+
+    ABSOLUTE = 90  # G90: the word is the target position
+    INCREMENTAL = 91  # G91: the word is the distance from the current position
+
+
+class Plane(IntEnum):
+    """Working plane for arcs (G17/G18/G19)."""
+
+    XY = 17  # G17: arcs in X,Y (I, J)
+    ZX = 18  # G18: arcs in Z,X (K, I)
+    YZ = 19  # G19: arcs in Y,Z (J, K)
+
+
+# plane -> names of its (p, q) axes; Motion.plane holds their channel axis indices
+PLANE_AXES = {Plane.XY: ("X", "Y"), Plane.ZX: ("Z", "X"), Plane.YZ: ("Y", "Z")}
+
+
+class GGroup(IntEnum):
+    """Groups of G functions; one block may hold at most one G of each group."""
+
+    MOTION = 0  # G0 G1 G2 G3 (modal)
+    DWELL = 1  # G4 (this block only)
+    PLANE = 2  # G17 G18 G19 (modal)
+    COMPENSATION = 3  # G40 G41 G42 (modal)
+    DISTANCE = 4  # G90 G91 (modal)
+
+
+# the G functions this decoder knows: number -> (group, value set in the modal state)
+G_CODES: dict[int, tuple[GGroup, IntEnum | None]] = {
+    0: (GGroup.MOTION, MotionKind.RAPID),
+    1: (GGroup.MOTION, MotionKind.LINEAR),
+    2: (GGroup.MOTION, MotionKind.ARC_CW),
+    3: (GGroup.MOTION, MotionKind.ARC_CCW),
+    4: (GGroup.DWELL, None),
+    17: (GGroup.PLANE, Plane.XY),
+    18: (GGroup.PLANE, Plane.ZX),
+    19: (GGroup.PLANE, Plane.YZ),
+    40: (GGroup.COMPENSATION, Compensation.OFF),
+    41: (GGroup.COMPENSATION, Compensation.LEFT),
+    42: (GGroup.COMPENSATION, Compensation.RIGHT),
+    90: (GGroup.DISTANCE, DistanceMode.ABSOLUTE),
+    91: (GGroup.DISTANCE, DistanceMode.INCREMENTAL),
+}
+
+
+class MCode(IntEnum):
+    """M functions that act on program flow (all others go to ``Block.m_functions``)."""
+
+    STOP = 0  # M0: programmed stop
+    OPTIONAL_STOP = 1  # M1: optional stop
+    PROGRAM_END = 2  # M2: end of program
+    SUBPROGRAM_END = 17  # M17: end of subprogram
+    SUBPROGRAM_END_FAST = 29  # M29: end of subprogram (ISG: without synchronisation)
+    PROGRAM_END_RESET = 30  # M30: end of program with reset
+
+
+@dataclass(slots=True)
+class ModalState:
+    """What a decoded block leaves for the next one (mutable, survives a Decoder)."""
+
+    position_mm: tuple[float, ...] = ()  # programmed absolute position per channel axis
+    distance: DistanceMode = DistanceMode.ABSOLUTE
+    plane: Plane = Plane.XY
+    motion: MotionKind = MotionKind.LINEAR
+    feed_mm_min: float | None = None  # F; None until programmed
+    compensation: Compensation = Compensation.OFF
+    tool_offset: int = 0  # D: active tool radius entry (D0 = radius 0)
+    spindle_speed_rpm: float | None = None  # last S
+    tool: int | None = None  # last T
+    variables_p: dict[str, Variable] = field(default_factory=dict)  # V.P. by upper name
+    variables_g: dict[str, Variable] = field(default_factory=dict)  # V.G. by upper name

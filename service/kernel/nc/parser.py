@@ -1,0 +1,414 @@
+"""Logical line -> statement: NC blocks, control statements, #-instructions, declarations.
+
+An NC line is ``[Nnn[:]] [[LABEL]] item item ...`` where an item is an address word
+(``X10``, ``X-.5``, ``X[expr]``, ``XV.L.A``, ``X-V.L.A``), an assignment
+(``V.L.A = expr``), a subprogram call (``LL name`` local, ``L name`` file) or
+``$GOTO target`` (executed last). A line whose first item is ``$KEYWORD`` is a control
+statement, ``#KEYWORD`` an instruction. Unknown letters and characters are errors,
+never ignored.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+
+from .errors import NcErrorId
+from .expressions import Const, ExpressionParser, Node, VarRef
+from .lexer import IDENT, SIGNED_NUMBER, VARIABLE, Cursor
+from .modal import G_CODES, GGroup
+from .source import LogicalLine
+from .statements import (
+    Assign, Call, Control, Declaration, Goto, NcBlock, StmtKind, Word, WordKind,
+)
+from .variables import Scope, VarType
+
+_N_WORD = re.compile(r"N[ \t]*([-+]?[0-9.]*)([ \t]*:)?")
+_LABEL = re.compile(r"\[[ \t]*([A-Z0-9_]+)[ \t]*\]")
+_KEYWORD = re.compile(r"\$([A-Z]*)")
+_DIRECTIVE = re.compile(r"#[ \t]*([A-Z_]*)")
+_GOTO_N = re.compile(r"N[ \t]*([0-9]+)[ \t]*:?")
+_UINT = re.compile(r"[0-9]+")
+
+# $KEYWORD -> statement kind; $GOTO is an item of an NC block
+_CONTROL = {
+    "IF": StmtKind.IF, "ELSEIF": StmtKind.ELSEIF, "ELSE": StmtKind.ELSE,
+    "ENDIF": StmtKind.ENDIF, "WHILE": StmtKind.WHILE, "ENDWHILE": StmtKind.ENDWHILE,
+    "FOR": StmtKind.FOR, "ENDFOR": StmtKind.ENDFOR, "REPEAT": StmtKind.REPEAT,
+    "UNTIL": StmtKind.UNTIL, "SWITCH": StmtKind.SWITCH, "CASE": StmtKind.CASE,
+    "DEFAULT": StmtKind.DEFAULT, "BREAK": StmtKind.BREAK, "CONTINUE": StmtKind.CONTINUE,
+    "ENDSWITCH": StmtKind.ENDSWITCH,
+}
+_WITH_CONDITION = frozenset({StmtKind.IF, StmtKind.ELSEIF, StmtKind.WHILE, StmtKind.UNTIL,
+                             StmtKind.SWITCH})
+_NOT_YET = frozenset({"DO", "ENDDO"})  # known ISG keywords of later issues
+_NOT_YET_WORDS = frozenset({"LA_ON", "LA_OFF"})  # MTC200 look-ahead switches: later issue
+
+WordTable = Mapping[str, tuple[WordKind, int]]
+
+
+def word_table(axes: tuple[str, ...]) -> dict[str, tuple[WordKind, int]]:
+    """Address letter -> (meaning, axis index) for a channel with ``axes``."""
+    index = {name: k for k, name in enumerate(axes)}
+    table = {
+        "F": (WordKind.FEED, -1), "S": (WordKind.SPINDLE, -1), "T": (WordKind.TOOL, -1),
+        "D": (WordKind.TOOL_OFFSET, -1), "G": (WordKind.G, -1), "M": (WordKind.M, -1),
+        "R": (WordKind.RADIUS, -1),
+        "I": (WordKind.OFFSET, index.get("X", -1)),
+        "J": (WordKind.OFFSET, index.get("Y", -1)),
+        "K": (WordKind.OFFSET, index.get("Z", -1)),
+        "X": (WordKind.AXIS, -1),  # X is also the dwell time word of G4
+    }
+    for name, k in index.items():
+        table[name] = (WordKind.AXIS, k)
+    return table
+
+
+RESERVED_LETTERS = frozenset("NGMFSTDLIJKRV")
+
+
+class LineParser:
+    """Parses the logical lines of one channel (the word table depends on its axes)."""
+
+    def __init__(self, table: WordTable) -> None:
+        self.table = table
+
+    # ------------------------------------------------------------ entry
+
+    def parse(self, line: LogicalLine) -> NcBlock | Control:
+        """The statement of one logical line (raises NcError on a syntax error)."""
+        cur = Cursor(line)
+        cur.skip_ws()
+        number = self._block_number(cur, None)
+        cur.skip_ws()
+        if cur.peek() == "[":
+            m = cur.match(_LABEL)
+            if m is None:
+                raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
+            cur.skip_ws()
+        c = cur.peek()
+        if c == "$" and not cur.up.startswith("$GOTO", cur.pos):
+            return self._control(cur, number)
+        if c == "#":
+            return self._directive(cur, number)
+        return self._block(cur, number)
+
+    # ------------------------------------------------------------ pieces
+
+    def _block_number(self, cur: Cursor, current: int | None) -> int | None:
+        if cur.peek() != "N":
+            return current
+        pos = cur.pos
+        m = cur.match(_N_WORD)
+        digits = m.group(1)
+        if current is not None:
+            raise cur.error(NcErrorId.BLOCK_NUMBER_TWICE, "block number N programmed twice", pos)
+        if not digits.isdigit():
+            if not digits:
+                raise cur.error(NcErrorId.MISSING_VALUE, "block number expected after 'N'", pos)
+            raise cur.error(
+                NcErrorId.INVALID_BLOCK_NUMBER,
+                f"block number N{digits} is not a non-negative integer", pos,
+            )
+        return int(digits)
+
+    def _control(self, cur: Cursor, number: int | None) -> Control:
+        pos = cur.pos
+        m = cur.match(_KEYWORD)
+        word = m.group(1)
+        kind = _CONTROL.get(word)
+        if kind is None:
+            if word in _NOT_YET:
+                raise cur.error(
+                    NcErrorId.INSTRUCTION_NOT_SUPPORTED, f"${word} is not supported yet", pos
+                )
+            raise cur.error(
+                NcErrorId.UNKNOWN_CONTROL_KEYWORD, f"unknown control statement '${word}'", pos
+            )
+        stmt = Control(kind, cur.line, pos, number=number)
+        expr = ExpressionParser(cur)
+        if kind in _WITH_CONDITION:
+            stmt.expr = expr.parse()
+            if kind == StmtKind.IF and cur.up.startswith("$GOTO", _skip(cur)):
+                cur.skip_ws()
+                stmt.kind = StmtKind.IF_GOTO
+                stmt.goto = self._goto(cur)
+        elif kind == StmtKind.FOR:
+            stmt.target = expr.variable()
+            expr.expect("=")
+            stmt.expr = expr.parse()
+            expr.expect(",")
+            stmt.end = expr.parse()
+            cur.skip_ws()
+            if cur.peek() == ",":
+                cur.pos += 1
+                stmt.step = expr.parse()
+        elif kind == StmtKind.CASE:
+            values = [expr.parse()]
+            cur.skip_ws()
+            while cur.peek() == ",":
+                cur.pos += 1
+                values.append(expr.parse())
+                cur.skip_ws()
+            stmt.values = tuple(values)
+        self._line_end(cur, f"${word}")
+        return stmt
+
+    def _directive(self, cur: Cursor, number: int | None) -> Control:
+        pos = cur.pos
+        m = cur.match(_DIRECTIVE)
+        word = m.group(1)
+        if word == "VAR":
+            stmt = Control(StmtKind.VAR, cur.line, pos, number=number)
+        elif word == "ENDVAR":
+            stmt = Control(StmtKind.ENDVAR, cur.line, pos, number=number)
+        elif word == "RT":
+            cur.skip_ws()
+            sub = cur.match(IDENT)
+            if sub is not None and sub.group() == "WHILE":
+                stmt = Control(StmtKind.RT_WHILE, cur.line, pos, number=number)
+                if not cur.at_end():
+                    stmt.expr = ExpressionParser(cur).parse()
+            elif sub is not None and sub.group() == "ENDWHILE":
+                stmt = Control(StmtKind.RT_ENDWHILE, cur.line, pos, number=number)
+            else:
+                shown = sub.group() if sub else cur.word_text()
+                raise cur.error(
+                    NcErrorId.INSTRUCTION_NOT_SUPPORTED, f"#RT {shown} is not supported yet", pos
+                )
+            word = "RT " + sub.group()
+        elif word:
+            raise cur.error(
+                NcErrorId.INSTRUCTION_NOT_SUPPORTED, f"#{word} is not supported yet", pos
+            )
+        else:
+            raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text(pos)}'", pos)
+        self._line_end(cur, f"#{word}")
+        return stmt
+
+    def _line_end(self, cur: Cursor, after: str) -> None:
+        if cur.at_end():
+            return
+        if cur.peek() == "=" and cur.peek(1) != "=":
+            raise cur.error(NcErrorId.EXPRESSION_SYNTAX, "'=' is an assignment; compare with ==")
+        raise cur.unexpected(f"after {after}")
+
+    def _goto(self, cur: Cursor) -> Goto:
+        pos = cur.pos
+        cur.pos += len("$GOTO")
+        cur.skip_ws()
+        m = cur.match(_GOTO_N)
+        if m is not None:
+            return Goto(f"N{int(m.group(1))}", pos)
+        m = cur.match(_LABEL)
+        if m is not None:
+            return Goto(f"[{m.group(1)}]", pos)
+        raise cur.error(
+            NcErrorId.BAD_GOTO_TARGET,
+            f"$GOTO needs Nnn or [LABEL], found '{cur.word_text()}'",
+        )
+
+    def _block(self, cur: Cursor, number: int | None) -> NcBlock:
+        block = NcBlock(cur.line, number)
+        letters: set[str] = set()
+        table = self.table
+        while not cur.at_end():
+            pos = cur.pos
+            c = cur.peek()
+            if c == "$":
+                if not cur.up.startswith("$GOTO", pos):
+                    word = cur.match(_KEYWORD).group(1)
+                    raise cur.error(
+                        NcErrorId.UNKNOWN_CONTROL_KEYWORD,
+                        f"${word} must stand at the start of its line", pos,
+                    )
+                if block.goto is not None:
+                    raise cur.error(NcErrorId.WORD_REPEATED, "$GOTO programmed twice", pos)
+                block.goto = self._goto(cur)
+            elif c == "V" and cur.peek(1) == ".":
+                block.items.append(self._assign(cur))
+            elif c == "L":
+                self._call(cur, block)
+            elif c == "N":
+                block.number = self._block_number(cur, block.number)
+            elif "A" <= c <= "Z" or c == "_":
+                spec = table.get(c)
+                if spec is None:
+                    m = IDENT.match(cur.up, pos)
+                    if m is not None and m.group() in _NOT_YET_WORDS:
+                        raise cur.error(
+                            NcErrorId.INSTRUCTION_NOT_SUPPORTED,
+                            f"{m.group()} is not supported yet",
+                        )
+                    raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
+                kind, axis = spec
+                if kind != WordKind.G and kind != WordKind.M:
+                    if c in letters:
+                        raise cur.error(
+                            NcErrorId.WORD_REPEATED, f"{c} programmed twice in one block"
+                        )
+                    letters.add(c)
+                cur.pos += 1
+                value = self._value(cur, c, pos)
+                if kind == WordKind.G and isinstance(value, float):
+                    if value != int(value) or int(value) not in G_CODES:
+                        raise cur.error(
+                            NcErrorId.UNSUPPORTED_G_CODE, f"G{value:g} is not supported", pos
+                        )
+                    if G_CODES[int(value)][0] == GGroup.DWELL:
+                        block.has_g4 = True
+                block.items.append(Word(kind, c, value, pos, axis))
+            else:
+                raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
+        block.letters = frozenset(letters)
+        return block
+
+    def _value(self, cur: Cursor, letter: str, letter_pos: int) -> float | Node:
+        cur.skip_ws()
+        m = cur.match(SIGNED_NUMBER)
+        if m is not None:
+            return float(m.group())
+        pos = cur.pos
+        negative = False
+        if cur.peek() in ("-", "+") and (cur.peek(1) == "[" or cur.up.startswith("V.", pos + 1)):
+            negative = cur.peek() == "-"
+            cur.pos += 1
+        c = cur.peek()
+        parser = ExpressionParser(cur)
+        if c == "[":
+            node = parser._primary()  # noqa: SLF001 - only the bracket, not what follows
+        elif c == "V" and cur.peek(1) == ".":
+            node = parser.variable()
+        else:
+            raise cur.error(NcErrorId.MISSING_VALUE, f"value expected after '{letter}'", letter_pos)
+        if negative:
+            inner = node
+            node = lambda env: _negate(inner(env))  # noqa: E731
+        if isinstance(node, Const):
+            value = node.value
+            if isinstance(value, str):
+                raise cur.error(
+                    NcErrorId.TYPE_MISMATCH, f"{letter} needs a number, not a string", pos
+                )
+            return float(value)
+        return node
+
+    def _assign(self, cur: Cursor) -> Assign:
+        pos = cur.pos
+        parser = ExpressionParser(cur)
+        target = parser.variable()
+        cur.skip_ws()
+        if cur.peek() != "=" or cur.peek(1) == "=":
+            raise cur.error(
+                NcErrorId.EXPRESSION_SYNTAX, f"'=' expected after {target.full}"
+            )
+        cur.pos += 1
+        return Assign(target, parser.parse(), pos)
+
+    def _call(self, cur: Cursor, block: NcBlock) -> None:
+        pos = cur.pos
+        m = IDENT.match(cur.up, pos)
+        ident = m.group() if m else "L"
+        if ident in _NOT_YET_WORDS:
+            raise cur.error(NcErrorId.INSTRUCTION_NOT_SUPPORTED, f"{ident} is not supported yet")
+        local = ident == "LL"
+        cur.pos += 2 if local else 1
+        name = cur.name()
+        if not name:
+            raise cur.error(
+                NcErrorId.MISSING_VALUE, f"subprogram name expected after '{'LL' if local else 'L'}'",
+                pos,
+            )
+        if name.upper().startswith("CYCLE") and (name.upper() == "CYCLE" or name[5] == "["):
+            raise cur.error(NcErrorId.CYCLE_NOT_SUPPORTED, "L CYCLE is not supported yet", pos)
+        if block.call is not None:
+            raise cur.error(NcErrorId.WORD_REPEATED, "two subprogram calls in one block", pos)
+        block.call = Call(local, name, pos)
+
+    # ------------------------------------------------------------ #VAR lines
+
+    def declaration(self, line: LogicalLine) -> Declaration:
+        """One line inside ``#VAR ... #ENDVAR``: ``V.x.NAME[dims] [: TYPE] [= init]``."""
+        cur = Cursor(line)
+        cur.skip_ws()
+        pos = cur.pos
+        m = cur.match(VARIABLE)
+        if m is None:
+            raise cur.error(
+                NcErrorId.INVALID_DECLARATION,
+                f"variable declaration expected, found '{cur.word_text()}'",
+            )
+        scope = _DECL_SCOPES.get(m.group(1))
+        if scope is None:
+            raise cur.error(
+                NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED,
+                f"V.{m.group(1)}. variables cannot be declared in #VAR", pos,
+            )
+        dims = []
+        while cur.peek() == "[":
+            cur.pos += 1
+            cur.skip_ws()
+            size = cur.match(_UINT)
+            cur.skip_ws()
+            if size is None or cur.peek() != "]" or int(size.group()) == 0:
+                raise cur.error(
+                    NcErrorId.INVALID_DECLARATION, "array size must be a positive integer"
+                )
+            cur.pos += 1
+            dims.append(int(size.group()))
+        vtype = VarType.REAL64
+        cur.skip_ws()
+        if cur.peek() == ":":
+            cur.pos += 1
+            cur.skip_ws()
+            tpos = cur.pos
+            t = cur.match(IDENT)
+            if t is None or t.group() not in VarType.__members__:
+                raise cur.error(
+                    NcErrorId.UNKNOWN_TYPE, f"unknown type '{cur.word_text(tpos)}'", tpos
+                )
+            vtype = VarType[t.group()]
+            if vtype == VarType.STRING and cur.peek() == "[":
+                if cur.match(re.compile(r"\[[ \t]*[0-9]+[ \t]*\]")) is None:
+                    raise cur.error(NcErrorId.INVALID_DECLARATION, "STRING[n] needs a length")
+        init: Node | list | None = None
+        cur.skip_ws()
+        if cur.peek() == "=":
+            cur.pos += 1
+            cur.skip_ws()
+            init = self._initializer(cur) if cur.peek() == "[" else ExpressionParser(cur).parse()
+        if not cur.at_end():
+            raise cur.unexpected(f"in the declaration of V.{m.group(1)}.{m.group(2)}")
+        return Declaration(scope, m.group(2), vtype, tuple(dims), init, line, pos)
+
+    def _initializer(self, cur: Cursor) -> Node | list:
+        """``[a, b, [c, d]]`` (nested lists of expressions) or one bracketed expression."""
+        items: list = []
+        cur.pos += 1  # '['
+        parser = ExpressionParser(cur)
+        while True:
+            cur.skip_ws()
+            items.append(self._initializer(cur) if cur.peek() == "[" else parser.parse())
+            cur.skip_ws()
+            if cur.peek() == ",":
+                cur.pos += 1
+                continue
+            parser.expect("]")
+            break
+        return items
+
+
+_DECL_SCOPES = {"L": Scope.L, "P": Scope.P, "G": Scope.G, "CYC": Scope.CYC}
+
+
+def _skip(cur: Cursor) -> int:
+    cur.skip_ws()
+    return cur.pos
+
+
+def _negate(value):
+    """-value; a string stays a string so that the word's evaluation reports it."""
+    return value if isinstance(value, str) else -value
+
+
+__all__ = ["LineParser", "RESERVED_LETTERS", "VarRef", "WordTable", "word_table"]
