@@ -1,4 +1,11 @@
-"""``make bench``: request dispatch measured against a raw ZeroMQ echo, in one run.
+"""``make bench``: request dispatch against a raw ZeroMQ echo, and the kernel's hot paths.
+
+Kernel part (``--part kernel``): the decoder against a ``str.split`` tokenizer of the same
+200,000-line file (``bench/decoder_bench.py``), the interpolator in simulated seconds per
+wall second (``bench/kernel_bench.py``), and the planner's machining time against the
+whole-program optimum of the same model (``bench/planner_bench.py``).
+
+Dispatch part (``--part dispatch``):
 
 Baseline: a raw pyzmq ROUTER in a second process that answers each msgpack frame with a
 reply of the same shape as ours (sync sockets, no dispatch), driven by a sync DEALER:
@@ -198,7 +205,44 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__.split("\n")[0])
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
+    parser.add_argument("--part", choices=("all", "dispatch", "kernel"), default="all",
+                        help="dispatch: request dispatch; kernel: decoder, interpolator, planner")
     args = parser.parse_args(argv)
+    if args.part in ("all", "dispatch"):
+        dispatch(args)
+    if args.part in ("all", "kernel"):
+        kernel(args.runs)
+    return 0
+
+
+def kernel(runs: int) -> None:
+    """Decoder, interpolator and planner figures, each against its reference of the run."""
+    from . import decoder_bench, kernel_bench, planner_bench
+
+    print("\nkernel benchmarks (in-process, virtual clock)", file=sys.stderr)
+    dec = decoder_bench.measure(runs=runs)
+    ipo = kernel_bench.measure(runs=min(runs, 3))
+    plan = planner_bench.measure(runs=min(runs, 3))
+    print(f"\n{'measurement':52} {'value':>12} {'ratio':>7}  target")
+    print(f"{'decoder, 200,000 lines (lines/s)':52} {dec['decoder_lines_s']:12,.0f} "
+          f"{dec['ratio']:7.2f}  >= 0.5 of str.split: "
+          f"{'met' if dec['ratio'] >= 0.5 else 'NOT met'}")
+    print(f"{'  reference: str.split tokenizer (lines/s)':52} {dec['split_lines_s']:12,.0f}")
+    print(f"{'interpolator, 3-axis program (simulated s / wall s)':52} "
+          f"{ipo['sim_per_wall']:12.1f} {'':7}  >= 50: "
+          f"{'met' if ipo['sim_per_wall'] >= 50 else 'NOT met'}")
+    for name, label in (("spiral", "spiral 10,000 x 0.05 mm F6000"),
+                        ("pocket", "pocket, 90 deg corners")):
+        ratio = plan[f"{name}_ratio"]
+        print(f"{'planner ' + label + ' (machining s)':52} {plan[name + '_time_s']:12.3f} "
+              f"{ratio:7.4f}  <= 1.01 of optimal: {'met' if ratio <= 1.01 else 'NOT met'}")
+    print(f"\ndecoder: median of {runs} paired runs; interpolator and planner: median of "
+          f"{min(runs, 3)} runs; planner ratio = streamed 120-block look-ahead / whole program "
+          "planned at once (same model)")
+
+
+def dispatch(args: argparse.Namespace) -> None:
+    """Request dispatch against the raw ZeroMQ echo."""
 
     ctx = mp.get_context("spawn")
     ready = ctx.Event()
@@ -241,7 +285,6 @@ def main(argv: list[str] | None = None) -> int:
     fig = {k: median_figure(v) for k, v in runs.items()}
     ratio = {k: statistics.median(v) for k, v in ratios.items()} | {"raw_seq": 1.0, "raw_pipe": 1.0}
     _report(fig, ratio, n_objects, args.runs, overruns)
-    return 0
 
 
 def _report(

@@ -3,16 +3,19 @@
 Imports protocol and objects, never service.
 """
 
-from .client import AsyncClient, Client, DeviceInfo, ObjectInfo, Sample
-from .errors import AdsConnectionError, AdsError, AdsTimeoutError
+from .client import AsyncClient, ChannelStatus, Client, DeviceInfo, ObjectInfo, ProgramEntry, Sample
+from .errors import AdsConnectionError, AdsError, AdsTimeoutError, ChannelError
 
 __all__ = [
     "AdsConnectionError",
     "AdsError",
     "AdsTimeoutError",
     "AsyncClient",
+    "ChannelError",
+    "ChannelStatus",
     "Client",
     "DeviceInfo",
     "ObjectInfo",
+    "ProgramEntry",
     "Sample",
 ]

@@ -289,3 +289,7 @@ def main() -> None:
         app()
     except KeyboardInterrupt:
         sys.exit(130)
+
+
+# The machine-operating commands register themselves on ``app``.
+from . import cli_machine  # noqa: E402,F401

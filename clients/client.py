@@ -42,6 +42,7 @@ from protocol.frames import (
     WriteRequest,
 )
 
+from .channel_ops import ChannelOps, ChannelStatus, ProgramEntry, ProgramOps
 from .errors import AdsConnectionError, AdsError
 from .sync_transport import SyncTransport, drive
 from .transport import AsyncTransport
@@ -127,7 +128,7 @@ def filetime_to_datetime(filetime: int) -> datetime:
     return _FILETIME_EPOCH + timedelta(microseconds=filetime // 10)
 
 
-class AsyncClient:
+class AsyncClient(ProgramOps, ChannelOps):
     """Asyncio client of a cnc-objects service. Use with ``async with``."""
 
     def __init__(
@@ -229,6 +230,13 @@ class AsyncClient:
         dtype = _coerce_type(dtype)
         data = _encode(dtype, value, f"0x{group:x}/0x{offset:x}")
         await self._call(WriteRequest, port, group, offset, data)
+
+    async def read_write_raw(
+        self, port: int, group: int, offset: int, data: bytes, read_length: int
+    ) -> bytes:
+        """ADS ReadWrite at an address: ``data`` in, up to ``read_length`` bytes out."""
+        reply = await self._call(ReadWriteRequest, port, group, offset, read_length, data)
+        return self._payload(reply)
 
     async def write_raw(self, port: int, group: int, offset: int, data: bytes) -> None:
         """Write raw bytes at an ADS address."""
@@ -357,4 +365,7 @@ for _name, _method in inspect.getmembers(AsyncClient, inspect.isfunction):
     if not _name.startswith("_"):
         setattr(Client, _name, _blocking(_method))
 
-__all__ = ["AsyncClient", "Client", "DeviceInfo", "ObjectInfo", "Sample", "filetime_to_datetime"]
+__all__ = [
+    "AsyncClient", "ChannelStatus", "Client", "DeviceInfo", "ObjectInfo", "ProgramEntry",
+    "Sample", "filetime_to_datetime",
+]

@@ -25,3 +25,14 @@ class AdsTimeoutError(AdsError, TimeoutError):
 
 class AdsConnectionError(AdsError, ConnectionError):
     """The client is not connected (ADS 0x748 PORTNOTOPEN) or got an unreadable reply."""
+
+
+class ChannelError(Exception):
+    """A program or manual block ended with the channel in ERROR; ``errors`` lists the
+    channel's errors as ``"error <id>: <file>:<line>:<column>: <text>"`` lines."""
+
+    def __init__(self, channel: int, errors: list[str]) -> None:
+        text = "; ".join(errors) if errors else "no error text"
+        super().__init__(f"channel {channel} went to ERROR: {text}")
+        self.channel = channel
+        self.errors = errors

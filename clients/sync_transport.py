@@ -46,6 +46,25 @@ class _Pending:
         return (yield self)
 
 
+class _Pause:
+    """An awaitable that makes ``drive`` sleep (the blocking client's asyncio.sleep)."""
+
+    __slots__ = ("seconds",)
+
+    def __init__(self, seconds: float) -> None:
+        self.seconds = seconds
+
+    @property
+    def transport(self) -> _Pause:
+        return self
+
+    def perform(self, pause: _Pause) -> None:
+        time.sleep(pause.seconds)
+
+    def __await__(self) -> Generator[_Pause, Any, Any]:
+        return (yield self)
+
+
 class SyncTransport(_Transport):
     """DEALER socket used by blocking calls; no event loop, no thread."""
 
@@ -69,6 +88,10 @@ class SyncTransport(_Transport):
         if self._sock is not None:
             self._sock.close(linger=0)
             self._sock = None
+
+    def pause(self, seconds: float) -> _Pause:
+        """Await to wait ``seconds`` of wall time (blocking)."""
+        return _Pause(seconds)
 
     def exchange(self, command: int, port: int, fields: tuple[Any, ...]) -> _Pending:
         """Awaitable reply to a request (performed by ``drive``)."""

@@ -143,6 +143,10 @@ class AsyncTransport(_Transport):
                 fut.set_exception(closed)
         self._pending.clear()
 
+    async def pause(self, seconds: float) -> None:
+        """Wait ``seconds`` of wall time."""
+        await asyncio.sleep(seconds)
+
     def exchange(self, command: int, port: int, fields: tuple[Any, ...]) -> asyncio.Future[Response]:
         """Send a request; the future is its reply, or fails after ``timeout_s`` (see the
         class doc). A plain function, so that awaiting a reply costs one frame less."""

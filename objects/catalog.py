@@ -83,10 +83,35 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "Axis request state: 0 link exists, 1 physical axis requested, "
         "2 waiting for acknowledgement",
     ),
+    ObjectTemplate(
+        "command_position_acs", Scope.CHANNEL_AXIS, GEO, IPO, 0x02, SGN32, R, "0.1 um",
+        "Command position of the channel axis (interpolator output) (project offset)",
+    ),
     # --- GEO interpolator, channel -------------------------------------------------------
     ObjectTemplate(
         "dist_prog_start", Scope.CHANNEL, GEO, IPO, 0x56, REAL64, R, "0.1 um",
         "Path distance from program start on the compensated path",
+    ),
+    ObjectTemplate(
+        "remaining_path_in_block", Scope.CHANNEL, GEO, IPO, 0x08, REAL64, R, "0.1 um",
+        "Remaining path of the block in the interpolator (offset as TwinSharp)",
+    ),
+    ObjectTemplate(
+        "actual_path_velocity", Scope.CHANNEL, GEO, IPO, 0x15, REAL64, R, "um/s",
+        "Actual path velocity, feed override applied (offset as TwinSharp)",
+    ),
+    ObjectTemplate(
+        "programmed_path_velocity", Scope.CHANNEL, GEO, IPO, 0x16, REAL64, R, "um/s",
+        "Programmed path velocity F of the block in the interpolator (offset as TwinSharp)",
+    ),
+    ObjectTemplate(
+        "actual_block_number", Scope.CHANNEL, GEO, IPO, 0x21, SGN32, R, "-",
+        "N number of the block in the interpolator; -1 = the block has none "
+        "(offset as TwinSharp)",
+    ),
+    ObjectTemplate(
+        "actual_block_count", Scope.CHANNEL, GEO, IPO, 0x2E, SGN32, R, "-",
+        "Blocks finished since program start (offset as TwinSharp)",
     ),
     # --- COM channel ----------------------------------------------------------------------
     ObjectTemplate(
@@ -112,6 +137,117 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
     ObjectTemplate(
         "mc_active_execution_mode_r", Scope.CHANNEL, COM, COM_CH, 0x41, SGN32, R, "-",
         "Execution mode in effect",
+    ),
+    ObjectTemplate(
+        "mc_command_single_block_w", Scope.CHANNEL, COM, COM_CH, 0x01, BOOLEAN, W, "-",
+        "Single block on (TRUE) or off (offset as TwinSharp)",
+    ),
+    ObjectTemplate(
+        "mc_active_single_block_r", Scope.CHANNEL, COM, COM_CH, 0x03, BOOLEAN, R, "-",
+        "Single block mode active (offset as TwinSharp)",
+    ),
+    # --- COM channel control (project offsets; HLI mode_and_state values) ----------------
+    ObjectTemplate(
+        "mc_active_mode_r", Scope.CHANNEL, COM, COM_CH, 0x3001, UNS32, R, "-",
+        "Operation mode: 1 STANDBY, 2 AUTOMATIC, 3 MDI, 4 MANUAL (project)",
+    ),
+    ObjectTemplate(
+        "mc_active_state_r", Scope.CHANNEL, COM, COM_CH, 0x3002, UNS32, R, "-",
+        "State: 1 DESELECTED, 2 SELECTED, 3 READY, 4 ACTIVE, 5 HOLD, 6 ERROR (project)",
+    ),
+    ObjectTemplate(
+        "mc_command_mode_w", Scope.CHANNEL, COM, COM_CH, 0x3003, UNS32, W, "-",
+        "Select the operation mode (1..4); only while the channel is not working (project)",
+    ),
+    ObjectTemplate(
+        "mc_command_program_name_w", Scope.CHANNEL, COM, COM_CH, 0x3004, STRING(84), W, "-",
+        "Select a program of the program store: AUTOMATIC/READY (project)",
+    ),
+    ObjectTemplate(
+        "mc_active_program_name_r", Scope.CHANNEL, COM, COM_CH, 0x3005, STRING(84), R, "-",
+        "Selected program (project)",
+    ),
+    ObjectTemplate(
+        "mc_command_start_w", Scope.CHANNEL, COM, COM_CH, 0x3006, BOOLEAN, W, "-",
+        "Write TRUE: start the selected program, resume from HOLD, continue after M0/M1 "
+        "or a single-block stop (project)",
+    ),
+    ObjectTemplate(
+        "mc_command_hold_w", Scope.CHANNEL, COM, COM_CH, 0x3007, BOOLEAN, W, "-",
+        "Write TRUE: feedhold, decelerate on the path and stop (project)",
+    ),
+    ObjectTemplate(
+        "mc_command_reset_w", Scope.CHANNEL, COM, COM_CH, 0x3008, BOOLEAN, W, "-",
+        "Write TRUE: RESET the channel from any state (project)",
+    ),
+    ObjectTemplate(
+        "mc_command_manual_block_w", Scope.CHANNEL, COM, COM_CH, 0x3009, STRING(992), W, "-",
+        "Run NC blocks (lines separated by LF or CR LF) as manual blocks, MDI (project)",
+    ),
+    ObjectTemplate(
+        "mc_active_file_name_r", Scope.CHANNEL, COM, COM_CH, 0x300A, STRING(84), R, "-",
+        "File of the block in the interpolator (FCT-C9 name; project offset)",
+    ),
+    ObjectTemplate(
+        "mc_active_file_offset_r", Scope.CHANNEL, COM, COM_CH, 0x300B, UNS32, R, "byte",
+        "Byte offset of that block's line in its file (FCT-C9 name; project offset)",
+    ),
+    ObjectTemplate(
+        "mc_active_line_r", Scope.CHANNEL, COM, COM_CH, 0x300C, UNS32, R, "-",
+        "Line of that block in its file, from 1; 0 = none (project)",
+    ),
+    ObjectTemplate(
+        "mc_block_count_r", Scope.CHANNEL, COM, COM_CH, 0x300D, UNS32, R, "-",
+        "Blocks finished since program start (TwinSharp name; project offset)",
+    ),
+    ObjectTemplate(
+        "mc_command_feedrate_r", Scope.CHANNEL, COM, COM_CH, 0x300E, REAL64, R, "um/s",
+        "Programmed feed F of the block in the interpolator (TwinSharp name; project offset)",
+    ),
+    ObjectTemplate(
+        "mc_active_feedrate_r", Scope.CHANNEL, COM, COM_CH, 0x300F, REAL64, R, "um/s",
+        "Actual path feed, override applied (TwinSharp name; project offset)",
+    ),
+    ObjectTemplate(
+        "program_time", Scope.CHANNEL, COM, COM_CH, 0x3010, REAL64, R, "s",
+        "Kernel time since the program started; frozen at its end (project)",
+    ),
+    ObjectTemplate(
+        "mc_waiting_for_start_r", Scope.CHANNEL, COM, COM_CH, 0x3011, BOOLEAN, R, "-",
+        "TRUE while the path stands at M0/M1 or a single-block stop and waits for START "
+        "(project)",
+    ),
+    ObjectTemplate(
+        "mc_manual_blocks_done_r", Scope.CHANNEL, COM, COM_CH, 0x3012, UNS32, R, "-",
+        "Manual blocks (MDI writes) finished since the service started (project)",
+    ),
+    ObjectTemplate(
+        "mc_error_count_r", Scope.CHANNEL, COM, COM_CH, 0x3020, UNS32, R, "-",
+        "Errors raised since program start or RESET; the first 8 are in mc_error_<k>_* "
+        "(project)",
+    ),
+    *(
+        ObjectTemplate(
+            f"mc_error_{k}_{field}_r", Scope.CHANNEL, COM, COM_CH, 0x3020 + 0x10 * k + n,
+            dtype, R, "-", f"Error {k} of the list: {meaning} (project)",
+        )
+        for k in range(1, 9)
+        for n, (field, dtype, meaning) in enumerate((
+            ("id", UNS32, "ISG-style error id; 0 = no error"),
+            ("text", STRING(256), "message"),
+            ("file", STRING(84), "NC file"),
+            ("line", UNS32, "line in the file, from 1"),
+            ("column", UNS32, "column in the line, from 1"),
+        ))
+    ),
+    # --- COM channel axes (offsets as TwinSharp, IG 0x12010<c>, IO 0x<a>00xx) -------------
+    ObjectTemplate(
+        "logical_axis_number", Scope.CHANNEL_AXIS, COM, COM_CH, 0x01, UNS16, R, "-",
+        "Logical axis number (kopf.achs_nr) of the channel axis",
+    ),
+    ObjectTemplate(
+        "axis_name", Scope.CHANNEL_AXIS, COM, COM_CH, 0x02, STRING(16), R, "-",
+        "Name of the channel axis",
     ),
     # --- COM platform (project offsets; found by name through the directory) -------------
     ObjectTemplate(
@@ -162,6 +298,10 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
     ObjectTemplate(
         "actual_position_acs", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x03, SGN32, R, "0.1 um",
         "Actual position of the drive in the axis coordinate system",
+    ),
+    ObjectTemplate(
+        "axis_name", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x09, STRING(16), R, "-",
+        "Name of the physical axis (offset as TwinSharp)",
     ),
     ObjectTemplate(
         "link_to_logical_axis", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x0F, UNS16, R, "-",

@@ -17,7 +17,20 @@ from protocol.constants import CncPort
 from protocol.errors import AdsReturnCode
 
 from . import __version__
-from .kernel.commands import Command, Refusal, RefusalReason, SetExecutionMode, SetFeedOverride
+from .kernel.commands import (
+    Command,
+    Feedhold,
+    ManualBlock,
+    Refusal,
+    RefusalReason,
+    ResetChannel,
+    SelectMode,
+    SelectProgram,
+    SetExecutionMode,
+    SetFeedOverride,
+    SetSingleBlock,
+    StartProgram,
+)
 from .kernel.kernel import Kernel
 
 Getter = Callable[[], Any]
@@ -27,6 +40,7 @@ REFUSAL_CODES: dict[RefusalReason, AdsReturnCode] = {
     RefusalReason.INVALID_VALUE: AdsReturnCode.DEVICE_INVALIDDATA,
     RefusalReason.NOT_READY: AdsReturnCode.DEVICE_NOTREADY,
     RefusalReason.BUSY: AdsReturnCode.DEVICE_BUSY,
+    RefusalReason.NOT_FOUND: AdsReturnCode.DEVICE_NOTFOUND,
 }
 
 
@@ -74,6 +88,42 @@ def _constant(value: Callable[[Kernel], Any]) -> Callable[[Kernel, CncObject], G
     return bind
 
 
+def _per_scope(
+    physical: Callable[[Kernel, CncObject], Getter],
+    channel_axis: Callable[[Kernel, CncObject], Getter],
+) -> Callable[[Kernel, CncObject], Getter]:
+    """One element name served for physical axes (no channel) and for channel axes."""
+
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        return (channel_axis if obj.channel else physical)(kernel, obj)
+
+    return bind
+
+
+def _channel_error(k: int, field: str) -> Callable[[Kernel, CncObject], Getter]:
+    """Field of the k-th error of a channel's list; 0 / empty when there is none."""
+    empty = "" if field in ("text", "file") else 0
+
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        ci = kernel.channel_index(obj.channel)
+
+        def get() -> Any:
+            errors = kernel.snapshot.channels[ci].errors
+            return getattr(errors[k - 1], field) if len(errors) >= k else empty
+
+        return get
+
+    return bind
+
+
+def _scaled(attr: str, factor: float) -> Callable[[Kernel, CncObject], Getter]:
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        ci = kernel.channel_index(obj.channel)
+        return lambda: getattr(kernel.snapshot.channels[ci], attr) * factor
+
+    return bind
+
+
 def _kernel_time(kernel: Kernel, obj: CncObject) -> Getter:
     return lambda: kernel.snapshot.time_ns / 1e9
 
@@ -97,9 +147,37 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "cnc_cycle_exec_time_max_r": _stats("exec_time_max_us", lambda v: min(v, 0xFFFFFFFF)),
     "cnc_kernel_time_r": _kernel_time,
     "cnc_kernel_running_r": _stats("running"),
-    "command_position_acs": _physical_axis("command_position_incr"),
+    "command_position_acs": _per_scope(
+        _physical_axis("command_position_incr"), _channel_axis("command_position_incr")
+    ),
     "actual_position_acs": _physical_axis("actual_position_incr"),
     "link_to_logical_axis": _physical_axis("linked_logical_axis"),
+    "axis_name": _per_scope(_physical_axis("name"), _channel_axis("name")),
+    "logical_axis_number": _channel_axis("logical_number"),
+    "remaining_path_in_block": _scaled("remaining_in_block_mm", 1e4),
+    "actual_path_velocity": _scaled("path_velocity_mm_s", 1e3),
+    "programmed_path_velocity": _scaled("programmed_velocity_mm_s", 1e3),
+    "actual_block_number": _channel("block_number"),
+    "actual_block_count": _channel("block_count"),
+    "mc_active_single_block_r": _channel("single_block"),
+    "mc_active_mode_r": _channel("mode"),
+    "mc_active_state_r": _channel("state"),
+    "mc_active_program_name_r": _channel("program_name"),
+    "mc_active_file_name_r": _channel("file_name"),
+    "mc_active_file_offset_r": _channel("file_offset"),
+    "mc_active_line_r": _channel("line"),
+    "mc_block_count_r": _channel("block_count"),
+    "mc_command_feedrate_r": _scaled("programmed_velocity_mm_s", 1e3),
+    "mc_active_feedrate_r": _scaled("path_velocity_mm_s", 1e3),
+    "program_time": _channel("program_time_s"),
+    "mc_waiting_for_start_r": _channel("waiting_for_start"),
+    "mc_manual_blocks_done_r": _channel("manual_blocks_done"),
+    "mc_error_count_r": _channel("error_count"),
+    **{
+        f"mc_error_{k}_{field}_r": _channel_error(k, field)
+        for k in range(1, 9)
+        for field in ("id", "text", "file", "line", "column")
+    },
 }
 
 
@@ -116,6 +194,13 @@ def _channel_command(
 WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
     "mc_command_feed_override_w": _channel_command(SetFeedOverride),
     "mc_command_execution_mode_w": _channel_command(SetExecutionMode),
+    "mc_command_single_block_w": _channel_command(SetSingleBlock),
+    "mc_command_mode_w": _channel_command(SelectMode),
+    "mc_command_program_name_w": _channel_command(SelectProgram),
+    "mc_command_start_w": _channel_command(StartProgram),
+    "mc_command_hold_w": _channel_command(Feedhold),
+    "mc_command_reset_w": _channel_command(ResetChannel),
+    "mc_command_manual_block_w": _channel_command(ManualBlock),
 }
 
 

@@ -8,6 +8,7 @@ default's array whole. Every mistake is refused at start with a message naming t
 from __future__ import annotations
 
 import tomllib
+from enum import StrEnum
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +26,9 @@ class AxisLimits(_Strict):
     acc_max_mm_s2: float = Field(5000.0, gt=0, description="maximum acceleration (mm/s^2)")
     sw_limit_min_mm: float = Field(-1000.0, description="negative software limit (mm)")
     sw_limit_max_mm: float = Field(1000.0, description="positive software limit (mm)")
+    vel_jump_mm_s: float = Field(
+        20.0, ge=0, description="permitted velocity jump of the axis at a block junction (mm/s)"
+    )
 
     @model_validator(mode="after")
     def _limits_ordered(self) -> AxisLimits:
@@ -50,6 +54,25 @@ class AxisConfig(_Strict):
     limits: AxisLimits = AxisLimits()
 
 
+class LookAhead(StrEnum):
+    """Look-ahead buffer size of a channel (P-CHAN-00650 interpolator functions)."""
+
+    LOW = "FCT_LOOK_AHEAD_LOW"  # 30 blocks
+    STANDARD = "FCT_LOOK_AHEAD_STANDARD"  # 120 blocks (default)
+    HIGH = "FCT_LOOK_AHEAD_HIGH"  # 190 blocks
+    CUSTOM = "FCT_LOOK_AHEAD_CUSTOM"  # look_ahead_custom_blocks (P-CHAN-00653)
+
+
+LOOK_AHEAD_BLOCKS = {LookAhead.LOW: 30, LookAhead.STANDARD: 120, LookAhead.HIGH: 190}
+
+
+class ToolConfig(_Strict):
+    """One entry of the tool table: D number and radius."""
+
+    d: int = Field(ge=1, le=9999, description="tool offset number (D word)")
+    radius_mm: float = Field(ge=0, description="tool radius (mm)")
+
+
 class ChannelConfig(_Strict):
     """A channel and its axes."""
 
@@ -63,6 +86,15 @@ class ChannelConfig(_Strict):
     feed_override_max: int = Field(
         1000, ge=0, le=0xFFFF, description="largest accepted feed override (0.1 %)"
     )
+    look_ahead: LookAhead = Field(LookAhead.STANDARD, description="P-CHAN-00650")
+    look_ahead_custom_blocks: int = Field(
+        120, ge=2, le=10_000, description="P-CHAN-00653: buffer size with FCT_LOOK_AHEAD_CUSTOM"
+    )
+
+    @property
+    def look_ahead_blocks(self) -> int:
+        """Blocks the look-ahead buffer holds."""
+        return LOOK_AHEAD_BLOCKS.get(self.look_ahead, self.look_ahead_custom_blocks)
 
     @model_validator(mode="after")
     def _unique_axis_names(self) -> ChannelConfig:
@@ -79,6 +111,10 @@ class MachineConfig(_Strict):
     cycle_ms: float = Field(1.0, gt=0.05, le=100.0, description="GEO cycle time (ms)")
     physical_axes: tuple[PhysicalAxisConfig, ...] = Field(min_length=1)
     channels: tuple[ChannelConfig, ...] = Field(min_length=1, max_length=12)
+    tools: tuple[ToolConfig, ...] = Field((), description="tool table (D number -> radius)")
+    program_store_dir: str | None = Field(
+        None, description="directory of the program store; default: per-user data directory"
+    )
 
     @model_validator(mode="after")
     def _references_resolve(self) -> MachineConfig:
@@ -88,6 +124,9 @@ class MachineConfig(_Strict):
         ids = [c.id for c in self.channels]
         if len(set(ids)) != len(ids):
             raise ValueError(f"channel ids repeat: {ids}")
+        d_numbers = [t.d for t in self.tools]
+        if len(set(d_numbers)) != len(d_numbers):
+            raise ValueError(f"tool D numbers repeat: {d_numbers}")
         logical = [a.logical_number for c in self.channels for a in c.axes]
         if len(set(logical)) != len(logical):
             raise ValueError(f"logical axis numbers (kopf.achs_nr) repeat: {logical}")
@@ -105,6 +144,11 @@ class MachineConfig(_Strict):
 DEFAULT_MACHINE: dict[str, Any] = {
     "name": "cnc-objects",
     "cycle_ms": 1.0,
+    "tools": [
+        {"d": 1, "radius_mm": 1.0},
+        {"d": 2, "radius_mm": 2.5},
+        {"d": 3, "radius_mm": 5.0},
+    ],
     "physical_axes": [
         {"number": 1, "name": "X"},
         {"number": 2, "name": "Y"},

@@ -1,7 +1,7 @@
 """``cnc-service``: the composition root. Builds kernel, address space and server, runs them.
 
     cnc-service [--config FILE] [--endpoint URL] [--clock realtime|virtual] [--speed X]
-                [--cycle-ms MS] [--log-level L]
+                [--cycle-ms MS] [--program-dir DIR] [--log-level L]
 
 Logs the endpoint it listens on (``listening on tcp://...``); SIGINT and SIGTERM stop it
 cleanly (sockets closed, cycle thread joined) with exit code 0. A bad configuration or
@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import logging
+import os
 import signal
 import sys
 from pathlib import Path
@@ -23,6 +24,8 @@ from .binding import build_address_space
 from .config import ConfigError, MachineConfig, load_config
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
+from .program_service import ProgramStoreService
+from .program_store import ProgramStore, StoreError
 from .server import AdsServer
 
 log = logging.getLogger("cnc-service")
@@ -41,6 +44,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--speed", type=float, help="virtual clock: times real time (default: as fast "
                    "as the CPU allows while busy)")
     p.add_argument("--cycle-ms", type=float, help="cycle time in ms (overrides the configuration)")
+    p.add_argument("--program-dir", type=Path, help="directory of the program store (default: "
+                   "program_store_dir of the configuration, else "
+                   "$XDG_DATA_HOME/cnc-objects/programs)")
     p.add_argument("--log-level", default="INFO",
                    choices=("DEBUG", "INFO", "WARNING", "ERROR"))
     return p
@@ -53,15 +59,40 @@ def make_clock(kind: str, cycle_s: float, speed: float | None) -> Clock:
     return VirtualClock(cycle_s, speed)
 
 
-async def serve(config: MachineConfig, endpoint: str, clock_kind: str, speed: float | None) -> int:
+def program_dir(arg: Path | None, config: MachineConfig) -> Path:
+    """Where the program store lives: the option, the configuration, the user's data dir."""
+    if arg is not None:
+        return arg
+    if config.program_store_dir:
+        return Path(config.program_store_dir).expanduser()
+    data_home = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
+    return Path(data_home) / "cnc-objects" / "programs"
+
+
+def _kernel_loader(store: ProgramStore):
+    """The store as the kernel sees it: text by name, KeyError when absent."""
+
+    def load(name: str) -> str:
+        try:
+            return store.read_text(name)
+        except StoreError:
+            raise KeyError(name) from None
+
+    return load, store.exists
+
+
+async def serve(
+    config: MachineConfig, endpoint: str, clock_kind: str, speed: float | None, store: ProgramStore
+) -> int:
     """Run kernel and server until SIGINT or SIGTERM."""
     loop = asyncio.get_running_loop()
     # The cycle thread must get the GIL soon after it wakes, even while the server is busy.
     sys.setswitchinterval(min(0.005, config.cycle_ms / 1000.0 / 4))
-    kernel = Kernel(config, make_clock(clock_kind, config.cycle_ms / 1000.0, speed))
+    load, exists = _kernel_loader(store)
+    kernel = Kernel(config, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists)
     space = build_address_space(kernel)
     try:
-        server = AdsServer(space, kernel, endpoint, loop)
+        server = AdsServer(space, kernel, endpoint, loop, programs=ProgramStoreService(store))
     except zmq.ZMQError as exc:
         print(f"cnc-service: cannot listen on {endpoint}: {exc}", file=sys.stderr)
         return 2
@@ -71,9 +102,10 @@ async def serve(config: MachineConfig, endpoint: str, clock_kind: str, speed: fl
     kernel.start()
     server.start()
     log.info(
-        "listening on %s (machine %s, %d channels, %d objects, %s clock, cycle %g ms)",
+        "listening on %s (machine %s, %d channels, %d objects, %s clock, cycle %g ms, "
+        "programs in %s)",
         server.endpoint, config.name, len(config.channels), len(space), clock_kind,
-        config.cycle_ms,
+        config.cycle_ms, store.root,
     )
     try:
         await stop.wait()
@@ -106,7 +138,14 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:  # --cycle-ms out of range
         print(f"cnc-service: bad --cycle-ms: {exc}", file=sys.stderr)
         return 2
-    return asyncio.run(serve(config, args.endpoint, args.clock, args.speed))
+    directory = program_dir(args.program_dir, config)
+    try:
+        store = ProgramStore(directory)
+    except OSError as exc:
+        print(f"cnc-service: cannot use program directory {directory}: {exc.strerror}",
+              file=sys.stderr)
+        return 2
+    return asyncio.run(serve(config, args.endpoint, args.clock, args.speed, store))
 
 
 if __name__ == "__main__":

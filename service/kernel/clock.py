@@ -59,6 +59,10 @@ class RealtimeClock:
         self._deadline += self.cycle_s
 
 
+#: A busy virtual clock yields the CPU to other threads once per this many cycles.
+YIELD_EVERY_CYCLES = 64
+
+
 class VirtualClock:
     """Kernel time detached from the wall clock.
 
@@ -69,6 +73,7 @@ class VirtualClock:
         self.cycle_s = cycle_s
         self.speed = speed
         self._deadline = 0.0
+        self._busy_cycles = 0
 
     def start(self) -> None:
         self._deadline = time.perf_counter()
@@ -82,6 +87,11 @@ class VirtualClock:
             else:
                 self._deadline = time.perf_counter()
         elif busy:
-            time.sleep(0)  # let the service's thread take the GIL between cycles
+            # Let the service's thread take the GIL now and then. Not every cycle: a
+            # sleep(0) costs tens of microseconds on a VM, several cycles' worth of work,
+            # and the interpreter's switch interval hands the GIL over anyway.
+            self._busy_cycles += 1
+            if self._busy_cycles % YIELD_EVERY_CYCLES == 0:
+                time.sleep(0)
         else:
             wake.wait_for_command(self.cycle_s)

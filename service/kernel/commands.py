@@ -20,6 +20,7 @@ class RefusalReason(IntEnum):
     INVALID_VALUE = 1  # the value is outside what the object accepts
     NOT_READY = 2  # the kernel or channel is not in a state that allows it
     BUSY = 3  # try again in a later cycle
+    NOT_FOUND = 4  # the named thing (a program) does not exist
 
 
 class Refusal(NamedTuple):
@@ -38,7 +39,7 @@ class Command(Protocol):
 
 
 #: Execution mode bits the kernel implements so far. Others are refused, never stored.
-IMPLEMENTED_EXECUTION_MODES = ExecutionMode.ISG_STANDARD
+IMPLEMENTED_EXECUTION_MODES = ExecutionMode.ISG_STANDARD | ExecutionMode.ADD_MDI_BLOCK
 _KNOWN_MODE_BITS = sum(m for m in ExecutionMode)
 
 
@@ -84,3 +85,71 @@ class SetExecutionMode:
             )
         state.channels[self.channel_index].execution_mode_command = self.value
         return None
+
+
+@dataclass(frozen=True, slots=True)
+class SetSingleBlock:
+    """Single block on or off; in effect from this cycle."""
+
+    channel_index: int
+    value: bool
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        state.channels[self.channel_index].single_block = bool(self.value)
+        return None
+
+
+@dataclass(frozen=True, slots=True)
+class SelectMode:
+    """Select the channel's operation mode (ChannelMode value)."""
+
+    channel_index: int
+    value: int
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        return state.runners[self.channel_index].select_mode(self.value)
+
+
+@dataclass(frozen=True, slots=True)
+class SelectProgram:
+    """Select a program of the store for AUTOMATIC."""
+
+    channel_index: int
+    value: str
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        return state.runners[self.channel_index].select_program(self.value)
+
+
+def _pulse(name: str, method: str) -> type:
+    """A command object written with TRUE to trigger ``method`` of the channel runner."""
+
+    @dataclass(frozen=True, slots=True)
+    class Pulse:
+        channel_index: int
+        value: bool
+
+        def apply(self, state: KernelState) -> Refusal | None:
+            if not self.value:
+                return None  # writing FALSE is accepted and does nothing, as a PLC edge
+            return getattr(state.runners[self.channel_index], method)()
+
+    Pulse.__name__ = Pulse.__qualname__ = name
+    Pulse.__doc__ = f"Write TRUE: ``ChannelRunner.{method}``."
+    return Pulse
+
+
+StartProgram = _pulse("StartProgram", "start")
+Feedhold = _pulse("Feedhold", "hold")
+ResetChannel = _pulse("ResetChannel", "reset")
+
+
+@dataclass(frozen=True, slots=True)
+class ManualBlock:
+    """Run NC text as manual blocks (MDI)."""
+
+    channel_index: int
+    value: str
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        return state.runners[self.channel_index].manual_block(self.value)

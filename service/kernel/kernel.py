@@ -18,13 +18,19 @@ from dataclasses import dataclass
 from enum import Enum
 
 from ..config import MachineConfig
-from .clock import Clock
+from .channel_run import ChannelRunner
+from .clock import Clock, VirtualClock
 from .commands import Command, Refusal, RefusalReason
 from .state import CycleStats, KernelState, Snapshot
 
 log = logging.getLogger(__name__)
 
 Done = Callable[[Refusal | None], None]
+Loader = Callable[[str], str]
+
+
+def _no_programs(name: str) -> str:
+    raise KeyError(name)
 
 
 class Control(Enum):
@@ -48,12 +54,23 @@ _SHUTDOWN = object()
 class Kernel:
     """Kernel state plus the cycle thread that owns it."""
 
-    def __init__(self, config: MachineConfig, clock: Clock) -> None:
+    def __init__(
+        self,
+        config: MachineConfig,
+        clock: Clock,
+        loader: Loader = _no_programs,
+        exists: Callable[[str], bool] = lambda name: False,
+    ) -> None:
+        """``loader(name)`` returns a program's text (KeyError when absent) and
+        ``exists(name)`` says whether it is there: the program store, seen by the kernel."""
         self.config = config
         self.cycle_s = config.cycle_ms / 1000.0
         self.cycle_ns = round(config.cycle_ms * 1e6)
         self._clock = clock
-        self.state = KernelState.from_config(config)
+        self._loader = loader
+        self._exists = exists
+        self._busy = False
+        self.state = self._initial_state()
         self.stats = CycleStats(cycle_us=round(config.cycle_ms * 1000))
         self.snapshot: Snapshot = self.state.snapshot(0, 0, self.stats)
         self.on_cycle_end: Callable[[Snapshot], None] | None = None
@@ -62,6 +79,17 @@ class Kernel:
         self._channel_index = {c.channel_id: k for k, c in enumerate(self.state.channels)}
         self._thread: threading.Thread | None = None
         self._closed = False
+
+    def _initial_state(self) -> KernelState:
+        state = KernelState.from_config(self.config)
+        # Virtual time must give the same result cycle by cycle: GEO waits for the decoder.
+        deterministic = isinstance(self._clock, VirtualClock)
+        state.runners = [
+            ChannelRunner(channel, cfg, self.config, self._loader, self._exists, self.cycle_s,
+                          deterministic)
+            for channel, cfg in zip(state.channels, self.config.channels, strict=True)
+        ]
+        return state
 
     # ------------------------------------------------------------ service side
 
@@ -148,6 +176,8 @@ class Kernel:
                 break
             applied.append((done, self._apply(command)))
         self.stats.cycles += 1
+        if self.stats.running:
+            self._work()
         self._publish()
         for done, result in applied:
             done(result)
@@ -187,7 +217,9 @@ class Kernel:
             case Control.STOP:
                 self.stats.running = False
             case Control.RESET:
-                self.state = KernelState.from_config(self.config)
+                for runner in self.state.runners:
+                    runner.reset()
+                self.state = self._initial_state()
                 self.stats.running = True
         return None
 
@@ -207,10 +239,16 @@ class Kernel:
         if hook is not None:
             hook(self.snapshot)
 
-    def state_has_work(self) -> bool:
-        """True while something must be computed every cycle.
+    def _work(self) -> None:
+        """The cycle's work: every channel's path, then the drives follow their axes."""
+        time_s = self.stats.cycles * self.cycle_s
+        busy = False
+        for runner in self.state.runners:
+            busy |= runner.cycle(time_s)
+        self.state.drive_axes()
+        self._busy = busy
 
-        The kernel of this issue has no motion yet: channels hold their axes and wait
-        for commands, so the virtual clock may idle between commands.
-        """
-        return False
+    def state_has_work(self) -> bool:
+        """True while a channel moves or decodes: the virtual clock runs cycles back to
+        back; otherwise it may idle until the next command."""
+        return self._busy

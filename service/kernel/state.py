@@ -62,19 +62,38 @@ class PhysicalAxis:
 
 @dataclass(slots=True)
 class LogicalAxis:
-    """An axis of a channel and its link to a physical axis."""
+    """An axis of a channel, its command position and its link to a physical axis."""
 
     name: str
     logical_number: int
     requested_link: int  # physical axis number the axis asks for
     actual_link: int = 0  # physical axis number linked now; 0 = none
     link_state: LinkState = LinkState.LINKED
+    position_mm: float = 0.0  # command position of the channel axis
+    command_position_incr: int = 0  # the same in 0.1 um, as the objects show it
+    output_incr: int = 0  # command position last handed to the physical axis
 
     def frozen(self) -> LogicalAxis:
         """A copy for the snapshot."""
         return LogicalAxis(
-            self.name, self.logical_number, self.requested_link, self.actual_link, self.link_state
+            self.name, self.logical_number, self.requested_link, self.actual_link,
+            self.link_state, self.position_mm, self.command_position_incr, self.output_incr,
         )
+
+
+@dataclass(frozen=True, slots=True)
+class ChannelError:
+    """An error of a channel: ISG-style id, text, and where in which NC file it arose."""
+
+    id: int
+    text: str
+    file: str = ""
+    line: int = 0
+    column: int = 0
+
+    def __str__(self) -> str:
+        where = f"{self.file}:{self.line}:{self.column}: " if self.file else ""
+        return f"error {self.id}: {where}{self.text}"
 
 
 @dataclass(slots=True)
@@ -91,20 +110,35 @@ class Channel:
     execution_mode_active: int = 0
     dist_prog_start_incr: float = 0.0  # 0.1 um
     output_suspended: bool = False
+    mode: int = 1  # ChannelMode
+    state: int = 1  # ChannelState
+    program_name: str = ""  # selected program
+    single_block: bool = False
+    waiting_for_start: bool = False  # standing at M0/M1 or a single-block stop
+    block_number: int = -1  # N of the block in the interpolator; -1 = none
+    line: int = 0  # its line in file_name (1-based; 0 = none)
+    file_name: str = ""  # file of the block in the interpolator
+    file_offset: int = 0  # byte offset of its line in that file
+    block_count: int = 0  # blocks finished since program start
+    manual_blocks_done: int = 0  # manual blocks finished since the channel started
+    path_velocity_mm_s: float = 0.0
+    programmed_velocity_mm_s: float = 0.0
+    remaining_in_block_mm: float = 0.0
+    program_time_s: float = 0.0
+    errors: tuple[ChannelError, ...] = ()
+    error_count: int = 0
 
     def frozen(self) -> Channel:
         """A copy for the snapshot, with copies of its axes."""
         return Channel(
-            self.channel_id,
-            self.name,
-            [a.frozen() for a in self.axes],
-            self.feed_override_max,
-            self.feed_override_command,
-            self.feed_override_active,
-            self.execution_mode_command,
-            self.execution_mode_active,
-            self.dist_prog_start_incr,
-            self.output_suspended,
+            self.channel_id, self.name, [a.frozen() for a in self.axes],
+            self.feed_override_max, self.feed_override_command, self.feed_override_active,
+            self.execution_mode_command, self.execution_mode_active,
+            self.dist_prog_start_incr, self.output_suspended, self.mode, self.state,
+            self.program_name, self.single_block, self.waiting_for_start, self.block_number,
+            self.line, self.file_name, self.file_offset, self.block_count,
+            self.manual_blocks_done, self.path_velocity_mm_s, self.programmed_velocity_mm_s,
+            self.remaining_in_block_mm, self.program_time_s, self.errors, self.error_count,
         )
 
 
@@ -148,6 +182,7 @@ class KernelState:
 
     channels: list[Channel] = field(default_factory=list)
     physical_axes: list[PhysicalAxis] = field(default_factory=list)
+    runners: list = field(default_factory=list)  # ChannelRunner per channel (kernel sets)
 
     @classmethod
     def from_config(cls, config: MachineConfig) -> KernelState:
@@ -169,6 +204,23 @@ class KernelState:
                 else:  # another channel holds it: the request waits
                     axis.link_state = LinkState.REQUESTED
         return state
+
+    def drive_axes(self) -> None:
+        """Position controller: each physical axis follows the increments of the logical
+        axis linked to it (ideal drive: actual position = command position)."""
+        drives = self.physical_axes
+        for channel in self.channels:
+            if channel.output_suspended:
+                continue
+            for axis in channel.axes:
+                delta = axis.command_position_incr - axis.output_incr
+                if delta and axis.actual_link:
+                    for drive in drives:
+                        if drive.number == axis.actual_link:
+                            drive.command_position_incr += delta
+                            drive.actual_position_incr = drive.command_position_incr
+                            break
+                axis.output_incr = axis.command_position_incr
 
     def snapshot(self, cycle: int, time_ns: int, stats: CycleStats) -> Snapshot:
         """Frozen copies of everything readable."""

@@ -40,7 +40,7 @@ def test_endpoint_from_environment(endpoint: str) -> None:
 
 
 def test_browse_json_keys(endpoint: str) -> None:
-    result = cnc("--json", "browse", "ch2.ax1.*", endpoint=endpoint)
+    result = cnc("--json", "browse", "ch2.ax1.*link*", endpoint=endpoint)
     assert result.returncode == 0, result.stderr
     rows = json_lines(result)
     assert [r["name"] for r in rows] == [

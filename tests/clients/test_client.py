@@ -141,6 +141,9 @@ async def test_browse_describes_objects(api: Any) -> None:
         "ch1.ax1.requested_link_to_physical_axis",
         "ch1.ax1.actual_link_to_physical_axis",
         "ch1.ax1.link_state",
+        "ch1.ax1.command_position_acs",
+        "ch1.ax1.logical_axis_number",
+        "ch1.ax1.axis_name",
     }
     link = found["ch1.ax1.link_state"]
     assert (link.port, link.group, link.offset, link.type, link.length, link.access) == (

@@ -101,6 +101,13 @@ def test_addresses_are_unique() -> None:
     assert len(addresses) == len(set(addresses))
 
 
+def _scope(obj) -> Scope:
+    """The scope an instance was made for, from its channel and axis."""
+    if obj.channel:
+        return Scope.CHANNEL_AXIS if obj.axis else Scope.CHANNEL
+    return Scope.PHYSICAL_AXIS if obj.axis else Scope.PLATFORM
+
+
 def test_every_template_is_instantiated_once_per_scope_member() -> None:
     objects = build_objects(LAYOUT)
     expected = {
@@ -110,15 +117,18 @@ def test_every_template_is_instantiated_once_per_scope_member() -> None:
         Scope.CHANNEL_AXIS: sum(c.axis_count for c in LAYOUT.channels),
     }
     for template in TEMPLATES:
-        count = sum(1 for o in objects if o.element == template.element)
+        count = sum(
+            1 for o in objects if o.element == template.element and _scope(o) == template.scope
+        )
         assert count == expected[template.scope], template.element
     assert len(objects) == sum(expected[t.scope] for t in TEMPLATES)
 
 
 def test_every_object_follows_the_address_rules() -> None:
-    templates = {t.element: t for t in TEMPLATES}
+    templates = {(t.element, t.scope): t for t in TEMPLATES}
+    assert len(templates) == len(TEMPLATES), "an element name repeats within one scope"
     for obj in build_objects(LAYOUT):
-        t = templates[obj.element]
+        t = templates[obj.element, _scope(obj)]
         assert obj.group & LOGICAL_BIT, obj.name
         assert obj.port == t.port and obj.dtype is t.dtype and obj.access is t.access
         match t.scope:

@@ -11,6 +11,7 @@ import re
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -54,6 +55,8 @@ def start_service(*args: str, timeout_s: float = 20.0) -> RunningService:
     argv = [sys.executable, "-m", "service.main", "--endpoint", "tcp://127.0.0.1:*"]
     if "--clock" not in args:
         argv += ["--clock", "virtual"]
+    if "--program-dir" not in args:  # every test service gets an empty store of its own
+        argv += ["--program-dir", tempfile.mkdtemp(prefix="cnc-programs-")]
     proc = subprocess.Popen(
         [*argv, *args], cwd=ROOT, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True
     )

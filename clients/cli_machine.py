@@ -1,0 +1,202 @@
+"""``cnc`` commands that operate the machine: program store, run, MDI, hold, status.
+
+    cnc upload FILE [--name NAME]        cnc download NAME [-o FILE]      cnc programs
+    cnc run FILE|NAME [--channel N] [--wait] [--timeout S]
+    cnc mdi "BLOCKS" [--channel N] [--wait] [--timeout S]
+    cnc hold|resume|reset [--channel N]  cnc status [--channel N]
+
+``--wait`` exits 0 when the program (or manual block) has finished, 4 with the channel's
+error text when the channel went to ERROR, 5 when ``--timeout`` passed first.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import asdict
+from pathlib import Path
+
+import typer
+
+from .cli import EXIT_USAGE, Settings, _emit, _fail, app, err, out
+from .errors import AdsError, AdsTimeoutError, ChannelError
+
+EXIT_CHANNEL_ERROR = 4
+EXIT_WAIT_TIMEOUT = 5
+
+ChannelOption = typer.Option(1, "--channel", "-c", min=1, help="Channel id (default 1).")
+WaitOption = typer.Option(False, "--wait", help="Return when finished; non-zero on ERROR.")
+WaitTimeoutOption = typer.Option(
+    None, "--timeout", min=0.0, help="With --wait: give up after S seconds (exit 5)."
+)
+
+
+def _finish_wait(exc: Exception) -> None:
+    if isinstance(exc, ChannelError):
+        err.print(f"error: {exc}")
+        raise typer.Exit(EXIT_CHANNEL_ERROR)
+    if isinstance(exc, AdsTimeoutError) and "still" in str(exc):
+        err.print(f"error: {exc}")
+        raise typer.Exit(EXIT_WAIT_TIMEOUT)
+    _fail(exc)
+
+
+@app.command()
+def upload(
+    ctx: typer.Context,
+    file: Path = typer.Argument(..., help="Local NC file."),
+    name: str = typer.Option(None, "--name", help="Name in the store (default: file name)."),
+) -> None:
+    """Upload a local NC file into the service's program store."""
+    settings: Settings = ctx.obj
+    try:
+        data = file.read_bytes()
+    except OSError as exc:
+        err.print(f"error: cannot read {file}: {exc.strerror}")
+        raise typer.Exit(EXIT_USAGE) from None
+    target = name or file.name
+    try:
+        with settings.client() as c:
+            c.upload(target, data)
+    except AdsError as exc:
+        _fail(exc)
+    _emit(settings, {"name": target, "size_bytes": len(data), "ok": True},
+          f"uploaded {target} ({len(data)} bytes)")
+
+
+@app.command()
+def download(
+    ctx: typer.Context,
+    name: str = typer.Argument(..., help="Name in the store."),
+    output: Path = typer.Option(None, "--output", "-o", help="Write here (default: stdout)."),
+) -> None:
+    """Download a file of the program store (programs, result files, logs)."""
+    settings: Settings = ctx.obj
+    try:
+        with settings.client() as c:
+            data = c.download(name)
+    except AdsError as exc:
+        _fail(exc)
+    if output is None:
+        sys.stdout.buffer.write(data)
+        sys.stdout.flush()
+        return
+    try:
+        output.write_bytes(data)
+    except OSError as exc:
+        err.print(f"error: cannot write {output}: {exc.strerror}")
+        raise typer.Exit(EXIT_USAGE) from None
+    _emit(settings, {"name": name, "size_bytes": len(data), "output": str(output)},
+          f"downloaded {name} ({len(data)} bytes) to {output}")
+
+
+@app.command()
+def programs(ctx: typer.Context) -> None:
+    """List the program store."""
+    settings: Settings = ctx.obj
+    try:
+        with settings.client() as c:
+            entries = c.programs()
+    except AdsError as exc:
+        _fail(exc)
+    for e in entries:
+        _emit(settings, asdict(e), f"{e.name:40} {e.size_bytes:10d} bytes")
+    if not settings.as_json:
+        out.print(f"{len(entries)} files")
+
+
+@app.command()
+def run(
+    ctx: typer.Context,
+    program: str = typer.Argument(..., help="A local file (uploaded first) or a stored name."),
+    channel: int = ChannelOption,
+    wait: bool = WaitOption,
+    timeout_s: float = WaitTimeoutOption,
+) -> None:
+    """Select a program in AUTOMATIC and START it (a local file is uploaded first)."""
+    settings: Settings = ctx.obj
+    local = Path(program)
+    name = local.name if local.is_file() else program
+    try:
+        with settings.client() as c:
+            if local.is_file():
+                c.upload(name, local.read_bytes())
+            c.run_program(name, channel)
+            if not wait:
+                _emit(settings, {"channel": channel, "program": name, "started": True},
+                      f"channel {channel}: {name} started")
+                return
+            c.wait_program(channel, timeout_s)
+            status = c.status(channel)
+    except (AdsError, ChannelError) as exc:
+        _finish_wait(exc)
+    _emit(settings, {"channel": channel, "program": name, "finished": True,
+                     "program_time_s": status.program_time_s},
+          f"channel {channel}: {name} finished in {status.program_time_s:.3f} s")
+
+
+@app.command()
+def mdi(
+    ctx: typer.Context,
+    blocks: str = typer.Argument(..., help="NC blocks; separate blocks with newlines or a "
+                                 "literal \\n (';' starts a comment, as in NC programs)."),
+    channel: int = ChannelOption,
+    wait: bool = WaitOption,
+    timeout_s: float = WaitTimeoutOption,
+) -> None:
+    """Run manual blocks (MDI) in a channel."""
+    settings: Settings = ctx.obj
+    text = blocks.replace("\\n", "\n")
+    try:
+        with settings.client() as c:
+            before = c.mdi(text, channel)
+            if wait:
+                c.wait_mdi(before, channel, timeout_s)
+    except (AdsError, ChannelError) as exc:
+        _finish_wait(exc)
+    _emit(settings, {"channel": channel, "ok": True, "finished": wait},
+          f"channel {channel}: manual block {'finished' if wait else 'started'}")
+
+
+def _channel_command(method: str, done: str):
+    def command(ctx: typer.Context, channel: int = ChannelOption) -> None:
+        settings: Settings = ctx.obj
+        try:
+            with settings.client() as c:
+                getattr(c, method)(channel)
+        except AdsError as exc:
+            _fail(exc)
+        _emit(settings, {"channel": channel, "ok": True}, f"channel {channel}: {done}")
+
+    return command
+
+
+app.command("hold", help="Feedhold: the path decelerates and stops (HOLD).")(
+    _channel_command("hold", "feedhold")
+)
+app.command("resume", help="START again after feedhold, M0/M1 or a single-block stop.")(
+    _channel_command("start", "resumed")
+)
+app.command("reset", help="RESET the channel from any state.")(
+    _channel_command("reset", "reset")
+)
+
+
+@app.command()
+def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
+    """Mode, state, program, block and axis positions (mm) of a channel."""
+    settings: Settings = ctx.obj
+    try:
+        with settings.client() as c:
+            s = c.status(channel)
+    except AdsError as exc:
+        _fail(exc)
+    positions = "  ".join(f"{n}={v:.4f}" for n, v in s.positions_mm.items())
+    lines = [
+        f"channel {s.channel}: {s.mode}/{s.state}  program {s.program or '-'}",
+        f"block N{s.block_number if s.block_number >= 0 else '-'} {s.file or '-'}:{s.line}  "
+        f"v={s.path_velocity_mm_s:.3f} mm/s  "
+        f"t={s.program_time_s:.3f} s",
+        f"positions (mm): {positions}",
+        *s.errors,
+    ]
+    _emit(settings, asdict(s), "\n".join(lines))

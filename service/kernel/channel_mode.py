@@ -1,0 +1,57 @@
+"""The channel's operation mode and state (HLI ``channel_mc_control.mode_and_state``).
+
+Modes and states carry the documented HLI values. The rules, as this kernel implements
+them (docs/kernel.md has the diagram):
+
+* A mode is chosen only while the channel is not working (DESELECTED, SELECTED, READY);
+  choosing a mode puts the channel in SELECTED (STANDBY: DESELECTED).
+* AUTOMATIC: SELECTED --select program--> READY --START--> ACTIVE; the program's end
+  returns to READY (the program stays selected and can be started again).
+* MDI: a manual block is loaded and started at once (READY -> ACTIVE -> READY). With the
+  execution mode bit ADD_MDI_BLOCK the end of a manual block is not the end of the
+  program: the channel stays ACTIVE and further manual blocks continue the same program
+  (same modal state, path distance and program time) until M30 or RESET.
+* ACTIVE --feedhold--> HOLD --START--> ACTIVE.
+* Any error -> ERROR; RESET from any state -> READY (a program is selected) or SELECTED.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+
+class ChannelMode(IntEnum):
+    """Operation mode of a channel (HLI values)."""
+
+    STANDBY = 1  # no operation mode selected
+    AUTOMATIC = 2  # programs from the program store
+    MDI = 3  # manual data input: manual blocks
+    MANUAL = 4  # jog / handwheel (manual mode; no NC program)
+    REFERENCE = 5  # homing (not offered by this kernel's commands)
+
+
+class ChannelState(IntEnum):
+    """State of the channel within its mode (HLI values)."""
+
+    DESELECTED = 1  # the mode is not selected
+    SELECTED = 2  # the mode is selected, nothing to run yet
+    READY = 3  # a program (or manual block) is ready to start
+    ACTIVE = 4  # running
+    HOLD = 5  # feedhold: the path is stopped and resumes on START
+    ERROR = 6  # an error stopped the channel; RESET clears it
+
+
+#: States in which the channel is not working: a mode or program may be chosen.
+IDLE_STATES = frozenset({ChannelState.DESELECTED, ChannelState.SELECTED, ChannelState.READY})
+
+#: Modes a client may select with ``mc_command_mode_w``.
+SELECTABLE_MODES = frozenset(
+    {ChannelMode.STANDBY, ChannelMode.AUTOMATIC, ChannelMode.MDI, ChannelMode.MANUAL}
+)
+
+
+def describe(mode: int, state: int) -> str:
+    """'AUTOMATIC/READY' for the values, tolerant of unknown numbers."""
+    m = ChannelMode(mode).name if mode in ChannelMode._value2member_map_ else str(mode)
+    s = ChannelState(state).name if state in ChannelState._value2member_map_ else str(state)
+    return f"{m}/{s}"

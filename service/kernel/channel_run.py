@@ -1,0 +1,310 @@
+"""One channel at work: its mode/state machine, its program run, its path.
+
+The GEO cycle calls ``ChannelRunner.cycle`` once per cycle; commands (select, start,
+feedhold, RESET, manual block) call the other methods, also on the cycle thread, and
+answer None or a ``Refusal`` with the reason. The decoder of a run lives in the run's
+SDA thread (``DecoderFeed``); blocks enter the look-ahead buffer of the
+``PathExecutor`` as slots free up.
+
+Errors take effect where they are in the program: the blocks before an erroneous block
+run to their end, the path stops there, and the channel goes to ERROR with the error
+(id, text, file, line, column) in its error list. A block that would leave a software
+limit is refused before it moves.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+
+from ..config import ChannelConfig, MachineConfig
+from .channel_mode import IDLE_STATES, SELECTABLE_MODES, ChannelMode, ChannelState, describe
+from .commands import Refusal, RefusalReason
+from .decoder_feed import DecodeEnd, DecoderFeed, Job
+from .nc import ModalState, NcError
+from .nc.blocks import Block, StopKind
+from .path.executor import AxisDynamics, PathError, PathExecutor
+from .path.interpolator import Waiting
+from .state import Channel, ChannelError, ExecutionMode
+
+log = logging.getLogger(__name__)
+
+MAX_ERRORS_KEPT = 8  # the error list keeps the first errors of a run (the first is the cause)
+_FEED_MARGIN_BLOCKS = 256  # the decoder may run this far ahead of the look-ahead buffer
+_MDI_NAME = "MDI"  # file name of manual blocks in errors and objects
+_INCR_PER_MM = 10_000  # 0.1 um increments per mm
+
+
+def _not_ready(channel: Channel, what: str) -> Refusal:
+    return Refusal(
+        RefusalReason.NOT_READY,
+        f"channel {channel.channel_id} is {describe(channel.mode, channel.state)}: {what}",
+    )
+
+
+class ChannelRunner:
+    """The working parts of one channel, driven by the GEO cycle."""
+
+    def __init__(
+        self,
+        channel: Channel,
+        config: ChannelConfig,
+        machine: MachineConfig,
+        loader: Callable[[str], str],
+        exists: Callable[[str], bool],
+        cycle_s: float,
+        deterministic: bool,
+    ) -> None:
+        self.channel = channel
+        self.config = config
+        self._loader = loader
+        self._exists = exists
+        self._cycle_s = cycle_s
+        self._deterministic = deterministic  # virtual clock: wait for the decoder
+        self._axes = tuple(a.name for a in config.axes)
+        self._tools = {t.d: t.radius_mm for t in machine.tools}
+        self._dynamics = tuple(
+            AxisDynamics(a.limits.vel_max_mm_s, a.limits.acc_max_mm_s2, a.limits.vel_jump_mm_s)
+            for a in config.axes
+        )
+        self._sw_limits = tuple(
+            (a.limits.sw_limit_min_mm, a.limits.sw_limit_max_mm) for a in config.axes
+        )
+        self._buffer_blocks = config.look_ahead_blocks
+        self._executor: PathExecutor | None = None
+        self._feed: DecoderFeed | None = None
+        self._modal: ModalState | None = None  # MDI: modal state carried between blocks
+        self._pending_error: ChannelError | None = None
+        self._fed_all = False
+        self._started_at_s = 0.0
+        self._time_s = 0.0
+
+    # ------------------------------------------------------------ commands
+
+    def select_mode(self, mode: int) -> Refusal | None:
+        """Choose the operation mode (only while the channel is not working)."""
+        ch = self.channel
+        if mode not in SELECTABLE_MODES:
+            names = ", ".join(f"{m.value} {m.name}" for m in sorted(SELECTABLE_MODES))
+            return Refusal(RefusalReason.INVALID_VALUE, f"mode {mode} cannot be selected; use {names}")
+        if ch.state not in IDLE_STATES:
+            return _not_ready(ch, "select a mode after the program ends or after RESET")
+        ch.mode = mode
+        ch.state = ChannelState.DESELECTED if mode == ChannelMode.STANDBY else ChannelState.SELECTED
+        if mode != ChannelMode.AUTOMATIC:
+            ch.program_name = ""
+        self._modal = None
+        return None
+
+    def select_program(self, name: str) -> Refusal | None:
+        """Select ``name`` from the program store: AUTOMATIC/READY."""
+        ch = self.channel
+        if ch.state not in IDLE_STATES:
+            return _not_ready(ch, f"cannot select {name!r} while it works; hold and RESET first")
+        if not name or not self._exists(name):
+            return Refusal(RefusalReason.NOT_FOUND, f"no program {name!r} in the program store")
+        ch.mode, ch.state, ch.program_name = ChannelMode.AUTOMATIC, ChannelState.READY, name
+        return None
+
+    def start(self) -> Refusal | None:
+        """START: run the selected program, resume from HOLD, continue after a stop."""
+        ch = self.channel
+        if ch.state == ChannelState.HOLD:
+            ch.state = ChannelState.ACTIVE
+            ch.waiting_for_start = False
+            self._executor.resume()
+            return None
+        if ch.state == ChannelState.ACTIVE:
+            if not ch.waiting_for_start:
+                return _not_ready(ch, "the program is running already")
+            ch.waiting_for_start = False
+            self._executor.resume()
+            return None
+        if ch.state != ChannelState.READY or ch.mode != ChannelMode.AUTOMATIC:
+            return _not_ready(ch, "START needs AUTOMATIC/READY (select a program first) or HOLD")
+        self._begin(Job(ch.program_name), keep_open=False, fresh_modal=True)
+        return None
+
+    def hold(self) -> Refusal | None:
+        """Feedhold: decelerate on the path and stop (ACTIVE -> HOLD)."""
+        ch = self.channel
+        if ch.state != ChannelState.ACTIVE:
+            return _not_ready(ch, "feedhold needs a running program (ACTIVE)")
+        ch.state = ChannelState.HOLD
+        self._executor.hold()
+        return None
+
+    def manual_block(self, text: str) -> Refusal | None:
+        """MDI: run ``text`` as manual blocks (selects MDI when the channel is idle)."""
+        ch = self.channel
+        extended = bool(ch.execution_mode_active & ExecutionMode.ADD_MDI_BLOCK)
+        if not text.strip():
+            return Refusal(RefusalReason.INVALID_VALUE, "the manual block is empty")
+        if ch.state == ChannelState.ACTIVE and ch.mode == ChannelMode.MDI and extended:
+            self._feed.add(Job(_MDI_NAME, text, manual=True))  # continues the same program
+            return None
+        if ch.state not in IDLE_STATES or ch.mode == ChannelMode.MANUAL:
+            return _not_ready(ch, "a manual block needs a channel that is not working")
+        if ch.mode != ChannelMode.MDI:
+            ch.mode = ChannelMode.MDI
+            ch.program_name = ""
+            self._modal = None
+        extended = bool(ch.execution_mode_command & ExecutionMode.ADD_MDI_BLOCK)
+        self._begin(Job(_MDI_NAME, text, manual=True), keep_open=extended, fresh_modal=False)
+        return None
+
+    def reset(self) -> Refusal | None:
+        """RESET from any state: stop at once, clear errors, back to READY or SELECTED."""
+        ch = self.channel
+        self._stop_run()
+        if self._executor is not None:
+            self._executor.stop_now()
+        self._pending_error = None
+        ch.errors, ch.error_count = (), 0
+        ch.waiting_for_start = False
+        ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
+        if ch.mode == ChannelMode.STANDBY:
+            ch.state = ChannelState.DESELECTED
+        elif ch.mode == ChannelMode.AUTOMATIC and ch.program_name:
+            ch.state = ChannelState.READY
+        else:
+            ch.state = ChannelState.SELECTED
+        self._modal = None
+        return None
+
+    # ------------------------------------------------------------ run
+
+    def _begin(self, job: Job, keep_open: bool, fresh_modal: bool) -> None:
+        ch = self.channel
+        ch.execution_mode_active = ch.execution_mode_command
+        position = tuple(a.position_mm for a in ch.axes)
+        if fresh_modal or self._modal is None:
+            self._modal = ModalState(position_mm=position)
+        else:
+            self._modal.position_mm = position
+        self._feed = DecoderFeed(
+            channel_id=ch.channel_id, axes=self._axes, loader=self._loader, tools=self._tools,
+            modal=self._modal, capacity=self._buffer_blocks + _FEED_MARGIN_BLOCKS,
+            keep_open=keep_open,
+        )
+        self._feed.add(job)
+        if not keep_open:
+            self._feed.finish()
+        self._executor = PathExecutor(
+            self._dynamics, position, cycle_s=self._cycle_s,
+            buffer_blocks=self._buffer_blocks, sw_limits_mm=self._sw_limits,
+        )
+        self._executor.single_block = ch.single_block
+        self._fed_all = False
+        self._pending_error = None
+        self._started_at_s = self._time_s
+        ch.state = ChannelState.ACTIVE
+        ch.waiting_for_start = False
+        ch.errors, ch.error_count = (), 0
+        ch.block_count = 0
+        ch.dist_prog_start_incr = 0.0
+        ch.program_time_s = 0.0
+        ch.file_name, ch.line, ch.file_offset, ch.block_number = job.name, 0, 0, -1
+
+    def _stop_run(self) -> None:
+        if self._feed is not None:
+            self._feed.cancel()
+            if self._modal is not None:
+                self._modal = self._feed.modal
+            self._feed = None
+
+    def _raise(self, error: ChannelError) -> None:
+        ch = self.channel
+        log.info("channel %d: %s", ch.channel_id, error)
+        ch.error_count += 1
+        if len(ch.errors) < MAX_ERRORS_KEPT:
+            ch.errors = (*ch.errors, error)
+
+    def _fail(self, error: ChannelError) -> None:
+        ch = self.channel
+        self._raise(error)
+        self._stop_run()
+        ch.state = ChannelState.ERROR
+        ch.waiting_for_start = False
+        ch.program_time_s = self._time_s - self._started_at_s
+
+    def _feed_blocks(self) -> None:
+        executor, feed = self._executor, self._feed
+        if feed is None or self._fed_all or self._pending_error is not None:
+            return
+        free = executor.free_slots()
+        if free <= 0:
+            return
+        for item in feed.take(free, wait=self._deterministic):
+            if isinstance(item, Block):
+                try:
+                    executor.push(item)
+                except PathError as exc:
+                    src = exc.block.source if exc.block is not None else item.source
+                    self._pending_error = ChannelError(
+                        int(exc.id), exc.message, src.file, src.line, src.column
+                    )
+                    return
+            elif isinstance(item, NcError):
+                self._pending_error = ChannelError(
+                    int(item.id), item.message, item.file, item.line, item.column
+                )
+                return
+            elif isinstance(item, DecodeEnd):
+                executor.close()
+                self._fed_all = True
+
+    def cycle(self, time_s: float) -> bool:
+        """One GEO cycle of the channel; True while it has motion or decoding to do."""
+        self._time_s = time_s
+        ch = self.channel
+        executor = self._executor
+        if executor is None or ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
+            return False
+        if executor.single_block != ch.single_block:
+            executor.single_block = ch.single_block
+        self._feed_blocks()
+        step = executor.step(ch.feed_override_active / 1000.0)
+        for axis, pos in zip(ch.axes, step.position_mm, strict=True):
+            axis.position_mm = pos
+            axis.command_position_incr = round(pos * _INCR_PER_MM)
+        ch.path_velocity_mm_s = step.path_velocity_mm_s
+        ch.programmed_velocity_mm_s = step.programmed_velocity_mm_s
+        ch.remaining_in_block_mm = step.remaining_in_block_mm
+        ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
+        ch.program_time_s = time_s - self._started_at_s
+        for block in step.finished:
+            ch.block_count += 1
+            if self._feed is not None and self._feed.is_marker(block):
+                ch.manual_blocks_done += 1
+        shown = step.current or (step.finished[-1] if step.finished else None)
+        if shown is not None and not (self._feed and self._feed.is_marker(shown)):
+            src = shown.source
+            ch.file_name, ch.line, ch.file_offset = src.file, src.line, src.offset
+            ch.block_number = shown.number if shown.number is not None else -1
+        stopped = step.stopped_at
+        if stopped is not None and stopped.stop == StopKind.PROGRAM_END:
+            return self._end_program()
+        # M0/M1 or a single-block stop: the path stands at a block end until START.
+        ch.waiting_for_start = ch.state == ChannelState.ACTIVE and executor.waiting in (
+            Waiting.PROGRAMMED_STOP, Waiting.SINGLE_BLOCK,
+        )
+        if executor.idle:
+            if self._pending_error is not None:
+                self._fail(self._pending_error)
+                return False
+            if self._fed_all:
+                return self._end_program()
+            if ch.mode == ChannelMode.MDI and self._feed is not None and self._feed.keep_open:
+                return False  # extended MDI: waiting for the next manual block
+        return True
+
+    def _end_program(self) -> bool:
+        ch = self.channel
+        self._stop_run()
+        ch.state = ChannelState.READY
+        ch.waiting_for_start = False
+        ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
+        ch.program_time_s = self._time_s - self._started_at_s
+        return False
+

@@ -1,0 +1,173 @@
+"""The SDA task of one program run: the decoder in a thread of its own, ahead of motion.
+
+The decoder turns NC text into blocks as fast as the queue to the GEO task takes them;
+the queue is bounded, so the decoder never runs further ahead than ``capacity`` blocks
+beyond the look-ahead buffer. The GEO cycle takes blocks without waiting (realtime
+clock: if the decoder falls behind, the path plans a stop at the last block it has, as a
+real CNC does) or, with the virtual clock, waits until the decoder has delivered what
+the look-ahead buffer can take, so that a run is the same cycle by cycle every time.
+
+Several texts can be decoded one after the other with one modal state: the extended
+manual block mode (ADD_MDI_BLOCK) continues a program with each new manual block.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+
+from .nc import Decoder, ModalState, NcError
+from .nc.blocks import Block, SourceRef
+
+log = logging.getLogger(__name__)
+
+_PUT_POLL_S = 0.05  # how often a decoder waiting on a full queue checks for cancel
+
+
+@dataclass(frozen=True, slots=True)
+class TextDone:
+    """Marker after the blocks of one text (a manual block): carried as a block."""
+
+    block: Block
+
+
+@dataclass(frozen=True, slots=True)
+class DecodeEnd:
+    """No more blocks will come."""
+
+
+@dataclass(frozen=True, slots=True)
+class Job:
+    """One text to decode: a program from the store (``text`` None) or a manual block."""
+
+    name: str
+    text: str | None = None
+    manual: bool = False
+
+
+Item = Block | NcError | DecodeEnd
+
+ProgramLoader = Callable[[str], str]
+
+
+class DecoderFeed:
+    """Decodes jobs in order in one SDA thread and queues the blocks for GEO."""
+
+    def __init__(
+        self,
+        *,
+        channel_id: int,
+        axes: tuple[str, ...],
+        loader: ProgramLoader,
+        tools: dict[int, float],
+        modal: ModalState,
+        capacity: int,
+        keep_open: bool = False,
+    ) -> None:
+        self._axes = axes
+        self._loader = loader
+        self._tools = tools
+        self.modal = modal
+        self.keep_open = keep_open  # extended MDI: wait for more jobs instead of ending
+        self._jobs: queue.SimpleQueue[Job | None] = queue.SimpleQueue()
+        self._out: queue.Queue[Item] = queue.Queue(maxsize=capacity)
+        self._cancel = threading.Event()
+        self._ended = False
+        self._markers: set[int] = set()
+        self._outstanding = 0  # jobs added whose end the GEO side has not taken yet
+        self._thread = threading.Thread(
+            target=self._run, name=f"cnc-sda-ch{channel_id}", daemon=True
+        )
+        self._thread.start()
+
+    # ------------------------------------------------------------ GEO side
+
+    def add(self, job: Job) -> None:
+        """Decode ``job`` after the ones before it."""
+        self._outstanding += 1
+        self._jobs.put(job)
+
+    def finish(self) -> None:
+        """End after the jobs already added."""
+        self._jobs.put(None)
+
+    def is_marker(self, block: Block) -> bool:
+        """True for the end-of-text marker block of a manual block."""
+        return id(block) in self._markers
+
+    def take(self, limit: int, wait: bool) -> list[Item]:
+        """Up to ``limit`` items; with ``wait``, block until ``limit`` items, the end of
+        the jobs added so far, or the end of decoding."""
+        items: list[Item] = []
+        while len(items) < limit and not self._ended:
+            try:
+                item = self._out.get_nowait()
+            except queue.Empty:
+                if not wait or self._outstanding <= 0:
+                    break
+                item = self._out.get()
+            items.append(item)
+            if isinstance(item, DecodeEnd | NcError):
+                self._ended = True
+            elif id(item) in self._markers:
+                self._outstanding -= 1
+        return items
+
+    def cancel(self) -> None:
+        """Stop decoding (RESET); the thread ends soon after."""
+        self._cancel.set()
+        self._jobs.put(None)
+
+    # ------------------------------------------------------------ SDA thread
+
+    def _put(self, item: Item) -> bool:
+        while not self._cancel.is_set():
+            try:
+                self._out.put(item, timeout=_PUT_POLL_S)
+                return True
+            except queue.Full:
+                continue
+        return False
+
+    def _blocks(self, job: Job) -> Iterator[Block]:
+        text = job.text if job.text is not None else self._loader(job.name)
+        decoder = Decoder(
+            text, job.name, axes=self._axes, loader=self._loader, tools=self._tools,
+            modal=self.modal, manual=job.manual,
+        )
+        yield from decoder.blocks()
+        self.modal = decoder.modal
+
+    def _run(self) -> None:
+        self._job = Job("?")
+        try:
+            while not self._cancel.is_set():
+                job = self._jobs.get()
+                if job is None:
+                    break
+                self._job = job
+                for block in self._blocks(job):
+                    if not self._put(block):
+                        return
+                    if block.stop == 3:  # PROGRAM_END: nothing after M30 is decoded
+                        self._put(DecodeEnd())
+                        return
+                if job.manual:
+                    marker = Block(SourceRef(job.name, 0), manual=True)
+                    self._markers.add(id(marker))
+                    if not self._put(marker):
+                        return
+                if not self.keep_open:
+                    break
+            self._put(DecodeEnd())
+        except NcError as exc:
+            self._put(exc)
+        except KeyError as exc:  # loader: the program vanished between select and start
+            name = self._job.name
+            self._put(NcError(20000, name, 0, 0, f"program {exc.args[0]!r} not found"))
+        except Exception as exc:  # a decoder fault is the program's error, never a crash
+            log.exception("decoder failed on %s", self._job.name)
+            self._put(NcError(20001, self._job.name, 0, 0, f"decoder fault: {exc!r}"))
