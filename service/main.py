@@ -27,6 +27,7 @@ from .kernel.kernel import Kernel
 from .program_service import ProgramStoreService
 from .program_store import ProgramStore, StoreError
 from .server import AdsServer
+from .store_writer import StoreWriter
 
 log = logging.getLogger("cnc-service")
 
@@ -89,10 +90,16 @@ async def serve(
     # The cycle thread must get the GIL soon after it wakes, even while the server is busy.
     sys.setswitchinterval(min(0.005, config.cycle_ms / 1000.0 / 4))
     load, exists = _kernel_loader(store)
-    kernel = Kernel(config, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists)
+    writer = StoreWriter(store)
+    kernel = Kernel(
+        config, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists,
+        writer.append,
+    )
     space = build_address_space(kernel)
     try:
-        server = AdsServer(space, kernel, endpoint, loop, programs=ProgramStoreService(store))
+        server = AdsServer(
+            space, kernel, endpoint, loop, programs=ProgramStoreService(store, writer.flush)
+        )
     except zmq.ZMQError as exc:
         print(f"cnc-service: cannot listen on {endpoint}: {exc}", file=sys.stderr)
         return 2
@@ -113,6 +120,7 @@ async def serve(
         log.info("stopping")
         server.close()
         kernel.close()
+        writer.close()
     log.info("stopped")
     return 0
 

@@ -8,6 +8,7 @@ an oversized upload or a short read buffer 0x705, a full store 0x70A.
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 
 from protocol.constants import ProgramStoreOffset as Op
 from protocol.datatypes import STRING_ENCODING
@@ -44,13 +45,16 @@ def _unknown(offset: int, what: str) -> Result:
 class ProgramStoreService:
     """ADS operations on a ``ProgramStore``."""
 
-    def __init__(self, store: ProgramStore) -> None:
+    def __init__(self, store: ProgramStore, flush: Callable[[], None] = lambda: None) -> None:
+        """``flush`` waits for files the kernel queued (see ``StoreWriter``)."""
         self.store = store
+        self._flush = flush
 
     def read(self, offset: int, length: int) -> Result:
         """ADS Read: the program list."""
         if offset != Op.LIST:
             return _unknown(offset, "answer a read")
+        self._flush()
         listing = "".join(
             f"{p.name}\t{p.size_bytes}\t{p.mtime_s:.3f}\n" for p in self.store.list()
         ).encode("utf-8")
@@ -80,6 +84,7 @@ class ProgramStoreService:
         """ADS ReadWrite: download."""
         if offset != Op.DOWNLOAD:
             return _unknown(offset, "answer a read-write")
+        self._flush()
         try:
             content = self.store.read(_name(data))
         except StoreError as exc:

@@ -101,14 +101,32 @@ class ProgramStore:
                 raise StoreError(
                     StoreFault.FULL, f"the store holds {self.max_files} files; delete some first"
                 )
-            fd, temp = tempfile.mkstemp(prefix=_TEMP_PREFIX, dir=self.root)
+            self._replace(name, data)
+
+    def append(self, name: str, data: bytes) -> None:
+        """Add ``data`` at the end of ``name`` (created when absent), atomically; when the
+        file would exceed the size bound its oldest bytes are dropped (whole lines)."""
+        with self._lock:
             try:
-                with os.fdopen(fd, "wb") as f:
-                    f.write(data)
-                os.replace(temp, path)
-            except OSError as exc:
-                Path(temp).unlink(missing_ok=True)
-                raise StoreError(StoreFault.IO, f"cannot store {name!r}: {exc.strerror}") from None
+                old = self._path(name).read_bytes()
+            except FileNotFoundError:
+                old = b""
+            content = old + data
+            if len(content) > self.max_bytes:
+                content = content[-self.max_bytes :]
+                content = content[content.find(b"\n") + 1 :]
+            self._replace(name, content)
+
+    def _replace(self, name: str, data: bytes) -> None:
+        path = self._path(name)
+        fd, temp = tempfile.mkstemp(prefix=_TEMP_PREFIX, dir=self.root)
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(data)
+            os.replace(temp, path)
+        except OSError as exc:
+            Path(temp).unlink(missing_ok=True)
+            raise StoreError(StoreFault.IO, f"cannot store {name!r}: {exc.strerror}") from None
 
     def read(self, name: str) -> bytes:
         """The content of ``name``."""

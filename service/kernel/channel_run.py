@@ -54,6 +54,7 @@ class ChannelRunner:
         exists: Callable[[str], bool],
         cycle_s: float,
         deterministic: bool,
+        files: Callable[[str, bytes], None] = lambda name, data: None,
     ) -> None:
         self.channel = channel
         self.config = config
@@ -61,6 +62,8 @@ class ChannelRunner:
         self._exists = exists
         self._cycle_s = cycle_s
         self._deterministic = deterministic  # virtual clock: wait for the decoder
+        self._files = files  # appends to a file of the program store, off this thread
+        self.error_log_name = f"errors-ch{channel.channel_id}.log"
         self._axes = tuple(a.name for a in config.axes)
         self._tools = {t.d: t.radius_mm for t in machine.tools}
         self._dynamics = tuple(
@@ -216,6 +219,7 @@ class ChannelRunner:
     def _raise(self, error: ChannelError) -> None:
         ch = self.channel
         log.info("channel %d: %s", ch.channel_id, error)
+        self._files(self.error_log_name, f"{self._time_s:.3f} s {error}\n".encode())
         ch.error_count += 1
         if len(ch.errors) < MAX_ERRORS_KEPT:
             ch.errors = (*ch.errors, error)

@@ -60,15 +60,18 @@ class Kernel:
         clock: Clock,
         loader: Loader = _no_programs,
         exists: Callable[[str], bool] = lambda name: False,
+        files: Callable[[str, bytes], None] = lambda name, data: None,
     ) -> None:
         """``loader(name)`` returns a program's text (KeyError when absent) and
-        ``exists(name)`` says whether it is there: the program store, seen by the kernel."""
+        ``exists(name)`` says whether it is there: the program store, seen by the kernel.
+        ``files(name, data)`` appends to a file of the store (logs); it must not block."""
         self.config = config
         self.cycle_s = config.cycle_ms / 1000.0
         self.cycle_ns = round(config.cycle_ms * 1e6)
         self._clock = clock
         self._loader = loader
         self._exists = exists
+        self._files = files
         self._busy = False
         self.state = self._initial_state()
         self.stats = CycleStats(cycle_us=round(config.cycle_ms * 1000))
@@ -86,7 +89,7 @@ class Kernel:
         deterministic = isinstance(self._clock, VirtualClock)
         state.runners = [
             ChannelRunner(channel, cfg, self.config, self._loader, self._exists, self.cycle_s,
-                          deterministic)
+                          deterministic, self._files)
             for channel, cfg in zip(state.channels, self.config.channels, strict=True)
         ]
         return state

@@ -102,6 +102,10 @@ def test_error_is_readable_through_objects(c):
     assert values["ch1.mc_error_1_line_r"] == 2
     assert values["ch1.mc_error_1_column_r"] == 8  # the Q of "G1 Y10 Q7"
     assert "Q" in values["ch1.mc_error_1_text_r"]
+    # The kernel logs every error into the store, where it can be downloaded.
+    log = c.download("errors-ch1.log").decode()
+    assert "bad.nc:2:8:" in log.splitlines()[-1]
+    assert "errors-ch1.log" in [p.name for p in c.programs()]
 
 
 def test_start_without_program_is_refused_with_a_reason(c):

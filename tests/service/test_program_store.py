@@ -99,3 +99,14 @@ def test_a_reader_never_sees_half_a_file(store):
         seen += 1
     t.join()
     assert seen > 0
+
+
+def test_append_creates_grows_and_drops_the_oldest_lines(store):
+    store.append("log.txt", b"first\n")
+    store.append("log.txt", b"second\n")
+    assert store.read("log.txt") == b"first\nsecond\n"
+    line = b"x" * 99 + b"\n"
+    for _ in range(15):
+        store.append("log.txt", line)
+    content = store.read("log.txt")
+    assert len(content) <= 1000 and content.endswith(line) and content.startswith(b"x")

@@ -1,0 +1,54 @@
+"""Files the kernel writes (logs, result files), written into the program store by a
+thread of their own: the cycle thread only queues the bytes and never touches a disk.
+
+``flush`` waits until everything queued so far is on disk; the program-store service
+calls it before answering a list or a download, so a client that saw an effect (a
+channel in ERROR) and then downloads the log sees the line that effect wrote.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+
+from .program_store import ProgramStore, StoreError
+
+log = logging.getLogger(__name__)
+
+
+class StoreWriter:
+    """Appends to files of the store in a background thread, in the order queued."""
+
+    def __init__(self, store: ProgramStore) -> None:
+        self._store = store
+        self._queue: queue.Queue[tuple[str, bytes] | None] = queue.Queue()
+        self._thread = threading.Thread(target=self._run, name="cnc-store-writer", daemon=True)
+        self._thread.start()
+
+    def append(self, name: str, data: bytes) -> None:
+        """Queue ``data`` for the end of ``name`` (any thread; never blocks)."""
+        self._queue.put((name, data))
+
+    def flush(self) -> None:
+        """Return once everything queued before the call is written."""
+        self._queue.join()
+
+    def close(self) -> None:
+        """Write what is queued, then stop the thread."""
+        self._queue.put(None)
+        self._thread.join(5.0)
+
+    def _run(self) -> None:
+        while True:
+            item = self._queue.get()
+            try:
+                if item is None:
+                    return
+                name, data = item
+                try:
+                    self._store.append(name, data)
+                except StoreError as exc:
+                    log.error("cannot write %s: %s", name, exc)
+            finally:
+                self._queue.task_done()
