@@ -54,3 +54,22 @@ def test_bad_configuration_names_the_key(overrides: dict, key: str) -> None:
         build_config(overrides, "machine.toml")
     assert key in str(caught.value)
     assert str(caught.value).startswith("machine.toml: ")
+
+
+def test_look_ahead_buffer_sizes_follow_p_chan_00650() -> None:
+    def blocks(**channel) -> int:
+        base = build_config().model_dump()["channels"][0]
+        return build_config({"channels": [{**base, **channel}]}).channels[0].look_ahead_blocks
+
+    assert blocks() == 120
+    assert blocks(look_ahead="FCT_LOOK_AHEAD_LOW") == 30
+    assert blocks(look_ahead="FCT_LOOK_AHEAD_HIGH") == 190
+    assert blocks(look_ahead="FCT_LOOK_AHEAD_CUSTOM", look_ahead_custom_blocks=500) == 500
+
+
+def test_unknown_look_ahead_and_repeated_tools_are_refused() -> None:
+    base = build_config().model_dump()["channels"][0]
+    with pytest.raises(ConfigError, match="look_ahead"):
+        build_config({"channels": [{**base, "look_ahead": "FAST"}]})
+    with pytest.raises(ConfigError, match="tool D numbers repeat"):
+        build_config({"tools": [{"d": 1, "radius_mm": 1}, {"d": 1, "radius_mm": 2}]})

@@ -2,15 +2,17 @@
 
 Public API: ``Decoder`` (text -> lazy stream of ``Block``), ``ModalState`` (what
 survives between decoders), ``NcError`` / ``NcErrorId`` (every error with id, file,
-line and column). The output contract is in ``blocks``.
+line and column), ``check_syntax`` (all parse errors of a file at once). The output
+contract is in ``blocks``.
 """
 
 from .blocks import Block, Compensation, Motion, MotionKind, SourceRef, StopKind
 from .decoder import Decoder
 from .errors import NcError, NcErrorId
 from .modal import DistanceMode, ModalState, Plane
+from .syntax import check_syntax
 
 __all__ = [
     "Block", "Compensation", "Decoder", "DistanceMode", "ModalState", "Motion",
-    "MotionKind", "NcError", "NcErrorId", "Plane", "SourceRef", "StopKind",
+    "MotionKind", "NcError", "NcErrorId", "Plane", "SourceRef", "StopKind", "check_syntax",
 ]

@@ -22,7 +22,7 @@ from typing import Any
 
 from .blocks import Block, Compensation, MotionKind, StopKind
 from .construct import make_block, make_motion, make_source
-from .errors import NcErrorId
+from .errors import NcError, NcErrorId
 from .expressions import evaluate_number
 from .geometry import centre_from_offsets, centre_from_radius
 from .modal import G_CODES, PLANE_AXES, DistanceMode, GGroup, MCode, ModalState, Plane
@@ -49,6 +49,14 @@ _M_FLOW = {
 }
 
 _OFFSET_LETTER = ("I", "J", "K")
+# the plain fields of the ModalState a block may change (variables excluded)
+_MODAL_FIELDS = ("position_mm", "distance", "plane", "motion", "feed_mm_min", "compensation",
+                 "tool_offset", "spindle_speed_rpm", "tool")
+# modal G groups -> the ModalState field they set
+_MODAL_FIELD = {
+    GGroup.MOTION: "motion", GGroup.PLANE: "plane",
+    GGroup.COMPENSATION: "compensation", GGroup.DISTANCE: "distance",
+}
 
 
 def _integer(value: float) -> int | None:
@@ -92,15 +100,28 @@ class BlockExecutor:
     def tool_radius(self, d: int) -> float | None:
         """Radius of tool entry D (0.0 for D0), None when not in the table."""
         if d == 0:
-            return float(self.tools.get(0, 0.0))
+            return 0.0
         radius = self.tools.get(d)
         return None if radius is None else float(radius)
 
     def execute(self, stmt: NcBlock, env: Any) -> tuple[Block | None, Flow, int]:
-        """Run one block: (block or None, flow, position of the flow M word)."""
+        """Run one block: (block or None, flow, position of the flow M word).
+
+        A block with an error leaves the modal state as it was (a manual block after
+        it continues from the last good one); its assignments are not undone.
+        """
+        modal = self.modal
+        saved = tuple(getattr(modal, name) for name in _MODAL_FIELDS)
+        try:
+            return self._execute(stmt, env)
+        except NcError:
+            for name, value in zip(_MODAL_FIELDS, saved):
+                setattr(modal, name, value)
+            raise
+
+    def _execute(self, stmt: NcBlock, env: Any) -> tuple[Block | None, Flow, int]:
         line = stmt.line
         err = line.error
-        modal = self.modal
         groups: dict[GGroup, tuple[int, int]] = {}  # group -> (G number, pos)
         axis_words: list[tuple[int, float, int, str]] = []  # (axis, value, pos, letter)
         offsets: dict[int, tuple[float, int]] = {}  # axis -> (offset, pos)
@@ -111,46 +132,35 @@ class BlockExecutor:
                 item.target.assign(env, item.value(env))
                 continue
             value = evaluate_number(item.value, env, line, item.pos)
-            kind = item.kind
-            if kind == WordKind.AXIS:
-                axis_words.append((item.axis, value, item.pos, item.letter))
-            elif kind == WordKind.OFFSET:
-                offsets[item.axis] = (value, item.pos)
-                if item.axis < 0:
-                    raise err(
-                        NcErrorId.ARC_OFFSET_OUT_OF_PLANE,
-                        f"{item.letter}: the channel has no axis "
-                        f"{'XYZ'[_OFFSET_LETTER.index(item.letter)]}", item.pos,
-                    )
-            elif kind == WordKind.G:
-                number = _integer(value)
-                if number is None or number not in G_CODES:
-                    raise err(NcErrorId.UNSUPPORTED_G_CODE, f"G{value:g} is not supported", item.pos)
-                group = G_CODES[number][0]
-                if group in groups:
-                    raise err(
-                        NcErrorId.CONFLICTING_G_CODES,
-                        f"G{groups[group][0]} and G{number} in one block", item.pos,
-                    )
-                groups[group] = (number, item.pos)
-            elif kind == WordKind.M:
-                number = _integer(value)
-                if number is None:
-                    raise err(
-                        NcErrorId.INVALID_M_CODE, f"M{value:g} is not a valid M function", item.pos
-                    )
-                m_codes.append((number, item.pos))
-            else:
-                words[kind] = (value, item.pos)
+            match item.kind:
+                case WordKind.AXIS:
+                    axis_words.append((item.axis, value, item.pos, item.letter))
+                case WordKind.OFFSET:
+                    if item.axis < 0:
+                        raise err(
+                            NcErrorId.ARC_OFFSET_OUT_OF_PLANE,
+                            f"{item.letter}: the channel has no axis "
+                            f"{'XYZ'[_OFFSET_LETTER.index(item.letter)]}", item.pos,
+                        )
+                    offsets[item.axis] = (value, item.pos)
+                case WordKind.G:
+                    self._g_word(value, item.pos, groups, err)
+                case WordKind.M:
+                    number = _integer(value)
+                    if number is None:
+                        raise err(NcErrorId.INVALID_M_CODE,
+                                  f"M{value:g} is not a valid M function", item.pos)
+                    m_codes.append((number, item.pos))
+                case _:  # F S T D R
+                    words[item.kind] = (value, item.pos)
         self._modal_groups(groups)
         self._technology(words, err)
-        dwell = WordKind.FEED in words and GGroup.DWELL in groups
-        if GGroup.DWELL in groups:
+        if GGroup.DWELL in groups:  # G4: X or F is the time, F stays as it was
             dwell_s = self._dwell(groups, axis_words, offsets, words, err)
             motion = None
         else:
             dwell_s = 0.0
-            if WordKind.FEED in words and not dwell:
+            if WordKind.FEED in words:
                 self._feed(words[WordKind.FEED], err)
             motion = self._motion(groups, axis_words, offsets, words, err)
         stop = StopKind.NONE
@@ -181,18 +191,21 @@ class BlockExecutor:
 
     # ------------------------------------------------------------ parts
 
+    def _g_word(self, value: float, pos: int, groups: dict, err) -> None:
+        number = _integer(value)
+        if number is None or number not in G_CODES:
+            raise err(NcErrorId.UNSUPPORTED_G_CODE, f"G{value:g} is not supported", pos)
+        group = G_CODES[number][0]
+        if group in groups:
+            raise err(NcErrorId.CONFLICTING_G_CODES,
+                      f"G{groups[group][0]} and G{number} in one block", pos)
+        groups[group] = (number, pos)
+
     def _modal_groups(self, groups: dict[GGroup, tuple[int, int]]) -> None:
-        modal = self.modal
         for group, (number, _pos) in groups.items():
-            value = G_CODES[number][1]
-            if group == GGroup.MOTION:
-                modal.motion = value
-            elif group == GGroup.PLANE:
-                modal.plane = value
-            elif group == GGroup.COMPENSATION:
-                modal.compensation = value
-            elif group == GGroup.DISTANCE:
-                modal.distance = value
+            field = _MODAL_FIELD.get(group)
+            if field is not None:  # G4 (DWELL) changes nothing modal
+                setattr(self.modal, field, G_CODES[number][1])
 
     def _technology(self, words: dict, err) -> None:
         modal = self.modal

@@ -21,8 +21,10 @@ import re
 from typing import TYPE_CHECKING
 
 from .errors import NcErrorId
+from .expressions import ExpressionParser, Node
 from .frames import Frame, FrameKind
-from .source import join_lines
+from .lexer import IDENT, VARIABLE, Cursor
+from .source import LogicalLine, join_lines
 from .statements import Control, Declaration
 from .variables import (
     Scope, Value, Variable, VariableFault, VarType, convert, default_value,
@@ -32,6 +34,9 @@ if TYPE_CHECKING:
     from .decoder import Decoder
 
 _ENDVAR = re.compile(r"[ \t]*#[ \t]*ENDVAR\b")
+_UINT = re.compile(r"[0-9]+")
+_STRING_LENGTH = re.compile(r"\[[ \t]*[0-9]+[ \t]*\]")
+_DECL_SCOPES = {"L": Scope.L, "P": Scope.P, "G": Scope.G, "CYC": Scope.CYC}
 
 
 def read_block(decoder: Decoder, frame: Frame, stmt: Control, after: int) -> tuple[list, int]:
@@ -60,9 +65,80 @@ def read_block(decoder: Decoder, frame: Frame, stmt: Control, after: int) -> tup
             k = k_more
             if more is not None:
                 line = join_lines(line, more)
-        declarations.append(decoder.parser.declaration(line))
+        declarations.append(parse_declaration(line))
     program.var_blocks[frame.index] = (declarations, k)
     return declarations, k
+
+
+def parse_declaration(line: LogicalLine) -> Declaration:
+    """One line inside ``#VAR ... #ENDVAR``: ``V.x.NAME[dims] [: TYPE] [= init]``."""
+    cur = Cursor(line)
+    cur.skip_ws()
+    pos = cur.pos
+    m = cur.match(VARIABLE)
+    if m is None:
+        raise cur.error(
+            NcErrorId.INVALID_DECLARATION,
+            f"variable declaration expected, found '{cur.word_text()}'",
+        )
+    scope = _DECL_SCOPES.get(m.group(1))
+    if scope is None:
+        raise cur.error(
+            NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED,
+            f"V.{m.group(1)}. variables cannot be declared in #VAR", pos,
+        )
+    dims = []
+    while cur.peek() == "[":
+        cur.pos += 1
+        cur.skip_ws()
+        size = cur.match(_UINT)
+        cur.skip_ws()
+        if size is None or cur.peek() != "]" or int(size.group()) == 0:
+            raise cur.error(
+                NcErrorId.INVALID_DECLARATION, "array size must be a positive integer"
+            )
+        cur.pos += 1
+        dims.append(int(size.group()))
+    vtype = VarType.REAL64
+    cur.skip_ws()
+    if cur.peek() == ":":
+        cur.pos += 1
+        cur.skip_ws()
+        tpos = cur.pos
+        t = cur.match(IDENT)
+        if t is None or t.group() not in VarType.__members__:
+            raise cur.error(
+                NcErrorId.UNKNOWN_TYPE, f"unknown type '{cur.word_text(tpos)}'", tpos
+            )
+        vtype = VarType[t.group()]
+        if vtype == VarType.STRING and cur.peek() == "[":
+            if cur.match(_STRING_LENGTH) is None:
+                raise cur.error(NcErrorId.INVALID_DECLARATION, "STRING[n] needs a length")
+    init: Node | list | None = None
+    cur.skip_ws()
+    if cur.peek() == "=":
+        cur.pos += 1
+        cur.skip_ws()
+        init = _initializer(cur) if cur.peek() == "[" else ExpressionParser(cur).parse()
+    if not cur.at_end():
+        raise cur.unexpected(f"in the declaration of V.{m.group(1)}.{m.group(2)}")
+    return Declaration(scope, m.group(2), vtype, tuple(dims), init, line, pos)
+
+def _initializer(cur: Cursor) -> Node | list:
+    """``[a, b, [c, d]]`` (nested lists of expressions) or one bracketed expression."""
+    items: list = []
+    cur.pos += 1  # '['
+    parser = ExpressionParser(cur)
+    while True:
+        cur.skip_ws()
+        items.append(_initializer(cur) if cur.peek() == "[" else parser.parse())
+        cur.skip_ws()
+        if cur.peek() == ",":
+            cur.pos += 1
+            continue
+        parser.expect("]")
+        break
+    return items
 
 
 def _open_brackets(text: str) -> int:
@@ -171,4 +247,4 @@ class _Default:
 
 _DEFAULT_NODE = _Default()
 
-__all__ = ["VarType", "declare", "read_block"]
+__all__ = ["VarType", "declare", "parse_declaration", "read_block"]

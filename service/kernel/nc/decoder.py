@@ -89,7 +89,7 @@ class Decoder:
         self._control = ControlFlow(self)
         self.finished = False
         self._started = False
-        self.emitted = 0  # blocks yielded so far
+        self.emitted = 0  # grows whenever blocks were yielded (the loop guard watches it)
         self.own_variables: set[int] = set()  # ids of the variables this decoder declared
 
     @property

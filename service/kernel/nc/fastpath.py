@@ -67,7 +67,7 @@ def run(decoder):
         radius = executor.tool_radius(modal.tool_offset) or 0.0
         plane, line_plane, roles, outside = executor.arc_setup(modal.plane)
         role_i, role_j, role_k = roles
-        emitted = 0
+        emitted = False
         try:
             while i < end:
                 m = match(lines[i])
@@ -158,23 +158,23 @@ def run(decoder):
                     else:
 {linear_motion}
                 # the line is valid: commit the modal state
-                if gcode is not None:
-                    kind = k
-                    modal.motion = k
+                kind = k
+                modal.motion = k
+                feed = feed_k
                 if ftext is not None:
-                    feed = feed_k
                     modal.feed_mm_min = f_new
                 pos = end_pos
                 {unpack_pos} = end_pos
                 modal.position_mm = end_pos
 {block}
                 i += 1
-                emitted += 1
+                emitted = True
                 yield block
         except Exception as exc:  # a decoder bug must still be the program's error
             raise decoder.fault(exc, frame, i) from exc
         frame.index = i
-        decoder.emitted += emitted
+        if emitted:
+            decoder.emitted += 1  # only the change matters (ControlFlow.loop_pass)
         # the line the hot path did not take: the general path
         block = slow_step(frame)
         if block is not None:

@@ -15,20 +15,18 @@ from collections.abc import Mapping
 
 from .errors import NcErrorId
 from .expressions import Const, ExpressionParser, Node, VarRef
-from .lexer import IDENT, SIGNED_NUMBER, VARIABLE, Cursor
+from .lexer import IDENT, SIGNED_NUMBER, Cursor
 from .modal import G_CODES, GGroup
 from .source import LogicalLine
 from .statements import (
-    Assign, Call, Control, Declaration, Goto, NcBlock, StmtKind, Word, WordKind,
+    Assign, Call, Control, Goto, NcBlock, StmtKind, Word, WordKind,
 )
-from .variables import Scope, VarType
 
 _N_WORD = re.compile(r"N[ \t]*([-+]?[0-9.]*)([ \t]*:)?")
 _LABEL = re.compile(r"\[[ \t]*([A-Z0-9_]+)[ \t]*\]")
 _KEYWORD = re.compile(r"\$([A-Z]*)")
 _DIRECTIVE = re.compile(r"#[ \t]*([A-Z_]*)")
 _GOTO_N = re.compile(r"N[ \t]*([0-9]+)[ \t]*:?")
-_UINT = re.compile(r"[0-9]+")
 
 # $KEYWORD -> statement kind; $GOTO is an item of an NC block
 _CONTROL = {
@@ -300,7 +298,7 @@ class LineParser:
         cur.skip_ws()
         if cur.peek() != "=" or cur.peek(1) == "=":
             raise cur.error(
-                NcErrorId.EXPRESSION_SYNTAX, f"'=' expected after {target.full}"
+                NcErrorId.EXPRESSION_SYNTAX, f"'=' expected after {target.full}", pos
             )
         cur.pos += 1
         return Assign(target, parser.parse(), pos)
@@ -319,86 +317,12 @@ class LineParser:
                 NcErrorId.MISSING_VALUE, f"subprogram name expected after '{'LL' if local else 'L'}'",
                 pos,
             )
-        if name.upper().startswith("CYCLE") and (name.upper() == "CYCLE" or name[5] == "["):
+        if name.upper().startswith("CYCLE[") or (name.upper() == "CYCLE" and _skip(cur) < cur.end
+                                                 and cur.peek() == "["):
             raise cur.error(NcErrorId.CYCLE_NOT_SUPPORTED, "L CYCLE is not supported yet", pos)
         if block.call is not None:
             raise cur.error(NcErrorId.WORD_REPEATED, "two subprogram calls in one block", pos)
         block.call = Call(local, name, pos)
-
-    # ------------------------------------------------------------ #VAR lines
-
-    def declaration(self, line: LogicalLine) -> Declaration:
-        """One line inside ``#VAR ... #ENDVAR``: ``V.x.NAME[dims] [: TYPE] [= init]``."""
-        cur = Cursor(line)
-        cur.skip_ws()
-        pos = cur.pos
-        m = cur.match(VARIABLE)
-        if m is None:
-            raise cur.error(
-                NcErrorId.INVALID_DECLARATION,
-                f"variable declaration expected, found '{cur.word_text()}'",
-            )
-        scope = _DECL_SCOPES.get(m.group(1))
-        if scope is None:
-            raise cur.error(
-                NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED,
-                f"V.{m.group(1)}. variables cannot be declared in #VAR", pos,
-            )
-        dims = []
-        while cur.peek() == "[":
-            cur.pos += 1
-            cur.skip_ws()
-            size = cur.match(_UINT)
-            cur.skip_ws()
-            if size is None or cur.peek() != "]" or int(size.group()) == 0:
-                raise cur.error(
-                    NcErrorId.INVALID_DECLARATION, "array size must be a positive integer"
-                )
-            cur.pos += 1
-            dims.append(int(size.group()))
-        vtype = VarType.REAL64
-        cur.skip_ws()
-        if cur.peek() == ":":
-            cur.pos += 1
-            cur.skip_ws()
-            tpos = cur.pos
-            t = cur.match(IDENT)
-            if t is None or t.group() not in VarType.__members__:
-                raise cur.error(
-                    NcErrorId.UNKNOWN_TYPE, f"unknown type '{cur.word_text(tpos)}'", tpos
-                )
-            vtype = VarType[t.group()]
-            if vtype == VarType.STRING and cur.peek() == "[":
-                if cur.match(re.compile(r"\[[ \t]*[0-9]+[ \t]*\]")) is None:
-                    raise cur.error(NcErrorId.INVALID_DECLARATION, "STRING[n] needs a length")
-        init: Node | list | None = None
-        cur.skip_ws()
-        if cur.peek() == "=":
-            cur.pos += 1
-            cur.skip_ws()
-            init = self._initializer(cur) if cur.peek() == "[" else ExpressionParser(cur).parse()
-        if not cur.at_end():
-            raise cur.unexpected(f"in the declaration of V.{m.group(1)}.{m.group(2)}")
-        return Declaration(scope, m.group(2), vtype, tuple(dims), init, line, pos)
-
-    def _initializer(self, cur: Cursor) -> Node | list:
-        """``[a, b, [c, d]]`` (nested lists of expressions) or one bracketed expression."""
-        items: list = []
-        cur.pos += 1  # '['
-        parser = ExpressionParser(cur)
-        while True:
-            cur.skip_ws()
-            items.append(self._initializer(cur) if cur.peek() == "[" else parser.parse())
-            cur.skip_ws()
-            if cur.peek() == ",":
-                cur.pos += 1
-                continue
-            parser.expect("]")
-            break
-        return items
-
-
-_DECL_SCOPES = {"L": Scope.L, "P": Scope.P, "G": Scope.G, "CYC": Scope.CYC}
 
 
 def _skip(cur: Cursor) -> int:

@@ -29,6 +29,9 @@ from .parser import LineParser
 from .source import LogicalLine, SourceText, comment_directive, read_logical, strip_comments
 from .statements import CLOSER_OF, OPENERS, SPELLING, Control, NcBlock, StmtKind
 
+# parsed lines kept for loops and repeated calls; a long straight program does not
+# keep all of its lines parsed in memory (the cache starts over when full)
+CACHE_LINES = 50_000
 _LOCAL_HEADER = re.compile(r"[ \t]*%[ \t]*L[ \t]+(\S+)", re.I)
 _MAIN_HEADER = re.compile(r"[ \t]*%[ \t]*(\S*)")
 # the statement keyword of a line, without parsing it: $WORD or #RT WHILE/ENDWHILE
@@ -107,6 +110,8 @@ class Program:
         got = self._logical.get(index)
         if got is None:
             got = read_logical(self.src, index, end, self.skip_levels)
+            if len(self._logical) >= CACHE_LINES:
+                self._logical.clear()
             self._logical[index] = got
         return got
 
@@ -116,6 +121,8 @@ class Program:
         if got is None:
             line, after = self.logical(index, end)
             got = (None if line is None else self.parser.parse(line), after)
+            if len(self._statements) >= CACHE_LINES:
+                self._statements.clear()
             self._statements[index] = got
         return got
 

@@ -152,7 +152,7 @@ def test_declaration_in_a_loop_reinitialises():
         ("G0 X[V.P.G[1].POS]\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 6),
         ("#VAR\nV.L.S : STRING\n#ENDVAR\nV.L.S = 1\nM30", NcErrorId.TYPE_MISMATCH, 4, 1),
         ("#VAR\nV.L.S\n#ENDVAR\nV.L.S = \"x\"\nM30", NcErrorId.TYPE_MISMATCH, 4, 1),
-        ("#VAR\nV.L.A\n#ENDVAR\nV.L.A == 1\nM30", NcErrorId.EXPRESSION_SYNTAX, 4, 7),
+        ("#VAR\nV.L.A\n#ENDVAR\nV.L.A == 1\nM30", NcErrorId.EXPRESSION_SYNTAX, 4, 1),
         ("LL S\nM30\n%L S\n#VAR\nV.P.X\n#ENDVAR\nM17", NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED, 5, 1),
     ],
 )
