@@ -173,7 +173,8 @@ class BlockExecutor:
                 m_functions.append(number)
                 continue
             if flow_pos >= 0:
-                raise err(NcErrorId.CONFLICTING_M_CODES, f"M{number} with another program-flow M", pos)
+                raise err(NcErrorId.CONFLICTING_M_CODES,
+                          f"M{number} with another program-flow M", pos)
             stop, flow = action
             flow_pos = pos
         spindle = words.get(WordKind.SPINDLE)
@@ -213,18 +214,21 @@ class BlockExecutor:
             value, pos = words[WordKind.TOOL_OFFSET]
             d = _integer(value)
             if d is None or self.tool_radius(d) is None:
-                raise err(NcErrorId.TOOL_NOT_IN_TABLE, f"tool D{value:g} is not in the tool table", pos)
+                raise err(NcErrorId.TOOL_NOT_IN_TABLE,
+                          f"tool D{value:g} is not in the tool table", pos)
             modal.tool_offset = d
         if WordKind.SPINDLE in words:
             value, pos = words[WordKind.SPINDLE]
             if value < 0:
-                raise err(NcErrorId.INVALID_SPINDLE_SPEED, f"spindle speed S{value:g} is negative", pos)
+                raise err(NcErrorId.INVALID_SPINDLE_SPEED,
+                          f"spindle speed S{value:g} is negative", pos)
             modal.spindle_speed_rpm = value
         if WordKind.TOOL in words:
             value, pos = words[WordKind.TOOL]
             t = _integer(value)
             if t is None:
-                raise err(NcErrorId.INVALID_TOOL_NUMBER, f"T{value:g} is not a valid tool number", pos)
+                raise err(NcErrorId.INVALID_TOOL_NUMBER,
+                          f"T{value:g} is not a valid tool number", pos)
             modal.tool = t
 
     def _feed(self, word: tuple[float, int], err) -> None:
@@ -244,9 +248,11 @@ class BlockExecutor:
                       + ([words[WordKind.RADIUS][1]] if WordKind.RADIUS in words else []))
             raise err(NcErrorId.INVALID_DWELL, "a G4 block cannot move axes", pos)
         if not times:
-            raise err(NcErrorId.INVALID_DWELL, "G4 needs the dwell time in seconds: G4 X.. or G4 F..", g_pos)
+            raise err(NcErrorId.INVALID_DWELL,
+                      "G4 needs the dwell time in seconds: G4 X.. or G4 F..", g_pos)
         if len(times) > 1:
-            raise err(NcErrorId.INVALID_DWELL, "G4 takes the time from X or F, not both", times[1][1])
+            raise err(NcErrorId.INVALID_DWELL, "G4 takes the time from X or F, not both",
+                      times[1][1])
         value, pos = times[0]
         if value < 0:
             raise err(NcErrorId.INVALID_DWELL, f"dwell time {value:g} s is negative", pos)
@@ -284,7 +290,8 @@ class BlockExecutor:
             feed = math.inf
         else:
             if modal.feed_mm_min is None:
-                raise err(NcErrorId.NO_FEED, f"no feed programmed for G{int(kind)}: program F", motion_pos)
+                raise err(NcErrorId.NO_FEED,
+                          f"no feed programmed for G{int(kind)}: program F", motion_pos)
             feed = modal.feed_mm_min / 60.0
         modal.position_mm = end_t
         comp = modal.compensation

@@ -196,7 +196,8 @@ def _create(decoder: Decoder, decl: Declaration, full: str, site) -> Variable:
             if init is not None:
                 if not isinstance(init, list):
                     raise VariableFault(
-                        NcErrorId.INVALID_DECLARATION, f"{full} is an array: initialise it with [..]"
+                        NcErrorId.INVALID_DECLARATION,
+                        f"{full} is an array: initialise it with [..]",
                     )
                 flat = _flatten(init, dims, full)
                 for n, node in enumerate(flat):

@@ -108,7 +108,9 @@ class NcErrorId(IntEnum):
 class NcError(Exception):
     """An error in an NC program, at a place: ``error <id>: <file>:<line>:<column>: <msg>``."""
 
-    def __init__(self, id: int, file: str, line: int, column: int, message: str) -> None:  # noqa: A002
+    def __init__(  # noqa: A002 - "id" is the field name the callers use
+        self, id: int, file: str, line: int, column: int, message: str
+    ) -> None:
         self.id = id
         self.file = file
         self.line = line

@@ -89,7 +89,7 @@ class VarRef:
 
 
 def _index(value: Value, line: LogicalLine, pos: int) -> int:
-    if isinstance(value, str) or value != int(value):
+    if isinstance(value, str) or not math.isfinite(value) or value != int(value):
         raise line.error(
             NcErrorId.ARRAY_INDEX_MISMATCH, f"array index {value!r} is not an integer", pos
         )
@@ -144,10 +144,14 @@ def _mod(a: Value, b: Value) -> Value:
     _numbers(a, b, "MOD")
     if b == 0:
         raise Fault(NcErrorId.DIVISION_BY_ZERO, "division by zero (MOD 0)")
-    return math.fmod(a, b)
+    try:
+        return math.fmod(a, b)
+    except ValueError:  # an infinite dividend
+        raise Fault(NcErrorId.MATH_DOMAIN, f"{a:g} MOD {b:g} is not defined") from None
 
 
 def pow_op(a: Value, b: Value) -> Value:
+    """a ** b (and a ^ b) as a float; Fault when undefined or too large."""
     _numbers(a, b, "**")
     try:
         return math.pow(a, b)
@@ -160,7 +164,7 @@ def _compare(op: str, fn: Callable[[Any, Any], bool]) -> Callable[[Value, Value]
         if isinstance(a, str) != isinstance(b, str):
             raise Fault(NcErrorId.TYPE_MISMATCH, f"cannot compare a string with a number ({op})")
         if isinstance(a, str) and op not in ("==", "!=", "<>"):
-            raise Fault(NcErrorId.TYPE_MISMATCH, f"strings can only be compared with == and !=")
+            raise Fault(NcErrorId.TYPE_MISMATCH, "strings can only be compared with == and !=")
         return fn(a, b)
 
     return apply
@@ -248,6 +252,7 @@ def logic(first: Node, rest: list[tuple[int, Node]], stop_on: bool, line: Logica
 
 
 def xor_op(a: Value, b: Value) -> Value:
+    """Logical exclusive or of two numbers / TRUE-FALSE values."""
     if isinstance(a, str) or isinstance(b, str):
         raise Fault(NcErrorId.TYPE_MISMATCH, "XOR needs numbers or TRUE/FALSE")
     return (a != 0) != (b != 0)

@@ -30,7 +30,9 @@ from collections.abc import Callable, Iterator
 from functools import lru_cache
 
 from .blocks import Block, Motion, MotionKind, SourceRef, StopKind
-from .construct import FAST, BlockTwin, MotionTwin, SourceRefTwin, make_block, make_motion, make_source
+from .construct import (
+    FAST, BlockTwin, MotionTwin, SourceRefTwin, make_block, make_motion, make_source,
+)
 from .geometry import ARC_TOLERANCE_MM
 from .modal import DistanceMode
 
@@ -249,8 +251,10 @@ def loop_source(axes: tuple[str, ...]) -> str:
                                      centre="None")
         block = _BLOCK_FAST
     else:
-        arc = " " * 20 + "motion = MAKE_MOTION(k, pos, end_pos, feed_k, plane, (cp, cq), comp, radius)"
-        linear = pad + "motion = MAKE_MOTION(k, pos, end_pos, f_mm_s, line_plane, None, comp, radius)"
+        arc = " " * 20 + ("motion = MAKE_MOTION(k, pos, end_pos, feed_k, plane, (cp, cq), "
+                          "comp, radius)")
+        linear = pad + ("motion = MAKE_MOTION(k, pos, end_pos, f_mm_s, line_plane, None, "
+                        "comp, radius)")
         block = _BLOCK_PLAIN
     return _TEMPLATE.format(
         unpack_pos=unpack,
@@ -268,7 +272,8 @@ def decoding_loop(axes: tuple[str, ...]) -> Callable[..., Iterator[Block]]:
     namespace = {
         "MATCH": line_pattern(axes).match, "NEW": object.__new__, "G_MOTION": _G_MOTION,
         "INCREMENTAL": DistanceMode.INCREMENTAL, "RAPID": MotionKind.RAPID,
-        "ARC_CW": MotionKind.ARC_CW, "ARC_CCW": MotionKind.ARC_CCW, "INF": math.inf, "HYPOT": math.hypot,
+        "ARC_CW": MotionKind.ARC_CW, "ARC_CCW": MotionKind.ARC_CCW, "INF": math.inf,
+        "HYPOT": math.hypot,
         "TOLERANCE": ARC_TOLERANCE_MM, "MOTION_TWIN": MotionTwin, "MOTION": Motion,
         "SOURCE_TWIN": SourceRefTwin, "SOURCE": SourceRef, "BLOCK_TWIN": BlockTwin,
         "BLOCK": Block, "NO_STOP": StopKind.NONE, "MAKE_MOTION": make_motion,

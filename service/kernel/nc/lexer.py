@@ -15,7 +15,8 @@ from .errors import NcError, NcErrorId
 from .source import LogicalLine
 
 _WS = re.compile(r"[ \t\f\v]*")
-NUMBER = re.compile(r"(?:[0-9]+\.?[0-9]*|\.[0-9]+)")  # unsigned; a sign is an operator or part of a word
+# unsigned: in an expression a sign is an operator
+NUMBER = re.compile(r"(?:[0-9]+\.?[0-9]*|\.[0-9]+)")
 SIGNED_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)")
 IDENT = re.compile(r"[A-Z_][A-Z0-9_]*")
 VARIABLE = re.compile(r"V\.([A-Z]+)\.([A-Z_][A-Z0-9_]*)")

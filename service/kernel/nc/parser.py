@@ -1,4 +1,4 @@
-"""Logical line -> statement: NC blocks, control statements, #-instructions, declarations.
+"""Logical line -> statement: NC blocks, control statements and #-instructions.
 
 An NC line is ``[Nnn[:]] [[LABEL]] item item ...`` where an item is an address word
 (``X10``, ``X-.5``, ``X[expr]``, ``XV.L.A``, ``X-V.L.A``), an assignment
@@ -314,7 +314,8 @@ class LineParser:
         name = cur.name()
         if not name:
             raise cur.error(
-                NcErrorId.MISSING_VALUE, f"subprogram name expected after '{'LL' if local else 'L'}'",
+                NcErrorId.MISSING_VALUE,
+                f"subprogram name expected after '{'LL' if local else 'L'}'",
                 pos,
             )
         if name.upper().startswith("CYCLE[") or (name.upper() == "CYCLE" and _skip(cur) < cur.end

@@ -31,7 +31,7 @@ from .statements import CLOSER_OF, OPENERS, SPELLING, Control, NcBlock, StmtKind
 
 # parsed lines kept for loops and repeated calls; a long straight program does not
 # keep all of its lines parsed in memory (the cache starts over when full)
-CACHE_LINES = 50_000
+CACHE_LINES = 20_000
 _LOCAL_HEADER = re.compile(r"[ \t]*%[ \t]*L[ \t]+(\S+)", re.I)
 _MAIN_HEADER = re.compile(r"[ \t]*%[ \t]*(\S*)")
 # the statement keyword of a line, without parsing it: $WORD or #RT WHILE/ENDWHILE

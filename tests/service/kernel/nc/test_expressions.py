@@ -87,3 +87,20 @@ def test_infinite_result_is_out_of_range():
     e = error_of("G0 X[10**300 * 10**300]\nM30")
     assert (e.id, e.column) == (NcErrorId.VALUE_OUT_OF_RANGE, 4)
     assert math.isinf(10.0**300 * 10.0**300)
+
+
+@pytest.mark.parametrize(
+    ("expr", "err"),
+    [
+        ("[10**300 * 10**300] MOD 3", NcErrorId.MATH_DOMAIN),
+        ("INT[10**300 * 10**300]", NcErrorId.MATH_DOMAIN),
+        ("ROUND[[10**300 * 10**300] - [10**300 * 10**300]]", NcErrorId.MATH_DOMAIN),
+    ],
+)
+def test_infinite_intermediate_values(expr, err):
+    assert error_of(f"G0 X[{expr}]\nM30").id == err
+
+
+def test_infinite_array_index():
+    e = error_of("#VAR\nV.L.A[2]\n#ENDVAR\nG0 X[V.L.A[10**300 * 10**300]]\nM30")
+    assert e.id == NcErrorId.ARRAY_INDEX_MISMATCH

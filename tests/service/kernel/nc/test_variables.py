@@ -114,7 +114,8 @@ def test_program_variables_continue_in_manual_blocks():
     blocks = decode("G0 X[V.P.N]", modal=modal, manual=True)
     assert blocks[0].motion.end_mm[0] == 2.0
     # a new program may declare it again
-    assert decode("#VAR\nV.P.N = 9\n#ENDVAR\nG0 X[V.P.N]\nM30", modal=modal)[0].motion.end_mm[0] == 9
+    blocks = decode("#VAR\nV.P.N = 9\n#ENDVAR\nG0 X[V.P.N]\nM30", modal=modal)
+    assert blocks[0].motion.end_mm[0] == 9
 
 
 def test_declaration_in_a_loop_reinitialises():
