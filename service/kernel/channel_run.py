@@ -81,6 +81,7 @@ class ChannelRunner:
         self._fed_all = False
         self._started_at_s = 0.0
         self._time_s = 0.0
+        self.touched = False  # the last cycle changed the channel's state
 
     # ------------------------------------------------------------ commands
 
@@ -264,7 +265,9 @@ class ChannelRunner:
         ch = self.channel
         executor = self._executor
         if executor is None or ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
+            self.touched = False
             return False
+        self.touched = True
         if executor.single_block != ch.single_block:
             executor.single_block = ch.single_block
         self._feed_blocks()

@@ -73,6 +73,7 @@ class Kernel:
         self._exists = exists
         self._files = files
         self._busy = False
+        self._changed: list[bool] | None = None  # channels the cycle touched; None = all
         self.state = self._initial_state()
         self.stats = CycleStats(cycle_us=round(config.cycle_ms * 1000))
         self.snapshot: Snapshot = self.state.snapshot(0, 0, self.stats)
@@ -180,7 +181,7 @@ class Kernel:
             applied.append((done, self._apply(command)))
         self.stats.cycles += 1
         if self.stats.running:
-            self._work()
+            self._work(bool(applied))
         self._publish()
         for done, result in applied:
             done(result)
@@ -237,19 +238,28 @@ class Kernel:
 
     def _publish(self) -> None:
         cycle = self.stats.cycles
-        self.snapshot = self.state.snapshot(cycle, cycle * self.cycle_ns, self.stats)
+        self.snapshot = self.state.snapshot(
+            cycle, cycle * self.cycle_ns, self.stats, self.snapshot, self._changed
+        )
+        self._changed = None
         hook = self.on_cycle_end
         if hook is not None:
             hook(self.snapshot)
 
-    def _work(self) -> None:
-        """The cycle's work: every channel's path, then the drives follow their axes."""
+    def _work(self, applied_commands: bool) -> None:
+        """The cycle's work: every channel's path, then the drives follow their axes.
+        Notes which channels changed, so the snapshot copies only those (commands may
+        have touched any channel: then all are copied)."""
         time_s = self.stats.cycles * self.cycle_s
         busy = False
+        changed = []
         for runner in self.state.runners:
             busy |= runner.cycle(time_s)
+            changed.append(runner.touched)
         self.state.drive_axes()
         self._busy = busy
+        if not applied_commands:
+            self._changed = changed
 
     def state_has_work(self) -> bool:
         """True while a channel moves or decodes: the virtual clock runs cycles back to

@@ -222,13 +222,29 @@ class KernelState:
                             break
                 axis.output_incr = axis.command_position_incr
 
-    def snapshot(self, cycle: int, time_ns: int, stats: CycleStats) -> Snapshot:
-        """Frozen copies of everything readable."""
+    def snapshot(
+        self,
+        cycle: int,
+        time_ns: int,
+        stats: CycleStats,
+        previous: Snapshot | None = None,
+        changed: list[bool] | None = None,
+    ) -> Snapshot:
+        """Frozen copies of everything readable.
+
+        With ``previous`` and ``changed`` (one flag per channel), a channel that did not
+        change this cycle keeps its frozen copy from ``previous``: an idle channel costs
+        nothing per cycle. Without them every channel is copied.
+        """
+        if previous is None or changed is None:
+            channels = tuple(c.frozen() for c in self.channels)
+        else:
+            channels = tuple(
+                c.frozen() if touched else old
+                for c, touched, old in zip(self.channels, changed, previous.channels, strict=True)
+            )
         return Snapshot(
-            cycle,
-            time_ns,
-            stats.frozen(),
-            tuple(c.frozen() for c in self.channels),
+            cycle, time_ns, stats.frozen(), channels,
             tuple(p.frozen() for p in self.physical_axes),
         )
 
