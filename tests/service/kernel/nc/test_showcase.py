@@ -19,9 +19,8 @@ from service.kernel.nc import NcError, NcErrorId
 
 from .support import decoder
 
-SHOWCASE = Path("/work/shared/testdata/isg-syntax-showcase.nc")
-TEXT = SHOWCASE.read_text(encoding="utf-8") if SHOWCASE.exists() else None
-pytestmark = pytest.mark.skipif(TEXT is None, reason="showcase file not available")
+SHOWCASE = Path(__file__).resolve().parents[3] / "data" / "isg-syntax-showcase.nc"
+TEXT = SHOWCASE.read_text(encoding="utf-8")
 
 
 @pytest.mark.parametrize("files", [{}, {"subPrograms.nc": "G0 X1\nM17\n"}])
