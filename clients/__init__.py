@@ -3,7 +3,15 @@
 Imports protocol and objects, never service.
 """
 
-from .client import AsyncClient, ChannelStatus, Client, DeviceInfo, ObjectInfo, ProgramEntry, Sample
+from .client import (
+    AsyncClient,
+    ChannelStatus,
+    Client,
+    DeviceInfo,
+    ObjectInfo,
+    ProgramEntry,
+    Sample,
+)
 from .errors import AdsConnectionError, AdsError, AdsTimeoutError, ChannelError
 
 __all__ = [

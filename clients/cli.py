@@ -14,8 +14,9 @@ import contextlib
 import json
 import os
 import sys
+from collections.abc import Callable
 from dataclasses import asdict
-from typing import Annotated, Any, NoReturn, Optional
+from typing import Annotated, Any, NoReturn, Optional, TypeVar
 
 import typer
 from rich.console import Console
@@ -26,6 +27,8 @@ from protocol.errors import AdsReturnCode
 
 from .client import DEFAULT_ENDPOINT, AsyncClient, Client, ObjectInfo
 from .errors import AdsError, AdsTimeoutError
+
+T = TypeVar("T")
 
 EXIT_ADS_ERROR = 1
 EXIT_USAGE = 2
@@ -63,6 +66,14 @@ class Settings:
     def client(self) -> Client:
         """A blocking client for one command."""
         return Client(self.endpoint, timeout_s=self.timeout_s)
+
+    def call(self, operation: Callable[[Client], T]) -> T:
+        """``operation`` on a client of its own; an ADS error ends the command."""
+        try:
+            with self.client() as c:
+                return operation(c)
+        except AdsError as exc:
+            _fail(exc)
 
 
 def _fail(exc: Exception) -> NoReturn:
@@ -137,11 +148,7 @@ def main_options(
 def info(ctx: typer.Context) -> None:
     """Device name, version and ADS state of the service."""
     settings: Settings = ctx.obj
-    try:
-        with settings.client() as c:
-            device = c.info()
-    except AdsError as exc:
-        _fail(exc)
+    device = settings.call(lambda c: c.info())
     record = {
         "name": device.name,
         "version": device.version,
@@ -159,11 +166,7 @@ def browse(
 ) -> None:
     """List the objects whose names match PATTERN."""
     settings: Settings = ctx.obj
-    try:
-        with settings.client() as c:
-            found = c.browse(pattern)
-    except AdsError as exc:
-        _fail(exc)
+    found = settings.call(lambda c: c.browse(pattern))
     if settings.as_json:
         for o in found:
             _emit(settings, asdict(o), "")

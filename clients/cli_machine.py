@@ -54,11 +54,7 @@ def upload(
         err.print(f"error: cannot read {file}: {exc.strerror}")
         raise typer.Exit(EXIT_USAGE) from None
     target = name or file.name
-    try:
-        with settings.client() as c:
-            c.upload(target, data)
-    except AdsError as exc:
-        _fail(exc)
+    settings.call(lambda c: c.upload(target, data))
     _emit(settings, {"name": target, "size_bytes": len(data), "ok": True},
           f"uploaded {target} ({len(data)} bytes)")
 
@@ -71,11 +67,7 @@ def download(
 ) -> None:
     """Download a file of the program store (programs, result files, logs)."""
     settings: Settings = ctx.obj
-    try:
-        with settings.client() as c:
-            data = c.download(name)
-    except AdsError as exc:
-        _fail(exc)
+    data = settings.call(lambda c: c.download(name))
     if output is None:
         sys.stdout.buffer.write(data)
         sys.stdout.flush()
@@ -93,11 +85,7 @@ def download(
 def programs(ctx: typer.Context) -> None:
     """List the program store."""
     settings: Settings = ctx.obj
-    try:
-        with settings.client() as c:
-            entries = c.programs()
-    except AdsError as exc:
-        _fail(exc)
+    entries = settings.call(lambda c: c.programs())
     for e in entries:
         _emit(settings, asdict(e), f"{e.name:40} {e.size_bytes:10d} bytes")
     if not settings.as_json:
@@ -160,11 +148,7 @@ def mdi(
 def _channel_command(method: str, done: str):
     def command(ctx: typer.Context, channel: int = ChannelOption) -> None:
         settings: Settings = ctx.obj
-        try:
-            with settings.client() as c:
-                getattr(c, method)(channel)
-        except AdsError as exc:
-            _fail(exc)
+        settings.call(lambda c: getattr(c, method)(channel))
         _emit(settings, {"channel": channel, "ok": True}, f"channel {channel}: {done}")
 
     return command
@@ -185,17 +169,12 @@ app.command("reset", help="RESET the channel from any state.")(
 def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
     """Mode, state, program, block and axis positions (mm) of a channel."""
     settings: Settings = ctx.obj
-    try:
-        with settings.client() as c:
-            s = c.status(channel)
-    except AdsError as exc:
-        _fail(exc)
+    s = settings.call(lambda c: c.status(channel))
     positions = "  ".join(f"{n}={v:.4f}" for n, v in s.positions_mm.items())
     lines = [
         f"channel {s.channel}: {s.mode}/{s.state}  program {s.program or '-'}",
-        f"block N{s.block_number if s.block_number >= 0 else '-'} {s.file or '-'}:{s.line}  "
-        f"v={s.path_velocity_mm_s:.3f} mm/s  "
-        f"t={s.program_time_s:.3f} s",
+        (f"block N{s.block_number if s.block_number >= 0 else '-'} {s.file or '-'}:{s.line}  "
+         f"v={s.path_velocity_mm_s:.3f} mm/s  t={s.program_time_s:.3f} s"),
         f"positions (mm): {positions}",
         *s.errors,
     ]

@@ -13,14 +13,19 @@ import asyncio
 import itertools
 import logging
 from collections import deque
-
 from typing import Any
 
 import zmq
 
 from protocol.constants import AdsCommand
 from protocol.errors import ProtocolError
-from protocol.frames import Notification, Response, Sample, decode_incoming, encode_request
+from protocol.frames import (
+    Notification,
+    Response,
+    Sample,
+    decode_incoming,
+    encode_request,
+)
 
 from .errors import AdsConnectionError, AdsTimeoutError
 

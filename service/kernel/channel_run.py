@@ -18,7 +18,13 @@ import logging
 from collections.abc import Callable
 
 from ..config import ChannelConfig, MachineConfig
-from .channel_mode import IDLE_STATES, SELECTABLE_MODES, ChannelMode, ChannelState, describe
+from .channel_mode import (
+    IDLE_STATES,
+    SELECTABLE_MODES,
+    ChannelMode,
+    ChannelState,
+    describe,
+)
 from .commands import Refusal, RefusalReason
 from .decoder_feed import DecodeEnd, DecoderFeed, Job
 from .nc import ModalState, NcError

@@ -19,8 +19,8 @@ import threading
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
-from .nc import Decoder, ModalState, NcError
-from .nc.blocks import Block, SourceRef
+from .nc import Decoder, ModalState, NcError, NcErrorId
+from .nc.blocks import Block, SourceRef, StopKind
 
 log = logging.getLogger(__name__)
 
@@ -152,7 +152,7 @@ class DecoderFeed:
                 for block in self._blocks(job):
                     if not self._put(block):
                         return
-                    if block.stop == 3:  # PROGRAM_END: nothing after M30 is decoded
+                    if block.stop == StopKind.PROGRAM_END:  # nothing after M30 is decoded
                         self._put(DecodeEnd())
                         return
                 if job.manual:
@@ -167,7 +167,11 @@ class DecoderFeed:
             self._put(exc)
         except KeyError as exc:  # loader: the program vanished between select and start
             name = self._job.name
-            self._put(NcError(20000, name, 0, 0, f"program {exc.args[0]!r} not found"))
+            self._put(NcError(
+                NcErrorId.PROGRAM_NOT_FOUND, name, 0, 0, f"program {exc.args[0]!r} not found"
+            ))
         except Exception as exc:  # a decoder fault is the program's error, never a crash
             log.exception("decoder failed on %s", self._job.name)
-            self._put(NcError(20001, self._job.name, 0, 0, f"decoder fault: {exc!r}"))
+            self._put(NcError(
+                NcErrorId.INTERNAL_ERROR, self._job.name, 0, 0, f"decoder fault: {exc!r}"
+            ))

@@ -152,9 +152,8 @@ class KernelHarness:
     def run(self, text: str, name: str = "test.nc", record: bool = False,
             timeout_s: float = 60.0) -> Run:
         """Store ``text`` as ``name``, select and START it, wait for READY or ERROR."""
-        self.programs[name] = text
-        assert self.command(SelectProgram(0, name)) is None
-        return self._run(StartProgram(0, True), record, timeout_s)
+        self.start(text, name, record)
+        return self.wait(timeout_s)
 
     def mdi(self, text: str, record: bool = False, timeout_s: float = 60.0) -> Run:
         """Run ``text`` as a manual block and wait until the channel is idle again."""

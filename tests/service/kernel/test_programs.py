@@ -15,13 +15,13 @@ from service.kernel.channel_mode import ChannelMode, ChannelState
 from service.kernel.commands import (
     Feedhold,
     ManualBlock,
+    RefusalReason,
     ResetChannel,
     SelectProgram,
     SetExecutionMode,
     SetSingleBlock,
     StartProgram,
 )
-from service.kernel.commands import RefusalReason
 from tests.support.kernel import KernelHarness
 
 CYCLE_S = 0.001
