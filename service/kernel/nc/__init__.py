@@ -6,13 +6,16 @@ line and column), ``check_syntax`` (all parse errors of a file at once). The out
 contract is in ``blocks``.
 """
 
-from .blocks import Block, Compensation, Motion, MotionKind, SourceRef, StopKind
+from .blocks import (
+    AxisExchange, AxisExchangeKind, Block, Compensation, Motion, MotionKind, SourceRef, StopKind,
+)
 from .decoder import Decoder
 from .errors import NcError, NcErrorId
 from .modal import DistanceMode, ModalState, Plane
 from .syntax import check_syntax
 
 __all__ = [
-    "Block", "Compensation", "Decoder", "DistanceMode", "ModalState", "Motion",
-    "MotionKind", "NcError", "NcErrorId", "Plane", "SourceRef", "StopKind", "check_syntax",
+    "AxisExchange", "AxisExchangeKind", "Block", "Compensation", "Decoder", "DistanceMode",
+    "ModalState", "Motion", "MotionKind", "NcError", "NcErrorId", "Plane", "SourceRef",
+    "StopKind", "check_syntax",
 ]

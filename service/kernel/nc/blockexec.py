@@ -10,6 +10,9 @@ G4 (dwell) takes its time in seconds from the ``X`` or the ``F`` word of its blo
 A ``Block`` is produced when the NC block has a motion, a dwell, a stop, M, S or T;
 blocks that only change modal state (``G90``, ``F500``, ``D1``) produce none. A G0/G1
 to the current position gives a block without motion.
+
+An axis released by ``#AX RELEASE`` (``exchange``) cannot be programmed: its axis word,
+its I/J/K offset or an arc in a plane that needs it is an error; its position stays.
 """
 
 from __future__ import annotations
@@ -20,13 +23,14 @@ from collections.abc import Mapping
 from enum import IntEnum
 from typing import Any
 
-from .blocks import Block, Compensation, MotionKind, StopKind
+from .blocks import AxisExchange, AxisExchangeKind, Block, Compensation, MotionKind, StopKind
 from .construct import make_block, make_motion, make_source
 from .errors import NcError, NcErrorId
+from .exchange import moved_axes
 from .expressions import evaluate_number
 from .geometry import centre_from_offsets, centre_from_radius
 from .modal import G_CODES, PLANE_AXES, DistanceMode, GGroup, MCode, ModalState, Plane
-from .statements import Assign, NcBlock, WordKind
+from .statements import Assign, AxisCommand, NcBlock, WordKind
 from .variables import VariableFault
 
 
@@ -71,9 +75,11 @@ class BlockExecutor:
 
     def __init__(
         self, axes: tuple[str, ...], tools: Mapping[int, float], modal: ModalState,
-        manual: bool,
+        manual: bool, axis_numbers: tuple[int, ...] | None = None,
     ) -> None:
         self.axes = axes
+        # logical axis number of each channel axis (#AX RELEASE NBR, #AX REQUEST)
+        self.axis_numbers = axis_numbers or tuple(range(1, len(axes) + 1))
         self.tools = tools
         self.modal = modal
         self.manual = manual
@@ -190,6 +196,24 @@ class BlockExecutor:
         )
         return block, flow, flow_pos
 
+    def exchange(self, stmt: AxisCommand, env: Any) -> Block | None:
+        """Run ``#AX RELEASE`` / ``#AX REQUEST``: the block that hands the axes over, or
+        None when no axis changes hands."""
+        modal = self.modal
+        moved = moved_axes(stmt, env, self.axes, self.axis_numbers, modal.released_axes)
+        if not moved:
+            return None
+        if stmt.kind == AxisExchangeKind.RELEASE:
+            modal.released_axes = modal.released_axes.union(moved)
+        else:
+            modal.released_axes = modal.released_axes.difference(moved)
+        line = stmt.line
+        line_no, column = line.locate(_first(line.text))
+        return make_block(
+            make_source(line.file, line_no, column, line.offset), stmt.number, None, 0.0,
+            StopKind.NONE, (), None, None, self.manual, AxisExchange(stmt.kind, moved),
+        )
+
     # ------------------------------------------------------------ parts
 
     def _g_word(self, value: float, pos: int, groups: dict, err) -> None:
@@ -263,6 +287,9 @@ class BlockExecutor:
         radius_word = words.get(WordKind.RADIUS)
         if not axis_words and not offsets and radius_word is None:
             return None
+        released = modal.released_axes
+        if released:
+            self._no_released_axis(released, axis_words, offsets, err)
         kind = modal.motion
         positions = [pos for _, _, pos, _ in axis_words] + [pos for _, pos in offsets.values()]
         if radius_word is not None:
@@ -307,6 +334,11 @@ class BlockExecutor:
             raise err(NcErrorId.PLANE_AXIS_MISSING,
                       f"G{int(modal.plane)} needs the axes {p} and {q}", motion_pos)
         p, q = plane
+        if p in released or q in released:
+            raise err(NcErrorId.AXIS_RELEASED,
+                      f"axis {self.axes[p if p in released else q]} is not in the channel "
+                      f"(released by #AX RELEASE): G{int(kind)} in G{int(modal.plane)} needs it",
+                      motion_pos)
         for axis, value, pos, letter in axis_words:
             if axis != p and axis != q and end[axis] != start[axis]:
                 raise err(NcErrorId.HELIX_NOT_SUPPORTED,
@@ -335,6 +367,16 @@ class BlockExecutor:
         except VariableFault as f:
             raise err(f.err_id, f.message, motion_pos) from None
         return make_motion(kind, start, end_t, feed, plane, centre, comp, radius)
+
+
+    def _no_released_axis(self, released, axis_words, offsets, err) -> None:
+        """An error at the leftmost word (axis or I/J/K) of a released axis, if any."""
+        hits = [(pos, axis) for axis, _, pos, _ in axis_words if axis in released]
+        hits += [(pos, axis) for axis, (_, pos) in offsets.items() if axis in released]
+        if hits:
+            pos, axis = min(hits)
+            raise err(NcErrorId.AXIS_RELEASED, f"axis {self.axes[axis]} is not in the channel "
+                      "(released by #AX RELEASE)", pos)
 
 
 def _first(text: str) -> int:

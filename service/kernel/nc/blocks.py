@@ -38,6 +38,13 @@ class StopKind(IntEnum):
     PROGRAM_END = 3  # M2 / M30: end of the main program
 
 
+class AxisExchangeKind(IntEnum):
+    """Direction of an axis exchange (#AX RELEASE / #AX REQUEST)."""
+
+    RELEASE = 1  # the axes leave the channel (back to the axis management)
+    REQUEST = 2  # the axes (re)join the channel
+
+
 @dataclass(frozen=True, slots=True)
 class SourceRef:
     """Where a block came from: file name, 1-based line and column, byte offset of the line."""
@@ -68,12 +75,21 @@ class Motion:
 
 
 @dataclass(frozen=True, slots=True)
+class AxisExchange:
+    """#AX RELEASE / #AX REQUEST: channel axis indices (0-based) leaving or (re)joining the channel."""
+
+    kind: AxisExchangeKind
+    axes: tuple[int, ...]  # channel axis indices, in programmed order, without duplicates
+
+
+@dataclass(frozen=True, slots=True)
 class Block:
     """One decoded NC block: optional motion plus what happens at its end.
 
     ``number`` is the programmed N number (None when the block has none). A block with
     ``motion`` None, no dwell and no stop is technology only (M/S/T output) and does not
-    interrupt the path.
+    interrupt the path. A block with ``axis_exchange`` has no motion and stops the
+    path: an axis changes hands only at standstill.
     """
 
     source: SourceRef
@@ -85,8 +101,10 @@ class Block:
     spindle_speed_rpm: float | None = None  # S
     tool: int | None = None  # T
     manual: bool = False  # decoded from a manual (MDI) block
+    axis_exchange: AxisExchange | None = None  # #AX RELEASE / #AX REQUEST
 
     @property
     def needs_stop(self) -> bool:
         """True when the path speed must be 0 at the end of this block."""
-        return self.dwell_s > 0.0 or self.stop != StopKind.NONE
+        return (self.dwell_s > 0.0 or self.stop != StopKind.NONE
+                or self.axis_exchange is not None)

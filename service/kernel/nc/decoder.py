@@ -32,7 +32,7 @@ from .modal import ModalState
 from .parser import RESERVED_LETTERS, LineParser, word_table
 from .program import Program, Section
 from .source import strip_comments
-from .statements import CLOSER_OF, SPELLING, Control, NcBlock
+from .statements import CLOSER_OF, SPELLING, AxisCommand, Control, NcBlock
 from .variables import Scope, Variable
 
 log = logging.getLogger(__name__)
@@ -47,7 +47,10 @@ class Decoder:
     tool radii in mm (D0 is radius 0). ``modal`` is continued (and changed) when given;
     otherwise decoding starts from a fresh ``ModalState`` at position 0. Bit n-1 of
     ``skip_levels`` skips the lines marked ``/n``. ``manual`` marks the blocks as
-    manual and lets the text end without M30.
+    manual and lets the text end without M30. ``axis_numbers``: the logical axis number
+    of each channel axis (default 1..n), for ``#AX RELEASE NBR`` and ``#AX REQUEST``.
+    A program (not ``manual``) starts with all axes in the channel; manual blocks keep
+    the axes released before (``modal.released_axes``).
     """
 
     def __init__(
@@ -61,6 +64,7 @@ class Decoder:
         modal: ModalState | None = None,
         skip_levels: int = 1,
         manual: bool = False,
+        axis_numbers: tuple[int, ...] | None = None,
     ) -> None:
         axes = tuple(axes)
         for name in axes:
@@ -69,6 +73,13 @@ class Decoder:
                                  f"{''.join(sorted(RESERVED_LETTERS))}")
         if len(set(axes)) != len(axes):
             raise ValueError(f"axis names repeat: {axes}")
+        if axis_numbers is None:
+            axis_numbers = tuple(range(1, len(axes) + 1))
+        axis_numbers = tuple(axis_numbers)
+        if (len(axis_numbers) != len(axes) or len(set(axis_numbers)) != len(axis_numbers)
+                or not all(type(n) is int and n >= 1 for n in axis_numbers)):
+            raise ValueError(f"axis numbers {axis_numbers} must be distinct integers >= 1, "
+                             f"one per axis of {axes}")
         if modal is None:
             modal = ModalState()
         if not modal.position_mm:
@@ -76,13 +87,19 @@ class Decoder:
         elif len(modal.position_mm) != len(axes):
             raise ValueError(f"modal position has {len(modal.position_mm)} axes, "
                              f"the channel {len(axes)}")
+        if not manual:  # a program starts with the channel's configured axes
+            modal.released_axes = frozenset()
+        elif not all(0 <= k < len(axes) for k in modal.released_axes):
+            raise ValueError(f"released axes {sorted(modal.released_axes)} are not axes "
+                             f"of the channel {axes}")
         self.axes = axes
+        self.axis_numbers = axis_numbers
         self.manual = manual
         self._loader = loader
         self._modal = modal
         self._skip_levels = skip_levels
         self.parser = LineParser(word_table(axes))
-        self.executor = BlockExecutor(axes, tools, modal, manual)
+        self.executor = BlockExecutor(axes, tools, modal, manual, axis_numbers)
         self._main = Program(text, file, self.parser, skip_levels)
         self._files: dict[str, Program] = {}
         self.frames: list[Frame] = []
@@ -161,6 +178,10 @@ class Decoder:
             frame.index = after
             return None
         if type(stmt) is not NcBlock:
+            if type(stmt) is AxisCommand:
+                block = self.executor.exchange(stmt, self)
+                frame.index = after
+                return block
             self._control.run(frame, stmt, after)
             return None
         here = frame.index

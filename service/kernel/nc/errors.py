@@ -58,6 +58,12 @@ class NcErrorId(IntEnum):
     PLANE_AXIS_MISSING = 20147  # the plane needs an axis the channel does not have
     ARC_RADIUS_DIFFERENCE = 21758  # ISG: end point not on the circle (radii differ)
 
+    # ---- axis exchange (#AX RELEASE / #AX REQUEST)
+    AXIS_RELEASED = 20150  # a word (X.., I/J/K) or arc plane needs an axis #AX RELEASE released
+    AXIS_EXCHANGE_NOT_SUPPORTED = 20151  # #AX REQUEST of a foreign axis, index or name
+    AXIS_COMMAND_NOT_ALONE = 20152  # #AX RELEASE/REQUEST with other words in its NC line
+    INVALID_AXIS_NUMBER = 20153  # #AX: axis number < 1 or index < 0, or not an integer
+
     # ---- expressions
     EXPRESSION_SYNTAX = 20200  # malformed expression (missing ']', operator without operand)
     DIVISION_BY_ZERO = 20201  # / or MOD by zero

@@ -8,7 +8,8 @@ constructors of ``construct``.
 
 Any other line (other words or orders, brackets, variables, ``$``, ``#``, ``%``, ``L``,
 ``/``, ``(``, lower case, ...) does not match and is decoded by the general path
-(``Decoder.slow_step``: parser, executor, control flow). A matching line that would be
+(``Decoder.slow_step``: parser, executor, control flow). While an axis is released
+(``#AX RELEASE``), every line goes there. A matching line that would be
 an error (arc end point off the circle, no F yet, I/J/K in a G1 block, a malformed
 number such as ``X1.2.3``) goes there too, untouched: the general path is the reference
 and raises the error with its exact column. So the hot path decodes only valid lines,
@@ -69,9 +70,12 @@ def run(decoder):
         radius = executor.tool_radius(modal.tool_offset) or 0.0
         plane, line_plane, roles, outside = executor.arc_setup(modal.plane)
         role_i, role_j, role_k = roles
+        # with an axis released (#AX RELEASE) every line takes the general path, which
+        # rejects the words of released axes
+        fast_end = i if modal.released_axes else end
         emitted = False
         try:
-            while i < end:
+            while i < fast_end:
                 m = match(lines[i])
                 if m is None:
                     break
@@ -215,6 +219,7 @@ _BLOCK_FAST = '''\
                 block.spindle_speed_rpm = None
                 block.tool = None
                 block.manual = manual
+                block.axis_exchange = None
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\

@@ -1,10 +1,11 @@
 """Modal state of a channel's decoder and the G functions that change it.
 
 ``ModalState`` is what a block leaves behind for the next: the programmed position,
-G90/G91, the plane, the motion mode, F, tool radius compensation and D, S, T, and the
-program-global (V.P.) and global (V.G.) variables. It is mutable and outlives a
-``Decoder``: in the extended manual (MDI) mode every new manual block is decoded with
-the modal state the previous one left.
+G90/G91, the plane, the motion mode, F, tool radius compensation and D, S, T, the
+program-global (V.P.) and global (V.G.) variables, and the axes released by
+``#AX RELEASE``. It is mutable and outlives a ``Decoder``: in the extended manual (MDI)
+mode every new manual block is decoded with the modal state the previous one left. A
+program start (a ``Decoder`` that is not manual) gives all axes back to the channel.
 
 Defaults after a reset: G90, G17, G01 (a motion block without F is an error until an F
 is programmed, never an accidental rapid), G40, D0, no F, S or T.
@@ -92,3 +93,4 @@ class ModalState:
     tool: int | None = None  # last T
     variables_p: dict[str, Variable] = field(default_factory=dict)  # V.P. by upper name
     variables_g: dict[str, Variable] = field(default_factory=dict)  # V.G. by upper name
+    released_axes: frozenset[int] = frozenset()  # channel axis indices out (#AX RELEASE)

@@ -4,8 +4,8 @@ An NC line is ``[Nnn[:]] [[LABEL]] item item ...`` where an item is an address w
 (``X10``, ``X-.5``, ``X[expr]``, ``XV.L.A``, ``X-V.L.A``), an assignment
 (``V.L.A = expr``), a subprogram call (``LL name`` local, ``L name`` file) or
 ``$GOTO target`` (executed last). A line whose first item is ``$KEYWORD`` is a control
-statement, ``#KEYWORD`` an instruction. Unknown letters and characters are errors,
-never ignored.
+statement, ``#KEYWORD`` an instruction (``#AX`` an axis exchange, ``exchange``).
+Unknown letters and characters are errors, never ignored.
 """
 
 from __future__ import annotations
@@ -14,12 +14,13 @@ import re
 from collections.abc import Mapping
 
 from .errors import NcErrorId
+from .exchange import AX_WORD, parse_axis_command
 from .expressions import Const, ExpressionParser, Node, VarRef
 from .lexer import IDENT, SIGNED_NUMBER, Cursor
 from .modal import G_CODES, GGroup
 from .source import LogicalLine
 from .statements import (
-    Assign, Call, Control, Goto, NcBlock, StmtKind, Word, WordKind,
+    Assign, AxisCommand, Call, Control, Goto, NcBlock, StmtKind, Word, WordKind,
 )
 
 _N_WORD = re.compile(r"N[ \t]*([-+]?[0-9.]*)([ \t]*:)?")
@@ -73,7 +74,7 @@ class LineParser:
 
     # ------------------------------------------------------------ entry
 
-    def parse(self, line: LogicalLine) -> NcBlock | Control:
+    def parse(self, line: LogicalLine) -> NcBlock | Control | AxisCommand:
         """The statement of one logical line (raises NcError on a syntax error)."""
         cur = Cursor(line)
         cur.skip_ws()
@@ -152,10 +153,12 @@ class LineParser:
         self._line_end(cur, f"${word}")
         return stmt
 
-    def _directive(self, cur: Cursor, number: int | None) -> Control:
+    def _directive(self, cur: Cursor, number: int | None) -> Control | AxisCommand:
         pos = cur.pos
         m = cur.match(_DIRECTIVE)
         word = m.group(1)
+        if word == "AX":
+            return parse_axis_command(cur, pos, number)
         if word == "VAR":
             stmt = Control(StmtKind.VAR, cur.line, pos, number=number)
         elif word == "ENDVAR":
@@ -256,6 +259,9 @@ class LineParser:
                     if G_CODES[int(value)][0] == GGroup.DWELL:
                         block.has_g4 = True
                 block.items.append(Word(kind, c, value, pos, axis))
+            elif c == "#" and AX_WORD.match(cur.up, pos):
+                raise cur.error(NcErrorId.AXIS_COMMAND_NOT_ALONE,
+                                "#AX must stand alone in its NC line")
             else:
                 raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
         block.letters = frozenset(letters)

@@ -27,7 +27,11 @@ from enum import IntEnum
 from .errors import NcError, NcErrorId
 from .parser import LineParser
 from .source import LogicalLine, SourceText, comment_directive, read_logical, strip_comments
-from .statements import CLOSER_OF, OPENERS, SPELLING, Control, NcBlock, StmtKind
+from .statements import (
+    CLOSER_OF, OPENERS, SPELLING, AxisCommand, Control, NcBlock, StmtKind,
+)
+
+Statement = NcBlock | Control | AxisCommand  # what a parsed line is
 
 # parsed lines kept for loops and repeated calls; a long straight program does not
 # keep all of its lines parsed in memory (the cache starts over when full)
@@ -97,7 +101,7 @@ class Program:
         self.parser = parser
         self.skip_levels = skip_levels
         self.main, self.locals = _sections(text.removeprefix("\ufeff"), self.src)
-        self._statements: dict[int, tuple[NcBlock | Control | None, int]] = {}
+        self._statements: dict[int, tuple[Statement | None, int]] = {}
         self._logical: dict[int, tuple[LogicalLine | None, int]] = {}
         self._structures: dict[int, Structure] = {}
         self._labels: dict[int, dict[str, list[int]]] = {}
@@ -115,7 +119,7 @@ class Program:
             self._logical[index] = got
         return got
 
-    def statement(self, index: int, end: int) -> tuple[NcBlock | Control | None, int]:
+    def statement(self, index: int, end: int) -> tuple[Statement | None, int]:
         """The parsed statement at ``index`` (cached) and the index after it."""
         got = self._statements.get(index)
         if got is None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import IntEnum
 
+from .blocks import AxisExchangeKind
 from .expressions import Node, VarRef
 from .source import LogicalLine
 from .variables import Scope, VarType
@@ -144,6 +145,30 @@ class Control:
     end: Node | None = None  # $FOR end value
     step: Node | None = None  # $FOR step (None: 1)
     values: tuple[Node, ...] = ()  # $CASE values
+    number: int | None = None  # N number of the line, if any
+
+
+@dataclass(slots=True)
+class AxisRef:
+    """One axis of an ``#AX`` command: ``X`` (RELEASE), ``2`` (RELEASE NBR) or
+    ``X, 1, 0`` (REQUEST: name, logical axis number, channel axis index)."""
+
+    pos: int  # position of the first part
+    name: str | None = None  # upper case
+    number: Node | None = None  # logical axis number
+    number_pos: int = -1
+    index: Node | None = None  # axis index in the channel (from 0)
+    index_pos: int = -1
+
+
+@dataclass(slots=True)
+class AxisCommand:
+    """``#AX RELEASE`` / ``#AX REQUEST``: alone in its NC line (besides N and a label)."""
+
+    kind: AxisExchangeKind
+    line: LogicalLine
+    pos: int  # position of the '#'
+    axes: tuple[AxisRef, ...] | None  # None: #AX RELEASE ALL
     number: int | None = None  # N number of the line, if any
 
 
