@@ -29,6 +29,8 @@ class Scope(Enum):
     PHYSICAL_AXIS = "physical_axis"  # per drive: ax<A>.element, offset 0x<A>00xx
     CHANNEL = "channel"  # per channel: ch<c>.element, group + CID
     CHANNEL_AXIS = "channel_axis"  # per axis of a channel: ch<c>.ax<a>.element
+    PLC_CHANNEL = "plc_channel"  # HLI per channel: gpCh[i].element, i = channel index from 0
+    PLC_AXIS = "plc_axis"  # HLI per axis: gpAx[i].element, i = HLI axis slot from 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -56,14 +58,23 @@ class ChannelLayout:
 
 @dataclass(frozen=True, slots=True)
 class MachineLayout:
-    """What the catalog is expanded over: channels and physical axis numbers."""
+    """What the catalog is expanded over: channels, physical axis numbers, and the axis
+    numbers of the HLI axis slots ``gpAx[0..]`` in slot order."""
 
     channels: tuple[ChannelLayout, ...]
     physical_axes: tuple[int, ...]
+    hli_axes: tuple[int, ...] = ()
+
+
+# PLC symbols (port 851) live in the PLC's memory area like TwinCAT PLC variables; the
+# offsets are this project's layout (clients find symbols by name or handle).
+PLC_GROUP = 0x4020
+PLC_CHANNEL_BASE, PLC_CHANNEL_STRIDE = 0x10000, 0x1000
+PLC_AXIS_BASE, PLC_AXIS_STRIDE = 0x80000, 0x100
 
 
 R, W, RW = Access.READ, Access.WRITE, Access.READ_WRITE
-GEO, COM = CncPort.GEO, CncPort.COM
+GEO, COM, PLC = CncPort.GEO, CncPort.COM, CncPort.PLC
 IPO = GroupBase.GEO_INTERPOLATOR
 COM_CH = GroupBase.COM_CHANNEL
 COM_AX = GroupBase.COM_PLATFORM_AXIS
@@ -86,6 +97,24 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
     ObjectTemplate(
         "command_position_acs", Scope.CHANNEL_AXIS, GEO, IPO, 0x02, SGN32, R, "0.1 um",
         "Command position of the channel axis (interpolator output) (project offset)",
+    ),
+    ObjectTemplate(
+        "position_offset", Scope.CHANNEL_AXIS, GEO, IPO, 0x800, SGN32, R, "0.1 um",
+        "Command position of the channel axis - position of its physical axis "
+        "(jog of path, FCT-C15) (project offset)",
+    ),
+    ObjectTemplate(
+        "vel_max", Scope.CHANNEL_AXIS, GEO, IPO, 0x801, REAL64, R, "mm/s",
+        "Maximum axis velocity the planner uses (getriebe[0].dynamik.vb_max) (project offset)",
+    ),
+    ObjectTemplate(
+        "acc_max", Scope.CHANNEL_AXIS, GEO, IPO, 0x802, REAL64, R, "mm/s^2",
+        "Maximum axis acceleration the planner uses (getriebe[0].dynamik.a_max) "
+        "(project offset)",
+    ),
+    ObjectTemplate(
+        "vel_jump_max", Scope.CHANNEL_AXIS, GEO, IPO, 0x803, REAL64, R, "mm/s",
+        "Permitted velocity jump of the axis at a block transition (project offset)",
     ),
     # --- GEO interpolator, channel -------------------------------------------------------
     ObjectTemplate(
@@ -307,11 +336,64 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "link_to_logical_axis", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x0F, UNS16, R, "-",
         "Logical axis number that drives this physical axis; 0 = none (project offset)",
     ),
+    # --- COM platform: axis parameter update (project) ------------------------------------
+    ObjectTemplate(
+        "axis_parameter_update_w", Scope.PLATFORM, COM, COM_CH, 0x1100, STRING(4096), W, "-",
+        "Write an ISG axis parameter list (kopf.achs_nr first): changes that axis's "
+        "parameters from the next program start; clones keep theirs (project)",
+    ),
+    # --- PLC (HLI) per channel: gpCh[i] (port 851) ---------------------------------------
+    ObjectTemplate(
+        "bahn_mc_control.suspend_axis_output.command_w", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        0x100, BOOLEAN, RW, "-",
+        "TRUE: suspend the channel's output to the physical axes (evaluated while enable_w)",
+    ),
+    ObjectTemplate(
+        "bahn_mc_control.suspend_axis_output.enable_w", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        0x101, BOOLEAN, RW, "-",
+        "TRUE: the CNC follows command_w; FALSE: it follows request_r",
+    ),
+    ObjectTemplate(
+        "bahn_mc_control.suspend_axis_output.request_r", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        0x102, BOOLEAN, R, "-",
+        "The CNC side's own request (the configured suspend_output_at_start)",
+    ),
+    ObjectTemplate(
+        "bahn_mc_control.suspend_axis_output.state_r", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        0x103, BOOLEAN, R, "-",
+        "TRUE while the channel's axis output is suspended (its axes are given up)",
+    ),
+    # --- PLC (HLI) per axis slot: gpAx[i] (port 851) -------------------------------------
+    ObjectTemplate(
+        "head.log_ax_n_r", Scope.PLC_AXIS, PLC, PLC_GROUP, 0x00, UNS16, R, "-",
+        "Axis number of this HLI axis slot",
+    ),
+    ObjectTemplate(
+        "lr_state.position_offset_r", Scope.PLC_AXIS, PLC, PLC_GROUP, 0x10, SGN32, R, "0.1 um",
+        "Offset between the logical axis linked to this physical axis and the physical "
+        "position (command - actual); 0 when none is linked",
+    ),
+    ObjectTemplate(
+        "lr_state.link_to_ipo_r", Scope.PLC_AXIS, PLC, PLC_GROUP, 0x14, UNS16, R, "-",
+        "Logical axis that drives this physical axis; 0 = not linked",
+    ),
+    ObjectTemplate(
+        "ipo_state.link_to_lr", Scope.PLC_AXIS, PLC, PLC_GROUP, 0x40, UNS16, R, "-",
+        "Physical axis this logical axis outputs to; 0 = not linked",
+    ),
 )
 
 
-def _instantiate(t: ObjectTemplate, channel: int = 0, axis: int = 0) -> CncObject:
+def _instantiate(
+    t: ObjectTemplate, channel: int = 0, axis: int = 0, index: int = 0
+) -> CncObject:
     match t.scope:
+        case Scope.PLC_CHANNEL:
+            name, group = f"gpCh[{index}].{t.element}", t.group_base
+            offset = PLC_CHANNEL_BASE + index * PLC_CHANNEL_STRIDE + t.offset
+        case Scope.PLC_AXIS:
+            name, group = f"gpAx[{index}].{t.element}", t.group_base
+            offset = PLC_AXIS_BASE + index * PLC_AXIS_STRIDE + t.offset
         case Scope.PLATFORM:
             name, group, offset = t.element, t.group_base, t.offset
         case Scope.PHYSICAL_AXIS:
@@ -352,5 +434,13 @@ def build_objects(
                     _instantiate(t, c.channel_id, a)
                     for c in layout.channels
                     for a in range(1, c.axis_count + 1)
+                )
+            case Scope.PLC_CHANNEL:
+                objects.extend(
+                    _instantiate(t, c.channel_id, index=i) for i, c in enumerate(layout.channels)
+                )
+            case Scope.PLC_AXIS:
+                objects.extend(
+                    _instantiate(t, axis=n, index=i) for i, n in enumerate(layout.hli_axes)
                 )
     return objects

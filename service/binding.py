@@ -29,8 +29,12 @@ from .kernel.commands import (
     SetExecutionMode,
     SetFeedOverride,
     SetSingleBlock,
+    SetSuspendCommand,
+    SetSuspendEnable,
     StartProgram,
+    UpdateAxisParameters,
 )
+from .config import MachineConfig
 from .kernel.kernel import Kernel
 
 Getter = Callable[[], Any]
@@ -88,6 +92,16 @@ def _constant(value: Callable[[Kernel], Any]) -> Callable[[Kernel, CncObject], G
     return bind
 
 
+def _constant_per_object(
+    value: Callable[[Kernel, CncObject], Any],
+) -> Callable[[Kernel, CncObject], Getter]:
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        fixed = value(kernel, obj)
+        return lambda: fixed
+
+    return bind
+
+
 def _per_scope(
     physical: Callable[[Kernel, CncObject], Getter],
     channel_axis: Callable[[Kernel, CncObject], Getter],
@@ -120,6 +134,42 @@ def _scaled(attr: str, factor: float) -> Callable[[Kernel, CncObject], Getter]:
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
         ci = kernel.channel_index(obj.channel)
         return lambda: getattr(kernel.snapshot.channels[ci], attr) * factor
+
+    return bind
+
+
+def _axis_param(attr: str) -> Callable[[Kernel, CncObject], Getter]:
+    """An effective axis parameter of a channel axis (clones resolved, updates seen)."""
+
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        number = kernel.config.channels[kernel.channel_index(obj.channel)].axes[obj.axis - 1]
+        return lambda: getattr(kernel.axis_params[number.logical_number], attr)
+
+    return bind
+
+
+def _hli_physical(attr: str) -> Callable[[Kernel, CncObject], Getter]:
+    """``gpAx[i].lr_state``: the physical axis with the slot's number (0 when none)."""
+
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        numbers = [p.number for p in kernel.config.physical_axes]
+        if obj.axis not in numbers:
+            return lambda: 0
+        index = numbers.index(obj.axis)
+        return lambda: getattr(kernel.snapshot.physical_axes[index], attr)
+
+    return bind
+
+
+def _hli_logical(attr: str) -> Callable[[Kernel, CncObject], Getter]:
+    """``gpAx[i].ipo_state``: the logical axis with the slot's number (0 when none)."""
+
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        for ci, channel in enumerate(kernel.config.channels):
+            for ai, axis in enumerate(channel.axes):
+                if axis.logical_number == obj.axis:
+                    return lambda: getattr(kernel.snapshot.channels[ci].axes[ai], attr)
+        return lambda: 0
 
     return bind
 
@@ -173,6 +223,18 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "mc_waiting_for_start_r": _channel("waiting_for_start"),
     "mc_manual_blocks_done_r": _channel("manual_blocks_done"),
     "mc_error_count_r": _channel("error_count"),
+    "position_offset": _channel_axis("position_offset_incr"),
+    "vel_max": _axis_param("vel_max_mm_s"),
+    "acc_max": _axis_param("acc_max_mm_s2"),
+    "vel_jump_max": _axis_param("vel_jump_mm_s"),
+    "bahn_mc_control.suspend_axis_output.command_w": _channel("suspend_command_w"),
+    "bahn_mc_control.suspend_axis_output.enable_w": _channel("suspend_enable_w"),
+    "bahn_mc_control.suspend_axis_output.request_r": _channel("suspend_request_r"),
+    "bahn_mc_control.suspend_axis_output.state_r": _channel("output_suspended"),
+    "head.log_ax_n_r": _constant_per_object(lambda kernel, obj: obj.axis),
+    "lr_state.position_offset_r": _hli_physical("position_offset_incr"),
+    "lr_state.link_to_ipo_r": _hli_physical("linked_logical_axis"),
+    "ipo_state.link_to_lr": _hli_logical("actual_link"),
     **{
         f"mc_error_{k}_{field}_r": _channel_error(k, field)
         for k in range(1, 9)
@@ -201,7 +263,20 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
     "mc_command_hold_w": _channel_command(Feedhold),
     "mc_command_reset_w": _channel_command(ResetChannel),
     "mc_command_manual_block_w": _channel_command(ManualBlock),
+    "bahn_mc_control.suspend_axis_output.command_w": _channel_command(SetSuspendCommand),
+    "bahn_mc_control.suspend_axis_output.enable_w": _channel_command(SetSuspendEnable),
+    "axis_parameter_update_w": lambda kernel, obj: _axis_parameter_update,
 }
+
+
+def _axis_parameter_update(text: str) -> Command:
+    """Parse the list here (service side), apply it on the cycle thread."""
+    from .param_list import ParamListError, parse_axis_list
+
+    try:
+        return UpdateAxisParameters(parse_axis_list(text, "axis_parameter_update_w"))
+    except ParamListError as exc:
+        return UpdateAxisParameters(None, str(exc))
 
 
 def machine_layout(kernel: Kernel) -> MachineLayout:
@@ -209,11 +284,23 @@ def machine_layout(kernel: Kernel) -> MachineLayout:
     return MachineLayout(
         channels=tuple(ChannelLayout(c.id, len(c.axes)) for c in kernel.config.channels),
         physical_axes=tuple(a.number for a in kernel.config.physical_axes),
+        hli_axes=hli_axis_numbers(kernel.config),
     )
+
+
+def hli_axis_numbers(config: MachineConfig) -> tuple[int, ...]:
+    """Axis numbers of the HLI axis slots ``gpAx[0..]``: every physical and logical axis
+    number, ascending. Slot i shows the physical axis with that number in ``lr_state``
+    and the logical axis with that number in ``ipo_state``."""
+    numbers = {a.number for a in config.physical_axes}
+    numbers |= {a.logical_number for c in config.channels for a in c.axes}
+    return tuple(sorted(numbers))
 
 
 def _aliases(kernel: Kernel, obj: CncObject) -> list[int]:
     """Other groups that address ``obj``: the index-based spelling, platform under ch 1."""
+    if obj.port == CncPort.PLC:
+        return []  # PLC symbols have one address
     if obj.channel:
         return [index_based(obj.group, obj.channel, kernel.channel_index(obj.channel) + 1)]
     aliases = [obj.group & ~LOGICAL_BIT]

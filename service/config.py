@@ -10,7 +10,7 @@ from __future__ import annotations
 import tomllib
 from enum import StrEnum
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
@@ -45,12 +45,25 @@ class PhysicalAxisConfig(_Strict):
 
 
 class AxisConfig(_Strict):
-    """A logical axis of a channel (ISG axis parameter list, ``kopf.*``)."""
+    """A logical axis of a channel: its name there and its axis parameter list.
+
+    A clone (``clone_of``) takes every parameter of its master when the kernel
+    initialises the axes and overrides only what is written here: which fields were
+    written is kept by pydantic (``model_fields_set``), so leave out what the clone
+    should inherit. ``link_to`` left out means the drive with the axis's own number
+    (or, for a clone, the master's drive).
+    """
 
     name: str = Field(min_length=1, max_length=15, description="axis name in the channel")
-    logical_number: int = Field(ge=1, le=0xFFFF, description="kopf.achs_nr")
-    link_to: int = Field(ge=1, le=0xFFFF, description="kopf.link_to (P-AXIS-00101)")
-    clone_of: int | None = Field(None, ge=1, description="kopf.clone_of (P-AXIS-00040)")
+    logical_number: int = Field(ge=1, le=0xFFFF, description="kopf.achs_nr (P-AXIS-00016)")
+    link_to: int | None = Field(None, ge=1, le=0xFFFF, description="kopf.link_to (P-AXIS-00101)")
+    clone_of: int | None = Field(
+        None, ge=1, le=0xFFFE, description="kopf.clone_of (P-AXIS-00040)"
+    )
+    axis_type: Literal["linear"] = Field("linear", description="kenngr.achs_typ (P-AXIS-00018)")
+    auto_release_of_axis_link: bool = Field(
+        False, description="kenngr.auto_release_of_axis_link (P-AXIS-00483)"
+    )
     limits: AxisLimits = AxisLimits()
 
 
@@ -133,12 +146,48 @@ class MachineConfig(_Strict):
         for ci, channel in enumerate(self.channels):
             for ai, axis in enumerate(channel.axes):
                 where = f"channels.{ci}.axes.{ai}"
-                if axis.link_to not in physical:
+                if axis.link_to is not None and axis.link_to not in physical:
                     raise ValueError(
                         f"{where}.link_to: physical axis {axis.link_to} does not exist "
                         f"(configured: {physical})"
                     )
+                link = self.link_of(axis.logical_number)
+                if link not in physical:
+                    raise ValueError(
+                        f"{where}.link_to: missing, and there is no physical axis {link} "
+                        "to link to (the axis's own number, or its master's drive)"
+                    )
         return self
+
+    def axis(self, logical_number: int) -> AxisConfig | None:
+        """The configured axis with ``logical_number``, or None."""
+        for channel in self.channels:
+            for axis in channel.axes:
+                if axis.logical_number == logical_number:
+                    return axis
+        return None
+
+    def link_of(self, logical_number: int) -> int:
+        """The physical axis a logical axis is linked to (``kopf.link_to``): written, or
+        inherited from the master of a clone, or else the axis's own number."""
+        seen: set[int] = set()
+        axis = self.axis(logical_number)
+        while axis is not None and axis.link_to is None and axis.clone_of is not None:
+            if axis.logical_number in seen:  # a clone ring: no master has a link
+                break
+            seen.add(axis.logical_number)
+            master = self.axis(axis.clone_of)
+            if master is None:
+                break
+            axis = master
+        if axis is not None and axis.link_to is not None:
+            return axis.link_to
+        return logical_number
+
+    def startup_axes(self) -> list[tuple[int, AxisConfig]]:
+        """Every logical axis in start-up order (channel by channel, axis by axis),
+        with the index of its channel: the order the kernel initialises them in."""
+        return [(ci, axis) for ci, c in enumerate(self.channels) for axis in c.axes]
 
 
 DEFAULT_MACHINE: dict[str, Any] = {
@@ -202,10 +251,80 @@ def _explain(exc: ValidationError, source: str) -> ConfigError:
     return ConfigError("\n".join(lines))
 
 
-def build_config(overrides: dict[str, Any] | None = None, source: str = "config") -> MachineConfig:
-    """The default machine with ``overrides`` laid over it, validated."""
+def _apply_parameter_lists(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:
+    """Read the ISG parameter lists the configuration names and lay them over it.
+
+    ``channels[i].parameter_list`` (a channel list) gives that channel's axes and
+    ``jog_of_path_only``; ``axis_parameter_lists`` (axis lists) give the parameters of
+    the axes whose ``kopf.achs_nr`` they carry. Paths are relative to ``base_dir``.
+    """
+    from .param_list import ParamListError, read_axis_list, read_channel_list
+
+    data = dict(data)
+    channels = [dict(c) for c in data.get("channels", [])]
+    problems: list[str] = []
+    for ci, channel in enumerate(channels):
+        name = channel.pop("parameter_list", None)
+        if name is None:
+            continue
+        try:
+            listed = read_channel_list(base_dir / name)
+        except ParamListError as exc:
+            problems.append(str(exc))
+            continue
+        if "axes" in listed and "axes" in channel:  # arrays replace: the user wrote both
+            problems.append(f"channels.{ci}: axes are given twice, here and in {name}")
+            continue
+        channel.update(listed)
+    axis_lists = data.pop("axis_parameter_lists", [])
+    if not isinstance(axis_lists, list):
+        problems.append("axis_parameter_lists: must be a list of file names")
+        axis_lists = []
+    for name in axis_lists:
+        try:
+            listed = read_axis_list(base_dir / str(name))
+        except ParamListError as exc:
+            problems.append(str(exc))
+            continue
+        number = listed["logical_number"]
+        target = [
+            (ci, ai)
+            for ci, c in enumerate(channels)
+            for ai, a in enumerate(c.get("axes") or [])
+            if isinstance(a, dict) and a.get("logical_number") == number
+        ]
+        if not target:
+            problems.append(
+                f"{base_dir / str(name)}: kopf.achs_nr {number} is not an axis of any channel"
+            )
+            continue
+        ci, ai = target[0]
+        axes = [dict(a) for a in channels[ci]["axes"]]
+        limits = {**axes[ai].get("limits", {}), **listed.get("limits", {})}
+        axes[ai].update(listed)
+        if limits:
+            axes[ai]["limits"] = limits
+        channels[ci]["axes"] = axes
+    if problems:
+        raise ConfigError("\n".join(problems))
+    if channels:
+        data["channels"] = channels
+    return data
+
+
+def build_config(
+    overrides: dict[str, Any] | None = None, source: str = "config", base_dir: Path | None = None
+) -> MachineConfig:
+    """The default machine with ``overrides`` laid over it, validated. Parameter lists
+    the overrides name are read relative to ``base_dir`` (default: the working
+    directory)."""
+    merged = _merge(DEFAULT_MACHINE, overrides or {})
+    if "axis_parameter_lists" in merged or any(
+        isinstance(c, dict) and "parameter_list" in c for c in merged.get("channels", [])
+    ):
+        merged = _apply_parameter_lists(merged, base_dir or Path.cwd())
     try:
-        return MachineConfig.model_validate(_merge(DEFAULT_MACHINE, overrides or {}))
+        return MachineConfig.model_validate(merged)
     except ValidationError as exc:
         raise _explain(exc, source) from None
 
@@ -220,4 +339,4 @@ def load_config(path: Path | None) -> MachineConfig:
         raise ConfigError(f"{path}: cannot read: {exc.strerror}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from None
-    return build_config(data, str(path))
+    return build_config(data, str(path), path.parent)

@@ -25,13 +25,15 @@ from .channel_mode import (
     ChannelState,
     describe,
 )
+from .axis_params import AxisErrorId, AxisParameters
 from .commands import Refusal, RefusalReason
 from .decoder_feed import DecodeEnd, DecoderFeed, Job
 from .nc import ModalState, NcError
-from .nc.blocks import Block, StopKind
+from .nc.blocks import AxisExchange, AxisExchangeKind, Block, StopKind
 from .path.executor import AxisDynamics, PathError, PathExecutor
 from .path.interpolator import Waiting
 from .state import Channel, ChannelError, ExecutionMode
+from .switchover import Switchover
 
 log = logging.getLogger(__name__)
 
@@ -61,7 +63,13 @@ class ChannelRunner:
         cycle_s: float,
         deterministic: bool,
         files: Callable[[str, bytes], None] = lambda name, data: None,
+        *,
+        params: dict[int, AxisParameters],
+        switchover: Switchover,
     ) -> None:
+        """``params`` are the kernel's effective axis parameters (read at each program
+        start, so a parameter update applies from the next run); ``switchover`` links
+        the channel's axes to the drives."""
         self.channel = channel
         self.config = config
         self._loader = loader
@@ -71,15 +79,16 @@ class ChannelRunner:
         self._files = files  # appends to a file of the program store, off this thread
         self.error_log_name = f"errors-ch{channel.channel_id}.log"
         self._axes = tuple(a.name for a in config.axes)
+        self._axis_numbers = tuple(a.logical_number for a in config.axes)
         self._tools = {t.d: t.radius_mm for t in machine.tools}
-        self._dynamics = tuple(
-            AxisDynamics(a.limits.vel_max_mm_s, a.limits.acc_max_mm_s2, a.limits.vel_jump_mm_s)
-            for a in config.axes
-        )
-        self._sw_limits = tuple(
-            (a.limits.sw_limit_min_mm, a.limits.sw_limit_max_mm) for a in config.axes
-        )
+        self._params = params
+        self._switchover = switchover
         self._buffer_blocks = config.look_ahead_blocks
+        self._pending_start: tuple[Job, bool, bool] | None = None  # waits for the axes
+        self._queued_jobs: list[Job] = []  # manual blocks sent while the start waits
+        self._exchange: Block | None = None  # an axis exchange waiting for standstill
+        self._backlog: list = []  # decoded items that came after that exchange
+        self._internal_hold = False  # feedhold of a suspend_axis_output request
         self._executor: PathExecutor | None = None
         self._feed: DecoderFeed | None = None
         self._modal: ModalState | None = None  # MDI: modal state carried between blocks
@@ -132,7 +141,7 @@ class ChannelRunner:
             return None
         if ch.state != ChannelState.READY or ch.mode != ChannelMode.AUTOMATIC:
             return _not_ready(ch, "START needs AUTOMATIC/READY (select a program first) or HOLD")
-        self._begin(Job(ch.program_name), keep_open=False, fresh_modal=True)
+        self._start_when_linked(Job(ch.program_name), keep_open=False, fresh_modal=True)
         return None
 
     def hold(self) -> Refusal | None:
@@ -151,7 +160,11 @@ class ChannelRunner:
         if not text.strip():
             return Refusal(RefusalReason.INVALID_VALUE, "the manual block is empty")
         if ch.state == ChannelState.ACTIVE and ch.mode == ChannelMode.MDI and extended:
-            self._feed.add(Job(_MDI_NAME, text, manual=True))  # continues the same program
+            job = Job(_MDI_NAME, text, manual=True)
+            if self._feed is None:  # the first block still waits for the axes
+                self._queued_jobs.append(job)
+            else:
+                self._feed.add(job)  # continues the same program
             return None
         if ch.state not in IDLE_STATES or ch.mode == ChannelMode.MANUAL:
             return _not_ready(ch, "a manual block needs a channel that is not working")
@@ -160,7 +173,9 @@ class ChannelRunner:
             ch.program_name = ""
             self._modal = None
         extended = bool(ch.execution_mode_command & ExecutionMode.ADD_MDI_BLOCK)
-        self._begin(Job(_MDI_NAME, text, manual=True), keep_open=extended, fresh_modal=False)
+        self._start_when_linked(
+            Job(_MDI_NAME, text, manual=True), keep_open=extended, fresh_modal=False
+        )
         return None
 
     def reset(self) -> Refusal | None:
@@ -170,6 +185,10 @@ class ChannelRunner:
         if self._executor is not None:
             self._executor.stop_now()
         self._pending_error = None
+        self._pending_start = self._exchange = None
+        self._queued_jobs.clear()
+        self._backlog = []
+        self._internal_hold = False
         ch.errors, ch.error_count = (), 0
         ch.waiting_for_start = False
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
@@ -180,13 +199,111 @@ class ChannelRunner:
         else:
             ch.state = ChannelState.SELECTED
         self._modal = None
+        self.initialise_channel()
         return None
 
+    def initialise_channel(self) -> None:
+        """Channel init (start-up, RESET): the configured axes are back in the channel,
+        the command positions take the drives' positions (offsets cleared), and a
+        jog-of-path channel checks that all its axes are clones (P-CHAN-00306)."""
+        for axis in self.channel.axes:
+            axis.released = False
+            axis.offset_live = False
+        self._switchover.adjust_to_drives(self.channel)
+        self._check_jog_of_path()
+
+    def _check_jog_of_path(self) -> bool:
+        """True when the channel may work: not a jog-of-path channel, or all its axes in
+        the channel are clones; otherwise the channel goes to ERROR naming the axis."""
+        if not self.config.jog_of_path_only:
+            return True
+        for axis in self.channel.axes:
+            if not axis.released and not axis.is_clone:
+                self._fail(ChannelError(
+                    AxisErrorId.JOG_OF_PATH_AXIS_NOT_CLONE,
+                    f"axis {axis.name} (kopf.achs_nr {axis.logical_number}) of jog-of-path "
+                    f"channel {self.channel.channel_id} is not a clone (jog_of_path_only, "
+                    "P-CHAN-00306): configure it with kopf.clone_of",
+                ))
+                return False
+        return True
+
+    def report(self, error: ChannelError) -> None:
+        """List ``error`` (a warning leaves the channel's state alone)."""
+        if error.warning:
+            self._raise(error)
+        else:
+            self._fail(error)
+
+    # ------------------------------------------------------------ jog of path
+
+    @property
+    def axes_ready(self) -> bool:
+        """The channel's output is not suspended and every axis in it is linked."""
+        ch = self.channel
+        if ch.output_suspended:
+            return False
+        for axis in ch.axes:
+            if not axis.actual_link and not axis.released:
+                return False
+        return True
+
+    @property
+    def moving(self) -> bool:
+        """The path is not at standstill."""
+        return self._executor is not None and self.channel.path_velocity_mm_s > 0.0
+
+    def internal_hold(self) -> bool:
+        """Brake the path for a suspend request (the channel stays ACTIVE); True when
+        this started the feedhold."""
+        if self._internal_hold or self._executor is None:
+            return False
+        self._internal_hold = True
+        self._executor.hold()
+        return True
+
+    def release_internal_hold(self) -> bool:
+        """End the internal feedhold (a HOLD the operator commanded stays); True when
+        one was active."""
+        if not self._internal_hold:
+            return False
+        self._internal_hold = False
+        if self._executor is not None and self.channel.state != ChannelState.HOLD:
+            self._executor.release_hold()
+        return True
+
     # ------------------------------------------------------------ run
+
+    def _start_when_linked(self, job: Job, keep_open: bool, fresh_modal: bool) -> None:
+        """Program start: the configured axes are back in the channel; the run begins
+        in the first cycle all of them are linked (at once when they are)."""
+        ch = self.channel
+        for axis in ch.axes:
+            axis.released = False
+        ch.state = ChannelState.ACTIVE
+        ch.waiting_for_start = False
+        ch.errors, ch.error_count = (), 0
+        self._pending_start = (job, keep_open, fresh_modal)
+        if self.axes_ready:
+            self._begin_pending()
+
+    def _begin_pending(self) -> None:
+        job, keep_open, fresh_modal = self._pending_start
+        self._pending_start = None
+        if not self._check_jog_of_path():
+            return
+        # Position adjustment: the channel starts where the physical axes are.
+        self._switchover.adjust_to_drives(self.channel)
+        self._begin(job, keep_open, fresh_modal)
 
     def _begin(self, job: Job, keep_open: bool, fresh_modal: bool) -> None:
         ch = self.channel
         ch.execution_mode_active = ch.execution_mode_command
+        params = [self._params[n] for n in self._axis_numbers]
+        dynamics = tuple(
+            AxisDynamics(p.vel_max_mm_s, p.acc_max_mm_s2, p.vel_jump_mm_s) for p in params
+        )
+        sw_limits = tuple((p.sw_limit_min_mm, p.sw_limit_max_mm) for p in params)
         position = tuple(a.position_mm for a in ch.axes)
         if fresh_modal or self._modal is None:
             self._modal = ModalState(position_mm=position)
@@ -195,16 +312,20 @@ class ChannelRunner:
         self._feed = DecoderFeed(
             channel_id=ch.channel_id, axes=self._axes, loader=self._loader, tools=self._tools,
             modal=self._modal, capacity=self._buffer_blocks + _FEED_MARGIN_BLOCKS,
-            keep_open=keep_open,
+            keep_open=keep_open, axis_numbers=self._axis_numbers,
         )
         self._feed.add(job)
+        for more in self._queued_jobs:
+            self._feed.add(more)
+        self._queued_jobs.clear()
         if not keep_open:
             self._feed.finish()
         self._executor = PathExecutor(
-            self._dynamics, position, cycle_s=self._cycle_s,
-            buffer_blocks=self._buffer_blocks, sw_limits_mm=self._sw_limits,
+            dynamics, position, cycle_s=self._cycle_s,
+            buffer_blocks=self._buffer_blocks, sw_limits_mm=sw_limits,
         )
         self._executor.single_block = ch.single_block
+        self._exchange, self._backlog = None, []
         self._fed_all = False
         self._pending_error = None
         self._started_at_s = self._time_s
@@ -246,7 +367,14 @@ class ChannelRunner:
         free = executor.free_slots()
         if free <= 0:
             return
-        for item in feed.take(free, wait=self._deterministic):
+        items, self._backlog = self._backlog or feed.take(free, wait=self._deterministic), []
+        for k, item in enumerate(items):
+            if isinstance(item, Block) and item.axis_exchange is not None:
+                # The axes change hands at standstill: flush, feed the rest after it.
+                self._exchange = item
+                self._backlog = items[k + 1:]
+                executor.close()
+                return
             if isinstance(item, Block):
                 try:
                     executor.push(item)
@@ -270,13 +398,28 @@ class ChannelRunner:
         self._time_s = time_s
         ch = self.channel
         executor = self._executor
-        if executor is None or ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
+        if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
             self.touched = False
             return False
+        if not self.axes_ready:  # suspended, or an axis waits for its link
+            self.touched = False
+            return False
+        if self._pending_start is not None:
+            self._begin_pending()
+            executor = self._executor
+            if executor is None:  # the start failed (jog-of-path check)
+                self.touched = True
+                return False
         self.touched = True
         if executor.single_block != ch.single_block:
             executor.single_block = ch.single_block
-        self._feed_blocks()
+        if self._exchange is not None and executor.idle:
+            if not self._apply_exchange():
+                return False
+            if not self.axes_ready:  # a requested axis links first
+                return False
+        if self._exchange is None:
+            self._feed_blocks()
         step = executor.step(ch.feed_override_active / 1000.0)
         for axis, pos in zip(ch.axes, step.position_mm, strict=True):
             axis.position_mm = pos
@@ -311,6 +454,20 @@ class ChannelRunner:
             if ch.mode == ChannelMode.MDI and self._feed is not None and self._feed.keep_open:
                 return False  # extended MDI: waiting for the next manual block
         return True
+
+    def _apply_exchange(self) -> bool:
+        """Carry out the axis exchange the path stands at; False when the channel failed."""
+        block, self._exchange = self._exchange, None
+        exchange: AxisExchange = block.axis_exchange
+        ch = self.channel
+        release = exchange.kind == AxisExchangeKind.RELEASE
+        for index in exchange.axes:
+            ch.axes[index].released = release
+        ch.block_count += 1
+        src = block.source
+        ch.file_name, ch.line, ch.file_offset = src.file, src.line, src.offset
+        ch.block_number = block.number if block.number is not None else -1
+        return self._check_jog_of_path()  # P-CHAN-00306: checked at axis exchange too
 
     def _end_program(self) -> bool:
         ch = self.channel

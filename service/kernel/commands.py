@@ -9,8 +9,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import IntEnum
-from typing import NamedTuple, Protocol
+from typing import Any, NamedTuple, Protocol
 
+from .axis_params import update_axis
+from .channel_mode import ChannelState
 from .state import ExecutionMode, KernelState
 
 
@@ -153,3 +155,69 @@ class ManualBlock:
 
     def apply(self, state: KernelState) -> Refusal | None:
         return state.runners[self.channel_index].manual_block(self.value)
+
+
+def _suspend_refused(state: KernelState, channel_index: int, command: bool, enable: bool) -> Refusal | None:
+    """Suspending the axis output is not possible while the channel is in error."""
+    channel = state.channels[channel_index]
+    wants = command if enable else channel.suspend_request_r
+    if wants and not channel.output_suspended and channel.state == ChannelState.ERROR:
+        return Refusal(
+            RefusalReason.NOT_READY,
+            f"channel {channel.channel_id} is in error: its axis output cannot be suspended; "
+            "clear the error (RESET) and try again",
+        )
+    return None
+
+
+@dataclass(frozen=True, slots=True)
+class SetSuspendCommand:
+    """``suspend_axis_output.command_w``: TRUE asks to suspend the channel's axis output."""
+
+    channel_index: int
+    value: bool
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        channel = state.channels[self.channel_index]
+        refused = _suspend_refused(state, self.channel_index, bool(self.value),
+                                   channel.suspend_enable_w)
+        if refused is None:
+            channel.suspend_command_w = bool(self.value)
+        return refused
+
+
+@dataclass(frozen=True, slots=True)
+class SetSuspendEnable:
+    """``suspend_axis_output.enable_w``: TRUE makes the CNC follow ``command_w``."""
+
+    channel_index: int
+    value: bool
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        channel = state.channels[self.channel_index]
+        refused = _suspend_refused(state, self.channel_index, channel.suspend_command_w,
+                                   bool(self.value))
+        if refused is None:
+            channel.suspend_enable_w = bool(self.value)
+        return refused
+
+
+@dataclass(frozen=True, slots=True)
+class UpdateAxisParameters:
+    """Change one axis's parameters from an axis parameter list (its clones keep theirs).
+
+    ``changes`` is the parsed list; ``problem`` the reader's report when it could not
+    be parsed (then nothing changes). Takes effect at the next program start.
+    """
+
+    changes: dict[str, Any] | None
+    problem: str = ""
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        if self.changes is None:
+            return Refusal(RefusalReason.INVALID_VALUE, self.problem)
+        updated, why = update_axis(state.axis_params, self.changes)
+        if updated is None:
+            return Refusal(RefusalReason.INVALID_VALUE, why)
+        state.axis_params[updated.logical_number] = updated
+        return None

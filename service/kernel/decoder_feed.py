@@ -66,8 +66,10 @@ class DecoderFeed:
         modal: ModalState,
         capacity: int,
         keep_open: bool = False,
+        axis_numbers: tuple[int, ...] | None = None,
     ) -> None:
         self._axes = axes
+        self._axis_numbers = axis_numbers
         self._loader = loader
         self._tools = tools
         self.modal = modal
@@ -136,7 +138,7 @@ class DecoderFeed:
         text = job.text if job.text is not None else self._loader(job.name)
         decoder = Decoder(
             text, job.name, axes=self._axes, loader=self._loader, tools=self._tools,
-            modal=self.modal, manual=job.manual,
+            modal=self.modal, manual=job.manual, axis_numbers=self._axis_numbers,
         )
         yield from decoder.blocks()
         self.modal = decoder.modal

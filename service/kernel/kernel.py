@@ -18,10 +18,12 @@ from dataclasses import dataclass
 from enum import Enum
 
 from ..config import MachineConfig
+from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, VirtualClock
 from .commands import Command, Refusal, RefusalReason
-from .state import CycleStats, KernelState, Snapshot
+from .state import ChannelError, CycleStats, KernelState, Snapshot
+from .switchover import Switchover
 
 log = logging.getLogger(__name__)
 
@@ -85,14 +87,29 @@ class Kernel:
         self._closed = False
 
     def _initial_state(self) -> KernelState:
+        """State, axis parameters (clones resolved), switchover and channel runners as
+        at start-up; the start-up messages go to the channels' error lists."""
         state = KernelState.from_config(self.config)
+        params, messages = initialise_axes(self.config)
+        self.axis_params: dict[int, AxisParameters] = params
+        state.axis_params = params  # shared: an update reaches runners and switchover
+        for channel in state.channels:
+            for axis in channel.axes:
+                axis.is_clone = params[axis.logical_number].cloned
+        self.switchover = Switchover(state, params)
         # Virtual time must give the same result cycle by cycle: GEO waits for the decoder.
         deterministic = isinstance(self._clock, VirtualClock)
         state.runners = [
             ChannelRunner(channel, cfg, self.config, self._loader, self._exists, self.cycle_s,
-                          deterministic, self._files)
+                          deterministic, self._files, params=params, switchover=self.switchover)
             for channel, cfg in zip(state.channels, self.config.channels, strict=True)
         ]
+        for message in messages:
+            state.runners[message.channel_index].report(
+                ChannelError(int(message.id), message.text, warning=message.warning)
+            )
+        for runner in state.runners:
+            runner.initialise_channel()
         return state
 
     # ------------------------------------------------------------ service side
@@ -252,14 +269,18 @@ class Kernel:
         have touched any channel: then all are copied)."""
         time_s = self.stats.cycles * self.cycle_s
         busy = False
+        runners = self.state.runners
+        switched = [False] * len(runners)
+        self.switchover.step(switched)
         changed = []
-        for runner in self.state.runners:
+        for runner in runners:
             busy |= runner.cycle(time_s)
             changed.append(runner.touched)
         self.state.drive_axes()
-        self._busy = busy
+        self.switchover.update_offsets(switched)
+        self._busy = busy or self.switchover.in_progress
         if not applied_commands:
-            self._changed = changed
+            self._changed = [a or b for a, b in zip(changed, switched, strict=True)]
 
     def state_has_work(self) -> bool:
         """True while a channel moves or decodes: the virtual clock runs cycles back to

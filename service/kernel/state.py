@@ -48,6 +48,8 @@ class PhysicalAxis:
     command_position_incr: int = 0  # 0.1 um
     actual_position_incr: int = 0  # 0.1 um
     linked_logical_axis: int = 0  # logical axis number driving it; 0 = none
+    last_logical_axis: int = 0  # the logical axis that was linked last (survives unlinking)
+    position_offset_incr: int = 0  # offset of the link: command of the linked axis - position
 
     def frozen(self) -> PhysicalAxis:
         """A copy for the snapshot."""
@@ -57,6 +59,8 @@ class PhysicalAxis:
             self.command_position_incr,
             self.actual_position_incr,
             self.linked_logical_axis,
+            self.last_logical_axis,
+            self.position_offset_incr,
         )
 
 
@@ -72,13 +76,24 @@ class LogicalAxis:
     position_mm: float = 0.0  # command position of the channel axis
     command_position_incr: int = 0  # the same in 0.1 um, as the objects show it
     output_incr: int = 0  # command position last handed to the physical axis
+    position_offset_incr: int = 0  # command position - physical position (jog of path)
+    offset_live: bool = False  # the axis took its drive over from another logical axis
+    released: bool = False  # left the channel by #AX RELEASE
+    is_clone: bool = False  # initialised as a clone (kopf.clone_of resolved)
 
     def frozen(self) -> LogicalAxis:
         """A copy for the snapshot."""
         return LogicalAxis(
             self.name, self.logical_number, self.requested_link, self.actual_link,
             self.link_state, self.position_mm, self.command_position_incr, self.output_incr,
+            self.position_offset_incr, self.offset_live, self.released, self.is_clone,
         )
+
+    def set_position_incr(self, incr: int) -> None:
+        """Move the command position to ``incr`` without handing a step to the drive
+        (a position adjustment: the channel takes the drive's position)."""
+        self.command_position_incr = self.output_incr = incr
+        self.position_mm = incr / 10_000
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,10 +105,12 @@ class ChannelError:
     file: str = ""
     line: int = 0
     column: int = 0
+    warning: bool = False  # a warning is listed but does not stop the channel
 
     def __str__(self) -> str:
         where = f"{self.file}:{self.line}:{self.column}: " if self.file else ""
-        return f"error {self.id}: {where}{self.text}"
+        kind = "warning" if self.warning else "error"
+        return f"{kind} {self.id}: {where}{self.text}"
 
 
 @dataclass(slots=True)
@@ -109,7 +126,7 @@ class Channel:
     execution_mode_command: int = 0
     execution_mode_active: int = 0
     dist_prog_start_incr: float = 0.0  # 0.1 um
-    output_suspended: bool = False
+    output_suspended: bool = False  # suspend_axis_output.state_r: the axes are given up
     mode: int = 1  # ChannelMode
     state: int = 1  # ChannelState
     program_name: str = ""  # selected program
@@ -127,6 +144,16 @@ class Channel:
     program_time_s: float = 0.0
     errors: tuple[ChannelError, ...] = ()
     error_count: int = 0
+    # gpCh[i].bahn_mc_control.suspend_axis_output (ISG control unit, see docs/jog-of-path.md)
+    suspend_command_w: bool = False
+    suspend_enable_w: bool = True
+    suspend_request_r: bool = False
+
+    @property
+    def suspend_commanded(self) -> bool:
+        """The value the unit commands: ``command_w`` while the PLC enables the unit,
+        else the CNC's own request."""
+        return self.suspend_command_w if self.suspend_enable_w else self.suspend_request_r
 
     def frozen(self) -> Channel:
         """A copy for the snapshot, with copies of its axes."""
@@ -139,6 +166,7 @@ class Channel:
             self.line, self.file_name, self.file_offset, self.block_count,
             self.manual_blocks_done, self.path_velocity_mm_s, self.programmed_velocity_mm_s,
             self.remaining_in_block_mm, self.program_time_s, self.errors, self.error_count,
+            self.suspend_command_w, self.suspend_enable_w, self.suspend_request_r,
         )
 
 
@@ -183,43 +211,49 @@ class KernelState:
     channels: list[Channel] = field(default_factory=list)
     physical_axes: list[PhysicalAxis] = field(default_factory=list)
     runners: list = field(default_factory=list)  # ChannelRunner per channel (kernel sets)
+    axis_params: dict = field(default_factory=dict)  # AxisParameters by logical number
 
     @classmethod
     def from_config(cls, config: MachineConfig) -> KernelState:
         """Initial state: every channel links its axes unless its output is suspended."""
         state = cls(
-            channels=[_channel_from_config(c) for c in config.channels],
+            channels=[_channel_from_config(c, config) for c in config.channels],
             physical_axes=[PhysicalAxis(a.number, a.name) for a in config.physical_axes],
         )
-        by_number = {p.number: p for p in state.physical_axes}
+        by_number = state.drive_by_number()
         for channel in state.channels:
             if channel.output_suspended:
                 continue
             for axis in channel.axes:
                 drive = by_number[axis.requested_link]
                 if drive.linked_logical_axis == 0:
-                    drive.linked_logical_axis = axis.logical_number
+                    drive.linked_logical_axis = drive.last_logical_axis = axis.logical_number
                     axis.actual_link = drive.number
                     axis.link_state = LinkState.LINKED
-                else:  # another channel holds it: the request waits
-                    axis.link_state = LinkState.REQUESTED
+                else:  # another channel holds it: the request waits for it
+                    axis.link_state = LinkState.WAITING_ACK
         return state
+
+    def drive_by_number(self) -> dict[int, PhysicalAxis]:
+        """The physical axes by number."""
+        return {p.number: p for p in self.physical_axes}
 
     def drive_axes(self) -> None:
         """Position controller: each physical axis follows the increments of the logical
-        axis linked to it (ideal drive: actual position = command position)."""
+        axis linked to it (ideal drive: actual position = command position). A logical
+        axis without a link keeps its output where it was: no step is lost or invented
+        when it links again."""
         drives = self.physical_axes
         for channel in self.channels:
-            if channel.output_suspended:
-                continue
             for axis in channel.axes:
                 delta = axis.command_position_incr - axis.output_incr
-                if delta and axis.actual_link:
-                    for drive in drives:
-                        if drive.number == axis.actual_link:
-                            drive.command_position_incr += delta
-                            drive.actual_position_incr = drive.command_position_incr
-                            break
+                if not delta or not axis.actual_link:
+                    continue
+                for drive in drives:
+                    if drive.number == axis.actual_link:
+                        drive.command_position_incr += delta
+                        drive.actual_position_incr = drive.command_position_incr
+                        break
                 axis.output_incr = axis.command_position_incr
 
     def snapshot(
@@ -249,13 +283,13 @@ class KernelState:
         )
 
 
-def _channel_from_config(config: ChannelConfig) -> Channel:
+def _channel_from_config(config: ChannelConfig, machine: MachineConfig) -> Channel:
     suspended = config.suspend_output_at_start
     axes = [
         LogicalAxis(
             a.name,
             a.logical_number,
-            a.link_to,
+            machine.link_of(a.logical_number),
             link_state=LinkState.REQUESTED if suspended else LinkState.LINKED,
         )
         for a in config.axes
@@ -268,4 +302,6 @@ def _channel_from_config(config: ChannelConfig) -> Channel:
         feed_override_command=min(1000, config.feed_override_max),
         feed_override_active=min(1000, config.feed_override_max),
         output_suspended=suspended,
+        suspend_command_w=suspended,
+        suspend_request_r=suspended,
     )

@@ -144,6 +144,10 @@ async def test_browse_describes_objects(api: Any) -> None:
         "ch1.ax1.command_position_acs",
         "ch1.ax1.logical_axis_number",
         "ch1.ax1.axis_name",
+        "ch1.ax1.position_offset",
+        "ch1.ax1.vel_max",
+        "ch1.ax1.acc_max",
+        "ch1.ax1.vel_jump_max",
     }
     link = found["ch1.ax1.link_state"]
     assert (link.port, link.group, link.offset, link.type, link.length, link.access) == (

@@ -17,11 +17,23 @@ from objects.addressing import (
     index_based,
     split_axis_offset,
 )
-from objects.catalog import TEMPLATES, ChannelLayout, MachineLayout, Scope, build_objects
+from objects.catalog import (
+    PLC_GROUP,
+    TEMPLATES,
+    ChannelLayout,
+    MachineLayout,
+    Scope,
+    build_objects,
+)
 from objects.model import Access, CncObject
+from protocol.constants import CncPort
 from protocol.datatypes import REAL64, SGN32, UNS16, UNS32, DataType
 
-LAYOUT = MachineLayout((ChannelLayout(1, 3), ChannelLayout(2, 3)), (1, 2, 3))
+PLC = CncPort.PLC
+
+LAYOUT = MachineLayout(
+    (ChannelLayout(1, 3), ChannelLayout(2, 3)), (1, 2, 3), hli_axes=(1, 2, 3, 11, 12, 13)
+)
 
 
 @pytest.fixture(scope="module")
@@ -102,7 +114,11 @@ def test_addresses_are_unique() -> None:
 
 
 def _scope(obj) -> Scope:
-    """The scope an instance was made for, from its channel and axis."""
+    """The scope an instance was made for, from its name, channel and axis."""
+    if obj.name.startswith("gpCh["):
+        return Scope.PLC_CHANNEL
+    if obj.name.startswith("gpAx["):
+        return Scope.PLC_AXIS
     if obj.channel:
         return Scope.CHANNEL_AXIS if obj.axis else Scope.CHANNEL
     return Scope.PHYSICAL_AXIS if obj.axis else Scope.PLATFORM
@@ -115,6 +131,8 @@ def test_every_template_is_instantiated_once_per_scope_member() -> None:
         Scope.PHYSICAL_AXIS: len(LAYOUT.physical_axes),
         Scope.CHANNEL: len(LAYOUT.channels),
         Scope.CHANNEL_AXIS: sum(c.axis_count for c in LAYOUT.channels),
+        Scope.PLC_CHANNEL: len(LAYOUT.channels),
+        Scope.PLC_AXIS: len(LAYOUT.hli_axes),
     }
     for template in TEMPLATES:
         count = sum(
@@ -129,7 +147,7 @@ def test_every_object_follows_the_address_rules() -> None:
     assert len(templates) == len(TEMPLATES), "an element name repeats within one scope"
     for obj in build_objects(LAYOUT):
         t = templates[obj.element, _scope(obj)]
-        assert obj.group & LOGICAL_BIT, obj.name
+        assert obj.port == PLC or obj.group & LOGICAL_BIT, obj.name
         assert obj.port == t.port and obj.dtype is t.dtype and obj.access is t.access
         match t.scope:
             case Scope.PLATFORM:
@@ -145,6 +163,14 @@ def test_every_object_follows_the_address_rules() -> None:
                 assert obj.name == f"ch{obj.channel}.ax{obj.axis}.{t.element}"
                 assert obj.group == t.group_base + obj.channel
                 assert split_axis_offset(obj.offset) == (obj.axis, t.offset)
+            case Scope.PLC_CHANNEL:  # gpCh[i]: i = position of the channel, from 0
+                i = [c.channel_id for c in LAYOUT.channels].index(obj.channel)
+                assert obj.name == f"gpCh[{i}].{t.element}"
+                assert (obj.group, obj.offset) == (PLC_GROUP, 0x10000 + i * 0x1000 + t.offset)
+            case Scope.PLC_AXIS:  # gpAx[i]: i = slot of the axis number
+                i = LAYOUT.hli_axes.index(obj.axis)
+                assert obj.name == f"gpAx[{i}].{t.element}"
+                assert (obj.group, obj.offset) == (PLC_GROUP, 0x80000 + i * 0x100 + t.offset)
 
 
 def test_layout_drives_the_instances() -> None:

@@ -88,10 +88,16 @@ class KernelHarness:
         if condition is not None and condition[0](snap):
             condition[1].set()
 
-    def wait_for(self, predicate: Any, timeout_s: float = 30.0) -> Snapshot:
-        """Wait until ``predicate(snapshot)`` holds for a published cycle; that snapshot."""
+    def watch(self, predicate: Any) -> threading.Event:
+        """Call ``predicate(snapshot)`` for every cycle published from now on (on the
+        cycle thread); the event is set once it returns True."""
         event = threading.Event()
         self._condition = (predicate, event)
+        return event
+
+    def wait_for(self, predicate: Any, timeout_s: float = 30.0) -> Snapshot:
+        """Wait until ``predicate(snapshot)`` holds for a published cycle; that snapshot."""
+        event = self.watch(predicate)
         if predicate(self.kernel.snapshot):
             event.set()
         assert event.wait(timeout_s), "the condition did not come true in time"

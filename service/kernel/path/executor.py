@@ -122,6 +122,10 @@ class PathExecutor:
         """Feedhold: decelerate on the path within the limits and stand."""
         self._ipo.hold = True
 
+    def release_hold(self) -> None:
+        """End a feedhold only (a programmed or single-block stop keeps waiting)."""
+        self._ipo.hold = False
+
     def resume(self) -> None:
         """Continue after feedhold, M0/M1/M2/M30 and single-block stops."""
         self._ipo.resume()
