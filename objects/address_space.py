@@ -8,7 +8,6 @@ the message layer answers with the code and a sentence that says why.
 
 from __future__ import annotations
 
-import fnmatch
 import logging
 import re
 from collections.abc import Callable, Iterable
@@ -43,6 +42,12 @@ class GroupHandler(Protocol):
     def read(self, offset: int, length: int) -> tuple[int, bytes | str]:
         """ADS read: (0, data) or (code, message)."""
         ...
+
+
+def _glob(pattern: str) -> re.Pattern[str]:
+    """A regex for a name pattern with ``*`` and ``?`` as the only wildcards."""
+    body = re.escape(pattern).replace(r"\*", ".*").replace(r"\?", ".")
+    return re.compile(f"(?s:{body})\\Z")
 
 
 class AddressSpace:
@@ -135,10 +140,12 @@ class AddressSpace:
         )
 
     def match(self, pattern: str) -> list[CncObject]:
-        """Objects whose name matches the glob ``pattern`` (case-insensitive)."""
+        """Objects whose name matches ``pattern`` (case-insensitive): ``*`` matches any
+        run of characters, ``?`` one character; brackets are literal, because PLC names
+        carry indices (``gpCh[0].*``)."""
         if pattern in ("", "*"):
             return self.objects()
-        regex = re.compile(fnmatch.translate(pattern.lower()))
+        regex = _glob(pattern.lower())
         return [e.obj for e in self._entries if regex.match(e.obj.name.lower())]
 
     # ----------------------------------------------------------------- values

@@ -173,16 +173,14 @@ class MachineConfig(_Strict):
         seen: set[int] = set()
         axis = self.axis(logical_number)
         while axis is not None and axis.link_to is None and axis.clone_of is not None:
-            if axis.logical_number in seen:  # a clone ring: no master has a link
+            master = self.axis(axis.clone_of)
+            if master is None or axis.logical_number in seen:  # no master, or a ring
                 break
             seen.add(axis.logical_number)
-            master = self.axis(axis.clone_of)
-            if master is None:
-                break
             axis = master
-        if axis is not None and axis.link_to is not None:
-            return axis.link_to
-        return logical_number
+        if axis is None:
+            return logical_number
+        return axis.link_to if axis.link_to is not None else axis.logical_number
 
     def startup_axes(self) -> list[tuple[int, AxisConfig]]:
         """Every logical axis in start-up order (channel by channel, axis by axis),

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from service.config import ConfigError, build_config
+import shutil
+from pathlib import Path
+
+from service.config import ConfigError, build_config, load_config
 
 
 def test_default_machine() -> None:
@@ -73,3 +76,72 @@ def test_unknown_look_ahead_and_repeated_tools_are_refused() -> None:
         build_config({"channels": [{**base, "look_ahead": "FAST"}]})
     with pytest.raises(ConfigError, match="tool D numbers repeat"):
         build_config({"tools": [{"d": 1, "radius_mm": 1}, {"d": 1, "radius_mm": 2}]})
+
+
+# ------------------------------------------------------------------ parameter lists
+
+PARAMS = Path(__file__).parent.parent / "data" / "params"
+
+
+def _toml(tmp_path: Path, text: str) -> Path:
+    for name in ("axis-1.lis", "axis-11.lis", "channel-2.lis", "axis-bad.lis"):
+        shutil.copy(PARAMS / name, tmp_path / name)
+    for number in (12, 13):
+        (tmp_path / f"axis-{number}.lis").write_text(
+            f"kopf.achs_nr {number}\nkopf.clone_of {number - 10}\n"
+        )
+    path = tmp_path / "machine.toml"
+    path.write_text(text)
+    return path
+
+
+JOG_CHANNEL = '[[channels]]\nid = 2\nname = "jog"\nparameter_list = "channel-2.lis"\n'
+MAIN_CHANNEL = (
+    '[[channels]]\nid = 1\nname = "main"\naxes = [{name = "X", logical_number = 1},'
+    ' {name = "Y", logical_number = 2}, {name = "Z", logical_number = 3}]\n'
+)
+
+
+def test_parameter_lists_give_channel_axes_and_axis_parameters(tmp_path: Path) -> None:
+    path = _toml(tmp_path, 'axis_parameter_lists = ["axis-1.lis", "axis-11.lis",'
+                 ' "axis-12.lis", "axis-13.lis"]\n' + MAIN_CHANNEL + JOG_CHANNEL)
+    config = load_config(path)
+    jog = config.channels[1]
+    assert jog.jog_of_path_only
+    assert [(a.name, a.logical_number) for a in jog.axes] == [("X", 11), ("Y", 12), ("Z", 13)]
+    clone = jog.axes[0]
+    assert (clone.link_to, clone.clone_of, clone.auto_release_of_axis_link) == (1, 1, True)
+    assert clone.limits.vel_max_mm_s == 250.0
+    assert "limits" in clone.model_fields_set  # written: the clone overrides only this
+    assert clone.limits.model_fields_set == {"vel_max_mm_s"}
+    # Axis 12's list writes no link_to: it follows its master, axis 2, to drive 2.
+    assert jog.axes[1].link_to is None and jog.axes[1].clone_of == 2
+    assert config.link_of(12) == 2 and config.link_of(11) == 1
+
+
+def test_parameter_list_problems_name_file_and_line(tmp_path: Path) -> None:
+    path = _toml(tmp_path, 'axis_parameter_lists = ["axis-bad.lis"]\n')
+    with pytest.raises(ConfigError) as caught:
+        load_config(path)
+    assert f"{tmp_path / 'axis-bad.lis'}:" in str(caught.value)
+    (tmp_path / "axis-42.lis").write_text("kopf.achs_nr 42\n")
+    path = _toml(tmp_path, 'axis_parameter_lists = ["axis-42.lis"]\n')
+    with pytest.raises(ConfigError, match="kopf.achs_nr 42 is not an axis of any channel"):
+        load_config(path)
+    path = _toml(tmp_path, JOG_CHANNEL + 'axes = [{name = "X", logical_number = 11}]\n')
+    with pytest.raises(ConfigError, match="axes are given twice"):
+        load_config(path)
+    path = _toml(tmp_path, '[[channels]]\nid = 2\nname = "j"\nparameter_list = "none.lis"\n')
+    with pytest.raises(ConfigError, match="none.lis"):
+        load_config(path)
+
+
+def test_link_to_defaults_to_the_own_drive_or_the_masters() -> None:
+    config = build_config({"channels": [
+        {"id": 1, "name": "a", "axes": [{"name": "X", "logical_number": 1}]},
+        {"id": 2, "name": "b", "axes": [{"name": "X", "logical_number": 11, "clone_of": 1}]},
+    ]})
+    assert config.link_of(1) == 1 and config.link_of(11) == 1
+    with pytest.raises(ConfigError, match="no physical axis 7"):
+        build_config({"channels": [
+            {"id": 1, "name": "a", "axes": [{"name": "X", "logical_number": 7}]}]})
