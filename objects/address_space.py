@@ -44,10 +44,35 @@ class GroupHandler(Protocol):
         ...
 
 
+_INDEX = re.compile(r"\[\d+\]")
+
+
 def _glob(pattern: str) -> re.Pattern[str]:
-    """A regex for a name pattern with ``*`` and ``?`` as the only wildcards."""
-    body = re.escape(pattern).replace(r"\*", ".*").replace(r"\?", ".")
-    return re.compile(f"(?s:{body})\\Z")
+    """A regex for a glob: ``*``, ``?`` and ``[...]`` classes as in fnmatch, except that
+    a bracketed number (``[0]``) is literal, as the index in a PLC name."""
+    out, k = [], 0
+    while k < len(pattern):
+        c = pattern[k]
+        index = _INDEX.match(pattern, k)
+        if index:
+            out.append(re.escape(index.group()))
+            k = index.end()
+            continue
+        if c == "*":
+            out.append(".*")
+        elif c == "?":
+            out.append(".")
+        elif c == "[" and (end := pattern.find("]", k + 2)) > 0:
+            body = pattern[k + 1:end]
+            negate = body.startswith("!")
+            body = re.escape(body[1:] if negate else body).replace("\\-", "-")
+            out.append(f"[{'^' if negate else ''}{body}]")
+            k = end + 1
+            continue
+        else:
+            out.append(re.escape(c))
+        k += 1
+    return re.compile(f"(?s:{''.join(out)})\\Z")
 
 
 class AddressSpace:
@@ -140,9 +165,8 @@ class AddressSpace:
         )
 
     def match(self, pattern: str) -> list[CncObject]:
-        """Objects whose name matches ``pattern`` (case-insensitive): ``*`` matches any
-        run of characters, ``?`` one character; brackets are literal, because PLC names
-        carry indices (``gpCh[0].*``)."""
+        """Objects whose name matches the glob ``pattern`` (case-insensitive); a
+        bracketed number is literal, as PLC names carry indices (``gpCh[0].*``)."""
         if pattern in ("", "*"):
             return self.objects()
         regex = _glob(pattern.lower())
