@@ -17,6 +17,7 @@ from protocol.constants import CncPort
 from protocol.errors import AdsReturnCode
 
 from . import __version__
+from .config import MachineConfig
 from .kernel.commands import (
     Command,
     Feedhold,
@@ -34,8 +35,8 @@ from .kernel.commands import (
     StartProgram,
     UpdateAxisParameters,
 )
-from .config import MachineConfig
 from .kernel.kernel import Kernel
+from .param_list import ParamListError, parse_axis_list
 
 Getter = Callable[[], Any]
 CommandFactory = Callable[[Any], Command]
@@ -271,8 +272,6 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
 
 def _axis_parameter_update(text: str) -> Command:
     """Parse the list here (service side), apply it on the cycle thread."""
-    from .param_list import ParamListError, parse_axis_list
-
     try:
         return UpdateAxisParameters(parse_axis_list(text, "axis_parameter_update_w"))
     except ParamListError as exc:

@@ -14,6 +14,8 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from .param_list import ParamListError, read_axis_list, read_channel_list
+
 
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
@@ -256,8 +258,6 @@ def _apply_parameter_lists(data: dict[str, Any], base_dir: Path) -> dict[str, An
     ``jog_of_path_only``; ``axis_parameter_lists`` (axis lists) give the parameters of
     the axes whose ``kopf.achs_nr`` they carry. Paths are relative to ``base_dir``.
     """
-    from .param_list import ParamListError, read_axis_list, read_channel_list
-
     data = dict(data)
     channels = [dict(c) for c in data.get("channels", [])]
     problems: list[str] = []

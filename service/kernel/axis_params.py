@@ -112,7 +112,10 @@ def initialise_axes(
                 "only its own parameter list applies",
                 channel_index,
             ))
-        params = _cloned(axis, master) if master else _own(axis, config.link_of(axis.logical_number))
+        if master is not None:
+            params = _cloned(axis, master)
+        else:
+            params = _own(axis, config.link_of(axis.logical_number))
         if params.sw_limit_min_mm >= params.sw_limit_max_mm:
             messages.append(AxisMessage(
                 AxisErrorId.CLONE_LIMITS_INCONSISTENT,

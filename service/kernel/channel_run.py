@@ -18,6 +18,7 @@ import logging
 from collections.abc import Callable
 
 from ..config import ChannelConfig, MachineConfig
+from .axis_params import AxisErrorId, AxisParameters
 from .channel_mode import (
     IDLE_STATES,
     SELECTABLE_MODES,
@@ -25,7 +26,6 @@ from .channel_mode import (
     ChannelState,
     describe,
 )
-from .axis_params import AxisErrorId, AxisParameters
 from .commands import Refusal, RefusalReason
 from .decoder_feed import DecodeEnd, DecoderFeed, Job
 from .nc import ModalState, NcError

@@ -157,7 +157,9 @@ class ManualBlock:
         return state.runners[self.channel_index].manual_block(self.value)
 
 
-def _suspend_refused(state: KernelState, channel_index: int, command: bool, enable: bool) -> Refusal | None:
+def _suspend_refused(
+    state: KernelState, channel_index: int, command: bool, enable: bool
+) -> Refusal | None:
     """Suspending the axis output is not possible while the channel is in error."""
     channel = state.channels[channel_index]
     wants = command if enable else channel.suspend_request_r

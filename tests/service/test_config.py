@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import pytest
-
 import shutil
 from pathlib import Path
+
+import pytest
 
 from service.config import ConfigError, build_config, load_config
 
