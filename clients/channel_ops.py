@@ -116,19 +116,20 @@ class ChannelOps:
     async def channel_errors(self, channel: int = 1) -> list[str]:
         """The channel's error list as readable lines."""
         count = await self.read(f"ch{channel}.mc_error_count_r")
+        fields = ("id", "file", "line", "column", "text", "warning")
         names = [
             f"ch{channel}.mc_error_{k}_{f}_r"
             for k in range(1, min(count, _ERROR_SLOTS) + 1)
-            for f in ("id", "file", "line", "column", "text")
+            for f in fields
         ]
         if not names:
             return []
         values = await self.read_many(names)
         lines = []
         for k in range(1, min(count, _ERROR_SLOTS) + 1):
-            v = [values[f"ch{channel}.mc_error_{k}_{f}_r"] for f in ("id", "file", "line", "column", "text")]
+            v = [values[f"ch{channel}.mc_error_{k}_{f}_r"] for f in fields]
             where = f"{v[1]}:{v[2]}:{v[3]}: " if v[1] else ""
-            lines.append(f"error {v[0]}: {where}{v[4]}")
+            lines.append(f"{'warning' if v[5] else 'error'} {v[0]}: {where}{v[4]}")
         return lines
 
     async def status(self, channel: int = 1) -> ChannelStatus:

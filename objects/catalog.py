@@ -267,6 +267,7 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
             ("file", STRING(84), "NC file"),
             ("line", UNS32, "line in the file, from 1"),
             ("column", UNS32, "column in the line, from 1"),
+            ("warning", BOOLEAN, "TRUE for a warning (the channel was not stopped)"),
         ))
     ),
     # --- COM channel axes (offsets as TwinSharp, IG 0x12010<c>, IO 0x<a>00xx) -------------

@@ -117,7 +117,7 @@ def _per_scope(
 
 def _channel_error(k: int, field: str) -> Callable[[Kernel, CncObject], Getter]:
     """Field of the k-th error of a channel's list; 0 / empty when there is none."""
-    empty = "" if field in ("text", "file") else 0
+    empty = {"text": "", "file": "", "warning": False}.get(field, 0)
 
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
         ci = kernel.channel_index(obj.channel)
@@ -239,7 +239,7 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     **{
         f"mc_error_{k}_{field}_r": _channel_error(k, field)
         for k in range(1, 9)
-        for field in ("id", "text", "file", "line", "column")
+        for field in ("id", "text", "file", "line", "column", "warning")
     },
 }
 

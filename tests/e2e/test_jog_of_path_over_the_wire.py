@@ -148,3 +148,22 @@ def start_service_expect_failure(*args: str) -> str:
     result = run_service(*args)
     assert result.returncode == 2, result.stderr
     return result.stderr
+
+
+def test_clone_of_a_missing_master_shows_two_warnings(tmp_path) -> None:
+    config = tmp_path / "machine.toml"
+    config.write_text(
+        '[[channels]]\nid = 1\nname = "main"\naxes = [{name = "X", logical_number = 1}]\n'
+        '[[channels]]\nid = 2\nname = "jog"\n'
+        'axes = [{name = "X", logical_number = 11, link_to = 1, clone_of = 99}]\n'
+    )
+    service = start_service("--config", str(config))
+    try:
+        with Client(service.endpoint, timeout_s=10) as c:
+            lines = c.channel_errors(2)
+            assert [line.split(":")[0] for line in lines] == ["warning 70172", "warning 50462"]
+            assert "master axis 99" in lines[0]
+            assert c.read("ch2.mc_error_1_warning_r") is True
+            assert c.read("ch2.mc_active_state_r") != 6  # a warning does not stop it
+    finally:
+        assert service.stop() == 0, "\n".join(service.log)
