@@ -153,11 +153,9 @@ def _hli_physical(attr: str) -> Callable[[Kernel, CncObject], Getter]:
     """``gpAx[i].lr_state``: the physical axis with the slot's number (0 when none)."""
 
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
-        numbers = [p.number for p in kernel.config.physical_axes]
-        if obj.axis not in numbers:
+        if obj.axis not in {p.number for p in kernel.config.physical_axes}:
             return lambda: 0
-        index = numbers.index(obj.axis)
-        return lambda: getattr(kernel.snapshot.physical_axes[index], attr)
+        return _physical_axis(attr)(kernel, obj)
 
     return bind
 
@@ -166,10 +164,10 @@ def _hli_logical(attr: str) -> Callable[[Kernel, CncObject], Getter]:
     """``gpAx[i].ipo_state``: the logical axis with the slot's number (0 when none)."""
 
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
-        for ci, channel in enumerate(kernel.config.channels):
-            for ai, axis in enumerate(channel.axes):
-                if axis.logical_number == obj.axis:
-                    return lambda: getattr(kernel.snapshot.channels[ci].axes[ai], attr)
+        for ci, axis in kernel.config.startup_axes():
+            if axis.logical_number == obj.axis:
+                ai = kernel.config.channels[ci].axes.index(axis)
+                return lambda: getattr(kernel.snapshot.channels[ci].axes[ai], attr)
         return lambda: 0
 
     return bind

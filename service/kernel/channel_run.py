@@ -218,7 +218,7 @@ class ChannelRunner:
         if not self.config.jog_of_path_only:
             return True
         for axis in self.channel.axes:
-            if not axis.released and not axis.is_clone:
+            if not axis.released and not self._params[axis.logical_number].cloned:
                 self._fail(ChannelError(
                     AxisErrorId.JOG_OF_PATH_AXIS_NOT_CLONE,
                     f"axis {axis.name} (kopf.achs_nr {axis.logical_number}) of jog-of-path "
@@ -328,10 +328,7 @@ class ChannelRunner:
         self._exchange, self._backlog = None, []
         self._fed_all = False
         self._pending_error = None
-        self._started_at_s = self._time_s
-        ch.state = ChannelState.ACTIVE
-        ch.waiting_for_start = False
-        ch.errors, ch.error_count = (), 0
+        self._started_at_s = self._time_s  # state, errors: set by _start_when_linked
         ch.block_count = 0
         ch.dist_prog_start_incr = 0.0
         ch.program_time_s = 0.0

@@ -93,9 +93,6 @@ class Kernel:
         params, messages = initialise_axes(self.config)
         self.axis_params: dict[int, AxisParameters] = params
         state.axis_params = params  # shared: an update reaches runners and switchover
-        for channel in state.channels:
-            for axis in channel.axes:
-                axis.is_clone = params[axis.logical_number].cloned
         self.switchover = Switchover(state, params)
         # Virtual time must give the same result cycle by cycle: GEO waits for the decoder.
         deterministic = isinstance(self._clock, VirtualClock)

@@ -79,14 +79,13 @@ class LogicalAxis:
     position_offset_incr: int = 0  # command position - physical position (jog of path)
     offset_live: bool = False  # the axis took its drive over from another logical axis
     released: bool = False  # left the channel by #AX RELEASE
-    is_clone: bool = False  # initialised as a clone (kopf.clone_of resolved)
 
     def frozen(self) -> LogicalAxis:
         """A copy for the snapshot."""
         return LogicalAxis(
             self.name, self.logical_number, self.requested_link, self.actual_link,
             self.link_state, self.position_mm, self.command_position_incr, self.output_incr,
-            self.position_offset_incr, self.offset_live, self.released, self.is_clone,
+            self.position_offset_incr, self.offset_live, self.released,
         )
 
     def set_position_incr(self, incr: int) -> None:

@@ -11,7 +11,8 @@ import pytest
 from clients import AdsError, ChannelError, Client
 from protocol.constants import CncPort
 from tests.clients.test_cli import cnc, json_lines
-from tests.support.service import start_service
+from tests.service.test_entry_point import run_service
+from tests.support.service import serving
 
 PARAMS = Path(__file__).parent.parent / "data" / "params"
 SUSPEND = "gpCh[{}].bahn_mc_control.suspend_axis_output.command_w"
@@ -30,8 +31,7 @@ def ok(endpoint: str, *args: str) -> None:
 
 def test_the_table_with_the_cli_only() -> None:
     """docs/jog-of-path.md, "Walkthrough": the same commands, the same numbers."""
-    service = start_service()
-    try:
+    with serving() as service:
         e = service.endpoint
         columns = ("ch1.ax1.command_position_acs", "ch2.ax1.command_position_acs",
                    "ax1.command_position_acs", "ch1.ax1.position_offset",
@@ -57,15 +57,12 @@ def test_the_table_with_the_cli_only() -> None:
                   "gpAx[0].lr_state.link_to_ipo_r", "gpAx[3].ipo_state.link_to_lr",
                   "gpAx[0].ipo_state.link_to_lr", endpoint=e)
         assert [r["value"] for r in json_lines(plc)] == [-300_000, 11, 1, 0]
-    finally:
-        assert service.stop() == 0, "\n".join(service.log)
 
 
 @pytest.fixture(scope="module")
 def machine():
-    service = start_service()
-    yield service
-    assert service.stop() == 0, "\n".join(service.log)
+    with serving() as service:
+        yield service
 
 
 def test_plc_symbols_live_on_port_851_and_refuse_bad_writes(machine) -> None:
@@ -122,32 +119,22 @@ def test_machine_from_isg_parameter_lists(tmp_path) -> None:
         '[[channels]]\nid = 2\nname = "jog"\nparameter_list = "channel-2.lis"\n'
         "suspend_output_at_start = true\n"
     )
-    service = start_service("--config", str(config))
-    try:
-        with Client(service.endpoint, timeout_s=10) as c:
-            values = c.read_many(["ch2.ax1.logical_axis_number", "ch2.ax1.axis_name",
-                                  "ch2.ax3.requested_link_to_physical_axis",
-                                  "ch2.mc_error_count_r", "ch2.mc_active_state_r",
-                                  "ch2.ax1.vel_max", "ch2.ax2.vel_max"])
-            assert values == {"ch2.ax1.logical_axis_number": 11, "ch2.ax1.axis_name": "X",
-                              "ch2.ax3.requested_link_to_physical_axis": 3,
-                              "ch2.mc_error_count_r": 0, "ch2.mc_active_state_r": 1,
-                              "ch2.ax1.vel_max": 250.0,  # axis-11.lis overrides it
-                              "ch2.ax2.vel_max": 500.0}  # inherited from axis 2
-    finally:
-        assert service.stop() == 0, "\n".join(service.log)
+    with serving("--config", str(config)) as service, \
+            Client(service.endpoint, timeout_s=10) as c:
+        values = c.read_many(["ch2.ax1.logical_axis_number", "ch2.ax1.axis_name",
+                              "ch2.ax3.requested_link_to_physical_axis",
+                              "ch2.mc_error_count_r", "ch2.mc_active_state_r",
+                              "ch2.ax1.vel_max", "ch2.ax2.vel_max"])
+        assert values == {"ch2.ax1.logical_axis_number": 11, "ch2.ax1.axis_name": "X",
+                          "ch2.ax3.requested_link_to_physical_axis": 3,
+                          "ch2.mc_error_count_r": 0, "ch2.mc_active_state_r": 1,
+                          "ch2.ax1.vel_max": 250.0,  # axis-11.lis overrides it
+                          "ch2.ax2.vel_max": 500.0}  # inherited from axis 2
     # A bad list refuses the start and names file and line.
     shutil.copy(PARAMS / "axis-bad.lis", tmp_path / "axis-11.lis")
-    bad = start_service_expect_failure("--config", str(config))
-    assert f"{tmp_path / 'axis-11.lis'}:" in bad
-
-
-def start_service_expect_failure(*args: str) -> str:
-    from tests.service.test_entry_point import run_service
-
-    result = run_service(*args)
-    assert result.returncode == 2, result.stderr
-    return result.stderr
+    bad = run_service("--config", str(config))
+    assert bad.returncode == 2, bad.stderr
+    assert f"{tmp_path / 'axis-11.lis'}:" in bad.stderr
 
 
 def test_clone_of_a_missing_master_shows_two_warnings(tmp_path) -> None:
@@ -157,13 +144,10 @@ def test_clone_of_a_missing_master_shows_two_warnings(tmp_path) -> None:
         '[[channels]]\nid = 2\nname = "jog"\n'
         'axes = [{name = "X", logical_number = 11, link_to = 1, clone_of = 99}]\n'
     )
-    service = start_service("--config", str(config))
-    try:
-        with Client(service.endpoint, timeout_s=10) as c:
-            lines = c.channel_errors(2)
-            assert [line.split(":")[0] for line in lines] == ["warning 70172", "warning 50462"]
-            assert "master axis 99" in lines[0]
-            assert c.read("ch2.mc_error_1_warning_r") is True
-            assert c.read("ch2.mc_active_state_r") != 6  # a warning does not stop it
-    finally:
-        assert service.stop() == 0, "\n".join(service.log)
+    with serving("--config", str(config)) as service, \
+            Client(service.endpoint, timeout_s=10) as c:
+        lines = c.channel_errors(2)
+        assert [line.split(":")[0] for line in lines] == ["warning 70172", "warning 50462"]
+        assert "master axis 99" in lines[0]
+        assert c.read("ch2.mc_error_1_warning_r") is True
+        assert c.read("ch2.mc_active_state_r") != 6  # a warning does not stop it

@@ -6,6 +6,7 @@ endpoint it got; we wait for that log line, never for a fixed time.
 
 from __future__ import annotations
 
+import contextlib
 import queue
 import re
 import signal
@@ -13,6 +14,7 @@ import subprocess
 import sys
 import tempfile
 import threading
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -47,6 +49,17 @@ class RunningService:
                 raise AssertionError(f"service exited before logging {pattern!r}")
             if regex.search(line):
                 return line
+
+
+@contextlib.contextmanager
+def serving(*args: str) -> Iterator[RunningService]:
+    """``start_service(*args)`` for a ``with`` block; on leaving, the service must stop
+    cleanly (exit code 0), else the test fails with its log."""
+    service = start_service(*args)
+    try:
+        yield service
+    finally:
+        assert service.stop() == 0, "\n".join(service.log)
 
 
 def start_service(*args: str, timeout_s: float = 20.0) -> RunningService:
