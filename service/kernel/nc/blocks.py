@@ -82,6 +82,54 @@ class AxisExchange:
     axes: tuple[int, ...]  # channel axis indices, in programmed order, without duplicates
 
 
+class ContourKind(IntEnum):
+    """What a contour look-ahead (FCT-C40) or path-distance command does.
+
+    LOG_ON, LOG_PARAM and LOG_OFF carry the ``block_type`` of their log entry.
+    RT_PASS and RT_END are markers the decoder inserts at the passes of a real-time loop
+    (``#RT WHILE``) that starts while a marked area is open (see
+    ``service/kernel/contour_lookahead.py``); they are not NC blocks of their own.
+    """
+
+    LOG_ON = 3  # #CONTOUR LOOKAHEAD LOG ON [PARAM=..]
+    LOG_PARAM = 4  # #CONTOUR LOOKAHEAD LOG [PARAM=..]
+    LOG_OFF = 5  # #CONTOUR LOOKAHEAD LOG OFF [PARAM=..]
+    LOG_CLEAR = 10  # #CONTOUR LOOKAHEAD LOG CLEAR: flush and wait, then empty the log
+    DISTANCE_CLEAR = 11  # #DISTANCE PROG START CLEAR: the path distance restarts at 0
+    RT_PASS = 12  # marker: pass ``rt_pass`` of real-time loop ``loop`` starts
+    RT_END = 13  # marker: real-time loop ``loop`` has ended
+
+
+class LogArea(IntEnum):
+    """The marked area of the contour look-ahead log, as LOG commands move it."""
+
+    NONE = 0  # no LOG ON yet (or since LOG CLEAR)
+    OPEN = 1  # after the LOG ON that opened it: elements are logged
+    CLOSED = 2  # after its LOG OFF: further LOG ON are ignored until LOG CLEAR
+
+
+def next_log_area(area: LogArea, kind: ContourKind) -> LogArea:
+    """The area after a command of ``kind``: only the first marked area is kept until
+    LOG CLEAR; a LOG ON while one is open or closed is ignored."""
+    if kind == ContourKind.LOG_ON:
+        return LogArea.OPEN if area == LogArea.NONE else area
+    if kind == ContourKind.LOG_OFF:
+        return LogArea.CLOSED if area == LogArea.OPEN else area
+    if kind == ContourKind.LOG_CLEAR:
+        return LogArea.NONE
+    return area
+
+
+@dataclass(frozen=True, slots=True)
+class ContourCommand:
+    """A contour look-ahead or path-distance command, or a real-time loop marker."""
+
+    kind: ContourKind
+    param: float | None = None  # PARAM= value as programmed (LOG ON/LOG/LOG OFF)
+    loop: int = 0  # RT_PASS/RT_END: serial number of the real-time loop (from 1)
+    rt_pass: int = 0  # RT_PASS: number of the pass (from 1)
+
+
 @dataclass(frozen=True, slots=True)
 class Block:
     """One decoded NC block: optional motion plus what happens at its end.
@@ -102,9 +150,12 @@ class Block:
     tool: int | None = None  # T
     manual: bool = False  # decoded from a manual (MDI) block
     axis_exchange: AxisExchange | None = None  # #AX RELEASE / #AX REQUEST
+    contour: ContourCommand | None = None  # #CONTOUR LOOKAHEAD, #DISTANCE, RT loop marker
 
     @property
     def needs_stop(self) -> bool:
-        """True when the path speed must be 0 at the end of this block."""
+        """True when the path speed must be 0 at the end of this block (LOG CLEAR
+        synchronises decoding and execution: flush and wait)."""
         return (self.dwell_s > 0.0 or self.stop != StopKind.NONE
-                or self.axis_exchange is not None)
+                or self.axis_exchange is not None
+                or (self.contour is not None and self.contour.kind == ContourKind.LOG_CLEAR))

@@ -14,7 +14,9 @@ not, the make_* functions fall back to the ordinary constructors.
 
 from __future__ import annotations
 
-from .blocks import AxisExchange, Block, Compensation, Motion, MotionKind, SourceRef, StopKind
+from .blocks import (
+    AxisExchange, Block, Compensation, ContourCommand, Motion, MotionKind, SourceRef, StopKind,
+)
 
 
 def _twin(cls: type) -> type:
@@ -60,6 +62,7 @@ def _fast_block(
     source: SourceRef, number: int | None, motion: Motion | None, dwell_s: float,
     stop: StopKind, m_functions: tuple[int, ...], spindle_speed_rpm: float | None,
     tool: int | None, manual: bool, axis_exchange: AxisExchange | None = None,
+    contour: ContourCommand | None = None,
 ) -> Block:
     b = new(BlockTwin)
     b.source = source
@@ -72,6 +75,7 @@ def _fast_block(
     b.tool = tool
     b.manual = manual
     b.axis_exchange = axis_exchange
+    b.contour = contour
     b.__class__ = Block
     return b
 

@@ -220,6 +220,7 @@ _BLOCK_FAST = '''\
                 block.tool = None
                 block.manual = manual
                 block.axis_exchange = None
+                block.contour = None
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\

@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import IntEnum
 
-from .blocks import Compensation, MotionKind
+from .blocks import Compensation, LogArea, MotionKind
 from .variables import Variable
 
 
@@ -94,3 +94,4 @@ class ModalState:
     variables_p: dict[str, Variable] = field(default_factory=dict)  # V.P. by upper name
     variables_g: dict[str, Variable] = field(default_factory=dict)  # V.G. by upper name
     released_axes: frozenset[int] = frozenset()  # channel axis indices out (#AX RELEASE)
+    contour_log_area: LogArea = LogArea.NONE  # marked area of #CONTOUR LOOKAHEAD LOG
