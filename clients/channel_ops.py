@@ -38,6 +38,43 @@ class ProgramEntry:
     mtime_s: float
 
 
+CONTOUR_BLOCK_FIELDS = (
+    "block_type", "block_number", "block_count_r", "start_position", "length",
+    "programmed_radius", "compensated_radius", "circle_angle", "length_min",
+    "tangent_variation",
+)
+CONTOUR_RESPONSE_BLOCKS = 32  # gpCh[i].contour_lookahead.response.block[0..31]
+CONTOUR_BLOCK_TYPES = {
+    1: "linear", 2: "circular", 3: "LOG ON", 4: "LOG PARAM", 5: "LOG OFF", 6: "polynomial",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class ContourBlock:
+    """One element of a contour look-ahead reply, in HLI units (0.1 um, rad)."""
+
+    block_type: int
+    block_number: int
+    block_count_r: int
+    start_position: float
+    length: float
+    programmed_radius: float
+    compensated_radius: float
+    circle_angle: float
+    length_min: float
+    tangent_variation: float
+
+
+@dataclass(frozen=True, slots=True)
+class ContourReply:
+    """The CNC's answer to a contour look-ahead request, with the unit's state."""
+
+    max_dist_prog_start: float  # 0.1 um
+    count_logged_blocks: int
+    log_active: bool
+    blocks: list[ContourBlock]  # up to the first entry of block_type 0
+
+
 @dataclass(frozen=True, slots=True)
 class ChannelStatus:
     """What ``cnc status`` shows of a channel."""
@@ -154,6 +191,36 @@ class ChannelOps:
             v[5], positions, v[6] / 1000, v[7],
             await self.channel_errors(channel) if v[1] == _ERROR else [],
         )
+
+    async def contour_lookahead(
+        self, start_position: float = 0.0, length: float = 0.0, *, plc_channel: int = 0
+    ) -> ContourReply:
+        """Ask the CNC for contour elements ahead (FCT-C40) through the control unit
+        ``gpCh[plc_channel].contour_lookahead``: ``length`` 0 is mode 1 (the marked area
+        from index ``start_position``), else mode 2 (elements starting in the path window
+        [start_position, start_position + length], 0.1 um). Writes the request, sets the
+        semaphore (the CNC answers before the write is acknowledged), reads the reply."""
+        unit = f"gpCh[{plc_channel}].contour_lookahead"
+        await self.write(f"{unit}.request.start_position", float(start_position))
+        await self.write(f"{unit}.request.length", float(length))
+        await self.write(f"{unit}.semaphor_rw", True)
+        state = [f"{unit}.semaphor_rw", f"{unit}.state.max_dist_prog_start",
+                 f"{unit}.state.count_logged_blocks", f"{unit}.state.f_log_is_active"]
+        names = [
+            f"{unit}.response.block[{k}].{field}"
+            for k in range(CONTOUR_RESPONSE_BLOCKS)
+            for field in CONTOUR_BLOCK_FIELDS
+        ]
+        values = await self.read_many([*state, *names])
+        if values[state[0]]:
+            raise AdsTimeoutError(f"{unit}: the CNC has not answered (semaphor_rw still TRUE)")
+        blocks = []
+        for k in range(CONTOUR_RESPONSE_BLOCKS):
+            fields = [values[f"{unit}.response.block[{k}].{f}"] for f in CONTOUR_BLOCK_FIELDS]
+            if fields[0] == 0:  # block_type 0 ends the list
+                break
+            blocks.append(ContourBlock(*fields))
+        return ContourReply(values[state[1]], values[state[2]], values[state[3]], blocks)
 
     async def _wait(self, channel: int, done: Any, timeout_s: float | None) -> None:
         deadline = None if timeout_s is None else time.monotonic() + timeout_s

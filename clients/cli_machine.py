@@ -4,6 +4,7 @@
     cnc run FILE|NAME [--channel N] [--wait] [--timeout S]
     cnc mdi "BLOCKS" [--channel N] [--wait] [--timeout S]
     cnc hold|resume|reset [--channel N]  cnc status [--channel N]
+    cnc lookahead [START] [--length L] [--index I]
 
 ``--wait`` exits 0 when the program (or manual block) has finished, 4 with the channel's
 error text when the channel went to ERROR, 5 when ``--timeout`` passed first.
@@ -11,12 +12,15 @@ error text when the channel went to ERROR, 5 when ``--timeout`` passed first.
 
 from __future__ import annotations
 
+import json
+import math
 import sys
 from dataclasses import asdict
 from pathlib import Path
 
 import typer
 
+from .channel_ops import CONTOUR_BLOCK_TYPES
 from .cli import EXIT_USAGE, Settings, _emit, _fail, app, err, out
 from .errors import AdsError, AdsTimeoutError, ChannelError
 
@@ -179,3 +183,45 @@ def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
         *s.errors,
     ]
     _emit(settings, asdict(s), "\n".join(lines))
+
+
+@app.command()
+def lookahead(
+    ctx: typer.Context,
+    start: float = typer.Argument(
+        0.0, help="Mode 1: index in the marked area; mode 2: path distance in 0.1 um."),
+    length: float = typer.Option(
+        0.0, "--length", "-l", min=0.0,
+        help="0: mode 1 (by index); else mode 2: window length in 0.1 um."),
+    index: int = typer.Option(
+        0, "--index", "-i", min=0, help="PLC channel index gpCh[i] (channel position from 0)."),
+) -> None:
+    """Contour look-ahead (FCT-C40): the contour elements ahead, as the PLC gets them."""
+    settings: Settings = ctx.obj
+    reply = settings.call(lambda c: c.contour_lookahead(start, length, plc_channel=index))
+    if settings.as_json:
+        out.print(json.dumps({
+            "max_dist_prog_start": reply.max_dist_prog_start,
+            "count_logged_blocks": reply.count_logged_blocks,
+            "f_log_is_active": reply.log_active,
+            "blocks": [asdict(b) for b in reply.blocks],
+        }))
+        return
+    out.print(f"gpCh[{index}]: {reply.count_logged_blocks} logged, log active "
+              f"{'TRUE' if reply.log_active else 'FALSE'}, max_dist_prog_start "
+              f"{reply.max_dist_prog_start / 10_000:.4f} mm")
+    # plain fixed-width lines: never truncated, whatever the terminal width
+    out.print(f"{'k':>3} {'type':<10} {'N':>5} {'count':>5} {'start mm':>10} "
+              f"{'length mm':>10} {'R prog mm':>9} {'R comp mm':>9} {'angle deg':>9} "
+              f"{'tang deg':>8}")
+    first = int(start) if length == 0.0 else 0  # mode 1 numbers the entries by log index
+    for k, b in enumerate(reply.blocks, start=first):
+        motion = b.block_type in (1, 2, 6)
+        size = f"{b.length / 10_000:.4f}" if motion else f"PARAM {b.length:g}"
+        number = str(b.block_number) if b.block_number >= 0 else "-"
+        out.print(
+            f"{k:>3} {CONTOUR_BLOCK_TYPES.get(b.block_type, str(b.block_type)):<10} "
+            f"{number:>5} {b.block_count_r:>5} {b.start_position / 10_000:>10.4f} {size:>10} "
+            f"{b.programmed_radius / 10_000:>9.4f} {b.compensated_radius / 10_000:>9.4f} "
+            f"{math.degrees(b.circle_angle):>9.3f} {math.degrees(b.tangent_variation):>8.3f}"
+        )

@@ -72,6 +72,24 @@ PLC_GROUP = 0x4020
 PLC_CHANNEL_BASE, PLC_CHANNEL_STRIDE = 0x10000, 0x1000
 PLC_AXIS_BASE, PLC_AXIS_STRIDE = 0x80000, 0x100
 
+# gpCh[i].contour_lookahead.response.block[0..N-1] (HLI_CONTOUR_LOOKAHEAD_BLOCK)
+CONTOUR_RESPONSE_BLOCKS = 32
+CONTOUR_RESPONSE_OFFSET, CONTOUR_BLOCK_STRIDE = 0x300, 0x50
+CONTOUR_BLOCK_FIELDS: tuple[tuple[str, int, DataType, str, str], ...] = (
+    ("block_type", 0x00, UNS16, "-",
+     "0 none (ends the list), 1 linear, 2 circular, 3 LOG ON, 4 LOG PARAM, 5 LOG OFF, "
+     "6 polynomial"),
+    ("block_number", 0x04, SGN32, "-", "programmed N; -1 = none"),
+    ("block_count_r", 0x08, UNS32, "-", "number of the block in the run (mc_block_count_r)"),
+    ("start_position", 0x10, REAL64, "0.1 um", "sum of the lengths of all earlier elements"),
+    ("length", 0x18, REAL64, "0.1 um", "element length; PARAM value for types 3..5"),
+    ("programmed_radius", 0x20, REAL64, "0.1 um", "radius of the programmed arc"),
+    ("compensated_radius", 0x28, REAL64, "0.1 um", "radius on the compensated path"),
+    ("circle_angle", 0x30, REAL64, "rad", "swept angle: cw in [-2pi, 0), ccw in (0, 2pi]"),
+    ("length_min", 0x38, REAL64, "0.1 um", "length on the scaled contour (die sinking): 0"),
+    ("tangent_variation", 0x40, REAL64, "rad", "angle to the previous motion element"),
+)
+
 
 R, W, RW = Access.READ, Access.WRITE, Access.READ_WRITE
 GEO, COM, PLC = CncPort.GEO, CncPort.COM, CncPort.PLC
@@ -363,6 +381,47 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "bahn_mc_control.suspend_axis_output.state_r", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
         0x103, BOOLEAN, R, "-",
         "TRUE while the channel's axis output is suspended (its axes are given up)",
+    ),
+    ObjectTemplate(
+        "bahn_state.dist_prog_start", Scope.PLC_CHANNEL, PLC, PLC_GROUP, 0x110, REAL64, R,
+        "0.1 um", "Path distance covered since program start or #DISTANCE PROG START CLEAR, "
+        "on the compensated path",
+    ),
+    # contour look-ahead control unit (FCT-C40), HLI_CONTOUR_LOOKAHEAD
+    ObjectTemplate(
+        "contour_lookahead.request.start_position", Scope.PLC_CHANNEL, PLC, PLC_GROUP, 0x200,
+        REAL64, RW, "-", "Mode 1 (length 0): index of the first element in the marked area; "
+        "mode 2: start of the path window (0.1 um)",
+    ),
+    ObjectTemplate(
+        "contour_lookahead.request.length", Scope.PLC_CHANNEL, PLC, PLC_GROUP, 0x208, REAL64,
+        RW, "0.1 um", "0: request by index (mode 1); else length of the path window (mode 2)",
+    ),
+    ObjectTemplate(
+        "contour_lookahead.semaphor_rw", Scope.PLC_CHANNEL, PLC, PLC_GROUP, 0x210, BOOLEAN, RW,
+        "-", "TRUE: the PLC requests; the CNC fills the response and resets it to FALSE",
+    ),
+    ObjectTemplate(
+        "contour_lookahead.state.max_dist_prog_start", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        0x218, REAL64, R, "0.1 um",
+        "Maximum look-ahead distance from program start: end of the path prepared so far",
+    ),
+    ObjectTemplate(
+        "contour_lookahead.state.count_logged_blocks", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        0x220, UNS32, R, "-", "Entries in the log of the marked area (readable by index)",
+    ),
+    ObjectTemplate(
+        "contour_lookahead.state.f_log_is_active", Scope.PLC_CHANNEL, PLC, PLC_GROUP, 0x224,
+        BOOLEAN, R, "-", "TRUE while the marked area is open and not all of it is read in",
+    ),
+    *(
+        ObjectTemplate(
+            f"contour_lookahead.response.block[{k}].{name}", Scope.PLC_CHANNEL, PLC,
+            PLC_GROUP, CONTOUR_RESPONSE_OFFSET + k * CONTOUR_BLOCK_STRIDE + offset, dtype, R,
+            unit, f"Reply entry {k}: {text}",
+        )
+        for k in range(CONTOUR_RESPONSE_BLOCKS)
+        for name, offset, dtype, unit, text in CONTOUR_BLOCK_FIELDS
     ),
     # --- PLC (HLI) per axis slot: gpAx[i] (port 851) -------------------------------------
     ObjectTemplate(

@@ -12,6 +12,7 @@ from typing import Any
 
 from objects import AddressSpace, ChannelLayout, CncObject, MachineLayout, build_objects
 from objects.addressing import LOGICAL_BIT, GroupBase, index_based
+from objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS
 from objects.directory import ObjectDirectory
 from protocol.constants import CncPort
 from protocol.errors import AdsReturnCode
@@ -27,6 +28,8 @@ from .kernel.commands import (
     ResetChannel,
     SelectMode,
     SelectProgram,
+    SetContourRequest,
+    SetContourSemaphore,
     SetExecutionMode,
     SetFeedOverride,
     SetSingleBlock,
@@ -46,6 +49,7 @@ REFUSAL_CODES: dict[RefusalReason, AdsReturnCode] = {
     RefusalReason.NOT_READY: AdsReturnCode.DEVICE_NOTREADY,
     RefusalReason.BUSY: AdsReturnCode.DEVICE_BUSY,
     RefusalReason.NOT_FOUND: AdsReturnCode.DEVICE_NOTFOUND,
+    RefusalReason.NOT_SUPPORTED: AdsReturnCode.DEVICE_SRVNOTSUPP,
 }
 
 
@@ -173,6 +177,32 @@ def _hli_logical(attr: str) -> Callable[[Kernel, CncObject], Getter]:
     return bind
 
 
+def _contour(attr: str) -> Callable[[Kernel, CncObject], Getter]:
+    """A field of ``gpCh[i].contour_lookahead`` (request, semaphore, state)."""
+
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        ci = kernel.channel_index(obj.channel)
+        return lambda: getattr(kernel.snapshot.channels[ci].contour, attr)
+
+    return bind
+
+
+def _contour_block(k: int, field: str) -> Callable[[Kernel, CncObject], Getter]:
+    """``response.block[k].<field>``: 0 beyond the reply's entries (block_type 0 ends
+    the list)."""
+
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        ci = kernel.channel_index(obj.channel)
+
+        def get() -> Any:
+            response = kernel.snapshot.channels[ci].contour.response
+            return getattr(response[k], field) if k < len(response) else 0
+
+        return get
+
+    return bind
+
+
 def _kernel_time(kernel: Kernel, obj: CncObject) -> Getter:
     return lambda: kernel.snapshot.time_ns / 1e9
 
@@ -230,6 +260,18 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "bahn_mc_control.suspend_axis_output.enable_w": _channel("suspend_enable_w"),
     "bahn_mc_control.suspend_axis_output.request_r": _channel("suspend_request_r"),
     "bahn_mc_control.suspend_axis_output.state_r": _channel("output_suspended"),
+    "bahn_state.dist_prog_start": _channel("dist_prog_start_incr"),
+    "contour_lookahead.request.start_position": _contour("request_start_position"),
+    "contour_lookahead.request.length": _contour("request_length"),
+    "contour_lookahead.semaphor_rw": _contour("semaphor"),
+    "contour_lookahead.state.max_dist_prog_start": _contour("max_dist_prog_start_incr"),
+    "contour_lookahead.state.count_logged_blocks": _contour("count_logged_blocks"),
+    "contour_lookahead.state.f_log_is_active": _contour("log_active"),
+    **{
+        f"contour_lookahead.response.block[{k}].{name}": _contour_block(k, name)
+        for k in range(CONTOUR_RESPONSE_BLOCKS)
+        for name, *_ in CONTOUR_BLOCK_FIELDS
+    },
     "head.log_ax_n_r": _constant_per_object(lambda kernel, obj: obj.axis),
     "lr_state.position_offset_r": _hli_physical("position_offset_incr"),
     "lr_state.link_to_ipo_r": _hli_physical("linked_logical_axis"),
@@ -265,6 +307,13 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
     "bahn_mc_control.suspend_axis_output.command_w": _channel_command(SetSuspendCommand),
     "bahn_mc_control.suspend_axis_output.enable_w": _channel_command(SetSuspendEnable),
     "axis_parameter_update_w": lambda kernel, obj: _axis_parameter_update,
+    "contour_lookahead.request.start_position": _channel_command(
+        lambda ci, value: SetContourRequest(ci, "start_position", value)
+    ),
+    "contour_lookahead.request.length": _channel_command(
+        lambda ci, value: SetContourRequest(ci, "length", value)
+    ),
+    "contour_lookahead.semaphor_rw": _channel_command(SetContourSemaphore),
 }
 
 

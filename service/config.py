@@ -12,7 +12,9 @@ from enum import StrEnum
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator,
+)
 
 from .param_list import ParamListError, read_axis_list, read_channel_list
 
@@ -69,16 +71,52 @@ class AxisConfig(_Strict):
     limits: AxisLimits = AxisLimits()
 
 
-class LookAhead(StrEnum):
-    """Look-ahead buffer size of a channel (P-CHAN-00650 interpolator functions)."""
+class InterpolatorFunction(StrEnum):
+    """Identifiers of the interpolator functions (P-CHAN-00650) this kernel implements."""
 
-    LOW = "FCT_LOOK_AHEAD_LOW"  # 30 blocks
-    STANDARD = "FCT_LOOK_AHEAD_STANDARD"  # 120 blocks (default)
-    HIGH = "FCT_LOOK_AHEAD_HIGH"  # 190 blocks
-    CUSTOM = "FCT_LOOK_AHEAD_CUSTOM"  # look_ahead_custom_blocks (P-CHAN-00653)
+    IPO_DEFAULT = "FCT_IPO_DEFAULT"  # = FCT_LOOK_AHEAD_STANDARD
+    LOOK_AHEAD_LOW = "FCT_LOOK_AHEAD_LOW"  # 30 blocks
+    LOOK_AHEAD_STANDARD = "FCT_LOOK_AHEAD_STANDARD"  # 120 blocks
+    LOOK_AHEAD_HIGH = "FCT_LOOK_AHEAD_HIGH"  # 190 blocks
+    LOOK_AHEAD_CUSTOM = "FCT_LOOK_AHEAD_CUSTOM"  # look_ahead_custom_blocks (P-CHAN-00653)
+    CONTOUR_LAH = "FCT_CONTOUR_LAH"  # contour look-ahead (FCT-C40)
 
 
-LOOK_AHEAD_BLOCKS = {LookAhead.LOW: 30, LookAhead.STANDARD: 120, LookAhead.HIGH: 190}
+LOOK_AHEAD_BLOCKS = {
+    InterpolatorFunction.IPO_DEFAULT: 120,
+    InterpolatorFunction.LOOK_AHEAD_LOW: 30,
+    InterpolatorFunction.LOOK_AHEAD_STANDARD: 120,
+    InterpolatorFunction.LOOK_AHEAD_HIGH: 190,
+}
+_LOOK_AHEAD_SIZES = frozenset(LOOK_AHEAD_BLOCKS) | {InterpolatorFunction.LOOK_AHEAD_CUSTOM}
+# ISG identifiers of functions this kernel does not have: named as such when configured
+_NOT_SUPPORTED_FUNCTIONS = frozenset({
+    "FCT_SYNC", "FCT_LOOK_AHEAD_OPT", "FCT_LIFT_UP_TIME", "FCT_SHIFT_NCBL",
+    "FCT_CALC_STATE_AT_T", "FCT_CALC_TIME", "FCT_DYN_POS_LIMIT", "FCT_EXTENSION_EQUIDIST",
+})
+
+
+def parse_interpolator_functions(text: str) -> frozenset[InterpolatorFunction]:
+    """The functions of a P-CHAN-00650 value such as ``FCT_IPO_DEFAULT | FCT_CONTOUR_LAH``
+    (identifiers separated by ``|``, commas or blanks); ValueError names what is wrong.
+    At most one look-ahead size; none means FCT_IPO_DEFAULT."""
+    words = [w for w in text.replace("|", " ").replace(",", " ").split() if w]
+    found: set[InterpolatorFunction] = set()
+    for word in words:
+        upper = word.upper()
+        if upper in _NOT_SUPPORTED_FUNCTIONS:
+            raise ValueError(f"{upper} is not supported by this kernel")
+        try:
+            found.add(InterpolatorFunction(upper))
+        except ValueError:
+            known = ", ".join(f.value for f in InterpolatorFunction)
+            raise ValueError(f"unknown interpolator function {word!r} (known: {known})") from None
+    sizes = sorted(f.value for f in found & _LOOK_AHEAD_SIZES)
+    if len(sizes) > 1:
+        raise ValueError(f"choose one look-ahead size, not {' and '.join(sizes)}")
+    if not sizes:
+        found.add(InterpolatorFunction.IPO_DEFAULT)
+    return frozenset(found)
 
 
 class ToolConfig(_Strict):
@@ -101,15 +139,43 @@ class ChannelConfig(_Strict):
     feed_override_max: int = Field(
         1000, ge=0, le=0xFFFF, description="largest accepted feed override (0.1 %)"
     )
-    look_ahead: LookAhead = Field(LookAhead.STANDARD, description="P-CHAN-00650")
+    interpolator_function: str = Field(
+        "FCT_IPO_DEFAULT",
+        description="P-CHAN-00650: interpolator functions, e.g. 'FCT_IPO_DEFAULT | "
+        "FCT_CONTOUR_LAH' (look-ahead size and functions such as contour look-ahead)",
+    )
     look_ahead_custom_blocks: int = Field(
         120, ge=2, le=10_000, description="P-CHAN-00653: buffer size with FCT_LOOK_AHEAD_CUSTOM"
     )
+    contour_lookahead_log_max: int = Field(
+        128, ge=0, le=0xFFFFFFFE,
+        description="P-CHAN-00658: contour elements the contour look-ahead log keeps",
+    )
+
+    @field_validator("interpolator_function")
+    @classmethod
+    def _known_functions(cls, value: str) -> str:
+        parse_interpolator_functions(value)
+        return value
+
+    @property
+    def interpolator_functions(self) -> frozenset[InterpolatorFunction]:
+        """The functions of ``interpolator_function``."""
+        return parse_interpolator_functions(self.interpolator_function)
 
     @property
     def look_ahead_blocks(self) -> int:
         """Blocks the look-ahead buffer holds."""
-        return LOOK_AHEAD_BLOCKS.get(self.look_ahead, self.look_ahead_custom_blocks)
+        functions = self.interpolator_functions
+        for function, blocks in LOOK_AHEAD_BLOCKS.items():
+            if function in functions:
+                return blocks
+        return self.look_ahead_custom_blocks
+
+    @property
+    def contour_lookahead(self) -> bool:
+        """FCT_CONTOUR_LAH is enabled: #CONTOUR LOOKAHEAD and the control unit work."""
+        return InterpolatorFunction.CONTOUR_LAH in self.interpolator_functions
 
     @model_validator(mode="after")
     def _unique_axis_names(self) -> ChannelConfig:
@@ -207,6 +273,7 @@ DEFAULT_MACHINE: dict[str, Any] = {
         {
             "id": 1,
             "name": "main",
+            "interpolator_function": "FCT_IPO_DEFAULT | FCT_CONTOUR_LAH",
             "axes": [
                 {"name": "X", "logical_number": 1, "link_to": 1},
                 {"name": "Y", "logical_number": 2, "link_to": 2},

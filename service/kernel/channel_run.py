@@ -27,11 +27,13 @@ from .channel_mode import (
     describe,
 )
 from .commands import Refusal, RefusalReason
+from .contour_lookahead import LOG_FULL_WARNING, ContourLog
 from .decoder_feed import DecodeEnd, DecoderFeed, Job
 from .nc import ModalState, NcError
-from .nc.blocks import AxisExchange, AxisExchangeKind, Block, StopKind
+from .nc.blocks import AxisExchange, AxisExchangeKind, Block, ContourKind, SourceRef, StopKind
 from .path.executor import AxisDynamics, PathError, PathExecutor
 from .path.interpolator import Waiting
+from .path.segments import Segment
 from .state import Channel, ChannelError, ExecutionMode
 from .switchover import Switchover
 
@@ -86,8 +88,10 @@ class ChannelRunner:
         self._buffer_blocks = config.look_ahead_blocks
         self._pending_start: tuple[Job, bool, bool] | None = None  # waits for the axes
         self._queued_jobs: list[Job] = []  # manual blocks sent while the start waits
-        self._exchange: Block | None = None  # an axis exchange waiting for standstill
-        self._backlog: list = []  # decoded items that came after that exchange
+        # a block that waits for standstill (axis exchange, LOG CLEAR: flush and wait)
+        self._sync: Block | None = None
+        self._backlog: list = []  # decoded items that came after it
+        self._contour: ContourLog | None = None  # contour look-ahead of the run
         self._internal_hold = False  # feedhold of a suspend_axis_output request
         self._executor: PathExecutor | None = None
         self._feed: DecoderFeed | None = None
@@ -185,9 +189,10 @@ class ChannelRunner:
         if self._executor is not None:
             self._executor.stop_now()
         self._pending_error = None
-        self._pending_start = self._exchange = None
+        self._pending_start = self._sync = None
         self._queued_jobs.clear()
         self._backlog = []
+        ch.contour.log_active = False
         self._internal_hold = False
         ch.errors, ch.error_count = (), 0
         ch.waiting_for_start = False
@@ -313,6 +318,7 @@ class ChannelRunner:
             channel_id=ch.channel_id, axes=self._axes, loader=self._loader, tools=self._tools,
             modal=self._modal, capacity=self._buffer_blocks + _FEED_MARGIN_BLOCKS,
             keep_open=keep_open, axis_numbers=self._axis_numbers,
+            contour_lookahead=self.config.contour_lookahead,
         )
         self._feed.add(job)
         for more in self._queued_jobs:
@@ -325,7 +331,11 @@ class ChannelRunner:
             buffer_blocks=self._buffer_blocks, sw_limits_mm=sw_limits,
         )
         self._executor.single_block = ch.single_block
-        self._exchange, self._backlog = None, []
+        self._sync, self._backlog = None, []
+        if self.config.contour_lookahead:  # the log is cleared at every program start
+            self._contour = ContourLog(self.config.contour_lookahead_log_max)
+            self._executor.on_prepared = self._prepared
+            self._show_contour_state()
         self._fed_all = False
         self._pending_error = None
         self._started_at_s = self._time_s  # state, errors: set by _start_when_linked
@@ -366,9 +376,10 @@ class ChannelRunner:
             return
         items, self._backlog = self._backlog or feed.take(free, wait=self._deterministic), []
         for k, item in enumerate(items):
-            if isinstance(item, Block) and item.axis_exchange is not None:
-                # The axes change hands at standstill: flush, feed the rest after it.
-                self._exchange = item
+            if isinstance(item, Block) and _waits_for_standstill(item):
+                # axes change hands, or the log is cleared, at standstill: flush, feed
+                # the rest after it
+                self._sync = item
                 self._backlog = items[k + 1:]
                 executor.close()
                 return
@@ -389,6 +400,8 @@ class ChannelRunner:
             elif isinstance(item, DecodeEnd):
                 executor.close()
                 self._fed_all = True
+                if self._contour is not None and self._contour.end_of_data():
+                    self._warn_log_full()
 
     def cycle(self, time_s: float) -> bool:
         """One GEO cycle of the channel; True while it has motion or decoding to do."""
@@ -410,13 +423,15 @@ class ChannelRunner:
         self.touched = True
         if executor.single_block != ch.single_block:
             executor.single_block = ch.single_block
-        if self._exchange is not None and executor.idle:
-            if not self._apply_exchange():
+        if self._sync is not None and executor.idle:
+            if not self._apply_sync():
                 return False
             if not self.axes_ready:  # a requested axis links first
                 return False
-        if self._exchange is None:
+        if self._sync is None:
             self._feed_blocks()
+        if self._contour is not None:
+            self._show_contour_state()
         step = executor.step(ch.feed_override_active / 1000.0)
         for axis, pos in zip(ch.axes, step.position_mm, strict=True):
             axis.position_mm = pos
@@ -427,6 +442,8 @@ class ChannelRunner:
         ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
         ch.program_time_s = time_s - self._started_at_s
         for block in step.finished:
+            if block.contour is not None and block.contour.kind >= ContourKind.RT_PASS:
+                continue  # a real-time loop marker is not an NC block of its own
             ch.block_count += 1
             if self._feed is not None and self._feed.is_marker(block):
                 ch.manual_blocks_done += 1
@@ -452,19 +469,62 @@ class ChannelRunner:
                 return False  # extended MDI: waiting for the next manual block
         return True
 
-    def _apply_exchange(self) -> bool:
-        """Carry out the axis exchange the path stands at; False when the channel failed."""
-        block, self._exchange = self._exchange, None
-        exchange: AxisExchange = block.axis_exchange
+    def _apply_sync(self) -> bool:
+        """Carry out the block the path stands at (axis exchange, LOG CLEAR); False
+        when the channel failed."""
+        block, self._sync = self._sync, None
         ch = self.channel
-        release = exchange.kind == AxisExchangeKind.RELEASE
-        for index in exchange.axes:
-            ch.axes[index].released = release
         ch.block_count += 1
         src = block.source
         ch.file_name, ch.line, ch.file_offset = src.file, src.line, src.offset
         ch.block_number = block.number if block.number is not None else -1
+        if self._contour is not None:
+            self._contour.count_block()
+        exchange: AxisExchange | None = block.axis_exchange
+        if exchange is None:  # #CONTOUR LOOKAHEAD LOG CLEAR
+            if self._contour is not None:
+                self._contour.clear()
+            return True
+        release = exchange.kind == AxisExchangeKind.RELEASE
+        for index in exchange.axes:
+            ch.axes[index].released = release
         return self._check_jog_of_path()  # P-CHAN-00306: checked at axis exchange too
+
+    # ------------------------------------------------------------ contour look-ahead
+
+    def _prepared(self, items: list[Segment | Block]) -> None:
+        """Blocks entering the look-ahead buffer: the contour log sees them."""
+        if self._contour.take(items):
+            self._warn_log_full()
+
+    def _warn_log_full(self) -> None:
+        """Warn (once per marked area) that the log dropped elements, at the block that
+        did not fit."""
+        block = self._contour.dropped_at
+        src = block.source if block is not None else SourceRef(self.channel.file_name, 0)
+        self._raise(ChannelError(
+            LOG_FULL_WARNING,
+            f"the contour look-ahead log is full ({self._contour.log_max} entries, "
+            "contour_lookahead_log_max P-CHAN-00658): later elements of the marked area "
+            "are not logged", src.file, src.line, src.column, warning=True,
+        ))
+
+    def _show_contour_state(self) -> None:
+        unit, log = self.channel.contour, self._contour
+        unit.max_dist_prog_start_incr = log.max_dist_prog_start_incr
+        unit.count_logged_blocks = len(log.log)
+        unit.log_active = log.active
+
+    def answer_contour_request(self) -> None:
+        """The PLC set the semaphore: fill the response from the log (mode 1) or the
+        recent elements (mode 2), then reset the semaphore."""
+        unit = self.channel.contour
+        if self._contour is None:
+            unit.response = ()
+        else:
+            unit.response = self._contour.answer(unit.request_start_position,
+                                                 unit.request_length)
+        unit.semaphor = False
 
     def _end_program(self) -> bool:
         ch = self.channel
@@ -475,3 +535,9 @@ class ChannelRunner:
         ch.program_time_s = self._time_s - self._started_at_s
         return False
 
+
+def _waits_for_standstill(block: Block) -> bool:
+    """An axis exchange or a LOG CLEAR: the path stops, the block runs at standstill."""
+    if block.axis_exchange is not None:
+        return True
+    return block.contour is not None and block.contour.kind == ContourKind.LOG_CLEAR

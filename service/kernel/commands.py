@@ -7,12 +7,14 @@ ADS return codes.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from enum import IntEnum
 from typing import Any, NamedTuple, Protocol
 
 from .axis_params import update_axis
 from .channel_mode import ChannelState
+from .contour_lookahead import RequestError, check_request
 from .state import ExecutionMode, KernelState
 
 
@@ -23,6 +25,7 @@ class RefusalReason(IntEnum):
     NOT_READY = 2  # the kernel or channel is not in a state that allows it
     BUSY = 3  # try again in a later cycle
     NOT_FOUND = 4  # the named thing (a program) does not exist
+    NOT_SUPPORTED = 5  # the function is not configured (e.g. not in P-CHAN-00650)
 
 
 class Refusal(NamedTuple):
@@ -222,4 +225,51 @@ class UpdateAxisParameters:
         if updated is None:
             return Refusal(RefusalReason.INVALID_VALUE, why)
         state.axis_params[updated.logical_number] = updated
+        return None
+
+
+@dataclass(frozen=True, slots=True)
+class SetContourRequest:
+    """Write ``request.start_position`` or ``request.length`` of the contour look-ahead
+    control unit (stored; read when the PLC sets the semaphore)."""
+
+    channel_index: int
+    field: str  # "start_position" or "length"
+    value: float
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        if not math.isfinite(self.value):
+            return Refusal(RefusalReason.INVALID_VALUE,
+                           f"request.{self.field} must be a finite number, not {self.value}")
+        setattr(state.channels[self.channel_index].contour, f"request_{self.field}", self.value)
+        return None
+
+
+@dataclass(frozen=True, slots=True)
+class SetContourSemaphore:
+    """``semaphor_rw``: TRUE asks the CNC to answer the request (the CNC fills the
+    response and resets it to FALSE before the write is acknowledged)."""
+
+    channel_index: int
+    value: bool
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        channel = state.channels[self.channel_index]
+        runner = state.runners[self.channel_index]
+        unit = channel.contour
+        if not self.value:
+            unit.semaphor = False
+            return None
+        if not runner.config.contour_lookahead:
+            return Refusal(
+                RefusalReason.NOT_SUPPORTED,
+                f"contour look-ahead is not enabled in channel {channel.channel_id}: add "
+                "FCT_CONTOUR_LAH to its interpolator_function (P-CHAN-00650)",
+            )
+        try:
+            check_request(unit.request_start_position, unit.request_length)
+        except RequestError as exc:
+            return Refusal(RefusalReason.INVALID_VALUE, str(exc))
+        unit.semaphor = True
+        runner.answer_contour_request()
         return None

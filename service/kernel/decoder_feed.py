@@ -67,8 +67,12 @@ class DecoderFeed:
         capacity: int,
         keep_open: bool = False,
         axis_numbers: tuple[int, ...] | None = None,
+        contour_lookahead: bool = False,
     ) -> None:
+        """``contour_lookahead``: FCT_CONTOUR_LAH is enabled (P-CHAN-00650), so the
+        decoder accepts ``#CONTOUR LOOKAHEAD``."""
         self._axes = axes
+        self._contour_lookahead = contour_lookahead
         self._axis_numbers = axis_numbers
         self._loader = loader
         self._tools = tools
@@ -139,6 +143,7 @@ class DecoderFeed:
         decoder = Decoder(
             text, job.name, axes=self._axes, loader=self._loader, tools=self._tools,
             modal=self.modal, manual=job.manual, axis_numbers=self._axis_numbers,
+            contour_lookahead=self._contour_lookahead,
         )
         yield from decoder.blocks()
         self.modal = decoder.modal

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import IntEnum
+from typing import NamedTuple
 
 from ..config import ChannelConfig, MachineConfig
 
@@ -112,6 +113,45 @@ class ChannelError:
         return f"{kind} {self.id}: {where}{self.text}"
 
 
+class ContourElement(NamedTuple):
+    """One entry of a contour look-ahead reply (``HLI_CONTOUR_LOOKAHEAD_BLOCK``).
+
+    Distances and radii in 0.1 um on the compensated path, angles in rad.
+    """
+
+    block_type: int  # 0 none, 1 linear, 2 circular, 3 LOG ON, 4 LOG PARAM, 5 LOG OFF
+    block_number: int  # programmed N; -1 = the block has none
+    block_count_r: int  # the block's number in the run: mc_block_count_r once it is done
+    start_position: float  # path distance at its start (sum of the earlier lengths)
+    length: float  # element length; for types 3..5 the PARAM value as programmed
+    programmed_radius: float  # radius of the programmed arc; 0 for lines
+    compensated_radius: float  # radius of the arc on the compensated path; 0 for lines
+    circle_angle: float  # swept angle: cw in [-2pi, 0), ccw in (0, 2pi]; 0 for lines
+    length_min: float  # length on the scaled contour of die sinking: 0 (no die sinking)
+    tangent_variation: float  # angle to the previous motion element, in [0, pi]
+
+
+@dataclass(slots=True)
+class ContourLookaheadUnit:
+    """``gpCh[i].contour_lookahead``: the PLC's request, the handshake, state, reply."""
+
+    request_start_position: float = 0.0  # mode 1: index; mode 2: distance (0.1 um)
+    request_length: float = 0.0  # 0: mode 1 (by index); else mode 2 (by distance)
+    semaphor: bool = False  # TRUE: a request waits; the CNC answers and resets it
+    max_dist_prog_start_incr: float = 0.0  # end of the path prepared so far (0.1 um)
+    count_logged_blocks: int = 0  # entries in the log of the marked area
+    log_active: bool = False  # the marked area is open and not all of it was read in
+    response: tuple[ContourElement, ...] = ()  # the last reply (at most N entries)
+
+    def frozen(self) -> ContourLookaheadUnit:
+        """A copy for the snapshot."""
+        return ContourLookaheadUnit(
+            self.request_start_position, self.request_length, self.semaphor,
+            self.max_dist_prog_start_incr, self.count_logged_blocks, self.log_active,
+            self.response,
+        )
+
+
 @dataclass(slots=True)
 class Channel:
     """A channel: its axes, override, execution mode and path distance."""
@@ -147,6 +187,7 @@ class Channel:
     suspend_command_w: bool = False
     suspend_enable_w: bool = True
     suspend_request_r: bool = False
+    contour: ContourLookaheadUnit = field(default_factory=ContourLookaheadUnit)
 
     @property
     def suspend_commanded(self) -> bool:
@@ -166,6 +207,7 @@ class Channel:
             self.manual_blocks_done, self.path_velocity_mm_s, self.programmed_velocity_mm_s,
             self.remaining_in_block_mm, self.program_time_s, self.errors, self.error_count,
             self.suspend_command_w, self.suspend_enable_w, self.suspend_request_r,
+            self.contour.frozen(),
         )
 
 

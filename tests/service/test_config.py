@@ -65,15 +65,41 @@ def test_look_ahead_buffer_sizes_follow_p_chan_00650() -> None:
         return build_config({"channels": [{**base, **channel}]}).channels[0].look_ahead_blocks
 
     assert blocks() == 120
-    assert blocks(look_ahead="FCT_LOOK_AHEAD_LOW") == 30
-    assert blocks(look_ahead="FCT_LOOK_AHEAD_HIGH") == 190
-    assert blocks(look_ahead="FCT_LOOK_AHEAD_CUSTOM", look_ahead_custom_blocks=500) == 500
+    assert blocks(interpolator_function="FCT_LOOK_AHEAD_LOW") == 30
+    assert blocks(interpolator_function="FCT_LOOK_AHEAD_HIGH | FCT_CONTOUR_LAH") == 190
+    assert blocks(interpolator_function="FCT_IPO_DEFAULT") == 120
+    assert blocks(interpolator_function="FCT_LOOK_AHEAD_CUSTOM",
+                  look_ahead_custom_blocks=500) == 500
 
 
-def test_unknown_look_ahead_and_repeated_tools_are_refused() -> None:
+def test_contour_lookahead_is_an_interpolator_function() -> None:
+    config = build_config()
+    assert config.channels[0].contour_lookahead  # the default machine's channel 1 has it
+    assert not config.channels[1].contour_lookahead
+    assert config.channels[0].contour_lookahead_log_max == 128  # P-CHAN-00658 default
+    base = config.model_dump()["channels"][1]
+    changed = build_config({"channels": [config.model_dump()["channels"][0], {
+        **base, "interpolator_function": "fct_ipo_default,FCT_CONTOUR_LAH",
+        "contour_lookahead_log_max": 0}]})
+    assert changed.channels[1].contour_lookahead
+    assert changed.channels[1].contour_lookahead_log_max == 0
+
+
+@pytest.mark.parametrize(("value", "message"), [
+    ("FAST", "unknown interpolator function 'FAST'"),
+    ("FCT_SYNC", "FCT_SYNC is not supported by this kernel"),
+    ("FCT_LOOK_AHEAD_LOW | FCT_LOOK_AHEAD_HIGH",
+     "choose one look-ahead size, not FCT_LOOK_AHEAD_HIGH and FCT_LOOK_AHEAD_LOW"),
+])
+def test_bad_interpolator_functions_are_refused(value: str, message: str) -> None:
     base = build_config().model_dump()["channels"][0]
-    with pytest.raises(ConfigError, match="look_ahead"):
-        build_config({"channels": [{**base, "look_ahead": "FAST"}]})
+    with pytest.raises(ConfigError) as caught:
+        build_config({"channels": [{**base, "interpolator_function": value}]})
+    assert "channels.0.interpolator_function" in str(caught.value)
+    assert message in str(caught.value)
+
+
+def test_repeated_tools_are_refused() -> None:
     with pytest.raises(ConfigError, match="tool D numbers repeat"):
         build_config({"tools": [{"d": 1, "radius_mm": 1}, {"d": 1, "radius_mm": 2}]})
 

@@ -7,7 +7,8 @@ contract is in ``blocks``.
 """
 
 from .blocks import (
-    AxisExchange, AxisExchangeKind, Block, Compensation, Motion, MotionKind, SourceRef, StopKind,
+    AxisExchange, AxisExchangeKind, Block, Compensation, ContourCommand, ContourKind, LogArea,
+    Motion, MotionKind, SourceRef, StopKind, next_log_area,
 )
 from .decoder import Decoder
 from .errors import NcError, NcErrorId
@@ -15,7 +16,7 @@ from .modal import DistanceMode, ModalState, Plane
 from .syntax import check_syntax
 
 __all__ = [
-    "AxisExchange", "AxisExchangeKind", "Block", "Compensation", "Decoder", "DistanceMode",
-    "ModalState", "Motion", "MotionKind", "NcError", "NcErrorId", "Plane", "SourceRef",
-    "StopKind", "check_syntax",
+    "AxisExchange", "AxisExchangeKind", "Block", "Compensation", "ContourCommand",
+    "ContourKind", "Decoder", "DistanceMode", "LogArea", "ModalState", "Motion", "MotionKind",
+    "NcError", "NcErrorId", "Plane", "SourceRef", "StopKind", "check_syntax", "next_log_area",
 ]

@@ -11,6 +11,10 @@ the loop into ordinary blocks, like ``$WHILE``. Without a condition the loop run
 until the program is reset; the decoder is lazy, so it produces blocks as long as the
 caller pulls them.
 
+A real-time loop entered while the contour look-ahead's marked area is open gets
+marker Blocks at its passes (``contour.RtLoopMarkers``): ``run`` returns them. They do
+not count as blocks for the endless-loop guard.
+
 A decode-time loop that runs ``MAX_IDLE_LOOP_PASSES`` passes without producing a
 single block is stopped with ENDLESS_LOOP (``$WHILE TRUE`` without motion would
 otherwise hang the SDA task).
@@ -20,6 +24,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from .blocks import Block
+from .contour import RtLoopMarkers
 from .errors import NcErrorId
 from .expressions import number, truth
 from .frames import ControlEntry, Frame
@@ -39,11 +45,12 @@ class ControlFlow:
         self.decoder = decoder
         self.idle_passes = 0
         self.blocks_at_last_pass = -1
+        self.markers = RtLoopMarkers(decoder)
         k = StmtKind
         self.handlers = {
             k.IF: self._if, k.IF_GOTO: self._if_goto, k.ELSEIF: self._else,
             k.ELSE: self._else, k.ENDIF: self._endif, k.WHILE: self._while,
-            k.RT_WHILE: self._while, k.ENDWHILE: self._endwhile,
+            k.RT_WHILE: self._rt_while, k.ENDWHILE: self._endwhile,
             k.RT_ENDWHILE: self._endwhile, k.FOR: self._for, k.ENDFOR: self._endfor,
             k.REPEAT: self._repeat, k.UNTIL: self._until, k.SWITCH: self._switch,
             k.CASE: self._case, k.DEFAULT: self._case, k.ENDSWITCH: self._endswitch,
@@ -51,9 +58,10 @@ class ControlFlow:
             k.ENDVAR: self._endvar,
         }
 
-    def run(self, frame: Frame, stmt: Control, after: int) -> None:
-        """Execute ``stmt`` (the line at ``frame.index``); sets the next ``frame.index``."""
-        self.handlers[stmt.kind](frame, stmt, after)
+    def run(self, frame: Frame, stmt: Control, after: int) -> Block | None:
+        """Execute ``stmt`` (the line at ``frame.index``); sets the next ``frame.index``.
+        Returns a real-time loop marker Block or None (the handlers return nothing else)."""
+        return self.handlers[stmt.kind](frame, stmt, after)
 
     # ------------------------------------------------------------ helpers
 
@@ -145,6 +153,18 @@ class ControlFlow:
         else:
             frame.index = self._structure(frame, stmt, frame.index).after
 
+    def _rt_while(self, frame: Frame, stmt: Control, after: int) -> Block | None:
+        """``$WHILE`` semantics; tells the markers about the test (first or re-test)."""
+        index = frame.index
+        entry = None
+        if self._cond(stmt):
+            entry = ControlEntry(stmt.kind, index, stmt, after)
+            frame.control.append(entry)
+            frame.index = after
+        else:
+            frame.index = self._structure(frame, stmt, index).after
+        return self.markers.tested(frame, stmt, index, entry)
+
     def _endwhile(self, frame: Frame, stmt: Control, after: int) -> None:
         opener = StmtKind.WHILE if stmt.kind == StmtKind.ENDWHILE else StmtKind.RT_WHILE
         top = self._top(frame, opener)
@@ -152,6 +172,8 @@ class ControlFlow:
             raise self._mismatch(frame, stmt, NcErrorId.LOOP_END_WITHOUT_BEGIN, opener)
         frame.control.pop()
         self.loop_pass(stmt.line, stmt.pos)
+        if opener == StmtKind.RT_WHILE:
+            self.markers.closed(frame, top)
         frame.index = top.index  # the loop statement tests its condition again
 
     def _for(self, frame: Frame, stmt: Control, after: int) -> None:
@@ -241,13 +263,14 @@ class ControlFlow:
 
     # ------------------------------------------------------------ $BREAK, $CONTINUE
 
-    def _break(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _break(self, frame: Frame, stmt: Control, after: int) -> Block | None:
         for n in range(len(frame.control) - 1, -1, -1):
             entry = frame.control[n]
             if entry.kind == StmtKind.SWITCH or entry.kind in LOOPS:
+                left = frame.control[n:]
                 del frame.control[n:]
                 frame.index = self._structure(frame, entry.stmt, entry.index).after
-                return
+                return self.markers.broken(frame, left)
         raise stmt.line.error(
             NcErrorId.BREAK_OUTSIDE_LOOP, "$BREAK outside a loop or $SWITCH", stmt.pos
         )

@@ -22,7 +22,8 @@ import logging
 from collections.abc import Callable, Iterator, Mapping
 
 from .blockexec import BlockExecutor, Flow
-from .blocks import Block
+from .blocks import Block, LogArea
+from .contour import execute_contour
 from .control import ControlFlow
 from .declarations import declare, read_block
 from .errors import NcError, NcErrorId
@@ -32,7 +33,7 @@ from .modal import ModalState
 from .parser import RESERVED_LETTERS, LineParser, word_table
 from .program import Program, Section
 from .source import strip_comments
-from .statements import CLOSER_OF, SPELLING, AxisCommand, Control, NcBlock
+from .statements import CLOSER_OF, SPELLING, AxisCommand, ContourStatement, Control, NcBlock
 from .variables import Scope, Variable
 
 log = logging.getLogger(__name__)
@@ -51,6 +52,11 @@ class Decoder:
     of each channel axis (default 1..n), for ``#AX RELEASE NBR`` and ``#AX REQUEST``.
     A program (not ``manual``) starts with all axes in the channel; manual blocks keep
     the axes released before (``modal.released_axes``).
+
+    ``contour_lookahead``: the channel has the contour look-ahead function
+    (FCT_CONTOUR_LAH is in the channel's interpolator functions, P-CHAN-00650); without
+    it ``#CONTOUR LOOKAHEAD`` is an error. A program starts without a marked area
+    (``modal.contour_log_area`` NONE); manual blocks keep the area.
     """
 
     def __init__(
@@ -65,6 +71,7 @@ class Decoder:
         skip_levels: int = 1,
         manual: bool = False,
         axis_numbers: tuple[int, ...] | None = None,
+        contour_lookahead: bool = False,
     ) -> None:
         axes = tuple(axes)
         for name in axes:
@@ -87,14 +94,16 @@ class Decoder:
         elif len(modal.position_mm) != len(axes):
             raise ValueError(f"modal position has {len(modal.position_mm)} axes, "
                              f"the channel {len(axes)}")
-        if not manual:  # a program starts with the channel's configured axes
+        if not manual:  # a program starts with the channel's axes and an empty log
             modal.released_axes = frozenset()
+            modal.contour_log_area = LogArea.NONE
         elif not all(0 <= k < len(axes) for k in modal.released_axes):
             raise ValueError(f"released axes {sorted(modal.released_axes)} are not axes "
                              f"of the channel {axes}")
         self.axes = axes
         self.axis_numbers = axis_numbers
         self.manual = manual
+        self.contour_lookahead = contour_lookahead
         self._loader = loader
         self._modal = modal
         self._skip_levels = skip_levels
@@ -182,8 +191,11 @@ class Decoder:
                 block = self.executor.exchange(stmt, self)
                 frame.index = after
                 return block
-            self._control.run(frame, stmt, after)
-            return None
+            if type(stmt) is ContourStatement:
+                block = execute_contour(stmt, self)
+                frame.index = after
+                return block
+            return self._control.run(frame, stmt, after)  # a real-time loop marker or None
         here = frame.index
         block, flow, flow_pos = self.executor.execute(stmt, self)
         frame.index = after

@@ -7,8 +7,9 @@ understands. The ids live in 20000..22999 like the decoder errors of the ISG ker
 Ids marked "ISG" are the documented ids of the ISG kernel for the same problem; the
 others are this kernel's own and stay stable.
 
-Reserved for later, deliberately not used: 22073 (``#CONTOUR LOOKAHEAD CLEAR`` inside
-``#RT WHILE``) and 21309 (warning: SYNCHK without MACHINE_LOCK).
+Reserved for later, deliberately not used: 21309 (warning: SYNCHK without
+MACHINE_LOCK). 22073 (``#CONTOUR LOOKAHEAD LOG CLEAR`` inside ``#RT WHILE``) is ISG's id
+and used for that.
 """
 
 from __future__ import annotations
@@ -63,6 +64,11 @@ class NcErrorId(IntEnum):
     AXIS_EXCHANGE_NOT_SUPPORTED = 20151  # #AX REQUEST of a foreign axis, index or name
     AXIS_COMMAND_NOT_ALONE = 20152  # #AX RELEASE/REQUEST with other words in its NC line
     INVALID_AXIS_NUMBER = 20153  # #AX: axis number < 1 or index < 0, or not an integer
+
+    # ---- contour look-ahead (#CONTOUR LOOKAHEAD, #DISTANCE PROG START CLEAR)
+    CONTOUR_LOOKAHEAD_NOT_ENABLED = 22070  # #CONTOUR LOOKAHEAD without FCT_CONTOUR_LAH
+    CONTOUR_COMMAND_SYNTAX = 22071  # malformed #CONTOUR LOOKAHEAD / #DISTANCE command
+    CONTOUR_CLEAR_IN_RT_LOOP = 22073  # ISG: #CONTOUR LOOKAHEAD LOG CLEAR inside #RT WHILE
 
     # ---- expressions
     EXPRESSION_SYNTAX = 20200  # malformed expression (missing ']', operator without operand)

@@ -34,6 +34,7 @@ from .blocks import Block, Motion, MotionKind, SourceRef, StopKind
 from .construct import (
     FAST, BlockTwin, MotionTwin, SourceRefTwin, make_block, make_motion, make_source,
 )
+from .contour import LOOP_MARKERS
 from .geometry import ARC_TOLERANCE_MM
 from .modal import DistanceMode
 
@@ -184,7 +185,9 @@ def run(decoder):
         # the line the hot path did not take: the general path
         block = slow_step(frame)
         if block is not None:
-            decoder.emitted += 1
+            # a real-time loop marker is no block of the program: the loop guard ignores it
+            if block.contour is None or block.contour.kind not in LOOP_MARKERS:
+                decoder.emitted += 1
             yield block
         if decoder.finished:
             return
@@ -283,7 +286,7 @@ def decoding_loop(axes: tuple[str, ...]) -> Callable[..., Iterator[Block]]:
         "TOLERANCE": ARC_TOLERANCE_MM, "MOTION_TWIN": MotionTwin, "MOTION": Motion,
         "SOURCE_TWIN": SourceRefTwin, "SOURCE": SourceRef, "BLOCK_TWIN": BlockTwin,
         "BLOCK": Block, "NO_STOP": StopKind.NONE, "MAKE_MOTION": make_motion,
-        "MAKE_BLOCK": make_block, "MAKE_SOURCE": make_source,
+        "MAKE_BLOCK": make_block, "MAKE_SOURCE": make_source, "LOOP_MARKERS": LOOP_MARKERS,
     }
     code = compile(loop_source(axes), f"<decoding loop {''.join(axes)}>", "exec")
     exec(code, namespace)  # noqa: S102 - our own template, no outside input

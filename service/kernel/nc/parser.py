@@ -4,7 +4,8 @@ An NC line is ``[Nnn[:]] [[LABEL]] item item ...`` where an item is an address w
 (``X10``, ``X-.5``, ``X[expr]``, ``XV.L.A``, ``X-V.L.A``), an assignment
 (``V.L.A = expr``), a subprogram call (``LL name`` local, ``L name`` file) or
 ``$GOTO target`` (executed last). A line whose first item is ``$KEYWORD`` is a control
-statement, ``#KEYWORD`` an instruction (``#AX`` an axis exchange, ``exchange``).
+statement, ``#KEYWORD`` an instruction (``#AX`` an axis exchange, ``exchange``;
+``#CONTOUR`` / ``#DISTANCE`` the contour look-ahead commands, ``contour``).
 Unknown letters and characters are errors, never ignored.
 """
 
@@ -13,6 +14,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 
+from .contour import CONTOUR_WORD, parse_contour_command
 from .errors import NcErrorId
 from .exchange import AX_WORD, parse_axis_command
 from .expressions import Const, ExpressionParser, Node, VarRef
@@ -20,7 +22,8 @@ from .lexer import IDENT, SIGNED_NUMBER, Cursor
 from .modal import G_CODES, GGroup
 from .source import LogicalLine
 from .statements import (
-    Assign, AxisCommand, Call, Control, Goto, NcBlock, StmtKind, Word, WordKind,
+    Assign, AxisCommand, Call, ContourStatement, Control, Goto, NcBlock, StmtKind, Word,
+    WordKind,
 )
 
 _N_WORD = re.compile(r"N[ \t]*([-+]?[0-9.]*)([ \t]*:)?")
@@ -74,7 +77,7 @@ class LineParser:
 
     # ------------------------------------------------------------ entry
 
-    def parse(self, line: LogicalLine) -> NcBlock | Control | AxisCommand:
+    def parse(self, line: LogicalLine) -> NcBlock | Control | AxisCommand | ContourStatement:
         """The statement of one logical line (raises NcError on a syntax error)."""
         cur = Cursor(line)
         cur.skip_ws()
@@ -153,12 +156,16 @@ class LineParser:
         self._line_end(cur, f"${word}")
         return stmt
 
-    def _directive(self, cur: Cursor, number: int | None) -> Control | AxisCommand:
+    def _directive(
+        self, cur: Cursor, number: int | None
+    ) -> Control | AxisCommand | ContourStatement:
         pos = cur.pos
         m = cur.match(_DIRECTIVE)
         word = m.group(1)
         if word == "AX":
             return parse_axis_command(cur, pos, number)
+        if word in ("CONTOUR", "DISTANCE"):
+            return parse_contour_command(cur, pos, word, number)
         if word == "VAR":
             stmt = Control(StmtKind.VAR, cur.line, pos, number=number)
         elif word == "ENDVAR":
@@ -262,6 +269,10 @@ class LineParser:
             elif c == "#" and AX_WORD.match(cur.up, pos):
                 raise cur.error(NcErrorId.AXIS_COMMAND_NOT_ALONE,
                                 "#AX must stand alone in its NC line")
+            elif c == "#" and CONTOUR_WORD.match(cur.up, pos):
+                word = _DIRECTIVE.match(cur.up, pos).group(1)
+                raise cur.error(NcErrorId.CONTOUR_COMMAND_SYNTAX,
+                                f"#{word} must stand alone in its NC line")
             else:
                 raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
         block.letters = frozenset(letters)

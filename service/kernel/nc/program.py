@@ -28,10 +28,10 @@ from .errors import NcError, NcErrorId
 from .parser import LineParser
 from .source import LogicalLine, SourceText, comment_directive, read_logical, strip_comments
 from .statements import (
-    CLOSER_OF, OPENERS, SPELLING, AxisCommand, Control, NcBlock, StmtKind,
+    CLOSER_OF, OPENERS, SPELLING, AxisCommand, ContourStatement, Control, NcBlock, StmtKind,
 )
 
-Statement = NcBlock | Control | AxisCommand  # what a parsed line is
+Statement = NcBlock | Control | AxisCommand | ContourStatement  # what a parsed line is
 
 # parsed lines kept for loops and repeated calls; a long straight program does not
 # keep all of its lines parsed in memory (the cache starts over when full)

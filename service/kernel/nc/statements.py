@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import IntEnum
 
-from .blocks import AxisExchangeKind
+from .blocks import AxisExchangeKind, ContourKind
 from .expressions import Node, VarRef
 from .source import LogicalLine
 from .variables import Scope, VarType
@@ -169,6 +169,19 @@ class AxisCommand:
     line: LogicalLine
     pos: int  # position of the '#'
     axes: tuple[AxisRef, ...] | None  # None: #AX RELEASE ALL
+    number: int | None = None  # N number of the line, if any
+
+
+@dataclass(slots=True)
+class ContourStatement:
+    """``#CONTOUR LOOKAHEAD LOG ...`` or ``#DISTANCE PROG START CLEAR``: alone in its NC
+    line (besides N and a label)."""
+
+    kind: ContourKind  # LOG_ON, LOG_PARAM, LOG_OFF, LOG_CLEAR or DISTANCE_CLEAR
+    line: LogicalLine
+    pos: int  # position of the '#'
+    param: Node | None = None  # PARAM= expression (evaluated when the command runs)
+    param_pos: int = -1  # position of the PARAM expression
     number: int | None = None  # N number of the line, if any
 
 

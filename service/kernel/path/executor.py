@@ -22,7 +22,7 @@ block accounting of the look-ahead buffer:
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from ..nc.blocks import Block
 from .errors import PathError, PathErrorId
@@ -59,6 +59,8 @@ class PathExecutor:
         self._ipo = Interpolator(self._planner, self.cycle_s, start)
         self._single_block = False
         self._closed = False
+        # sees every segment and bare block as it enters the buffer (contour look-ahead)
+        self.on_prepared: Callable[[list[Segment | Block]], None] | None = None
 
     # -- blocks in --------------------------------------------------------------------
 
@@ -94,6 +96,8 @@ class PathExecutor:
         return self._closed
 
     def _take(self, items: list[Segment | Block]) -> None:
+        if self.on_prepared is not None:
+            self.on_prepared(items)
         planner, ipo = self._planner, self._ipo
         for item in items:
             if isinstance(item, Segment):
@@ -167,12 +171,9 @@ class PathExecutor:
 
     @property
     def distance_mm(self) -> float:
-        """Path length covered since program start (or the last ``clear_distance``)."""
+        """Path length covered since program start (or the last block with
+        ``#DISTANCE PROG START CLEAR``)."""
         return self._ipo.distance_base_mm + self._ipo.s_mm
-
-    def clear_distance(self) -> None:
-        """Restart the path distance at 0 here (#DISTANCE PROG START CLEAR)."""
-        self._ipo.distance_base_mm = -self._ipo.s_mm
 
     @property
     def holding(self) -> bool:

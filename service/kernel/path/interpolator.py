@@ -15,7 +15,8 @@ already carries every later constraint in the buffer (backward pass).
 
 At a segment end the blocks ending there are processed in order: a dwell stands for
 ``dwell_s`` (time of the same cycle counts), a programmed stop (M0/M1/M2/M30) waits for
-``resume``, single block waits for ``resume``; other blocks are finished at once.
+``resume``, single block waits for ``resume``; other blocks are finished at once. A block
+with ``#DISTANCE PROG START CLEAR`` restarts the path distance where it ends.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from collections import deque
 from dataclasses import dataclass
 from enum import IntEnum
 
-from ..nc.blocks import Block, StopKind
+from ..nc.blocks import Block, ContourKind, StopKind
 from .planner import LookAhead
 from .profile import advance
 from .segments import Segment
@@ -229,6 +230,9 @@ class Interpolator:
 
     def _finish(self, block: Block, single: bool, finished: list[Block]) -> bool:
         finished.append(block)
+        contour = block.contour
+        if contour is not None and contour.kind == ContourKind.DISTANCE_CLEAR:
+            self.distance_base_mm = -self.s_mm  # the path distance restarts here
         if block.stop != StopKind.NONE:
             self.waiting = Waiting.PROGRAMMED_STOP
         elif single:

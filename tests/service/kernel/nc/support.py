@@ -24,11 +24,12 @@ def loader_of(files: Mapping[str, str] | None):
 
 def decoder(text: str, *, files: Mapping[str, str] | None = None, axes=AXES,
             tools=TOOLS, modal: ModalState | None = None, manual: bool = False,
-            skip_levels: int = 1, file: str = "prog.nc", axis_numbers=None) -> Decoder:
+            skip_levels: int = 1, file: str = "prog.nc", axis_numbers=None,
+            contour_lookahead: bool = False) -> Decoder:
     """A Decoder with the test defaults."""
     return Decoder(text, file, axes=axes, loader=loader_of(files), tools=tools,
                    modal=modal, skip_levels=skip_levels, manual=manual,
-                   axis_numbers=axis_numbers)
+                   axis_numbers=axis_numbers, contour_lookahead=contour_lookahead)
 
 
 def decode(text: str, **kw) -> list[Block]:

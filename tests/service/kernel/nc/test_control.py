@@ -172,7 +172,8 @@ def test_loop_guard_counts_passes_without_blocks_only(monkeypatch):
         ("$GOTO X10\nM30", NcErrorId.BAD_GOTO_TARGET, 1, 7),
         ("$GOTO N1 $GOTO N1\nN1: M30", NcErrorId.WORD_REPEATED, 1, 10),
         ("#MSG SAVE [\"x\"]\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 1),
-        ("N5 #CONTOUR LOOKAHEAD LOG ON\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 4),
+        ("N5 #CONTOUR LOOKAHEAD LOG ON\nM30", NcErrorId.CONTOUR_LOOKAHEAD_NOT_ENABLED, 1, 4),
+        ("N5 #CONTOUR MODE [DEV]\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 4),
         ("#RT CLEAR\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 1),
     ],
 )

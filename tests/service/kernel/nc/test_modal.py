@@ -84,7 +84,8 @@ def test_error_ids():
     values = [int(m) for m in NcErrorId]
     assert len(values) == len(set(values))
     assert all(20000 <= v <= 22999 for v in values)
-    assert 22073 not in values and 21309 not in values  # reserved for later use
+    assert 21309 not in values  # reserved for later use
+    assert NcErrorId(22073) == NcErrorId.CONTOUR_CLEAR_IN_RT_LOOP  # ISG's id
 
 
 def test_a_block_with_an_error_leaves_the_modal_state_unchanged():

@@ -1,0 +1,271 @@
+"""Contour look-ahead (ISG FCT-C40): future contour elements for the PLC.
+
+``ContourLog`` watches the path of one program run as it is prepared, i.e. as blocks
+enter the look-ahead buffer, before they are executed. It keeps
+
+* the **log** of the marked area (``#CONTOUR LOOKAHEAD LOG ON`` .. ``LOG OFF``): the LOG
+  entries (types 3, 4, 5) and every element of the compensated path in between, at most
+  ``contour_lookahead_log_max`` (P-CHAN-00658) entries. Only the first marked area is
+  kept until ``LOG CLEAR``; mode 1 requests read it by index;
+* the **recent elements** of the whole path, the last ``contour_lookahead_log_max`` of
+  them, which mode 2 requests read by path distance;
+* the **prepared path distance**: the start position of the next element, i.e. the sum
+  of the lengths of all earlier elements on the compensated path since program start or
+  ``#DISTANCE PROG START CLEAR``. Its value after the last prepared element is the
+  maximum look-ahead distance (``state.max_dist_prog_start``): it depends on the
+  look-ahead buffer and the block supply only, not on feedhold, override, M functions
+  or dwell.
+
+An element is a piece of the compensated path: a block's line or arc, and also the
+pieces tool radius compensation adds (the approach line of the selection block, the
+connecting arc of radius r around an outside corner, which belongs to the following
+block). A block therefore gives one element or more, all with its N and block count.
+
+Real-time loops (``#RT WHILE``): the decoder unrolls them and marks the passes of a loop
+entered while the marked area is open (``ContourKind.RT_PASS``/``RT_END``). ISG logs such
+a body three times, once per transition: start of loop, loop to loop, end of loop. Here
+the first pass (its first element has the angle to the block before the loop), the
+second pass (angle to the end of the body) and the last pass (its end meets what follows
+the loop) are logged; passes 3 .. n-1 repeat the second and are left out. A loop with
+fewer passes has fewer transitions, and is logged with as many copies as it has passes.
+LOG ON inside the loop opens the area in the first pass; the later passes' LOG ON are
+ignored (only the first area is kept), so the body is logged once, with the angle to the
+block before the loop.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Iterable, Sequence
+
+from .nc.blocks import Block, ContourKind, LogArea, MotionKind, next_log_area
+from .path.geometry import Arc
+from .path.segments import Segment
+from .state import ContourElement
+
+RESPONSE_BLOCKS = 32  # entries of gpCh[i].contour_lookahead.response.block[0..31]
+LOG_FULL_WARNING = 22074  # warning id: the marked area has more entries than the log keeps
+
+LINEAR, CIRCULAR = 1, 2  # block_type of motion elements
+_INCR_PER_MM = 10_000.0  # 0.1 um per mm
+_SAME_CENTRE_MM = 1e-6  # an offset arc keeps the centre of its programmed arc
+_WINDOW_TOLERANCE_INCR = 1e-6  # mode 2 window edges: rounding of the client's numbers
+
+
+class RequestError(ValueError):
+    """A request the CNC cannot answer (the semaphore write is refused)."""
+
+
+def tangent_angle_rad(a: Sequence[float], b: Sequence[float]) -> float:
+    """Angle between unit vectors ``a`` and ``b`` in [0, pi], exact near 0 and pi."""
+    diff = math.sqrt(sum((x - y) * (x - y) for x, y in zip(a, b, strict=True)))
+    total = math.sqrt(sum((x + y) * (x + y) for x, y in zip(a, b, strict=True)))
+    return 2.0 * math.atan2(diff, total)
+
+
+def _programmed_radius_mm(segment: Segment) -> float:
+    """Radius of the programmed arc this element is the (offset) image of; 0 for a line
+    and for the pieces compensation adds (connecting arcs, approach lines)."""
+    element, motion = segment.element, segment.block.motion
+    if not isinstance(element, Arc) or motion is None or motion.center_mm is None:
+        return 0.0
+    if motion.kind not in (MotionKind.ARC_CW, MotionKind.ARC_CCW):
+        return 0.0
+    cp, cq = motion.center_mm
+    if math.hypot(element.center[0] - cp, element.center[1] - cq) > _SAME_CENTRE_MM:
+        return 0.0  # a connecting arc around a corner of the programmed contour
+    p, q = motion.plane
+    return math.hypot(motion.start_mm[p] - cp, motion.start_mm[q] - cq)
+
+
+class ContourLog:
+    """The contour look-ahead of one program run (GEO task)."""
+
+    def __init__(self, log_max: int) -> None:
+        self.log_max = log_max
+        self.log: list[ContourElement] = []
+        self.recent: deque[ContourElement] = deque(maxlen=log_max)
+        self.area = LogArea.NONE
+        self.distance_mm = 0.0  # start of the next element on the compensated path
+        self.complete = False  # the end of data was prepared: everything is read in
+        self.full_warned = False  # the log-full warning was given for this area
+        self.dropped_at: Block | None = None  # the block of the first entry that did not fit
+        self._tangent: tuple[float, ...] | None = None  # end tangent of the last element
+        self._block: Block | None = None
+        self._ordinal = 0  # number of the block being prepared in the run (block_count_r)
+        self._loop = 0  # serial of the real-time loop whose passes are being sorted
+        self._pending: list[ContourElement] | None = None  # pass >= 3, not yet logged
+
+    # ------------------------------------------------------------ state
+
+    @property
+    def max_dist_prog_start_incr(self) -> float:
+        """Maximum look-ahead distance: the end of the path prepared so far (0.1 um)."""
+        return self.distance_mm * _INCR_PER_MM
+
+    @property
+    def active(self) -> bool:
+        """``f_log_is_active``: the area is open and not all of its elements are read in."""
+        return self.area == LogArea.OPEN and not self.complete
+
+    # ------------------------------------------------------------ prepared path
+
+    def take(self, items: Iterable[Segment | Block]) -> bool:
+        """Watch segments and bare blocks as they enter the look-ahead buffer, in path
+        order; True when this made the log overflow for the first time in its area."""
+        overflowed = False
+        for item in items:
+            if isinstance(item, Segment):
+                self._count(item.block)
+                overflowed |= self._element(item)
+            else:
+                contour = item.contour
+                if contour is None or contour.kind < ContourKind.RT_PASS:
+                    self._count(item)  # the RT markers are not NC blocks of their own
+                if contour is not None:
+                    overflowed |= self._command(item, contour.kind, contour.param)
+        return overflowed
+
+    def count_block(self) -> None:
+        """A block that did not enter the look-ahead buffer (axis exchange, LOG CLEAR)
+        still has its number in the run."""
+        self._block = None
+        self._ordinal += 1
+
+    def end_of_data(self) -> bool:
+        """All blocks are prepared; True when the last pass of a loop overflowed."""
+        self.complete = True
+        return self._flush_pending()
+
+    def clear(self) -> None:
+        """LOG CLEAR, reached at standstill: empty the log; the next LOG ON opens a new
+        area. The recent elements (mode 2) and the path distance stay."""
+        self.log = []
+        self.area = LogArea.NONE
+        self.full_warned = False
+        self._pending = None
+        self._loop = 0
+
+    def _count(self, block: Block) -> None:
+        if block is not self._block:
+            self._block = block
+            self._ordinal += 1
+
+    def _number(self, block: Block) -> int:
+        return block.number if block.number is not None else -1
+
+    def _element(self, segment: Segment) -> bool:
+        element = segment.element
+        block = segment.block
+        start = self.distance_mm
+        self.distance_mm = start + element.length_mm
+        previous, self._tangent = self._tangent, element.tangent_end
+        variation = 0.0 if previous is None else tangent_angle_rad(previous, element.tangent_start)
+        if isinstance(element, Arc):
+            entry = ContourElement(
+                CIRCULAR, self._number(block), self._ordinal, start * _INCR_PER_MM,
+                element.length_mm * _INCR_PER_MM,
+                _programmed_radius_mm(segment) * _INCR_PER_MM,
+                element.radius_mm * _INCR_PER_MM, element.sweep_rad, 0.0, variation,
+            )
+        else:
+            entry = ContourElement(
+                LINEAR, self._number(block), self._ordinal, start * _INCR_PER_MM,
+                element.length_mm * _INCR_PER_MM, 0.0, 0.0, 0.0, 0.0, variation,
+            )
+        if self.log_max:
+            self.recent.append(entry)
+        if self.area == LogArea.OPEN:
+            return self._log(entry)
+        return False
+
+    def _command(self, block: Block, kind: ContourKind, param: float | None) -> bool:
+        if kind == ContourKind.DISTANCE_CLEAR:
+            self.distance_mm = 0.0
+            return False
+        if kind == ContourKind.RT_PASS:
+            return self._rt_pass(block)
+        if kind == ContourKind.RT_END:
+            return self._flush_pending()
+        if kind == ContourKind.LOG_CLEAR:  # normally applied at standstill by the channel
+            self.clear()
+            return False
+        before = self.area
+        self.area = next_log_area(before, kind)
+        entry = ContourElement(
+            int(kind), self._number(block), self._ordinal, self.distance_mm * _INCR_PER_MM,
+            0.0 if param is None else param, 0.0, 0.0, 0.0, 0.0, 0.0,
+        )
+        if kind == ContourKind.LOG_ON:
+            return self._log(entry) if before == LogArea.NONE else False
+        if before != LogArea.OPEN:
+            return False  # PARAM or OFF outside the area
+        if kind == ContourKind.LOG_OFF:
+            overflowed = self._flush_pending()
+            return self._log(entry) or overflowed
+        return self._log(entry)
+
+    def _rt_pass(self, block: Block) -> bool:
+        contour = block.contour
+        if self.area != LogArea.OPEN:
+            return False
+        if contour.loop != self._loop:  # a new loop: what was pending belongs to the last
+            overflowed = self._flush_pending()
+            self._loop = contour.loop
+        else:
+            overflowed = False
+        if contour.rt_pass >= 3:
+            self._pending = []  # the pass before it repeated the loop-to-loop transition
+        return overflowed
+
+    def _flush_pending(self) -> bool:
+        pending, self._pending = self._pending, None
+        overflowed = False
+        for entry in pending or ():
+            overflowed |= self._log(entry)
+        return overflowed
+
+    def _log(self, entry: ContourElement) -> bool:
+        if self._pending is not None:
+            self._pending.append(entry)
+            return False
+        if len(self.log) < self.log_max:
+            self.log.append(entry)
+            return False
+        if self.full_warned:
+            return False
+        self.full_warned = True
+        self.dropped_at = self._block
+        return True
+
+    # ------------------------------------------------------------ requests
+
+    def answer(self, start_position: float, length: float) -> tuple[ContourElement, ...]:
+        """The reply to a request: mode 1 (``length`` 0) the log from index
+        ``start_position`` on; mode 2 the recent elements whose start lies in
+        [start_position, start_position + length] (0.1 um). At most RESPONSE_BLOCKS."""
+        check_request(start_position, length)
+        if length == 0.0:
+            index = int(start_position)
+            return tuple(self.log[index:index + RESPONSE_BLOCKS])
+        low = start_position - _WINDOW_TOLERANCE_INCR
+        high = start_position + length + _WINDOW_TOLERANCE_INCR
+        found = [e for e in self.recent if low <= e.start_position <= high]
+        return tuple(found[:RESPONSE_BLOCKS])
+
+
+def check_request(start_position: float, length: float) -> None:
+    """Raise RequestError for a request no CNC could answer."""
+    if not (math.isfinite(start_position) and math.isfinite(length)):
+        raise RequestError("request.start_position and request.length must be finite numbers")
+    if length == 0.0:
+        if start_position < 0 or start_position != int(start_position):
+            raise RequestError(
+                f"mode 1 (length 0) needs an element index >= 0 in start_position, "
+                f"not {start_position:g}"
+            )
+    elif length < 0.0:
+        raise RequestError(
+            f"mode 2 needs a positive length (0.1 um), not {length:g}; length 0 is mode 1"
+        )
