@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from dataclasses import replace
 
 from ..config import ChannelConfig, MachineConfig
 from .axis_params import AxisErrorId, AxisParameters
@@ -92,6 +93,7 @@ class ChannelRunner:
         self._sync: Block | None = None
         self._backlog: list = []  # decoded items that came after it
         self._contour: ContourLog | None = None  # contour look-ahead of the run
+        self._contour_changed = False  # blocks were prepared: show the unit's new state
         self._internal_hold = False  # feedhold of a suspend_axis_output request
         self._executor: PathExecutor | None = None
         self._feed: DecoderFeed | None = None
@@ -192,7 +194,8 @@ class ChannelRunner:
         self._pending_start = self._sync = None
         self._queued_jobs.clear()
         self._backlog = []
-        ch.contour.log_active = False
+        if ch.contour.log_active:
+            ch.contour = replace(ch.contour, log_active=False)
         self._internal_hold = False
         ch.errors, ch.error_count = (), 0
         ch.waiting_for_start = False
@@ -400,8 +403,10 @@ class ChannelRunner:
             elif isinstance(item, DecodeEnd):
                 executor.close()
                 self._fed_all = True
-                if self._contour is not None and self._contour.end_of_data():
-                    self._warn_log_full()
+                if self._contour is not None:
+                    if self._contour.end_of_data():
+                        self._warn_log_full()
+                    self._show_contour_state()
 
     def cycle(self, time_s: float) -> bool:
         """One GEO cycle of the channel; True while it has motion or decoding to do."""
@@ -430,8 +435,9 @@ class ChannelRunner:
                 return False
         if self._sync is None:
             self._feed_blocks()
-        if self._contour is not None:
-            self._show_contour_state()
+            if self._contour_changed:  # once per cycle, not per block
+                self._contour_changed = False
+                self._show_contour_state()
         step = executor.step(ch.feed_override_active / 1000.0)
         for axis, pos in zip(ch.axes, step.position_mm, strict=True):
             axis.position_mm = pos
@@ -484,6 +490,7 @@ class ChannelRunner:
         if exchange is None:  # #CONTOUR LOOKAHEAD LOG CLEAR
             if self._contour is not None:
                 self._contour.clear()
+                self._show_contour_state()
             return True
         release = exchange.kind == AxisExchangeKind.RELEASE
         for index in exchange.axes:
@@ -496,6 +503,7 @@ class ChannelRunner:
         """Blocks entering the look-ahead buffer: the contour log sees them."""
         if self._contour.take(items):
             self._warn_log_full()
+        self._contour_changed = True
 
     def _warn_log_full(self) -> None:
         """Warn (once per marked area) that the log dropped elements, at the block that
@@ -510,21 +518,20 @@ class ChannelRunner:
         ))
 
     def _show_contour_state(self) -> None:
-        unit, log = self.channel.contour, self._contour
-        unit.max_dist_prog_start_incr = log.max_dist_prog_start_incr
-        unit.count_logged_blocks = len(log.log)
-        unit.log_active = log.active
+        """The unit's state after blocks were prepared, the log cleared or ended."""
+        log = self._contour
+        self.channel.contour = replace(
+            self.channel.contour, max_dist_prog_start_incr=log.max_dist_prog_start_incr,
+            count_logged_blocks=len(log.log), log_active=log.active,
+        )
 
     def answer_contour_request(self) -> None:
         """The PLC set the semaphore: fill the response from the log (mode 1) or the
         recent elements (mode 2), then reset the semaphore."""
         unit = self.channel.contour
-        if self._contour is None:
-            unit.response = ()
-        else:
-            unit.response = self._contour.answer(unit.request_start_position,
-                                                 unit.request_length)
-        unit.semaphor = False
+        response = () if self._contour is None else self._contour.answer(
+            unit.request_start_position, unit.request_length)
+        self.channel.contour = replace(unit, response=response, semaphor=False)
 
     def _end_program(self) -> bool:
         ch = self.channel

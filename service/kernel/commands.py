@@ -8,7 +8,7 @@ ADS return codes.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import IntEnum
 from typing import Any, NamedTuple, Protocol
 
@@ -241,7 +241,8 @@ class SetContourRequest:
         if not math.isfinite(self.value):
             return Refusal(RefusalReason.INVALID_VALUE,
                            f"request.{self.field} must be a finite number, not {self.value}")
-        setattr(state.channels[self.channel_index].contour, f"request_{self.field}", self.value)
+        channel = state.channels[self.channel_index]
+        channel.contour = replace(channel.contour, **{f"request_{self.field}": self.value})
         return None
 
 
@@ -258,7 +259,7 @@ class SetContourSemaphore:
         runner = state.runners[self.channel_index]
         unit = channel.contour
         if not self.value:
-            unit.semaphor = False
+            channel.contour = replace(unit, semaphor=False)
             return None
         if not runner.config.contour_lookahead:
             return Refusal(
@@ -270,6 +271,6 @@ class SetContourSemaphore:
             check_request(unit.request_start_position, unit.request_length)
         except RequestError as exc:
             return Refusal(RefusalReason.INVALID_VALUE, str(exc))
-        unit.semaphor = True
+        channel.contour = replace(unit, semaphor=True)
         runner.answer_contour_request()
         return None

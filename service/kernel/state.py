@@ -131,9 +131,13 @@ class ContourElement(NamedTuple):
     tangent_variation: float  # angle to the previous motion element, in [0, pi]
 
 
-@dataclass(slots=True)
+@dataclass(frozen=True, slots=True)
 class ContourLookaheadUnit:
-    """``gpCh[i].contour_lookahead``: the PLC's request, the handshake, state, reply."""
+    """``gpCh[i].contour_lookahead``: the PLC's request, the handshake, state, reply.
+
+    Immutable: a change replaces the whole unit (``dataclasses.replace``), which happens
+    when blocks are prepared or a request comes, so the snapshot of a running channel
+    shares it instead of copying it every cycle."""
 
     request_start_position: float = 0.0  # mode 1: index; mode 2: distance (0.1 um)
     request_length: float = 0.0  # 0: mode 1 (by index); else mode 2 (by distance)
@@ -142,14 +146,6 @@ class ContourLookaheadUnit:
     count_logged_blocks: int = 0  # entries in the log of the marked area
     log_active: bool = False  # the marked area is open and not all of it was read in
     response: tuple[ContourElement, ...] = ()  # the last reply (at most N entries)
-
-    def frozen(self) -> ContourLookaheadUnit:
-        """A copy for the snapshot."""
-        return ContourLookaheadUnit(
-            self.request_start_position, self.request_length, self.semaphor,
-            self.max_dist_prog_start_incr, self.count_logged_blocks, self.log_active,
-            self.response,
-        )
 
 
 @dataclass(slots=True)
@@ -207,7 +203,7 @@ class Channel:
             self.manual_blocks_done, self.path_velocity_mm_s, self.programmed_velocity_mm_s,
             self.remaining_in_block_mm, self.program_time_s, self.errors, self.error_count,
             self.suspend_command_w, self.suspend_enable_w, self.suspend_request_r,
-            self.contour.frozen(),
+            self.contour,
         )
 
 
