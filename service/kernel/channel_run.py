@@ -31,7 +31,16 @@ from .commands import Refusal, RefusalReason
 from .contour_lookahead import LOG_FULL_WARNING, ContourLog
 from .decoder_feed import DecodeEnd, DecoderFeed, Job
 from .nc import ModalState, NcError
-from .nc.blocks import AxisExchange, AxisExchangeKind, Block, ContourKind, SourceRef, StopKind
+from .nc.blocks import (
+    AxisExchange,
+    AxisExchangeKind,
+    Block,
+    ContourKind,
+    LogArea,
+    SourceRef,
+    StopKind,
+)
+from .nc.contour import LOOP_MARKERS
 from .path.executor import AxisDynamics, PathError, PathExecutor
 from .path.interpolator import Waiting
 from .path.segments import Segment
@@ -194,8 +203,9 @@ class ChannelRunner:
         self._pending_start = self._sync = None
         self._queued_jobs.clear()
         self._backlog = []
-        if ch.contour.log_active:
-            ch.contour = replace(ch.contour, log_active=False)
+        if self._contour is not None:
+            self._contour.stop()
+            self._show_contour_state()
         self._internal_hold = False
         ch.errors, ch.error_count = (), 0
         ch.waiting_for_start = False
@@ -335,8 +345,10 @@ class ChannelRunner:
         )
         self._executor.single_block = ch.single_block
         self._sync, self._backlog = None, []
+        self._modal.contour_log_area = LogArea.NONE  # as the new log: no marked area yet
         if self.config.contour_lookahead:  # the log is cleared at every program start
-            self._contour = ContourLog(self.config.contour_lookahead_log_max)
+            self._contour = ContourLog(self.config.contour_lookahead_log_max,
+                                       self._buffer_blocks)
             self._executor.on_prepared = self._prepared
             self._show_contour_state()
         self._fed_all = False
@@ -366,6 +378,9 @@ class ChannelRunner:
         ch = self.channel
         self._raise(error)
         self._stop_run()
+        if self._contour is not None:  # nothing more of the area will be read in
+            self._contour.stop()
+            self._show_contour_state()
         ch.state = ChannelState.ERROR
         ch.waiting_for_start = False
         ch.program_time_s = self._time_s - self._started_at_s
@@ -378,35 +393,59 @@ class ChannelRunner:
         if free <= 0:
             return
         items, self._backlog = self._backlog or feed.take(free, wait=self._deterministic), []
+        contour = self._contour
         for k, item in enumerate(items):
+            if isinstance(item, Block) and item.contour is not None and (
+                    item.contour.kind in LOOP_MARKERS):
+                # a real-time loop pass: for the contour log only, never a block of the path
+                if contour is not None:
+                    contour.mark(item.contour)
+                continue
             if isinstance(item, Block) and _waits_for_standstill(item):
                 # axes change hands, or the log is cleared, at standstill: flush, feed
                 # the rest after it
-                self._sync = item
                 self._backlog = items[k + 1:]
-                executor.close()
+                if self._close(item):
+                    self._sync = item
                 return
             if isinstance(item, Block):
+                if contour is not None:
+                    contour.expect(item)
                 try:
                     executor.push(item)
                 except PathError as exc:
-                    src = exc.block.source if exc.block is not None else item.source
-                    self._pending_error = ChannelError(
-                        int(exc.id), exc.message, src.file, src.line, src.column
-                    )
+                    self._stop_feeding(_path_error(exc, item))
                     return
             elif isinstance(item, NcError):
-                self._pending_error = ChannelError(
+                self._stop_feeding(ChannelError(
                     int(item.id), item.message, item.file, item.line, item.column
-                )
+                ))
                 return
             elif isinstance(item, DecodeEnd):
-                executor.close()
                 self._fed_all = True
-                if self._contour is not None:
-                    if self._contour.end_of_data():
+                if self._close(None) and contour is not None:
+                    if contour.end_of_data():
                         self._warn_log_full()
                     self._show_contour_state()
+
+    def _stop_feeding(self, error: ChannelError) -> None:
+        """Nothing after this error enters the path; what radius compensation holds
+        back is released, so the blocks before the error run to their end."""
+        self._pending_error = error
+        self._close(None)  # an error of a held block replaces it: it comes first
+
+    def _close(self, block: Block | None) -> bool:
+        """End of the data so far (end of program, or ``block`` waits for standstill):
+        what radius compensation holds back is released. False when that fails (the
+        error takes effect where the path stops)."""
+        if self._contour is not None:
+            self._contour.expect(None)
+        try:
+            self._executor.close()
+        except PathError as exc:
+            self._pending_error = _path_error(exc, block)
+            return False
+        return True
 
     def cycle(self, time_s: float) -> bool:
         """One GEO cycle of the channel; True while it has motion or decoding to do."""
@@ -448,9 +487,10 @@ class ChannelRunner:
         ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
         ch.program_time_s = time_s - self._started_at_s
         for block in step.finished:
-            if block.contour is not None and block.contour.kind >= ContourKind.RT_PASS:
-                continue  # a real-time loop marker is not an NC block of its own
             ch.block_count += 1
+            if self._contour is not None and block.contour is not None and (
+                    block.contour.kind == ContourKind.DISTANCE_CLEAR):
+                self._contour.distance_cleared()  # mode 2 answers in the new distances
             if self._feed is not None and self._feed.is_marker(block):
                 ch.manual_blocks_done += 1
         shown = step.current or (step.finished[-1] if step.finished else None)
@@ -536,11 +576,26 @@ class ChannelRunner:
     def _end_program(self) -> bool:
         ch = self.channel
         self._stop_run()
+        if self._contour is not None and not self._contour.complete:
+            # M30 reached before the end of the data was taken: what a loop held back
+            # is logged now
+            if self._contour.end_of_data():
+                self._warn_log_full()
+            self._show_contour_state()
         ch.state = ChannelState.READY
         ch.waiting_for_start = False
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
         ch.program_time_s = self._time_s - self._started_at_s
         return False
+
+
+def _path_error(exc: PathError, block: Block | None) -> ChannelError:
+    """The channel error of a path error, at the block it names (else ``block``)."""
+    named = exc.block if exc.block is not None else block
+    if named is None:
+        return ChannelError(int(exc.id), exc.message)
+    src = named.source
+    return ChannelError(int(exc.id), exc.message, src.file, src.line, src.column)
 
 
 def _waits_for_standstill(block: Block) -> bool:

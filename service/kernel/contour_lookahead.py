@@ -7,8 +7,10 @@ enter the look-ahead buffer, before they are executed. It keeps
   entries (types 3, 4, 5) and every element of the compensated path in between, at most
   ``contour_lookahead_log_max`` (P-CHAN-00658) entries. Only the first marked area is
   kept until ``LOG CLEAR``; mode 1 requests read it by index;
-* the **recent elements** of the whole path, the last ``contour_lookahead_log_max`` of
-  them, which mode 2 requests read by path distance;
+* the **recent elements** of the whole path for mode 2 requests by path distance:
+  every element that can still be in the look-ahead buffer and at least the last
+  ``contour_lookahead_log_max`` before them, each with the distance epoch it counts in
+  (``#DISTANCE PROG START CLEAR`` starts a new one);
 * the **prepared path distance**: the start position of the next element, i.e. the sum
   of the lengths of all earlier elements on the compensated path since program start or
   ``#DISTANCE PROG START CLEAR``. Its value after the last prepared element is the
@@ -22,7 +24,9 @@ connecting arc of radius r around an outside corner, which belongs to the follow
 block). A block therefore gives one element or more, all with its N and block count.
 
 Real-time loops (``#RT WHILE``): the decoder unrolls them and marks the passes of a loop
-entered while the marked area is open (``ContourKind.RT_PASS``/``RT_END``). ISG logs such
+entered while the marked area is open (``ContourKind.RT_PASS``/``RT_END``). The marks
+never enter the path; ``mark``/``expect`` apply them in path order, after what radius
+compensation still holds of the pass before. ISG logs such
 a body three times, once per transition: start of loop, loop to loop, end of loop. Here
 the first pass (its first element has the angle to the block before the loop), the
 second pass (angle to the end of the body) and the last pass (its end meets what follows
@@ -39,7 +43,7 @@ import math
 from collections import deque
 from collections.abc import Iterable, Sequence
 
-from .nc.blocks import Block, ContourKind, LogArea, MotionKind, next_log_area
+from .nc.blocks import Block, ContourCommand, ContourKind, LogArea, MotionKind, next_log_area
 from .path.geometry import Arc
 from .path.segments import Segment
 from .state import ContourElement
@@ -50,7 +54,9 @@ LOG_FULL_WARNING = 22074  # warning id: the marked area has more entries than th
 LINEAR, CIRCULAR = 1, 2  # block_type of motion elements
 _INCR_PER_MM = 10_000.0  # 0.1 um per mm
 _SAME_CENTRE_MM = 1e-6  # an offset arc keeps the centre of its programmed arc
-_WINDOW_TOLERANCE_INCR = 1e-6  # mode 2 window edges: rounding of the client's numbers
+# mode 2 window edges: start positions are exact sums of the lengths in 0.1 um, as a
+# PLC adds them; this only absorbs a client's own rounding
+_WINDOW_TOLERANCE_INCR = 1e-6
 
 
 class RequestError(ValueError):
@@ -80,14 +86,23 @@ def _programmed_radius_mm(segment: Segment) -> float:
 
 
 class ContourLog:
-    """The contour look-ahead of one program run (GEO task)."""
+    """The contour look-ahead of one program run (GEO task).
 
-    def __init__(self, log_max: int) -> None:
+    ``buffer_blocks`` is the look-ahead size: mode 2 keeps every element that may still
+    be in the buffer (a block gives at most three: approach line, connecting arc and its
+    own element) plus the last ``log_max`` before them.
+    """
+
+    def __init__(self, log_max: int, buffer_blocks: int) -> None:
         self.log_max = log_max
         self.log: list[ContourElement] = []
-        self.recent: deque[ContourElement] = deque(maxlen=log_max)
+        # mode 2: (distance epoch, element); nothing when P-CHAN-00658 is 0
+        self.recent: deque[tuple[int, ContourElement]] = deque(
+            maxlen=log_max + 3 * buffer_blocks if log_max else 0)
         self.area = LogArea.NONE
-        self.distance_mm = 0.0  # start of the next element on the compensated path
+        self.distance_incr = 0.0  # start of the next element (0.1 um, summed as the PLC does)
+        self.epoch = 0  # #DISTANCE PROG START CLEAR prepared so far
+        self.executed_epoch = 0  # ... and executed: the distances dist_prog_start counts in
         self.complete = False  # the end of data was prepared: everything is read in
         self.full_warned = False  # the log-full warning was given for this area
         self.dropped_at: Block | None = None  # the block of the first entry that did not fit
@@ -95,14 +110,16 @@ class ContourLog:
         self._block: Block | None = None
         self._ordinal = 0  # number of the block being prepared in the run (block_count_r)
         self._loop = 0  # serial of the real-time loop whose passes are being sorted
-        self._pending: list[ContourElement] | None = None  # pass >= 3, not yet logged
+        self._pending: list[tuple[ContourElement, Block]] | None = None  # pass >= 3
+        self._marks: list[ContourCommand] = []  # loop markers not yet bound to a block
+        self._bound: deque[tuple[Block | None, list[ContourCommand]]] = deque()
 
     # ------------------------------------------------------------ state
 
     @property
     def max_dist_prog_start_incr(self) -> float:
         """Maximum look-ahead distance: the end of the path prepared so far (0.1 um)."""
-        return self.distance_mm * _INCR_PER_MM
+        return self.distance_incr
 
     @property
     def active(self) -> bool:
@@ -111,20 +128,35 @@ class ContourLog:
 
     # ------------------------------------------------------------ prepared path
 
+    def mark(self, command: ContourCommand) -> None:
+        """A real-time loop marker from the decoder; it takes effect in path order just
+        before the next block handed to the path (``expect``)."""
+        self._marks.append(command)
+
+    def expect(self, block: Block | None) -> None:
+        """``block`` is handed to the path next (None: the end of the data so far). The
+        markers that came before it apply when the path preparation releases its first
+        piece: radius compensation may still hold the block before the markers."""
+        if self._marks:
+            self._bound.append((block, self._marks))
+            self._marks = []
+
     def take(self, items: Iterable[Segment | Block]) -> bool:
         """Watch segments and bare blocks as they enter the look-ahead buffer, in path
         order; True when this made the log overflow for the first time in its area."""
         overflowed = False
+        bound = self._bound
         for item in items:
+            block = item.block if isinstance(item, Segment) else item
+            while bound and bound[0][0] is block:
+                overflowed |= self._markers(bound.popleft()[1])
+            self._count(block)
             if isinstance(item, Segment):
-                self._count(item.block)
                 overflowed |= self._element(item)
-            else:
-                contour = item.contour
-                if contour is None or contour.kind < ContourKind.RT_PASS:
-                    self._count(item)  # the RT markers are not NC blocks of their own
-                if contour is not None:
-                    overflowed |= self._command(item, contour.kind, contour.param)
+            elif item.contour is not None:
+                overflowed |= self._command(item, item.contour.kind, item.contour.param)
+        while bound and bound[0][0] is None:  # markers at the end of the data so far
+            overflowed |= self._markers(bound.popleft()[1])
         return overflowed
 
     def count_block(self) -> None:
@@ -137,6 +169,14 @@ class ContourLog:
         """All blocks are prepared; True when the last pass of a loop overflowed."""
         self.complete = True
         return self._flush_pending()
+
+    def stop(self) -> None:
+        """The run ended early (error, RESET): nothing more will be read in."""
+        self.complete = True
+
+    def distance_cleared(self) -> None:
+        """The path passed a ``#DISTANCE PROG START CLEAR``."""
+        self.executed_epoch += 1
 
     def clear(self) -> None:
         """LOG CLEAR, reached at standstill: empty the log; the next LOG ON opens a new
@@ -158,77 +198,80 @@ class ContourLog:
     def _element(self, segment: Segment) -> bool:
         element = segment.element
         block = segment.block
-        start = self.distance_mm
-        self.distance_mm = start + element.length_mm
+        start = self.distance_incr
+        length = element.length_mm * _INCR_PER_MM
+        self.distance_incr = start + length
         previous, self._tangent = self._tangent, element.tangent_end
         variation = 0.0 if previous is None else tangent_angle_rad(previous, element.tangent_start)
         if isinstance(element, Arc):
             entry = ContourElement(
-                CIRCULAR, self._number(block), self._ordinal, start * _INCR_PER_MM,
-                element.length_mm * _INCR_PER_MM,
+                CIRCULAR, self._number(block), self._ordinal, start, length,
                 _programmed_radius_mm(segment) * _INCR_PER_MM,
                 element.radius_mm * _INCR_PER_MM, element.sweep_rad, 0.0, variation,
             )
         else:
             entry = ContourElement(
-                LINEAR, self._number(block), self._ordinal, start * _INCR_PER_MM,
-                element.length_mm * _INCR_PER_MM, 0.0, 0.0, 0.0, 0.0, variation,
+                LINEAR, self._number(block), self._ordinal, start, length, 0.0, 0.0, 0.0,
+                0.0, variation,
             )
         if self.log_max:
-            self.recent.append(entry)
+            self.recent.append((self.epoch, entry))
         if self.area == LogArea.OPEN:
-            return self._log(entry)
+            return self._log(entry, block)
         return False
 
     def _command(self, block: Block, kind: ContourKind, param: float | None) -> bool:
         if kind == ContourKind.DISTANCE_CLEAR:
-            self.distance_mm = 0.0
+            self.distance_incr = 0.0
+            self.epoch += 1
             return False
-        if kind == ContourKind.RT_PASS:
-            return self._rt_pass(block)
-        if kind == ContourKind.RT_END:
-            return self._flush_pending()
         if kind == ContourKind.LOG_CLEAR:  # normally applied at standstill by the channel
             self.clear()
             return False
         before = self.area
         self.area = next_log_area(before, kind)
         entry = ContourElement(
-            int(kind), self._number(block), self._ordinal, self.distance_mm * _INCR_PER_MM,
+            int(kind), self._number(block), self._ordinal, self.distance_incr,
             0.0 if param is None else param, 0.0, 0.0, 0.0, 0.0, 0.0,
         )
         if kind == ContourKind.LOG_ON:
-            return self._log(entry) if before == LogArea.NONE else False
+            return self._log(entry, block) if before == LogArea.NONE else False
         if before != LogArea.OPEN:
             return False  # PARAM or OFF outside the area
         if kind == ContourKind.LOG_OFF:
             overflowed = self._flush_pending()
-            return self._log(entry) or overflowed
-        return self._log(entry)
+            return self._log(entry, block) or overflowed
+        return self._log(entry, block)
 
-    def _rt_pass(self, block: Block) -> bool:
-        contour = block.contour
-        if self.area != LogArea.OPEN:
-            return False
-        if contour.loop != self._loop:  # a new loop: what was pending belongs to the last
+    def _markers(self, commands: list[ContourCommand]) -> bool:
+        overflowed = False
+        for command in commands:
+            if command.kind == ContourKind.RT_END:
+                overflowed |= self._flush_pending()
+            elif self.area == LogArea.OPEN:
+                overflowed |= self._rt_pass(command)
+        return overflowed
+
+    def _rt_pass(self, command: ContourCommand) -> bool:
+        overflowed = False
+        if command.rt_pass == 1 or command.loop != self._loop:
+            # a new loop: what is pending was the last pass of the one before
             overflowed = self._flush_pending()
-            self._loop = contour.loop
-        else:
-            overflowed = False
-        if contour.rt_pass >= 3:
+            self._loop = command.loop
+        if command.rt_pass >= 3:
             self._pending = []  # the pass before it repeated the loop-to-loop transition
         return overflowed
 
     def _flush_pending(self) -> bool:
         pending, self._pending = self._pending, None
         overflowed = False
-        for entry in pending or ():
-            overflowed |= self._log(entry)
+        for entry, block in pending or ():
+            overflowed |= self._log(entry, block)
         return overflowed
 
-    def _log(self, entry: ContourElement) -> bool:
+    def _log(self, entry: ContourElement, block: Block) -> bool:
         if self._pending is not None:
-            self._pending.append(entry)
+            self._pending.append((entry, block))
             return False
         if len(self.log) < self.log_max:
             self.log.append(entry)
@@ -236,7 +279,7 @@ class ContourLog:
         if self.full_warned:
             return False
         self.full_warned = True
-        self.dropped_at = self._block
+        self.dropped_at = block
         return True
 
     # ------------------------------------------------------------ requests
@@ -244,14 +287,16 @@ class ContourLog:
     def answer(self, start_position: float, length: float) -> tuple[ContourElement, ...]:
         """The reply to a request: mode 1 (``length`` 0) the log from index
         ``start_position`` on; mode 2 the recent elements whose start lies in
-        [start_position, start_position + length] (0.1 um). At most RESPONSE_BLOCKS."""
+        [start_position, start_position + length] (0.1 um), counted in the distances
+        ``dist_prog_start`` shows now. At most RESPONSE_BLOCKS."""
         check_request(start_position, length)
         if length == 0.0:
             index = int(start_position)
             return tuple(self.log[index:index + RESPONSE_BLOCKS])
         low = start_position - _WINDOW_TOLERANCE_INCR
         high = start_position + length + _WINDOW_TOLERANCE_INCR
-        found = [e for e in self.recent if low <= e.start_position <= high]
+        epoch = self.executed_epoch
+        found = [e for k, e in self.recent if k == epoch and low <= e.start_position <= high]
         return tuple(found[:RESPONSE_BLOCKS])
 
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from .blocks import (
-    Block, ContourCommand, ContourKind, LogArea, StopKind, next_log_area,
+    Block, Compensation, ContourCommand, ContourKind, LogArea, StopKind, next_log_area,
 )
 from .construct import make_block, make_source
 from .errors import NcError, NcErrorId
@@ -63,6 +63,8 @@ _SPELLING = {
 NOT_ENABLED = ("#CONTOUR LOOKAHEAD needs the contour look-ahead function: add "
                "FCT_CONTOUR_LAH to the channel's interpolator_function (P-CHAN-00650)")
 CLEAR_IN_RT_LOOP = "#CONTOUR LOOKAHEAD LOG CLEAR is not allowed inside #RT WHILE"
+CLEAR_WITH_COMPENSATION = ("#CONTOUR LOOKAHEAD LOG CLEAR is not allowed while tool radius "
+                           "compensation (G41/G42) is active: program it after G40")
 
 
 # ------------------------------------------------------------------ parsing
@@ -185,6 +187,11 @@ def execute_contour(stmt: ContourStatement, decoder: Any) -> Block:
         raise stmt.line.error(NcErrorId.CONTOUR_LOOKAHEAD_NOT_ENABLED, NOT_ENABLED, stmt.pos)
     if kind == ContourKind.LOG_CLEAR and inside_rt_loop(decoder.frames):
         raise stmt.line.error(NcErrorId.CONTOUR_CLEAR_IN_RT_LOOP, CLEAR_IN_RT_LOOP, stmt.pos)
+    if kind == ContourKind.LOG_CLEAR and decoder.modal.compensation != Compensation.OFF:
+        # Flush and wait needs the path to end here; tool radius compensation cannot end
+        # an offset element before it knows the next one (it would deselect and jump).
+        raise stmt.line.error(NcErrorId.CONTOUR_CLEAR_WITH_COMPENSATION,
+                              CLEAR_WITH_COMPENSATION, stmt.pos)
     param = None
     if stmt.param is not None:
         param = evaluate_number(stmt.param, decoder, stmt.line, stmt.param_pos)

@@ -22,6 +22,7 @@ from service.kernel.commands import (
     ResetChannel,
     SetContourRequest,
     SetContourSemaphore,
+    SetSingleBlock,
     StartProgram,
 )
 from service.kernel.contour_lookahead import RESPONSE_BLOCKS
@@ -411,3 +412,89 @@ def test_response_size_matches_the_catalog():
     from objects.catalog import CONTOUR_RESPONSE_BLOCKS
 
     assert RESPONSE_BLOCKS == CONTOUR_RESPONSE_BLOCKS
+
+
+# --- found in review: compensation, buffer-sized mode 2, markers, distance epochs ------
+def test_clear_with_radius_compensation_is_error_22072_and_nothing_jumps(kernel):
+    run = kernel.run("N10 G41 D1 G1 X10 Y0 F600\nN20 X20\n"
+                     "N25 #CONTOUR LOOKAHEAD LOG CLEAR\nN30 X30\nN40 G40 X40\nM30\n",
+                     record=True)
+    error = run.channel.errors[0]
+    assert (error.id, error.line, error.column) == (22072, 3, 5) and "G40" in error.text
+    # the blocks before it ran to their end on the offset path, without a jump
+    assert run.positions_mm[:2] == pytest.approx((20.0, 1.0))
+    steps = [math.dist(a.positions_mm, b.positions_mm)
+             for a, b in zip(run.samples, run.samples[1:])]
+    assert max(steps) <= 10.0 * 0.001 + 1e-9  # F600 = 10 mm/s in 1 ms cycles
+
+
+def test_mode_2_sees_every_element_still_in_the_look_ahead_buffer(kernel):
+    squares = "".join("G1 Y10\nX10\nY0\nX0\n" for _ in range(40))  # 2 elements per corner
+    kernel.start(f"N2 G41 D1 G1 X0 Y0.5 F600\n{squares}G40 G1 X-5 Y-5\nM30\n")
+    snap = kernel.wait_for(lambda s: s.channels[0].dist_prog_start_incr > 0.0)
+    ahead = snap.channels[0].contour.max_dist_prog_start_incr
+    assert ahead > 1000 * INCR  # the buffer holds 120 blocks, far more elements than 128
+    reply = request(kernel, 0.0, 12 * INCR)  # the first elements are still to come
+    # the approach line (r = 1 mm), N2's offset line (0.5 mm), then the first square
+    assert [e.start_position for e in reply][:3] == [0.0, 10000.0, 15000.0]
+    kernel.command(ResetChannel(0, True))
+
+
+def test_start_positions_are_exact_sums_of_the_lengths(kernel):
+    kernel.run(G41_PROGRAM)
+    motion = [e for e in request(kernel, 0) if e.block_type in (LINEAR, CIRCULAR)]
+    for before, after in zip(motion, motion[1:]):
+        assert after.start_position == before.start_position + before.length  # exactly
+
+
+def test_loop_markers_are_no_blocks_of_the_path(kernel):
+    """Single block stops at the same places with and without logging the loop."""
+    def stops(log: bool) -> list[tuple[float, float, int]]:
+        on, off = (("#CONTOUR LOOKAHEAD LOG ON\n", "#CONTOUR LOOKAHEAD LOG OFF\n") if log
+                   else ("M8\n", "M9\n"))
+        program = ("#VAR\nV.L.I = 0\n#ENDVAR\n" + on + "#RT WHILE [V.L.I < 3]\n"
+                   "V.L.I = V.L.I + 1\nG91 G1 X1 F6000\nY1\n#RT ENDWHILE\n" + off + "M30\n")
+        kernel.command(ResetChannel(0, True))
+        kernel.mdi("G90 G0 X0 Y0")
+        kernel.command(SetSingleBlock(0, True))
+        kernel.start(program)
+        seen = []
+        while True:
+            snap = kernel.wait_for(lambda s: s.channels[0].waiting_for_start
+                                   or s.channels[0].state != ChannelState.ACTIVE)
+            ch = snap.channels[0]
+            if ch.state != ChannelState.ACTIVE:
+                break
+            seen.append((ch.axes[0].position_mm, ch.axes[1].position_mm, ch.block_count))
+            # applied and published before it returns: a stop seen next is the next one
+            assert kernel.command(StartProgram(0, True)) is None
+        kernel.command(SetSingleBlock(0, False))
+        return seen
+
+    plain = stops(log=False)
+    assert len(plain) == 8 and stops(log=True) == plain
+    assert len(request(kernel, 0)) == 2 + 3 * 2  # ON, three passes of two lines, OFF
+
+
+def test_mode_2_answers_in_the_distances_dist_prog_start_counts(kernel):
+    lines = "".join(f"N{100 + k} X{k + 1}\n" for k in range(40))
+    more = "".join(f"N{600 + k} X{41 + k}\n" for k in range(40))
+    kernel.start(f"G90 G1 F600\n{lines}N500 #DISTANCE PROG START CLEAR\n{more}M30\n")
+    kernel.wait_for(lambda s: s.channels[0].dist_prog_start_incr > 0.0)
+    # before the path reaches the CLEAR: the elements of the first 40 mm
+    assert [e.block_number for e in request(kernel, 0, 2.5 * INCR)] == [100, 101, 102]
+    run = kernel.wait()
+    assert run.channel.dist_prog_start_incr == pytest.approx(40 * INCR)
+    # after it: the same window holds the elements after the CLEAR only
+    assert [e.block_number for e in request(kernel, 0, 2.5 * INCR)] == [600, 601, 602]
+
+
+def test_each_manual_block_start_begins_a_new_marked_area(kernel):
+    loop = ("#VAR\nV.L.I = 0\n#ENDVAR\n#CONTOUR LOOKAHEAD LOG ON\n#RT WHILE [V.L.I < 5]\n"
+            "V.L.I = V.L.I + 1\nG91 G1 X1 F6000\nY1\nX-1\nY-1\n#RT ENDWHILE\n"
+            "#CONTOUR LOOKAHEAD LOG OFF\nG90\n")
+    counts = []
+    for _ in range(2):
+        assert kernel.mdi(loop).channel.state == ChannelState.READY
+        counts.append(kernel.kernel.snapshot.channels[0].contour.count_logged_blocks)
+    assert counts == [2 + 3 * 4, 2 + 3 * 4]  # ON, three transitions of four lines, OFF

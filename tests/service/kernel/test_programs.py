@@ -97,6 +97,13 @@ FAILING = {
     "limit after a good block": ("G1 X10 F600\nG1 X-2000\nM30\n", 2, None, 10.0),
     "missing M30": ("G1 X10 F600\n", None, None, 10.0),
     "goto unknown label": ("G1 X1 F600\n$GOTO [NOWHERE]\nM30\n", 2, None, 1.0),
+    # radius compensation holds a block back until the next: the error must release it
+    "error after a compensated block": (
+        "G41 D1 G1 X10 Y0 F600\nX20\nQ5\nM30\n", 3, 1, 20.0),
+    # the held block fails only when released at the end of the data (limit with r = 5);
+    # its approach line, released before, has run: X ends at the offset start point
+    "limit of a compensated block at the end": (
+        "G0 Y990\nG41 D3 G1 X20 Y998 F6000\nM30\n", 2, None, -5 * 8 / math.hypot(20, 8)),
 }
 
 
