@@ -95,12 +95,6 @@ def request(kernel: KernelHarness, start: float, length: float = 0.0, channel: i
     return unit.response
 
 
-@pytest.fixture(scope="module")
-def kernel():
-    with KernelHarness() as harness:
-        yield harness
-
-
 @pytest.fixture(autouse=True)
 def fresh_channel(kernel):
     kernel.command(ResetChannel(0, True))

@@ -22,7 +22,6 @@ from service.kernel.commands import (
     SetSingleBlock,
     StartProgram,
 )
-from tests.support.kernel import KernelHarness
 
 CYCLE_S = 0.001
 V, A = 500.0, 5000.0
@@ -33,12 +32,6 @@ def trapezoid_s(length_mm: float, v_mm_s: float, a_mm_s2: float) -> float:
     if length_mm >= v_mm_s**2 / a_mm_s2:
         return length_mm / v_mm_s + v_mm_s / a_mm_s2
     return 2.0 * math.sqrt(length_mm / a_mm_s2)
-
-
-@pytest.fixture(scope="module")
-def kernel():
-    with KernelHarness() as harness:
-        yield harness
 
 
 @pytest.fixture(autouse=True)
