@@ -12,7 +12,7 @@ the kernel. Waiting polls the channel's objects every ``POLL_S`` of wall time.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any
 
 from protocol.constants import MAX_DATA_BYTES, PROGRAM_STORE_GROUP, CncPort
@@ -38,11 +38,6 @@ class ProgramEntry:
     mtime_s: float
 
 
-CONTOUR_BLOCK_FIELDS = (
-    "block_type", "block_number", "block_count_r", "start_position", "length",
-    "programmed_radius", "compensated_radius", "circle_angle", "length_min",
-    "tangent_variation",
-)
 CONTOUR_RESPONSE_BLOCKS = 32  # gpCh[i].contour_lookahead.response.block[0..31]
 CONTOUR_BLOCK_TYPES = {
     1: "linear", 2: "circular", 3: "LOG ON", 4: "LOG PARAM", 5: "LOG OFF", 6: "polynomial",
@@ -63,6 +58,9 @@ class ContourBlock:
     circle_angle: float
     length_min: float
     tangent_variation: float
+
+
+CONTOUR_BLOCK_FIELDS = tuple(f.name for f in fields(ContourBlock))  # the HLI field names
 
 
 @dataclass(frozen=True, slots=True)
@@ -216,10 +214,10 @@ class ChannelOps:
             raise AdsTimeoutError(f"{unit}: the CNC has not answered (semaphor_rw still TRUE)")
         blocks = []
         for k in range(CONTOUR_RESPONSE_BLOCKS):
-            fields = [values[f"{unit}.response.block[{k}].{f}"] for f in CONTOUR_BLOCK_FIELDS]
-            if fields[0] == 0:  # block_type 0 ends the list
+            entry = [values[f"{unit}.response.block[{k}].{f}"] for f in CONTOUR_BLOCK_FIELDS]
+            if entry[0] == 0:  # block_type 0 ends the list
                 break
-            blocks.append(ContourBlock(*fields))
+            blocks.append(ContourBlock(*entry))
         return ContourReply(values[state[1]], values[state[2]], values[state[3]], blocks)
 
     async def _wait(self, channel: int, done: Any, timeout_s: float | None) -> None:

@@ -288,8 +288,8 @@ class ContourLog:
         """The reply to a request: mode 1 (``length`` 0) the log from index
         ``start_position`` on; mode 2 the recent elements whose start lies in
         [start_position, start_position + length] (0.1 um), counted in the distances
-        ``dist_prog_start`` shows now. At most RESPONSE_BLOCKS."""
-        check_request(start_position, length)
+        ``dist_prog_start`` shows now. At most RESPONSE_BLOCKS. The request was checked
+        when the semaphore was set (``check_request``)."""
         if length == 0.0:
             index = int(start_position)
             return tuple(self.log[index:index + RESPONSE_BLOCKS])

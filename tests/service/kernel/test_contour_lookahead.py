@@ -402,10 +402,14 @@ def test_the_marked_area_is_there_before_it_runs_and_through_feedhold(kernel):
     assert run.channel.state == ChannelState.READY
 
 
-def test_response_size_matches_the_catalog():
-    from objects.catalog import CONTOUR_RESPONSE_BLOCKS
+def test_response_size_and_fields_match_the_catalog_and_the_client():
+    from clients.channel_ops import CONTOUR_BLOCK_FIELDS as CLIENT_FIELDS
+    from clients.channel_ops import CONTOUR_RESPONSE_BLOCKS as CLIENT_BLOCKS
+    from objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS
 
-    assert RESPONSE_BLOCKS == CONTOUR_RESPONSE_BLOCKS
+    assert RESPONSE_BLOCKS == CONTOUR_RESPONSE_BLOCKS == CLIENT_BLOCKS
+    names = tuple(name for name, *_ in CONTOUR_BLOCK_FIELDS)
+    assert names == CLIENT_FIELDS == ContourElement._fields
 
 
 # --- found in review: compensation, buffer-sized mode 2, markers, distance epochs ------
