@@ -52,6 +52,10 @@ _M_FLOW = {
     MCode.SUBPROGRAM_END_FAST: (StopKind.NONE, Flow.SUBPROGRAM_END),
 }
 
+# The largest feed: the path velocity is carried in 0.1 um/s as SGN32 (as the ISG
+# interface objects carry it), 2**31 - 1 increments = 12,884,901.88 mm/min.
+FEED_MAX_MM_MIN = (2**31 - 1) * 1e-4 * 60.0
+
 _OFFSET_LETTER = ("I", "J", "K")
 # the plain fields of the ModalState a block may change (variables excluded)
 _MODAL_FIELDS = ("position_mm", "distance", "plane", "motion", "feed_mm_min", "compensation",
@@ -83,6 +87,7 @@ class BlockExecutor:
         self.tools = tools
         self.modal = modal
         self.manual = manual
+        self.items_done = 0  # items of the last block executed before it ended or failed
         index = {name: k for k, name in enumerate(axes)}
         # plane -> (p, q) channel axis indices, or None when the channel lacks an axis
         self.plane_axes: dict[Plane, tuple[int, int] | None] = {}
@@ -133,9 +138,11 @@ class BlockExecutor:
         offsets: dict[int, tuple[float, int]] = {}  # axis -> (offset, pos)
         words: dict[WordKind, tuple[float, int]] = {}  # F S T D R -> (value, pos)
         m_codes: list[tuple[int, int]] = []
+        self.items_done = 0
         for item in stmt.items:
             if type(item) is Assign:
                 item.target.assign(env, item.value(env))
+                self.items_done += 1
                 continue
             value = evaluate_number(item.value, env, line, item.pos)
             match item.kind:
@@ -159,6 +166,7 @@ class BlockExecutor:
                     m_codes.append((number, item.pos))
                 case _:  # F S T D R
                     words[item.kind] = (value, item.pos)
+            self.items_done += 1
         self._modal_groups(groups)
         self._technology(words, err)
         if GGroup.DWELL in groups:  # G4: X or F is the time, F stays as it was
@@ -259,6 +267,9 @@ class BlockExecutor:
         value, pos = word
         if value <= 0:
             raise err(NcErrorId.INVALID_FEED, f"feed F{value:g} must be greater than 0", pos)
+        if value > FEED_MAX_MM_MIN:
+            raise err(NcErrorId.VALUE_OUT_OF_RANGE,
+                      f"feed F{value:.17g} overflows: at most {FEED_MAX_MM_MIN:,.2f} mm/min", pos)
         self.modal.feed_mm_min = value
 
     def _dwell(self, groups, axis_words, offsets, words, err) -> float:

@@ -20,9 +20,11 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Iterator, Mapping
+from dataclasses import replace
 
 from .blockexec import BlockExecutor, Flow
 from .blocks import Block, LogArea
+from .check import CHECK_FEED_MM_MIN, CheckAborted, ErrorCategory, SyntaxCheck, categorize
 from .contour import execute_contour
 from .control import ControlFlow
 from .declarations import declare, read_block
@@ -33,7 +35,10 @@ from .modal import ModalState
 from .parser import RESERVED_LETTERS, LineParser, word_table
 from .program import Program, Section
 from .source import strip_comments
-from .statements import CLOSER_OF, SPELLING, AxisCommand, ContourStatement, Control, NcBlock
+from .statements import (
+    CLOSER_OF, OPENERS, SPELLING, Assign, AxisCommand, ContourStatement, Control, NcBlock, Word,
+    WordKind,
+)
 from .variables import Scope, Variable
 
 log = logging.getLogger(__name__)
@@ -72,6 +77,7 @@ class Decoder:
         manual: bool = False,
         axis_numbers: tuple[int, ...] | None = None,
         contour_lookahead: bool = False,
+        check: SyntaxCheck | None = None,
     ) -> None:
         axes = tuple(axes)
         for name in axes:
@@ -104,12 +110,13 @@ class Decoder:
         self.axis_numbers = axis_numbers
         self.manual = manual
         self.contour_lookahead = contour_lookahead
+        self.check = check
         self._loader = loader
         self._modal = modal
         self._skip_levels = skip_levels
         self.parser = LineParser(word_table(axes))
         self.executor = BlockExecutor(axes, tools, modal, manual, axis_numbers)
-        self._main = Program(text, file, self.parser, skip_levels)
+        self._main = Program(text, file, self.parser, skip_levels, check)
         self._files: dict[str, Program] = {}
         self.frames: list[Frame] = []
         self._control = ControlFlow(self)
@@ -130,7 +137,7 @@ class Decoder:
         self._started = True
         main = self._main
         self.frames.append(Frame(main, main.main, main.main.start, FrameKind.MAIN))
-        return decoding_loop(self.axes)(self)
+        return decoding_loop(self.axes, self.check is not None)(self)
 
     # ------------------------------------------------------------ variables (Env)
 
@@ -160,6 +167,8 @@ class Decoder:
     def slow_step(self, frame: Frame) -> Block | None:
         """Decode the logical line at ``frame.index`` with the general parser (or end
         the frame's section); the Block it produces, if any."""
+        if self.check is not None:
+            return self._checked_step(frame)
         try:
             if frame.index >= frame.section.end:
                 self._end_of_section(frame)
@@ -197,7 +206,10 @@ class Decoder:
                 return block
             return self._control.run(frame, stmt, after)  # a real-time loop marker or None
         here = frame.index
-        block, flow, flow_pos = self.executor.execute(stmt, self)
+        if self.check is None:
+            block, flow, flow_pos = self.executor.execute(stmt, self)
+        else:
+            block, flow, flow_pos = self._execute_checked(stmt)
         frame.index = after
         if flow == Flow.PROGRAM_END:
             self.finished = True
@@ -215,6 +227,77 @@ class Decoder:
         if stmt.goto is not None:
             self._control.goto(frame, stmt.goto, stmt.line, here)
         return block
+
+    # ------------------------------------------------------------ syntax check
+
+    def _checked_step(self, frame: Frame) -> Block | None:
+        """``slow_step`` of the syntax check: an error is reported, decoding goes on."""
+        check = self.check
+        program = frame.program
+        index = frame.index
+        end = frame.section.end
+        if index >= end:
+            self._end_of_section(frame)
+            return None
+        block = None
+        try:
+            block = self._step(frame)
+        except CheckAborted:
+            raise
+        except RecursionError:
+            error = NcError(NcErrorId.EXPRESSION_TOO_COMPLEX, program.name, index + 1, 1,
+                            "program too deeply nested to decode")
+            check.report(error, ErrorCategory.RESOURCE)
+            frame.index = program.statement(index, end)[1]
+        except Exception as exc:  # noqa: BLE001 - every error is the program's, reported
+            error = self.fault(exc, frame, index)
+            stmt, after = program.statement(index, end)
+            line = getattr(stmt, "line", None)
+            check.report(error, categorize(error, line))
+            if frame.index == index:
+                frame.index = self._skip_failed(frame, stmt, index, after)
+        check.line(program.src, index, program.statement(index, end)[1])
+        return block
+
+    def _skip_failed(self, frame: Frame, stmt, index: int, after: int) -> int:
+        """Where to go on after the statement at ``index`` failed: an opening control
+        statement skips its block (so its end is no follow-up error), others the line."""
+        if type(stmt) is Control and stmt.kind in OPENERS:
+            try:
+                return frame.program.structure(stmt, index, frame.section.end).after
+            except NcError:
+                return after
+        return after
+
+    def _execute_checked(self, stmt: NcBlock):
+        """``executor.execute`` for the syntax check: after an error the offending word
+        is dropped and the block executed again (assignments that ran stay done)."""
+        check = self.check
+        executor = self.executor
+        count = 0
+        while True:
+            try:
+                return executor.execute(stmt, self)
+            except NcError as error:
+                check.report(error, categorize(error, stmt.line))
+                count += 1
+                if check.errors_per_block and count >= check.errors_per_block:
+                    return None, Flow.NONE, -1
+                done = executor.items_done
+                items = stmt.items
+                if error.id == NcErrorId.NO_FEED:  # go on as if F were programmed
+                    self._modal.feed_mm_min = CHECK_FEED_MM_MIN
+                    drop = -1
+                else:
+                    drop = next((k for k, item in enumerate(items) if item.pos == error.pos), None)
+                    if drop is None:
+                        return None, Flow.NONE, -1
+                    item = items[drop]
+                    if type(item) is Word and item.kind == WordKind.FEED:  # F unknown now
+                        self._modal.feed_mm_min = self._modal.feed_mm_min or CHECK_FEED_MM_MIN
+                kept = [item for k, item in enumerate(items)
+                        if k != drop and not (k < done and type(item) is Assign)]
+                stmt = replace(stmt, items=kept)
 
     # ------------------------------------------------------------ subprograms
 
@@ -254,11 +337,27 @@ class Decoder:
                 raise line.error(
                     NcErrorId.FILE_NOT_FOUND, f"file {call.name} cannot be read: {exc}", call.pos
                 ) from None
-            program = Program(text, call.name, self.parser, self._skip_levels)
+            program = Program(text, call.name, self.parser, self._skip_levels, self.check)
             self._files[call.name] = program
         self.frames.append(Frame(program, program.main, program.main.start, FrameKind.FILE))
 
     def _end_of_section(self, frame: Frame) -> None:
+        if self.check is None:
+            self._end_section(frame)
+            return
+        try:
+            self._end_section(frame)
+        except NcError as error:
+            self.check.report(error, categorize(error, None))
+            frame.control.clear()
+            if error.id == NcErrorId.BLOCK_NOT_CLOSED:
+                self._end_of_section(frame)  # the end itself may be an error too
+            elif frame.kind == FrameKind.MAIN:
+                self.finished = True
+            else:
+                self.frames.pop()
+
+    def _end_section(self, frame: Frame) -> None:
         if frame.control:
             entry = frame.control[-1]
             closer = next(c for c, o in CLOSER_OF.items() if o == entry.kind)

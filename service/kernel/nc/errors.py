@@ -7,8 +7,8 @@ understands. The ids live in 20000..22999 like the decoder errors of the ISG ker
 Ids marked "ISG" are the documented ids of the ISG kernel for the same problem; the
 others are this kernel's own and stay stable.
 
-Reserved for later, deliberately not used: 21309 (warning: SYNCHK without
-MACHINE_LOCK). 22073 (``#CONTOUR LOOKAHEAD LOG CLEAR`` inside ``#RT WHILE``) is ISG's id
+21309 (warning: SYNCHK without MACHINE_LOCK) is ISG's id and raised by the kernel when a
+syntax check starts (``service.kernel.syntax_check``). 22073 (``#CONTOUR LOOKAHEAD LOG CLEAR`` inside ``#RT WHILE``) is ISG's id
 and used for that.
 """
 
@@ -34,7 +34,7 @@ class NcErrorId(IntEnum):
     MISSING_VALUE = 20110  # address letter without a value (e.g. "X" alone)
     WORD_REPEATED = 20111  # the same address twice in one block (X1 X2)
     INVALID_BLOCK_NUMBER = 20112  # N not a non-negative integer
-    VALUE_OUT_OF_RANGE = 20113  # a number that is not finite or too large for its word
+    VALUE_OUT_OF_RANGE = 20113  # a number that is not finite or too large for its word (F)
     UNSUPPORTED_G_CODE = 20120  # a G function this decoder does not know
     CONFLICTING_G_CODES = 20121  # two G functions of one group in a block (G0 G1)
     INVALID_M_CODE = 20122  # M not a non-negative integer
@@ -90,6 +90,7 @@ class NcErrorId(IntEnum):
     INVALID_DECLARATION = 20307  # malformed line inside #VAR ... #ENDVAR
     VAR_BLOCK_NOT_CLOSED = 20308  # #VAR without #ENDVAR
     ENDVAR_WITHOUT_VAR = 20309  # #ENDVAR without #VAR
+    UNKNOWN_VARIABLE = 20310  # V.E.name: no external variable of that name
 
     # ---- control flow
     ENDIF_WITHOUT_IF = 20218  # ISG: $ENDIF that matches no $IF
@@ -119,7 +120,13 @@ class NcErrorId(IntEnum):
 
 
 class NcError(Exception):
-    """An error in an NC program, at a place: ``error <id>: <file>:<line>:<column>: <msg>``."""
+    """An error in an NC program, at a place: ``error <id>: <file>:<line>:<column>: <msg>``.
+
+    ``pos`` is the position in the logical line's text when the error was made from one
+    (``LogicalLine.error``), else -1: the syntax check repositions by it.
+    """
+
+    pos = -1
 
     def __init__(  # noqa: A002 - "id" is the field name the callers use
         self, id: int, file: str, line: int, column: int, message: str

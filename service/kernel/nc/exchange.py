@@ -3,6 +3,8 @@
 * ``#AX RELEASE [X, Y]``, ``#AX RELEASE NBR [2, V.L.N]``, ``#AX RELEASE ALL`` release
   axes of the channel (by name, by logical axis number, all). An axis that is not, or
   no longer, in the channel is passed over without error.
+* ``#CALL AX [...]`` and ``#PUT AX [...]`` are ISG's older spellings of ``#AX REQUEST``
+  and ``#AX RELEASE`` and take the same lists.
 * ``#AX REQUEST [X, 1, 0] [Y, 2, 1]`` requests axes by name, logical axis number and
   axis index in the channel (from 0). This kernel has no axis management shared
   between channels: an axis can only come back into its own channel, at its own index
@@ -31,11 +33,14 @@ from .statements import AxisCommand, AxisRef
 AX_WORD = re.compile(r"#[ \t]*AX\b")
 
 
-def parse_axis_command(cur: Cursor, hash_pos: int, number: int | None) -> AxisCommand:
-    """The ``#AX`` command whose ``#`` is at ``hash_pos``; the cursor stands after AX."""
-    cur.skip_ws()
-    m = cur.match(IDENT)
-    sub = m.group() if m is not None else ""
+def parse_axis_command(cur: Cursor, hash_pos: int, number: int | None,
+                       sub: str | None = None) -> AxisCommand:
+    """The ``#AX`` command whose ``#`` is at ``hash_pos``; the cursor stands after AX
+    (``sub`` given: after ``#CALL AX`` / ``#PUT AX``, which mean REQUEST / RELEASE)."""
+    if sub is None:
+        cur.skip_ws()
+        m = cur.match(IDENT)
+        sub = m.group() if m is not None else ""
     if sub == "RELEASE":
         kind = AxisExchangeKind.RELEASE
         axes = _release_axes(cur)

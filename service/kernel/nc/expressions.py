@@ -295,6 +295,12 @@ class ExpressionParser:
             raise cur.error(NcErrorId.EXPRESSION_SYNTAX, "variable name expected after 'V.'")
         scope = _SCOPES.get(m.group(1))
         if scope is None:
+            if m.group(1) == "E":  # external variables link to the PLC; none are configured
+                raise cur.error(
+                    NcErrorId.UNKNOWN_VARIABLE,
+                    f"unknown variable V.E.{m.group(2)}: no external variable of that name "
+                    "(this kernel configures no V.E. variables)", pos,
+                )
             raise cur.error(
                 NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED,
                 f"V.{m.group(1)}. variables are not supported yet", pos,

@@ -30,7 +30,9 @@ import re
 from collections.abc import Callable, Iterator
 from functools import lru_cache
 
-from .blocks import Block, Motion, MotionKind, SourceRef, StopKind
+from .blockexec import FEED_MAX_MM_MIN
+from .blocks import Block, Compensation, Motion, MotionKind, SourceRef, StopKind
+from .check import BATCH_LINES, PointBatch
 from .construct import (
     FAST, BlockTwin, MotionTwin, SourceRefTwin, make_block, make_motion, make_source,
 )
@@ -73,8 +75,9 @@ def run(decoder):
         role_i, role_j, role_k = roles
         # with an axis released (#AX RELEASE) every line takes the general path, which
         # rejects the words of released axes
-        fast_end = i if modal.released_axes else end
+        fast_end = {fast_end}
         emitted = False
+{setup}
         try:
             while i < fast_end:
                 m = match(lines[i])
@@ -85,7 +88,7 @@ def run(decoder):
                 try:
                     if ftext is not None:
                         f_new = float(ftext)
-                        if f_new <= 0.0:
+                        if not 0.0 < f_new <= FEED_MAX:
                             break
                         feed_k = f_new / 60.0
                     else:
@@ -173,13 +176,11 @@ def run(decoder):
                 pos = end_pos
                 {unpack_pos} = end_pos
                 modal.position_mm = end_pos
-{block}
-                i += 1
-                emitted = True
-                yield block
+{emit}
         except Exception as exc:  # a decoder bug must still be the program's error
             raise decoder.fault(exc, frame, i) from exc
         frame.index = i
+{flush}
         if emitted:
             decoder.emitted += 1  # only the change matters (ControlFlow.loop_pass)
         # the line the hot path did not take: the general path
@@ -232,6 +233,34 @@ _BLOCK_PLAIN = '''\
                                    NO_STOP, (), None, None, manual)'''
 
 
+_EMIT_BLOCK = '''\
+{block}
+                i += 1
+                emitted = True
+                yield block'''
+
+# check mode (syntax check, dry run): a record per moving line instead of a Block
+_EMIT_RECORD = '''\
+                if motion is not None:
+                    record((i, k, end_pos, motion))
+                i += 1'''
+
+_SETUP_RECORDS = '''\
+        start_i = i
+        start_pos = pos
+        records = []
+        record = records.append'''
+
+_FLUSH_RECORDS = '''\
+        if i > start_i:
+            emitted = True
+            yield POINT_BATCH(program.src, start_i, i, start_pos, plane, records)'''
+
+# check mode: compensation and single-stepping take the general path; batches are bounded
+_FAST_END_CHECK = ("i if modal.released_axes or decoder.check.line_by_line or comp != COMP_OFF "
+                   "else min(end, i + BATCH_LINES)")
+
+
 def line_pattern(axes: tuple[str, ...]) -> re.Pattern[str]:
     """The regular expression of a plain motion line for a channel with ``axes``."""
     words = "".join(f"(?:{name}{_NUM})?" for name in axes)
@@ -242,8 +271,9 @@ def line_pattern(axes: tuple[str, ...]) -> re.Pattern[str]:
     )
 
 
-def loop_source(axes: tuple[str, ...]) -> str:
-    """The generated Python source of the decoding loop for ``axes``."""
+def loop_source(axes: tuple[str, ...], check: bool = False) -> str:
+    """The generated Python source of the decoding loop for ``axes`` (``check``: the
+    syntax-check variant that yields ``PointBatch`` records from the hot path)."""
     n = len(axes)
     pad = " " * 24
     unpack = ", ".join(f"p{k}" for k in range(n)) + ("," if n == 1 else "")
@@ -253,7 +283,11 @@ def loop_source(axes: tuple[str, ...]) -> str:
     incremental = "\n".join(
         f"{pad}e{k} = p{k} if a{k} is None else p{k} + float(a{k})" for k in range(n)
     ) or f"{pad}pass"
-    if FAST:
+    if check:
+        arc = " " * 20 + "motion = (cp, cq)"
+        linear = pad + "motion = 0"
+        block = ""
+    elif FAST:
         arc = _MOTION_FAST.format(pad=" " * 20, feed="feed_k", plane="plane",
                                   centre="(cp, cq)")
         linear = _MOTION_FAST.format(pad=pad, feed="f_mm_s", plane="line_plane",
@@ -271,23 +305,30 @@ def loop_source(axes: tuple[str, ...]) -> str:
         no_axis_word=" and ".join(f"a{k} is None" for k in range(n)) or "True",
         absolute=absolute, incremental=incremental,
         end_tuple=", ".join(f"e{k}" for k in range(n)) + ("," if n == 1 else ""),
-        arc_motion=arc, linear_motion=linear, block=block,
+        arc_motion=arc, linear_motion=linear,
+        fast_end=_FAST_END_CHECK if check else "i if modal.released_axes else end",
+        emit=_EMIT_RECORD if check else _EMIT_BLOCK.format(block=block),
+        flush=_FLUSH_RECORDS if check else "",
+        setup=_SETUP_RECORDS if check else "",
     )
 
 
 @lru_cache(maxsize=16)
-def decoding_loop(axes: tuple[str, ...]) -> Callable[..., Iterator[Block]]:
-    """The compiled decoding loop for ``axes``: ``loop(decoder)`` yields the blocks."""
+def decoding_loop(axes: tuple[str, ...], check: bool = False) -> Callable[..., Iterator[Block]]:
+    """The compiled decoding loop for ``axes``: ``loop(decoder)`` yields the blocks
+    (``check``: and ``PointBatch`` records of the hot path's lines)."""
     namespace = {
         "MATCH": line_pattern(axes).match, "NEW": object.__new__, "G_MOTION": _G_MOTION,
         "INCREMENTAL": DistanceMode.INCREMENTAL, "RAPID": MotionKind.RAPID,
         "ARC_CW": MotionKind.ARC_CW, "ARC_CCW": MotionKind.ARC_CCW, "INF": math.inf,
-        "HYPOT": math.hypot,
+        "HYPOT": math.hypot, "FEED_MAX": FEED_MAX_MM_MIN,
         "TOLERANCE": ARC_TOLERANCE_MM, "MOTION_TWIN": MotionTwin, "MOTION": Motion,
         "SOURCE_TWIN": SourceRefTwin, "SOURCE": SourceRef, "BLOCK_TWIN": BlockTwin,
         "BLOCK": Block, "NO_STOP": StopKind.NONE, "MAKE_MOTION": make_motion,
         "MAKE_BLOCK": make_block, "MAKE_SOURCE": make_source, "LOOP_MARKERS": LOOP_MARKERS,
+        "POINT_BATCH": PointBatch, "BATCH_LINES": BATCH_LINES, "COMP_OFF": Compensation.OFF,
     }
-    code = compile(loop_source(axes), f"<decoding loop {''.join(axes)}>", "exec")
+    code = compile(loop_source(axes, check),
+                   f"<decoding loop {''.join(axes)}{' check' if check else ''}>", "exec")
     exec(code, namespace)  # noqa: S102 - our own template, no outside input
     return namespace["run"]

@@ -30,6 +30,8 @@ _N_WORD = re.compile(r"N[ \t]*([-+]?[0-9.]*)([ \t]*:)?")
 _LABEL = re.compile(r"\[[ \t]*([A-Z0-9_]+)[ \t]*\]")
 _KEYWORD = re.compile(r"\$([A-Z]*)")
 _DIRECTIVE = re.compile(r"#[ \t]*([A-Z_]*)")
+_OLD_AX = {"CALL": "REQUEST", "PUT": "RELEASE"}
+_AX_AFTER = re.compile(r"AX\b")
 _GOTO_N = re.compile(r"N[ \t]*([0-9]+)[ \t]*:?")
 
 # $KEYWORD -> statement kind; $GOTO is an item of an NC block
@@ -164,6 +166,10 @@ class LineParser:
         word = m.group(1)
         if word == "AX":
             return parse_axis_command(cur, pos, number)
+        if word in _OLD_AX:  # #CALL AX / #PUT AX: ISG's older axis exchange spellings
+            cur.skip_ws()
+            if cur.match(_AX_AFTER) is not None:
+                return parse_axis_command(cur, pos, number, _OLD_AX[word])
         if word in ("CONTOUR", "DISTANCE"):
             return parse_contour_command(cur, pos, word, number)
         if word == "VAR":

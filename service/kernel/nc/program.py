@@ -24,6 +24,7 @@ import re
 from dataclasses import dataclass, field
 from enum import IntEnum
 
+from .check import SyntaxCheck, categorize, parse_checked
 from .errors import NcError, NcErrorId
 from .parser import LineParser
 from .source import LogicalLine, SourceText, comment_directive, read_logical, strip_comments
@@ -95,7 +96,11 @@ class Structure:
 class Program:
     """One NC file prepared for decoding (sections, caches)."""
 
-    def __init__(self, text: str, name: str, parser: LineParser, skip_levels: int) -> None:
+    def __init__(self, text: str, name: str, parser: LineParser, skip_levels: int,
+                 check: SyntaxCheck | None = None) -> None:
+        """With ``check`` (syntax check) an error in a line is reported and the line
+        repositioned after it (``check.parse_checked``), never raised."""
+        self.check = check
         self.src = SourceText(text, name)
         self.name = name
         self.parser = parser
@@ -113,7 +118,14 @@ class Program:
         """The logical line at ``index`` (cached) and the index after it."""
         got = self._logical.get(index)
         if got is None:
-            got = read_logical(self.src, index, end, self.skip_levels)
+            try:
+                got = read_logical(self.src, index, end, self.skip_levels)
+            except NcError as error:
+                if self.check is None:
+                    raise
+                self.check.report(error, categorize(error, None))
+                # an unclosed #COMMENT BEGIN comments out the rest; else skip the line
+                got = (None, end if error.id == NcErrorId.COMMENT_BLOCK_NOT_CLOSED else index + 1)
             if len(self._logical) >= CACHE_LINES:
                 self._logical.clear()
             self._logical[index] = got
@@ -124,7 +136,12 @@ class Program:
         got = self._statements.get(index)
         if got is None:
             line, after = self.logical(index, end)
-            got = (None if line is None else self.parser.parse(line), after)
+            if line is None:
+                got = (None, after)
+            elif self.check is None:
+                got = (self.parser.parse(line), after)
+            else:
+                got = (parse_checked(self.parser.parse, line, self.check), after)
             if len(self._statements) >= CACHE_LINES:
                 self._statements.clear()
             self._statements[index] = got

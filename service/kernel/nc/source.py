@@ -90,7 +90,9 @@ class LogicalLine:
     def error(self, err_id: NcErrorId, message: str, pos: int) -> NcError:
         """An NcError pointing at ``pos`` of this line."""
         line, column = self.locate(pos)
-        return NcError(err_id, self.file, line, column, message)
+        error = NcError(err_id, self.file, line, column, message)
+        error.pos = pos
+        return error
 
     def first_column(self) -> int:
         """1-based column of the first non-blank character (1 for an empty line)."""

@@ -149,7 +149,7 @@ def test_declaration_in_a_loop_reinitialises():
         ("#VAR\nV.L.A\n", NcErrorId.VAR_BLOCK_NOT_CLOSED, 1, 1),
         ("#ENDVAR\nM30", NcErrorId.ENDVAR_WITHOUT_VAR, 1, 1),
         ("#VAR\nV.E.A\n#ENDVAR\nM30", NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED, 2, 1),
-        ("G0 X[V.E.A]\nM30", NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED, 1, 6),
+        ("G0 X[V.E.A]\nM30", NcErrorId.UNKNOWN_VARIABLE, 1, 6),
         ("G0 X[V.P.G[1].POS]\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 6),
         ("#VAR\nV.L.S : STRING\n#ENDVAR\nV.L.S = 1\nM30", NcErrorId.TYPE_MISMATCH, 4, 1),
         ("#VAR\nV.L.S\n#ENDVAR\nV.L.S = \"x\"\nM30", NcErrorId.TYPE_MISMATCH, 4, 1),

@@ -1,0 +1,281 @@
+"""Decoding that goes on after an error: the decoder's part of the syntax check (FCT-C9).
+
+With a ``SyntaxCheck`` the decoder reports each error (``SyntaxCheck.report``) and goes
+on, with the response the ISG function description gives per error category:
+
+==============================  ===========================================================
+category                        response
+==============================  ===========================================================
+``resource`` (call depth, ...)  discard the NC line
+``command`` (in a $ / # line)   discard the NC line (an opening $IF/$WHILE/$FOR/$SWITCH
+                                whose expression fails skips its whole block, so its
+                                closing line does not give a follow-up error)
+``after_command``               use the command as far as it was understood (the text
+                                after it is dropped)
+``term`` (unknown word, bad     use what was understood of the line: the term is dropped
+number, ...)                    and the rest of the line decoded
+``assignment`` (bad left-hand   reposition after the assignment: it is dropped, the rest of
+side)                           the line decoded
+``combination``, ``limit``,     continue without repositioning: the offending word is
+``value``, ``incomplete``       dropped and the block decoded again; when no single word is
+                                at fault, the line is dropped
+==============================  ===========================================================
+
+A word dropped this way takes its effect with it (``G0 G1``: G0 stays; a bad F leaves
+the feed unknown, so the check goes on as if F were programmed rather than report "no
+feed" on every following line: ``CHECK_FEED_MM_MIN``). ``errors_per_block`` (P-CHAN-00020)
+errors in one line skip the rest of that line; the total limit (P-CHAN-00019) is the
+caller's: ``report`` raises ``CheckAborted`` to end decoding.
+
+In check mode the hot path does not build Block objects: it yields ``PointBatch`` records
+(line, motion kind, end point, arc centre) of up to ``BATCH_LINES`` plain lines, which
+is what the check of software limits needs; every other line is decoded by the general
+path, reported to ``SyntaxCheck.line`` and yields its Block as usual. While tool radius
+compensation is active or the check steps line by line, every line takes the general
+path.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from enum import IntEnum
+from typing import Protocol
+
+from .errors import NcError, NcErrorId
+from .source import LogicalLine, SourceText
+
+BATCH_LINES = 2048  # plain lines per PointBatch (bounds the memory of one batch)
+CHECK_FEED_MM_MIN = 1000.0  # the feed the check assumes after a missing or bad F
+
+
+class ErrorCategory(IntEnum):
+    """The rows of the ISG error table of the syntax check."""
+
+    RESOURCE = 1  # e.g. stack overflow: discard the line
+    COMMAND = 2  # error in a $ or # command: discard the line
+    AFTER_COMMAND = 3  # unexpected character/term after a $ or # command: use the command
+    TERM = 4  # unexpected or invalid character/term: use the rest of the line
+    ASSIGNMENT = 5  # left-hand side of an assignment: reposition after the assignment
+    COMBINATION = 6  # NC commands not permitted together: continue
+    LIMIT = 7  # a limit over- or undershot: continue
+    VALUE = 8  # programmed value impractical: continue
+    INCOMPLETE = 9  # incomplete information: continue
+
+    @property
+    def label(self) -> str:
+        """The lower-case name used in logs and JSON (``after_command``)."""
+        return self.name.lower()
+
+
+class CheckAborted(Exception):
+    """Raised by ``SyntaxCheck.report`` to end decoding (error limit, RESET)."""
+
+
+class SyntaxCheck(Protocol):
+    """What the decoder tells the syntax check; implemented by the kernel."""
+
+    errors_per_block: int  # 0: no limit (P-CHAN-00020)
+    line_by_line: bool  # every line through the general path and ``line`` (single step)
+
+    def report(self, error: NcError, category: ErrorCategory) -> None:
+        """An error the decoder goes on after; may block (interactive) or raise
+        ``CheckAborted``."""
+
+    def line(self, src: SourceText, index: int, after: int) -> None:
+        """Lines ``index``..``after``-1 of ``src`` were decoded by the general path; may
+        block (single step)."""
+
+
+@dataclass(slots=True)
+class PointBatch:
+    """Plain motion lines decoded by the hot path in check mode.
+
+    ``records`` holds ``(line index, MotionKind, end point, centre)`` per line that
+    moves; ``centre`` is the arc centre ``(p, q)`` in ``plane``, else None. The first
+    record starts at ``start_mm``, each following one at the end of the one before.
+    Lines ``first``..``stop``-1 of ``src`` were decoded.
+    """
+
+    src: SourceText
+    first: int
+    stop: int
+    start_mm: tuple[float, ...]
+    plane: tuple[int, int] | None
+    records: list = field(default_factory=list)
+
+
+# ---------------------------------------------------------------- categories
+
+_RESOURCE = frozenset({
+    NcErrorId.CALL_DEPTH_EXCEEDED, NcErrorId.EXPRESSION_TOO_COMPLEX, NcErrorId.ENDLESS_LOOP,
+    NcErrorId.FILE_NOT_FOUND, NcErrorId.SUBPROGRAM_NOT_FOUND, NcErrorId.DUPLICATE_SUBPROGRAM,
+    NcErrorId.INTERNAL_ERROR,
+})
+_COMBINATION = frozenset({
+    NcErrorId.CONFLICTING_G_CODES, NcErrorId.CONFLICTING_M_CODES, NcErrorId.WORD_REPEATED,
+    NcErrorId.BLOCK_NUMBER_TWICE, NcErrorId.ARC_CENTRE_AND_RADIUS,
+    NcErrorId.ARC_WORDS_WITHOUT_ARC, NcErrorId.ARC_OFFSET_OUT_OF_PLANE,
+    NcErrorId.HELIX_NOT_SUPPORTED, NcErrorId.AXIS_RELEASED, NcErrorId.AXIS_COMMAND_NOT_ALONE,
+    NcErrorId.CONTOUR_CLEAR_WITH_COMPENSATION, NcErrorId.CONTOUR_CLEAR_IN_RT_LOOP,
+    NcErrorId.SUBPROGRAM_END_IN_MAIN,
+})
+_LIMIT = frozenset({
+    NcErrorId.VALUE_OUT_OF_RANGE, NcErrorId.VALUE_OUT_OF_TYPE_RANGE,
+    NcErrorId.ARRAY_INDEX_OUT_OF_RANGE, NcErrorId.INVALID_SKIP_LEVEL,
+})
+_VALUE = frozenset({
+    NcErrorId.INVALID_FEED, NcErrorId.INVALID_SPINDLE_SPEED, NcErrorId.INVALID_TOOL_NUMBER,
+    NcErrorId.TOOL_NOT_IN_TABLE, NcErrorId.INVALID_M_CODE, NcErrorId.INVALID_DWELL,
+    NcErrorId.DIVISION_BY_ZERO, NcErrorId.MATH_DOMAIN, NcErrorId.ARC_RADIUS_ZERO,
+    NcErrorId.ARC_RADIUS_TOO_SMALL, NcErrorId.ARC_FULL_CIRCLE_WITH_R,
+    NcErrorId.ARC_RADIUS_DIFFERENCE, NcErrorId.FOR_STEP_ZERO, NcErrorId.INVALID_AXIS_NUMBER,
+    NcErrorId.INVALID_BLOCK_NUMBER, NcErrorId.AXIS_EXCHANGE_NOT_SUPPORTED,
+    NcErrorId.TYPE_MISMATCH,
+})
+_INCOMPLETE = frozenset({
+    NcErrorId.NO_FEED, NcErrorId.PLANE_AXIS_MISSING, NcErrorId.MISSING_PROGRAM_END,
+    NcErrorId.SUBPROGRAM_END_MISSING, NcErrorId.BLOCK_NOT_CLOSED, NcErrorId.VAR_BLOCK_NOT_CLOSED,
+    NcErrorId.COMMENT_BLOCK_NOT_CLOSED, NcErrorId.STRING_NOT_CLOSED,
+    NcErrorId.UNDECLARED_VARIABLE, NcErrorId.UNKNOWN_VARIABLE, NcErrorId.LABEL_NOT_FOUND,
+})
+
+# the $ or # that starts the command of a line (after an N number and a label)
+_COMMAND_START = re.compile(r"[ \t]*(?:N[ \t]*[0-9]*[ \t]*:?[ \t]*)?(?:\[[^\]]*\][ \t]*)?([$#])")
+# "V.x.name[...] =" (not "==") at a position: the target of an assignment
+_ASSIGN_TARGET = re.compile(r"V\.[A-Z]+\.[A-Z_][A-Z0-9_]*(?:\[[^\]=]*\])*[ \t]*=(?!=)")
+
+
+def command_position(line: LogicalLine) -> int:
+    """Position of the ``$``/``#`` of a command line ($GOTO is an NC word), else -1."""
+    m = _COMMAND_START.match(line.upper)
+    if m is None or line.upper.startswith("$GOTO", m.start(1)):
+        return -1
+    return m.start(1)
+
+
+def categorize(error: NcError, line: LogicalLine | None) -> ErrorCategory:
+    """The category of ``error`` found in ``line`` (None: not in one line)."""
+    err_id = error.id
+    if err_id in _RESOURCE:
+        return ErrorCategory.RESOURCE
+    if line is not None and error.pos >= 0:
+        if _ASSIGN_TARGET.match(line.upper, error.pos):
+            return ErrorCategory.ASSIGNMENT
+        if command_position(line) >= 0:
+            return ErrorCategory.COMMAND
+    if err_id in _COMBINATION:
+        return ErrorCategory.COMBINATION
+    if err_id in _LIMIT:
+        return ErrorCategory.LIMIT
+    if err_id in _VALUE:
+        return ErrorCategory.VALUE
+    if err_id in _INCOMPLETE:
+        return ErrorCategory.INCOMPLETE
+    return ErrorCategory.TERM
+
+
+# ---------------------------------------------------------------- repositioning
+
+def blanked(line: LogicalLine, start: int, stop: int) -> LogicalLine:
+    """``line`` with ``[start, stop)`` replaced by blanks (columns stay as they were)."""
+    text = line.text[:start] + " " * (stop - start) + line.text[stop:]
+    return LogicalLine(line.file, text, line.segments, line.offset)
+
+
+def term_end(text: str, pos: int) -> int:
+    """End of the term at ``pos``: the next blank outside brackets and strings."""
+    depth = 0
+    quoted = False
+    k = pos
+    n = len(text)
+    while k < n:
+        c = text[k]
+        if c == '"':
+            quoted = not quoted
+        elif not quoted:
+            if c == "[":
+                depth += 1
+            elif c == "]":
+                depth = max(depth - 1, 0)
+            elif c in " \t" and depth == 0 and k > pos:
+                break
+        k += 1
+    return k
+
+
+def assignment_end(line: LogicalLine, pos: int) -> int:
+    """End of the assignment whose target starts at ``pos``: after its right-hand
+    expression, or the end of the line when that cannot be parsed either."""
+    from .expressions import ExpressionParser  # noqa: PLC0415 - expressions imports errors
+    from .lexer import Cursor  # noqa: PLC0415
+
+    m = _ASSIGN_TARGET.match(line.upper, pos)
+    if m is None:
+        return len(line.text)
+    cur = Cursor(line, m.end())
+    try:
+        ExpressionParser(cur).parse()
+    except NcError:
+        return len(line.text)
+    return cur.pos
+
+
+def without_error(line: LogicalLine, error: NcError, category: ErrorCategory
+                  ) -> LogicalLine | None:
+    """The line to parse again after ``error``, or None to drop the line."""
+    pos = error.pos
+    if pos < 0 or pos >= len(line.text):
+        return None
+    if category == ErrorCategory.ASSIGNMENT:
+        return blanked(line, pos, assignment_end(line, pos))
+    if category == ErrorCategory.AFTER_COMMAND:
+        return blanked(line, pos, len(line.text))
+    if category in (ErrorCategory.RESOURCE, ErrorCategory.COMMAND):
+        return None
+    return blanked(line, pos, term_end(line.text, pos))
+
+
+def after_command(line: LogicalLine, error: NcError, parse) -> object | None:
+    """For an error in a command line: the command as understood before ``error``
+    (``parse`` of the line cut there) when that is a command, else None."""
+    start = command_position(line)
+    if start < 0 or error.pos <= start + 1 or error.pos >= len(line.text):
+        return None
+    try:
+        stmt = parse(blanked(line, error.pos, len(line.text)))
+    except NcError:
+        return None
+    from .statements import NcBlock  # noqa: PLC0415
+
+    return None if isinstance(stmt, NcBlock) else stmt
+
+
+def parse_checked(parse, line: LogicalLine, check: SyntaxCheck):
+    """Parse ``line``, reporting each error and repositioning after it; the statement
+    of what was understood, or None when the line is dropped."""
+    count = 0
+    while True:
+        try:
+            return parse(line)
+        except NcError as error:
+            command = after_command(line, error, parse)
+            if command is not None:
+                check.report(error, ErrorCategory.AFTER_COMMAND)
+                return command
+            category = categorize(error, line)
+            check.report(error, category)
+            count += 1
+            if check.errors_per_block and count >= check.errors_per_block:
+                return None
+            again = without_error(line, error, category)
+            if again is None or again.text == line.text:
+                return None
+            line = again
+
+
+__all__ = [
+    "BATCH_LINES", "CHECK_FEED_MM_MIN", "CheckAborted", "ErrorCategory", "PointBatch",
+    "SyntaxCheck", "categorize", "command_position", "parse_checked",
+]
+
