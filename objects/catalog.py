@@ -30,6 +30,7 @@ class Scope(Enum):
     CHANNEL = "channel"  # per channel: ch<c>.element, group + CID
     CHANNEL_AXIS = "channel_axis"  # per axis of a channel: ch<c>.ax<a>.element
     PLC_CHANNEL = "plc_channel"  # HLI per channel: gpCh[i].element, i = channel index from 0
+    PLC_MC = "plc_mc"  # older HLI per channel: pMC[i].element (same address block as gpCh[i])
     PLC_AXIS = "plc_axis"  # HLI per axis: gpAx[i].element, i = HLI axis slot from 0
 
 
@@ -356,6 +357,26 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "Logical axis number that drives this physical axis; 0 = none (project offset)",
     ),
     # --- COM platform: axis parameter update (project) ------------------------------------
+    # --- syntax check parameters (FCT-C9; channel list values, writable; project offsets)
+    ObjectTemplate(
+        "syn_chk.errors_total", Scope.CHANNEL, COM, COM_CH, 0x3100, UNS16, RW, "-",
+        "P-CHAN-00019: the syntax check ends after this many errors, 0 = no limit; from "
+        "the next program start (project)",
+    ),
+    ObjectTemplate(
+        "syn_chk.errors_per_block", Scope.CHANNEL, COM, COM_CH, 0x3101, UNS16, RW, "-",
+        "P-CHAN-00020: errors in one NC line after which the check goes on with the next "
+        "line, 0 = no limit (project)",
+    ),
+    ObjectTemplate(
+        "syn_chk.interactive", Scope.CHANNEL, COM, COM_CH, 0x3102, BOOLEAN, RW, "-",
+        "P-CHAN-00028: TRUE = stop in HOLD after each error until START or RESET (project)",
+    ),
+    ObjectTemplate(
+        "syn_chk.record_result", Scope.CHANNEL, COM, COM_CH, 0x3103, BOOLEAN, RW, "-",
+        "P-CHAN-00416: TRUE = write every checked line and error to dec0<c>.sc in the "
+        "program store (project)",
+    ),
     ObjectTemplate(
         "axis_parameter_update_w", Scope.PLATFORM, COM, COM_CH, 0x1100, STRING(4096), W, "-",
         "Write an ISG axis parameter list (kopf.achs_nr first): changes that axis's "
@@ -386,6 +407,45 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "bahn_state.dist_prog_start", Scope.PLC_CHANNEL, PLC, PLC_GROUP, 0x110, REAL64, R,
         "0.1 um", "Path distance covered since program start or #DISTANCE PROG START CLEAR, "
         "on the compensated path",
+    ),
+    # execution mode control unit (FCT-C9), MC_CONTROL_SGN32_UNIT
+    ObjectTemplate(
+        "decoder_mc_control.execution_mode.command_w", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        0x120, SGN32, RW, "-",
+        "Execution mode the PLC commands (evaluated at program start while enable_w)",
+    ),
+    ObjectTemplate(
+        "decoder_mc_control.execution_mode.enable_w", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        0x124, BOOLEAN, RW, "-",
+        "TRUE: a program start takes command_w; FALSE: the HMI's request (request_r)",
+    ),
+    ObjectTemplate(
+        "decoder_mc_control.execution_mode.request_r", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        0x128, SGN32, R, "-", "Execution mode the HMI requests (mc_command_execution_mode_w)",
+    ),
+    ObjectTemplate(
+        "decoder_mc_control.execution_mode.state_r", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        0x12C, SGN32, R, "-", "Execution mode in effect (SYNCHK implies MACHINE_LOCK and "
+        "SUPPRESS_TECHNO_OUTPUT)",
+    ),
+    # decoder display flags (FCT-C9), pMC[i]^.addr^.StateDecoder_Data
+    *(
+        ObjectTemplate(
+            f"StateDecoder_Data.{name}", Scope.PLC_MC, PLC, PLC_GROUP, 0x140 + n, BOOLEAN, R,
+            "-", text,
+        )
+        for n, (name, text) in enumerate((
+            ("X_SyntaxCheck", "The decoder works in the syntax check"),
+            ("X_WaitAfterError", "Syntax check: the decoder waits after an error for "
+             "continue (START) or abort (RESET)"),
+            ("X_SyntaxCheckReleaseNextBlockCleared", "Syntax check: after an error and the "
+             "enable to go on, the decoder waits until the enable is cancelled (one cycle: "
+             "the service cancels it)"),
+            ("X_WaitContinue", "Decoding is interrupted (single step, STOP) and waits for "
+             "the enable to go on"),
+            ("X_WaitReleaseNextBlockCleared", "Decoding goes on after an interruption and "
+             "waits until the enable is cancelled (one cycle)"),
+        ))
     ),
     # contour look-ahead control unit (FCT-C40), HLI_CONTOUR_LOOKAHEAD
     ObjectTemplate(
@@ -448,8 +508,9 @@ def _instantiate(
     t: ObjectTemplate, channel: int = 0, axis: int = 0, index: int = 0
 ) -> CncObject:
     match t.scope:
-        case Scope.PLC_CHANNEL:
-            name, group = f"gpCh[{index}].{t.element}", t.group_base
+        case Scope.PLC_CHANNEL | Scope.PLC_MC:
+            prefix = "gpCh" if t.scope == Scope.PLC_CHANNEL else "pMC"
+            name, group = f"{prefix}[{index}].{t.element}", t.group_base
             offset = PLC_CHANNEL_BASE + index * PLC_CHANNEL_STRIDE + t.offset
         case Scope.PLC_AXIS:
             name, group = f"gpAx[{index}].{t.element}", t.group_base
@@ -495,7 +556,7 @@ def build_objects(
                     for c in layout.channels
                     for a in range(1, c.axis_count + 1)
                 )
-            case Scope.PLC_CHANNEL:
+            case Scope.PLC_CHANNEL | Scope.PLC_MC:
                 objects.extend(
                     _instantiate(t, c.channel_id, index=i) for i, c in enumerate(layout.channels)
                 )

@@ -31,14 +31,18 @@ from .kernel.commands import (
     SetContourRequest,
     SetContourSemaphore,
     SetExecutionMode,
+    SetExecutionModeEnable,
+    SetExecutionModePlc,
     SetFeedOverride,
     SetSingleBlock,
     SetSuspendCommand,
     SetSuspendEnable,
+    SetSyntaxCheckParameter,
     StartProgram,
     UpdateAxisParameters,
 )
 from .kernel.kernel import Kernel
+from .kernel.state import DecoderFlag
 from .param_list import ParamListError, parse_axis_list
 
 Getter = Callable[[], Any]
@@ -207,6 +211,26 @@ def _kernel_time(kernel: Kernel, obj: CncObject) -> Getter:
     return lambda: kernel.snapshot.time_ns / 1e9
 
 
+def _syn_chk(name: str) -> Callable[[Kernel, CncObject], Getter]:
+    """``ch<c>.syn_chk.<name>``: the syntax check parameter for the next check."""
+
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        ci = kernel.channel_index(obj.channel)
+        return lambda: getattr(kernel.snapshot.channels[ci].syn_chk, name)
+
+    return bind
+
+
+def _decoder_flag(flag: DecoderFlag) -> Callable[[Kernel, CncObject], Getter]:
+    """``pMC[i].StateDecoder_Data.X_...``: one display flag of the decoder."""
+
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        ci = kernel.channel_index(obj.channel)
+        return lambda: bool(kernel.snapshot.channels[ci].decoder_flags & flag)
+
+    return bind
+
+
 READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "requested_link_to_physical_axis": _channel_axis("requested_link"),
     "actual_link_to_physical_axis": _channel_axis("actual_link"),
@@ -215,6 +239,19 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "mc_command_feed_override_r": _channel("feed_override_command"),
     "mc_active_feed_override_r": _channel("feed_override_active"),
     "mc_command_execution_mode_r": _channel("execution_mode_command"),
+    "decoder_mc_control.execution_mode.command_w": _channel("execution_mode_plc_command"),
+    "decoder_mc_control.execution_mode.enable_w": _channel("execution_mode_plc_enable"),
+    "decoder_mc_control.execution_mode.request_r": _channel("execution_mode_command"),
+    "decoder_mc_control.execution_mode.state_r": _channel("execution_mode_active"),
+    **{f"syn_chk.{name}": _syn_chk(name)
+       for name in ("errors_total", "errors_per_block", "interactive", "record_result")},
+    "StateDecoder_Data.X_SyntaxCheck": _decoder_flag(DecoderFlag.SYNTAX_CHECK),
+    "StateDecoder_Data.X_WaitAfterError": _decoder_flag(DecoderFlag.WAIT_AFTER_ERROR),
+    "StateDecoder_Data.X_SyntaxCheckReleaseNextBlockCleared": _decoder_flag(
+        DecoderFlag.SYNTAX_CHECK_RELEASE_CLEARED),
+    "StateDecoder_Data.X_WaitContinue": _decoder_flag(DecoderFlag.WAIT_CONTINUE),
+    "StateDecoder_Data.X_WaitReleaseNextBlockCleared": _decoder_flag(
+        DecoderFlag.WAIT_RELEASE_CLEARED),
     "mc_active_execution_mode_r": _channel("execution_mode_active"),
     "cnc_version_r": _constant(lambda k: f"cnc-objects {__version__}"),
     "cnc_number_of_channel_r": _constant(lambda k: len(k.config.channels)),
@@ -297,6 +334,11 @@ def _channel_command(
 WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
     "mc_command_feed_override_w": _channel_command(SetFeedOverride),
     "mc_command_execution_mode_w": _channel_command(SetExecutionMode),
+    "decoder_mc_control.execution_mode.command_w": _channel_command(SetExecutionModePlc),
+    "decoder_mc_control.execution_mode.enable_w": _channel_command(SetExecutionModeEnable),
+    **{f"syn_chk.{name}": _channel_command(
+        lambda ci, value, name=name: SetSyntaxCheckParameter(ci, name, value))
+       for name in ("errors_total", "errors_per_block", "interactive", "record_result")},
     "mc_command_single_block_w": _channel_command(SetSingleBlock),
     "mc_command_mode_w": _channel_command(SelectMode),
     "mc_command_program_name_w": _channel_command(SelectProgram),

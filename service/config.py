@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import (
-    BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator,
+    AliasChoices, BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator,
 )
 
 from .param_list import ParamListError, read_axis_list, read_channel_list
@@ -126,6 +126,28 @@ class ToolConfig(_Strict):
     radius_mm: float = Field(ge=0, description="tool radius (mm)")
 
 
+class SyntaxCheckConfig(_Strict):
+    """Channel parameters of the syntax check (FCT-C9), ``syn_chk.*``; ISG's spellings
+    before V2.11.2012.07 (``fehler_gesamt``, ``fehler_pro_zeile``) are accepted too."""
+
+    errors_total: int = Field(
+        0, ge=0, le=0xFFFF, validation_alias=AliasChoices("errors_total", "fehler_gesamt"),
+        description="P-CHAN-00019: the check ends after this many errors (0: no limit)",
+    )
+    errors_per_block: int = Field(
+        0, ge=0, le=0xFFFF,
+        validation_alias=AliasChoices("errors_per_block", "fehler_pro_zeile"),
+        description="P-CHAN-00020: after this many errors in one NC line the check goes on "
+        "with the next line (0: no limit)",
+    )
+    interactive: bool = Field(
+        False, description="P-CHAN-00028: stop after each error and wait for START or RESET"
+    )
+    record_result: bool = Field(
+        False, description="P-CHAN-00416: write every checked line and error to dec0<c>.sc"
+    )
+
+
 class ChannelConfig(_Strict):
     """A channel and its axes."""
 
@@ -150,6 +172,9 @@ class ChannelConfig(_Strict):
     contour_lookahead_log_max: int = Field(
         128, ge=0, le=0xFFFFFFFE,
         description="P-CHAN-00658: contour elements the contour look-ahead log keeps",
+    )
+    syn_chk: SyntaxCheckConfig = Field(
+        default_factory=SyntaxCheckConfig, description="syntax check (P-CHAN-00019/20/28/416)"
     )
 
     @field_validator("interpolator_function")
@@ -321,8 +346,8 @@ def _explain(exc: ValidationError, source: str) -> ConfigError:
 def _apply_parameter_lists(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:
     """Read the ISG parameter lists the configuration names and lay them over it.
 
-    ``channels[i].parameter_list`` (a channel list) gives that channel's axes and
-    ``jog_of_path_only``; ``axis_parameter_lists`` (axis lists) give the parameters of
+    ``channels[i].parameter_list`` (a channel list) gives that channel's axes,
+    ``jog_of_path_only`` and ``syn_chk.*``; ``axis_parameter_lists`` (axis lists) give the parameters of
     the axes whose ``kopf.achs_nr`` they carry. Paths are relative to ``base_dir``.
     """
     data = dict(data)
@@ -340,6 +365,8 @@ def _apply_parameter_lists(data: dict[str, Any], base_dir: Path) -> dict[str, An
         if "axes" in listed and "axes" in channel:  # arrays replace: the user wrote both
             problems.append(f"channels.{ci}: axes are given twice, here and in {name}")
             continue
+        if "syn_chk" in listed:  # the list's syn_chk keys complete those of the TOML
+            channel["syn_chk"] = {**channel.get("syn_chk", {}), **listed.pop("syn_chk")}
         channel.update(listed)
     axis_lists = data.pop("axis_parameter_lists", [])
     if not isinstance(axis_lists, list):

@@ -305,6 +305,17 @@ _CHANNEL_PARAMS = {
         _Param("gruppe[0].achse[n].bezeichnung", "P-CHAN-00006", _axis_name, ("name",),
                _ONE_GROUP),
         _Param("jog_of_path_only", "P-CHAN-00306", _boolean, ("jog_of_path_only",)),
+        _Param("syn_chk.errors_total", "P-CHAN-00019", _ranged(0, 0xFFFF),
+               ("syn_chk", "errors_total")),
+        _Param("syn_chk.fehler_gesamt", "P-CHAN-00019", _ranged(0, 0xFFFF),
+               ("syn_chk", "errors_total")),
+        _Param("syn_chk.errors_per_block", "P-CHAN-00020", _ranged(0, 0xFFFF),
+               ("syn_chk", "errors_per_block")),
+        _Param("syn_chk.fehler_pro_zeile", "P-CHAN-00020", _ranged(0, 0xFFFF),
+               ("syn_chk", "errors_per_block")),
+        _Param("syn_chk.interactive", "P-CHAN-00028", _boolean, ("syn_chk", "interactive")),
+        _Param("syn_chk.record_result", "P-CHAN-00416", _boolean,
+               ("syn_chk", "record_result")),
     )
 }
 _AXIS_FIELDS = {"name": "bezeichnung", "logical_number": "log_achs_nr"}
@@ -314,7 +325,7 @@ def parse_channel_list(text: str, source: str) -> dict[str, Any]:
     """Parse a channel parameter list; ``source`` names it in problems.
 
     Returns ``{"axes": [{"name": "X", "logical_number": 11}, ...], "jog_of_path_only":
-    bool}`` with each key only when the list gives it (``axes`` when any ``gruppe[0]``
+    bool, "syn_chk": {"errors_total": 20, ...}}`` with each key only when the list gives it (``axes`` when any ``gruppe[0]``
     key is there), axes in ``achse`` index order. Names are returned in capitals.
     ``gruppe[0].achs_anzahl`` is required with axes and must equal their number; achse
     indices run 0, 1, 2, ... without gaps; names and numbers are unique. Raises
@@ -326,6 +337,14 @@ def parse_channel_list(text: str, source: str) -> dict[str, Any]:
     jog = items.get("jog_of_path_only")
     if jog is not None and jog.value is not _INVALID:
         result["jog_of_path_only"] = jog.value
+    for key, item in items.items():  # syn_chk.*: new and old spellings, one field each
+        if key.startswith("syn_chk.") and item.value is not _INVALID:
+            field = item.param.field
+            if field[-1] in result.get("syn_chk", {}):
+                problems.append(Problem(source, item.line, f"{key} ({item.param.pid}) sets "
+                                        f"syn_chk.{field[-1]} a second time"))
+                continue
+            _store(result, field, item.value)
     if any(key.startswith("gruppe[") for key in items):
         result["axes"] = _channel_axes(items, source, problems)
     if problems:

@@ -18,17 +18,19 @@ log = logging.getLogger(__name__)
 
 
 class StoreWriter:
-    """Appends to files of the store in a background thread, in the order queued."""
+    """Appends to (or replaces) files of the store in a background thread, in the order
+    queued."""
 
     def __init__(self, store: ProgramStore) -> None:
         self._store = store
-        self._queue: queue.Queue[tuple[str, bytes] | None] = queue.Queue()
+        self._queue: queue.Queue[tuple[str, bytes, bool] | None] = queue.Queue()
         self._thread = threading.Thread(target=self._run, name="cnc-store-writer", daemon=True)
         self._thread.start()
 
-    def append(self, name: str, data: bytes) -> None:
-        """Queue ``data`` for the end of ``name`` (any thread; never blocks)."""
-        self._queue.put((name, data))
+    def append(self, name: str, data: bytes, replace: bool = False) -> None:
+        """Queue ``data`` for the end of ``name`` (``replace``: as its whole content);
+        any thread, never blocks."""
+        self._queue.put((name, data, replace))
 
     def flush(self) -> None:
         """Return once everything queued before the call is written."""
@@ -45,9 +47,12 @@ class StoreWriter:
             try:
                 if item is None:
                     return
-                name, data = item
+                name, data, replace = item
                 try:
-                    self._store.append(name, data)
+                    if replace:
+                        self._store.write(name, data)
+                    else:
+                        self._store.append(name, data)
                 except StoreError as exc:
                     log.error("cannot write %s: %s", name, exc)
             finally:

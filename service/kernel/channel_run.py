@@ -15,6 +15,7 @@ limit is refused before it moves.
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Callable
 from dataclasses import replace
 
@@ -44,8 +45,9 @@ from .nc.contour import LOOP_MARKERS
 from .path.executor import AxisDynamics, PathError, PathExecutor
 from .path.interpolator import Waiting
 from .path.segments import Segment
-from .state import Channel, ChannelError, ExecutionMode
+from .state import Channel, ChannelError, DecoderFlag, ExecutionMode
 from .switchover import Switchover
+from .syntax_check import SYNCHK_WITHOUT_MACHINE_LOCK, CHECK_STOPPED_WARNING, CheckRun, Pause
 
 log = logging.getLogger(__name__)
 
@@ -53,6 +55,9 @@ MAX_ERRORS_KEPT = 8  # the error list keeps the first errors of a run (the first
 _FEED_MARGIN_BLOCKS = 256  # the decoder may run this far ahead of the look-ahead buffer
 _MDI_NAME = "MDI"  # file name of manual blocks in errors and objects
 _INCR_PER_MM = 10_000  # 0.1 um increments per mm
+PROD_TIME_STEPS_PER_CYCLE = 5_000  # virtual clock: simulated cycles per GEO cycle (PROD_TIME)
+_PROD_TIME_SHARE = 0.5  # realtime clock: share of a GEO cycle the calculation may use
+_CHECK_MODES = ExecutionMode.SYNCHK | ExecutionMode.MACHINE_LOCK
 
 
 def _not_ready(channel: Channel, what: str) -> Refusal:
@@ -74,7 +79,7 @@ class ChannelRunner:
         exists: Callable[[str], bool],
         cycle_s: float,
         deterministic: bool,
-        files: Callable[[str, bytes], None] = lambda name, data: None,
+        files: Callable[..., None] = lambda name, data, replace=False: None,
         *,
         params: dict[int, AxisParameters],
         switchover: Switchover,
@@ -111,6 +116,10 @@ class ChannelRunner:
         self._fed_all = False
         self._started_at_s = 0.0
         self._time_s = 0.0
+        self._check: CheckRun | None = None  # syntax check or dry run of the program
+        self._released: Pause = Pause.NONE  # START ended this pause (flag for one cycle)
+        self._prod_time = False  # PROD_TIME: the run is simulated, no axis moves
+        self._sim_steps = 0  # PROD_TIME: cycles simulated so far
         self.touched = False  # the last cycle changed the channel's state
 
     # ------------------------------------------------------------ commands
@@ -146,7 +155,11 @@ class ChannelRunner:
         if ch.state == ChannelState.HOLD:
             ch.state = ChannelState.ACTIVE
             ch.waiting_for_start = False
-            self._executor.resume()
+            if self._check is not None:  # continue decoding (after an error, a step, STOP)
+                self._released = self._check.pause
+                self._check.resume()
+            elif self._executor is not None:
+                self._executor.resume()
             return None
         if ch.state == ChannelState.ACTIVE:
             if not ch.waiting_for_start:
@@ -165,7 +178,10 @@ class ChannelRunner:
         if ch.state != ChannelState.ACTIVE:
             return _not_ready(ch, "feedhold needs a running program (ACTIVE)")
         ch.state = ChannelState.HOLD
-        self._executor.hold()
+        if self._check is not None:  # STOP acts on decoding
+            self._check.stop()
+        elif self._executor is not None and not self._prod_time:
+            self._executor.hold()
         return None
 
     def manual_block(self, text: str) -> Refusal | None:
@@ -197,6 +213,11 @@ class ChannelRunner:
         """RESET from any state: stop at once, clear errors, back to READY or SELECTED."""
         ch = self.channel
         self._stop_run()
+        if self._check is not None:
+            self._check.cancel()
+            self._check = None
+        self._prod_time = False
+        ch.decoder_flags = 0
         if self._executor is not None:
             self._executor.stop_now()
         self._pending_error = None
@@ -314,9 +335,26 @@ class ChannelRunner:
         self._switchover.adjust_to_drives(self.channel)
         self._begin(job, keep_open, fresh_modal)
 
+    def _active_mode(self) -> int:
+        """The commanded execution mode as it takes effect at this start: SYNCHK implies
+        MACHINE_LOCK (warning 21309 when it was not commanded) and SUPPRESS_TECHNO_OUTPUT."""
+        mode = self.channel.execution_mode_commanded
+        if mode & ExecutionMode.SYNCHK:
+            if not mode & ExecutionMode.MACHINE_LOCK:
+                self._raise(ChannelError(
+                    SYNCHK_WITHOUT_MACHINE_LOCK, "syntax check (SYNCHK) without MACHINE_LOCK: "
+                    "MACHINE_LOCK is set implicitly, the axes do not move", warning=True))
+            mode |= ExecutionMode.MACHINE_LOCK | ExecutionMode.SUPPRESS_TECHNO_OUTPUT
+        return mode
+
     def _begin(self, job: Job, keep_open: bool, fresh_modal: bool) -> None:
         ch = self.channel
-        ch.execution_mode_active = ch.execution_mode_command
+        mode = ch.execution_mode_active = self._active_mode()
+        self._prod_time = False
+        ch.decoder_flags = 0
+        if not job.manual and mode & _CHECK_MODES and not mode & ExecutionMode.PROD_TIME:
+            self._begin_check(job, mode)
+            return
         params = [self._params[n] for n in self._axis_numbers]
         dynamics = tuple(
             AxisDynamics(p.vel_max_mm_s, p.acc_max_mm_s2, p.vel_jump_mm_s) for p in params
@@ -343,7 +381,10 @@ class ChannelRunner:
             dynamics, position, cycle_s=self._cycle_s,
             buffer_blocks=self._buffer_blocks, sw_limits_mm=sw_limits,
         )
-        self._executor.single_block = ch.single_block
+        self._prod_time = not job.manual and bool(mode & ExecutionMode.PROD_TIME)
+        self._sim_steps = 0
+        # the machining time calculation runs through without stops
+        self._executor.single_block = ch.single_block and not self._prod_time
         self._sync, self._backlog = None, []
         self._modal.contour_log_area = LogArea.NONE  # as the new log: no marked area yet
         if self.config.contour_lookahead:  # the log is cleared at every program start
@@ -358,6 +399,96 @@ class ChannelRunner:
         ch.dist_prog_start_incr = 0.0
         ch.program_time_s = 0.0
         ch.file_name, ch.line, ch.file_offset, ch.block_number = job.name, 0, 0, -1
+
+    def _begin_check(self, job: Job, mode: int) -> None:
+        """Start the syntax check (SYNCHK) or dry run (MACHINE_LOCK) of the program."""
+        ch = self.channel
+        params = [self._params[n] for n in self._axis_numbers]
+        synchk = bool(mode & ExecutionMode.SYNCHK)
+        self._check = CheckRun(
+            channel_id=ch.channel_id, name=job.name, text_of=self._loader, axes=self._axes,
+            axis_numbers=self._axis_numbers, tools=self._tools,
+            contour_lookahead=self.config.contour_lookahead,
+            start_mm=tuple(a.position_mm for a in ch.axes),
+            dynamics=tuple(AxisDynamics(p.vel_max_mm_s, p.acc_max_mm_s2, p.vel_jump_mm_s)
+                           for p in params),
+            sw_limits_mm=tuple((p.sw_limit_min_mm, p.sw_limit_max_mm) for p in params),
+            settings=ch.syn_chk if synchk else None, single_step=ch.single_block,
+            deterministic=self._deterministic, files=self._files,
+        )
+        self._released = Pause.NONE
+        self._executor = None
+        self._pending_error = None
+        self._started_at_s = self._time_s
+        ch.decoder_flags = DecoderFlag.SYNTAX_CHECK if synchk else 0
+        ch.block_count = 0
+        ch.dist_prog_start_incr = 0.0
+        ch.program_time_s = 0.0
+        ch.file_name, ch.line, ch.file_offset, ch.block_number = job.name, 0, 0, -1
+
+    def _check_cycle(self, time_s: float) -> bool:
+        """One GEO cycle of a syntax check or dry run: show where the decoder is."""
+        ch = self.channel
+        run = self._check
+        run.set_single_step(ch.single_block)
+        if self._deterministic and ch.state == ChannelState.ACTIVE:
+            run.advance()
+        p = run.progress()
+        ch.file_name, ch.line, ch.file_offset = p.file, p.line, p.offset
+        ch.block_number = p.block_number
+        ch.block_count = p.blocks
+        ch.program_time_s = time_s - self._started_at_s
+        for found in p.errors:
+            err = found.error
+            self._raise(ChannelError(int(err.id), err.message, found.file, found.line,
+                                     found.column, warning=True))
+        flags = ch.decoder_flags & DecoderFlag.SYNTAX_CHECK
+        if p.pause == Pause.AFTER_ERROR:
+            flags |= DecoderFlag.WAIT_AFTER_ERROR
+        elif p.pause != Pause.NONE:
+            flags |= DecoderFlag.WAIT_CONTINUE
+        if self._released == Pause.AFTER_ERROR:  # the implicit enable, cleared this cycle
+            flags |= DecoderFlag.SYNTAX_CHECK_RELEASE_CLEARED
+        elif self._released != Pause.NONE:
+            flags |= DecoderFlag.WAIT_RELEASE_CLEARED
+        self._released = Pause.NONE
+        ch.decoder_flags = flags
+        if p.done:
+            self._check = None
+            ch.decoder_flags = 0
+            if p.failure is not None:
+                err = p.failure.error
+                self._fail(ChannelError(int(err.id), err.message, p.failure.file,
+                                        p.failure.line, p.failure.column))
+                return False
+            if p.stopped_early:
+                self._raise(ChannelError(
+                    CHECK_STOPPED_WARNING, f"syntax check stopped after {p.error_count} errors "
+                    "(syn_chk.errors_total, P-CHAN-00019)", p.file, p.line, warning=True))
+            return self._end_program()
+        if p.pause != Pause.NONE:
+            ch.state = ChannelState.HOLD
+            ch.waiting_for_start = True
+            return False
+        return ch.state == ChannelState.ACTIVE
+
+    def _prod_time_cycle(self) -> bool:
+        """PROD_TIME: simulate cycles of the run in kernel time as fast as the CPU allows
+        (a share of each GEO cycle); ``program_time`` is the simulated time."""
+        if self.channel.state == ChannelState.HOLD:
+            return False
+        deadline = time.perf_counter() + _PROD_TIME_SHARE * self._cycle_s
+        for n in range(PROD_TIME_STEPS_PER_CYCLE):
+            if not self._deterministic and n % 64 == 0 and time.perf_counter() > deadline:
+                break
+            self._sim_steps += 1
+            self._time_s = self._started_at_s + self._sim_steps * self._cycle_s
+            if not self._motion_cycle(self._time_s, 1.0, output=False):
+                return False
+            if self._executor.waiting in (Waiting.PROGRAMMED_STOP, Waiting.SINGLE_BLOCK):
+                self._executor.resume()  # M0/M1: the calculation does not wait
+                self.channel.waiting_for_start = False
+        return True
 
     def _stop_run(self) -> None:
         if self._feed is not None:
@@ -461,11 +592,22 @@ class ChannelRunner:
         if self._pending_start is not None:
             self._begin_pending()
             executor = self._executor
-            if executor is None:  # the start failed (jog-of-path check)
+            if executor is None and self._check is None:  # the start failed (jog of path)
                 self.touched = True
                 return False
         self.touched = True
-        if executor.single_block != ch.single_block:
+        if self._check is not None:
+            return self._check_cycle(time_s)
+        if self._prod_time:
+            return self._prod_time_cycle()
+        return self._motion_cycle(time_s, ch.feed_override_active / 1000.0, output=True)
+
+    def _motion_cycle(self, time_s: float, override: float, output: bool) -> bool:
+        """One interpolation cycle of the path; ``output`` False: the axes stay where
+        they are (PROD_TIME). True while there is motion or decoding to do."""
+        ch = self.channel
+        executor = self._executor
+        if output and executor.single_block != ch.single_block:
             executor.single_block = ch.single_block
         if self._sync is not None and executor.idle:
             if not self._apply_sync():
@@ -477,14 +619,15 @@ class ChannelRunner:
             if self._contour_changed:  # once per cycle, not per block
                 self._contour_changed = False
                 self._show_contour_state()
-        step = executor.step(ch.feed_override_active / 1000.0)
-        for axis, pos in zip(ch.axes, step.position_mm, strict=True):
-            axis.position_mm = pos
-            axis.command_position_incr = round(pos * _INCR_PER_MM)
-        ch.path_velocity_mm_s = step.path_velocity_mm_s
-        ch.programmed_velocity_mm_s = step.programmed_velocity_mm_s
-        ch.remaining_in_block_mm = step.remaining_in_block_mm
-        ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
+        step = executor.step(override)
+        if output:
+            for axis, pos in zip(ch.axes, step.position_mm, strict=True):
+                axis.position_mm = pos
+                axis.command_position_incr = round(pos * _INCR_PER_MM)
+            ch.path_velocity_mm_s = step.path_velocity_mm_s
+            ch.programmed_velocity_mm_s = step.programmed_velocity_mm_s
+            ch.remaining_in_block_mm = step.remaining_in_block_mm
+            ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
         ch.program_time_s = time_s - self._started_at_s
         for block in step.finished:
             ch.block_count += 1

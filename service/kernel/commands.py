@@ -43,9 +43,36 @@ class Command(Protocol):
         ...
 
 
-#: Execution mode bits the kernel implements so far. Others are refused, never stored.
-IMPLEMENTED_EXECUTION_MODES = ExecutionMode.ISG_STANDARD | ExecutionMode.ADD_MDI_BLOCK
+#: Execution mode bits the kernel implements. Others are refused, never stored.
+IMPLEMENTED_EXECUTION_MODES = (
+    ExecutionMode.ISG_STANDARD | ExecutionMode.SYNCHK | ExecutionMode.PROD_TIME
+    | ExecutionMode.MACHINE_LOCK | ExecutionMode.ADD_MDI_BLOCK
+    | ExecutionMode.SUPPRESS_TECHNO_OUTPUT
+)
 _KNOWN_MODE_BITS = sum(m for m in ExecutionMode)
+
+
+def execution_mode_refused(value: int) -> Refusal | None:
+    """Why ``value`` cannot be an execution mode of this kernel, or None."""
+    if value < 0 or value & ~_KNOWN_MODE_BITS:
+        return Refusal(
+            RefusalReason.INVALID_VALUE,
+            f"execution mode 0x{value & 0xFFFFFFFF:x} has bits that are not execution modes",
+        )
+    missing = value & ~IMPLEMENTED_EXECUTION_MODES
+    if missing:
+        names = "|".join(m.name for m in ExecutionMode if m and m & missing)
+        return Refusal(
+            RefusalReason.INVALID_VALUE,
+            f"execution mode {names} (0x{missing:x}) is not implemented by this kernel; "
+            "it has SYNCHK 0x8, PROD_TIME 0x10, MACHINE_LOCK 0x40, ADD_MDI_BLOCK 0x80 and "
+            "SUPPRESS_TECHNO_OUTPUT 0x2000",
+        )
+    if value & ExecutionMode.SYNCHK and value & ExecutionMode.PROD_TIME:
+        return Refusal(RefusalReason.INVALID_VALUE,
+                       "SYNCHK and PROD_TIME cannot be combined: choose the syntax check or "
+                       "the machining time calculation")
+    return None
 
 
 @dataclass(frozen=True, slots=True)
@@ -69,26 +96,63 @@ class SetFeedOverride:
 
 @dataclass(frozen=True, slots=True)
 class SetExecutionMode:
-    """Command the channel's execution mode; it takes effect at the next program start."""
+    """The HMI commands the channel's execution mode (``mc_command_execution_mode_w``,
+    the control unit's ``request_r``); it takes effect at the next program start."""
 
     channel_index: int
     value: int
 
     def apply(self, state: KernelState) -> Refusal | None:
-        if self.value < 0 or self.value & ~_KNOWN_MODE_BITS:
-            return Refusal(
-                RefusalReason.INVALID_VALUE,
-                f"execution mode 0x{self.value & 0xFFFFFFFF:x} has bits that are not "
-                "execution modes",
-            )
-        missing = self.value & ~IMPLEMENTED_EXECUTION_MODES
-        if missing:
-            names = "|".join(m.name for m in ExecutionMode if m and m & missing)
-            return Refusal(
-                RefusalReason.INVALID_VALUE,
-                f"execution mode {names} is not implemented by this kernel yet",
-            )
-        state.channels[self.channel_index].execution_mode_command = self.value
+        refused = execution_mode_refused(self.value)
+        if refused is None:
+            state.channels[self.channel_index].execution_mode_command = self.value
+        return refused
+
+
+@dataclass(frozen=True, slots=True)
+class SetExecutionModePlc:
+    """``decoder_mc_control.execution_mode.command_w``: the PLC's execution mode."""
+
+    channel_index: int
+    value: int
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        refused = execution_mode_refused(self.value)
+        if refused is None:
+            state.channels[self.channel_index].execution_mode_plc_command = self.value
+        return refused
+
+
+@dataclass(frozen=True, slots=True)
+class SetExecutionModeEnable:
+    """``decoder_mc_control.execution_mode.enable_w``: TRUE makes the next program start
+    take the PLC's ``command_w`` instead of the HMI's request."""
+
+    channel_index: int
+    value: bool
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        state.channels[self.channel_index].execution_mode_plc_enable = bool(self.value)
+        return None
+
+
+@dataclass(frozen=True, slots=True)
+class SetSyntaxCheckParameter:
+    """``ch<c>.syn_chk.<name>`` (P-CHAN-00019/20/28/416) for the next syntax check."""
+
+    channel_index: int
+    name: str
+    value: int
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        channel = state.channels[self.channel_index]
+        value = self.value
+        if self.name in ("errors_total", "errors_per_block") and not 0 <= value <= 0xFFFF:
+            return Refusal(RefusalReason.INVALID_VALUE,
+                           f"syn_chk.{self.name} {value} is outside 0..65535")
+        if self.name in ("interactive", "record_result"):
+            value = bool(value)
+        channel.syn_chk = channel.syn_chk.model_copy(update={self.name: value})
         return None
 
 

@@ -62,11 +62,12 @@ class Kernel:
         clock: Clock,
         loader: Loader = _no_programs,
         exists: Callable[[str], bool] = lambda name: False,
-        files: Callable[[str, bytes], None] = lambda name, data: None,
+        files: Callable[..., None] = lambda name, data, replace=False: None,
     ) -> None:
         """``loader(name)`` returns a program's text (KeyError when absent) and
         ``exists(name)`` says whether it is there: the program store, seen by the kernel.
-        ``files(name, data)`` appends to a file of the store (logs); it must not block."""
+        ``files(name, data, replace=False)`` appends to a file of the store (logs), or
+        replaces its content (a result file); it must not block."""
         self.config = config
         self.cycle_s = config.cycle_ms / 1000.0
         self.cycle_ns = round(config.cycle_ms * 1e6)

@@ -8,8 +8,8 @@ consistent within one cycle and never waits for the kernel.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from enum import IntEnum
-from typing import NamedTuple
+from enum import IntEnum, IntFlag
+from typing import Any, NamedTuple
 
 from ..config import ChannelConfig, MachineConfig
 
@@ -20,6 +20,16 @@ class LinkState(IntEnum):
     LINKED = 0  # the link exists: this logical axis drives the physical axis
     REQUESTED = 1  # the physical axis is requested from the position controller
     WAITING_ACK = 2  # waiting for the position controller's acknowledgement
+
+
+class DecoderFlag(IntFlag):
+    """Display flags of the decoder (``pMC[i].StateDecoder_Data``, FCT-C9)."""
+
+    SYNTAX_CHECK = 0x1  # X_SyntaxCheck: the decoder works in the syntax check
+    WAIT_AFTER_ERROR = 0x2  # X_WaitAfterError: waits after an error for continue/abort
+    SYNTAX_CHECK_RELEASE_CLEARED = 0x4  # X_SyntaxCheckReleaseNextBlockCleared
+    WAIT_CONTINUE = 0x8  # X_WaitContinue: decoding interrupted (single step, STOP)
+    WAIT_RELEASE_CLEARED = 0x10  # X_WaitReleaseNextBlockCleared
 
 
 class ExecutionMode(IntEnum):
@@ -184,6 +194,20 @@ class Channel:
     suspend_enable_w: bool = True
     suspend_request_r: bool = False
     contour: ContourLookaheadUnit = field(default_factory=ContourLookaheadUnit)
+    # gpCh[i].decoder_mc_control.execution_mode (ISG control unit): request_r is the HMI's
+    # execution_mode_command; the PLC's command_w counts while enable_w is TRUE
+    execution_mode_plc_command: int = 0
+    execution_mode_plc_enable: bool = False
+    syn_chk: Any = None  # SyntaxCheckConfig for the next check (ch<c>.syn_chk.*)
+    decoder_flags: int = 0  # DecoderFlag bits (pMC[i].StateDecoder_Data)
+
+    @property
+    def execution_mode_commanded(self) -> int:
+        """The execution mode the next program start takes: the PLC's ``command_w``
+        while it enables the unit, else the HMI's request."""
+        if self.execution_mode_plc_enable:
+            return self.execution_mode_plc_command
+        return self.execution_mode_command
 
     @property
     def suspend_commanded(self) -> bool:
@@ -203,7 +227,8 @@ class Channel:
             self.manual_blocks_done, self.path_velocity_mm_s, self.programmed_velocity_mm_s,
             self.remaining_in_block_mm, self.program_time_s, self.errors, self.error_count,
             self.suspend_command_w, self.suspend_enable_w, self.suspend_request_r,
-            self.contour,
+            self.contour, self.execution_mode_plc_command, self.execution_mode_plc_enable,
+            self.syn_chk, self.decoder_flags,
         )
 
 
@@ -341,4 +366,5 @@ def _channel_from_config(config: ChannelConfig, machine: MachineConfig) -> Chann
         output_suspended=suspended,
         suspend_command_w=suspended,
         suspend_request_r=suspended,
+        syn_chk=config.syn_chk,
     )

@@ -78,14 +78,17 @@ async def test_write_is_applied_before_the_reply(api: Any) -> None:
     assert await api.read_address(COM, 0x120101, 0x0C, "UNS16") == 1000
 
 
-async def test_execution_mode_standard_is_accepted_others_refused(api: Any) -> None:
-    await api.write("ch1.mc_command_execution_mode_w", 0)
-    assert await api.read("ch1.mc_command_execution_mode_r") == 0
+async def test_execution_mode_implemented_bits_are_accepted_others_refused(api: Any) -> None:
+    await api.write("ch1.mc_command_execution_mode_w", 0x48)  # SYNCHK | MACHINE_LOCK
+    assert await api.read("ch1.mc_command_execution_mode_r") == 0x48
+    assert await api.read("gpCh[0].decoder_mc_control.execution_mode.request_r") == 0x48
     with pytest.raises(AdsError) as caught:
-        await api.write("ch1.mc_command_execution_mode_w", 0x8)
+        await api.write("ch1.mc_command_execution_mode_w", 0x1)
     assert caught.value.code == 0x706
-    assert "SYNCHK" in str(caught.value)
-    assert await api.read("ch1.mc_active_execution_mode_r") == 0
+    assert "BLOCK_SEARCH" in str(caught.value)
+    assert await api.read("ch1.mc_command_execution_mode_r") == 0x48  # nothing stored
+    assert await api.read("ch1.mc_active_execution_mode_r") == 0  # from the next start
+    await api.write("ch1.mc_command_execution_mode_w", 0)
 
 
 async def test_error_names_code_and_reason(api: Any) -> None:

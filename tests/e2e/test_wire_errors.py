@@ -401,7 +401,8 @@ def test_out_of_range_feed_override_is_0x706_and_not_applied(service: RunningSer
 @pytest.mark.parametrize(
     "mode",
     [
-        pytest.param(0x8, id="SYNCHK-not-implemented"),
+        pytest.param(0x1, id="block-search-not-implemented"),
+        pytest.param(0x18, id="SYNCHK-with-PROD_TIME"),
         pytest.param(0x4000_0000, id="undefined-bit"),
         pytest.param(-1, id="negative"),
     ],

@@ -117,6 +117,8 @@ def _scope(obj) -> Scope:
     """The scope an instance was made for, from its name, channel and axis."""
     if obj.name.startswith("gpCh["):
         return Scope.PLC_CHANNEL
+    if obj.name.startswith("pMC["):
+        return Scope.PLC_MC
     if obj.name.startswith("gpAx["):
         return Scope.PLC_AXIS
     if obj.channel:
@@ -132,6 +134,7 @@ def test_every_template_is_instantiated_once_per_scope_member() -> None:
         Scope.CHANNEL: len(LAYOUT.channels),
         Scope.CHANNEL_AXIS: sum(c.axis_count for c in LAYOUT.channels),
         Scope.PLC_CHANNEL: len(LAYOUT.channels),
+        Scope.PLC_MC: len(LAYOUT.channels),
         Scope.PLC_AXIS: len(LAYOUT.hli_axes),
     }
     for template in TEMPLATES:
@@ -166,6 +169,10 @@ def test_every_object_follows_the_address_rules() -> None:
             case Scope.PLC_CHANNEL:  # gpCh[i]: i = position of the channel, from 0
                 i = [c.channel_id for c in LAYOUT.channels].index(obj.channel)
                 assert obj.name == f"gpCh[{i}].{t.element}"
+                assert (obj.group, obj.offset) == (PLC_GROUP, 0x10000 + i * 0x1000 + t.offset)
+            case Scope.PLC_MC:  # pMC[i]: the older name of the same per-channel block
+                i = [c.channel_id for c in LAYOUT.channels].index(obj.channel)
+                assert obj.name == f"pMC[{i}].{t.element}"
                 assert (obj.group, obj.offset) == (PLC_GROUP, 0x10000 + i * 0x1000 + t.offset)
             case Scope.PLC_AXIS:  # gpAx[i]: i = slot of the axis number
                 i = LAYOUT.hli_axes.index(obj.axis)

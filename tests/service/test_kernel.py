@@ -77,8 +77,8 @@ def test_refusals_say_why(kernel: Kernel) -> None:
     refusal = submit(kernel, SetFeedOverride(0, 1001))
     assert refusal is not None and refusal.reason is RefusalReason.INVALID_VALUE
     assert "100.1 %" in refusal.message
-    refusal = submit(kernel, SetExecutionMode(0, 0x48))
-    assert refusal is not None and "SYNCHK|MACHINE_LOCK" in refusal.message
+    refusal = submit(kernel, SetExecutionMode(0, 0x102))
+    assert refusal is not None and "SOLLKON|KIN_TRAFO_OFF" in refusal.message
     refusal = submit(kernel, SetExecutionMode(0, -1))
     assert refusal is not None and refusal.reason is RefusalReason.INVALID_VALUE
 

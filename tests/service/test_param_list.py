@@ -417,7 +417,9 @@ def test_an_axis_without_log_achs_nr_is_reported_at_its_name() -> None:
 def test_unknown_channel_key_lists_the_supported_ones() -> None:
     assert problems_of(parse_channel_list, "grp_anzahl 1") == [
         (1, "unknown key 'grp_anzahl' (supported: gruppe[0].achs_anzahl, "
-            "gruppe[0].achse[n].log_achs_nr, gruppe[0].achse[n].bezeichnung, jog_of_path_only)")
+            "gruppe[0].achse[n].log_achs_nr, gruppe[0].achse[n].bezeichnung, jog_of_path_only, "
+            "syn_chk.errors_total, syn_chk.fehler_gesamt, syn_chk.errors_per_block, "
+            "syn_chk.fehler_pro_zeile, syn_chk.interactive, syn_chk.record_result)")
     ]
 
 

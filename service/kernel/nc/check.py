@@ -72,6 +72,11 @@ class CheckAborted(Exception):
     """Raised by ``SyntaxCheck.report`` to end decoding (error limit, RESET)."""
 
 
+class ErrorReported(Exception):
+    """Raised where the decoder uses a control statement whose line the check dropped
+    (its error is reported already): it goes on as after a failing statement."""
+
+
 class SyntaxCheck(Protocol):
     """What the decoder tells the syntax check; implemented by the kernel."""
 
@@ -177,10 +182,48 @@ def categorize(error: NcError, line: LogicalLine | None) -> ErrorCategory:
 
 # ---------------------------------------------------------------- repositioning
 
+class RepositionedLine(LogicalLine):
+    """A line with parts blanked after errors; ``errors``: how many were reported in it
+    (they count towards ``errors_per_block`` when the block is executed)."""
+
+    __slots__ = ("errors",)
+
+    def __init__(self, line: LogicalLine, text: str, errors: int = 0) -> None:
+        super().__init__(line.file, text, line.segments, line.offset)
+        self.errors = errors
+
+
 def blanked(line: LogicalLine, start: int, stop: int) -> LogicalLine:
     """``line`` with ``[start, stop)`` replaced by blanks (columns stay as they were)."""
     text = line.text[:start] + " " * (stop - start) + line.text[stop:]
-    return LogicalLine(line.file, text, line.segments, line.offset)
+    return RepositionedLine(line, text, getattr(line, "errors", 0))
+
+
+def term_start(text: str, pos: int) -> int:
+    """Start of the term that holds ``pos``: ``pos`` itself, or when ``pos`` is inside
+    brackets or a string, the start of the word whose ``[`` or ``"`` opened them (an
+    error inside ``X[...]`` drops all of ``X[...]``, not the part after the error)."""
+    depth = 0
+    quoted = False
+    opened = pos
+    for k in range(min(pos, len(text))):
+        c = text[k]
+        if c == '"':
+            if not quoted and depth == 0:
+                opened = k
+            quoted = not quoted
+        elif not quoted:
+            if c == "[":
+                if depth == 0:
+                    opened = k
+                depth += 1
+            elif c == "]":
+                depth = max(depth - 1, 0)
+    if depth == 0 and not quoted:
+        return pos
+    while opened > 0 and (text[opened - 1].isalpha() or text[opened - 1] in "._+-"):
+        opened -= 1
+    return opened
 
 
 def term_end(text: str, pos: int) -> int:
@@ -225,15 +268,37 @@ def without_error(line: LogicalLine, error: NcError, category: ErrorCategory
                   ) -> LogicalLine | None:
     """The line to parse again after ``error``, or None to drop the line."""
     pos = error.pos
-    if pos < 0 or pos >= len(line.text):
+    if pos < 0 or pos > len(line.text) or category in (ErrorCategory.RESOURCE,
+                                                        ErrorCategory.COMMAND):
         return None
-    if category == ErrorCategory.ASSIGNMENT:
-        return blanked(line, pos, assignment_end(line, pos))
-    if category == ErrorCategory.AFTER_COMMAND:
-        return blanked(line, pos, len(line.text))
-    if category in (ErrorCategory.RESOURCE, ErrorCategory.COMMAND):
+    if pos < len(line.text):
+        if category == ErrorCategory.ASSIGNMENT:
+            return blanked(line, pos, assignment_end(line, pos))
+        if category == ErrorCategory.AFTER_COMMAND:
+            return blanked(line, pos, len(line.text))
+    start = term_start(line.text, pos)  # at the end: an unclosed bracket or string
+    if start >= len(line.text):
         return None
-    return blanked(line, pos, term_end(line.text, pos))
+    return blanked(line, start, term_end(line.text, start))
+
+
+def item_at(line: LogicalLine, items: list, pos: int) -> int | None:
+    """Index of the item (word or assignment) of an NC block whose text holds ``pos``
+    (an error in ``X[1/0]`` or ``V.L.A = 1/0`` is that item's), or None."""
+    from .statements import Assign  # noqa: PLC0415 - statements imports expressions
+
+    found = None
+    for k, item in enumerate(items):
+        if item.pos <= pos and (found is None or item.pos > items[found].pos):
+            found = k
+    if found is None:
+        return None
+    start = items[found].pos
+    if type(items[found]) is Assign:
+        end = assignment_end(line, start)
+    else:
+        end = term_end(line.text, start)
+    return found if pos < end else None
 
 
 def after_command(line: LogicalLine, error: NcError, parse) -> object | None:
@@ -251,9 +316,53 @@ def after_command(line: LogicalLine, error: NcError, parse) -> object | None:
     return None if isinstance(stmt, NcBlock) else stmt
 
 
+class _Dropped:
+    """The expressions (and the ``$FOR`` variable) of a control statement whose line
+    was dropped: evaluating them raises ``ErrorReported``."""
+
+    __slots__ = ()
+
+    def __call__(self, env):
+        raise ErrorReported
+
+    def assign(self, env, value) -> None:
+        raise ErrorReported
+
+
+_DROPPED = _Dropped()
+# the keyword of a control statement that has an expression
+_CONTROL_WITH_EXPRESSION = re.compile(
+    r"\$(IF|ELSEIF|WHILE|FOR|SWITCH|CASE|UNTIL)\b|#[ \t]*RT[ \t]+WHILE\b")
+
+
+def dropped_control(line: LogicalLine):
+    """For a dropped line of a control statement with an expression ($IF, $ELSEIF,
+    $WHILE, $FOR, $SWITCH, $CASE, $UNTIL, #RT WHILE): a statement of that kind whose
+    expressions raise ``ErrorReported``, so the control flow keeps its structure (a
+    dropped $IF skips its block, a dropped $CASE never matches, ...); else None."""
+    from .statements import Control, StmtKind  # noqa: PLC0415
+
+    start = command_position(line)
+    if start < 0:
+        return None
+    m = _CONTROL_WITH_EXPRESSION.match(line.upper, start)
+    if m is None:
+        return None
+    if m.group(1) is None:
+        kind = StmtKind.RT_WHILE
+    elif m.group(1) == "IF" and "$GOTO" in line.upper[m.end():]:
+        kind = StmtKind.IF_GOTO
+    else:
+        kind = StmtKind[m.group(1)]
+    return Control(kind, line, start, expr=_DROPPED, target=_DROPPED, end=_DROPPED,
+                   step=_DROPPED, values=(_DROPPED,))
+
+
 def parse_checked(parse, line: LogicalLine, check: SyntaxCheck):
     """Parse ``line``, reporting each error and repositioning after it; the statement
-    of what was understood, or None when the line is dropped."""
+    of what was understood, or None when the line is dropped (a control statement
+    with an expression stays as ``dropped_control``)."""
+    original = line
     count = 0
     while True:
         try:
@@ -267,15 +376,17 @@ def parse_checked(parse, line: LogicalLine, check: SyntaxCheck):
             check.report(error, category)
             count += 1
             if check.errors_per_block and count >= check.errors_per_block:
-                return None
+                return dropped_control(original)
             again = without_error(line, error, category)
             if again is None or again.text == line.text:
-                return None
+                return dropped_control(original)
+            again.errors = count
             line = again
 
 
 __all__ = [
-    "BATCH_LINES", "CHECK_FEED_MM_MIN", "CheckAborted", "ErrorCategory", "PointBatch",
-    "SyntaxCheck", "categorize", "command_position", "parse_checked",
+    "BATCH_LINES", "CHECK_FEED_MM_MIN", "CheckAborted", "ErrorCategory", "ErrorReported",
+    "PointBatch", "SyntaxCheck", "categorize", "command_position", "item_at",
+    "parse_checked",
 ]
 

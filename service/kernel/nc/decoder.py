@@ -24,7 +24,10 @@ from dataclasses import replace
 
 from .blockexec import BlockExecutor, Flow
 from .blocks import Block, LogArea
-from .check import CHECK_FEED_MM_MIN, CheckAborted, ErrorCategory, SyntaxCheck, categorize
+from .check import (
+    CHECK_FEED_MM_MIN, CheckAborted, ErrorCategory, ErrorReported, SyntaxCheck, categorize,
+    item_at,
+)
 from .contour import execute_contour
 from .control import ControlFlow
 from .declarations import declare, read_block
@@ -124,6 +127,11 @@ class Decoder:
         self._started = False
         self.emitted = 0  # grows whenever blocks were yielded (the loop guard watches it)
         self.own_variables: set[int] = set()  # ids of the variables this decoder declared
+
+    @property
+    def source(self):
+        """The text of the program being decoded (``SourceText``: lines, offsets)."""
+        return self._main.src
 
     @property
     def modal(self) -> ModalState:
@@ -231,7 +239,10 @@ class Decoder:
     # ------------------------------------------------------------ syntax check
 
     def _checked_step(self, frame: Frame) -> Block | None:
-        """``slow_step`` of the syntax check: an error is reported, decoding goes on."""
+        """``slow_step`` of the syntax check: an error is reported, decoding goes on.
+
+        When the call or ``$GOTO`` of an NC block fails after its words ran, the Block
+        of the words is still yielded (the modal state has moved to its end)."""
         check = self.check
         program = frame.program
         index = frame.index
@@ -240,33 +251,45 @@ class Decoder:
             self._end_of_section(frame)
             return None
         block = None
+        self._executed = None  # the Block of the line's words, set by _execute_checked
+        depth = len(frame.control)
         try:
             block = self._step(frame)
         except CheckAborted:
             raise
+        except ErrorReported:  # a statement the check dropped: its error is reported
+            stmt, after = program.statement(index, end)
+            if frame.index == index:
+                frame.index = self._skip_failed(frame, stmt, index, after, depth)
         except RecursionError:
             error = NcError(NcErrorId.EXPRESSION_TOO_COMPLEX, program.name, index + 1, 1,
                             "program too deeply nested to decode")
             check.report(error, ErrorCategory.RESOURCE)
             frame.index = program.statement(index, end)[1]
         except Exception as exc:  # noqa: BLE001 - every error is the program's, reported
+            block = self._executed
             error = self.fault(exc, frame, index)
             stmt, after = program.statement(index, end)
             line = getattr(stmt, "line", None)
             check.report(error, categorize(error, line))
             if frame.index == index:
-                frame.index = self._skip_failed(frame, stmt, index, after)
+                frame.index = self._skip_failed(frame, stmt, index, after, depth)
         check.line(program.src, index, program.statement(index, end)[1])
         return block
 
-    def _skip_failed(self, frame: Frame, stmt, index: int, after: int) -> int:
+    def _skip_failed(self, frame: Frame, stmt, index: int, after: int, depth: int) -> int:
         """Where to go on after the statement at ``index`` failed: an opening control
-        statement skips its block (so its end is no follow-up error), others the line."""
+        statement skips its block (so its end is no follow-up error), others the line.
+        A failing ``$UNTIL`` or ``$ENDFOR`` (``depth``: the open blocks before it) ends
+        its loop, so the end of an enclosing block is no follow-up error either."""
         if type(stmt) is Control and stmt.kind in OPENERS:
             try:
                 return frame.program.structure(stmt, index, frame.section.end).after
             except NcError:
                 return after
+        if (type(stmt) is Control and stmt.kind in CLOSER_OF and len(frame.control) == depth
+                and frame.control and frame.control[-1].kind == CLOSER_OF[stmt.kind]):
+            frame.control.pop()
         return after
 
     def _execute_checked(self, stmt: NcBlock):
@@ -274,10 +297,19 @@ class Decoder:
         is dropped and the block executed again (assignments that ran stay done)."""
         check = self.check
         executor = self.executor
-        count = 0
+        count = getattr(stmt.line, "errors", 0)  # errors reported when it was parsed
         while True:
             try:
-                return executor.execute(stmt, self)
+                block, flow, flow_pos = executor.execute(stmt, self)
+                if flow == Flow.SUBPROGRAM_END and self.frames[-1].kind == FrameKind.MAIN:
+                    # M17/M29 in the main program: dropped, the rest of the block used
+                    check.report(stmt.line.error(
+                        NcErrorId.SUBPROGRAM_END_IN_MAIN,
+                        "M17/M29 ends a subprogram; the main program ends with M30", flow_pos,
+                    ), ErrorCategory.COMBINATION)
+                    flow, flow_pos = Flow.NONE, -1
+                self._executed = block
+                return block, flow, flow_pos
             except NcError as error:
                 check.report(error, categorize(error, stmt.line))
                 count += 1
@@ -289,7 +321,7 @@ class Decoder:
                     self._modal.feed_mm_min = CHECK_FEED_MM_MIN
                     drop = -1
                 else:
-                    drop = next((k for k, item in enumerate(items) if item.pos == error.pos), None)
+                    drop = item_at(stmt.line, items, error.pos)
                     if drop is None:
                         return None, Flow.NONE, -1
                     item = items[drop]

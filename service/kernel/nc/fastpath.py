@@ -240,10 +240,13 @@ _EMIT_BLOCK = '''\
                 yield block'''
 
 # check mode (syntax check, dry run): a record per moving line instead of a Block
+# (``motion`` is the arc centre, 0 for a straight line: its record has centre None);
+# ``emitted`` as where the normal loop yields a Block, so the loop guard sees the same
 _EMIT_RECORD = '''\
                 if motion is not None:
-                    record((i, k, end_pos, motion))
-                i += 1'''
+                    record((i, k, end_pos, motion or None))
+                i += 1
+                emitted = True'''
 
 _SETUP_RECORDS = '''\
         start_i = i
@@ -253,7 +256,6 @@ _SETUP_RECORDS = '''\
 
 _FLUSH_RECORDS = '''\
         if i > start_i:
-            emitted = True
             yield POINT_BATCH(program.src, start_i, i, start_pos, plane, records)'''
 
 # check mode: compensation and single-stepping take the general path; batches are bounded

@@ -1,0 +1,415 @@
+"""The syntax check (SYNCHK) and the dry run (MACHINE_LOCK) of one program, in its SDA thread.
+
+Both decode the whole program with the decoder's check mode and interpolate to block
+end points only: no axis moves, no M/H/T, spindle or dwell is executed, feedhold,
+override and feed enables do not matter. Each end point (and each arc's extent) is
+checked against the software limit switches (``path.endpoints``); blocks under tool
+radius compensation go through the path preparation, so its errors are found too.
+
+* **Syntax check** (``settings`` given): every error is reported with its category and
+  decoding goes on (``nc.check``). ``errors_total`` ends the check after that many
+  errors (warning ``CHECK_STOPPED_WARNING``), ``errors_per_block`` is the decoder's.
+  With ``interactive`` the check waits after each error (``Pause.AFTER_ERROR``) until
+  ``resume`` (START) or ``cancel`` (RESET). With ``record_result`` every checked line
+  and every error go to ``dec0<channel>.sc``, written in one piece when the check ends.
+* **Dry run** (``settings`` None): the first error ends the run, as in a real run.
+
+A software limit violation ends both with that error. Single step at decoder level
+(``single_step``) stops after every NC line (``Pause.SINGLE_STEP``); ``stop`` (STOP)
+pauses decoding at the next line or batch (``Pause.STOPPED``); ``resume`` goes on.
+
+The GEO cycle reads ``progress()`` (file position of the decoder, lines and blocks
+checked, new errors, pause, end) and shows it; it never waits for the check, except
+with the virtual clock, where each cycle lets the check decode ``lines_per_cycle``
+lines (``advance``) so that a run is the same cycle by cycle every time.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+import threading
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from enum import IntEnum
+
+from protocol.constants import PROGRAM_MAX_BYTES
+
+from ..config import SyntaxCheckConfig
+from .nc import Decoder, ModalState, NcError, NcErrorId
+from .nc.blocks import Block, Compensation, StopKind
+from .nc.check import CheckAborted, ErrorCategory, PointBatch
+from .nc.source import SourceText
+from .path.endpoints import first_violation
+from .path.errors import PathError
+from .path.limits import AxisDynamics
+from .path.segments import PathPreparation
+
+log = logging.getLogger(__name__)
+
+SYNCHK_WITHOUT_MACHINE_LOCK = 21309  # ISG P-ERR-21309 (warning): MACHINE_LOCK set implicitly
+CHECK_STOPPED_WARNING = 21310  # the check ended early: syn_chk.errors_total reached
+LINES_PER_CYCLE = 20_000  # virtual clock: lines decoded per GEO cycle
+_N_WORD = re.compile(r"[ \t]*N[ \t]*([0-9]+)", re.IGNORECASE)
+
+
+def log_name(channel_id: int) -> str:
+    """The result file of a syntax check in channel ``channel_id`` (``dec01.sc``)."""
+    return f"dec0{channel_id}.sc"
+
+
+class Pause(IntEnum):
+    """Why the check waits."""
+
+    NONE = 0
+    AFTER_ERROR = 1  # interactive: an error was reported (X_WaitAfterError)
+    SINGLE_STEP = 2  # single step: one NC line was decoded (X_WaitContinue)
+    STOPPED = 3  # STOP: decoding interrupted (X_WaitContinue)
+
+
+@dataclass(frozen=True, slots=True)
+class CheckedError:
+    """An error the check reported, with its category (None: it ended the run)."""
+
+    error: NcError | PathError
+    category: ErrorCategory | None
+    file: str = ""
+    line: int = 0
+    column: int = 0
+
+
+@dataclass(slots=True)
+class Progress:
+    """What the GEO cycle shows of the check."""
+
+    file: str = ""
+    line: int = 0  # 1-based line of the decoder (0: none yet)
+    offset: int = 0  # byte offset of that line
+    block_number: int = -1  # its N, -1 when it has none
+    lines: int = 0  # NC lines decoded
+    blocks: int = 0  # blocks checked (motion lines and other blocks)
+    errors: list[CheckedError] = field(default_factory=list)  # not yet taken by GEO
+    error_count: int = 0
+    pause: Pause = Pause.NONE
+    done: bool = False
+    failure: CheckedError | None = None  # the error that ended the run
+    stopped_early: bool = False  # errors_total reached
+
+
+class CheckRun:
+    """A syntax check or dry run of ``name`` in a thread of its own."""
+
+    def __init__(
+        self,
+        *,
+        channel_id: int,
+        name: str,
+        text_of: Callable[[str], str],
+        axes: tuple[str, ...],
+        axis_numbers: tuple[int, ...],
+        tools: dict[int, float],
+        contour_lookahead: bool,
+        start_mm: tuple[float, ...],
+        dynamics: Sequence[AxisDynamics],
+        sw_limits_mm: Sequence[tuple[float, float]],
+        settings: SyntaxCheckConfig | None,
+        single_step: bool,
+        deterministic: bool,
+        files: Callable[..., None],
+    ) -> None:
+        self.channel_id = channel_id
+        self.name = name
+        self.settings = settings
+        self.errors_per_block = settings.errors_per_block if settings else 0
+        self.line_by_line = single_step
+        self._text_of = text_of
+        self._axes = axes
+        self._axis_numbers = axis_numbers
+        self._tools = tools
+        self._contour_lookahead = contour_lookahead
+        self._start = start_mm
+        self._dynamics = tuple(dynamics)
+        self._limits = tuple(sw_limits_mm)
+        self._deterministic = deterministic
+        self._files = files
+        self._record = bool(settings and settings.record_result)
+        self._log: list[str] = []
+        self._pending_log: list[str] = []  # errors of the line being decoded
+        self._sources: dict[str, SourceText] = {}  # files decoded so far, by name
+        self._cond = threading.Condition()
+        self._progress = Progress(file=name)
+        self._budget = 0  # virtual clock: lines the check may still decode
+        self._pause_wanted = False
+        self._cancelled = False
+        self._position = start_mm  # where the last checked block ended
+        self._prep: PathPreparation | None = None  # blocks under radius compensation
+        self._thread = threading.Thread(target=self._run, name=f"cnc-check-ch{channel_id}",
+                                        daemon=True)
+        self._thread.start()
+
+    # ------------------------------------------------------------ GEO side
+
+    def progress(self) -> Progress:
+        """A copy of the progress; the errors reported since the last call move out."""
+        with self._cond:
+            p = self._progress
+            taken = Progress(p.file, p.line, p.offset, p.block_number, p.lines, p.blocks,
+                             p.errors, p.error_count, p.pause, p.done, p.failure,
+                             p.stopped_early)
+            p.errors = []
+            return taken
+
+    def advance(self, lines: int = LINES_PER_CYCLE) -> None:
+        """Virtual clock: let the check decode ``lines`` more lines and wait until it
+        did, paused or ended."""
+        with self._cond:
+            self._budget += lines
+            self._cond.notify_all()
+            self._cond.wait_for(lambda: self._budget <= 0 or self._progress.pause
+                                or self._progress.done)
+
+    def resume(self) -> bool:
+        """START / RESUME: go on after a pause; False when the check was not paused."""
+        with self._cond:
+            if self._progress.pause == Pause.NONE and not self._pause_wanted:
+                return False
+            self._pause_wanted = False
+            self._progress.pause = Pause.NONE
+            self._cond.notify_all()
+            return True
+
+    def stop(self) -> None:
+        """STOP: interrupt decoding at the next line or batch."""
+        with self._cond:
+            self._pause_wanted = True
+
+    def set_single_step(self, on: bool) -> None:
+        """Single step at decoder level on or off (from the next line)."""
+        self.line_by_line = bool(on)
+
+    def cancel(self) -> None:
+        """RESET: end the check; the thread stops soon after (no log is written)."""
+        with self._cond:
+            self._cancelled = True
+            self._cond.notify_all()
+
+    @property
+    def pause(self) -> Pause:
+        """Why the check waits now (NONE: it does not)."""
+        return self._progress.pause
+
+    # ------------------------------------------------------------ decoder callbacks
+
+    def report(self, error: NcError, category: ErrorCategory) -> None:
+        """The decoder found ``error`` and goes on after it (syntax check) or stops."""
+        checked = CheckedError(error, category, error.file, error.line, error.column)
+        if self.settings is None:  # dry run: the first error ends it
+            self._end_with(checked)
+            raise CheckAborted
+        if self._record:  # written after the line it belongs to
+            self._pending_log.append(_error_line(error, category))
+        with self._cond:
+            p = self._progress
+            p.errors.append(checked)
+            p.error_count += 1
+            src = self._sources.get(error.file)
+            if src is not None and 0 < error.line <= len(src.lines):  # the decoder is here
+                p.file, p.line, p.offset = error.file, error.line, src.offset(error.line - 1)
+            total = self.settings.errors_total
+            if total and p.error_count >= total:
+                p.stopped_early = True
+                raise CheckAborted
+        if self.settings.interactive:
+            self._wait(Pause.AFTER_ERROR)
+
+    def line(self, src: SourceText, index: int, after: int) -> None:
+        """Lines ``index``..``after``-1 were decoded by the general path."""
+        self._lines(src, index, after)
+        if self.line_by_line:
+            self._wait(Pause.SINGLE_STEP)
+
+    # ------------------------------------------------------------ SDA thread
+
+    def _run(self) -> None:
+        try:
+            text = self._text_of(self.name)
+            decoder = Decoder(
+                text, self.name, axes=self._axes, loader=self._text_of, tools=self._tools,
+                modal=ModalState(position_mm=self._start), axis_numbers=self._axis_numbers,
+                contour_lookahead=self._contour_lookahead, check=self,
+            )
+            self._sources[self.name] = decoder.source
+            if self._record:
+                self._log.append(f"; syntax check of {self.name} in channel {self.channel_id}")
+            for item in decoder.blocks():
+                if self._checkpoint():
+                    return
+                if type(item) is PointBatch:
+                    if self._batch(item):
+                        break
+                elif self._block(item):
+                    break
+            self._flush_prep()
+        except CheckAborted:
+            pass
+        except KeyError as exc:
+            self._end_with(CheckedError(NcError(
+                NcErrorId.PROGRAM_NOT_FOUND, self.name, 0, 0,
+                f"program {exc.args[0]!r} not found"), None, self.name))
+        except Exception as exc:  # a fault is the run's error, never a dead thread
+            log.exception("syntax check of %s failed", self.name)
+            self._end_with(CheckedError(NcError(
+                NcErrorId.INTERNAL_ERROR, self.name, 0, 0, f"check fault: {exc!r}"), None,
+                self.name))
+        if self._cancelled:
+            return
+        self._write_log()
+        with self._cond:
+            self._progress.done = True
+            self._progress.pause = Pause.NONE
+            self._cond.notify_all()
+
+    def _checkpoint(self) -> bool:
+        """Between two items: honour STOP and the virtual clock's budget; True when
+        cancelled."""
+        with self._cond:
+            if self._pause_wanted:
+                self._pause_wanted = False
+                self._progress.pause = Pause.STOPPED
+                self._cond.notify_all()
+            self._cond.wait_for(lambda: self._cancelled or (
+                self._progress.pause == Pause.NONE
+                and (self._budget > 0 or not self._deterministic)))
+            return self._cancelled
+
+    def _wait(self, why: Pause) -> None:
+        """Pause inside the decoder until ``resume`` (or ``cancel``: ends decoding)."""
+        with self._cond:
+            self._progress.pause = why
+            self._cond.notify_all()
+            self._cond.wait_for(lambda: self._cancelled or self._progress.pause == Pause.NONE)
+            if self._cancelled:
+                raise CheckAborted
+
+    def _lines(self, src: SourceText, first: int, stop: int) -> None:
+        if stop <= first:
+            return
+        self._sources[src.name] = src
+        last = stop - 1
+        raw = src.lines[last]
+        m = _N_WORD.match(raw)
+        if self._record:
+            lines = src.lines
+            name = src.name
+            self._log.extend(f"{name}:{k + 1}: {lines[k].rstrip()}" for k in range(first, stop)
+                             if lines[k].strip() and not lines[k].lstrip().startswith(";"))
+            self._log.extend(self._pending_log)
+            self._pending_log.clear()
+        with self._cond:
+            p = self._progress
+            p.file, p.line, p.offset = src.name, last + 1, src.offset(last)
+            p.block_number = int(m.group(1)) if m else -1
+            p.lines += stop - first
+            self._budget -= stop - first
+
+    def _batch(self, batch: PointBatch) -> bool:
+        """Check a batch of plain motion lines; True when a limit ended the run."""
+        self._flush_prep()
+        self._lines(batch.src, batch.first, batch.stop)
+        records = batch.records
+        if records:
+            found = first_violation(batch.start_mm, records, batch.plane, self._limits)
+            if found is not None:
+                k, error = found
+                self._end_with(_limit_error(error, batch.src.name, records[k][0] + 1))
+                return True
+            self._position = records[-1][2]
+        with self._cond:
+            self._progress.blocks += len(records)
+        return False
+
+    def _block(self, block: Block) -> bool:
+        """Check one block of the general path; True when the run ends here."""
+        with self._cond:
+            self._progress.blocks += 1
+        motion = block.motion
+        if motion is not None:
+            compensated = motion.compensation != Compensation.OFF
+            try:
+                if compensated or self._prep is not None:
+                    self._prepared(block)
+                else:
+                    found = first_violation(motion.start_mm, [(0, motion.kind, motion.end_mm,
+                                            motion.center_mm)], motion.plane, self._limits)
+                    if found is not None:
+                        raise found[1]
+            except PathError as error:
+                src = block.source
+                if error.id.name.startswith("SW_LIMIT"):
+                    self._end_with(_limit_error(error, src.file, src.line, src.column))
+                    return True
+                self._path_error(error, block)
+            self._position = motion.end_mm
+        return block.stop == StopKind.PROGRAM_END
+
+    def _prepared(self, block: Block) -> None:
+        """Blocks under radius compensation run through the path preparation (it checks
+        compensation and software limits as in a real run)."""
+        if self._prep is None:
+            self._prep = PathPreparation(self._dynamics, block.motion.start_mm, self._limits)
+        self._prep.prepare(block)
+        if block.motion.compensation == Compensation.OFF:
+            self._flush_prep()
+
+    def _flush_prep(self) -> None:
+        if self._prep is None:
+            return
+        prep, self._prep = self._prep, None
+        try:
+            prep.flush()
+        except PathError as error:
+            self._path_error(error, error.block)
+
+    def _path_error(self, error: PathError, block: Block | None) -> None:
+        """A path preparation error (not a limit): reported like a decoder error."""
+        src = block.source if block is not None else None
+        nc = NcError(int(error.id), src.file if src else self.name, src.line if src else 0,
+                     src.column if src else 0, error.message)
+        self.report(nc, ErrorCategory.VALUE)
+        self._prep = None
+
+    def _end_with(self, checked: CheckedError) -> None:
+        if self._record:
+            self._log.extend(self._pending_log)
+            self._pending_log.clear()
+            err = checked.error
+            self._log.append(f"error {int(err.id)} (abort) at {checked.file}:{checked.line}:"
+                             f"{checked.column}: {err.message}")
+        with self._cond:
+            self._progress.failure = checked
+
+    def _write_log(self) -> None:
+        if not self._record:
+            return
+        self._log.extend(self._pending_log)
+        p = self._progress
+        how = ("stopped: syn_chk.errors_total reached" if p.stopped_early
+               else "aborted" if p.failure is not None else "complete")
+        end = (f"; end: {p.lines} lines, {p.blocks} blocks, {p.error_count} errors, {how}")
+        data = ("\n".join(self._log) + "\n" + end + "\n").encode()
+        if len(data) > PROGRAM_MAX_BYTES:  # the store's file limit: keep every error
+            kept = [self._log[0], "; the checked lines are left out: the log would exceed "
+                    f"the store's file limit of {PROGRAM_MAX_BYTES} bytes"]
+            kept += [entry for entry in self._log if entry.startswith("error ")]
+            data = ("\n".join(kept) + "\n" + end + "\n").encode()[-PROGRAM_MAX_BYTES:]
+        self._files(log_name(self.channel_id), data, replace=True)
+
+
+def _error_line(error: NcError, category: ErrorCategory) -> str:
+    """An error as the log writes it (``clients`` parse this form)."""
+    return (f"error {int(error.id)} ({category.label}) at {error.file}:{error.line}:"
+            f"{error.column}: {error.message}")
+
+
+def _limit_error(error: PathError, file: str, line: int, column: int = 1) -> CheckedError:
+    return CheckedError(error, None, file, line, column)
