@@ -39,7 +39,7 @@ from ..config import SyntaxCheckConfig
 from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, Compensation, StopKind
 from .nc.check import CheckAborted, ErrorCategory, PointBatch
-from .nc.source import SourceText
+from .nc.source import SourceText, strip_comments
 from .path.endpoints import first_violation
 from .path.errors import PathError
 from .path.limits import AxisDynamics
@@ -182,6 +182,7 @@ class CheckRun:
         """STOP: interrupt decoding at the next line or batch."""
         with self._cond:
             self._pause_wanted = True
+            self._cond.notify_all()
 
     def set_single_step(self, on: bool) -> None:
         """Single step at decoder level on or off (from the next line)."""
@@ -225,7 +226,7 @@ class CheckRun:
     def line(self, src: SourceText, index: int, after: int) -> None:
         """Lines ``index``..``after``-1 were decoded by the general path."""
         self._lines(src, index, after)
-        if self.line_by_line:
+        if self.line_by_line and strip_comments(src.lines[index]).strip():  # an NC line
             self._wait(Pause.SINGLE_STEP)
 
     # ------------------------------------------------------------ SDA thread
@@ -273,14 +274,17 @@ class CheckRun:
         """Between two items: honour STOP and the virtual clock's budget; True when
         cancelled."""
         with self._cond:
-            if self._pause_wanted:
-                self._pause_wanted = False
-                self._progress.pause = Pause.STOPPED
-                self._cond.notify_all()
-            self._cond.wait_for(lambda: self._cancelled or (
-                self._progress.pause == Pause.NONE
-                and (self._budget > 0 or not self._deterministic)))
-            return self._cancelled
+            while True:
+                if self._pause_wanted:
+                    self._pause_wanted = False
+                    self._progress.pause = Pause.STOPPED
+                if self._cancelled:
+                    return True
+                if self._progress.pause == Pause.NONE and (
+                        self._budget > 0 or not self._deterministic):
+                    return False
+                self._cond.notify_all()  # advance() and the GEO side wait for this
+                self._cond.wait()
 
     def _wait(self, why: Pause) -> None:
         """Pause inside the decoder until ``resume`` (or ``cancel``: ends decoding)."""

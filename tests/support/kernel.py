@@ -54,10 +54,11 @@ class KernelHarness:
     def __init__(self, programs: dict[str, str] | None = None,
                  config: MachineConfig | None = None) -> None:
         self.programs = dict(programs or {})
+        self.files: dict[str, bytes] = {}  # files the kernel wrote (logs, dec0<c>.sc)
         self.config = config or build_config()
         self.kernel = Kernel(
             self.config, VirtualClock(self.config.cycle_ms / 1000.0),
-            self._load, lambda name: name in self.programs,
+            self._load, lambda name: name in self.programs, self._write,
         )
         self._recording: list[Sample] | None = None
         self._finished = threading.Event()
@@ -67,6 +68,9 @@ class KernelHarness:
 
     def _load(self, name: str) -> str:
         return self.programs[name]
+
+    def _write(self, name: str, data: bytes, replace: bool = False) -> None:
+        self.files[name] = data if replace else self.files.get(name, b"") + data
 
     def __enter__(self) -> KernelHarness:
         self.kernel.start()
