@@ -56,7 +56,7 @@ _FEED_MARGIN_BLOCKS = 256  # the decoder may run this far ahead of the look-ahea
 _MDI_NAME = "MDI"  # file name of manual blocks in errors and objects
 _INCR_PER_MM = 10_000  # 0.1 um increments per mm
 PROD_TIME_STEPS_PER_CYCLE = 5_000  # virtual clock: simulated cycles per GEO cycle (PROD_TIME)
-_PROD_TIME_SHARE = 0.5  # realtime clock: share of a GEO cycle the calculation may use
+_PROD_TIME_SHARE = 0.4  # realtime clock: share of a GEO cycle the calculation may use
 _CHECK_MODES = ExecutionMode.SYNCHK | ExecutionMode.MACHINE_LOCK
 
 
@@ -479,7 +479,7 @@ class ChannelRunner:
             return False
         deadline = time.perf_counter() + _PROD_TIME_SHARE * self._cycle_s
         for n in range(PROD_TIME_STEPS_PER_CYCLE):
-            if not self._deterministic and n % 64 == 0 and time.perf_counter() > deadline:
+            if not self._deterministic and n % 4 == 0 and time.perf_counter() > deadline:
                 break
             self._sim_steps += 1
             self._time_s = self._started_at_s + self._sim_steps * self._cycle_s
