@@ -6,6 +6,8 @@ Imports protocol and objects, never service.
 from .client import (
     AsyncClient,
     ChannelStatus,
+    CheckError,
+    CheckResult,
     Client,
     DeviceInfo,
     ObjectInfo,
@@ -21,6 +23,8 @@ __all__ = [
     "AsyncClient",
     "ChannelError",
     "ChannelStatus",
+    "CheckError",
+    "CheckResult",
     "Client",
     "DeviceInfo",
     "ObjectInfo",

@@ -4,6 +4,7 @@
     await c.run_program("part.nc", channel=1)          # select + START
     status = await c.wait_program(channel=1, timeout_s=60)
     await c.mdi("G1 X10 F600", channel=1)
+    result = await c.syntax_check("part.nc", channel=1)   # SYNCHK: nothing moves
 
 Everything goes through objects and the program-store index group; nothing here knows
 the kernel. Waiting polls the channel's objects every ``POLL_S`` of wall time.
@@ -11,6 +12,7 @@ the kernel. Waiting polls the channel's objects every ``POLL_S`` of wall time.
 
 from __future__ import annotations
 
+import re
 import time
 from dataclasses import dataclass, fields
 from typing import Any
@@ -18,8 +20,9 @@ from typing import Any
 from protocol.constants import MAX_DATA_BYTES, PROGRAM_STORE_GROUP, CncPort
 from protocol.constants import ProgramStoreOffset as Op
 from protocol.datatypes import STRING_ENCODING
+from protocol.errors import AdsReturnCode
 
-from .errors import AdsTimeoutError, ChannelError
+from .errors import AdsError, AdsTimeoutError, ChannelError
 
 POLL_S = 0.01  # how often waiting re-reads the channel state (wall time)
 
@@ -27,6 +30,7 @@ MODES = {1: "STANDBY", 2: "AUTOMATIC", 3: "MDI", 4: "MANUAL", 5: "REFERENCE"}
 STATES = {1: "DESELECTED", 2: "SELECTED", 3: "READY", 4: "ACTIVE", 5: "HOLD", 6: "ERROR"}
 _ACTIVE, _HOLD, _ERROR = 4, 5, 6
 _ERROR_SLOTS = 8
+SYNCHK, MACHINE_LOCK = 0x8, 0x40  # execution mode bits (FCT-C9)
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,6 +92,98 @@ class ChannelStatus:
     path_velocity_mm_s: float
     program_time_s: float
     errors: list[str]
+
+
+@dataclass(frozen=True, slots=True)
+class CheckError:
+    """One error a syntax check reported (a record, not an exception): where it is,
+    its ISG error id, its category (``term``, ``limit``, ...; ``abort`` for the error
+    that ended the check) and its message."""
+
+    file: str
+    line: int
+    column: int
+    id: int
+    category: str
+    message: str
+
+
+@dataclass(frozen=True, slots=True)
+class CheckResult:
+    """The outcome of a syntax check (``syntax_check``), read from ``dec0<c>.sc``.
+
+    ``errors``: the reported errors in log order; ``aborted``: the error that ended the
+    check (a software limit violation, a missing program, ...), else None; ``lines``
+    and ``blocks``: how many NC lines and blocks were checked; ``stopped_early``: the
+    check stopped at ``syn_chk.errors_total``; ``log``: the whole log file.
+    """
+
+    errors: tuple[CheckError, ...]
+    aborted: CheckError | None
+    lines: int
+    blocks: int
+    log: str
+    stopped_early: bool
+
+    @property
+    def clean(self) -> bool:
+        """True when the check found no error and ran to the end."""
+        return not self.errors and self.aborted is None and not self.stopped_early
+
+
+def check_log_name(channel: int) -> str:
+    """The program-store file a syntax check in ``channel`` writes (``dec01.sc``)."""
+    return f"dec0{channel}.sc"
+
+
+_LOG_HEADER = re.compile(r"; syntax check of (.*) in channel (\d+)")
+_LOG_END = re.compile(r"; end: (\d+) lines, (\d+) blocks, (\d+) errors, (.*)")
+_LOG_ERROR = re.compile(r"error (\d+) \((\w+)\) at (.*)")
+_LOG_POSITION = re.compile(r":(\d+):(\d+): ")  # after the file name of an error
+_LOG_LINE = re.compile(r":(\d+): ")  # after the file name of a checked line
+
+
+def parse_check_log(text: str, program: str = "") -> CheckResult:
+    """Parse a syntax check log (``dec0<c>.sc``; format in ``service/kernel/syntax_check``).
+
+    A file name may hold colons: an error's position is found at ``:<line>:<column>: ``
+    and, where its text offers several such places, the split whose file name the log
+    (or ``program``) names elsewhere wins. Raises ``ValueError`` when the log has no
+    end line (it is not a complete syntax check log).
+    """
+    entries = text.split("\n")  # names never hold a newline; other breaks are text
+    known = {program} if program else set()
+    for entry in entries:
+        header = _LOG_HEADER.fullmatch(entry)
+        if header:
+            known.add(header.group(1))
+        elif entry and not entry.startswith(";") and not _LOG_ERROR.fullmatch(entry):
+            known.update(entry[:m.start()] for m in _LOG_LINE.finditer(entry))
+    errors: list[CheckError] = []
+    aborted: CheckError | None = None
+    end = None
+    for entry in entries:
+        if entry.startswith("; end: "):
+            end = _LOG_END.fullmatch(entry) or end
+            continue
+        found = _LOG_ERROR.fullmatch(entry)
+        if not found:
+            continue
+        rest = found.group(3)
+        splits = list(_LOG_POSITION.finditer(rest))
+        if not splits:
+            continue
+        where = next((m for m in splits if rest[:m.start()] in known), splits[0])
+        error = CheckError(rest[:where.start()], int(where.group(1)), int(where.group(2)),
+                           int(found.group(1)), found.group(2), rest[where.end():])
+        if error.category == "abort":
+            aborted = error
+        else:
+            errors.append(error)
+    if end is None:
+        raise ValueError("the log has no '; end: ...' line: it is not a complete syntax check log")
+    return CheckResult(tuple(errors), aborted, int(end.group(1)), int(end.group(2)), text,
+                       end.group(4).startswith("stopped"))
 
 
 def _name_bytes(name: str) -> bytes:
@@ -248,3 +344,154 @@ class ChannelOps:
             lambda state, count: count > before or state not in (_ACTIVE, _HOLD),
             timeout_s,
         )
+
+    async def syntax_check(
+        self,
+        program: str,
+        channel: int = 1,
+        errors_total: int | None = None,
+        timeout_s: float | None = None,
+    ) -> CheckResult:
+        """Syntax check (ISG FCT-C9) of the stored ``program`` in ``channel``: nothing moves.
+
+        Sets the execution mode SYNCHK | MACHINE_LOCK (0x48), ``syn_chk.record_result``
+        TRUE, ``syn_chk.interactive`` FALSE, single block off and, when given,
+        ``syn_chk.errors_total`` (0: no limit); selects and starts ``program``; waits
+        until the channel is READY or ERROR; reads and parses ``dec0<channel>.sc``.
+        Whatever happens, the values it changed are written back afterwards; a check
+        that is still running then (``timeout_s`` passed, the wait was interrupted) is
+        ended with RESET first. A check ended by an error (a software limit violation)
+        is a result (``aborted``), not an exception; the channel stays in ERROR, with
+        that error in its error list, until RESET, as after a real run.
+
+        Raises ``AdsError`` when the channel cannot start the check (it is working or in
+        ERROR, ``program`` is not stored, the PLC commands another execution mode),
+        ``AdsTimeoutError`` after ``timeout_s``, ``ChannelError`` when the channel went
+        to ERROR without a check (the start failed).
+        """
+        ch = f"ch{channel}"
+        readback = {
+            f"{ch}.mc_command_execution_mode_w": f"{ch}.mc_command_execution_mode_r",
+            f"{ch}.mc_command_single_block_w": f"{ch}.mc_active_single_block_r",
+            f"{ch}.syn_chk.record_result": f"{ch}.syn_chk.record_result",
+            f"{ch}.syn_chk.interactive": f"{ch}.syn_chk.interactive",
+            f"{ch}.syn_chk.errors_total": f"{ch}.syn_chk.errors_total",
+        }
+        wanted: dict[str, Any] = {
+            f"{ch}.mc_command_execution_mode_w": SYNCHK | MACHINE_LOCK,
+            f"{ch}.mc_command_single_block_w": False,  # else it stops after every line
+            f"{ch}.syn_chk.record_result": True,
+            f"{ch}.syn_chk.interactive": False,  # else it stops after every error
+        }
+        if errors_total is not None:
+            wanted[f"{ch}.syn_chk.errors_total"] = errors_total
+        state_names = [f"{ch}.mc_active_mode_r", f"{ch}.mc_active_state_r"]
+        before = await self.read_many([*state_names, *(readback[name] for name in wanted)])
+        mode, state = (before[n] for n in state_names)
+        if state in (_ACTIVE, _HOLD, _ERROR):  # before anything changes (the last log)
+            raise AdsError(
+                AdsReturnCode.DEVICE_NOTREADY,
+                f"channel {channel} is {MODES.get(mode, mode)}/{STATES.get(state, state)}: "
+                "a syntax check needs a channel that is not working; hold and RESET first",
+            )
+        await self._refuse_plc_execution_mode(channel)
+        log_file = check_log_name(channel)
+        if program != log_file:  # an older log must not pass for this check's
+            try:
+                await self.delete_program(log_file)
+            except AdsError as exc:
+                if exc.code != AdsReturnCode.DEVICE_NOTFOUND:
+                    raise
+        changed: list[tuple[str, Any]] = []  # (object, value before), in write order
+        started = finished = False
+        try:
+            for name, value in wanted.items():
+                old = before[readback[name]]
+                if old != value:
+                    changed.append((name, old))
+                    await self.write(name, value)
+            await self.run_program(program, channel)
+            started = True
+            result = await self._check_result(program, channel, log_file, timeout_s)
+            finished = True
+            return result
+        finally:
+            await self._end_check(channel, changed, cancel=started and not finished,
+                                  quiet=not finished)
+
+    async def _refuse_plc_execution_mode(self, channel: int) -> None:
+        """Refuse a check the PLC would turn into a real run: while its control unit
+        ``gpCh[i].decoder_mc_control.execution_mode`` is enabled, a program start takes
+        the PLC's ``command_w`` instead of ``mc_command_execution_mode_w``."""
+        order = [o.name.lower() for o in await self.browse("ch*.mc_active_state_r")]
+        index = order.index(f"ch{channel}.mc_active_state_r")  # gpCh[i]: layout position
+        unit = f"gpCh[{index}].decoder_mc_control.execution_mode"
+        values = await self.read_many([f"{unit}.enable_w", f"{unit}.command_w"])
+        command = values[f"{unit}.command_w"]
+        if values[f"{unit}.enable_w"] and not command & SYNCHK:
+            raise AdsError(
+                AdsReturnCode.DEVICE_INVALIDSTATE,
+                f"channel {channel}: the PLC commands execution mode 0x{command & 0xFFFFFFFF:x} "
+                f"({unit}.enable_w is TRUE), so a start would run the program, not check it",
+            )
+
+    async def _check_result(
+        self, program: str, channel: int, log_file: str, timeout_s: float | None
+    ) -> CheckResult:
+        """Wait for the end of a started check (READY or ERROR) and read its log."""
+        ended_in_error: ChannelError | None = None
+        try:
+            await self.wait_program(channel, timeout_s)
+        except ChannelError as exc:  # an error ended the check: it is in the log
+            ended_in_error = exc
+        except AdsTimeoutError as exc:
+            if not exc.detail.startswith(f"channel {channel} still "):
+                raise  # a request timed out, not the check
+            raise AdsTimeoutError(
+                f"syntax check of {program} in channel {channel} did not end within "
+                f"{timeout_s:g} s; it is cancelled (RESET)"
+            ) from None
+        try:
+            data = await self.download(log_file)
+        except AdsError as exc:
+            if exc.code != AdsReturnCode.DEVICE_NOTFOUND:
+                raise
+            if ended_in_error is not None:  # the start failed: no check ran
+                raise ended_in_error from None
+            raise AdsError(exc.code, f"the syntax check of {program} in channel {channel} "
+                           f"ended without writing {log_file} (RESET during the check?)") from None
+        text = data.decode("utf-8", errors="replace")
+        header = _LOG_HEADER.match(text)
+        if header and (header.group(1), int(header.group(2))) != (program, channel):
+            raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID,
+                           f"{log_file} is the log of {header.group(1)} in channel "
+                           f"{header.group(2)}, not of {program} in channel {channel}")
+        try:
+            result = parse_check_log(text, program)
+        except ValueError as exc:
+            raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, f"{log_file}: {exc}") from None
+        if ended_in_error is not None and result.aborted is None:
+            raise ended_in_error  # ERROR, but not from the check
+        return result
+
+    async def _end_check(
+        self, channel: int, changed: list[tuple[str, Any]], cancel: bool, quiet: bool
+    ) -> None:
+        """RESET a check that still runs (``cancel``), then write back every changed
+        value, even when one write fails; the first failure is raised unless ``quiet``
+        (an exception is on its way already)."""
+        first: AdsError | None = None
+        if cancel:
+            try:
+                state = await self.read(f"ch{channel}.mc_active_state_r")
+                if state in (_ACTIVE, _HOLD):
+                    await self.reset(channel)
+            except AdsError as exc:
+                first = exc
+        for name, old in reversed(changed):
+            try:
+                await self.write(name, old)
+            except AdsError as exc:
+                first = first or exc
+        if first is not None and not quiet:
+            raise first

@@ -5,9 +5,12 @@
     cnc mdi "BLOCKS" [--channel N] [--wait] [--timeout S]
     cnc hold|resume|reset [--channel N]  cnc status [--channel N]
     cnc lookahead [START] [--length L] [--index I]
+    cnc check FILE|NAME [--channel N] [--errors-total K] [--log] [--timeout S]
 
 ``--wait`` exits 0 when the program (or manual block) has finished, 4 with the channel's
 error text when the channel went to ERROR, 5 when ``--timeout`` passed first.
+``check`` exits 0 when the program is clean, 1 when the check found errors or was
+aborted, 2 when there is no result (bad usage, no service, an ADS error, ``--timeout``).
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from pathlib import Path
 
 import typer
 
-from .channel_ops import CONTOUR_BLOCK_TYPES
+from .channel_ops import CONTOUR_BLOCK_TYPES, CheckError, CheckResult
 from .cli import EXIT_USAGE, Settings, _emit, _fail, app, err, out
 from .errors import AdsError, AdsTimeoutError, ChannelError
 
@@ -225,3 +228,77 @@ def lookahead(
             f"{b.programmed_radius / 10_000:>9.4f} {b.compensated_radius / 10_000:>9.4f} "
             f"{math.degrees(b.circle_angle):>9.3f} {math.degrees(b.tangent_variation):>8.3f}"
         )
+
+
+EXIT_CHECK_ERRORS = 1  # cnc check: the program has errors, or the check was aborted
+EXIT_CHECK_TROUBLE = 2  # cnc check: no result (usage, connection, ADS error, timeout)
+
+
+def _check_record(e: CheckError) -> dict:
+    return {"file": e.file, "line": e.line, "column": e.column, "id": e.id,
+            "category": e.category, "message": e.message}
+
+
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+def _check_summary(result: CheckResult, channel: int) -> str:
+    lines = _plural(result.lines, "line")
+    if result.clean:
+        return f"clean: {lines}"
+    text = f"{_plural(len(result.errors), 'error')} in {lines}"
+    if result.stopped_early:
+        text += ", stopped early: syn_chk.errors_total reached"
+    if result.aborted is not None:
+        text += (f", aborted by error {result.aborted.id} "
+                 f"(channel {channel} is in ERROR until 'cnc reset')")
+    return text
+
+
+@app.command()
+def check(
+    ctx: typer.Context,
+    program: str = typer.Argument(..., help="A local file (uploaded first) or a stored name."),
+    channel: int = ChannelOption,
+    errors_total: int = typer.Option(
+        None, "--errors-total", min=0, max=0xFFFF,
+        help="Stop after K errors (syn_chk.errors_total; 0: no limit). Default: as set."),
+    show_log: bool = typer.Option(
+        False, "--log", help="Print the log dec0<N>.sc (with --json: one {\"log\": ...} line)."),
+    timeout_s: float = typer.Option(
+        None, "--timeout", min=0.0, help="Give up after S seconds (the check is RESET; exit 2)."),
+) -> None:
+    """Syntax check (SYNCHK | MACHINE_LOCK): decode the program, report every error, move
+    nothing. Exit 0 clean, 1 errors or aborted, 2 no result."""
+    settings: Settings = ctx.obj
+    local = Path(program)
+    name = local.name if local.is_file() else program
+    try:
+        data = local.read_bytes() if local.is_file() else None
+    except OSError as exc:
+        err.print(f"error: cannot read {local}: {exc.strerror}", markup=False, emoji=False)
+        raise typer.Exit(EXIT_CHECK_TROUBLE) from None
+    try:
+        with settings.client() as c:
+            if data is not None:
+                c.upload(name, data)
+            result: CheckResult = c.syntax_check(name, channel, errors_total, timeout_s)
+    except (AdsError, ChannelError) as exc:
+        err.print(f"error: {exc}", markup=False, emoji=False)
+        raise typer.Exit(EXIT_CHECK_TROUBLE) from None
+    if show_log and not settings.as_json:
+        out.print(result.log, end="", markup=False, emoji=False, highlight=False)
+    found = [*result.errors, *([result.aborted] if result.aborted else [])]
+    for e in found:
+        if settings.as_json:
+            out.print(json.dumps(_check_record(e)), markup=False, emoji=False)
+        else:
+            out.print(f"{e.file}:{e.line}:{e.column}: error {e.id} ({e.category}): "
+                      f"{e.message}", markup=False, emoji=False)
+    if show_log and settings.as_json:
+        out.print(json.dumps({"log": result.log}), markup=False, emoji=False)
+    if not settings.as_json:
+        err.print(_check_summary(result, channel), markup=False, emoji=False)
+    if not result.clean:
+        raise typer.Exit(EXIT_CHECK_ERRORS)

@@ -42,7 +42,9 @@ from protocol.frames import (
     WriteRequest,
 )
 
-from .channel_ops import ChannelOps, ChannelStatus, ProgramEntry, ProgramOps
+from .channel_ops import (
+    ChannelOps, ChannelStatus, CheckError, CheckResult, ProgramEntry, ProgramOps,
+)
 from .errors import AdsConnectionError, AdsError
 from .sync_transport import SyncTransport, drive
 from .transport import AsyncTransport
@@ -366,6 +368,6 @@ for _name, _method in inspect.getmembers(AsyncClient, inspect.isfunction):
         setattr(Client, _name, _blocking(_method))
 
 __all__ = [
-    "AsyncClient", "ChannelStatus", "Client", "DeviceInfo", "ObjectInfo", "ProgramEntry",
-    "Sample", "filetime_to_datetime",
+    "AsyncClient", "ChannelStatus", "CheckError", "CheckResult", "Client", "DeviceInfo",
+    "ObjectInfo", "ProgramEntry", "Sample", "filetime_to_datetime",
 ]

@@ -441,7 +441,7 @@ class ChannelRunner:
         for found in p.errors:
             err = found.error
             self._raise(ChannelError(int(err.id), err.message, found.file, found.line,
-                                     found.column, warning=True))
+                                     found.column, warning=True), to_log=False)
         flags = ch.decoder_flags & DecoderFlag.SYNTAX_CHECK
         if p.pause == Pause.AFTER_ERROR:
             flags |= DecoderFlag.WAIT_AFTER_ERROR
@@ -497,10 +497,13 @@ class ChannelRunner:
                 self._modal = self._feed.modal
             self._feed = None
 
-    def _raise(self, error: ChannelError) -> None:
+    def _raise(self, error: ChannelError, to_log: bool = True) -> None:
+        """List ``error``; ``to_log``: also in the channel's error log file (not the
+        findings of a syntax check, which may be thousands: they go to dec0<c>.sc)."""
         ch = self.channel
-        log.info("channel %d: %s", ch.channel_id, error)
-        self._files(self.error_log_name, f"{self._time_s:.3f} s {error}\n".encode())
+        if to_log:
+            log.info("channel %d: %s", ch.channel_id, error)
+            self._files(self.error_log_name, f"{self._time_s:.3f} s {error}\n".encode())
         ch.error_count += 1
         if len(ch.errors) < MAX_ERRORS_KEPT:
             ch.errors = (*ch.errors, error)

@@ -136,6 +136,7 @@ class CheckRun:
         self._log: list[str] = []
         self._pending_log: list[str] = []  # errors of the line being decoded
         self._sources: dict[str, SourceText] = {}  # files decoded so far, by name
+        self._limit_reached = False  # errors_total: the check ends after the current line
         self._cond = threading.Condition()
         self._progress = Progress(file=name)
         self._budget = 0  # virtual clock: lines the check may still decode
@@ -207,6 +208,8 @@ class CheckRun:
         if self.settings is None:  # dry run: the first error ends it
             self._end_with(checked)
             raise CheckAborted
+        if self._limit_reached:  # the rest of the line the check ends at
+            return
         if self._record:  # written after the line it belongs to
             self._pending_log.append(_error_line(error, category))
         with self._cond:
@@ -217,15 +220,17 @@ class CheckRun:
             if src is not None and 0 < error.line <= len(src.lines):  # the decoder is here
                 p.file, p.line, p.offset = error.file, error.line, src.offset(error.line - 1)
             total = self.settings.errors_total
-            if total and p.error_count >= total:
-                p.stopped_early = True
-                raise CheckAborted
+            if total and p.error_count >= total:  # the check ends after this line
+                p.stopped_early = self._limit_reached = True
+                return
         if self.settings.interactive:
             self._wait(Pause.AFTER_ERROR)
 
     def line(self, src: SourceText, index: int, after: int) -> None:
         """Lines ``index``..``after``-1 were decoded by the general path."""
         self._lines(src, index, after)
+        if self._limit_reached:
+            raise CheckAborted
         if self.line_by_line and strip_comments(src.lines[index]).strip():  # an NC line
             self._wait(Pause.SINGLE_STEP)
 
@@ -273,6 +278,8 @@ class CheckRun:
     def _checkpoint(self) -> bool:
         """Between two items: honour STOP and the virtual clock's budget; True when
         cancelled."""
+        if self._limit_reached:  # errors_total was reached outside a line
+            raise CheckAborted
         with self._cond:
             while True:
                 if self._pause_wanted:

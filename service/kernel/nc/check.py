@@ -335,11 +335,12 @@ _CONTROL_WITH_EXPRESSION = re.compile(
     r"\$(IF|ELSEIF|WHILE|FOR|SWITCH|CASE|UNTIL)\b|#[ \t]*RT[ \t]+WHILE\b")
 
 
-def dropped_control(line: LogicalLine):
+def dropped_control(line: LogicalLine, errors: int):
     """For a dropped line of a control statement with an expression ($IF, $ELSEIF,
     $WHILE, $FOR, $SWITCH, $CASE, $UNTIL, #RT WHILE): a statement of that kind whose
     expressions raise ``ErrorReported``, so the control flow keeps its structure (a
-    dropped $IF skips its block, a dropped $CASE never matches, ...); else None."""
+    dropped $IF skips its block, a dropped $CASE never matches, ...); else None.
+    ``errors``: the errors reported in the line."""
     from .statements import Control, StmtKind  # noqa: PLC0415
 
     start = command_position(line)
@@ -354,6 +355,7 @@ def dropped_control(line: LogicalLine):
         kind = StmtKind.IF_GOTO
     else:
         kind = StmtKind[m.group(1)]
+    line = RepositionedLine(line, line.text, errors)
     return Control(kind, line, start, expr=_DROPPED, target=_DROPPED, end=_DROPPED,
                    step=_DROPPED, values=(_DROPPED,))
 
@@ -369,17 +371,17 @@ def parse_checked(parse, line: LogicalLine, check: SyntaxCheck):
             return parse(line)
         except NcError as error:
             command = after_command(line, error, parse)
-            if command is not None:
-                check.report(error, ErrorCategory.AFTER_COMMAND)
-                return command
-            category = categorize(error, line)
+            category = ErrorCategory.AFTER_COMMAND if command is not None else \
+                categorize(error, line)
             check.report(error, category)
             count += 1
             if check.errors_per_block and count >= check.errors_per_block:
-                return dropped_control(original)
+                return dropped_control(original, count)
+            if command is not None:
+                return command
             again = without_error(line, error, category)
             if again is None or again.text == line.text:
-                return dropped_control(original)
+                return dropped_control(original, count)
             again.errors = count
             line = again
 

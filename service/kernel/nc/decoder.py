@@ -271,7 +271,9 @@ class Decoder:
             error = self.fault(exc, frame, index)
             stmt, after = program.statement(index, end)
             line = getattr(stmt, "line", None)
-            check.report(error, categorize(error, line))
+            limit = check.errors_per_block
+            if not limit or getattr(line, "errors", 0) < limit:  # else the line is done
+                check.report(error, categorize(error, line))
             if frame.index == index:
                 frame.index = self._skip_failed(frame, stmt, index, after, depth)
         check.line(program.src, index, program.statement(index, end)[1])
@@ -294,7 +296,8 @@ class Decoder:
 
     def _execute_checked(self, stmt: NcBlock):
         """``executor.execute`` for the syntax check: after an error the offending word
-        is dropped and the block executed again (assignments that ran stay done)."""
+        is dropped and the block executed again (assignments that ran stay done). When
+        the whole line is dropped it raises ``ErrorReported`` (no call, no $GOTO)."""
         check = self.check
         executor = self.executor
         count = getattr(stmt.line, "errors", 0)  # errors reported when it was parsed
@@ -307,6 +310,9 @@ class Decoder:
                         NcErrorId.SUBPROGRAM_END_IN_MAIN,
                         "M17/M29 ends a subprogram; the main program ends with M30", flow_pos,
                     ), ErrorCategory.COMBINATION)
+                    count += 1
+                    if check.errors_per_block and count >= check.errors_per_block:
+                        raise ErrorReported
                     flow, flow_pos = Flow.NONE, -1
                 self._executed = block
                 return block, flow, flow_pos
@@ -314,7 +320,7 @@ class Decoder:
                 check.report(error, categorize(error, stmt.line))
                 count += 1
                 if check.errors_per_block and count >= check.errors_per_block:
-                    return None, Flow.NONE, -1
+                    raise ErrorReported  # the line is dropped, its call and $GOTO too
                 done = executor.items_done
                 items = stmt.items
                 if error.id == NcErrorId.NO_FEED:  # go on as if F were programmed
@@ -322,8 +328,8 @@ class Decoder:
                     drop = -1
                 else:
                     drop = item_at(stmt.line, items, error.pos)
-                    if drop is None:
-                        return None, Flow.NONE, -1
+                    if drop is None:  # no single word at fault: the line is dropped
+                        raise ErrorReported from None
                     item = items[drop]
                     if type(item) is Word and item.kind == WordKind.FEED:  # F unknown now
                         self._modal.feed_mm_min = self._modal.feed_mm_min or CHECK_FEED_MM_MIN

@@ -130,12 +130,27 @@ def test_a_clean_program_passes_without_errors(harness) -> None:
 def test_errors_total_stops_the_check_after_that_many_errors(harness) -> None:
     _mode(harness, SYNCHK | MACHINE_LOCK)
     _param(harness, "errors_total", 2)
+    _param(harness, "record_result", 1)
     run = harness.run(EXAMPLE, "check_syntax.nc")
     ch = run.channel
     assert _errors(ch) == EXAMPLE_ERRORS[:2]
     assert ch.errors[-1].id == 21310 and ch.errors[-1].warning
     assert ch.state == ChannelState.READY
     assert ch.line == 8  # it ended where the second error was
+    log = harness.files["dec01.sc"].decode().splitlines()
+    assert log[-3:] == [  # the line of the last error is logged before it, then the end
+        "check_syntax.nc:8: N50 #COMMAND UNKNOWN [...]",
+        "error 20500 (command) at check_syntax.nc:8:5: #COMMAND is not supported yet",
+        "; end: 6 lines, 1 blocks, 2 errors, stopped: syn_chk.errors_total reached"]
+
+
+def test_many_errors_do_not_go_to_the_error_log_file(harness) -> None:
+    _mode(harness, SYNCHK | MACHINE_LOCK)
+    text = "".join(f"N{k} G1 X1 F100 Q7\n" for k in range(1, 3001)) + "M30\n"
+    run = harness.run(text, "many.nc")
+    assert run.channel.error_count == 3000  # no 21309: MACHINE_LOCK was commanded
+    assert len(run.channel.errors) == 8
+    assert b"Q7" not in harness.files.get("errors-ch1.log", b"")
 
 
 def test_errors_per_block_skips_the_rest_of_the_line(harness) -> None:
