@@ -3,22 +3,21 @@
 The syntax check and the dry run (MACHINE_LOCK) interpolate to block end points only,
 but a block that would leave a software limit switch must still stop them with an
 error, including an arc whose bulge crosses a limit while both of its ends are inside.
-``first_violation`` checks a run of plain motion records (``nc.check.PointBatch``) at
-once: every end point, and for arcs the box of their full circle; only an arc whose
-circle box crosses a limit is checked exactly, as the path preparation does
-(``limits.check_software_limits`` on the arc element). numpy does the screening, so
-the check costs a few array operations per batch rather than Python per line.
+``first_violation`` screens a run of plain motion records (``nc.check.PointBatch``) at
+once: the box of all end points (``min``/``max`` over the columns, in C), and for each
+arc the box of its full circle. Only when the screening finds a suspect is the batch
+checked record by record, exactly as the path preparation checks an element
+(``limits.check_software_limits`` on the same ``Line`` / ``Arc``).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
-
-import numpy as np
 
 from ..nc.blocks import MotionKind
 from .errors import PathError
-from .geometry import Arc, Line
+from .geometry import ARC_RADIUS_TOLERANCE_MM, Arc, Line
 from .limits import SW_LIMIT_TOLERANCE_MM, check_software_limits
 
 Limits = Sequence[tuple[float, float]]
@@ -31,37 +30,41 @@ def first_violation(start_mm: Sequence[float], records: list, plane: tuple[int, 
     when all stay inside."""
     if not records:
         return None
-    lows = np.array([lo for lo, _ in sw_limits_mm]) - SW_LIMIT_TOLERANCE_MM
-    highs = np.array([hi for _, hi in sw_limits_mm]) + SW_LIMIT_TOLERANCE_MM
-    ends = np.array([r[2] for r in records], dtype=float)
-    suspects = np.flatnonzero(((ends < lows) | (ends > highs)).any(axis=1))
-    first = int(suspects[0]) if suspects.size else len(records)
-    if plane is not None:
-        arcs = np.fromiter((type(r[3]) is tuple for r in records[:first]), bool, first)
-        if arcs.any():
-            first = min(first, _first_arc_suspect(start_mm, records, ends, arcs, plane,
-                                                  lows, highs))
-    for k in range(first, len(records)):
-        error = _exact(start_mm if k == 0 else records[k - 1][2], records[k], plane,
-                       sw_limits_mm)
+    if _inside(start_mm, records, plane, sw_limits_mm):
+        return None
+    position = start_mm
+    for k, record in enumerate(records):
+        error = _exact(position, record, plane, sw_limits_mm)
         if error is not None:
             return k, error
+        position = record[2]
     return None
 
 
-def _first_arc_suspect(start_mm, records, ends, arcs, plane, lows, highs) -> int:
-    """Index of the first arc whose full-circle box leaves the limits (len if none)."""
+def _inside(start_mm, records: list, plane, sw_limits_mm: Limits) -> bool:
+    """True when every end point and every arc's full circle is inside the limits."""
+    tol = SW_LIMIT_TOLERANCE_MM
+    ends = [r[2] for r in records]
+    for column, (lo, hi) in zip(zip(*ends), sw_limits_mm):
+        if min(column) < lo - tol or max(column) > hi + tol:
+            return False
+    arcs = [k for k, r in enumerate(records) if type(r[3]) is tuple]
+    if not arcs or plane is None:
+        return True
     p, q = plane
-    index = np.flatnonzero(arcs)
-    starts = np.vstack((np.asarray(start_mm, dtype=float)[None, :], ends[:-1]))[index]
-    centres = np.array([records[k][3] for k in index], dtype=float)
-    r0 = np.hypot(starts[:, p] - centres[:, 0], starts[:, q] - centres[:, 1])
-    r1 = np.hypot(ends[index, p] - centres[:, 0], ends[index, q] - centres[:, 1])
-    radius = np.maximum(r0, r1)
-    out = ((centres[:, 0] - radius < lows[p]) | (centres[:, 0] + radius > highs[p])
-           | (centres[:, 1] - radius < lows[q]) | (centres[:, 1] + radius > highs[q]))
-    hits = np.flatnonzero(out)
-    return int(index[hits[0]]) if hits.size else len(records)
+    lo_p, hi_p = sw_limits_mm[p]
+    lo_q, hi_q = sw_limits_mm[q]
+    lo_p, hi_p, lo_q, hi_q = lo_p - tol, hi_p + tol, lo_q - tol, hi_q + tol
+    sqrt = math.sqrt
+    for k in arcs:
+        start = records[k - 1][2] if k else start_mm
+        cp, cq = records[k][3]
+        dp, dq = start[p] - cp, start[q] - cq
+        # the end lies within the arc tolerance of the circle through the start
+        r = sqrt(dp * dp + dq * dq) + ARC_RADIUS_TOLERANCE_MM
+        if cp - r < lo_p or cp + r > hi_p or cq - r < lo_q or cq + r > hi_q:
+            return False
+    return True
 
 
 def _exact(start: Sequence[float], record: tuple, plane: tuple[int, int] | None,
