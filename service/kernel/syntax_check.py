@@ -313,7 +313,7 @@ class CheckRun:
             lines = src.lines
             name = src.name
             self._log.extend(f"{name}:{k + 1}: {lines[k].rstrip()}" for k in range(first, stop)
-                             if lines[k].strip() and not lines[k].lstrip().startswith(";"))
+                             if strip_comments(lines[k]).strip())  # NC lines, not comments
             self._log.extend(self._pending_log)
             self._pending_log.clear()
         with self._cond:
