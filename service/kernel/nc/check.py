@@ -24,8 +24,9 @@ side)                           the line decoded
 A word dropped this way takes its effect with it (``G0 G1``: G0 stays; a bad F leaves
 the feed unknown, so the check goes on as if F were programmed rather than report "no
 feed" on every following line: ``CHECK_FEED_MM_MIN``). ``errors_per_block`` (P-CHAN-00020)
-errors in one line skip the rest of that line; the total limit (P-CHAN-00019) is the
-caller's: ``report`` raises ``CheckAborted`` to end decoding.
+errors in one line (parse and execution errors together) skip the rest of that line, its
+call and $GOTO included; the total limit (P-CHAN-00019) is the caller's: ``report``
+raises ``CheckAborted`` to end decoding.
 
 In check mode the hot path does not build Block objects: it yields ``PointBatch`` records
 (line, motion kind, end point, arc centre) of up to ``BATCH_LINES`` plain lines, which

@@ -127,6 +127,7 @@ class Decoder:
         self._started = False
         self.emitted = 0  # grows whenever blocks were yielded (the loop guard watches it)
         self.own_variables: set[int] = set()  # ids of the variables this decoder declared
+        self._executed: Block | None = None  # check mode: the Block of the line's words
 
     @property
     def source(self):
