@@ -10,28 +10,9 @@ from clients.channel_ops import CheckError, CheckResult, parse_check_log
 from tests.clients.test_cli import cnc, json_lines
 from tests.support.service import RunningService
 
+EXAMPLE_PATH = Path(__file__).resolve().parents[2] / "docs" / "examples" / "check-syntax.nc"
 # the example program of the function description (FCT-C9), character for character
-SEED_EXAMPLE = """\
-;Test syntax check of decoder)
-%check_syntax
-
-;\u25a1 overflow error
-N40 G01 X10 F1111111111111111
-
-(\u25a1 syntax error
-N50 #COMMAND UNKNOWN [...]
-
-(\u25a1 syntax error
-N60 V.E.not_present = 1
-
-(\u25a1 syntax error
-N70 #CALL AX [X2, 11, 0]
-
-(-> semantic error
-N80 G00 G01 X100 F1000
-
-N130 M30
-"""
+SEED_EXAMPLE = EXAMPLE_PATH.read_text(encoding="utf-8")
 SEED_ERRORS = [(5, 20113), (8, 20500), (11, 20310), (14, 20151), (17, 20121)]  # (line, id)
 CLEAN = "N10 G1 X10 Y5 F6000\nN20 G2 X20 Y5 I5 J0\nN30 M30\n"
 BEYOND_LIMIT = "N10 G1 X5000 F100\nN20 M30\n"  # the default X limit is 1000 mm

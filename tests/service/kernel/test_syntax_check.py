@@ -3,6 +3,8 @@ real kernel on the virtual clock (FCT-C9)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from bench.decoder_bench import generate_program
@@ -24,28 +26,9 @@ from tests.support.kernel import KernelHarness
 SYNCHK, MACHINE_LOCK, PROD_TIME = 0x8, 0x40, 0x10
 SUPPRESS_TECHNO_OUTPUT = 0x2000
 
-# the example program of the function description, as printed there
-EXAMPLE = """\
-;Test syntax check of decoder)
-%check_syntax
-
-;\u25a1 overflow error
-N40 G01 X10 F1111111111111111
-
-(\u25a1 syntax error
-N50 #COMMAND UNKNOWN [...]
-
-(\u25a1 syntax error
-N60 V.E.not_present = 1
-
-(\u25a1 syntax error
-N70 #CALL AX [X2, 11, 0]
-
-(-> semantic error
-N80 G00 G01 X100 F1000
-
-N130 M30
-"""
+EXAMPLE_PATH = Path(__file__).resolve().parents[3] / "docs" / "examples" / "check-syntax.nc"
+# the example program of the function description (FCT-C9), character for character
+EXAMPLE = EXAMPLE_PATH.read_text(encoding="utf-8")
 EXAMPLE_ERRORS = [(20113, 5), (20500, 8), (20310, 11), (20151, 14), (20121, 17)]
 
 

@@ -3,6 +3,8 @@ category and decoding goes on with the response of that category (``nc/check.py`
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import dataclasses
 from itertools import islice
 
@@ -23,28 +25,9 @@ MAX_ITEMS = 100_000  # a check that does not end is cut off here (and fails the 
 E = NcErrorId
 C = ErrorCategory
 
-# the example program of the function description, character for character
-SEED_EXAMPLE = """\
-;Test syntax check of decoder)
-%check_syntax
-
-;□ overflow error
-N40 G01 X10 F1111111111111111
-
-(□ syntax error
-N50 #COMMAND UNKNOWN [...]
-
-(□ syntax error
-N60 V.E.not_present = 1
-
-(□ syntax error
-N70 #CALL AX [X2, 11, 0]
-
-(-> semantic error
-N80 G00 G01 X100 F1000
-
-N130 M30
-"""
+EXAMPLE_PATH = Path(__file__).resolve().parents[4] / "docs" / "examples" / "check-syntax.nc"
+# the example program of the function description (FCT-C9), character for character
+SEED_EXAMPLE = EXAMPLE_PATH.read_text(encoding="utf-8")
 
 
 class Recorder:
