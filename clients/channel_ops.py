@@ -17,7 +17,7 @@ import time
 from dataclasses import dataclass, fields
 from typing import Any
 
-from protocol.constants import MAX_DATA_BYTES, PROGRAM_STORE_GROUP, CncPort
+from protocol.constants import MAX_DATA_BYTES, PROGRAM_MAX_BYTES, PROGRAM_STORE_GROUP, CncPort
 from protocol.constants import ProgramStoreOffset as Op
 from protocol.datatypes import STRING_ENCODING
 from protocol.errors import AdsReturnCode
@@ -194,7 +194,13 @@ class ProgramOps:
     """Upload, list, download and delete programs of the service's store."""
 
     async def upload(self, name: str, data: bytes) -> None:
-        """Store ``data`` as ``name``, replacing an older version atomically."""
+        """Store ``data`` as ``name``, replacing an older version atomically. A program
+        larger than the store takes is refused here (ADS 0x705): sent, its frame would
+        exceed the wire's limit and the service would drop it without a reply."""
+        if len(data) > PROGRAM_MAX_BYTES:
+            raise AdsError(AdsReturnCode.DEVICE_INVALIDSIZE,
+                           f"program {name!r} has {len(data):,} bytes; the store takes at most "
+                           f"{PROGRAM_MAX_BYTES:,}")
         await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD, _name_bytes(name) + data)
 
     async def download(self, name: str) -> bytes:

@@ -266,3 +266,10 @@ async def test_many_requests_in_flight_are_matched_by_invoke_id(service: Running
                  "ch1.ax3.actual_link_to_physical_axis"] * 100
         values = await asyncio.gather(*(c.read(n) for n in names))
     assert values == [1, 2, 3] * 100
+
+
+async def test_a_program_larger_than_the_store_is_refused_before_it_is_sent(api: Any) -> None:
+    with pytest.raises(AdsError) as caught:
+        await api.upload("big.nc", b"G1 X1 F100\n" * 100_000)  # 1.1 MB
+    assert caught.value.code == 0x705 and "at most 1,000,000" in str(caught.value)
+    assert "big.nc" not in [p.name for p in await api.programs()]
