@@ -135,6 +135,7 @@ class CheckRun:
         self._record = bool(settings and settings.record_result)
         self._log: list[str] = []
         self._pending_log: list[str] = []  # errors of the line being decoded
+        self._log_bytes = 0  # size of the checked lines logged (they stop at the store limit)
         self._sources: dict[str, SourceText] = {}  # files decoded so far, by name
         self._limit_reached = False  # errors_total: the check ends after the current line
         self._cond = threading.Condition()
@@ -229,7 +230,7 @@ class CheckRun:
     def line(self, src: SourceText, index: int, after: int) -> None:
         """Lines ``index``..``after``-1 were decoded by the general path."""
         self._lines(src, index, after)
-        if self._limit_reached:
+        if self._checkpoint():  # also inside loops that yield nothing: STOP, RESET, budget
             raise CheckAborted
         if self.line_by_line and strip_comments(src.lines[index]).strip():  # an NC line
             self._wait(Pause.SINGLE_STEP)
@@ -309,11 +310,14 @@ class CheckRun:
         last = stop - 1
         raw = src.lines[last]
         m = _N_WORD.match(raw)
-        if self._record:
+        if self._record and self._log_bytes < PROGRAM_MAX_BYTES:
             lines = src.lines
             name = src.name
+            start = len(self._log)
             self._log.extend(f"{name}:{k + 1}: {lines[k].rstrip()}" for k in range(first, stop)
                              if strip_comments(lines[k]).strip())  # NC lines, not comments
+            self._log_bytes += sum(len(entry) + 1 for entry in self._log[start:])
+        if self._record:
             self._log.extend(self._pending_log)
             self._pending_log.clear()
         with self._cond:
@@ -408,7 +412,8 @@ class CheckRun:
                else "aborted" if p.failure is not None else "complete")
         end = (f"; end: {p.lines} lines, {p.blocks} blocks, {p.error_count} errors, {how}")
         data = ("\n".join(self._log) + "\n" + end + "\n").encode()
-        if len(data) > PROGRAM_MAX_BYTES:  # the store's file limit: keep every error
+        if len(data) > PROGRAM_MAX_BYTES or self._log_bytes >= PROGRAM_MAX_BYTES:
+            # the store's file limit: keep every error
             kept = [self._log[0], "; the checked lines are left out: the log would exceed "
                     f"the store's file limit of {PROGRAM_MAX_BYTES} bytes"]
             kept += [entry for entry in self._log if entry.startswith("error ")]

@@ -261,3 +261,16 @@ def test_prod_time_does_not_wait_at_m0_or_single_block(harness) -> None:
     assert harness.command(SetSingleBlock(0, True)) is None
     run = harness.run("G1 X10 F6000\nM0\nG1 X0\nM30\n", "a.nc")
     assert run.channel.state == ChannelState.READY and run.channel.program_time_s > 0.2
+
+
+def test_a_loop_without_blocks_does_not_block_the_cycle_and_reset_ends_it(harness) -> None:
+    _mode(harness, SYNCHK | MACHINE_LOCK)
+    _param(harness, "record_result", 1)
+    harness.start("#VAR\nV.L.I = 0\n#ENDVAR\n$WHILE 1\nV.L.I = V.L.I + 1\n$ENDWHILE\nM30\n",
+                  "loop.nc")
+    # the decoder pauses for each cycle's budget inside the loop, so commands still apply
+    snap = harness.wait_for(lambda s: s.channels[0].line == 5)
+    assert snap.channels[0].state == ChannelState.ACTIVE
+    assert harness.command(ResetChannel(0, True)) is None
+    snap = harness.wait_for(lambda s: s.channels[0].state == ChannelState.READY)
+    assert snap.channels[0].decoder_flags == 0
