@@ -329,7 +329,8 @@ class CheckRun:
 
     def _batch(self, batch: PointBatch) -> bool:
         """Check a batch of plain motion lines; True when a limit ended the run."""
-        self._flush_prep()
+        if self._flush_prep():
+            return True
         self._lines(batch.src, batch.first, batch.stop)
         records = batch.records
         if records:
@@ -352,46 +353,51 @@ class CheckRun:
             compensated = motion.compensation != Compensation.OFF
             try:
                 if compensated or self._prep is not None:
-                    self._prepared(block)
+                    # radius compensation: the path preparation checks compensation and
+                    # software limits as in a real run
+                    if self._prep is None:
+                        self._prep = PathPreparation(self._dynamics, motion.start_mm,
+                                                     self._limits)
+                    self._prep.prepare(block)
+                    if not compensated:
+                        prep, self._prep = self._prep, None
+                        prep.flush()
                 else:
                     found = first_violation(motion.start_mm, [(0, motion.kind, motion.end_mm,
                                             motion.center_mm)], motion.plane, self._limits)
                     if found is not None:
                         raise found[1]
             except PathError as error:
-                src = block.source
-                if error.id.name.startswith("SW_LIMIT"):
-                    self._end_with(_limit_error(error, src.file, src.line, src.column))
+                self._prep = None
+                if self._path_failure(error, block):
                     return True
-                self._path_error(error, block)
             self._position = motion.end_mm
         return block.stop == StopKind.PROGRAM_END
 
-    def _prepared(self, block: Block) -> None:
-        """Blocks under radius compensation run through the path preparation (it checks
-        compensation and software limits as in a real run)."""
+    def _flush_prep(self) -> bool:
+        """Release what radius compensation holds back; True when that ended the run."""
         if self._prep is None:
-            self._prep = PathPreparation(self._dynamics, block.motion.start_mm, self._limits)
-        self._prep.prepare(block)
-        if block.motion.compensation == Compensation.OFF:
-            self._flush_prep()
-
-    def _flush_prep(self) -> None:
-        if self._prep is None:
-            return
+            return False
         prep, self._prep = self._prep, None
         try:
             prep.flush()
         except PathError as error:
-            self._path_error(error, error.block)
+            return self._path_failure(error, None)
+        return False
 
-    def _path_error(self, error: PathError, block: Block | None) -> None:
-        """A path preparation error (not a limit): reported like a decoder error."""
-        src = block.source if block is not None else None
-        nc = NcError(int(error.id), src.file if src else self.name, src.line if src else 0,
-                     src.column if src else 0, error.message)
-        self.report(nc, ErrorCategory.VALUE)
-        self._prep = None
+    def _path_failure(self, error: PathError, block: Block | None) -> bool:
+        """A path preparation error, at the block it names (a block compensation held
+        back) or ``block``: a software limit ends the run (True); others are reported
+        like decoder errors and the check goes on."""
+        named = error.block if error.block is not None else block
+        src = named.source if named is not None else None
+        file, line, column = (src.file, src.line, src.column) if src else (self.name, 0, 0)
+        if error.id.name.startswith("SW_LIMIT"):
+            self._end_with(_limit_error(error, file, line, column))
+            return True
+        self.report(NcError(int(error.id), file, line, column, error.message),
+                    ErrorCategory.VALUE)
+        return False
 
     def _end_with(self, checked: CheckedError) -> None:
         if self._record:

@@ -274,3 +274,16 @@ def test_a_loop_without_blocks_does_not_block_the_cycle_and_reset_ends_it(harnes
     assert harness.command(ResetChannel(0, True)) is None
     snap = harness.wait_for(lambda s: s.channels[0].state == ChannelState.READY)
     assert snap.channels[0].decoder_flags == 0
+
+
+@pytest.mark.parametrize("after", ["G1 X10\nG40 X0 Y0\nM30\n", "M30\n", "G40\nG1 X0 Y0\nM30\n"])
+@pytest.mark.parametrize("mode", [SYNCHK | MACHINE_LOCK, MACHINE_LOCK])
+def test_a_compensated_arc_over_a_limit_aborts_as_in_a_real_run(harness, mode, after) -> None:
+    # G42 with D3: the compensated arc of line 4 reaches beyond X 1000; the error comes
+    # when compensation releases the held arc (next block, G40 or the end of the data)
+    _mode(harness, mode)
+    run = harness.run("G1 X0 Y0 F6000\nD3 G42 X10 Y0\nG1 X990\nG3 X990 Y20 I0 J10\n" + after,
+                      "comp.nc")
+    ch = run.channel
+    assert ch.state == ChannelState.ERROR
+    assert [(e.id, e.line, e.warning) for e in ch.errors if e.id != 21309] == [(50101, 4, False)]
