@@ -58,6 +58,7 @@ _INCR_PER_MM = 10_000  # 0.1 um increments per mm
 PROD_TIME_STEPS_PER_CYCLE = 5_000  # virtual clock: simulated cycles per GEO cycle (PROD_TIME)
 _PROD_TIME_SHARE = 0.4  # realtime clock: share of a GEO cycle the calculation may use
 _CHECK_MODES = ExecutionMode.SYNCHK | ExecutionMode.MACHINE_LOCK
+_PROGRAM_MODES = _CHECK_MODES | ExecutionMode.PROD_TIME | ExecutionMode.SUPPRESS_TECHNO_OUTPUT
 
 
 def _not_ready(channel: Channel, what: str) -> Refusal:
@@ -349,7 +350,11 @@ class ChannelRunner:
 
     def _begin(self, job: Job, keep_open: bool, fresh_modal: bool) -> None:
         ch = self.channel
-        mode = ch.execution_mode_active = self._active_mode()
+        if job.manual:  # the simulation modes act on programs; manual blocks run as usual
+            mode = ch.execution_mode_commanded & ~_PROGRAM_MODES
+        else:
+            mode = self._active_mode()
+        ch.execution_mode_active = mode
         self._prod_time = False
         ch.decoder_flags = 0
         if not job.manual and mode & _CHECK_MODES and not mode & ExecutionMode.PROD_TIME:

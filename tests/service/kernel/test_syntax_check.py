@@ -287,3 +287,12 @@ def test_a_compensated_arc_over_a_limit_aborts_as_in_a_real_run(harness, mode, a
     ch = run.channel
     assert ch.state == ChannelState.ERROR
     assert [(e.id, e.line, e.warning) for e in ch.errors if e.id != 21309] == [(50101, 4, False)]
+
+
+@pytest.mark.parametrize("mode", [SYNCHK, MACHINE_LOCK, PROD_TIME])
+def test_manual_blocks_run_as_usual_and_show_no_simulation_mode(harness, mode) -> None:
+    _mode(harness, mode)
+    run = harness.mdi("G1 X5 F6000")
+    ch = run.channel
+    assert ch.axes[0].position_mm == pytest.approx(5.0) and ch.errors == ()
+    assert ch.execution_mode_active == 0
