@@ -484,8 +484,11 @@ class ChannelRunner:
             return False
         deadline = time.perf_counter() + _PROD_TIME_SHARE * self._cycle_s
         for n in range(PROD_TIME_STEPS_PER_CYCLE):
-            if not self._deterministic and n % 4 == 0 and time.perf_counter() > deadline:
-                break
+            if not self._deterministic:
+                if n % 4 == 0 and time.perf_counter() > deadline:
+                    break
+                if not self._feed_ready():  # the decoder is behind: go on next cycle
+                    break
             self._sim_steps += 1
             self._time_s = self._started_at_s + self._sim_steps * self._cycle_s
             if not self._motion_cycle(self._time_s, 1.0, output=False):
@@ -494,6 +497,14 @@ class ChannelRunner:
                 self._executor.resume()  # M0/M1: the calculation does not wait
                 self.channel.waiting_for_start = False
         return True
+
+    def _feed_ready(self) -> bool:
+        """The next cycle's feed would not wait for the decoder."""
+        feed = self._feed
+        if (feed is None or self._fed_all or self._backlog or self._sync is not None
+                or self._pending_error is not None):
+            return True
+        return feed.ready(self._executor.free_slots())
 
     def _stop_run(self) -> None:
         if self._feed is not None:
@@ -531,7 +542,10 @@ class ChannelRunner:
         free = executor.free_slots()
         if free <= 0:
             return
-        items, self._backlog = self._backlog or feed.take(free, wait=self._deterministic), []
+        # PROD_TIME waits for the decoder as the virtual clock does: a simulated cycle
+        # must never pass starved (``_prod_time_cycle`` only steps when the feed is ready)
+        wait = self._deterministic or self._prod_time
+        items, self._backlog = self._backlog or feed.take(free, wait=wait), []
         contour = self._contour
         for k, item in enumerate(items):
             if isinstance(item, Block) and item.contour is not None and (

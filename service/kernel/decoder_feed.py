@@ -83,6 +83,7 @@ class DecoderFeed:
         self._cancel = threading.Event()
         self._ended = False
         self._markers: set[int] = set()
+        self.decoded_all = False  # the SDA thread has queued its last item
         self._outstanding = 0  # jobs added whose end the GEO side has not taken yet
         self._thread = threading.Thread(
             target=self._run, name=f"cnc-sda-ch{channel_id}", daemon=True
@@ -122,6 +123,11 @@ class DecoderFeed:
                 self._outstanding -= 1
         return items
 
+    def ready(self, limit: int) -> bool:
+        """``take(limit, wait=True)`` would return at once: ``limit`` items are queued or
+        decoding has ended."""
+        return self._ended or self.decoded_all or self._out.qsize() >= limit
+
     def cancel(self) -> None:
         """Stop decoding (RESET); the thread ends soon after."""
         self._cancel.set()
@@ -149,6 +155,12 @@ class DecoderFeed:
         self.modal = decoder.modal
 
     def _run(self) -> None:
+        try:
+            self._decode()
+        finally:
+            self.decoded_all = True
+
+    def _decode(self) -> None:
         self._job = Job("?")
         try:
             while not self._cancel.is_set():

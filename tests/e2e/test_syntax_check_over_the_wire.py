@@ -56,3 +56,24 @@ def test_mode_objects_plc_unit_flags_and_log_over_the_wire() -> None:
         assert "error 20121 (combination) at prog.nc:3:9: " in log
         assert log.rstrip().endswith("; end: 4 lines, 4 blocks, 2 errors, complete")
         assert api.read("ax1.command_position_acs") == 0  # nothing moved
+
+
+def test_prod_time_on_the_realtime_clock_waits_for_a_slow_decoder() -> None:
+    """A computation before the motion must not count as machining time: the calculation
+    waits for the decoder and gives the virtual-clock run's time exactly."""
+    from service.kernel.commands import SetExecutionMode
+    from tests.support.kernel import KernelHarness
+
+    program = ("#VAR\nV.L.I = 0\n#ENDVAR\n$WHILE V.L.I < 20000\nV.L.I = V.L.I + 1\n$ENDWHILE\n"
+               "G1 X10 F6000\nG2 X20 I5 J0\nG1 X0\nM30\n")
+    with KernelHarness() as harness:
+        expected = harness.run(program, "p.nc").channel.program_time_s
+        assert harness.command(SetExecutionMode(0, 0x10)) is None
+        assert harness.run(program, "p.nc").channel.program_time_s == expected
+    with serving("--clock", "realtime") as service, Client(service.endpoint) as api:
+        api.upload("p.nc", program.encode())
+        api.write("ch1.mc_command_execution_mode_w", 0x10)
+        api.run_program("p.nc")
+        api.wait_program(timeout_s=60)
+        assert api.read("ch1.program_time") == pytest.approx(expected, abs=1e-9)
+        assert api.read("ax1.command_position_acs") == 0
