@@ -115,7 +115,9 @@ class CheckResult:
     ``errors``: the reported errors in log order; ``aborted``: the error that ended the
     check (a software limit violation, a missing program, ...), else None; ``lines``
     and ``blocks``: how many NC lines and blocks were checked; ``stopped_early``: the
-    check stopped at ``syn_chk.errors_total``; ``log``: the whole log file.
+    check stopped at ``syn_chk.errors_total``; ``log``: the whole log file;
+    ``error_count``: all errors the check found (more than ``errors`` when the log had to
+    leave some out at the program store's file limit).
     """
 
     errors: tuple[CheckError, ...]
@@ -124,11 +126,13 @@ class CheckResult:
     blocks: int
     log: str
     stopped_early: bool
+    error_count: int = 0
 
     @property
     def clean(self) -> bool:
         """True when the check found no error and ran to the end."""
-        return not self.errors and self.aborted is None and not self.stopped_early
+        return (not self.errors and not self.error_count and self.aborted is None
+                and not self.stopped_early)
 
 
 def check_log_name(channel: int) -> str:
@@ -183,7 +187,7 @@ def parse_check_log(text: str, program: str = "") -> CheckResult:
     if end is None:
         raise ValueError("the log has no '; end: ...' line: it is not a complete syntax check log")
     return CheckResult(tuple(errors), aborted, int(end.group(1)), int(end.group(2)), text,
-                       end.group(4).startswith("stopped"))
+                       end.group(4).startswith("stopped"), int(end.group(3)))
 
 
 def _name_bytes(name: str) -> bytes:

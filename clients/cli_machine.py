@@ -247,7 +247,7 @@ def _check_summary(result: CheckResult, channel: int) -> str:
     lines = _plural(result.lines, "line")
     if result.clean:
         return f"clean: {lines}"
-    text = f"{_plural(len(result.errors), 'error')} in {lines}"
+    text = f"{_plural(max(result.error_count, len(result.errors)), 'error')} in {lines}"
     if result.stopped_early:
         text += ", stopped early: syn_chk.errors_total reached"
     if result.aborted is not None:

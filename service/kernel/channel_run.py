@@ -178,6 +178,8 @@ class ChannelRunner:
         ch = self.channel
         if ch.state != ChannelState.ACTIVE:
             return _not_ready(ch, "feedhold needs a running program (ACTIVE)")
+        if self._check is not None and self._check.settings is None:
+            return None  # a dry run (MACHINE_LOCK) ignores feedhold
         ch.state = ChannelState.HOLD
         if self._check is not None:  # STOP acts on decoding
             self._check.stop()
@@ -324,8 +326,15 @@ class ChannelRunner:
         ch.waiting_for_start = False
         ch.errors, ch.error_count = (), 0
         self._pending_start = (job, keep_open, fresh_modal)
-        if self.axes_ready:
+        if self.axes_ready or self._checks_only(job):
             self._begin_pending()
+
+    def _checks_only(self, job: Job) -> bool:
+        """The run is a syntax check or dry run: it needs no axis output (it starts and
+        runs while the output is suspended)."""
+        mode = self.channel.execution_mode_commanded
+        return (not job.manual and bool(mode & _CHECK_MODES)
+                and not mode & ExecutionMode.PROD_TIME)
 
     def _begin_pending(self) -> None:
         job, keep_open, fresh_modal = self._pending_start
@@ -446,7 +455,7 @@ class ChannelRunner:
         for found in p.errors:
             err = found.error
             self._raise(ChannelError(int(err.id), err.message, found.file, found.line,
-                                     found.column, warning=True), to_log=False)
+                                     found.column, warning=True), to_log=False, keep_last=True)
         flags = ch.decoder_flags & DecoderFlag.SYNTAX_CHECK
         if p.pause == Pause.AFTER_ERROR:
             flags |= DecoderFlag.WAIT_AFTER_ERROR
@@ -513,15 +522,17 @@ class ChannelRunner:
                 self._modal = self._feed.modal
             self._feed = None
 
-    def _raise(self, error: ChannelError, to_log: bool = True) -> None:
+    def _raise(self, error: ChannelError, to_log: bool = True, keep_last: bool = False) -> None:
         """List ``error``; ``to_log``: also in the channel's error log file (not the
-        findings of a syntax check, which may be thousands: they go to dec0<c>.sc)."""
+        findings of a syntax check, which may be thousands: they go to dec0<c>.sc);
+        ``keep_last``: leave the last slot free (for the error or warning that ends a
+        check)."""
         ch = self.channel
         if to_log:
             log.info("channel %d: %s", ch.channel_id, error)
             self._files(self.error_log_name, f"{self._time_s:.3f} s {error}\n".encode())
         ch.error_count += 1
-        if len(ch.errors) < MAX_ERRORS_KEPT:
+        if len(ch.errors) < MAX_ERRORS_KEPT - keep_last:
             ch.errors = (*ch.errors, error)
 
     def _fail(self, error: ChannelError) -> None:
@@ -608,7 +619,7 @@ class ChannelRunner:
         if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
             self.touched = False
             return False
-        if not self.axes_ready:  # suspended, or an axis waits for its link
+        if not self.axes_ready and self._check is None:  # suspended, or a link waits
             self.touched = False
             return False
         if self._pending_start is not None:

@@ -135,7 +135,9 @@ class CheckRun:
         self._record = bool(settings and settings.record_result)
         self._log: list[str] = []
         self._pending_log: list[str] = []  # errors of the line being decoded
-        self._log_bytes = 0  # size of the checked lines logged (they stop at the store limit)
+        self._log_bytes = 0  # size of the log kept so far (it stops at the store limit)
+        self._errors_not_logged = 0  # errors after the log reached the store limit
+        self._decoder: Decoder | None = None
         self._sources: dict[str, SourceText] = {}  # files decoded so far, by name
         self._limit_reached = False  # errors_total: the check ends after the current line
         self._cond = threading.Condition()
@@ -212,12 +214,19 @@ class CheckRun:
         if self._limit_reached:  # the rest of the line the check ends at
             return
         if self._record:  # written after the line it belongs to
-            self._pending_log.append(_error_line(error, category))
+            if self._log_bytes < PROGRAM_MAX_BYTES:
+                entry = _error_line(error, category)
+                self._pending_log.append(entry)
+                self._log_bytes += len(entry) + 1
+            else:  # the log is full: counted, not kept (memory stays bounded)
+                self._errors_not_logged += 1
         with self._cond:
             p = self._progress
             p.errors.append(checked)
             p.error_count += 1
             src = self._sources.get(error.file)
+            if src is None and self._decoder is not None:
+                src = self._decoder.source_of(error.file)
             if src is not None and 0 < error.line <= len(src.lines):  # the decoder is here
                 p.file, p.line, p.offset = error.file, error.line, src.offset(error.line - 1)
             total = self.settings.errors_total
@@ -246,6 +255,7 @@ class CheckRun:
                 contour_lookahead=self._contour_lookahead, check=self,
             )
             self._sources[self.name] = decoder.source
+            self._decoder = decoder
             if self._record:
                 self._log.append(f"; syntax check of {self.name} in channel {self.channel_id}")
             for item in decoder.blocks():
@@ -397,6 +407,8 @@ class CheckRun:
             return True
         self.report(NcError(int(error.id), file, line, column, error.message),
                     ErrorCategory.VALUE)
+        self._log.extend(self._pending_log)  # its line is logged already
+        self._pending_log.clear()
         return False
 
     def _end_with(self, checked: CheckedError) -> None:
@@ -417,13 +429,24 @@ class CheckRun:
         how = ("stopped: syn_chk.errors_total reached" if p.stopped_early
                else "aborted" if p.failure is not None else "complete")
         end = (f"; end: {p.lines} lines, {p.blocks} blocks, {p.error_count} errors, {how}")
-        data = ("\n".join(self._log) + "\n" + end + "\n").encode()
-        if len(data) > PROGRAM_MAX_BYTES or self._log_bytes >= PROGRAM_MAX_BYTES:
-            # the store's file limit: keep every error
-            kept = [self._log[0], "; the checked lines are left out: the log would exceed "
-                    f"the store's file limit of {PROGRAM_MAX_BYTES} bytes"]
-            kept += [entry for entry in self._log if entry.startswith("error ")]
-            data = ("\n".join(kept) + "\n" + end + "\n").encode()[-PROGRAM_MAX_BYTES:]
+        entries = self._log
+        if self._errors_not_logged or self._log_bytes >= PROGRAM_MAX_BYTES:
+            # the store's file limit: the first errors are kept, the checked lines go
+            errors = [entry for entry in entries if entry.startswith("error ")]
+            entries = [entries[0], "; the checked lines are left out: the log would exceed "
+                       f"the store's file limit of {PROGRAM_MAX_BYTES} bytes"]
+            room = PROGRAM_MAX_BYTES - 400 - sum(len(e) + 1 for e in entries)
+            kept = 0
+            for entry in errors:
+                room -= len(entry) + 1
+                if room < 0:
+                    break
+                kept += 1
+            entries += errors[:kept]
+            left = len(errors) - kept + self._errors_not_logged
+            if left:
+                entries.append(f"; {left} more errors are not listed (the store's file limit)")
+        data = ("\n".join(entries) + "\n" + end + "\n").encode()
         self._files(log_name(self.channel_id), data, replace=True)
 
 

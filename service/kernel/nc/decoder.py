@@ -134,6 +134,13 @@ class Decoder:
         """The text of the program being decoded (``SourceText``: lines, offsets)."""
         return self._main.src
 
+    def source_of(self, name: str):
+        """The text of file ``name`` if this decoder has loaded it (main or subprogram)."""
+        if name == self._main.name:
+            return self._main.src
+        program = self._files.get(name)
+        return None if program is None else program.src
+
     @property
     def modal(self) -> ModalState:
         """The modal state (the one passed in, changed as decoding goes)."""

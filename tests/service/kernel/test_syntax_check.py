@@ -132,7 +132,7 @@ def test_many_errors_do_not_go_to_the_error_log_file(harness) -> None:
     text = "".join(f"N{k} G1 X1 F100 Q7\n" for k in range(1, 3001)) + "M30\n"
     run = harness.run(text, "many.nc")
     assert run.channel.error_count == 3000  # no 21309: MACHINE_LOCK was commanded
-    assert len(run.channel.errors) == 8
+    assert len(run.channel.errors) == 7  # the last slot is kept for an error that ends it
     assert b"Q7" not in harness.files.get("errors-ch1.log", b"")
 
 
@@ -296,3 +296,53 @@ def test_manual_blocks_run_as_usual_and_show_no_simulation_mode(harness, mode) -
     ch = run.channel
     assert ch.axes[0].position_mm == pytest.approx(5.0) and ch.errors == ()
     assert ch.execution_mode_active == 0
+
+
+def test_the_error_that_ends_a_check_is_listed_after_many_findings(harness) -> None:
+    _mode(harness, SYNCHK | MACHINE_LOCK)
+    text = "".join(f"G1 X1 F100 Q{k}\n" for k in range(10)) + "G1 X5000\nM30\n"
+    ch = harness.run(text, "a.nc").channel
+    assert ch.state == ChannelState.ERROR and ch.error_count == 11
+    assert (ch.errors[-1].id, ch.errors[-1].line, ch.errors[-1].warning) == (50101, 11, False)
+
+
+def test_a_check_runs_while_the_axis_output_is_suspended() -> None:
+    with KernelHarness() as h:
+        h.kernel.state.channels[0].output_suspended = True  # as channel 2 of the default
+        _mode(h, SYNCHK | MACHINE_LOCK)
+        run = h.run("G1 X1 F100 Q1\nM30\n", "a.nc")
+        assert run.channel.state == ChannelState.READY
+        assert [e.id for e in run.channel.errors] == [21220]
+
+
+def test_the_dry_run_ignores_feedhold(harness) -> None:
+    _mode(harness, MACHINE_LOCK)
+    harness.start(generate_program(60_000), "long.nc")
+    assert harness.command(Feedhold(0, True)) is None
+    run = harness.wait()
+    assert run.channel.state == ChannelState.READY
+
+
+def test_an_error_in_a_subprogram_shows_the_subprogram_at_the_pause(harness) -> None:
+    harness.programs["sub.nc"] = "G1 X1 Q1\nM17\n"
+    _mode(harness, SYNCHK | MACHINE_LOCK)
+    _param(harness, "interactive", 1)
+    harness.start("G1 X0 F100\nL sub.nc\nM30\n", "m.nc")
+    ch = harness.wait_for(lambda s: s.channels[0].state == ChannelState.HOLD).channels[0]
+    assert (ch.file_name, ch.line, ch.file_offset) == ("sub.nc", 1, 0)
+    assert harness.command(ResetChannel(0, True)) is None
+
+
+def test_a_log_over_the_store_limit_keeps_the_first_errors_and_the_count(harness) -> None:
+    _mode(harness, SYNCHK | MACHINE_LOCK)
+    _param(harness, "record_result", 1)
+    text = "".join(f"N{k} G1 X1 F100 Q7\n" for k in range(1, 30001)) + "M30\n"
+    run = harness.run(text, "many.nc")
+    assert run.channel.error_count == 30000
+    data = harness.files["dec01.sc"]
+    assert len(data) <= 1_000_000
+    log = data.decode().splitlines()
+    assert log[0] == "; syntax check of many.nc in channel 1"
+    assert log[2].startswith("error 21220 (term) at many.nc:1:")  # the first error is kept
+    assert log[-2].endswith("more errors are not listed (the store's file limit)")
+    assert log[-1] == "; end: 30001 lines, 30001 blocks, 30000 errors, complete"
