@@ -620,6 +620,8 @@ class ChannelRunner:
             self.touched = False
             return False
         if not self.axes_ready and self._check is None:  # suspended, or a link waits
+            if self._prod_time and self._pending_start is None:
+                self._sim_steps += 1  # a real run's time runs on while a link waits
             self.touched = False
             return False
         if self._pending_start is not None:
