@@ -165,6 +165,8 @@ def categorize(error: NcError, line: LogicalLine | None) -> ErrorCategory:
     err_id = error.id
     if err_id in _RESOURCE:
         return ErrorCategory.RESOURCE
+    if err_id == NcErrorId.COMMENT_END_WITHOUT_BEGIN:  # a # command, found before parsing
+        return ErrorCategory.COMMAND
     if line is not None and error.pos >= 0:
         if _ASSIGN_TARGET.match(line.upper, error.pos):
             return ErrorCategory.ASSIGNMENT

@@ -741,3 +741,9 @@ def test_check_reports_first_what_a_normal_run_stops_at(monkeypatch, text):
             error.id, error.file, error.line, error.column), (str(error), str(first))
     elif len(blocks) < 300:
         assert check.errors == []
+
+
+def test_comment_end_without_begin_is_a_command_error():
+    run = check_run("G1 X1 F100\n#COMMENT END\nG1 X2\nM30\n")
+    assert [(e.id, e.line, c) for e, c in run.check.errors] == [
+        (NcErrorId.COMMENT_END_WITHOUT_BEGIN, 2, ErrorCategory.COMMAND)]
