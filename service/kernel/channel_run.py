@@ -369,11 +369,7 @@ class ChannelRunner:
         if not job.manual and mode & _CHECK_MODES and not mode & ExecutionMode.PROD_TIME:
             self._begin_check(job, mode)
             return
-        params = [self._params[n] for n in self._axis_numbers]
-        dynamics = tuple(
-            AxisDynamics(p.vel_max_mm_s, p.acc_max_mm_s2, p.vel_jump_mm_s) for p in params
-        )
-        sw_limits = tuple((p.sw_limit_min_mm, p.sw_limit_max_mm) for p in params)
+        dynamics, sw_limits = self._axis_limits()
         position = tuple(a.position_mm for a in ch.axes)
         if fresh_modal or self._modal is None:
             self._modal = ModalState(position_mm=position)
@@ -414,19 +410,26 @@ class ChannelRunner:
         ch.program_time_s = 0.0
         ch.file_name, ch.line, ch.file_offset, ch.block_number = job.name, 0, 0, -1
 
+    def _axis_limits(self) -> tuple[tuple[AxisDynamics, ...], tuple[tuple[float, float], ...]]:
+        """Dynamics and software limits of the channel's axes from the effective axis
+        parameters (read at each start, so an update applies from the next run)."""
+        params = [self._params[n] for n in self._axis_numbers]
+        dynamics = tuple(
+            AxisDynamics(p.vel_max_mm_s, p.acc_max_mm_s2, p.vel_jump_mm_s) for p in params
+        )
+        return dynamics, tuple((p.sw_limit_min_mm, p.sw_limit_max_mm) for p in params)
+
     def _begin_check(self, job: Job, mode: int) -> None:
         """Start the syntax check (SYNCHK) or dry run (MACHINE_LOCK) of the program."""
         ch = self.channel
-        params = [self._params[n] for n in self._axis_numbers]
+        dynamics, sw_limits = self._axis_limits()
         synchk = bool(mode & ExecutionMode.SYNCHK)
         self._check = CheckRun(
             channel_id=ch.channel_id, name=job.name, text_of=self._loader, axes=self._axes,
             axis_numbers=self._axis_numbers, tools=self._tools,
             contour_lookahead=self.config.contour_lookahead,
             start_mm=tuple(a.position_mm for a in ch.axes),
-            dynamics=tuple(AxisDynamics(p.vel_max_mm_s, p.acc_max_mm_s2, p.vel_jump_mm_s)
-                           for p in params),
-            sw_limits_mm=tuple((p.sw_limit_min_mm, p.sw_limit_max_mm) for p in params),
+            dynamics=dynamics, sw_limits_mm=sw_limits,
             settings=ch.syn_chk if synchk else None, single_step=ch.single_block,
             deterministic=self._deterministic, files=self._files,
         )

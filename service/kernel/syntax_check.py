@@ -30,7 +30,7 @@ import logging
 import re
 import threading
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
 from protocol.constants import PROGRAM_MAX_BYTES
@@ -156,11 +156,8 @@ class CheckRun:
     def progress(self) -> Progress:
         """A copy of the progress; the errors reported since the last call move out."""
         with self._cond:
-            p = self._progress
-            taken = Progress(p.file, p.line, p.offset, p.block_number, p.lines, p.blocks,
-                             p.errors, p.error_count, p.pause, p.done, p.failure,
-                             p.stopped_early)
-            p.errors = []
+            taken = replace(self._progress)
+            self._progress.errors = []
             return taken
 
     def advance(self, lines: int = LINES_PER_CYCLE) -> None:
