@@ -56,6 +56,11 @@ _M_FLOW = {
 # interface objects carry it), 2**31 - 1 increments = 12,884,901.88 mm/min.
 FEED_MAX_MM_MIN = (2**31 - 1) * 1e-4 * 60.0
 
+# plane -> (p, q, normal) as indices into (X, Y, Z); and the plane of each normal
+_CS_PLANE = {Plane.XY: (0, 1, 2), Plane.ZX: (2, 0, 1), Plane.YZ: (1, 2, 0)}
+_PLANE_OF_NORMAL = {2: Plane.XY, 1: Plane.ZX, 0: Plane.YZ}
+WEIGHTING_MIN_PCT = 1.0  # G133/G134 percent range
+WEIGHTING_MAX_PCT = 1000.0
 _OFFSET_LETTER = ("I", "J", "K")
 # the plain fields of the ModalState a block may change (variables excluded)
 _MODAL_FIELDS = ("position_mm", "distance", "plane", "motion", "feed_mm_min", "compensation",
@@ -89,6 +94,8 @@ class BlockExecutor:
         self.manual = manual
         self.items_done = 0  # items of the last block executed before it ended or failed
         index = {name: k for k, name in enumerate(axes)}
+        # channel axis indices of X, Y, Z (the axes #CS transforms; #CS needs all three)
+        self.xyz = tuple(index.get(name, -1) for name in "XYZ")
         # plane -> (p, q) channel axis indices, or None when the channel lacks an axis
         self.plane_axes: dict[Plane, tuple[int, int] | None] = {}
         self._arc_setup: dict[Plane, tuple] = {}
@@ -164,6 +171,8 @@ class BlockExecutor:
                         raise err(NcErrorId.INVALID_M_CODE,
                                   f"M{value:g} is not a valid M function", item.pos)
                     m_codes.append((number, item.pos))
+                case WordKind.WEIGHTING:
+                    self._weighting(item.letter, value, item.pos, err)
                 case _:  # F S T D R
                     words[item.kind] = (value, item.pos)
             self.items_done += 1
@@ -233,6 +242,18 @@ class BlockExecutor:
             raise err(NcErrorId.CONFLICTING_G_CODES,
                       f"G{groups[group][0]} and G{number} in one block", pos)
         groups[group] = (number, pos)
+
+    def _weighting(self, letter: str, value: float, pos: int, err) -> None:
+        """G133 = <%> (acceleration) / G134 = <%> (ramp time): shown, see technology."""
+        if not WEIGHTING_MIN_PCT <= value <= WEIGHTING_MAX_PCT:
+            raise err(NcErrorId.VALUE_OUT_OF_RANGE,
+                      f"{letter} = {value:g} is outside {WEIGHTING_MIN_PCT:g}.."
+                      f"{WEIGHTING_MAX_PCT:g} %", pos)
+        settings = self.modal.settings
+        if letter == "G133":
+            settings.acc_weight_pct = value
+        else:
+            settings.ramp_weight_pct = value
 
     def _modal_groups(self, groups: dict[GGroup, tuple[int, int]]) -> None:
         for group, (number, _pos) in groups.items():
@@ -311,10 +332,15 @@ class BlockExecutor:
         start = modal.position_mm
         end = list(start)
         incremental = modal.distance == DistanceMode.INCREMENTAL
+        placement = modal.cs_placement
+        cs_axes = self.xyz if placement is not None else ()
         for axis, value, pos, letter in axis_words:
             if axis < 0:
                 raise err(NcErrorId.UNKNOWN_WORD, f"{letter} is not an axis of this channel", pos)
-            end[axis] = start[axis] + value if incremental else value
+            if axis not in cs_axes:
+                end[axis] = start[axis] + value if incremental else value
+        if placement is not None:  # X, Y, Z are programmed in the machining coordinates
+            cs_start, cs_end = self._cs_targets(placement, start, end, axis_words, incremental)
         for axis, value, pos, letter in axis_words:
             if not math.isfinite(end[axis]):
                 raise err(NcErrorId.VALUE_OUT_OF_RANGE, f"{letter} position is out of range", pos)
@@ -339,6 +365,9 @@ class BlockExecutor:
             if end_t == start:
                 return None
             return make_motion(kind, start, end_t, feed, plane_default, None, comp, radius)
+        if placement is not None:
+            return self._arc_in_cs(kind, placement, cs_start, cs_end, start, end_t, offsets,
+                                   radius_word, motion_pos, feed, comp, radius, err)
         plane = self.plane_axes[modal.plane]
         if plane is None:
             p, q = PLANE_AXES[modal.plane]
@@ -379,6 +408,75 @@ class BlockExecutor:
             raise err(f.err_id, f.message, motion_pos) from None
         return make_motion(kind, start, end_t, feed, plane, centre, comp, radius)
 
+
+    # ------------------------------------------------------------ machining coordinates
+
+    def _cs_targets(self, placement, start, end, axis_words, incremental):
+        """Set X, Y, Z of ``end`` from words in machining coordinates: (start, end) in
+        machining coordinates. Unprogrammed coordinates keep their machining value; when
+        none changes, the machine position stays exactly (no rounding motion)."""
+        ix, iy, iz = self.xyz
+        cs_start = placement.from_machine((start[ix], start[iy], start[iz]))
+        cs_end = list(cs_start)
+        for axis, value, _pos, _letter in axis_words:
+            if axis in self.xyz:
+                k = self.xyz.index(axis)
+                cs_end[k] = cs_start[k] + value if incremental else value
+        cs_end = tuple(cs_end)
+        if cs_end != cs_start:
+            end[ix], end[iy], end[iz] = placement.to_machine(cs_end)
+        return cs_start, cs_end
+
+    def _arc_in_cs(self, kind, placement, cs_start, cs_end, start, end_t, offsets,
+                   radius_word, motion_pos, feed, comp, radius, err):
+        """G2/G3 in a machining coordinate system: the centre is found in machining
+        coordinates, then the arc is placed in the machine plane its plane maps to."""
+        modal = self.modal
+        p, q, n = _CS_PLANE[modal.plane]
+        if cs_end[n] != cs_start[n]:
+            raise err(NcErrorId.HELIX_NOT_SUPPORTED,
+                      f"{'XYZ'[n]} is outside the G{int(modal.plane)} plane: helical arcs are "
+                      "not supported", motion_pos)
+        column = tuple(row[n] for row in placement.rotation)  # the plane normal on the machine
+        m = max(range(3), key=lambda k: abs(column[k]))
+        if abs(abs(column[m]) - 1.0) > 1e-12:
+            raise err(NcErrorId.ARC_PLANE_TILTED,
+                      f"G{int(kind)} in a machining coordinate system whose G{int(modal.plane)} "
+                      "plane is tilted against the machine's planes: arcs run in the machine "
+                      "planes only (program the arc as straight lines)", motion_pos)
+        cs_offsets = {}
+        for axis, (value, pos) in offsets.items():
+            k = self.xyz.index(axis)
+            if k == n:
+                raise err(NcErrorId.ARC_OFFSET_OUT_OF_PLANE,
+                          f"{_OFFSET_LETTER[k]} is not in the G{int(modal.plane)} plane", pos)
+            cs_offsets[k] = value
+        try:
+            if radius_word is not None:
+                if offsets:
+                    raise err(NcErrorId.ARC_CENTRE_AND_RADIUS,
+                              "program the arc centre (I/J/K) or the radius (R), not both",
+                              radius_word[1])
+                cp, cq = centre_from_radius(cs_start[p], cs_start[q], cs_end[p], cs_end[q],
+                                            radius_word[0], kind == MotionKind.ARC_CCW)
+            elif offsets:
+                cp, cq = centre_from_offsets(cs_start[p], cs_start[q], cs_end[p], cs_end[q],
+                                             cs_offsets.get(p, 0.0), cs_offsets.get(q, 0.0))
+            else:
+                raise err(NcErrorId.MISSING_VALUE,
+                          f"G{int(kind)} needs the centre (I/J/K) or the radius (R)", motion_pos)
+        except VariableFault as f:
+            raise err(f.err_id, f.message, motion_pos) from None
+        centre = list(cs_start)
+        centre[p] = cp
+        centre[q] = cq
+        machine_centre = placement.to_machine(tuple(centre))
+        machine_plane = _PLANE_OF_NORMAL[m]
+        mp, mq, _ = _CS_PLANE[machine_plane]
+        if column[m] < 0.0:  # the normal turned over: clockwise seen from the machine
+            kind = MotionKind.ARC_CCW if kind == MotionKind.ARC_CW else MotionKind.ARC_CW
+        return make_motion(kind, start, end_t, feed, self.plane_axes[machine_plane],
+                           (machine_centre[mp], machine_centre[mq]), comp, radius)
 
     def _no_released_axis(self, released, axis_words, offsets, err) -> None:
         """An error at the leftmost word (axis or I/J/K) of a released axis, if any."""

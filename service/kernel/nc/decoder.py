@@ -42,7 +42,11 @@ from .statements import (
     CLOSER_OF, OPENERS, SPELLING, Assign, AxisCommand, ContourStatement, Control, NcBlock, Word,
     WordKind,
 )
-from .variables import Scope, Variable
+from .cycle_run import call_cycle
+from .instruction_run import pattern_error, run_instruction
+from .instructions import Instruction
+from .technology import HSCS_MODES, Surroundings
+from .variables import Scope, Variable, VarType
 
 log = logging.getLogger(__name__)
 
@@ -81,6 +85,7 @@ class Decoder:
         axis_numbers: tuple[int, ...] | None = None,
         contour_lookahead: bool = False,
         check: SyntaxCheck | None = None,
+        surroundings: Surroundings | None = None,
     ) -> None:
         axes = tuple(axes)
         for name in axes:
@@ -106,6 +111,7 @@ class Decoder:
         if not manual:  # a program starts with the channel's axes and an empty log
             modal.released_axes = frozenset()
             modal.contour_log_area = LogArea.NONE
+            modal.start_program()
         elif not all(0 <= k < len(axes) for k in modal.released_axes):
             raise ValueError(f"released axes {sorted(modal.released_axes)} are not axes "
                              f"of the channel {axes}")
@@ -114,6 +120,8 @@ class Decoder:
         self.manual = manual
         self.contour_lookahead = contour_lookahead
         self.check = check
+        self.surroundings = surroundings or Surroundings()
+        self.files_written: set[str] = set()  # #MSG SAVE files written in this run
         self._loader = loader
         self._modal = modal
         self._skip_levels = skip_levels
@@ -164,12 +172,76 @@ class Decoder:
         if scope == Scope.P:
             return self._modal.variables_p.get(name)
         if scope == Scope.G:
-            return self._modal.variables_g.get(name)
+            found = self._modal.variables_g.get(name)
+            return found if found is not None or "." not in name else self._provided(name)
         for frame in reversed(self.frames):
             found = frame.cycle_vars.get(name)
             if found is not None:
                 return found
         return None
+
+    def _provided(self, name: str) -> Variable | None:
+        """The V.G. variables the decoder provides: ``HSCS.<MODE>.TOLERANCE`` (mm) and
+        ``WZ_AKT.R`` (radius of the active tool, mm). Read only: a fresh copy each time."""
+        if name == "WZ_AKT.R":
+            value = self.executor.tool_radius(self._modal.tool_offset) or 0.0
+        else:
+            parts = name.split(".")
+            if len(parts) != 3 or parts[0] != "HSCS" or parts[2] != "TOLERANCE" \
+                    or parts[1] not in HSCS_MODES:
+                return None
+            setting = self.surroundings.hscs.get(parts[1])
+            value = setting.tolerance_mm if setting is not None else 0.0
+        return Variable(f"V.G.{name}", VarType.REAL64, (), [float(value)])
+
+    def cycle_parameter(self, number: int, line, pos: int):
+        """``@P<number>`` in the innermost running cycle."""
+        for frame in reversed(self.frames):
+            params = frame.cycle_params
+            if params is not None:
+                if number in params:
+                    return params[number]
+                raise line.error(NcErrorId.CYCLE_PARAMETER_UNDEFINED,
+                                 f"@P{number} was not given in the call of this cycle "
+                                 f"({frame.program.name})", pos)
+        raise line.error(NcErrorId.CYCLE_PARAMETER_UNDEFINED,
+                         f"@P{number} outside a cycle: cycle parameters exist only in a cycle "
+                         "called with L CYCLE [...]", pos)
+
+    def push_cycle(self, frame: Frame, params: dict | None) -> None:
+        """Run ``frame`` as a cycle: with its parameters, returning the caller's modal
+        G functions (G0..G3, G90/G91, G17..G19) when it ends."""
+        if len(self.frames) > MAX_CALL_DEPTH:
+            raise NcError(NcErrorId.CALL_DEPTH_EXCEEDED, frame.program.name, 1, 1,
+                          f"subprogram calls nested deeper than {MAX_CALL_DEPTH}")
+        modal = self._modal
+        frame.cycle_params = params if params is not None else {}
+        frame.restore = (modal.motion, modal.distance, modal.plane)
+        self.frames.append(frame)
+
+    def _return(self) -> None:
+        """End the running frame (M17/M29, end of a %L section)."""
+        frame = self.frames.pop()
+        if frame.restore is not None:
+            self._modal.motion, self._modal.distance, self._modal.plane = frame.restore
+
+    def load(self, name: str) -> Program:
+        """File ``name`` of the program store, prepared (cached); KeyError when missing,
+        OSError/ValueError when unreadable."""
+        program = self._files.get(name)
+        if program is None:
+            text = self._loader(name)
+            program = Program(text, name, self.parser, self._skip_levels, self.check)
+            self._files[name] = program
+        return program
+
+    def has_file(self, name: str) -> bool:
+        """True when the program store has file ``name``."""
+        try:
+            self.load(name)
+        except (KeyError, OSError, ValueError):
+            return False
+        return True
 
     def declare_block(self, frame: Frame, stmt: Control, after: int) -> None:
         """Run the ``#VAR`` block at ``frame.index``."""
@@ -211,6 +283,12 @@ class Decoder:
         if stmt is None:
             frame.index = after
             return None
+        if type(stmt) is Instruction:
+            run_instruction(stmt, self)
+            frame.index = after
+            return None
+        if self._modal.pattern is not None and type(stmt) is not Control:
+            raise pattern_error(stmt.line, _first_pos(stmt.line))
         if type(stmt) is not NcBlock:
             if type(stmt) is AxisCommand:
                 block = self.executor.exchange(stmt, self)
@@ -236,7 +314,7 @@ class Decoder:
                     NcErrorId.SUBPROGRAM_END_IN_MAIN,
                     "M17/M29 ends a subprogram; the main program ends with M30", flow_pos,
                 )
-            self.frames.pop()
+            self._return()
             return block
         if stmt.call is not None:
             self._call(frame, stmt)
@@ -350,6 +428,9 @@ class Decoder:
     def _call(self, frame: Frame, stmt: NcBlock) -> None:
         call = stmt.call
         line = stmt.line
+        if call.cycle is not None:
+            call_cycle(self, frame, stmt)
+            return
         if len(self.frames) > MAX_CALL_DEPTH:
             raise line.error(
                 NcErrorId.CALL_DEPTH_EXCEEDED,
@@ -371,20 +452,16 @@ class Decoder:
             section = sections[0]
             self.frames.append(Frame(frame.program, section, section.start, FrameKind.LOCAL))
             return
-        program = self._files.get(call.name)
-        if program is None:
-            try:
-                text = self._loader(call.name)
-            except KeyError:
-                raise line.error(
-                    NcErrorId.FILE_NOT_FOUND, f"file {call.name} not found", call.pos
-                ) from None
-            except (OSError, ValueError) as exc:
-                raise line.error(
-                    NcErrorId.FILE_NOT_FOUND, f"file {call.name} cannot be read: {exc}", call.pos
-                ) from None
-            program = Program(text, call.name, self.parser, self._skip_levels, self.check)
-            self._files[call.name] = program
+        try:
+            program = self.load(call.name)
+        except KeyError:
+            raise line.error(
+                NcErrorId.FILE_NOT_FOUND, f"file {call.name} not found", call.pos
+            ) from None
+        except (OSError, ValueError) as exc:
+            raise line.error(
+                NcErrorId.FILE_NOT_FOUND, f"file {call.name} cannot be read: {exc}", call.pos
+            ) from None
         self.frames.append(Frame(program, program.main, program.main.start, FrameKind.FILE))
 
     def _end_of_section(self, frame: Frame) -> None:
@@ -401,9 +478,15 @@ class Decoder:
             elif frame.kind == FrameKind.MAIN:
                 self.finished = True
             else:
-                self.frames.pop()
+                self._return()
 
     def _end_section(self, frame: Frame) -> None:
+        pattern = self._modal.pattern
+        if pattern is not None and frame.kind == FrameKind.MAIN:
+            self._modal.pattern = None
+            raise pattern.line.error(NcErrorId.PATTERN_NOT_CLOSED,
+                                     f"#PATTERN BEGIN [ID={pattern.id}] without #PATTERN END",
+                                     pattern.pos)
         if frame.control:
             entry = frame.control[-1]
             closer = next(c for c, o in CLOSER_OF.items() if o == entry.kind)
@@ -412,7 +495,7 @@ class Decoder:
                 f"{SPELLING[entry.kind]} without {SPELLING[closer]}", entry.stmt.pos,
             )
         if frame.kind == FrameKind.LOCAL:  # %L ends at the next % line: implicit M17
-            self.frames.pop()
+            self._return()
             return
         line = _last_code_line(frame.program, frame.section)
         name = frame.program.name
@@ -424,6 +507,12 @@ class Decoder:
             return
         raise NcError(NcErrorId.MISSING_PROGRAM_END, name, line, 1,
                       f"program {name} ends without M30 (or M2)")
+
+
+def _first_pos(line) -> int:
+    """Position of the first non-blank character of ``line``."""
+    text = line.text
+    return len(text) - len(text.lstrip())
 
 
 def _last_code_line(program: Program, section: Section) -> int:

@@ -57,6 +57,7 @@ class NcErrorId(IntEnum):
     ARC_FULL_CIRCLE_WITH_R = 20145  # R with end point == start point (no unique circle)
     ARC_CENTRE_AND_RADIUS = 20146  # I/J/K and R in the same block
     PLANE_AXIS_MISSING = 20147  # the plane needs an axis the channel does not have
+    ARC_PLANE_TILTED = 20148  # G2/G3 in a #CS whose plane maps to no machine plane
     ARC_RADIUS_DIFFERENCE = 21758  # ISG: end point not on the circle (radii differ)
 
     # ---- axis exchange (#AX RELEASE / #AX REQUEST)
@@ -116,7 +117,28 @@ class NcErrorId(IntEnum):
 
     # ---- known but not implemented yet
     INSTRUCTION_NOT_SUPPORTED = 20500  # a #instruction or keyword of a later issue
-    CYCLE_NOT_SUPPORTED = 20501  # L CYCLE [...]
+
+    # ---- cycles (L CYCLE [...]) and their instructions
+    CYCLE_SYNTAX = 20510  # malformed L CYCLE [...] (no NAME, no ']', unknown keyword)
+    CYCLE_NOT_FOUND = 20511  # NAME= names no built-in cycle and no file of the store
+    CYCLE_PARAMETER_MISSING = 20512  # a required @P parameter was not given
+    CYCLE_PARAMETER_UNKNOWN = 20513  # an @P parameter the cycle does not have
+    CYCLE_PARAMETER_RANGE = 20514  # an @P value outside its range (or of the wrong type)
+    CYCLE_PARAMETER_UNDEFINED = 20515  # @Pn read in a cycle that was called without it
+    CYCLE_POINTS_IDENTICAL = 20516  # calculation cycle: the points coincide
+    CYCLE_POINTS_COLLINEAR = 20517  # calculation cycle: the points lie on one line
+    CYCLE_POINTS_COPLANAR = 20518  # SysCalcSphere: the points lie in one plane
+    TRAFO_NOT_CONFIGURED = 20519  # a cycle mode rotates the tool: needs a kinematic trafo
+    CYCLE_PARAMETER_TWICE = 20520  # the same @P (or NAME, PATTERN_ID) twice in one call
+    PATTERN_NOT_DEFINED = 20521  # PATTERN_ID / #PATTERN DELETE of an undefined pattern
+    PATTERN_NESTED = 20522  # #PATTERN BEGIN inside a pattern definition
+    PATTERN_COMMAND_INSIDE = 20523  # an ordinary command inside #PATTERN BEGIN ... END
+    PATTERN_SYNTAX = 20524  # malformed #PATTERN / #AT, #AT outside a definition
+    PATTERN_NOT_CLOSED = 20525  # #PATTERN BEGIN without #PATTERN END
+    PATTERN_ROTATION_NOT_SUPPORTED = 20526  # #AT with a rotation about X or Y
+    INSTRUCTION_SYNTAX = 20530  # malformed #CS, #FILE, #MSG, #TRAFO, #HSC, #SLOPE, #FILTER
+    MESSAGE_FORMAT = 20531  # #MSG: format and arguments do not match
+    FILE_WRITE_FAILED = 20532  # #MSG SAVE: the file store refused the write
 
 
 class NcError(Exception):

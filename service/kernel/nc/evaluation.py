@@ -88,6 +88,20 @@ class VarRef:
             raise self.line.error(f.err_id, f.message, self.pos) from None
 
 
+class ParamRef:
+    """``@P<n>`` inside a cycle: the value its call passed (read only)."""
+
+    __slots__ = ("number", "line", "pos")
+
+    def __init__(self, number: int, line: LogicalLine, pos: int) -> None:
+        self.number = number
+        self.line = line
+        self.pos = pos
+
+    def __call__(self, env: Any) -> Value:
+        return env.cycle_parameter(self.number, self.line, self.pos)
+
+
 def _index(value: Value, line: LogicalLine, pos: int) -> int:
     if isinstance(value, str) or not math.isfinite(value) or value != int(value):
         raise line.error(

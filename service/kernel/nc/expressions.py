@@ -11,7 +11,7 @@ Grammar (lowest precedence first; ``( )`` are comments in ISG, so ``[ ]`` group)
     mul     := unary { (* | / | MOD) unary }
     unary   := (- | +) unary | power
     power   := primary [ (** | ^) unary ]          right associative
-    primary := number | "string" | TRUE | FALSE | variable | FUNC[args] | [ or ]
+    primary := number | "string" | TRUE | FALSE | variable | @P<n> | FUNC[args] | [ or ]
 
 Functions: ABS SQR SQRT SIN COS TAN ASIN ACOS ATAN ATAN2 EXP LN INT ROUND FRACT, each
 called with brackets: ``SIN[30]``. The parser builds the nodes of ``evaluation``;
@@ -22,14 +22,21 @@ line of 10,000 ``[`` is an error and never exhausts Python's stack.
 
 from __future__ import annotations
 
+import re
+
 from .errors import NcError, NcErrorId
 from .evaluation import (
-    ADD_OPS, CMP_OPS, CMP_SYMBOLS, FUNCTIONS, MUL_OPS, Const, Node, VarRef, evaluate_number,
+    ADD_OPS, CMP_OPS, CMP_SYMBOLS, FUNCTIONS, MUL_OPS, Const, Node, ParamRef, VarRef,
+    evaluate_number,
     fold, logic, number, pow_op, truth, xor_op,
 )
 from .lexer import IDENT, NUMBER, VARIABLE, Cursor
 from .variables import Scope
 
+_PARAM_REF = re.compile(r"@P([0-9]+)")
+# V.G. variables with members that the decoder provides (they are not declared)
+_MEMBER_NAMES = frozenset({"HSCS", "WZ_AKT"})
+_MEMBER = re.compile(r"(?:\.[A-Z_][A-Z0-9_]*)+")
 MAX_DEPTH = 32  # nesting of brackets / unary operators; keeps Python's stack small
 
 _SCOPES = {"L": Scope.L, "P": Scope.P, "G": Scope.G, "CYC": Scope.CYC}
@@ -202,6 +209,13 @@ class ExpressionParser:
             return Const(float(m.group()))
         if c == "V" and cur.peek(1) == ".":
             return self.variable()
+        if c == "@":
+            m = cur.match(_PARAM_REF)
+            if m is None:
+                raise cur.error(NcErrorId.EXPRESSION_SYNTAX,
+                                f"unexpected '{cur.word_text()}' in expression: cycle "
+                                "parameters are written @P<n>")
+            return ParamRef(int(m.group(1)), self.line, pos)
         m = cur.match(IDENT)
         if m is not None:
             word = m.group()
@@ -313,12 +327,17 @@ class ExpressionParser:
             indices.append(self._or())
             self.depth -= 1
             self.expect("]", open_pos)
+        name = m.group(2)
+        if scope == Scope.G and name in _MEMBER_NAMES and cur.peek() == ".":
+            member = cur.match(_MEMBER)  # V.G.HSCS.<MODE>.TOLERANCE, V.G.WZ_AKT.R
+            if member is not None:
+                name += member.group()
         if cur.peek() == ".":
             raise cur.error(
                 NcErrorId.INSTRUCTION_NOT_SUPPORTED,
                 f"structure member access ({cur.word_text(pos)}) is not supported yet", pos,
             )
-        return VarRef(scope, m.group(2), tuple(indices), self.line, pos)
+        return VarRef(scope, name, tuple(indices), self.line, pos)
 
 
 def parse_expression(cur: Cursor) -> Node:

@@ -9,7 +9,8 @@ constructors of ``construct``.
 Any other line (other words or orders, brackets, variables, ``$``, ``#``, ``%``, ``L``,
 ``/``, ``(``, lower case, ...) does not match and is decoded by the general path
 (``Decoder.slow_step``: parser, executor, control flow). While an axis is released
-(``#AX RELEASE``), every line goes there. A matching line that would be
+(``#AX RELEASE``), a machining coordinate system is active (``#CS``) or a call pattern
+is being defined (``#PATTERN BEGIN``), every line goes there. A matching line that would be
 an error (arc end point off the circle, no F yet, I/J/K in a G1 block, a malformed
 number such as ``X1.2.3``) goes there too, untouched: the general path is the reference
 and raises the error with its exact column. So the hot path decodes only valid lines,
@@ -258,8 +259,11 @@ _FLUSH_RECORDS = '''\
         if i > start_i:
             yield POINT_BATCH(program.src, start_i, i, start_pos, plane, records)'''
 
+# a machining coordinate system (#CS) or a pattern definition open: the general path
+_FAST_END = "i if modal.released_axes or modal.cs or modal.pattern is not None else end"
 # check mode: compensation and single-stepping take the general path; batches are bounded
-_FAST_END_CHECK = ("i if modal.released_axes or decoder.check.line_by_line or comp != COMP_OFF "
+_FAST_END_CHECK = ("i if modal.released_axes or modal.cs or modal.pattern is not None "
+                   "or decoder.check.line_by_line or comp != COMP_OFF "
                    "else min(end, i + BATCH_LINES)")
 
 
@@ -308,7 +312,7 @@ def loop_source(axes: tuple[str, ...], check: bool = False) -> str:
         absolute=absolute, incremental=incremental,
         end_tuple=", ".join(f"e{k}" for k in range(n)) + ("," if n == 1 else ""),
         arc_motion=arc, linear_motion=linear,
-        fast_end=_FAST_END_CHECK if check else "i if modal.released_axes else end",
+        fast_end=_FAST_END_CHECK if check else _FAST_END,
         emit=_EMIT_RECORD if check else _EMIT_BLOCK.format(block=block),
         flush=_FLUSH_RECORDS if check else "",
         setup=_SETUP_RECORDS if check else "",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import IntEnum
+from typing import Any
 
 from .program import Program, Section
 from .statements import Control, StmtKind
@@ -44,3 +45,8 @@ class Frame:
     cycle_vars: dict[str, Variable] = field(default_factory=dict)  # V.CYC. declared here
     control: list[ControlEntry] = field(default_factory=list)
     jumped: bool = False  # a $GOTO ran in this frame (it may enter $IF blocks from outside)
+    # a cycle: its @P parameters (None: no cycle), the caller's modal G functions to
+    # restore when it returns, and for the pattern wrapper the call it repeats
+    cycle_params: dict[int, Value] | None = None
+    restore: tuple | None = None
+    pattern_call: Any = None

@@ -2,8 +2,9 @@
 
 ``ModalState`` is what a block leaves behind for the next: the programmed position,
 G90/G91, the plane, the motion mode, F, tool radius compensation and D, S, T, the
-program-global (V.P.) and global (V.G.) variables, and the axes released by
-``#AX RELEASE``. It is mutable and outlives a ``Decoder``: in the extended manual (MDI)
+program-global (V.P.) and global (V.G.) variables, the axes released by
+``#AX RELEASE``, the machining coordinate systems (``#CS``), call patterns
+(``#PATTERN``) and high-speed settings (``#HSC``, ``G133``, ...). It is mutable and outlives a ``Decoder``: in the extended manual (MDI)
 mode every new manual block is decoded with the modal state the previous one left. A
 program start (a ``Decoder`` that is not manual) gives all axes back to the channel.
 
@@ -17,6 +18,9 @@ from dataclasses import dataclass, field
 from enum import IntEnum
 
 from .blocks import Compensation, LogArea, MotionKind
+from .coordinates import CoordinateSystem, Placement
+from .patterns import OpenPattern, PatternPosition
+from .technology import MachiningSettings
 from .variables import Variable
 
 
@@ -95,3 +99,23 @@ class ModalState:
     variables_g: dict[str, Variable] = field(default_factory=dict)  # V.G. by upper name
     released_axes: frozenset[int] = frozenset()  # channel axis indices out (#AX RELEASE)
     contour_log_area: LogArea = LogArea.NONE  # marked area of #CONTOUR LOOKAHEAD LOG
+    # machining coordinate systems (#CS): the selected chain and its placement (None:
+    # none selected, positions are machine positions), and the ones #CS DEF defined
+    cs: tuple[CoordinateSystem, ...] = ()
+    cs_placement: Placement | None = None
+    cs_defined: dict[str, CoordinateSystem] = field(default_factory=dict)
+    # call patterns (#PATTERN): the one being defined, and the defined ones by id
+    pattern: OpenPattern | None = None
+    patterns: dict[int, tuple[PatternPosition, ...]] = field(default_factory=dict)
+    settings: MachiningSettings = field(default_factory=MachiningSettings)  # #HSC, G133 ..
+    msg_file: str | None = None  # #FILE NAME [MSG=..]: the file of #MSG SAVE
+
+    def start_program(self) -> None:
+        """What a program start resets: no coordinate system, patterns or settings."""
+        self.cs = ()
+        self.cs_placement = None
+        self.cs_defined = {}
+        self.pattern = None
+        self.patterns = {}
+        self.settings = MachiningSettings()
+        self.msg_file = None

@@ -15,8 +15,11 @@ import re
 from collections.abc import Mapping
 
 from .contour import CONTOUR_WORD, parse_contour_command
+from .cycle_call import CYCLE_WORD, parse_cycle_call
 from .errors import NcErrorId
 from .exchange import AX_WORD, parse_axis_command
+from .instructions import WORDS as INSTRUCTION_WORDS
+from .instructions import Instruction, parse_instruction
 from .expressions import Const, ExpressionParser, Node, VarRef
 from .lexer import IDENT, SIGNED_NUMBER, Cursor
 from .modal import G_CODES, GGroup
@@ -45,6 +48,7 @@ _CONTROL = {
 }
 _WITH_CONDITION = frozenset({StmtKind.IF, StmtKind.ELSEIF, StmtKind.WHILE, StmtKind.UNTIL,
                              StmtKind.SWITCH})
+_WEIGHTINGS = (133.0, 134.0)  # G133 = <%> acceleration, G134 = <%> ramp time weighting
 _NOT_YET = frozenset({"DO", "ENDDO"})  # known ISG keywords of later issues
 _NOT_YET_WORDS = frozenset({"LA_ON", "LA_OFF"})  # MTC200 look-ahead switches: later issue
 
@@ -79,7 +83,9 @@ class LineParser:
 
     # ------------------------------------------------------------ entry
 
-    def parse(self, line: LogicalLine) -> NcBlock | Control | AxisCommand | ContourStatement:
+    def parse(
+        self, line: LogicalLine
+    ) -> NcBlock | Control | AxisCommand | ContourStatement | Instruction:
         """The statement of one logical line (raises NcError on a syntax error)."""
         cur = Cursor(line)
         cur.skip_ws()
@@ -160,7 +166,7 @@ class LineParser:
 
     def _directive(
         self, cur: Cursor, number: int | None
-    ) -> Control | AxisCommand | ContourStatement:
+    ) -> Control | AxisCommand | ContourStatement | Instruction:
         pos = cur.pos
         m = cur.match(_DIRECTIVE)
         word = m.group(1)
@@ -172,6 +178,8 @@ class LineParser:
                 return parse_axis_command(cur, pos, number, _OLD_AX[word])
         if word in ("CONTOUR", "DISTANCE"):
             return parse_contour_command(cur, pos, word, number)
+        if word in INSTRUCTION_WORDS:
+            return parse_instruction(cur, word, pos, number)
         if word == "VAR":
             stmt = Control(StmtKind.VAR, cur.line, pos, number=number)
         elif word == "ENDVAR":
@@ -264,6 +272,12 @@ class LineParser:
                     letters.add(c)
                 cur.pos += 1
                 value = self._value(cur, c, pos)
+                if kind == WordKind.G and value in _WEIGHTINGS and _skip(cur) < cur.end \
+                        and cur.peek() == "=" and cur.peek(1) != "=":
+                    cur.pos += 1  # G133 = <percent> / G134 = <percent>
+                    block.items.append(Word(WordKind.WEIGHTING, f"G{int(value)}",
+                                            ExpressionParser(cur).parse(), pos))
+                    continue
                 if kind == WordKind.G and isinstance(value, float):
                     if value != int(value) or int(value) not in G_CODES:
                         raise cur.error(
@@ -334,19 +348,21 @@ class LineParser:
             raise cur.error(NcErrorId.INSTRUCTION_NOT_SUPPORTED, f"{ident} is not supported yet")
         local = ident == "LL"
         cur.pos += 2 if local else 1
-        name = cur.name()
-        if not name:
-            raise cur.error(
-                NcErrorId.MISSING_VALUE,
-                f"subprogram name expected after '{'LL' if local else 'L'}'",
-                pos,
-            )
-        if name.upper().startswith("CYCLE[") or (name.upper() == "CYCLE" and _skip(cur) < cur.end
-                                                 and cur.peek() == "["):
-            raise cur.error(NcErrorId.CYCLE_NOT_SUPPORTED, "L CYCLE is not supported yet", pos)
+        cur.skip_ws()
+        if CYCLE_WORD.match(cur.up, cur.pos):
+            call = parse_cycle_call(cur, local, pos)
+        else:
+            name = cur.name()
+            if not name:
+                raise cur.error(
+                    NcErrorId.MISSING_VALUE,
+                    f"subprogram name expected after '{'LL' if local else 'L'}'",
+                    pos,
+                )
+            call = Call(local, name, pos)
         if block.call is not None:
             raise cur.error(NcErrorId.WORD_REPEATED, "two subprogram calls in one block", pos)
-        block.call = Call(local, name, pos)
+        block.call = call
 
 
 def _skip(cur: Cursor) -> int:

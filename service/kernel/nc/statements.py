@@ -80,6 +80,7 @@ class WordKind(IntEnum):
     TOOL_OFFSET = 6  # D: tool radius entry
     G = 7  # G: preparatory function
     M = 8  # M: miscellaneous function
+    WEIGHTING = 9  # G133 = <%> / G134 = <%>: acceleration / ramp time weighting
 
 
 @dataclass(slots=True)
@@ -103,12 +104,35 @@ class Assign:
 
 
 @dataclass(slots=True)
+class CycleParam:
+    """``@P<n> = <expr>`` of a cycle call."""
+
+    number: int
+    value: Node
+    pos: int  # position of the '@'
+
+
+@dataclass(slots=True)
+class CycleArgs:
+    """What ``L CYCLE [NAME=.. @P1=.. PATTERN_ID=.. PATTERN_RETRACT=..]`` passes."""
+
+    params: tuple[CycleParam, ...]
+    pattern_id: Node | None = None
+    pattern_id_pos: int = -1
+    pattern_retract: Node | None = None
+    pattern_retract_pos: int = -1
+
+
+@dataclass(slots=True)
 class Call:
-    """``LL name`` (local) or ``L name`` (file subprogram)."""
+    """``LL name`` (local) or ``L name`` (file subprogram); with ``cycle`` a cycle call
+    ``L CYCLE [NAME=name ...]`` (``LL CYCLE``: a ``%L`` section as the cycle), ``pos``
+    then points at ``NAME``'s value."""
 
     local: bool
     name: str
     pos: int
+    cycle: CycleArgs | None = None
 
 
 @dataclass(slots=True)

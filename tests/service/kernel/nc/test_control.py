@@ -171,7 +171,8 @@ def test_loop_guard_counts_passes_without_blocks_only(monkeypatch):
         ("$GOTO [NOPE]\nM30", NcErrorId.LABEL_NOT_FOUND, 1, 1),
         ("$GOTO X10\nM30", NcErrorId.BAD_GOTO_TARGET, 1, 7),
         ("$GOTO N1 $GOTO N1\nN1: M30", NcErrorId.WORD_REPEATED, 1, 10),
-        ("#MSG SAVE [\"x\"]\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 1),
+        ("#MSG SAVE [\"x %f\"]\nM30", NcErrorId.MESSAGE_FORMAT, 1, 12),
+        ("#WAIT\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 1),
         ("N5 #CONTOUR LOOKAHEAD LOG ON\nM30", NcErrorId.CONTOUR_LOOKAHEAD_NOT_ENABLED, 1, 4),
         ("N5 #CONTOUR MODE [DEV]\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 4),
         ("#RT CLEAR\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 1),
@@ -186,7 +187,8 @@ def test_control_error_messages():
     assert error_of("$ENDIF\nM30").message == "$ENDIF without $IF"
     assert error_of("$IF 0\nM30").message == "$IF without $ENDIF"
     assert error_of("$GOTO [FOO]\nM30").message == "label [FOO] not found"
-    assert error_of("#MSG SAVE\nM30").message == "#MSG is not supported yet"
+    assert error_of("#MSG SAVE\nM30").message == "'[\"<text>\", ...]' expected after #MSG"
+    assert error_of("#WAIT\nM30").message == "#WAIT is not supported yet"
 
 
 def test_error_comes_after_the_blocks_before_it():

@@ -1,0 +1,196 @@
+"""Running a cycle call: built-in cycles, user cycles and call patterns.
+
+``L CYCLE [NAME=<name> @P<n>=<expr> ...]`` evaluates its parameters in the caller,
+then:
+
+* a built-in cycle (``cycles.registry``, case-insensitive name) checks its parameters
+  (every problem is an error naming the parameter; a syntax check reports them all),
+  runs in Python and may return NC text for its motion part, which runs as the cycle's
+  body in a frame named after the cycle;
+* any other name is a user cycle: with ``LL CYCLE`` a ``%L`` section of the calling
+  file, else a file of the program store (``*.ecy`` or any NC file). It runs like a
+  file subprogram (ending with M17) and reads its parameters as ``@P<n>``; reading one
+  the call did not give is an error naming it.
+
+A cycle leaves the caller's G0..G3, G90/G91 and G17..G19 as they were (its own moves
+do not change the caller's modal motion). Results go to the caller's ``V.CYC.``
+variables when the caller declared them.
+
+With ``PATTERN_ID`` (and ``PATTERN_RETRACT``) the cycle runs at every position of the
+pattern (``patterns``), through a wrapper program ``SysPosPatternWrapper.ecy`` that
+this module writes for the call, as ISG's cycle package does.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from decimal import Decimal
+from typing import Any
+
+from .check import ErrorReported, categorize
+from .errors import NcError, NcErrorId
+from .evaluation import number
+from .frames import Frame, FrameKind
+from .program import Program
+from .statements import Call, NcBlock
+from .variables import Scope, Value
+
+PATTERN_WRAPPER = "SysPosPatternWrapper.ecy"
+
+
+@dataclass(slots=True)
+class CycleCall:
+    """A cycle call with its parameters evaluated (kept by the pattern wrapper)."""
+
+    call: Call
+    params: dict[int, Value]
+    line: Any  # the LogicalLine of the call
+    program: Program  # the calling file (LL CYCLE looks for its %L section there)
+
+
+class CycleContext:
+    """What a built-in cycle sees: its parameters (defaults filled in), the decoder's
+    state, outputs into the caller's ``V.CYC.`` variables, the file store."""
+
+    def __init__(self, decoder: Any, cycle_call: CycleCall, params: dict[int, Value]) -> None:
+        self.decoder = decoder
+        self.modal = decoder.modal
+        self.params = params
+        self.given = cycle_call.params
+        self._call = cycle_call
+
+    def error(self, err_id: NcErrorId, message: str, param: int | None = None) -> NcError:
+        """An error at the parameter's ``@P`` in the call (else at its NAME)."""
+        return self._call.line.error(err_id, message, _param_pos(self._call, param))
+
+    def set_output(self, name: str, value: Value) -> None:
+        """``V.CYC.<name>`` of the caller, when it declared one (else nothing)."""
+        variable = self.decoder.find_variable(Scope.CYC, name.upper())
+        if variable is not None:
+            variable.set(value)
+
+    def write_file(self, name: str, text: str) -> None:
+        """Replace file ``name`` of the store (nothing in a syntax check)."""
+        if self.decoder.check is None:
+            self.decoder.surroundings.write_file(name, text, True)
+
+
+def _param_pos(cycle_call: CycleCall, param: int | None) -> int:
+    for p in cycle_call.call.cycle.params:
+        if p.number == param:
+            return p.pos
+    return cycle_call.call.pos
+
+
+def call_cycle(decoder: Any, frame: Frame, stmt: NcBlock) -> None:
+    """Run the cycle call of ``stmt`` (the block's words ran already)."""
+    call = stmt.call
+    args = call.cycle
+    params = {p.number: p.value(decoder) for p in args.params}
+    cycle_call = CycleCall(call, params, stmt.line, frame.program)
+    if args.pattern_id is None:
+        if args.pattern_retract is not None:
+            raise stmt.line.error(NcErrorId.CYCLE_PARAMETER_UNKNOWN,
+                                  "PATTERN_RETRACT without PATTERN_ID", args.pattern_retract_pos)
+        run_cycle(decoder, cycle_call)
+        return
+    _run_pattern(decoder, cycle_call)
+
+
+def run_cycle(decoder: Any, cycle_call: CycleCall) -> None:
+    """Start the cycle of ``cycle_call``: a built-in one runs (and may push its motion
+    body), a user cycle's frame is pushed."""
+    from .cycles.registry import BUILTIN_CYCLES, builtin_problems
+
+    call = cycle_call.call
+    line = cycle_call.line
+    builtin = None if call.local else BUILTIN_CYCLES.get(call.name.upper())
+    if builtin is not None:
+        problems, params = builtin_problems(builtin, cycle_call.params)
+        if problems:
+            errors = [line.error(p.err_id, p.message, _param_pos(cycle_call, p.number))
+                      for p in problems]
+            _raise_all(decoder, errors, line)
+        text = builtin.run(CycleContext(decoder, cycle_call, params))
+        if text:
+            program = Program(text, builtin.name, decoder.parser, 1, decoder.check)
+            decoder.push_cycle(Frame(program, program.main, program.main.start,
+                                     FrameKind.FILE), cycle_call.params)
+        return
+    if call.local:
+        sections = cycle_call.program.local(call.name)
+        if len(sections) != 1:
+            raise line.error(NcErrorId.CYCLE_NOT_FOUND if not sections
+                             else NcErrorId.DUPLICATE_SUBPROGRAM,
+                             f"cycle {call.name}: {'no' if not sections else 'more than one'} "
+                             f"%L {call.name} in {cycle_call.program.name}", call.pos)
+        section = sections[0]
+        decoder.push_cycle(Frame(cycle_call.program, section, section.start, FrameKind.LOCAL),
+                           cycle_call.params)
+        return
+    try:
+        program = decoder.load(call.name)
+    except KeyError:
+        raise line.error(NcErrorId.CYCLE_NOT_FOUND,
+                         f"cycle {call.name} not found: it is no built-in cycle and no file "
+                         "of the program store", call.pos) from None
+    decoder.push_cycle(Frame(program, program.main, program.main.start, FrameKind.FILE),
+                       cycle_call.params)
+
+
+def _raise_all(decoder: Any, errors: list[NcError], line: Any) -> None:
+    """The first error; a syntax check reports every one of them."""
+    check = decoder.check
+    if check is None or len(errors) == 1:
+        raise errors[0]
+    for error in errors:
+        check.report(error, categorize(error, line))
+    raise ErrorReported
+
+
+# ---------------------------------------------------------------- call patterns
+
+def _run_pattern(decoder: Any, cycle_call: CycleCall) -> None:
+    args = cycle_call.call.cycle
+    line = cycle_call.line
+    pattern_value = number(args.pattern_id(decoder), line, args.pattern_id_pos, "a pattern ID")
+    if args.pattern_retract is None:
+        raise line.error(NcErrorId.CYCLE_PARAMETER_MISSING,
+                         "PATTERN_RETRACT (the retraction plane in Z) is missing: a cycle "
+                         "called with PATTERN_ID needs it", args.pattern_id_pos)
+    retract = number(args.pattern_retract(decoder), line, args.pattern_retract_pos,
+                     "a Z position for PATTERN_RETRACT")
+    positions = decoder.modal.patterns.get(int(pattern_value)) \
+        if pattern_value == int(pattern_value) else None
+    if positions is None:
+        raise line.error(NcErrorId.PATTERN_NOT_DEFINED,
+                         f"pattern {pattern_value:g} is not defined (#PATTERN BEGIN [ID="
+                         f"{pattern_value:g}] ... #PATTERN END before the call)",
+                         args.pattern_id_pos)
+    missing = [n for n in "XYZ" if n not in decoder.axes]
+    if missing:
+        raise line.error(NcErrorId.PATTERN_SYNTAX, "a call pattern needs the axes X, Y and Z",
+                         args.pattern_id_pos)
+    text = pattern_wrapper(positions, retract)
+    program = Program(text, PATTERN_WRAPPER, decoder.parser, 1, decoder.check)
+    frame = Frame(program, program.main, program.main.start, FrameKind.FILE)
+    frame.pattern_call = cycle_call
+    decoder.push_cycle(frame, None)
+
+
+def pattern_wrapper(positions, retract_mm: float) -> str:
+    """The NC text that runs a cycle at every position (``#PATTERN CALL`` runs it)."""
+    r = nc_number(retract_mm)
+    lines = [f"; call pattern: {len(positions)} positions, retraction plane Z{r}"]
+    for p in positions:
+        x, y, z, c = (nc_number(v) for v in (p.x_mm, p.y_mm, p.z_mm, p.c_deg))
+        lines += [f"G90 G00 Z{r}", f"G00 X{x} Y{y}", f"#CS ON [{x}, {y}, {z}, 0, 0, {c}]",
+                  "#PATTERN CALL", "#CS OFF"]
+    lines += [f"G90 G00 Z{r}", "M17"]
+    return "\n".join(lines) + "\n"
+
+
+def nc_number(value: float) -> str:
+    """``value`` as an NC number literal that reads back exactly (no exponent)."""
+    text = format(Decimal(repr(float(value))), "f")
+    return text if text.startswith("-") or text[0].isdigit() else text

@@ -1,0 +1,132 @@
+"""The calculation cycles: least-squares fits of measured points (CYCLES-ADC §4).
+
+Points are passed in @P50..@P59 (X), @P60..@P69 (Y), @P70..@P79 (Z, not for the 2D
+circle), point k in @P5k/@P6k/@P7k, at most 10. The points are given in order: point
+k+1 only with point k, and every coordinate of a given point. The fits are the
+geometric least-squares fits of ``fitting``; degenerate points (identical, collinear,
+coplanar) are an error with their own id, never a number. The results go to the
+caller's ``V.CYC.SysRet*`` variables.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+
+from ..errors import NcErrorId
+from ..variables import Value
+from .fitting import (
+    Degeneracy, FitError, fit_circle_2d, fit_circle_3d, fit_line, fit_plane, fit_sphere,
+)
+from .spec import BuiltinCycle, ParamProblem, ParamSpec
+
+MAX_POINTS = 10
+_AXES = ("X", "Y", "Z")
+_ERROR_OF = {
+    Degeneracy.IDENTICAL: NcErrorId.CYCLE_POINTS_IDENTICAL,
+    Degeneracy.COLLINEAR: NcErrorId.CYCLE_POINTS_COLLINEAR,
+    Degeneracy.COPLANAR: NcErrorId.CYCLE_POINTS_COPLANAR,
+}
+
+
+def _point_params(dims: int) -> dict[int, ParamSpec]:
+    return {50 + 10 * d + k: ParamSpec(f"{_AXES[d]} coordinate of point {k + 1}")
+            for d in range(dims) for k in range(MAX_POINTS)}
+
+
+def _points_check(name: str, dims: int, minimum: int):
+    def check(values: Mapping[int, Value]) -> list[ParamProblem]:
+        problems = []
+        count = sum(1 for k in range(MAX_POINTS) if 50 + k in values)
+        for k in range(MAX_POINTS):
+            given = [50 + 10 * d + k in values for d in range(dims)]
+            if k < max(count, minimum):
+                for d in range(dims):
+                    if not given[d]:
+                        what = (f"point {k + 1} needs @P{50 + 10 * d + k} ({_AXES[d]})"
+                                if k < count or any(given) else
+                                f"{name} needs at least {minimum} points: @P{50 + 10 * d + k} "
+                                f"({_AXES[d]} of point {k + 1}) is missing")
+                        problems.append(ParamProblem(NcErrorId.CYCLE_PARAMETER_MISSING,
+                                                     None, what))
+            elif any(given):
+                first = next(50 + 10 * d + k for d in range(dims) if given[d])
+                problems.append(ParamProblem(
+                    NcErrorId.CYCLE_PARAMETER_MISSING, first,
+                    f"@P{first} gives point {k + 1}, but point {count + 1} is missing "
+                    f"(@P{50 + count}): points are given in order"))
+        return problems
+    return check
+
+
+def _points(values: Mapping[int, Value], dims: int) -> list[tuple[float, ...]]:
+    points = []
+    for k in range(MAX_POINTS):
+        if 50 + k not in values:
+            break
+        points.append(tuple(float(values[50 + 10 * d + k]) for d in range(dims)))
+    return points
+
+
+def _fitted(context, fit: Callable, points):
+    try:
+        return fit(points)
+    except FitError as fault:
+        err_id = _ERROR_OF.get(fault.degeneracy, NcErrorId.CYCLE_PARAMETER_RANGE)
+        raise context.error(err_id, f"{context.name}: {fault.message}") from None
+
+
+def _circle(context) -> None:
+    result = _fitted(context, fit_circle_2d, _points(context.params, 2))
+    context.set_output("SysRetCenterX", result.center_x)
+    context.set_output("SysRetCenterY", result.center_y)
+    context.set_output("SysRetRadius", result.radius)
+    context.set_output("SysRetVariance", result.variance)
+
+
+def _plane(context) -> None:
+    result = _fitted(context, fit_plane, _points(context.params, 3))
+    for axis, n, s in zip(_AXES, result.normal, result.support):
+        context.set_output(f"SysRetNormal{axis}", n)
+        context.set_output(f"SysRetSupVector{axis}", s)
+
+
+def _line(context) -> None:
+    result = _fitted(context, fit_line, _points(context.params, 3))
+    for axis, d, s in zip(_AXES, result.direction, result.support):
+        context.set_output(f"SysRetDirVector{axis}", d)
+        context.set_output(f"SysRetSupVector{axis}", s)
+    context.set_output("SysRetVariance", result.variance)
+
+
+def _sphere(context) -> None:
+    result = _fitted(context, fit_sphere, _points(context.params, 3))
+    for axis, c in zip(_AXES, result.center):
+        context.set_output(f"SysRetCenter{axis}", c)
+    context.set_output("SysRetRadius", result.radius)
+    context.set_output("SysRetVariance", result.variance)
+
+
+def _plane_circle(context) -> None:
+    result = _fitted(context, fit_circle_3d, _points(context.params, 3))
+    for axis, c, n in zip(_AXES, result.center, result.normal):
+        context.set_output(f"SysRetCenter{axis}", c)
+        context.set_output(f"SysRetNormal{axis}", n)
+    context.set_output("SysRetRadius", result.radius)
+    context.set_output("SysRetRadVariance", result.radius_variance)
+
+
+def _cycle(name: str, dims: int, minimum: int, run) -> BuiltinCycle:
+    def body(context) -> None:
+        context.name = name
+        run(context)
+
+    return BuiltinCycle(name, _point_params(dims), body, _points_check(name, dims, minimum))
+
+
+CALCULATION_CYCLES = (
+    _cycle("SysCalcCircle.ecy", 2, 3, _circle),
+    _cycle("SysCalcPlane.ecy", 3, 3, _plane),
+    _cycle("SysCalcLine.ecy", 3, 2, _line),
+    _cycle("SysCalcSphere.ecy", 3, 4, _sphere),
+    _cycle("SysCalcPlaneCircle.ecy", 3, 3, _plane_circle),
+)

@@ -1,0 +1,256 @@
+"""Running the ``#`` instructions of ``instructions`` against the decoder's state.
+
+None of them moves an axis or produces a Block: they change the modal state
+(coordinate systems, patterns, settings) or send a text out (``#MSG``). ``#MSG SAVE``
+writes at decode time, as ISG's decoder does; a syntax check formats it (so a bad
+format is reported) but writes nothing.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .coordinates import CoordinateSystem, placement_of
+from .errors import NcErrorId
+from .evaluation import evaluate_number
+from .instructions import Instruction, InstructionKind
+from .messages import format_message
+from .patterns import OpenPattern, PatternPosition
+from .variables import VariableFault
+
+DEFAULT_MSG_FILE = "msg_save.txt"  # #MSG SAVE before any #FILE NAME
+MAX_PATTERN_POSITIONS = 1000
+
+
+def run_instruction(stmt: Instruction, decoder: Any) -> None:
+    """Execute ``stmt`` (raises NcError on a bad value)."""
+    modal = decoder.modal
+    kind = stmt.kind
+    if modal.pattern is not None and kind not in (InstructionKind.AT,
+                                                  InstructionKind.PATTERN_END):
+        if kind == InstructionKind.PATTERN_BEGIN:
+            raise stmt.line.error(NcErrorId.PATTERN_NESTED,
+                                  "#PATTERN BEGIN inside a pattern definition: close it with "
+                                  "#PATTERN END first", stmt.pos)
+        raise pattern_error(stmt.line, stmt.pos)
+    _RUN[kind](stmt, decoder)
+
+
+def pattern_error(line, pos: int):
+    """The error for an ordinary command inside ``#PATTERN BEGIN ... END``."""
+    return line.error(NcErrorId.PATTERN_COMMAND_INSIDE,
+                      "only #AT may stand between #PATTERN BEGIN and #PATTERN END", pos)
+
+
+def _numbers(stmt: Instruction, decoder: Any) -> list[float]:
+    return [evaluate_number(v, decoder, stmt.line, p) for v, p in zip(stmt.values, stmt.value_pos)]
+
+
+def _integer_id(stmt: Instruction, decoder: Any) -> int:
+    value = evaluate_number(stmt.values[0], decoder, stmt.line, stmt.value_pos[0])
+    if value != int(value) or not 0 <= value <= 0xFFFFFFFF:
+        raise stmt.line.error(NcErrorId.PATTERN_SYNTAX,
+                              f"pattern ID {value:g} is not a non-negative integer",
+                              stmt.value_pos[0])
+    return int(value)
+
+
+# ---------------------------------------------------------------- coordinate systems
+
+def _xyz_present(stmt: Instruction, decoder: Any) -> None:
+    missing = [n for n in "XYZ" if n not in decoder.axes]
+    if missing:
+        raise stmt.line.error(NcErrorId.INSTRUCTION_SYNTAX,
+                              f"#CS needs the main axes X, Y and Z; the channel has no "
+                              f"{', '.join(missing)}", stmt.pos)
+
+
+def _cs_from_values(stmt: Instruction, decoder: Any) -> CoordinateSystem:
+    values = _numbers(stmt, decoder)
+    angles = tuple(values[3:]) if len(values) == 6 else (0.0, 0.0, 0.0)
+    return CoordinateSystem.from_values(tuple(values[:3]), angles, stmt.name)
+
+
+def _select(decoder: Any, cs: CoordinateSystem) -> None:
+    modal = decoder.modal
+    modal.cs = modal.cs + (cs,)
+    modal.cs_placement = placement_of(modal.cs)
+
+
+def _cs_on(stmt: Instruction, decoder: Any) -> None:
+    _xyz_present(stmt, decoder)
+    modal = decoder.modal
+    if stmt.values:
+        cs = _cs_from_values(stmt, decoder)
+        if stmt.name:
+            modal.cs_defined[stmt.name] = cs
+    else:
+        cs = modal.cs_defined.get(stmt.name)
+        if cs is None:
+            raise stmt.line.error(NcErrorId.INSTRUCTION_SYNTAX,
+                                  f"no coordinate system named {stmt.name}: define it with "
+                                  f"#CS DEF [{stmt.name}] [x, y, z, a, b, c]", stmt.pos)
+    _select(decoder, cs)
+
+
+def _cs_def(stmt: Instruction, decoder: Any) -> None:
+    _xyz_present(stmt, decoder)
+    decoder.modal.cs_defined[stmt.name] = _cs_from_values(stmt, decoder)
+
+
+def _cs_off(stmt: Instruction, decoder: Any) -> None:
+    modal = decoder.modal
+    modal.cs = () if stmt.all else modal.cs[:-1]
+    modal.cs_placement = placement_of(modal.cs)
+
+
+# ---------------------------------------------------------------- patterns
+
+def _pattern_begin(stmt: Instruction, decoder: Any) -> None:
+    decoder.modal.pattern = OpenPattern(_integer_id(stmt, decoder), stmt.line, stmt.pos)
+
+
+def _pattern_end(stmt: Instruction, decoder: Any) -> None:
+    modal = decoder.modal
+    pattern = modal.pattern
+    if pattern is None:
+        raise stmt.line.error(NcErrorId.PATTERN_SYNTAX, "#PATTERN END without #PATTERN BEGIN",
+                              stmt.pos)
+    modal.pattern = None
+    if not pattern.positions:
+        raise stmt.line.error(NcErrorId.PATTERN_SYNTAX,
+                              f"pattern {pattern.id} has no position: program #AT [x, y, z] "
+                              "before #PATTERN END", stmt.pos)
+    modal.patterns[pattern.id] = tuple(pattern.positions)
+
+
+def _pattern_delete(stmt: Instruction, decoder: Any) -> None:
+    modal = decoder.modal
+    if stmt.all:
+        modal.patterns.clear()
+        return
+    number = _integer_id(stmt, decoder)
+    if modal.patterns.pop(number, None) is None:
+        raise stmt.line.error(NcErrorId.PATTERN_NOT_DEFINED,
+                              f"pattern {number} is not defined: only defined patterns can "
+                              "be deleted", stmt.value_pos[0])
+
+
+def _at(stmt: Instruction, decoder: Any) -> None:
+    pattern = decoder.modal.pattern
+    if pattern is None:
+        raise stmt.line.error(NcErrorId.PATTERN_SYNTAX,
+                              "#AT outside a pattern definition (#PATTERN BEGIN ... END)",
+                              stmt.pos)
+    values = _numbers(stmt, decoder)
+    if len(values) == 6:
+        for k, letter in ((3, "a (about X)"), (4, "b (about Y)")):
+            if values[k] != 0.0:
+                raise stmt.line.error(NcErrorId.PATTERN_ROTATION_NOT_SUPPORTED,
+                                      f"#AT rotation {letter} = {values[k]:g}: only a rotation "
+                                      "about Z (the 6th value) is permitted", stmt.value_pos[k])
+    if len(pattern.positions) >= MAX_PATTERN_POSITIONS:
+        raise stmt.line.error(NcErrorId.PATTERN_SYNTAX,
+                              f"a pattern holds at most {MAX_PATTERN_POSITIONS} positions",
+                              stmt.pos)
+    c = values[5] if len(values) == 6 else 0.0
+    pattern.positions.append(PatternPosition(values[0], values[1], values[2], c))
+
+
+def _pattern_call(stmt: Instruction, decoder: Any) -> None:
+    from .cycle_run import run_cycle
+
+    cycle_call = decoder.frames[-1].pattern_call
+    if cycle_call is None:
+        raise stmt.line.error(NcErrorId.PATTERN_SYNTAX,
+                              "#PATTERN CALL belongs to the pattern wrapper; call a cycle at a "
+                              "pattern with L CYCLE [NAME=.. PATTERN_ID=.. PATTERN_RETRACT=..]",
+                              stmt.pos)
+    run_cycle(decoder, cycle_call)
+
+
+# ---------------------------------------------------------------- messages
+
+def _message_text(stmt: Instruction, decoder: Any) -> str:
+    fmt = stmt.text(decoder)
+    args = tuple(v(decoder) for v in stmt.values)
+    if not isinstance(fmt, str):
+        raise stmt.line.error(NcErrorId.TYPE_MISMATCH, "#MSG needs a text in quotes first",
+                              stmt.text_pos)
+    try:
+        return format_message(fmt, args)
+    except VariableFault as fault:
+        raise stmt.line.error(fault.err_id, fault.message, stmt.text_pos) from None
+
+
+def _file_name(stmt: Instruction, decoder: Any) -> None:
+    decoder.modal.msg_file = stmt.name
+
+
+def _msg(stmt: Instruction, decoder: Any) -> None:
+    text = _message_text(stmt, decoder)
+    if decoder.check is None:
+        decoder.surroundings.show_message(text)
+
+
+def _msg_save(stmt: Instruction, decoder: Any) -> None:
+    text = _message_text(stmt, decoder)
+    if decoder.check is not None:
+        return
+    name = decoder.modal.msg_file or DEFAULT_MSG_FILE
+    # EXCLUSIVE: the first write of this program run replaces the file's content
+    replace = stmt.exclusive and name not in decoder.files_written
+    decoder.files_written.add(name)
+    try:
+        decoder.surroundings.write_file(name, text + "\n", replace)
+    except (OSError, ValueError) as exc:
+        raise stmt.line.error(NcErrorId.FILE_WRITE_FAILED,
+                              f"#MSG SAVE cannot write {name}: {exc}", stmt.pos) from None
+
+
+# ---------------------------------------------------------------- technology
+
+def _tolerance(stmt: Instruction, decoder: Any, key: str) -> float:
+    node, pos = stmt.options[key]
+    value = evaluate_number(node, decoder, stmt.line, pos)
+    if value < 0:
+        raise stmt.line.error(NcErrorId.VALUE_OUT_OF_RANGE, f"{key} {value:g} is negative", pos)
+    return value
+
+
+def _trafo(stmt: Instruction, decoder: Any) -> None:
+    decoder.modal.settings.trafo = stmt.on
+
+
+def _hsc(stmt: Instruction, decoder: Any) -> None:
+    settings = decoder.modal.settings
+    settings.hsc = stmt.on
+    if not stmt.on:
+        return
+    settings.hsc_surface = "SURFACE" in stmt.options
+    settings.hsc_path_dev_mm = (_tolerance(stmt, decoder, "PATH_DEV")
+                                if "PATH_DEV" in stmt.options else 0.0)
+    settings.hsc_track_dev_mm = (_tolerance(stmt, decoder, "TRACK_DEV")
+                                 if "TRACK_DEV" in stmt.options else 0.0)
+
+
+def _slope(stmt: Instruction, decoder: Any) -> None:
+    decoder.modal.settings.slope = stmt.name
+
+
+def _filter(stmt: Instruction, decoder: Any) -> None:
+    settings = decoder.modal.settings
+    settings.filter = stmt.on
+    if stmt.on:
+        settings.filter_ax_dev_mm = (_tolerance(stmt, decoder, "AX_DEV")
+                                     if "AX_DEV" in stmt.options else 0.0)
+
+
+_RUN = {
+    InstructionKind.CS_ON: _cs_on, InstructionKind.CS_DEF: _cs_def,
+    InstructionKind.CS_OFF: _cs_off, InstructionKind.PATTERN_BEGIN: _pattern_begin,
+    InstructionKind.PATTERN_END: _pattern_end, InstructionKind.PATTERN_DELETE: _pattern_delete,
+    InstructionKind.AT: _at, InstructionKind.PATTERN_CALL: _pattern_call, InstructionKind.FILE_NAME: _file_name, InstructionKind.MSG: _msg,
+    InstructionKind.MSG_SAVE: _msg_save, InstructionKind.TRAFO: _trafo,
+    InstructionKind.HSC: _hsc, InstructionKind.SLOPE: _slope, InstructionKind.FILTER: _filter,
+}
