@@ -98,6 +98,21 @@ IPO = GroupBase.GEO_INTERPOLATOR
 COM_CH = GroupBase.COM_CHANNEL
 COM_AX = GroupBase.COM_PLATFORM_AXIS
 
+# ch<c>.<name>_r of the #TRAFO/#HSC/#SLOPE/#FILTER/G133/G134 settings (nc.technology):
+# (name, MachiningSettings field, type, unit, meaning), at COM 0x3210 + n
+MACHINING_FIELDS: tuple[tuple[str, str, DataType, str, str], ...] = (
+    ("trafo_active", "trafo", BOOLEAN, "-", "#TRAFO ON: kinematic transformation selected"),
+    ("hsc_active", "hsc", BOOLEAN, "-", "#HSC ON: high-speed cutting mode selected"),
+    ("hsc_surface", "hsc_surface", BOOLEAN, "-", "#HSC ON [SURFACE]"),
+    ("hsc_path_dev", "hsc_path_dev_mm", REAL64, "mm", "#HSC ON [PATH_DEV=..]; 0 = not set"),
+    ("hsc_track_dev", "hsc_track_dev_mm", REAL64, "mm", "#HSC ON [TRACK_DEV=..]; 0 = not set"),
+    ("slope_type", "slope", STRING(16), "-", "#SLOPE [TYPE=..]: STEP, TRAPEZ or HSC"),
+    ("filter_active", "filter", BOOLEAN, "-", "#FILTER ON: axis filter selected"),
+    ("filter_ax_dev", "filter_ax_dev_mm", REAL64, "mm", "#FILTER ON [AX_DEV=..]; 0 = not set"),
+    ("acc_weight", "acc_weight_pct", REAL64, "%", "G133 = ..: acceleration weighting"),
+    ("ramp_weight", "ramp_weight_pct", REAL64, "%", "G134 = ..: ramp time weighting"),
+)
+
 TEMPLATES: tuple[ObjectTemplate, ...] = (
     # --- GEO interpolator, channel axes (FCT-C15 "CNC objects") -------------------------
     ObjectTemplate(
@@ -357,6 +372,24 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "Logical axis number that drives this physical axis; 0 = none (project offset)",
     ),
     # --- COM platform: axis parameter update (project) ------------------------------------
+    # --- #MSG message list and high-speed settings (CYCLES-ADC; project offsets) ----------
+    ObjectTemplate(
+        "mc_message_count_r", Scope.CHANNEL, COM, COM_CH, 0x3200, UNS32, R, "-",
+        "#MSG texts of the program since its start; the newest 8 are in "
+        "mc_message_<k>_text_r (project)",
+    ),
+    *(
+        ObjectTemplate(
+            f"mc_message_{k}_text_r", Scope.CHANNEL, COM, COM_CH, 0x3200 + k, STRING(256), R,
+            "-", f"#MSG text {k} of the message list, 1 = newest; empty = none (project)",
+        )
+        for k in range(1, 9)
+    ),
+    *(
+        ObjectTemplate(f"{name}_r", Scope.CHANNEL, COM, COM_CH, 0x3210 + n, dtype, R, unit,
+                       f"{meaning}, as decoded so far; a program start resets it (project)")
+        for n, (name, _attr, dtype, unit, meaning) in enumerate(MACHINING_FIELDS)
+    ),
     # --- syntax check parameters (FCT-C9; channel list values, writable; project offsets)
     ObjectTemplate(
         "syn_chk.errors_total", Scope.CHANNEL, COM, COM_CH, 0x3100, UNS16, RW, "-",

@@ -12,7 +12,7 @@ from typing import Any
 
 from objects import AddressSpace, ChannelLayout, CncObject, MachineLayout, build_objects
 from objects.addressing import LOGICAL_BIT, GroupBase, index_based
-from objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS
+from objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS, MACHINING_FIELDS
 from objects.directory import ObjectDirectory
 from protocol.constants import CncPort
 from protocol.errors import AdsReturnCode
@@ -135,6 +135,29 @@ def _channel_error(k: int, field: str) -> Callable[[Kernel, CncObject], Getter]:
             return getattr(errors[k - 1], field) if len(errors) >= k else empty
 
         return get
+
+    return bind
+
+
+def _channel_message(k: int) -> Callable[[Kernel, CncObject], Getter]:
+    """The k-th newest #MSG text of a channel; empty when there is none."""
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        ci = kernel.channel_index(obj.channel)
+
+        def get() -> str:
+            messages = kernel.snapshot.channels[ci].messages
+            return messages[k - 1] if len(messages) >= k else ""
+
+        return get
+
+    return bind
+
+
+def _machining(attr: str) -> Callable[[Kernel, CncObject], Getter]:
+    """A field of the channel's #HSC/#SLOPE/#FILTER/#TRAFO/G133/G134 settings."""
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        ci = kernel.channel_index(obj.channel)
+        return lambda: getattr(kernel.snapshot.channels[ci].machining, attr)
 
     return bind
 
@@ -318,6 +341,9 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
         for k in range(1, 9)
         for field in ("id", "text", "file", "line", "column", "warning")
     },
+    "mc_message_count_r": _channel("message_count"),
+    **{f"mc_message_{k}_text_r": _channel_message(k) for k in range(1, 9)},
+    **{f"{name}_r": _machining(attr) for name, attr, *_ in MACHINING_FIELDS},
 }
 
 

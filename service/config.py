@@ -148,6 +148,31 @@ class SyntaxCheckConfig(_Strict):
     )
 
 
+class HscsModeConfig(_Strict):
+    """One mode of the high-speed settings (SysHscSettings): ``hscs.<mode>.*``."""
+
+    prog: str = Field("", max_length=83, description="program the cycle calls (L <prog>)")
+    tolerance: int = Field(
+        0, ge=0, le=0x7FFFFFFF,
+        description="machining tolerance in 0.1 um; NC programs read it in mm as "
+        "V.G.HSCS.<MODE>.TOLERANCE",
+    )
+
+
+def _hscs_default(mode: str, tolerance: int) -> HscsModeConfig:
+    return HscsModeConfig(prog=f"manufacturerHsc{mode}Settings.nc", tolerance=tolerance)
+
+
+class HscsConfig(_Strict):
+    """Channel parameters of the SysHscSettings cycle (``hscs.<mode>.prog/.tolerance``).
+    The defaults name the example programs of the cycle documentation (docs/examples/hsc)."""
+
+    deselect: HscsModeConfig = Field(default_factory=lambda: _hscs_default("Deselect", 0))
+    rough: HscsModeConfig = Field(default_factory=lambda: _hscs_default("Rough", 1000))
+    prefinish: HscsModeConfig = Field(default_factory=lambda: _hscs_default("Prefinish", 500))
+    finish: HscsModeConfig = Field(default_factory=lambda: _hscs_default("Finish", 100))
+
+
 class ChannelConfig(_Strict):
     """A channel and its axes."""
 
@@ -175,6 +200,9 @@ class ChannelConfig(_Strict):
     )
     syn_chk: SyntaxCheckConfig = Field(
         default_factory=SyntaxCheckConfig, description="syntax check (P-CHAN-00019/20/28/416)"
+    )
+    hscs: HscsConfig = Field(
+        default_factory=HscsConfig, description="high-speed settings cycle (hscs.*)"
     )
 
     @field_validator("interpolator_function")
@@ -367,6 +395,11 @@ def _apply_parameter_lists(data: dict[str, Any], base_dir: Path) -> dict[str, An
             continue
         if "syn_chk" in listed:  # the list's syn_chk keys complete those of the TOML
             channel["syn_chk"] = {**channel.get("syn_chk", {}), **listed.pop("syn_chk")}
+        if "hscs" in listed:  # so do its hscs.<mode>.* keys
+            hscs = channel.get("hscs", {})
+            for mode, values in listed.pop("hscs").items():
+                hscs[mode] = {**hscs.get(mode, {}), **values}
+            channel["hscs"] = hscs
         channel.update(listed)
     axis_lists = data.pop("axis_parameter_lists", [])
     if not isinstance(axis_lists, list):

@@ -102,6 +102,15 @@ def _boolean(text: str) -> bool:
     return text == "1"
 
 
+_PROGRAM_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]{0,82}")
+
+
+def _program_name(text: str) -> str:
+    if _PROGRAM_NAME.fullmatch(text) is None:
+        raise _Bad(f"{text!r} is not a program name (letters, digits, _ - .)")
+    return text
+
+
 _LINEAR, _ROTARY, _SPINDLE = 1, 2, 4
 _AXIS_TYPES = {"ACHSTYP_TRANSLATOR": _LINEAR, "ACHSTYP_ROTATOR": _ROTARY,
                "ACHSTYP_SPINDEL": _SPINDLE}
@@ -316,6 +325,11 @@ _CHANNEL_PARAMS = {
         _Param("syn_chk.interactive", "P-CHAN-00028", _boolean, ("syn_chk", "interactive")),
         _Param("syn_chk.record_result", "P-CHAN-00416", _boolean,
                ("syn_chk", "record_result")),
+        *(param for mode in ("deselect", "rough", "prefinish", "finish") for param in (
+            _Param(f"hscs.{mode}.prog", "hscs", _program_name, ("hscs", mode, "prog")),
+            _Param(f"hscs.{mode}.tolerance", "hscs", _ranged(0, 0x7FFFFFFF),
+                   ("hscs", mode, "tolerance")),
+        )),
     )
 }
 _AXIS_FIELDS = {"name": "bezeichnung", "logical_number": "log_achs_nr"}
@@ -325,7 +339,7 @@ def parse_channel_list(text: str, source: str) -> dict[str, Any]:
     """Parse a channel parameter list; ``source`` names it in problems.
 
     Returns ``{"axes": [{"name": "X", "logical_number": 11}, ...], "jog_of_path_only":
-    bool, "syn_chk": {"errors_total": 20, ...}}`` with each key only when the list gives it (``axes`` when any ``gruppe[0]``
+    bool, "syn_chk": {"errors_total": 20, ...}, "hscs": {"finish": {"prog": ..}}}`` with each key only when the list gives it (``axes`` when any ``gruppe[0]``
     key is there), axes in ``achse`` index order. Names are returned in capitals.
     ``gruppe[0].achs_anzahl`` is required with axes and must equal their number; achse
     indices run 0, 1, 2, ... without gaps; names and numbers are unique. Raises
@@ -345,6 +359,8 @@ def parse_channel_list(text: str, source: str) -> dict[str, Any]:
                                         f"syn_chk.{field[-1]} a second time"))
                 continue
             _store(result, field, item.value)
+        elif key.startswith("hscs.") and item.value is not _INVALID:
+            _store(result, item.param.field, item.value)
     if any(key.startswith("gruppe[") for key in items):
         result["axes"] = _channel_axes(items, source, problems)
     if problems:

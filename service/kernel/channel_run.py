@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import replace
 
@@ -42,10 +43,11 @@ from .nc.blocks import (
     StopKind,
 )
 from .nc.contour import LOOP_MARKERS
+from .nc.technology import HscProgram, MachiningSettings, Surroundings
 from .path.executor import AxisDynamics, PathError, PathExecutor
 from .path.interpolator import Waiting
 from .path.segments import Segment
-from .state import Channel, ChannelError, DecoderFlag, ExecutionMode
+from .state import MESSAGES_KEPT, Channel, ChannelError, DecoderFlag, ExecutionMode
 from .switchover import Switchover
 from .syntax_check import SYNCHK_WITHOUT_MACHINE_LOCK, CHECK_STOPPED_WARNING, CheckRun, Pause
 
@@ -122,6 +124,15 @@ class ChannelRunner:
         self._prod_time = False  # PROD_TIME: the run is simulated, no axis moves
         self._sim_steps = 0  # PROD_TIME: cycles simulated so far
         self.touched = False  # the last cycle changed the channel's state
+        # #MSG texts from the decoder thread (deque appends are thread-safe)
+        self._messages: deque[str] = deque(maxlen=MESSAGES_KEPT)
+        self._surroundings = Surroundings(
+            write_file=lambda name, text, replace: files(name, text.encode(), replace=replace),
+            show_message=self._messages.append,
+            hscs={mode.upper(): HscProgram(c.prog, c.tolerance * 1e-4)  # 0.1 um -> mm
+                  for mode, c in config.hscs},
+            kinematics=False,  # this kernel configures no kinematic transformation
+        )
 
     # ------------------------------------------------------------ commands
 
@@ -379,7 +390,7 @@ class ChannelRunner:
             channel_id=ch.channel_id, axes=self._axes, loader=self._loader, tools=self._tools,
             modal=self._modal, capacity=self._buffer_blocks + _FEED_MARGIN_BLOCKS,
             keep_open=keep_open, axis_numbers=self._axis_numbers,
-            contour_lookahead=self.config.contour_lookahead,
+            contour_lookahead=self.config.contour_lookahead, surroundings=self._surroundings,
         )
         self._feed.add(job)
         for more in self._queued_jobs:
@@ -409,6 +420,22 @@ class ChannelRunner:
         ch.dist_prog_start_incr = 0.0
         ch.program_time_s = 0.0
         ch.file_name, ch.line, ch.file_offset, ch.block_number = job.name, 0, 0, -1
+        if not job.manual:  # a program starts with no messages and default settings
+            self._messages.clear()
+            ch.messages, ch.message_count = (), 0
+            ch.machining = MachiningSettings()
+
+    def _show_decoder_state(self) -> None:
+        """The #MSG texts and the #HSC/G133/.. settings the decoder reached."""
+        ch = self.channel
+        new = []
+        while self._messages:
+            new.append(self._messages.popleft())
+        if new:
+            ch.messages = (tuple(reversed(new)) + ch.messages)[:MESSAGES_KEPT]
+            ch.message_count += len(new)
+        if self._modal is not None and self._modal.settings != ch.machining:
+            ch.machining = replace(self._modal.settings)
 
     def _axis_limits(self) -> tuple[tuple[AxisDynamics, ...], tuple[tuple[float, float], ...]]:
         """Dynamics and software limits of the channel's axes from the effective axis
@@ -432,6 +459,7 @@ class ChannelRunner:
             dynamics=dynamics, sw_limits_mm=sw_limits,
             settings=ch.syn_chk if synchk else None, single_step=ch.single_block,
             deterministic=self._deterministic, files=self._files,
+            surroundings=self._surroundings,
         )
         self._released = Pause.NONE
         self._executor = None
@@ -442,6 +470,10 @@ class ChannelRunner:
         ch.dist_prog_start_incr = 0.0
         ch.program_time_s = 0.0
         ch.file_name, ch.line, ch.file_offset, ch.block_number = job.name, 0, 0, -1
+        if not job.manual:  # a program starts with no messages and default settings
+            self._messages.clear()
+            ch.messages, ch.message_count = (), 0
+            ch.machining = MachiningSettings()
 
     def _check_cycle(self, time_s: float) -> bool:
         """One GEO cycle of a syntax check or dry run: show where the decoder is."""
@@ -560,6 +592,8 @@ class ChannelRunner:
         # must never pass starved (``_prod_time_cycle`` only steps when the feed is ready)
         wait = self._deterministic or self._prod_time
         items, self._backlog = self._backlog or feed.take(free, wait=wait), []
+        if items:
+            self._show_decoder_state()
         contour = self._contour
         for k, item in enumerate(items):
             if isinstance(item, Block) and item.contour is not None and (

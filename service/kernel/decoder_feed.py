@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, SourceRef, StopKind
+from .nc.technology import Surroundings
 
 log = logging.getLogger(__name__)
 
@@ -68,9 +69,12 @@ class DecoderFeed:
         keep_open: bool = False,
         axis_numbers: tuple[int, ...] | None = None,
         contour_lookahead: bool = False,
+        surroundings: Surroundings | None = None,
     ) -> None:
         """``contour_lookahead``: FCT_CONTOUR_LAH is enabled (P-CHAN-00650), so the
-        decoder accepts ``#CONTOUR LOOKAHEAD``."""
+        decoder accepts ``#CONTOUR LOOKAHEAD``; ``surroundings``: the file store, message
+        list and cycle parameters the decoder reaches (``nc.technology``)."""
+        self._surroundings = surroundings
         self._axes = axes
         self._contour_lookahead = contour_lookahead
         self._axis_numbers = axis_numbers
@@ -149,7 +153,7 @@ class DecoderFeed:
         decoder = Decoder(
             text, job.name, axes=self._axes, loader=self._loader, tools=self._tools,
             modal=self.modal, manual=job.manual, axis_numbers=self._axis_numbers,
-            contour_lookahead=self._contour_lookahead,
+            contour_lookahead=self._contour_lookahead, surroundings=self._surroundings,
         )
         yield from decoder.blocks()
         self.modal = decoder.modal

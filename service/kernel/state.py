@@ -12,6 +12,9 @@ from enum import IntEnum, IntFlag
 from typing import Any, NamedTuple
 
 from ..config import ChannelConfig, MachineConfig
+from .nc.technology import MachiningSettings
+
+MESSAGES_KEPT = 8  # #MSG texts a channel shows (ch<c>.mc_message_<k>_text_r)
 
 
 class LinkState(IntEnum):
@@ -200,6 +203,11 @@ class Channel:
     execution_mode_plc_enable: bool = False
     syn_chk: Any = None  # SyntaxCheckConfig for the next check (ch<c>.syn_chk.*)
     decoder_flags: int = 0  # DecoderFlag bits (pMC[i].StateDecoder_Data)
+    # #MSG texts of the program, newest first (at most MESSAGES_KEPT), and their count
+    messages: tuple[str, ...] = ()
+    message_count: int = 0
+    # #TRAFO/#HSC/#SLOPE/#FILTER/G133/G134 as decoded so far (nc.technology)
+    machining: MachiningSettings = field(default_factory=MachiningSettings)
 
     @property
     def execution_mode_commanded(self) -> int:
@@ -228,7 +236,8 @@ class Channel:
             self.remaining_in_block_mm, self.program_time_s, self.errors, self.error_count,
             self.suspend_command_w, self.suspend_enable_w, self.suspend_request_r,
             self.contour, self.execution_mode_plc_command, self.execution_mode_plc_enable,
-            self.syn_chk, self.decoder_flags,
+            self.syn_chk, self.decoder_flags, self.messages, self.message_count,
+            self.machining,
         )
 
 

@@ -40,6 +40,7 @@ from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, Compensation, StopKind
 from .nc.check import CheckAborted, ErrorCategory, PointBatch
 from .nc.source import SourceText, strip_comments
+from .nc.technology import Surroundings
 from .path.endpoints import first_violation
 from .path.errors import PathError
 from .path.limits import AxisDynamics
@@ -116,6 +117,7 @@ class CheckRun:
         single_step: bool,
         deterministic: bool,
         files: Callable[..., None],
+        surroundings: Surroundings | None = None,
     ) -> None:
         self.channel_id = channel_id
         self.name = name
@@ -147,6 +149,7 @@ class CheckRun:
         self._cancelled = False
         self._position = start_mm  # where the last checked block ended
         self._prep: PathPreparation | None = None  # blocks under radius compensation
+        self._surroundings = surroundings  # cycle parameters (files and messages: none)
         self._thread = threading.Thread(target=self._run, name=f"cnc-check-ch{channel_id}",
                                         daemon=True)
         self._thread.start()
@@ -250,6 +253,7 @@ class CheckRun:
                 text, self.name, axes=self._axes, loader=self._text_of, tools=self._tools,
                 modal=ModalState(position_mm=self._start), axis_numbers=self._axis_numbers,
                 contour_lookahead=self._contour_lookahead, check=self,
+                surroundings=self._surroundings,
             )
             self._sources[self.name] = decoder.source
             self._decoder = decoder

@@ -419,8 +419,20 @@ def test_unknown_channel_key_lists_the_supported_ones() -> None:
         (1, "unknown key 'grp_anzahl' (supported: gruppe[0].achs_anzahl, "
             "gruppe[0].achse[n].log_achs_nr, gruppe[0].achse[n].bezeichnung, jog_of_path_only, "
             "syn_chk.errors_total, syn_chk.fehler_gesamt, syn_chk.errors_per_block, "
-            "syn_chk.fehler_pro_zeile, syn_chk.interactive, syn_chk.record_result)")
+            "syn_chk.fehler_pro_zeile, syn_chk.interactive, syn_chk.record_result, "
+            "hscs.deselect.prog, hscs.deselect.tolerance, hscs.rough.prog, "
+            "hscs.rough.tolerance, hscs.prefinish.prog, hscs.prefinish.tolerance, "
+            "hscs.finish.prog, hscs.finish.tolerance)")
     ]
+
+
+def test_hscs_keys_of_a_channel_list() -> None:
+    parsed = parse_channel_list("hscs.finish.prog myFinish.nc\nhscs.finish.tolerance 50\n"
+                                "hscs.rough.tolerance 2000\n", "ch.lis")
+    assert parsed["hscs"] == {"finish": {"prog": "myFinish.nc", "tolerance": 50},
+                              "rough": {"tolerance": 2000}}
+    assert problems_of(parse_channel_list, "hscs.finish.prog ../x") == [
+        (1, "hscs.finish.prog (hscs): '../x' is not a program name (letters, digits, _ - .)")]
 
 
 # --- properties ---------------------------------------------------------------------

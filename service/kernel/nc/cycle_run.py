@@ -33,7 +33,7 @@ from .evaluation import number
 from .frames import Frame, FrameKind
 from .program import Program
 from .statements import Call, NcBlock
-from .variables import Scope, Value
+from .variables import Scope, Value, VariableFault
 
 PATTERN_WRAPPER = "SysPosPatternWrapper.ecy"
 
@@ -67,7 +67,11 @@ class CycleContext:
         """``V.CYC.<name>`` of the caller, when it declared one (else nothing)."""
         variable = self.decoder.find_variable(Scope.CYC, name.upper())
         if variable is not None:
-            variable.set(value)
+            try:
+                variable.set(value)
+            except VariableFault as fault:  # declared with a type the result does not fit
+                raise self.error(fault.err_id, f"result of {self._call.call.name}: "
+                                 f"{fault.message}") from None
 
     def write_file(self, name: str, text: str) -> None:
         """Replace file ``name`` of the store (nothing in a syntax check)."""

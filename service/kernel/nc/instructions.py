@@ -83,13 +83,18 @@ def parse_instruction(cur: Cursor, word: str, hash_pos: int, number: int | None)
     parse = _PARSERS[word]
     parse(cur, stmt)
     if not cur.at_end():
-        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX,
+        raise cur.error(_syntax_id(word),
                         f"unexpected '{cur.word_text()}' after #{word}: it stands alone "
                         "in its NC line")
     return stmt
 
 
 # ---------------------------------------------------------------- pieces
+
+def _syntax_id(word: str) -> NcErrorId:
+    """The id of a malformed ``#<word>``: #PATTERN and #AT have their own (errors.py)."""
+    return NcErrorId.PATTERN_SYNTAX if word in ("PATTERN", "AT") else NcErrorId.INSTRUCTION_SYNTAX
+
 
 def _sub(cur: Cursor, word: str, allowed: tuple[str, ...], optional: bool = False) -> str:
     cur.skip_ws()
@@ -102,16 +107,18 @@ def _sub(cur: Cursor, word: str, allowed: tuple[str, ...], optional: bool = Fals
         return ""
     cur.pos = pos
     shown = f"'{cur.word_text()}'" if not cur.at_end() else "the end of the line"
-    raise cur.error(NcErrorId.INSTRUCTION_SYNTAX,
+    raise cur.error(_syntax_id(word),
                     f"#{word} needs {' or '.join(allowed)}, found {shown}", pos)
 
 
-def _list(cur: Cursor, what: str, counts: tuple[int, ...]) -> tuple[tuple[Node, ...], tuple[int, ...]]:
+def _list(cur: Cursor, what: str, counts: tuple[int, ...],
+          err_id: NcErrorId = NcErrorId.INSTRUCTION_SYNTAX,
+          ) -> tuple[tuple[Node, ...], tuple[int, ...]]:
     """``[expr, expr, ...]`` with one of ``counts`` elements."""
     cur.skip_ws()
     open_pos = cur.pos
     if cur.peek() != "[":
-        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX, f"'[' expected after {what}")
+        raise cur.error(err_id, f"'[' expected after {what}")
     cur.pos += 1
     parser = ExpressionParser(cur)
     values: list[Node] = []
@@ -128,8 +135,7 @@ def _list(cur: Cursor, what: str, counts: tuple[int, ...]) -> tuple[tuple[Node, 
         break
     if len(values) not in counts:
         wanted = " or ".join(str(c) for c in counts)
-        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX,
-                        f"{what} takes {wanted} values, got {len(values)}", open_pos)
+        raise cur.error(err_id, f"{what} takes {wanted} values, got {len(values)}", open_pos)
     return tuple(values), tuple(positions)
 
 
@@ -245,7 +251,7 @@ def _pattern(cur: Cursor, stmt: Instruction) -> None:
 
 def _at(cur: Cursor, stmt: Instruction) -> None:
     stmt.kind = InstructionKind.AT
-    stmt.values, stmt.value_pos = _list(cur, "#AT", (3, 6))
+    stmt.values, stmt.value_pos = _list(cur, "#AT", (3, 6), NcErrorId.PATTERN_SYNTAX)
 
 
 def _file(cur: Cursor, stmt: Instruction) -> None:

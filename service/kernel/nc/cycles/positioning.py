@@ -125,7 +125,8 @@ def _run(context) -> str | None:
     retract = float(p[2])
     if retract > 0.0:
         body.append(_retraction(context, retract))
-    body.append(cs_line)
+    if mode in (1, 3):  # @P1=2 rotates only the tool: the MCS stays as it is
+        body.append(cs_line)
     body.append("M17")
     return "\n".join(body) + "\n"
 

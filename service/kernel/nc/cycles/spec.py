@@ -52,7 +52,8 @@ class BuiltinCycle:
 
 
 def check_parameters(cycle: BuiltinCycle, values: Mapping[int, Value]) -> list[ParamProblem]:
-    """Every problem of ``values`` against the cycle's parameters, in @P order."""
+    """Every problem of ``values`` against the cycle's parameters: those of single
+    parameters in @P order, then those between parameters."""
     problems: list[ParamProblem] = []
     for number in sorted(values):
         spec = cycle.params.get(number)
@@ -69,8 +70,9 @@ def check_parameters(cycle: BuiltinCycle, values: Mapping[int, Value]) -> list[P
             problems.append(ParamProblem(NcErrorId.CYCLE_PARAMETER_RANGE, number,
                                          f"@P{number} ({spec.meaning}) of {cycle.name} = "
                                          f"{value:g} is outside {_range(spec)}"))
-    if not problems:
-        problems = cycle.check(values)
+    # the problems between parameters too (a syntax check reports all of them); they
+    # depend on which parameters are given, so the ones the cycle does not have are left out
+    problems += cycle.check({n: v for n, v in values.items() if n in cycle.params})
     return problems
 
 
