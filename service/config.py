@@ -316,6 +316,8 @@ DEFAULT_MACHINE: dict[str, Any] = {
         {"d": 1, "radius_mm": 1.0},
         {"d": 2, "radius_mm": 2.5},
         {"d": 3, "radius_mm": 5.0},
+        {"d": 8, "radius_mm": 4.0},  # the tools of the cycle documentation's examples
+        {"d": 9, "radius_mm": 3.0},
     ],
     "physical_axes": [
         {"number": 1, "name": "X"},
