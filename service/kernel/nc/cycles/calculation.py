@@ -5,7 +5,9 @@ circle), point k in @P5k/@P6k/@P7k, at most 10. The points are given in order: p
 k+1 only with point k, and every coordinate of a given point. The fits are the
 geometric least-squares fits of ``fitting``; degenerate points (identical, collinear,
 coplanar) are an error with their own id, never a number. The results go to the
-caller's ``V.CYC.SysRet*`` variables.
+caller's ``V.CYC.SysRet*`` variables; components of result points and unit vectors that
+are rounding noise (below 1e-13 relative to the largest coordinate, resp. to 1) are
+set to 0, so exact input prints exact output (no ``-0.000000``).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from .fitting import (
 from .spec import BuiltinCycle, ParamProblem, ParamSpec
 
 MAX_POINTS = 10
+_NOISE = 1e-13  # result components this small (relative to the points) are rounding noise
 _AXES = ("X", "Y", "Z")
 _ERROR_OF = {
     Degeneracy.IDENTICAL: NcErrorId.CYCLE_POINTS_IDENTICAL,
@@ -69,16 +72,29 @@ def _points(values: Mapping[int, Value], dims: int) -> list[tuple[float, ...]]:
 
 def _fitted(context, fit: Callable, points):
     try:
-        return fit(points)
+        result = fit(points)
     except FitError as fault:
         err_id = _ERROR_OF.get(fault.degeneracy, NcErrorId.CYCLE_PARAMETER_RANGE)
         raise context.error(err_id, f"{context.name}: {fault.message}") from None
+    context.scale = 1.0 + max(abs(c) for point in points for c in point)
+    return result
+
+
+def _position(context, value: float) -> float:
+    """A coordinate of a result point: rounding noise (relative to the points) is 0, so
+    that the unit circle's centre prints as 0.000000, not -0.000000."""
+    return 0.0 if abs(value) <= _NOISE * context.scale else value
+
+
+def _unit(value: float) -> float:
+    """A component of a result unit vector: rounding noise is 0."""
+    return 0.0 if abs(value) <= _NOISE else value
 
 
 def _circle(context) -> None:
     result = _fitted(context, fit_circle_2d, _points(context.params, 2))
-    context.set_output("SysRetCenterX", result.center_x)
-    context.set_output("SysRetCenterY", result.center_y)
+    context.set_output("SysRetCenterX", _position(context, result.center_x))
+    context.set_output("SysRetCenterY", _position(context, result.center_y))
     context.set_output("SysRetRadius", result.radius)
     context.set_output("SysRetVariance", result.variance)
 
@@ -86,22 +102,22 @@ def _circle(context) -> None:
 def _plane(context) -> None:
     result = _fitted(context, fit_plane, _points(context.params, 3))
     for axis, n, s in zip(_AXES, result.normal, result.support):
-        context.set_output(f"SysRetNormal{axis}", n)
-        context.set_output(f"SysRetSupVector{axis}", s)
+        context.set_output(f"SysRetNormal{axis}", _unit(n))
+        context.set_output(f"SysRetSupVector{axis}", _position(context, s))
 
 
 def _line(context) -> None:
     result = _fitted(context, fit_line, _points(context.params, 3))
     for axis, d, s in zip(_AXES, result.direction, result.support):
-        context.set_output(f"SysRetDirVector{axis}", d)
-        context.set_output(f"SysRetSupVector{axis}", s)
+        context.set_output(f"SysRetDirVector{axis}", _unit(d))
+        context.set_output(f"SysRetSupVector{axis}", _position(context, s))
     context.set_output("SysRetVariance", result.variance)
 
 
 def _sphere(context) -> None:
     result = _fitted(context, fit_sphere, _points(context.params, 3))
     for axis, c in zip(_AXES, result.center):
-        context.set_output(f"SysRetCenter{axis}", c)
+        context.set_output(f"SysRetCenter{axis}", _position(context, c))
     context.set_output("SysRetRadius", result.radius)
     context.set_output("SysRetVariance", result.variance)
 
@@ -109,8 +125,8 @@ def _sphere(context) -> None:
 def _plane_circle(context) -> None:
     result = _fitted(context, fit_circle_3d, _points(context.params, 3))
     for axis, c, n in zip(_AXES, result.center, result.normal):
-        context.set_output(f"SysRetCenter{axis}", c)
-        context.set_output(f"SysRetNormal{axis}", n)
+        context.set_output(f"SysRetCenter{axis}", _position(context, c))
+        context.set_output(f"SysRetNormal{axis}", _unit(n))
     context.set_output("SysRetRadius", result.radius)
     context.set_output("SysRetRadVariance", result.radius_variance)
 
