@@ -8,62 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from service.kernel.nc import Decoder, MotionKind, NcError, NcErrorId, StopKind
-from service.kernel.nc.technology import Surroundings
+from service.kernel.nc import MotionKind, NcError, NcErrorId, StopKind
+
+from .cycle_support import Channel, assert_at
 
 E = NcErrorId
-AXES = ("X", "Y", "Z")
-TOOLS = {1: 2.5}
-
-
-class Channel:
-    """The program store (also where files are written), the message list."""
-
-    def __init__(self, files=None, *, kinematics: bool = False) -> None:
-        self.files: dict[str, str] = dict(files or {})
-        self.messages: list[str] = []
-        self.kinematics = kinematics
-
-    def load(self, name: str) -> str:
-        return self.files[name]
-
-    def write_file(self, name: str, text: str, replace: bool) -> None:
-        self.files[name] = text if replace else self.files.get(name, "") + text
-
-    def decoder(self, text: str, *, modal=None, manual: bool = False) -> Decoder:
-        return Decoder(text, "prog.nc", axes=AXES, loader=self.load, tools=TOOLS, modal=modal,
-                       manual=manual,
-                       surroundings=Surroundings(write_file=self.write_file,
-                                                 show_message=self.messages.append,
-                                                 kinematics=self.kinematics))
-
-    def run(self, text: str, **kw):
-        d = self.decoder(text, **kw)
-        return d, list(d.blocks())
-
-    def moves(self, text: str, **kw):
-        d, blocks = self.run(text, **kw)
-        return d, [b for b in blocks if b.motion is not None]
-
-    def error(self, text: str, **kw) -> NcError:
-        with pytest.raises(NcError) as info:
-            self.run(text, **kw)
-        return info.value
-
-
-def where(text: str, needle: str, occurrence: int = 0) -> tuple[int, int]:
-    """1-based (line, column) of the ``occurrence``-th ``needle`` in ``text``."""
-    index = -1
-    for _ in range(occurrence + 1):
-        index = text.index(needle, index + 1)
-    line = text.count("\n", 0, index) + 1
-    return line, index - (text.rfind("\n", 0, index) + 1) + 1
-
-
-def assert_at(error: NcError, err_id, text: str, needle: str, occurrence: int = 0) -> None:
-    assert error.id == err_id, error
-    assert error.file == "prog.nc"
-    assert (error.line, error.column) == where(text, needle, occurrence), error
 
 
 def rot(axis: str, deg: float) -> np.ndarray:
