@@ -416,11 +416,17 @@ class ChannelRunner:
         self._fed_all = False
         self._pending_error = None
         self._started_at_s = self._time_s  # state, errors: set by _start_when_linked
+        self._show_start(job)
+
+    def _show_start(self, job: Job) -> None:
+        """What a run or check shows at its start: counters at 0, the job's file; a
+        program also starts with no messages and default high-speed settings."""
+        ch = self.channel
         ch.block_count = 0
         ch.dist_prog_start_incr = 0.0
         ch.program_time_s = 0.0
         ch.file_name, ch.line, ch.file_offset, ch.block_number = job.name, 0, 0, -1
-        if not job.manual:  # a program starts with no messages and default settings
+        if not job.manual:
             self._messages.clear()
             ch.messages, ch.message_count = (), 0
             ch.machining = MachiningSettings()
@@ -466,14 +472,7 @@ class ChannelRunner:
         self._pending_error = None
         self._started_at_s = self._time_s
         ch.decoder_flags = DecoderFlag.SYNTAX_CHECK if synchk else 0
-        ch.block_count = 0
-        ch.dist_prog_start_incr = 0.0
-        ch.program_time_s = 0.0
-        ch.file_name, ch.line, ch.file_offset, ch.block_number = job.name, 0, 0, -1
-        if not job.manual:  # a program starts with no messages and default settings
-            self._messages.clear()
-            ch.messages, ch.message_count = (), 0
-            ch.machining = MachiningSettings()
+        self._show_start(job)
 
     def _check_cycle(self, time_s: float) -> bool:
         """One GEO cycle of a syntax check or dry run: show where the decoder is."""

@@ -196,5 +196,4 @@ def pattern_wrapper(positions, retract_mm: float) -> str:
 
 def nc_number(value: float) -> str:
     """``value`` as an NC number literal that reads back exactly (no exponent)."""
-    text = format(Decimal(repr(float(value))), "f")
-    return text if text.startswith("-") or text[0].isdigit() else text
+    return format(Decimal(repr(float(value))), "f")
