@@ -173,6 +173,26 @@ class HscsConfig(_Strict):
     finish: HscsModeConfig = Field(default_factory=lambda: _hscs_default("Finish", 100))
 
 
+class EnhancedLookAheadConfig(_Strict):
+    """Defaults of the enhanced look-ahead parameters (MTC200 names), ``la.*``; a
+    program changes them with ``METB=``, ``VFBT=``, ``BBTRC=`` (docs/lookahead.md)."""
+
+    metb_s: float = Field(
+        0.010, gt=0, le=10.0,
+        description="METB: shortest execution time of a sub-block the section planner "
+        "creates (s); must exceed the cycle time",
+    )
+    vfbt: float = Field(
+        1.0, gt=0, le=1.0,
+        description="VFBT: factor on the permitted speed at non-tangential block transitions",
+    )
+    bbtrc: int = Field(
+        8, ge=1, le=1000,
+        description="BBTRC: blocks the bottleneck check of the tool radius compensation "
+        "compares each compensated block with",
+    )
+
+
 class ChannelConfig(_Strict):
     """A channel and its axes."""
 
@@ -203,6 +223,10 @@ class ChannelConfig(_Strict):
     )
     hscs: HscsConfig = Field(
         default_factory=HscsConfig, description="high-speed settings cycle (hscs.*)"
+    )
+    la: EnhancedLookAheadConfig = Field(
+        default_factory=EnhancedLookAheadConfig,
+        description="enhanced look-ahead defaults (LA_ON/LA_OFF; METB, VFBT, BBTRC)",
     )
 
     @field_validator("interpolator_function")
@@ -265,6 +289,11 @@ class MachineConfig(_Strict):
         if len(set(logical)) != len(logical):
             raise ValueError(f"logical axis numbers (kopf.achs_nr) repeat: {logical}")
         for ci, channel in enumerate(self.channels):
+            if channel.la.metb_s <= self.cycle_ms / 1000.0:
+                raise ValueError(
+                    f"channels.{ci}.la.metb_s: METB {channel.la.metb_s:g} s must be greater "
+                    f"than the cycle time {self.cycle_ms / 1000.0:g} s"
+                )
             for ai, axis in enumerate(channel.axes):
                 where = f"channels.{ci}.axes.{ai}"
                 if axis.link_to is not None and axis.link_to not in physical:

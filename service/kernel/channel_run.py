@@ -19,6 +19,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import replace
+from functools import partial
 
 from ..config import ChannelConfig, MachineConfig
 from .axis_params import AxisErrorId, AxisParameters
@@ -39,6 +40,7 @@ from .nc.blocks import (
     Block,
     ContourKind,
     LogArea,
+    LookAheadMark,
     SourceRef,
     StopKind,
 )
@@ -46,6 +48,7 @@ from .nc.contour import LOOP_MARKERS
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
 from .path.executor import AxisDynamics, PathError, PathExecutor
 from .path.interpolator import Waiting
+from .path.section_plan import plan_section
 from .path.segments import Segment
 from .state import MESSAGES_KEPT, Channel, ChannelError, DecoderFlag, ExecutionMode
 from .switchover import Switchover
@@ -114,6 +117,7 @@ class ChannelRunner:
         self._internal_hold = False  # feedhold of a suspend_axis_output request
         self._executor: PathExecutor | None = None
         self._feed: DecoderFeed | None = None
+        self._last_pushed: Block | None = None  # the block that entered the buffer last
         self._modal: ModalState | None = None  # MDI: modal state carried between blocks
         self._pending_error: ChannelError | None = None
         self._fed_all = False
@@ -383,7 +387,7 @@ class ChannelRunner:
         dynamics, sw_limits = self._axis_limits()
         position = tuple(a.position_mm for a in ch.axes)
         if fresh_modal or self._modal is None:
-            self._modal = ModalState(position_mm=position)
+            self._modal = self.new_modal(position)
         else:
             self._modal.position_mm = position
         self._feed = DecoderFeed(
@@ -391,7 +395,10 @@ class ChannelRunner:
             modal=self._modal, capacity=self._buffer_blocks + _FEED_MARGIN_BLOCKS,
             keep_open=keep_open, axis_numbers=self._axis_numbers,
             contour_lookahead=self.config.contour_lookahead, surroundings=self._surroundings,
+            section_planner=partial(plan_section, dynamics=dynamics,
+                                    buffer_blocks=self._buffer_blocks, cycle_s=self._cycle_s),
         )
+        self._last_pushed = None
         self._feed.add(job)
         for more in self._queued_jobs:
             self._feed.add(more)
@@ -417,6 +424,14 @@ class ChannelRunner:
         self._pending_error = None
         self._started_at_s = self._time_s  # state, errors: set by _start_when_linked
         self._show_start(job)
+
+    def new_modal(self, position_mm: tuple[float, ...]) -> ModalState:
+        """The modal state a run starts with: the channel's look-ahead defaults and
+        cycle time (METB must exceed it)."""
+        la = self.config.la
+        defaults = LookAheadMark(metb_s=la.metb_s, vfbt=la.vfbt, bbtrc=la.bbtrc)
+        return ModalState(position_mm=position_mm, look_ahead_defaults=defaults,
+                          look_ahead_params=defaults, cycle_s=self._cycle_s)
 
     def _show_start(self, job: Job) -> None:
         """What a run or check shows at its start: counters at 0, the job's file; a
@@ -466,6 +481,7 @@ class ChannelRunner:
             settings=ch.syn_chk if synchk else None, single_step=ch.single_block,
             deterministic=self._deterministic, files=self._files,
             surroundings=self._surroundings,
+            modal=self.new_modal(tuple(a.position_mm for a in ch.axes)),
         )
         self._released = Pause.NONE
         self._executor = None
@@ -590,6 +606,9 @@ class ChannelRunner:
         # PROD_TIME waits for the decoder as the virtual clock does: a simulated cycle
         # must never pass starved (``_prod_time_cycle`` only steps when the feed is ready)
         wait = self._deterministic or self._prod_time
+        pending = self._section_pending()
+        if pending and not wait:  # planned already: waiting only takes the SDA's put
+            free, wait = min(free, pending), True
         items, self._backlog = self._backlog or feed.take(free, wait=wait), []
         if items:
             self._show_decoder_state()
@@ -616,6 +635,10 @@ class ChannelRunner:
                 except PathError as exc:
                     self._stop_feeding(_path_error(exc, item))
                     return
+                self._last_pushed = item
+            elif isinstance(item, PathError):  # LA_ON section planning (bottleneck)
+                self._stop_feeding(_path_error(item, item.block))
+                return
             elif isinstance(item, NcError):
                 self._stop_feeding(ChannelError(
                     int(item.id), item.message, item.file, item.line, item.column
@@ -627,6 +650,15 @@ class ChannelRunner:
                     if contour.end_of_data():
                         self._warn_log_full()
                     self._show_contour_state()
+
+    def _section_pending(self) -> int:
+        """Blocks of the planned LA_ON section still to come after the last one pushed:
+        the path runs towards them at the section's planned speed, so they must enter
+        the buffer in time (they are planned, the wait is short and bounded)."""
+        last = self._last_pushed
+        if last is None or last.look_ahead is None or last.look_ahead.exit_mm_s <= 0.0:
+            return 0
+        return last.look_ahead.blocks_after
 
     def _stop_feeding(self, error: ChannelError) -> None:
         """Nothing after this error enters the path; what radius compensation holds

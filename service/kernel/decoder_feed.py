@@ -20,8 +20,10 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 from .nc import Decoder, ModalState, NcError, NcErrorId
-from .nc.blocks import Block, SourceRef, StopKind
+from .nc.blocks import Block, Compensation, SourceRef, StopKind
 from .nc.technology import Surroundings
+from .path.errors import PathError
+from .path.section_plan import SectionPlan
 
 log = logging.getLogger(__name__)
 
@@ -49,7 +51,62 @@ class Job:
     manual: bool = False
 
 
-Item = Block | NcError | DecodeEnd
+Item = Block | NcError | DecodeEnd | PathError
+
+SECTION_MAX_BLOCKS = 250_000  # an LA_ON section longer than this is planned in parts
+SectionPlanner = Callable[[list[Block]], SectionPlan]
+
+
+class SectionCollector:
+    """Collects the blocks of an LA_ON section and hands them over planned.
+
+    A section is a run of blocks decoded under LA_ON; it ends at the first block
+    without the mark (LA_OFF), after a block that needs a stop, or at the end of the
+    decoding. It may only start where the tool radius compensation holds nothing back
+    (the last motion block before it ran with G40): the section is prepared from a
+    fresh compensation state, which must be the GEO task's state too. LA_ON blocks
+    that cannot start a section pass unplanned.
+    """
+
+    def __init__(self, planner: SectionPlanner) -> None:
+        self._planner = planner
+        self._section: list[Block] = []
+        self._compensation_free = True  # nothing held back by the compensation
+
+    @property
+    def open(self) -> bool:
+        """A section is being collected."""
+        return bool(self._section)
+
+    def note(self, block: Block) -> None:
+        """A block passing outside any section (keeps the compensation state)."""
+        motion = block.motion
+        if motion is not None:
+            self._compensation_free = motion.compensation == Compensation.OFF
+
+    def push(self, block: Block) -> list[Item]:
+        """The items to hand over now (nothing while a section is being collected)."""
+        if block.look_ahead is None or not (self._section or self._compensation_free):
+            out = self.flush()
+            out.append(block)
+            self.note(block)
+            return out
+        self._section.append(block)
+        self.note(block)
+        if block.needs_stop or len(self._section) >= SECTION_MAX_BLOCKS:
+            return self.flush()
+        return []
+
+    def flush(self) -> list[Item]:
+        """The section so far, planned (with the bottleneck error that cut it short)."""
+        if not self._section:
+            return []
+        plan = self._planner(self._section)
+        self._section = []
+        out: list[Item] = list(plan.blocks)
+        if plan.error is not None:
+            out.append(plan.error)
+        return out
 
 ProgramLoader = Callable[[str], str]
 
@@ -70,11 +127,14 @@ class DecoderFeed:
         axis_numbers: tuple[int, ...] | None = None,
         contour_lookahead: bool = False,
         surroundings: Surroundings | None = None,
+        section_planner: SectionPlanner | None = None,
     ) -> None:
         """``contour_lookahead``: FCT_CONTOUR_LAH is enabled (P-CHAN-00650), so the
         decoder accepts ``#CONTOUR LOOKAHEAD``; ``surroundings``: the file store, message
-        list and cycle parameters the decoder reaches (``nc.technology``)."""
+        list and cycle parameters the decoder reaches (``nc.technology``);
+        ``section_planner``: plans the LA_ON sections (None: they pass unplanned)."""
         self._surroundings = surroundings
+        self._sections = SectionCollector(section_planner) if section_planner else None
         self._axes = axes
         self._contour_lookahead = contour_lookahead
         self._axis_numbers = axis_numbers
@@ -148,6 +208,16 @@ class DecoderFeed:
                 continue
         return False
 
+    def _put_all(self, items: list[Item]) -> bool:
+        for item in items:
+            if not self._put(item):
+                return False
+        return True
+
+    def _flush_section(self) -> bool:
+        """Hand over the LA_ON section collected so far (end of a text, an error)."""
+        return self._sections is None or self._put_all(self._sections.flush())
+
     def _blocks(self, job: Job) -> Iterator[Block]:
         text = job.text if job.text is not None else self._loader(job.name)
         decoder = Decoder(
@@ -172,12 +242,20 @@ class DecoderFeed:
                 if job is None:
                     break
                 self._job = job
+                sections = self._sections
                 for block in self._blocks(job):
-                    if not self._put(block):
+                    if sections is None or (block.look_ahead is None and not sections.open):
+                        if sections is not None:
+                            sections.note(block)
+                        if not self._put(block):
+                            return
+                    elif not self._put_all(sections.push(block)):
                         return
                     if block.stop == StopKind.PROGRAM_END:  # nothing after M30 is decoded
                         self._put(DecodeEnd())
                         return
+                if not self._flush_section():
+                    return
                 if job.manual:
                     marker = Block(SourceRef(job.name, 0), manual=True)
                     self._markers.add(id(marker))
@@ -187,7 +265,8 @@ class DecoderFeed:
                     break
             self._put(DecodeEnd())
         except NcError as exc:
-            self._put(exc)
+            if self._flush_section():  # the blocks before the error run to their end
+                self._put(exc)
         except KeyError as exc:  # loader: the program vanished between select and start
             name = self._job.name
             self._put(NcError(

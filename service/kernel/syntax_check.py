@@ -118,6 +118,7 @@ class CheckRun:
         deterministic: bool,
         files: Callable[..., None],
         surroundings: Surroundings | None = None,
+        modal: ModalState | None = None,
     ) -> None:
         self.channel_id = channel_id
         self.name = name
@@ -130,6 +131,8 @@ class CheckRun:
         self._tools = tools
         self._contour_lookahead = contour_lookahead
         self._start = start_mm
+        # the modal state the check starts with (the channel's look-ahead defaults ..)
+        self._modal = modal if modal is not None else ModalState(position_mm=start_mm)
         self._dynamics = tuple(dynamics)
         self._limits = tuple(sw_limits_mm)
         self._deterministic = deterministic
@@ -251,7 +254,7 @@ class CheckRun:
             text = self._text_of(self.name)
             decoder = Decoder(
                 text, self.name, axes=self._axes, loader=self._text_of, tools=self._tools,
-                modal=ModalState(position_mm=self._start), axis_numbers=self._axis_numbers,
+                modal=self._modal, axis_numbers=self._axis_numbers,
                 contour_lookahead=self._contour_lookahead, check=self,
                 surroundings=self._surroundings,
             )

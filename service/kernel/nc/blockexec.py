@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import operator
 from collections.abc import Mapping
+from dataclasses import replace
 from enum import IntEnum
 from typing import Any
 
@@ -61,10 +62,12 @@ _CS_PLANE = {Plane.XY: (0, 1, 2), Plane.ZX: (2, 0, 1), Plane.YZ: (1, 2, 0)}
 _PLANE_OF_NORMAL = {2: Plane.XY, 1: Plane.ZX, 0: Plane.YZ}
 WEIGHTING_MIN_PCT = 1.0  # G133/G134 percent range
 WEIGHTING_MAX_PCT = 1000.0
+BBTRC_MAX = 1000  # blocks the bottleneck check of an LA_ON section may compare
 _OFFSET_LETTER = ("I", "J", "K")
 # the plain fields of the ModalState a block may change (variables excluded)
 _MODAL_FIELDS = ("position_mm", "distance", "plane", "motion", "feed_mm_min", "compensation",
-                 "tool_offset", "spindle_speed_rpm", "tool")
+                 "tool_offset", "spindle_speed_rpm", "tool", "look_ahead_params",
+                 "look_ahead_mark")
 # modal G groups -> the ModalState field they set
 _MODAL_FIELD = {
     GGroup.MOTION: "motion", GGroup.PLANE: "plane",
@@ -173,6 +176,10 @@ class BlockExecutor:
                     m_codes.append((number, item.pos))
                 case WordKind.WEIGHTING:
                     self._weighting(item.letter, value, item.pos, err)
+                case WordKind.LOOK_AHEAD:
+                    self._look_ahead_switch(value != 0.0)
+                case WordKind.LOOK_AHEAD_PARAM:
+                    self._look_ahead_param(item.letter, value, item.pos, err)
                 case _:  # F S T D R
                     words[item.kind] = (value, item.pos)
             self.items_done += 1
@@ -209,7 +216,8 @@ class BlockExecutor:
         block = make_block(
             make_source(line.file, line_no, column, line.offset), stmt.number, motion,
             dwell_s, stop, tuple(m_functions), None if spindle is None else spindle[0],
-            None if tool is None else int(tool[0]), self.manual,
+            None if tool is None else int(tool[0]), self.manual, None, None,
+            self.modal.look_ahead_mark,
         )
         return block, flow, flow_pos
 
@@ -228,7 +236,8 @@ class BlockExecutor:
         line_no, column = line.locate(_first(line.text))
         return make_block(
             make_source(line.file, line_no, column, line.offset), stmt.number, None, 0.0,
-            StopKind.NONE, (), None, None, self.manual, AxisExchange(stmt.kind, moved),
+            StopKind.NONE, (), None, None, self.manual, AxisExchange(stmt.kind, moved), None,
+            modal.look_ahead_mark,
         )
 
     # ------------------------------------------------------------ parts
@@ -254,6 +263,39 @@ class BlockExecutor:
             settings.acc_weight_pct = value
         else:
             settings.ramp_weight_pct = value
+
+    def _look_ahead_switch(self, on: bool) -> None:
+        """LA_ON / LA_OFF: the blocks from here on carry the parameters (or nothing)."""
+        modal = self.modal
+        modal.look_ahead_mark = modal.look_ahead_params if on else None
+
+    def _look_ahead_param(self, name: str, value: float, pos: int, err) -> None:
+        """METB = <s> (> the cycle time), VFBT = <factor> (0 < f <= 1), BBTRC = <blocks>
+        (an integer 1..BBTRC_MAX); they apply to the blocks that follow."""
+        modal = self.modal
+        params = modal.look_ahead_params
+        if name == "METB":
+            if not (math.isfinite(value) and value > modal.cycle_s):
+                raise err(NcErrorId.VALUE_OUT_OF_RANGE,
+                          f"METB = {value:g} s must be greater than the cycle time "
+                          f"{modal.cycle_s:g} s", pos)
+            params = replace(params, metb_s=value)
+        elif name == "VFBT":
+            if not 0.0 < value <= 1.0:
+                raise err(NcErrorId.VALUE_OUT_OF_RANGE,
+                          f"VFBT = {value:g} is outside 0 < VFBT <= 1 (a factor above 1 "
+                          "would exceed the axes' velocity jumps)", pos)
+            params = replace(params, vfbt=value)
+        else:
+            blocks = _integer(value)
+            if blocks is None or not 1 <= blocks <= BBTRC_MAX:
+                raise err(NcErrorId.VALUE_OUT_OF_RANGE,
+                          f"BBTRC = {value:g} must be a whole number of blocks 1..{BBTRC_MAX}",
+                          pos)
+            params = replace(params, bbtrc=blocks)
+        modal.look_ahead_params = params
+        if modal.look_ahead_mark is not None:
+            modal.look_ahead_mark = params
 
     def _modal_groups(self, groups: dict[GGroup, tuple[int, int]]) -> None:
         for group, (number, _pos) in groups.items():

@@ -8,6 +8,7 @@ expressions, no incremental coordinates).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from enum import IntEnum
 
@@ -131,6 +132,34 @@ class ContourCommand:
 
 
 @dataclass(frozen=True, slots=True)
+class LookAheadMark:
+    """A block decoded inside ``LA_ON`` .. ``LA_OFF`` (enhanced look-ahead, MTC200).
+
+    The decoder sets the parameters in effect for the block; the section planner of the
+    SDA task (``service.kernel.path.section_plan``) adds what it planned:
+
+    * ``metb_s``: METB, the shortest execution time of a sub-block the planner creates;
+    * ``vfbt``: VFBT, factor on the permitted speed of a non-tangential transition
+      into this block (0 < VFBT <= 1);
+    * ``bbtrc``: BBTRC, how many following blocks the bottleneck check of the tool
+      radius compensation compares each compensated block with;
+    * ``exit_mm_s``: planned: the highest speed at the end of the block from which every
+      later constraint of the section (its end is a stop) can still be met; 0: none;
+    * ``max_mm_s``: planned: the block's speed limit from the block rate the look-ahead
+      buffer can pass (it holds whatever the feed override);
+    * ``blocks_after``: planned: blocks of the section that follow this one (already
+      planned, so the GEO task may wait for them without waiting for decoding).
+    """
+
+    metb_s: float
+    vfbt: float
+    bbtrc: int
+    exit_mm_s: float = 0.0
+    max_mm_s: float = math.inf
+    blocks_after: int = 0
+
+
+@dataclass(frozen=True, slots=True)
 class Block:
     """One decoded NC block: optional motion plus what happens at its end.
 
@@ -151,6 +180,7 @@ class Block:
     manual: bool = False  # decoded from a manual (MDI) block
     axis_exchange: AxisExchange | None = None  # #AX RELEASE / #AX REQUEST
     contour: ContourCommand | None = None  # #CONTOUR LOOKAHEAD, #DISTANCE, RT loop marker
+    look_ahead: LookAheadMark | None = None  # decoded inside LA_ON .. LA_OFF
 
     @property
     def needs_stop(self) -> bool:

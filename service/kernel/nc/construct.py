@@ -15,7 +15,8 @@ not, the make_* functions fall back to the ordinary constructors.
 from __future__ import annotations
 
 from .blocks import (
-    AxisExchange, Block, Compensation, ContourCommand, Motion, MotionKind, SourceRef, StopKind,
+    AxisExchange, Block, Compensation, ContourCommand, LookAheadMark, Motion, MotionKind, SourceRef,
+    StopKind,
 )
 
 
@@ -62,7 +63,7 @@ def _fast_block(
     source: SourceRef, number: int | None, motion: Motion | None, dwell_s: float,
     stop: StopKind, m_functions: tuple[int, ...], spindle_speed_rpm: float | None,
     tool: int | None, manual: bool, axis_exchange: AxisExchange | None = None,
-    contour: ContourCommand | None = None,
+    contour: ContourCommand | None = None, look_ahead: LookAheadMark | None = None,
 ) -> Block:
     b = new(BlockTwin)
     b.source = source
@@ -76,6 +77,7 @@ def _fast_block(
     b.manual = manual
     b.axis_exchange = axis_exchange
     b.contour = contour
+    b.look_ahead = look_ahead
     b.__class__ = Block
     return b
 

@@ -71,6 +71,7 @@ def run(decoder):
         feed = None if modal.feed_mm_min is None else modal.feed_mm_min / 60.0
         incremental = modal.distance == INCREMENTAL
         comp = modal.compensation
+        look_ahead = modal.look_ahead_mark  # LA_ON: the parameters in effect, else None
         radius = executor.tool_radius(modal.tool_offset) or 0.0
         plane, line_plane, roles, outside = executor.arc_setup(modal.plane)
         role_i, role_j, role_k = roles
@@ -226,12 +227,14 @@ _BLOCK_FAST = '''\
                 block.manual = manual
                 block.axis_exchange = None
                 block.contour = None
+                block.look_ahead = look_ahead
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\
                 block = MAKE_BLOCK(MAKE_SOURCE(file, i + 1, len(ws) + 1, starts[i] + i),
                                    None if number is None else int(number), motion, 0.0,
-                                   NO_STOP, (), None, None, manual)'''
+                                   NO_STOP, (), None, None, manual, None, None,
+                                   look_ahead)'''
 
 
 _EMIT_BLOCK = '''\

@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import IntEnum
 
-from .blocks import Compensation, LogArea, MotionKind
+from .blocks import Compensation, LogArea, LookAheadMark, MotionKind
 from .coordinates import CoordinateSystem, Placement
 from .patterns import OpenPattern, PatternPosition
 from .technology import MachiningSettings
@@ -40,6 +40,8 @@ class Plane(IntEnum):
 
 
 # plane -> names of its (p, q) axes; Motion.plane holds their channel axis indices
+# METB 10 ms, VFBT 1 (the velocity jumps as configured), BBTRC 8 blocks
+DEFAULT_LOOK_AHEAD = LookAheadMark(metb_s=0.010, vfbt=1.0, bbtrc=8)
 PLANE_AXES = {Plane.XY: ("X", "Y"), Plane.ZX: ("Z", "X"), Plane.YZ: ("Y", "Z")}
 
 
@@ -109,6 +111,12 @@ class ModalState:
     patterns: dict[int, tuple[PatternPosition, ...]] = field(default_factory=dict)
     settings: MachiningSettings = field(default_factory=MachiningSettings)  # #HSC, G133 ..
     msg_file: str | None = None  # #FILE NAME [MSG=..]: the file of #MSG SAVE
+    # enhanced look-ahead (LA_ON/LA_OFF, METB/VFBT/BBTRC): the configured defaults, the
+    # values in effect, and the mark blocks get while LA_ON is on (None: LA_OFF)
+    look_ahead_defaults: LookAheadMark = DEFAULT_LOOK_AHEAD
+    look_ahead_params: LookAheadMark = DEFAULT_LOOK_AHEAD
+    look_ahead_mark: LookAheadMark | None = None
+    cycle_s: float = 0.001  # GEO cycle time: METB must exceed it
 
     def start_program(self) -> None:
         """What a program start resets: no coordinate system, patterns or settings."""
@@ -119,3 +127,5 @@ class ModalState:
         self.patterns = {}
         self.settings = MachiningSettings()
         self.msg_file = None
+        self.look_ahead_params = self.look_ahead_defaults
+        self.look_ahead_mark = None

@@ -50,7 +50,10 @@ _WITH_CONDITION = frozenset({StmtKind.IF, StmtKind.ELSEIF, StmtKind.WHILE, StmtK
                              StmtKind.SWITCH})
 _WEIGHTINGS = (133.0, 134.0)  # G133 = <%> acceleration, G134 = <%> ramp time weighting
 _NOT_YET = frozenset({"DO", "ENDDO"})  # known ISG keywords of later issues
-_NOT_YET_WORDS = frozenset({"LA_ON", "LA_OFF"})  # MTC200 look-ahead switches: later issue
+# enhanced look-ahead (MTC200 names): the switches and the parameters set with '='
+LOOK_AHEAD_SWITCHES = {"LA_ON": 1.0, "LA_OFF": 0.0}
+LOOK_AHEAD_PARAMS = frozenset({"METB", "VFBT", "BBTRC"})
+_LOOK_AHEAD_INITIALS = frozenset("LMVB")
 
 WordTable = Mapping[str, tuple[WordKind, int]]
 
@@ -249,6 +252,8 @@ class LineParser:
                 block.goto = self._goto(cur)
             elif c == "V" and cur.peek(1) == ".":
                 block.items.append(self._assign(cur))
+            elif c in _LOOK_AHEAD_INITIALS and self._look_ahead_word(cur, block):
+                continue
             elif c == "L":
                 self._call(cur, block)
             elif c == "N":
@@ -256,12 +261,6 @@ class LineParser:
             elif "A" <= c <= "Z" or c == "_":
                 spec = table.get(c)
                 if spec is None:
-                    m = IDENT.match(cur.up, pos)
-                    if m is not None and m.group() in _NOT_YET_WORDS:
-                        raise cur.error(
-                            NcErrorId.INSTRUCTION_NOT_SUPPORTED,
-                            f"{m.group()} is not supported yet",
-                        )
                     raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
                 kind, axis = spec
                 if kind != WordKind.G and kind != WordKind.M:
@@ -297,6 +296,29 @@ class LineParser:
                 raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
         block.letters = frozenset(letters)
         return block
+
+    def _look_ahead_word(self, cur: Cursor, block: NcBlock) -> bool:
+        """``LA_ON`` / ``LA_OFF`` or ``METB|VFBT|BBTRC = <expr>`` at the cursor: parsed
+        into ``block``; False when the word is none of them."""
+        pos = cur.pos
+        m = IDENT.match(cur.up, pos)
+        if m is None:
+            return False
+        word = m.group()
+        switch = LOOK_AHEAD_SWITCHES.get(word)
+        if switch is not None:
+            cur.pos = m.end()
+            block.items.append(Word(WordKind.LOOK_AHEAD, word, switch, pos))
+            return True
+        if word not in LOOK_AHEAD_PARAMS:
+            return False
+        cur.pos = m.end()
+        if _skip(cur) >= cur.end or cur.peek() != "=" or cur.peek(1) == "=":
+            raise cur.error(NcErrorId.EXPRESSION_SYNTAX, f"'=' expected after {word}", pos)
+        cur.pos += 1
+        block.items.append(Word(WordKind.LOOK_AHEAD_PARAM, word, ExpressionParser(cur).parse(),
+                                pos))
+        return True
 
     def _value(self, cur: Cursor, letter: str, letter_pos: int) -> float | Node:
         cur.skip_ws()
@@ -344,8 +366,6 @@ class LineParser:
         pos = cur.pos
         m = IDENT.match(cur.up, pos)
         ident = m.group() if m else "L"
-        if ident in _NOT_YET_WORDS:
-            raise cur.error(NcErrorId.INSTRUCTION_NOT_SUPPORTED, f"{ident} is not supported yet")
         local = ident == "LL"
         cur.pos += 2 if local else 1
         cur.skip_ws()

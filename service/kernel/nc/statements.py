@@ -81,6 +81,8 @@ class WordKind(IntEnum):
     G = 7  # G: preparatory function
     M = 8  # M: miscellaneous function
     WEIGHTING = 9  # G133 = <%> / G134 = <%>: acceleration / ramp time weighting
+    LOOK_AHEAD = 10  # LA_ON (value 1) / LA_OFF (value 0): enhanced look-ahead
+    LOOK_AHEAD_PARAM = 11  # METB = <s> / VFBT = <factor> / BBTRC = <blocks>
 
 
 @dataclass(slots=True)

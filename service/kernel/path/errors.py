@@ -34,6 +34,7 @@ class PathErrorId(IntEnum):
     COMP_DESELECT_ON_ARC = 50204  # G40 programmed in an arc block (deselect in a line)
     COMP_NO_PLANE_MOTION = 50205  # compensated block without motion in the plane
     COMP_PLANE_CHANGE = 50206  # plane changed while compensation is active
+    COMP_BOTTLENECK = 50207  # LA_ON, BBTRC: compensated elements of two blocks cross
     BUFFER_FULL = 50300  # push() without a free slot in the look-ahead buffer
 
 

@@ -87,12 +87,19 @@ class LookAhead:
         cap = seg.speed_mm_s * self.override
         return cap if cap < seg.axis_speed_mm_s else seg.axis_speed_mm_s
 
-    @staticmethod
-    def _junction(seg: Segment) -> None:
-        if seg.next is None or seg.stop or seg.single_stop:
+    def _junction(self, seg: Segment) -> None:
+        if seg.stop or seg.single_stop:
             seg.junction_mm_s = 0.0
-        else:
+        elif seg.next is not None:
             seg.junction_mm_s = min(seg.corner_mm_s, seg.cap_mm_s)
+        elif seg.la_exit_mm_s > 0.0:
+            # the buffer's end inside a planned LA_ON section: the section's plan
+            # guarantees a stop is reachable from this speed (scaled like the caps by
+            # an override below 100 %; above it the caps only grow)
+            scale = self.override if self.override < 1.0 else 1.0
+            seg.junction_mm_s = min(seg.la_exit_mm_s * scale, seg.cap_mm_s)
+        else:
+            seg.junction_mm_s = 0.0
 
     def append(self, seg: Segment) -> None:
         """Append ``seg`` behind the last segment (planned at the next ``update``)."""
@@ -104,13 +111,17 @@ class LookAhead:
         tail = self.tail
         self.tail = seg
         self.dirty = True
+        if seg.la_exit_mm_s > 0.0:
+            self._junction(seg)  # the buffer's end inside an LA_ON section
         if tail is None:
             self.head = seg
             return
         tail.next = seg
         seg.prev = tail
-        tail.corner_mm_s = corner_limit_mm_s(tail.tangent_end, seg.tangent_start,
-                                             self.vel_jump_mm_s)
+        corner = corner_limit_mm_s(tail.tangent_end, seg.tangent_start, self.vel_jump_mm_s)
+        if seg.vfbt and tail.vfbt and corner != math.inf:  # a transition inside LA_ON
+            corner *= seg.vfbt
+        tail.corner_mm_s = corner
         self._junction(tail)
 
     def update(self) -> None:
@@ -182,7 +193,8 @@ class LookAhead:
         Stops at the first planned segment whose exit speed stays the same.
         """
         sqrt = math.sqrt
-        nxt_entry = seg.next.entry_mm_s if seg.next is not None else 0.0
+        # the last segment's junction is its exit limit (0, or an LA_ON section's plan)
+        nxt_entry = seg.next.entry_mm_s if seg.next is not None else math.inf
         while seg is not None:
             exit_ = seg.junction_mm_s
             if nxt_entry < exit_:

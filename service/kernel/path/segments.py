@@ -34,6 +34,7 @@ class Segment:
         "speed_mm_s", "axis_speed_mm_s", "programmed_mm_s", "tangent_start", "tangent_end",
         "block_rest_mm", "events", "stop", "single_stop", "cap_mm_s", "corner_mm_s",
         "junction_mm_s", "entry_mm_s", "exit_mm_s", "planned", "prev", "next",
+        "la_exit_mm_s", "vfbt",
     )
 
     def __init__(self, element: Element, block: Block, dynamics: Sequence[AxisDynamics],
@@ -43,6 +44,11 @@ class Segment:
         rapid = motion.kind == MotionKind.RAPID
         feed = math.inf if rapid else motion.feed_mm_s
         limits = element_limits(element, feed, dynamics)
+        mark = block.look_ahead
+        if mark is not None and mark.max_mm_s < limits.axis_speed_mm_s:
+            # a planned LA_ON block: the block rate the buffer can pass limits it too
+            limits = limits._replace(axis_speed_mm_s=mark.max_mm_s,
+                                     speed_mm_s=min(limits.speed_mm_s, mark.max_mm_s))
         self.element = element
         self.block = block
         self.point_at = element.point_at
@@ -67,6 +73,10 @@ class Segment:
         self.planned = False  # the backward pass has set entry/exit
         self.prev: Segment | None = None
         self.next: Segment | None = None
+        # LA_ON: planned speed from which the rest of the section can be met (at the
+        # buffer's end instead of a stop; 0: none), VFBT of transitions into it (0: none)
+        self.la_exit_mm_s = mark.exit_mm_s if mark is not None and ends_block else 0.0
+        self.vfbt = mark.vfbt if mark is not None else 0.0
 
     def __repr__(self) -> str:
         return (f"Segment({self.element!r}, L={self.length_mm:.6g}, cap={self.cap_mm_s:.6g}, "

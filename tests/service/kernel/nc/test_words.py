@@ -87,7 +87,12 @@ def test_dwell_x_word_without_an_x_axis():
         ("M17\nM30", NcErrorId.SUBPROGRAM_END_IN_MAIN, 1, 1),
         ("G0 X1\n\n; end\n", NcErrorId.MISSING_PROGRAM_END, 1, 1),
         ("", NcErrorId.MISSING_PROGRAM_END, 1, 1),
-        ("LA_ON\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 1),
+        ("N1 METB=0.0005\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 4),
+        ("VFBT=0\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 1),
+        ("VFBT=1.01\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 1),
+        ("BBTRC=2.5\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 1),
+        ("BBTRC=0\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 1),
+        ("METB 0.01\nM30", NcErrorId.EXPRESSION_SYNTAX, 1, 1),
     ],
 )
 def test_word_errors(program, err, line, column):
