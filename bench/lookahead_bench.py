@@ -68,6 +68,7 @@ class Result:
     program_time_s: float
     optimum_s: float
     violations: list[str]
+    warnings: list[int]  # ids of the channel's warnings (50301: the buffer limits)
     end_error_mm: float
     wall_s: float
     run: Run | None = None
@@ -95,13 +96,14 @@ def run_program(program: BenchProgram, variant: Variant, keep_run: bool = False)
         run = harness.run(text, name=f"{program.name}.nc", record=True, timeout_s=600.0)
         wall = time.perf_counter() - t0
     channel = run.channel
-    violations = [f"error {e.id}: {e.text}" for e in channel.errors]
+    violations = [f"error {e.id}: {e.text}" for e in channel.errors if not e.warning]
     violations += check_samples(run, program, config)
+    warnings = [e.id for e in channel.errors if e.warning]
     end = program.elements[-1].end
     end_error = max(abs(a - b) for a, b in zip(run.positions_mm, end))
     return Result(program.name, variant, channel.program_time_s,
                   optimum_time_s(program.elements, axis_limits(config)), violations,
-                  end_error, wall, run if keep_run else None)
+                  warnings, end_error, wall, run if keep_run else None)
 
 
 def check_samples(run: Run, program: BenchProgram, config: MachineConfig) -> list[str]:
@@ -196,7 +198,8 @@ def table(results: list[Result], programs: list[BenchProgram]) -> str:
                 cells.append(f"{'-':>11}")
                 continue
             optimum = r.optimum_s
-            flag = "!" if r.violations or r.end_error_mm > 1e-9 else " "
+            flag = ("!" if r.violations or r.end_error_mm > 1e-9
+                    else "w" if r.warnings else " ")
             cells.append(f"{r.ratio:>10.4f}{flag}")
         rows.append(f"{p.name:<18} {p.blocks:>7} {optimum or 0.0:>10.4f} " + " ".join(cells)
                     + f"  {'yes' if covers_stop(p, 120, config) else 'no'}")
@@ -215,6 +218,8 @@ def main(argv: list[str] | None = None) -> int:
         for variant in VARIANTS:
             results.append(run_program(program, variant))
     print(table(results, programs))
+    print("ratio = ch1.program_time / optimum;  w: warning 50301 (the buffer limits the "
+          "speed);  !: a limit or the end point was missed")
     bad = [r for r in results if r.violations or r.end_error_mm > 1e-9]
     for r in bad:
         print(f"{r.program} {r.variant.label}: end off by {r.end_error_mm:.3g} mm; "

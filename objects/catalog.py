@@ -156,6 +156,11 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "Path distance from program start on the compensated path",
     ),
     ObjectTemplate(
+        "lookahead_blocks", Scope.CHANNEL, GEO, IPO, 0x801, UNS32, R, "-",
+        "Blocks the look-ahead buffer holds (P-CHAN-00650/00653), the size the planner "
+        "uses (project offset)",
+    ),
+    ObjectTemplate(
         "remaining_path_in_block", Scope.CHANNEL, GEO, IPO, 0x08, REAL64, R, "0.1 um",
         "Remaining path of the block in the interpolator (offset as TwinSharp)",
     ),

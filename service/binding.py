@@ -180,6 +180,16 @@ def _axis_param(attr: str) -> Callable[[Kernel, CncObject], Getter]:
     return bind
 
 
+def _channel_config(attr: str) -> Callable[[Kernel, CncObject], Getter]:
+    """A value of the channel's configuration (constant while the service runs)."""
+
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        value = getattr(kernel.config.channels[kernel.channel_index(obj.channel)], attr)
+        return lambda: value
+
+    return bind
+
+
 def _hli_physical(attr: str) -> Callable[[Kernel, CncObject], Getter]:
     """``gpAx[i].lr_state``: the physical axis with the slot's number (0 when none)."""
 
@@ -316,6 +326,7 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "vel_max": _axis_param("vel_max_mm_s"),
     "acc_max": _axis_param("acc_max_mm_s2"),
     "vel_jump_max": _axis_param("vel_jump_mm_s"),
+    "lookahead_blocks": _channel_config("look_ahead_blocks"),
     "bahn_mc_control.suspend_axis_output.command_w": _channel("suspend_command_w"),
     "bahn_mc_control.suspend_axis_output.enable_w": _channel("suspend_enable_w"),
     "bahn_mc_control.suspend_axis_output.request_r": _channel("suspend_request_r"),

@@ -46,6 +46,7 @@ from .nc.blocks import (
 )
 from .nc.contour import LOOP_MARKERS
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
+from .path.errors import PathErrorId
 from .path.executor import AxisDynamics, PathError, PathExecutor
 from .path.interpolator import Waiting
 from .path.section_plan import plan_section
@@ -118,6 +119,7 @@ class ChannelRunner:
         self._executor: PathExecutor | None = None
         self._feed: DecoderFeed | None = None
         self._last_pushed: Block | None = None  # the block that entered the buffer last
+        self._buffer_warned = False  # BUFFER_LIMITS_SPEED shown in this run
         self._modal: ModalState | None = None  # MDI: modal state carried between blocks
         self._pending_error: ChannelError | None = None
         self._fed_all = False
@@ -399,6 +401,7 @@ class ChannelRunner:
                                     buffer_blocks=self._buffer_blocks, cycle_s=self._cycle_s),
         )
         self._last_pushed = None
+        self._buffer_warned = False
         self._feed.add(job)
         for more in self._queued_jobs:
             self._feed.add(more)
@@ -722,7 +725,11 @@ class ChannelRunner:
             if self._contour_changed:  # once per cycle, not per block
                 self._contour_changed = False
                 self._show_contour_state()
+        # the buffer is full and more blocks wait: does its end hold the speed down?
+        full = not (self._buffer_warned or self._fed_all) and executor.free_slots() == 0
         step = executor.step(override)
+        if full and executor.buffer_limits_speed():
+            self._warn_buffer_limits()
         if output:
             for axis, pos in zip(ch.axes, step.position_mm, strict=True):
                 axis.position_mm = pos
@@ -790,6 +797,18 @@ class ChannelRunner:
         if self._contour.take(items):
             self._warn_log_full()
         self._contour_changed = True
+
+    def _warn_buffer_limits(self) -> None:
+        """Warn (once per run) that the look-ahead buffer's size limits the path speed,
+        at the block the path is in."""
+        self._buffer_warned = True
+        ch = self.channel
+        self._raise(ChannelError(
+            int(PathErrorId.BUFFER_LIMITS_SPEED),
+            f"the look-ahead buffer of {self._buffer_blocks} blocks limits the path speed "
+            f"to {ch.path_velocity_mm_s:.1f} mm/s (the path must be able to stop after the "
+            "last buffered block): choose a larger buffer (interpolator_function, "
+            "P-CHAN-00650) or program LA_ON", ch.file_name, ch.line, warning=True))
 
     def _warn_log_full(self) -> None:
         """Warn (once per marked area) that the log dropped elements, at the block that

@@ -36,6 +36,7 @@ class PathErrorId(IntEnum):
     COMP_PLANE_CHANGE = 50206  # plane changed while compensation is active
     COMP_BOTTLENECK = 50207  # LA_ON, BBTRC: compensated elements of two blocks cross
     BUFFER_FULL = 50300  # push() without a free slot in the look-ahead buffer
+    BUFFER_LIMITS_SPEED = 50301  # warning: the end of the full buffer holds the speed down
 
 
 class PathError(Exception):

@@ -31,6 +31,8 @@ from .limits import AxisDynamics
 from .planner import LookAhead, plan_time_optimal
 from .segments import PathPreparation, Segment
 
+_ON_BRAKING_CURVE = 0.98  # share of the braking reach that counts as "on the curve"
+
 __all__ = ["AxisDynamics", "PathError", "PathErrorId", "PathExecutor", "StepResult",
            "Waiting", "plan_time_optimal"]
 
@@ -89,6 +91,27 @@ class PathExecutor:
             self._ipo.unfinished -= dropped
             raise
         self._take(items)
+
+    def buffer_limits_speed(self) -> bool:
+        """The end of the look-ahead buffer holds the path speed down: no stop is due
+        at the last buffered segment, and the path runs below its speed limit on the
+        braking curve towards a stop after that segment (the look-ahead must always be
+        able to stop there). Meaningful after a cycle that started with every slot
+        taken; a larger buffer or LA_ON helps."""
+        ipo = self._ipo
+        seg, v = ipo.seg, ipo.v_mm_s
+        if (seg is None or v <= 0.0 or v >= seg.cap_mm_s * (1.0 - 1e-6) or ipo.hold
+                or self._closed):
+            return False
+        tail = self._planner.tail
+        if tail.junction_mm_s > 0.0 or tail.stop or tail.single_stop:
+            return False
+        reach2 = 2.0 * seg.acc_mm_s2 * (seg.length_mm - ipo.s_mm)  # v^2 the rest can take
+        nxt = seg.next
+        while nxt is not None:
+            reach2 += nxt.two_acc_len
+            nxt = nxt.next
+        return v * v >= _ON_BRAKING_CURVE * reach2
 
     @property
     def closed(self) -> bool:
