@@ -5,6 +5,11 @@ Kernel part (``--part kernel``): the decoder against a ``str.split`` tokenizer o
 wall second (``bench/kernel_bench.py``), and the planner's machining time against the
 whole-program optimum of the same model (``bench/planner_bench.py``).
 
+Look-ahead part (``--part lookahead``): ``ch1.program_time`` of the look-ahead programs
+on the kernel against the time-optimal limit of a separate reference implementation,
+LA_OFF with 30/120/190 blocks and LA_ON (``bench/lookahead_bench.py``); it writes the
+spiral's speed plot to ``lookahead-spiral.png``.
+
 Dispatch part (``--part dispatch``):
 
 Baseline: a raw pyzmq ROUTER in a second process that answers each msgpack frame with a
@@ -205,13 +210,20 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__.split("\n")[0])
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
-    parser.add_argument("--part", choices=("all", "dispatch", "kernel"), default="all",
-                        help="dispatch: request dispatch; kernel: decoder, interpolator, planner")
+    parser.add_argument("--part", choices=("all", "dispatch", "kernel", "lookahead"),
+                        default="all",
+                        help="dispatch: request dispatch; kernel: decoder, interpolator, "
+                        "planner; lookahead: machining time against the optimum")
     args = parser.parse_args(argv)
     if args.part in ("all", "dispatch"):
         dispatch(args)
     if args.part in ("all", "kernel"):
         kernel(args.runs)
+    if args.part in ("all", "lookahead"):
+        from . import lookahead_bench
+
+        print("\nlook-ahead: ch1.program_time / time-optimal limit (virtual clock)")
+        return lookahead_bench.main(["--plot", "lookahead-spiral.png"])
     return 0
 
 

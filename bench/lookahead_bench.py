@@ -171,10 +171,11 @@ def speed_plot(path: str, program: BenchProgram | None = None) -> None:
         distance = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(pos, axis=0),
                                                                    axis=1))))
         speed = np.array([s.path_velocity_mm_s for s in result.run.samples])
-        series.append(Series(f"{result.variant.label}: {result.ratio:.4f} x optimum",
+        series.append(Series(f"{result.variant.label} {result.ratio:.4f}",
                              distance, speed, colours[la_on]))
     grid = np.linspace(0.0, optimum[-1].start_mm + optimum[-1].length_mm, 4000)
     series.insert(0, Series("optimum", grid, speed_at(optimum, grid), (20, 20, 20), 3))
+    series[1:3] = series[2:0:-1]  # LA_ON drawn first, so the LA_OFF line stays visible
     feed = program.elements[0].feed_mm_min / 60.0
     series.append(Series("programmed feed", grid[[0, -1]], np.array([feed, feed]),
                          (120, 120, 120)))

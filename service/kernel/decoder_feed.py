@@ -53,7 +53,7 @@ class Job:
 
 Item = Block | NcError | DecodeEnd | PathError
 
-SECTION_MAX_BLOCKS = 250_000  # an LA_ON section longer than this is planned in parts
+SECTION_MAX_BLOCKS = 500_000  # an LA_ON section longer than this is planned in parts
 SectionPlanner = Callable[[list[Block]], SectionPlan]
 
 

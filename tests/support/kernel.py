@@ -125,8 +125,10 @@ class KernelHarness:
         self.begin(start, record)
         return self.wait(timeout_s)
 
-    def begin(self, start: Any, record: bool = False) -> None:
-        """Apply ``start`` (START, a manual block) and return at once; ``wait`` ends it."""
+    def begin(self, start: Any, record: bool = False, timeout_s: float = 10.0) -> None:
+        """Apply ``start`` (START, a manual block) and return at once; ``wait`` ends it.
+        START is applied in the cycle after it; a long LA_ON section is planned before
+        that cycle ends (``timeout_s``)."""
         self._recording = [] if record else None
         self._finished.clear()
         applied = threading.Event()
@@ -141,7 +143,7 @@ class KernelHarness:
             applied.set()
 
         self.kernel.submit(start, started)
-        assert applied.wait(10.0), "START was not applied"
+        assert applied.wait(timeout_s), "START was not applied"
         assert result[0] is None, result[0]
 
     def wait(self, timeout_s: float = 60.0) -> Run:
@@ -153,16 +155,17 @@ class KernelHarness:
             samples.pop(0)  # cycles before START was applied
         return Run(self.kernel.snapshot, samples)
 
-    def start(self, text: str, name: str = "test.nc", record: bool = False) -> None:
+    def start(self, text: str, name: str = "test.nc", record: bool = False,
+              timeout_s: float = 10.0) -> None:
         """Store, select and START ``text`` without waiting for its end."""
         self.programs[name] = text
         assert self.command(SelectProgram(0, name)) is None
-        self.begin(StartProgram(0, True), record)
+        self.begin(StartProgram(0, True), record, timeout_s)
 
     def run(self, text: str, name: str = "test.nc", record: bool = False,
             timeout_s: float = 60.0) -> Run:
         """Store ``text`` as ``name``, select and START it, wait for READY or ERROR."""
-        self.start(text, name, record)
+        self.start(text, name, record, timeout_s)
         return self.wait(timeout_s)
 
     def mdi(self, text: str, record: bool = False, timeout_s: float = 60.0) -> Run:

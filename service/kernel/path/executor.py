@@ -104,7 +104,8 @@ class PathExecutor:
                 or self._closed):
             return False
         tail = self._planner.tail
-        if tail.junction_mm_s > 0.0 or tail.stop or tail.single_stop:
+        if (tail.junction_mm_s > 0.0 or tail.stop or tail.single_stop
+                or tail.block.look_ahead is not None):  # a section's end is planned
             return False
         reach2 = 2.0 * seg.acc_mm_s2 * (seg.length_mm - ipo.s_mm)  # v^2 the rest can take
         nxt = seg.next

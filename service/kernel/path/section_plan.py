@@ -10,7 +10,10 @@ once, as the MTC200 NC compiler does at download. The model is exactly the kerne
 * block rate: the look-ahead buffer takes new blocks between cycles only, so a block
   of the section never lasts less than ``cycle / (buffer_blocks - 1)``: then the path
   can never pass the whole buffer within one cycle (that is what makes the planned
-  exit speeds below safe to use at the buffer's end).
+  exit speeds below safe to use at the buffer's end). Bare blocks (no motion, zero
+  length) take a slot but no time: a moving block's time covers the bare blocks next
+  to it too (``_slots``), and where bare blocks alone would fill the buffer the plan
+  stops.
 
 Geometry is prepared as the GEO task will prepare it (``PathPreparation``, tool radius
 compensation included). A section starts only where nothing is held back by the
@@ -32,10 +35,11 @@ Blocks are then rewritten, never moved off the contour:
   ordinary blocks of the same source line and number (block counter, F on the HMI);
   their end points lie on the original element.
 
-BBTRC: with compensation on, each compensated element is compared with the elements
-of the next BBTRC blocks (beyond the neighbour the compensation itself trims against);
-when two of them cross, the tool would cut the contour between them (a bottleneck),
-and the section stops before the first of them with COMP_BOTTLENECK.
+BBTRC: with compensation on, each compensated element is compared with the compensated
+elements of the next BBTRC blocks (beyond the neighbour the compensation itself trims
+against; moves without compensation are not part of the compensated path); when two of
+them cross, the tool would cut the contour between them (a bottleneck), and the section
+stops before the first of them with COMP_BOTTLENECK.
 """
 
 from __future__ import annotations
@@ -137,8 +141,12 @@ def _limits(elements: list[_Element], blocks: list[Block], buffer_blocks: int,
     block_mm = [0.0] * len(blocks)
     for e in elements:
         block_mm[e.index] += e.seg.length_mm
-    rate = max(buffer_blocks - 1, 1) / cycle_s  # blocks per second the buffer can pass
-    rate_caps = [length * rate for length in block_mm]
+    slots, stops, per_cycle = _slots(blocks, block_mm, buffer_blocks)
+    rate = per_cycle / cycle_s  # blocks per second the buffer can pass
+    rate_caps = [length * rate / n for length, n in zip(block_mm, slots)]
+    last = {e.index: e for e in elements}
+    for k in stops:  # bare blocks alone fill the buffer behind block k: it must stop
+        last[k].stop = True
     for e, nxt in zip(elements, elements[1:] + [None]):
         e.cap = min(e.cap, rate_caps[e.index])
         if nxt is None:
@@ -148,6 +156,47 @@ def _limits(elements: list[_Element], blocks: list[Block], buffer_blocks: int,
             corner *= blocks[nxt.index].look_ahead.vfbt
         e.corner = corner
     return rate_caps
+
+
+def _slots(blocks: list[Block], block_mm: list[float],
+           buffer_blocks: int) -> tuple[list[int], list[int], int]:
+    """How many blocks the path may pass per cycle, how many of them each moving block
+    stands for, and the moving blocks after which the buffer holds nothing to move.
+
+    A bare block (no element: no motion, zero length, trimmed away by the compensation)
+    takes a slot of the buffer but no time: a moving block stands for itself and the
+    bare blocks on both sides of it, so any ``buffer_blocks - 1`` consecutive blocks
+    still last a cycle. With compensation, the last compensated block in the buffer
+    is held back (no segment yet) with the bare blocks after it: one slot less per
+    cycle, and the block before it stands for those bare blocks too. Where bare (or
+    held) blocks alone fill the rest of the buffer behind a moving block, nothing
+    behind them can enter before the path has passed it: the path must be able to
+    stop at its end."""
+    held = any(_compensated(b) for b in blocks)
+    per_cycle = max(buffer_blocks - 1 - held, 1)
+    moving = [k for k, length in enumerate(block_mm) if length > 0.0]
+    slots = [1] * len(blocks)
+    stops = []
+    bounds = [-1, *moving, len(blocks)]
+    for i, k in enumerate(moving, start=1):
+        nxt = bounds[i + 1]
+        before = k - bounds[i - 1] - 1
+        after = nxt - k - 1
+        gap = after  # blocks behind k that give the path nothing to move
+        if nxt < len(blocks) and _compensated(blocks[nxt]):
+            trailing = bounds[i + 2] - nxt - 1  # held with nxt
+            after += trailing
+            gap += 1 + trailing
+        slots[k] = 1 + before + after
+        if gap >= buffer_blocks - 1:
+            stops.append(k)
+    return slots, stops, per_cycle
+
+
+def _compensated(block: Block) -> bool:
+    """The block runs with tool radius compensation (a radius of 0 compensates nothing)."""
+    m = block.motion
+    return m is not None and m.compensation != Compensation.OFF and m.tool_radius_mm > 0.0
 
 
 def _passes(elements: list[_Element]) -> None:
@@ -329,11 +378,13 @@ def _point_at(element: Element, motion: Motion, s_mm: float) -> tuple[float, ...
 
 def _bottleneck(elements: list[_Element], blocks: list[Block],
                 planned: int) -> tuple[PathError | None, int]:
-    """Compare each compensated element with those of the following BBTRC blocks that
-    are not its neighbours; a crossing cuts the section before the earlier block."""
+    """Compare each compensated element with the compensated elements of the following
+    BBTRC blocks that are not its neighbours; a crossing cuts the section before the
+    earlier block. Moves without compensation (G40, or a tool radius of 0) are not
+    part of the compensated path: a rapid that crosses it higher up is no bottleneck."""
     for i, e in enumerate(elements):
         motion = e.seg.block.motion
-        if motion is None or motion.compensation == Compensation.OFF or e.index >= planned:
+        if not _compensated(e.seg.block) or e.index >= planned:
             continue
         reach = e.index + blocks[e.index].look_ahead.bbtrc
         for other in elements[i + 2:]:
@@ -341,6 +392,8 @@ def _bottleneck(elements: list[_Element], blocks: list[Block],
                 break
             if other.index <= e.index + 1:
                 continue  # the compensation trims neighbours against each other
+            if not _compensated(other.seg.block):
+                continue  # not the compensated path (G40 departure, moves after it)
             point = _crossing(e.seg.element, other.seg.element, motion.plane)
             if point is not None:
                 later = blocks[other.index]
