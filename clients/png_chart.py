@@ -296,7 +296,7 @@ def _fit_plot_area(
             units_per_px = max((x_hi - x_lo) / (width - 1), (y_hi - y_lo) / (height - 1))
             x_lo, x_hi = _widen(x_lo, x_hi, units_per_px * (width - 1))
             y_lo, y_hi = _widen(y_lo, y_hi, units_per_px * (height - 1))
-        y_axis = _axis(y_lo, y_hi, height, 40 * scale)
+        y_axis = _axis(y_lo, y_hi, height, 30 * scale)
         needed = max((_text_width(t, scale) for t in y_axis.labels), default=0)
         if needed <= labels_w:
             return _PlotArea(left, top, width, height, _x_axis(x_lo, x_hi, width, scale), y_axis)
