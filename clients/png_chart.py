@@ -105,6 +105,7 @@ def line_chart(
     if y_range is None:
         y_range = _auto_range([y for _, y in data], from_zero=not equal_aspect)
     scale = max(1, min(width_px, height_px) // 300)  # 2 for the default 1200 x 600
+    title_scale = _title_scale(title, width_px, scale)
     legend = _legend_lines(series, width_px, scale)
     area = _fit_plot_area(
         width_px,
@@ -113,7 +114,7 @@ def line_chart(
         _checked_range(x_range, "x_range"),
         _checked_range(y_range, "y_range"),
         equal_aspect,
-        has_title=bool(title),
+        title_h=_GLYPH_H * title_scale if title else 0,
         has_x_label=bool(x_label),
         has_y_label=bool(y_label),
         legend_w=_legend_width(legend, scale),
@@ -124,7 +125,7 @@ def line_chart(
     for s, (x, y) in zip(series, data):
         _draw_polyline(img, area, x, y, s.color, s.width_px)
     _draw_frame_and_ticks(img, area, scale)
-    _draw_titles(img, area, scale, title, x_label, y_label)
+    _draw_titles(img, area, scale, title_scale, (title, x_label, y_label))
     _draw_legend(img, area, scale, legend, series)
     return encode_png(img)
 
@@ -233,6 +234,7 @@ def _x_axis(lo: float, hi: float, length_px: int, scale: int) -> _Axis:
 
 
 def _widen(lo: float, hi: float, span: float) -> tuple[float, float]:
+    """The range ``span`` wide with the same middle as (lo, hi)."""
     mid = (lo + hi) / 2
     return mid - span / 2, mid + span / 2
 
@@ -271,20 +273,20 @@ def _fit_plot_area(
     yr: tuple[float, float],
     equal_aspect: bool,
     *,
-    has_title: bool,
+    title_h: int,
     has_x_label: bool,
     has_y_label: bool,
     legend_w: int,
 ) -> _PlotArea:
     """Place the plot area in the margins left for title, labels, ticks and legend."""
     pad, tick_len, line_h = 4 * scale, 3 * scale, _GLYPH_H * scale
-    top = pad + ((_GLYPH_H * (scale + 1) + pad) if has_title else 0) + 1
+    top = pad + (title_h + pad if title_h else 0) + 1
     bottom = 1 + tick_len + pad + line_h + ((pad + line_h) if has_x_label else 0) + pad
     right = 1 + pad + (legend_w + pad if legend_w else 3 * _ADVANCE * scale)
     height = height_px - top - bottom
     # The left margin holds the y tick labels, whose width depends on the y range,
     # which (equal_aspect) depends on the plot width: grow it until the labels fit.
-    # This ends because labels only widen as the margin grows, and they are short.
+    # This ends: labels_w only grows, and no tick label is longer than ~12 characters.
     labels_w = 0
     while True:
         left = pad + ((line_h + pad) if has_y_label else 0) + labels_w + pad + tick_len + 1
@@ -307,6 +309,7 @@ def _fit_plot_area(
 
 
 def _draw_grid(img: np.ndarray, area: _PlotArea) -> None:
+    """Light lines across the plot area at every tick."""
     plot = _plot_pixels(img, area)
     plot[:, np.rint(area.cols(area.x.ticks)).astype(int)] = _GRID
     plot[np.rint(area.rows(area.y.ticks)).astype(int), :] = _GRID
@@ -329,14 +332,23 @@ def _draw_frame_and_ticks(img: np.ndarray, area: _PlotArea, scale: int) -> None:
         _draw_text(img, label, x, row - _CAP_H * scale // 2, scale)
 
 
+def _title_scale(title: str, width_px: int, scale: int) -> int:
+    """The title's font scale: one up from the rest, unless that makes it too wide."""
+    fits = _text_width(title, scale + 1) <= width_px - 8 * scale
+    return scale + 1 if fits else scale
+
+
 def _draw_titles(
-    img: np.ndarray, area: _PlotArea, scale: int, title: str, x_label: str, y_label: str
+    img: np.ndarray, area: _PlotArea, scale: int, title_scale: int, texts: tuple[str, str, str]
 ) -> None:
-    """Title centred above the plot, x label below the tick labels, y label turned left."""
+    """Title centred above the plot (but kept on the image), x label below the tick
+    labels, y label turned to read upwards."""
+    title, x_label, y_label = texts
     pad, line_h = 4 * scale, _GLYPH_H * scale
     centre_x, centre_y = area.left + area.width // 2, area.top + area.height // 2
-    title_scale = scale + 1
-    _draw_text(img, title, centre_x - _text_width(title, title_scale) // 2, pad, title_scale)
+    title_w = _text_width(title, title_scale)
+    title_left = max(pad, min(centre_x - title_w // 2, img.shape[1] - pad - title_w))
+    _draw_text(img, title, title_left, pad, title_scale)
     label_y = area.top + area.height + 1 + 3 * scale + pad + line_h + pad
     _draw_text(img, x_label, centre_x - _text_width(x_label, scale) // 2, label_y, scale)
     turned = np.rot90(_text_mask(y_label, scale))  # reads bottom to top
@@ -344,14 +356,15 @@ def _draw_titles(
 
 
 def _legend_lines(series: Sequence[Series], width_px: int, scale: int) -> list[str]:
-    """The labels as the legend shows them: cut with ".." so the legend keeps under a
-    quarter of the chart width."""
+    """The labels as the legend shows them: cut with ".." so that the legend takes
+    about a quarter of the chart width at most."""
     max_chars = max(4, width_px // 4 // (_ADVANCE * scale) - 6)
     cut = max_chars - 2
     return [s.label if len(s.label) <= max_chars else f"{s.label[:cut]}.." for s in series]
 
 
 def _legend_width(lines: list[str], scale: int) -> int:
+    """Pixel width of the legend box; 0 when there is no series."""
     if not lines:
         return 0
     pad, sample_w = 4 * scale, 6 * _ADVANCE * scale
@@ -373,8 +386,9 @@ def _draw_legend(
     sample_w = 6 * _ADVANCE * scale
     for i, (label, s) in enumerate(zip(lines, series)):
         text_top = top + pad + i * line_h
-        # a sample at least 2 px thick, so that thin lines' colours can be told apart
-        thickness = max(2, s.width_px)
+        # a sample at least 2 px thick, so that thin lines' colours can be told apart,
+        # and at most a capital letter high, so that thick ones do not hide the next row
+        thickness = min(max(2, s.width_px), _CAP_H * scale)
         mid = text_top + _CAP_H * scale // 2 - thickness // 2
         img[mid : mid + thickness, left + pad : left + pad + sample_w] = s.color
         _draw_text(img, label, left + pad + sample_w + pad, text_top, scale)
@@ -393,7 +407,10 @@ _BATCH_PX = 1 << 20  # pixels rasterised per numpy batch: bounds the temporary a
 def _draw_polyline(
     img: np.ndarray, area: _PlotArea, x: np.ndarray, y: np.ndarray, color: RGB, width_px: int
 ) -> None:
+    """Draw one series into the plot area, clipped to it."""
     cols, rows, stretch = _decimate(area.cols(x), area.rows(y), area.width)
+    if cols.size == 0:  # nothing finite to draw
+        return
     x0, y0, x1, y1 = _clip_segments(*_segments(cols, rows, stretch), area.width, area.height)
     mask = np.zeros((area.height, area.width), dtype=bool)
     _rasterise(mask, x0, y0, x1, y1)
