@@ -55,7 +55,8 @@ def offset_element(element: Element, plane: tuple[int, int], side: float,
                element.start_mm, r1)
 
 
-def _line_circle(p0, d, center, radius) -> list[tuple[float, float]]:
+def line_circle(p0, d, center, radius) -> list[tuple[float, float]]:
+    """Points where the line through ``p0`` with unit direction ``d`` meets the circle."""
     fx, fy = p0[0] - center[0], p0[1] - center[1]
     b = fx * d[0] + fy * d[1]
     c = fx * fx + fy * fy - radius * radius
@@ -68,7 +69,8 @@ def _line_circle(p0, d, center, radius) -> list[tuple[float, float]]:
     return [(p0[0] + t * d[0], p0[1] + t * d[1]) for t in (-b - root, -b + root)]
 
 
-def _circle_circle(c1, r1, c2, r2) -> list[tuple[float, float]]:
+def circle_circle(c1, r1, c2, r2) -> list[tuple[float, float]]:
+    """Points where two circles meet (none for concentric circles)."""
     dx, dy = c2[0] - c1[0], c2[1] - c1[1]
     dist = math.hypot(dx, dy)
     if dist <= 1e-12:
@@ -97,11 +99,11 @@ def intersect(first: Element, second: Element, plane: tuple[int, int],
         return p1[0] + t * d1[0], p1[1] + t * d1[1]
     if isinstance(first, Line) or isinstance(second, Line):
         line, arc = (first, second) if isinstance(first, Line) else (second, first)
-        candidates = _line_circle(plane_point(line.start_mm, plane),
+        candidates = line_circle(plane_point(line.start_mm, plane),
                                   plane_tangent(line.direction, plane), arc.center,
                                   arc.radius_mm)
     else:
-        candidates = _circle_circle(first.center, first.radius_mm, second.center,
+        candidates = circle_circle(first.center, first.radius_mm, second.center,
                                     second.radius_mm)
     if not candidates:
         return None

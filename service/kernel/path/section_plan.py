@@ -52,7 +52,7 @@ from ..nc.blocks import Block, Compensation, LookAheadMark, Motion, MotionKind
 from .errors import PathError, PathErrorId
 from .geometry import Arc, Element, Line
 from .limits import AxisDynamics, corner_limit_mm_s
-from .offsets import plane_point
+from .offsets import circle_circle, line_circle, plane_point, plane_tangent
 from .planner import trapezoid
 from .segments import PathPreparation, Segment
 
@@ -434,34 +434,9 @@ def _carrier_points(first: Element, second: Element,
         return [(p1[0] + t * u[0], p1[1] + t * u[1])]
     if isinstance(first, Line) or isinstance(second, Line):
         line, arc = (first, second) if isinstance(first, Line) else (second, first)
-        return _line_circle(plane_point(line.start_mm, plane), plane_point(line.end_mm, plane),
-                            arc.center, arc.radius_mm)
-    return _circle_circle(first.center, first.radius_mm, second.center, second.radius_mm)
-
-
-def _line_circle(a, b, center, radius) -> list[tuple[float, float]]:
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    fx, fy = a[0] - center[0], a[1] - center[1]
-    qa = dx * dx + dy * dy
-    qb = 2.0 * (fx * dx + fy * dy)
-    qc = fx * fx + fy * fy - radius * radius
-    disc = qb * qb - 4.0 * qa * qc
-    if qa == 0.0 or disc < 0.0:
-        return []
-    root = math.sqrt(disc)
-    return [(a[0] + t * dx, a[1] + t * dy) for t in ((-qb - root) / (2 * qa),
-                                                       (-qb + root) / (2 * qa))]
-
-
-def _circle_circle(c1, r1, c2, r2) -> list[tuple[float, float]]:
-    d = math.dist(c1, c2)
-    if d == 0.0 or d > r1 + r2 or d < abs(r1 - r2):
-        return []
-    x = (d * d + r1 * r1 - r2 * r2) / (2.0 * d)
-    h = math.sqrt(max(r1 * r1 - x * x, 0.0))
-    ux, uy = (c2[0] - c1[0]) / d, (c2[1] - c1[1]) / d
-    mx, my = c1[0] + x * ux, c1[1] + x * uy
-    return [(mx - h * uy, my + h * ux), (mx + h * uy, my - h * ux)]
+        return line_circle(plane_point(line.start_mm, plane), plane_tangent(line.direction, plane),
+                           arc.center, arc.radius_mm)
+    return circle_circle(first.center, first.radius_mm, second.center, second.radius_mm)
 
 
 _INSIDE_MM = 1e-6  # a crossing this close to an element's end is a touching end point
