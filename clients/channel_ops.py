@@ -395,31 +395,14 @@ class ChannelOps:
         }
         if errors_total is not None:
             wanted[f"{ch}.syn_chk.errors_total"] = errors_total
-        state_names = [f"{ch}.mc_active_mode_r", f"{ch}.mc_active_state_r"]
-        before = await self.read_many([*state_names, *(readback[name] for name in wanted)])
-        mode, state = (before[n] for n in state_names)
-        if state in (_ACTIVE, _HOLD, _ERROR):  # before anything changes (the last log)
-            raise AdsError(
-                AdsReturnCode.DEVICE_NOTREADY,
-                f"channel {channel} is {MODES.get(mode, mode)}/{STATES.get(state, state)}: "
-                "a syntax check needs a channel that is not working; hold and RESET first",
-            )
-        await self._refuse_plc_execution_mode(channel)
         log_file = check_log_name(channel)
-        if program != log_file:  # an older log must not pass for this check's
-            try:
-                await self.delete_program(log_file)
-            except AdsError as exc:
-                if exc.code != AdsReturnCode.DEVICE_NOTFOUND:
-                    raise
+        before = await self._prepare_simulation(
+            channel, "a syntax check", wanted, readback, SYNCHK,
+            stale_file=log_file if program != log_file else None)
         changed: list[tuple[str, Any]] = []  # (object, value before), in write order
         started = finished = False
         try:
-            for name, value in wanted.items():
-                old = before[readback[name]]
-                if old != value:
-                    changed.append((name, old))
-                    await self.write(name, value)
+            await self._write_remembered(wanted, readback, before, changed)
             await self.run_program(program, channel)
             started = True
             result = await self._check_result(program, channel, log_file, timeout_s)
@@ -429,20 +412,60 @@ class ChannelOps:
             await self._end_check(channel, changed, cancel=started and not finished,
                                   quiet=not finished)
 
-    async def _refuse_plc_execution_mode(self, channel: int) -> None:
-        """Refuse a check the PLC would turn into a real run: while its control unit
+    async def _prepare_simulation(
+        self, channel: int, what: str, wanted: dict[str, Any], readback: dict[str, str],
+        mode_bit: int, stale_file: str | None,
+    ) -> dict[str, Any]:
+        """Before a syntax check or traced PROD_TIME run: read what ``wanted`` will change
+        (through ``readback``), refuse a working channel or a PLC-commanded execution mode
+        without ``mode_bit``, delete the result file of an earlier run (``stale_file``) so
+        that it cannot pass for this one. Returns the values read."""
+        ch = f"ch{channel}"
+        state_names = [f"{ch}.mc_active_mode_r", f"{ch}.mc_active_state_r"]
+        before = await self.read_many([*state_names, *(readback[name] for name in wanted)])
+        mode, state = (before[n] for n in state_names)
+        if state in (_ACTIVE, _HOLD, _ERROR):  # before anything changes (the last log)
+            raise AdsError(
+                AdsReturnCode.DEVICE_NOTREADY,
+                f"channel {channel} is {MODES.get(mode, mode)}/{STATES.get(state, state)}: "
+                f"{what} needs a channel that is not working; hold and RESET first",
+            )
+        await self._refuse_plc_execution_mode(channel, mode_bit)
+        if stale_file is not None:
+            try:
+                await self.delete_program(stale_file)
+            except AdsError as exc:
+                if exc.code != AdsReturnCode.DEVICE_NOTFOUND:
+                    raise
+        return before
+
+    async def _write_remembered(
+        self, wanted: dict[str, Any], readback: dict[str, str], before: dict[str, Any],
+        changed: list[tuple[str, Any]],
+    ) -> None:
+        """Write ``wanted``, appending (object, value before) of each change to ``changed``
+        (in write order, for ``_end_check``)."""
+        for name, value in wanted.items():
+            old = before[readback[name]]
+            if old != value:
+                changed.append((name, old))
+                await self.write(name, value)
+
+    async def _refuse_plc_execution_mode(self, channel: int, mode_bit: int) -> None:
+        """Refuse a simulation the PLC would turn into a real run: while its control unit
         ``gpCh[i].decoder_mc_control.execution_mode`` is enabled, a program start takes
-        the PLC's ``command_w`` instead of ``mc_command_execution_mode_w``."""
+        the PLC's ``command_w`` (which must hold ``mode_bit``) instead of
+        ``mc_command_execution_mode_w``."""
         order = [o.name.lower() for o in await self.browse("ch*.mc_active_state_r")]
         index = order.index(f"ch{channel}.mc_active_state_r")  # gpCh[i]: layout position
         unit = f"gpCh[{index}].decoder_mc_control.execution_mode"
         values = await self.read_many([f"{unit}.enable_w", f"{unit}.command_w"])
         command = values[f"{unit}.command_w"]
-        if values[f"{unit}.enable_w"] and not command & SYNCHK:
+        if values[f"{unit}.enable_w"] and not command & mode_bit:
             raise AdsError(
                 AdsReturnCode.DEVICE_INVALIDSTATE,
                 f"channel {channel}: the PLC commands execution mode 0x{command & 0xFFFFFFFF:x} "
-                f"({unit}.enable_w is TRUE), so a start would run the program, not check it",
+                f"({unit}.enable_w is TRUE), so a start would run the program, not simulate it",
             )
 
     async def _check_result(

@@ -295,4 +295,4 @@ def main() -> None:
 
 
 # The machine-operating commands register themselves on ``app``.
-from . import cli_machine  # noqa: E402,F401
+from . import cli_machine, cli_plot  # noqa: E402,F401

@@ -47,6 +47,19 @@ def _finish_wait(exc: Exception) -> None:
     _fail(exc)
 
 
+def local_program(program: str) -> tuple[str, bytes | None]:
+    """``FILE|NAME`` of run/check/plot: (store name, bytes to upload) for a local file,
+    (name, None) for a stored program. An unreadable file exits 2 with its reason."""
+    local = Path(program)
+    if not local.is_file():
+        return program, None
+    try:
+        return local.name, local.read_bytes()
+    except OSError as exc:
+        err.print(f"error: cannot read {local}: {exc.strerror}", markup=False, emoji=False)
+        raise typer.Exit(EXIT_USAGE) from None
+
+
 @app.command()
 def upload(
     ctx: typer.Context,
@@ -109,12 +122,11 @@ def run(
 ) -> None:
     """Select a program in AUTOMATIC and START it (a local file is uploaded first)."""
     settings: Settings = ctx.obj
-    local = Path(program)
-    name = local.name if local.is_file() else program
+    name, data = local_program(program)
     try:
         with settings.client() as c:
-            if local.is_file():
-                c.upload(name, local.read_bytes())
+            if data is not None:
+                c.upload(name, data)
             c.run_program(name, channel)
             if not wait:
                 _emit(settings, {"channel": channel, "program": name, "started": True},
@@ -272,13 +284,7 @@ def check(
     """Syntax check (SYNCHK | MACHINE_LOCK): decode the program, report every error, move
     nothing. Exit 0 clean, 1 errors or aborted, 2 no result."""
     settings: Settings = ctx.obj
-    local = Path(program)
-    name = local.name if local.is_file() else program
-    try:
-        data = local.read_bytes() if local.is_file() else None
-    except OSError as exc:
-        err.print(f"error: cannot read {local}: {exc.strerror}", markup=False, emoji=False)
-        raise typer.Exit(EXIT_CHECK_TROUBLE) from None
+    name, data = local_program(program)
     try:
         with settings.client() as c:
             if data is not None:

@@ -46,6 +46,7 @@ from .channel_ops import (
     ChannelOps, ChannelStatus, CheckError, CheckResult, ProgramEntry, ProgramOps,
 )
 from .errors import AdsConnectionError, AdsError
+from .path_trace import PathTrace, TraceOps
 from .sync_transport import SyncTransport, drive
 from .transport import AsyncTransport
 
@@ -130,7 +131,7 @@ def filetime_to_datetime(filetime: int) -> datetime:
     return _FILETIME_EPOCH + timedelta(microseconds=filetime // 10)
 
 
-class AsyncClient(ProgramOps, ChannelOps):
+class AsyncClient(ProgramOps, ChannelOps, TraceOps):
     """Asyncio client of a cnc-objects service. Use with ``async with``."""
 
     def __init__(

@@ -77,7 +77,13 @@ class Series:
             raise ValueError(f"series {self.label!r}: width_px must be >= 1, not {self.width_px}")
 
 
-def line_chart(
+def line_chart(series: Sequence[Series], **kw: Any) -> bytes:
+    """Draw ``series`` as a line chart and return the PNG file's bytes (the arguments
+    of ``chart_image``)."""
+    return encode_png(chart_image(series, **kw))
+
+
+def chart_image(
     series: Sequence[Series],
     *,
     title: str,
@@ -88,8 +94,9 @@ def line_chart(
     x_range: tuple[float, float] | None = None,
     y_range: tuple[float, float] | None = None,
     equal_aspect: bool = False,
-) -> bytes:
-    """Draw ``series`` as a line chart and return the PNG file's bytes.
+) -> np.ndarray:
+    """Draw ``series`` as a line chart: an 8-bit RGB image, ``height_px`` x ``width_px``
+    x 3 (``encode_png`` makes a PNG of it; several stack with ``np.vstack``).
 
     The chart has a title, a framed plot area with grid lines at 1/2/5 x 10^k ticks,
     tick labels, axis labels and, right of the plot, a legend of the series labels.
@@ -127,7 +134,7 @@ def line_chart(
     _draw_frame_and_ticks(img, area, scale)
     _draw_titles(img, area, scale, title_scale, (title, x_label, y_label))
     _draw_legend(img, area, scale, legend, series)
-    return encode_png(img)
+    return img
 
 
 def write_line_chart(path: str | os.PathLike[str], series: Sequence[Series], **kw: Any) -> None:

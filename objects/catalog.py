@@ -416,6 +416,11 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "program store (project)",
     ),
     ObjectTemplate(
+        "prod_time_trace", Scope.CHANNEL, COM, COM_CH, 0x3110, BOOLEAN, RW, "-",
+        "TRUE: the next PROD_TIME run (machining time calculation) writes its path, one "
+        "row per cycle, to prodtime0<c>.csv in the program store; cnc plot uses it (project)",
+    ),
+    ObjectTemplate(
         "axis_parameter_update_w", Scope.PLATFORM, COM, COM_CH, 0x1100, STRING(4096), W, "-",
         "Write an ISG axis parameter list (kopf.achs_nr first): changes that axis's "
         "parameters from the next program start; clones keep theirs (project)",

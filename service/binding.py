@@ -34,6 +34,7 @@ from .kernel.commands import (
     SetExecutionModeEnable,
     SetExecutionModePlc,
     SetFeedOverride,
+    SetProdTimeTrace,
     SetSingleBlock,
     SetSuspendCommand,
     SetSuspendEnable,
@@ -276,6 +277,7 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "decoder_mc_control.execution_mode.enable_w": _channel("execution_mode_plc_enable"),
     "decoder_mc_control.execution_mode.request_r": _channel("execution_mode_command"),
     "decoder_mc_control.execution_mode.state_r": _channel("execution_mode_active"),
+    "prod_time_trace": _channel("prod_time_trace"),
     **{f"syn_chk.{name}": _syn_chk(name)
        for name in ("errors_total", "errors_per_block", "interactive", "record_result")},
     "StateDecoder_Data.X_SyntaxCheck": _decoder_flag(DecoderFlag.SYNTAX_CHECK),
@@ -377,6 +379,7 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
         lambda ci, value, name=name: SetSyntaxCheckParameter(ci, name, value))
        for name in ("errors_total", "errors_per_block", "interactive", "record_result")},
     "mc_command_single_block_w": _channel_command(SetSingleBlock),
+    "prod_time_trace": _channel_command(SetProdTimeTrace),
     "mc_command_mode_w": _channel_command(SelectMode),
     "mc_command_program_name_w": _channel_command(SelectProgram),
     "mc_command_start_w": _channel_command(StartProgram),

@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import queue
 import threading
+from collections.abc import Callable
 
 from .program_store import ProgramStore, StoreError
 
@@ -27,9 +28,11 @@ class StoreWriter:
         self._thread = threading.Thread(target=self._run, name="cnc-store-writer", daemon=True)
         self._thread.start()
 
-    def append(self, name: str, data: bytes, replace: bool = False) -> None:
+    def append(self, name: str, data: bytes | Callable[[], bytes], replace: bool = False) -> None:
         """Queue ``data`` for the end of ``name`` (``replace``: as its whole content);
-        any thread, never blocks."""
+        any thread, never blocks. ``data`` may be a function that makes the bytes: it is
+        called in the writer thread, so that a large file (a PROD_TIME trace) is
+        formatted off the cycle thread."""
         self._queue.put((name, data, replace))
 
     def flush(self) -> None:
@@ -49,11 +52,15 @@ class StoreWriter:
                     return
                 name, data, replace = item
                 try:
+                    if callable(data):
+                        data = data()
                     if replace:
                         self._store.write(name, data)
                     else:
                         self._store.append(name, data)
                 except StoreError as exc:
                     log.error("cannot write %s: %s", name, exc)
+                except Exception:  # a maker that failed must not end the writer thread
+                    log.exception("cannot make the content of %s", name)
             finally:
                 self._queue.task_done()

@@ -51,6 +51,7 @@ from .path.executor import AxisDynamics, PathError, PathExecutor
 from .path.interpolator import Waiting
 from .path.section_plan import plan_section
 from .path.segments import Segment
+from .prod_time_trace import ProdTimeTrace, trace_file_name
 from .state import MESSAGES_KEPT, Channel, ChannelError, DecoderFlag, ExecutionMode
 from .switchover import Switchover
 from .syntax_check import SYNCHK_WITHOUT_MACHINE_LOCK, CHECK_STOPPED_WARNING, CheckRun, Pause
@@ -129,6 +130,7 @@ class ChannelRunner:
         self._released: Pause = Pause.NONE  # START ended this pause (flag for one cycle)
         self._prod_time = False  # PROD_TIME: the run is simulated, no axis moves
         self._sim_steps = 0  # PROD_TIME: cycles simulated so far
+        self._trace: ProdTimeTrace | None = None  # PROD_TIME with ch<c>.prod_time_trace
         self.touched = False  # the last cycle changed the channel's state
         # #MSG texts from the decoder thread (deque appends are thread-safe)
         self._messages: deque[str] = deque(maxlen=MESSAGES_KEPT)
@@ -414,6 +416,10 @@ class ChannelRunner:
         )
         self._prod_time = not job.manual and bool(mode & ExecutionMode.PROD_TIME)
         self._sim_steps = 0
+        self._trace = None
+        if self._prod_time and ch.prod_time_trace:
+            self._trace = ProdTimeTrace(job.name, ch.channel_id, self._axes, self._cycle_s)
+            self._trace.record(0.0, position, 0.0, 0.0, 0.0, 0)
         # the machining time calculation runs through without stops
         self._executor.single_block = ch.single_block and not self._prod_time
         self._sync, self._backlog = None, []
@@ -598,6 +604,7 @@ class ChannelRunner:
         ch.state = ChannelState.ERROR
         ch.waiting_for_start = False
         ch.program_time_s = self._time_s - self._started_at_s
+        self._write_trace(f"ERROR {error.id}")
 
     def _feed_blocks(self) -> None:
         executor, feed = self._executor, self._feed
@@ -739,6 +746,11 @@ class ChannelRunner:
             ch.remaining_in_block_mm = step.remaining_in_block_mm
             ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
         ch.program_time_s = time_s - self._started_at_s
+        if self._trace is not None:
+            shown_line = step.current.source.line if step.current is not None else 0
+            self._trace.record(ch.program_time_s, step.position_mm, step.distance_mm,
+                               step.path_velocity_mm_s, step.programmed_velocity_mm_s,
+                               shown_line)
         for block in step.finished:
             ch.block_count += 1
             if self._contour is not None and block.contour is not None and (
@@ -851,7 +863,16 @@ class ChannelRunner:
         ch.waiting_for_start = False
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
         ch.program_time_s = self._time_s - self._started_at_s
+        self._write_trace("READY")
         return False
+
+    def _write_trace(self, ended: str) -> None:
+        """The end of a traced PROD_TIME run: its rows go to the program store."""
+        trace, self._trace = self._trace, None
+        if trace is not None:
+            # formatted by the store writer's thread, not in this cycle
+            self._files(trace_file_name(self.channel.channel_id),
+                        partial(trace.csv_bytes, ended), replace=True)
 
 
 def _path_error(exc: PathError, block: Block | None) -> ChannelError:

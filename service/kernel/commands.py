@@ -169,6 +169,18 @@ class SetSingleBlock:
 
 
 @dataclass(frozen=True, slots=True)
+class SetProdTimeTrace:
+    """``ch<c>.prod_time_trace``: the next PROD_TIME run records its path (for plots)."""
+
+    channel_index: int
+    value: bool
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        state.channels[self.channel_index].prod_time_trace = bool(self.value)
+        return None
+
+
+@dataclass(frozen=True, slots=True)
 class SelectMode:
     """Select the channel's operation mode (ChannelMode value)."""
 

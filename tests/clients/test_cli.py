@@ -6,17 +6,21 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 from tests.support.service import ROOT, RunningService
 
 
-def cnc(*args: str, endpoint: str | None = None, env: dict | None = None) -> subprocess.CompletedProcess:
-    """Run ``cnc`` as a user would (module entry point of the installed script)."""
+def cnc(
+    *args: str, endpoint: str | None = None, env: dict | None = None, cwd: Path | None = None
+) -> subprocess.CompletedProcess:
+    """Run ``cnc`` as a user would (module entry point of the installed script), in
+    ``cwd`` (default: the project root)."""
     argv = [sys.executable, "-c", "from clients.cli import main; main()"]
     if endpoint is not None:
         argv += ["--endpoint", endpoint]
     return subprocess.run(
-        [*argv, *args], cwd=ROOT, capture_output=True, text=True, timeout=60,
+        [*argv, *args], cwd=cwd or ROOT, capture_output=True, text=True, timeout=60,
         env={**os.environ, **(env or {})},
     )
 
