@@ -1,0 +1,143 @@
+"""docker/Dockerfile and docker/compose.yaml: what can be proven without a Docker engine.
+
+The compose file goes through ``docker compose config`` (or Debian's ``docker-compose``)
+wherever one is installed, and its structure is checked everywhere. The Dockerfile's
+entry point, command and health check run here as the image would run them.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import yaml
+
+from tests.support.service import ROOT, serving
+
+DOCKER = ROOT / "docker"
+
+
+def _instructions() -> list[tuple[str, str]]:
+    """(INSTRUCTION, arguments) of the Dockerfile, continuation lines joined."""
+    text = (DOCKER / "Dockerfile").read_text().replace("\\\n", " ")
+    out = []
+    for line in text.splitlines():
+        line = line.strip()
+        if line and not line.startswith("#"):
+            word, _, rest = line.partition(" ")
+            out.append((word.upper(), rest.strip()))
+    return out
+
+
+def _exec_form(args: str) -> list[str]:
+    return json.loads(args)
+
+
+def _compose_cli() -> list[str] | None:
+    docker = shutil.which("docker")
+    if docker and subprocess.run([docker, "compose", "version"], capture_output=True).returncode == 0:
+        return [docker, "compose"]
+    legacy = shutil.which("docker-compose")
+    return [legacy] if legacy else None
+
+
+def _compose() -> dict:
+    """The compose file as ``docker compose config`` resolves it where the tool exists,
+    else as YAML (anchors and merge keys resolved by the YAML loader)."""
+    cli = _compose_cli()
+    if cli is not None:
+        result = subprocess.run([*cli, "-f", str(DOCKER / "compose.yaml"), "config"],
+                                capture_output=True, text=True, timeout=60)
+        assert result.returncode == 0, result.stderr
+        return yaml.safe_load(result.stdout)
+    return yaml.safe_load((DOCKER / "compose.yaml").read_text())
+
+
+def test_dockerfile_slim_non_root_entry_point_and_health_check() -> None:
+    steps = _instructions()
+    kinds = [k for k, _ in steps]
+    base = dict(steps)["FROM"]
+    assert base.startswith("python:3.11") and base.endswith("-slim")
+    user = [a for k, a in steps if k == "USER"]
+    assert user and user[-1] not in ("root", "0")
+    assert kinds.index("USER") > kinds.index("RUN")  # installs as root, runs as the user
+    assert _exec_form(dict(steps)["ENTRYPOINT"]) == ["cnc-service"]
+    health = dict(steps)["HEALTHCHECK"]
+    assert _exec_form(health.split("CMD", 1)[1].strip())[:1] == ["cnc"]
+    assert health.rstrip().endswith('"info"]')
+
+
+def test_dockerfile_copies_every_package_the_project_installs() -> None:
+    copied = {a.split()[0] for k, a in _instructions() if k == "COPY"}
+    meta = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    packages = {p.rstrip("*") for p in meta["tool"]["setuptools"]["packages"]["find"]["include"]}
+    assert packages <= copied
+    for source in copied:
+        assert (ROOT / source).exists(), source
+    ignore = (DOCKER / "Dockerfile.dockerignore").read_text().splitlines()
+    for source in copied:  # the ignore file lets each of them into the build context
+        assert f"!{source}" in ignore or f"!{source}/**" in ignore, source
+
+
+def test_image_command_and_health_check_run(tmp_path: Path) -> None:
+    """The CMD's options start the service; the HEALTHCHECK's command finds it healthy
+    (with the image's CNC_ENDPOINT pointing at it) and unhealthy when it is gone."""
+    steps = _instructions()
+    cmd = _exec_form(dict(steps)["CMD"])
+    assert cmd[cmd.index("--endpoint") + 1] == "tcp://0.0.0.0:5555"
+    cmd[cmd.index("--endpoint") + 1] = "tcp://127.0.0.1:*"  # a free port for the test
+    cmd[cmd.index("--program-dir") + 1] = str(tmp_path)
+    health = _exec_form(dict(steps)["HEALTHCHECK"].split("CMD", 1)[1].strip())
+    check = [sys.executable, "-c", "from clients.cli import main; main()", *health[1:]]
+    with serving(*cmd) as service:
+        env = {**os.environ, "CNC_ENDPOINT": service.endpoint}
+        healthy = subprocess.run(check, env=env, capture_output=True, text=True, timeout=30)
+        assert healthy.returncode == 0, healthy.stderr
+        assert "ADS state RUN" in healthy.stdout
+    gone = subprocess.run(check, env=env, capture_output=True, text=True, timeout=30)
+    assert gone.returncode != 0
+
+
+def test_compose_runs_service_broker_and_bridge() -> None:
+    compose = _compose()
+    services = compose["services"]
+    assert set(services) == {"cnc", "mosquitto", "mqtt-bridge"}
+    cnc, bridge = services["cnc"], services["mqtt-bridge"]
+    assert Path(cnc["build"]["dockerfile"]).name == "Dockerfile"
+    assert any(str(p.get("target", p)).split(":")[-1] == "5555" if isinstance(p, str) else
+               p["target"] == 5555 for p in cnc["ports"])
+    assert services["mosquitto"]["image"].startswith("eclipse-mosquitto:")
+    assert bridge["image"] == cnc["image"]
+    assert bridge["entrypoint"] == ["cnc-mqtt"]
+    assert bridge["depends_on"]["cnc"]["condition"] == "service_healthy"
+    args = bridge["command"]
+    args = shlex.split(args) if isinstance(args, str) else args
+    assert args[args.index("--endpoint") + 1] == "tcp://cnc:5555"
+    assert args[args.index("--broker") + 1] == "mosquitto:1883"
+
+
+def test_compose_bridge_options_are_the_bridges() -> None:
+    """Every option the compose file gives the bridge is one ``cnc-mqtt`` knows."""
+    args = _compose()["services"]["mqtt-bridge"]["command"]
+    options = {a for a in args if a.startswith("--")}
+    help_text = subprocess.run(
+        [sys.executable, "-c", "from clients.mqtt.cli import main; main()", "--help"],
+        capture_output=True, text=True, timeout=30, env={**os.environ, "COLUMNS": "200"},
+    ).stdout
+    for option in options:
+        assert option in help_text, option
+
+
+def test_mosquitto_config_is_mounted_from_the_project() -> None:
+    volumes = _compose()["services"]["mosquitto"]["volumes"]
+    sources = [v["source"] if isinstance(v, dict) else v.split(":")[0] for v in volumes]
+    config = [s for s in sources if s.endswith("mosquitto.conf")]
+    assert config and (DOCKER / "mosquitto.conf").is_file()
+    text = (DOCKER / "mosquitto.conf").read_text()
+    assert "listener 1883" in text
