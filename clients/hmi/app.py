@@ -1,0 +1,279 @@
+"""``cnc-hmi [--endpoint URL] [--timeout S]``: the terminal HMI of a cnc-objects service.
+
+    .venv/bin/cnc-hmi --endpoint tcp://127.0.0.1:5555
+
+The app owns no machine state: tables are filled by subscriptions (``session``), keys
+write objects (``control``), the look-ahead panel re-requests (``lookahead``). Key
+bindings are in ``HmiApp.BINDINGS`` and in docs/hmi.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import os
+from collections.abc import Awaitable, Callable, Sequence
+from typing import Any
+
+from textual.app import App, ComposeResult
+from textual.binding import Binding
+from textual.containers import VerticalScroll
+from textual.widgets import DataTable, Footer, Header, Label
+
+from clients.client import DEFAULT_ENDPOINT, AsyncClient, DeviceInfo
+from clients.errors import AdsError
+
+from . import control, text
+from .axes import AxesTable
+from .channels import ChannelTable, ErrorsPanel
+from .lookahead import MIN_GAP_S, REFRESH_S, LookaheadMode, LookaheadPanel, fetch
+from .machine import ChannelView, Machine
+from .message_line import MessageLine
+from .program_picker import ProgramPicker
+from .session import Feed, run_sessions
+
+DEFAULT_TIMEOUT_S = 2.0  # an HMI should say "not reachable" quickly, not after 5 s
+Operation = Callable[[AsyncClient, ChannelView], Awaitable[str]]
+
+
+class HmiApp(App[None]):
+    """Channels, axes, program control, jog of path and contour look-ahead of one service."""
+
+    TITLE = "cnc-hmi"
+    # Inline, not a .tcss file: package data would need its own line in pyproject.
+    CSS = """
+    #body { height: 1fr; }
+    .title { height: 1; padding: 0 1; color: $text-muted; }
+    .stale { opacity: 60%; }
+    """
+    ENABLE_COMMAND_PALETTE = False  # every command is a key; the footer needs the room
+    BINDINGS = [
+        Binding("c", "next_channel", "Channel"),
+        Binding("p", "select_program", "Program"),
+        Binding("s", "start", "Start"),
+        Binding("h", "hold", "Hold"),
+        Binding("r", "reset", "Reset"),
+        Binding("b", "single_block", "Single"),
+        Binding("plus,equals_sign", "override(100)", "Ovr+", key_display="+"),
+        Binding("minus", "override(-100)", "Ovr-", key_display="-"),
+        Binding("j", "suspend", "Jog path"),
+        Binding("l", "lookahead", "Look-ahead"),
+        Binding("m", "lookahead_mode", "LA mode"),
+        Binding("q", "quit", "Quit"),
+    ]
+    _DIALOG_ACTIONS = {"quit"}  # what the keys may still do while the program dialog is open
+
+    def __init__(self, endpoint: str = DEFAULT_ENDPOINT, timeout_s: float = DEFAULT_TIMEOUT_S):
+        super().__init__()
+        self.endpoint = endpoint
+        self.timeout_s = timeout_s
+        self.client: AsyncClient | None = None  # None while the service does not answer
+        self.machine: Machine | None = None
+        self.lookahead_mode = LookaheadMode.AHEAD
+        self._lookahead_wake = asyncio.Event()
+        self.channels = ChannelTable(id="channels")
+        self.axes = AxesTable(id="axes")
+        self.errors = ErrorsPanel(id="errors")
+        self.lookahead = LookaheadPanel(id="lookahead")
+        self.message = MessageLine(id="message")
+
+    def compose(self) -> ComposeResult:
+        """Header, the panels, the message line, the key bindings."""
+        yield Header()
+        with VerticalScroll(id="body"):
+            yield Label("channels (cursor row = current channel)", classes="title")
+            yield self.channels
+            yield Label("axes", classes="title")
+            yield self.axes
+            yield self.errors
+            yield self.lookahead
+        yield self.message
+        yield Footer(compact=True)
+
+    def on_mount(self) -> None:
+        """Start the session with the service (it retries until the service answers)."""
+        self.sub_title = f"connecting to {self.endpoint}"
+        self.message.say(f"connecting to {self.endpoint} …")
+        self.channels.focus()
+        self.run_worker(run_sessions(self.endpoint, self.timeout_s, self), name="session",
+                        group="session", exclusive=True)
+
+    # ------------------------------------------------------------ session events
+
+    def session_started(
+        self, client: AsyncClient, machine: Machine, info: DeviceInfo
+    ) -> Sequence[Feed]:
+        """Show the discovered machine; the returned feeds fill it."""
+        self.client, self.machine = client, machine
+        row = self.channels.cursor_row  # a reconnect keeps the current channel
+        self.channels.load(machine)
+        self.channels.move_cursor(row=max(0, min(row, len(machine.channels) - 1)))
+        self.axes.load(machine)
+        for widget in (self.channels, self.axes):
+            widget.remove_class("stale")
+        self.sub_title = f"{info.name} {info.version} at {self.endpoint}"
+        self.message.say(f"connected to {self.endpoint}: {len(machine.channels)} channels")
+        current = self.current_channel
+        if current is not None:
+            self.errors.show_channel(current)
+        self._lookahead_wake.set()
+        blocks = [Feed(ch.obj("mc_block_count_r"), self._block_finished(ch))
+                  for ch in machine.channels]
+        return [*self.channels.feeds(machine), *self.axes.feeds(machine),
+                *self.errors.feeds(client, machine), *blocks]
+
+    def session_lost(self, reason: str) -> None:
+        """Say that the service does not answer; the shown values are stale."""
+        self.client = None
+        self.sub_title = f"not connected: {self.endpoint}"
+        for widget in (self.channels, self.axes):
+            widget.add_class("stale")
+        self.message.say(reason, error=True)
+
+    def feed_failed(self, feed: Feed, exc: AdsError) -> None:
+        """One object could not be subscribed: say which and why."""
+        self.message.say(f"cannot follow {feed.name}: {exc}", error=True)
+
+    def _block_finished(self, channel: ChannelView) -> Callable[[Any], None]:
+        def apply(_: Any) -> None:
+            if self.current_channel == channel:
+                self._lookahead_wake.set()  # a new block: ask for the contour again
+        return apply
+
+    # ------------------------------------------------------------ current channel
+
+    @property
+    def current_channel(self) -> ChannelView | None:
+        """The channel of the channel table's cursor row (the one the keys act on)."""
+        if self.machine is None or not self.machine.channels:
+            return None
+        return self.machine.channel(self.channels.cursor_row)
+
+    def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
+        """Another current channel: its errors and look-ahead."""
+        if event.data_table is self.channels and self.current_channel is not None:
+            self.errors.show_channel(self.current_channel)
+            self._lookahead_wake.set()
+
+    def action_next_channel(self) -> None:
+        """Make the next channel current."""
+        if self.channels.row_count:
+            self.channels.move_cursor(row=(self.channels.cursor_row + 1) % self.channels.row_count)
+
+    # ------------------------------------------------------------ commands
+
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """While the program dialog is open its keys are text, not commands."""
+        if isinstance(self.screen, ProgramPicker) and action not in self._DIALOG_ACTIONS:
+            return False
+        return True
+
+    def _command(self, what: str, operation: Operation) -> None:
+        client, channel = self.client, self.current_channel
+        if client is None or channel is None:
+            self.message.say(f"{what}: {text.unreachable(self.endpoint)}", error=True)
+            return
+        self.run_worker(self._report(what, operation(client, channel)), group="command")
+
+    async def _report(self, what: str, operation: Awaitable[str]) -> None:
+        try:
+            line = await operation
+        except AdsError as exc:  # refused or unanswered: a message, never a crash
+            self.message.say(text.refused(what, exc, self.endpoint), error=True)
+        else:
+            self.message.say(line)
+
+    def action_start(self) -> None:
+        """START (also resumes after HOLD)."""
+        self._command("START", control.start)
+
+    def action_hold(self) -> None:
+        """Feedhold."""
+        self._command("HOLD", control.hold)
+
+    def action_reset(self) -> None:
+        """RESET."""
+        self._command("RESET", control.reset)
+
+    def action_single_block(self) -> None:
+        """Toggle single block."""
+        self._command("single block", control.toggle_single_block)
+
+    def action_override(self, step_01pct: int) -> None:
+        """Feed override up or down by ``step_01pct`` (0.1 %)."""
+        self._command("feed override",
+                      lambda client, ch: control.step_override(client, ch, step_01pct))
+
+    def action_suspend(self) -> None:
+        """Toggle the jog-of-path suspension of the current channel's axis output."""
+        self._command("suspend axis output", control.toggle_suspend)
+
+    def action_select_program(self) -> None:
+        """Ask for a program (the store's list) and select it in the current channel."""
+
+        async def pick(client: AsyncClient, channel: ChannelView) -> str:
+            names = [p.name for p in await client.programs()]
+            name = await self.push_screen_wait(ProgramPicker(channel.id, names))
+            if not name:
+                return f"ch{channel.id}: no program selected"
+            return await control.select_program(client, channel, name)
+
+        self._command("select program", pick)
+
+    # ------------------------------------------------------------ look-ahead
+
+    def action_lookahead(self) -> None:
+        """Show or hide the contour look-ahead panel (requests run only while shown)."""
+        shown = not self.lookahead.display
+        self.lookahead.display = shown
+        if shown:
+            self.run_worker(self._follow_lookahead(), name="lookahead", group="lookahead",
+                            exclusive=True)
+        else:
+            self.workers.cancel_group(self, "lookahead")
+
+    def action_lookahead_mode(self) -> None:
+        """Switch between the elements ahead (mode 2) and the marked area (mode 1)."""
+        self.lookahead_mode = (LookaheadMode.MARKED_AREA
+                               if self.lookahead_mode is LookaheadMode.AHEAD
+                               else LookaheadMode.AHEAD)
+        self.message.say("contour look-ahead: " + (
+            "the marked area (mode 1)" if self.lookahead_mode is LookaheadMode.MARKED_AREA
+            else "the elements ahead (mode 2)"))
+        self._lookahead_wake.set()
+
+    async def _follow_lookahead(self) -> None:
+        while True:
+            self._lookahead_wake.clear()
+            client, channel = self.client, self.current_channel
+            if client is not None and channel is not None:
+                try:
+                    self.lookahead.show(await fetch(client, channel, self.lookahead_mode))
+                except AdsError as exc:  # e.g. 0x701: this channel has no FCT_CONTOUR_LAH
+                    self.lookahead.show_error(
+                        channel, text.refused("contour look-ahead request", exc, self.endpoint))
+            elif channel is not None:
+                self.lookahead.show_error(channel, text.unreachable(self.endpoint))
+            # Block ends wake the loop early, but a program of short blocks must not turn
+            # the request into a busy loop: MIN_GAP_S first, then wait for a reason.
+            await asyncio.sleep(MIN_GAP_S)
+            with contextlib.suppress(TimeoutError):
+                async with asyncio.timeout(REFRESH_S - MIN_GAP_S):
+                    await self._lookahead_wake.wait()
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Entry point of ``cnc-hmi``."""
+    parser = argparse.ArgumentParser(prog="cnc-hmi",
+                                     description="Terminal HMI of a cnc-objects service.")
+    parser.add_argument("--endpoint", default=os.environ.get("CNC_ENDPOINT", DEFAULT_ENDPOINT),
+                        help="service endpoint (default: $CNC_ENDPOINT, else %(default)s)")
+    parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S",
+                        help="seconds without a reply before the service counts as unreachable")
+    args = parser.parse_args(argv)
+    HmiApp(args.endpoint, args.timeout).run()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,127 @@
+"""The channel table (one row per channel) and the error list of the current channel."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from rich.text import Text
+from textual.widgets import DataTable, Static
+
+from clients.client import AsyncClient
+
+from . import text
+from .machine import ChannelView, Machine
+from .session import Feed
+
+# column key, header, width
+COLUMNS: tuple[tuple[str, str, int], ...] = (
+    ("channel", "ch", 3),
+    ("mode", "mode", 9),
+    ("state", "state", 10),
+    ("program", "program", 16),
+    ("block", "block", 20),
+    ("override", "override", 8),
+    ("single", "single", 6),
+    ("output", "output", 9),
+    ("errors", "errors", 6),
+)
+
+
+class ChannelTable(DataTable):
+    """Mode, state, program, block, override, single block, axis output and error count of
+    every channel. The cursor row is the current channel, the one the keys act on."""
+
+    DEFAULT_CSS = "ChannelTable { height: auto; max-height: 12; }"
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(cursor_type="row", zebra_stripes=False, **kwargs)
+        self._block: dict[str, dict[str, Any]] = {}  # parts of the block cell per channel
+
+    def on_mount(self) -> None:
+        """Columns are fixed: widths do not jump while values change."""
+        for key, label, width in COLUMNS:
+            self.add_column(label, key=key, width=width)
+
+    def load(self, machine: Machine) -> None:
+        """One row per channel of ``machine``, values to come from the feeds."""
+        self.clear()
+        for channel in machine.channels:
+            self.add_row(str(channel.id), *("…" for _ in COLUMNS[1:]), key=channel.key)
+            self._block[channel.key] = {"number": -1, "file": "", "line": 0}
+
+    def feeds(self, machine: Machine) -> list[Feed]:
+        """The subscriptions that fill the table."""
+        feeds: list[Feed] = []
+        for ch in machine.channels:
+            cell = self._setter(ch.key)
+            feeds += [
+                Feed(ch.obj("mc_active_mode_r"), cell("mode", text.mode)),
+                Feed(ch.obj("mc_active_state_r"), cell("state", text.state)),
+                Feed(ch.obj("mc_active_program_name_r"), cell("program", lambda v: v or "-")),
+                Feed(ch.obj("actual_block_number"), self._block_part(ch.key, "number")),
+                Feed(ch.obj("mc_active_file_name_r"), self._block_part(ch.key, "file")),
+                Feed(ch.obj("mc_active_line_r"), self._block_part(ch.key, "line")),
+                Feed(ch.obj("mc_active_feed_override_r"), cell("override", text.percent)),
+                Feed(ch.obj("mc_active_single_block_r"), cell("single", text.on_off)),
+                Feed(ch.suspend("state_r"),
+                     cell("output", lambda v: "suspended" if v else "active")),
+                Feed(ch.obj("mc_error_count_r"), cell("errors", str)),
+            ]
+        return feeds
+
+    def cell(self, channel: ChannelView | str, column: str) -> str:
+        """The text shown for ``channel`` in ``column``."""
+        key = channel if isinstance(channel, str) else channel.key
+        return str(self.get_cell(key, column))
+
+    def _setter(self, row: str) -> Callable[[str, Callable[[Any], str]], Callable[[Any], None]]:
+        def column(key: str, show: Callable[[Any], str]) -> Callable[[Any], None]:
+            # Text, not str: a str cell is parsed as markup, and names may hold brackets
+            return lambda value: self.update_cell(row, key, Text(show(value)))
+        return column
+
+    def _block_part(self, row: str, part: str) -> Callable[[Any], None]:
+        def apply(value: Any) -> None:
+            parts = self._block[row]
+            parts[part] = value
+            number = f"N{parts['number']}" if parts["number"] >= 0 else "-"
+            where = f" {parts['file']}:{parts['line']}" if parts["line"] else ""
+            self.update_cell(row, "block", Text(number + where))
+        return apply
+
+
+class ErrorsPanel(Static):
+    """The error list (``mc_error_<k>_*``, via ``channel_errors``) of the current channel,
+    re-read whenever a channel's ``mc_error_count_r`` changes."""
+
+    DEFAULT_CSS = "ErrorsPanel { height: auto; max-height: 10; border: round $error 50%; }"
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("", markup=False, **kwargs)  # error texts may hold brackets
+        self.errors: dict[str, list[str]] = {}  # per channel key: the lines shown
+        self._current = ""
+
+    def feeds(self, client: AsyncClient, machine: Machine) -> list[Feed]:
+        """One error-count subscription per channel; each change re-reads the list."""
+        self.errors = {ch.key: [] for ch in machine.channels}
+
+        def follow(channel: ChannelView) -> Callable[[int], Any]:
+            async def apply(count: int) -> None:
+                lines = await client.channel_errors(channel.id) if count else []
+                self.errors[channel.key] = lines
+                if channel.key == self._current:
+                    self._render_current()
+            return apply
+
+        return [Feed(ch.obj("mc_error_count_r"), follow(ch)) for ch in machine.channels]
+
+    def show_channel(self, channel: ChannelView) -> None:
+        """Show the errors of ``channel``."""
+        self._current = channel.key
+        self._render_current()
+
+    def _render_current(self) -> None:
+        lines = self.errors.get(self._current, [])
+        self.border_title = f"{self._current} errors"
+        self.update("\n".join(lines) if lines else "no errors")

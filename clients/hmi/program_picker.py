@@ -1,0 +1,57 @@
+"""The program selection dialog: type a name, or pick one of the program store."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from textual.binding import Binding
+from textual.containers import Vertical
+from textual.screen import ModalScreen
+from textual.widgets import Input, Label, OptionList
+
+
+class ProgramPicker(ModalScreen[str | None]):
+    """Returns the chosen program name, or None when cancelled (escape)."""
+
+    BINDINGS = [Binding("escape", "cancel", "Cancel")]
+    DEFAULT_CSS = """
+    ProgramPicker { align: center middle; }
+    ProgramPicker > Vertical {
+        width: 60; height: auto; max-height: 24; border: round $accent; background: $surface;
+    }
+    ProgramPicker OptionList { height: auto; max-height: 16; }
+    """
+
+    def __init__(self, channel_id: int, programs: list[str]) -> None:
+        super().__init__()
+        self.channel_id = channel_id
+        self.programs = programs
+
+    def compose(self) -> Any:
+        """A prompt, the name input and the store's programs (filtered by the input)."""
+        with Vertical():
+            yield Label(f"Program for channel {self.channel_id} (enter selects, esc cancels)")
+            yield Input(placeholder="program name", id="program-name")
+            yield OptionList(*self.programs, id="program-list")
+
+    def on_input_changed(self, event: Input.Changed) -> None:
+        """Narrow the list to the names that contain what was typed."""
+        options = self.query_one(OptionList)
+        options.clear_options()
+        options.add_options([p for p in self.programs if event.value.lower() in p.lower()])
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        """Enter in the input: that name (or the only one the filter left)."""
+        name = event.value.strip()
+        matches = [p for p in self.programs if name.lower() in p.lower()]
+        if name not in self.programs and len(matches) == 1:
+            name = matches[0]
+        self.dismiss(name or None)
+
+    def on_option_list_option_selected(self, event: OptionList.OptionSelected) -> None:
+        """Enter on a listed program."""
+        self.dismiss(str(event.option.prompt))
+
+    def action_cancel(self) -> None:
+        """Leave without selecting."""
+        self.dismiss(None)

@@ -1,0 +1,60 @@
+"""How values are shown: units converted at the boundary, names for the enumerations."""
+
+from __future__ import annotations
+
+from clients.channel_ops import CONTOUR_BLOCK_TYPES, MODES, STATES
+from clients.errors import AdsConnectionError, AdsError, AdsTimeoutError
+
+UM01_PER_MM = 10_000  # positions and distances travel in 0.1 um
+PERMILLE_PER_PERCENT = 10  # override travels in 0.1 %
+# ch<c>.ax<a>.link_state; 1 is also what a suspended channel's axes read
+LINK_STATES = {0: "linked", 1: "requested", 2: "waiting ack"}
+
+
+def mm(value_01um: float) -> str:
+    """A position or length in 0.1 um as mm with 4 decimals (0.1 um resolution)."""
+    return f"{value_01um / UM01_PER_MM:.4f}"
+
+
+def percent(value_01pct: int) -> str:
+    """An override in 0.1 % as percent."""
+    return f"{value_01pct / PERMILLE_PER_PERCENT:.1f} %"
+
+
+def mode(value: int) -> str:
+    """Operation mode name (``mc_active_mode_r``)."""
+    return MODES.get(value, str(value))
+
+
+def state(value: int) -> str:
+    """Channel state name (``mc_active_state_r``)."""
+    return STATES.get(value, str(value))
+
+
+def link(state_value: int, drive: int) -> str:
+    """Link state of a channel axis, with the drive it holds (``actual_link``)."""
+    name = f"{state_value} {LINK_STATES.get(state_value, '?')}"
+    return f"{name} → ax{drive}" if drive else name
+
+
+def block_type(value: int) -> str:
+    """Contour look-ahead element type (``block_type``)."""
+    return CONTOUR_BLOCK_TYPES.get(value, str(value))
+
+
+def on_off(value: bool) -> str:
+    """A BOOLEAN as on/off."""
+    return "on" if value else "off"
+
+
+def unreachable(endpoint: str) -> str:
+    """The line shown while the service does not answer."""
+    return f"service at {endpoint} not reachable — retrying"
+
+
+def refused(what: str, exc: AdsError, endpoint: str) -> str:
+    """The line shown when a command failed: the ADS code in hex and the service's text;
+    a missing reply says that the service is not reachable instead."""
+    if isinstance(exc, (AdsTimeoutError, AdsConnectionError)):
+        return f"{what}: no reply — {unreachable(endpoint)} ({exc})"
+    return f"{what} refused: {exc}"  # "ADS 0x707 NOTREADY: channel 1 is ..."

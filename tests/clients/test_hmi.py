@@ -1,0 +1,266 @@
+"""``cnc-hmi`` driven by textual's headless Pilot against a real service (virtual clock).
+
+Every assertion waits for a condition (``wait_until``), never for a fixed time: values
+reach the widgets by subscription, commands by the keys a user presses.
+"""
+
+from __future__ import annotations
+
+import socket
+import time
+from collections.abc import Callable
+
+import pytest
+from textual.pilot import Pilot
+
+from clients.client import AsyncClient
+from clients.hmi import text
+from clients.hmi.app import HmiApp
+from clients.hmi.program_picker import ProgramPicker
+from tests.support.service import RunningService, start_service
+
+SIZE = (110, 48)  # the HMI's tables want about 110 columns
+WAIT_S = 15.0  # generous: the machine running the tests may be busy
+# 20 blocks of 1 mm at 6 mm/min: 200 s of kernel time, seconds of wall time even with the
+# virtual clock, so the keys act while it runs. The marked area is for look-ahead mode 1.
+LONG_PROGRAM = "\n".join(
+    ["N5 G90 G17", "N8 #CONTOUR LOOKAHEAD LOG ON [PARAM=7]"]
+    + [f"N{10 * k} G1 X{k} Y{k % 2} F6" for k in range(1, 21)]
+    + ["N300 #CONTOUR LOOKAHEAD LOG OFF", "N310 M30", ""]
+).encode()
+
+
+@pytest.fixture
+def free_endpoint() -> str:
+    """An endpoint where nothing listens (a port the OS just handed out and took back)."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    return f"tcp://127.0.0.1:{port}"
+
+
+async def wait_until(
+    pilot: Pilot, predicate: Callable[[], bool], timeout_s: float = WAIT_S, what: str = ""
+) -> None:
+    """Let the app run until ``predicate()`` holds; fail after ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"not within {timeout_s:g} s: {what or predicate}")
+        await pilot.pause()
+
+
+def filled(app: HmiApp) -> bool:
+    """Connected, and every cell of both tables has a value from the service."""
+    if app.client is None or app.machine is None or not app.axes.row_count:
+        return False
+    cells = [str(c) for t in (app.channels, app.axes) for row in range(t.row_count)
+             for c in t.get_row_at(row)]
+    return "…" not in cells
+
+
+async def started(pilot: Pilot) -> HmiApp:
+    app = pilot.app
+    assert isinstance(app, HmiApp)
+    await wait_until(pilot, lambda: filled(app), what="tables filled from the service")
+    return app
+
+
+async def test_shows_channels_and_axes_from_the_service(endpoint: str) -> None:
+    async with HmiApp(endpoint).run_test(size=SIZE) as pilot, AsyncClient(endpoint) as c:
+        app = await started(pilot)
+        assert [ch.key for ch in app.machine.channels] == ["ch1", "ch2"]
+        assert [a.name for a in app.machine.channels[1].axes] == ["X", "Y", "Z"]
+        for ch in app.machine.channels:
+            v = await c.read_many([ch.obj("mc_active_mode_r"), ch.obj("mc_active_state_r"),
+                                   ch.obj("mc_active_feed_override_r"), ch.suspend("state_r")])
+            assert app.channels.cell(ch, "mode") == text.mode(v[ch.obj("mc_active_mode_r")])
+            assert app.channels.cell(ch, "state") == text.state(v[ch.obj("mc_active_state_r")])
+            assert app.channels.cell(ch, "override") == text.percent(
+                v[ch.obj("mc_active_feed_override_r")])
+            assert app.channels.cell(ch, "output") == (
+                "suspended" if v[ch.suspend("state_r")] else "active")
+        # The default machine: channel 1 holds the drives, channel 2 (jog of path) waits.
+        assert app.axes.cell("ch1.ax1", "axis") == "ch1.X"
+        assert app.axes.cell("ch1.ax1", "link") == "0 linked → ax1"
+        assert app.axes.cell("ch2.ax3", "link") == "1 requested"
+        actual = await c.read("ax2.actual_position_acs")
+        assert app.axes.cell("ch1.ax2", "actual") == app.axes.cell("ch2.ax2", "actual") == text.mm(
+            actual)
+        # The key bindings are in the footer.
+        shown = {(k.key_display or k.key) for k in app.query("FooterKey")}
+        assert {"c", "p", "s", "h", "r", "b", "+", "-", "j", "l", "m", "q"} <= shown
+
+
+async def test_program_keys_select_start_hold_resume_reset(service: RunningService) -> None:
+    ep = service.endpoint
+    async with AsyncClient(ep) as c, HmiApp(ep).run_test(size=SIZE) as pilot:
+        await c.upload("long.nc", LONG_PROGRAM)
+        app = await started(pilot)
+        state = "ch1.mc_active_state_r"
+
+        await pilot.press("p")  # the dialog lists the store; typing narrows it, enter selects
+        await wait_until(pilot, lambda: isinstance(app.screen, ProgramPicker), what="dialog")
+        await pilot.press("l", "o", "n", "g", "enter")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "program") == "long.nc")
+        assert app.message.text == "ch1: selected long.nc" and not app.message.is_error
+        assert await c.read("ch1.mc_active_program_name_r") == "long.nc"
+
+        await pilot.press("s")
+        await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "command") != "0.0000",
+                         what="X moves")
+        await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "actual") != "0.0000")
+        assert app.channels.cell("ch1", "state") in ("ACTIVE", "HOLD")  # not ended: 200 s
+        assert app.channels.cell("ch1", "block").startswith("N")
+
+        await pilot.press("h")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "HOLD")
+        assert text.state(await c.read(state)) == "HOLD"
+        await pilot.press("s")  # resume
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "ACTIVE")
+        await pilot.press("r")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") not in ("ACTIVE", "HOLD"))
+        assert app.channels.cell("ch1", "state") == text.state(await c.read(state))
+        assert app.message.text == "ch1: RESET"
+
+
+async def test_override_and_single_block_keys(service: RunningService) -> None:
+    ep = service.endpoint
+    async with AsyncClient(ep) as c, HmiApp(ep).run_test(size=SIZE) as pilot:
+        app = await started(pilot)
+        override = "ch1.mc_active_feed_override_r"
+        assert await c.read(override) == 1000
+        await pilot.press("minus", "minus")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "override") == "80.0 %")
+        assert await c.read(override) == 800
+        await pilot.press("plus")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "override") == "90.0 %")
+        assert await c.read(override) == 900
+        await pilot.press("plus", "plus")  # held at 100 %
+        await wait_until(pilot, lambda: app.message.text == "ch1: feed override 100.0 %")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "override") == "100.0 %")
+
+        await pilot.press("b")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "single") == "on")
+        assert await c.read("ch1.mc_active_single_block_r") is True
+        await pilot.press("b")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "single") == "off")
+        assert await c.read("ch1.mc_active_single_block_r") is False
+
+
+async def test_jog_of_path_key_hands_the_axes_over(service: RunningService) -> None:
+    ep = service.endpoint
+    suspended = "gpCh[{}].bahn_mc_control.suspend_axis_output.state_r"
+    async with AsyncClient(ep) as c, HmiApp(ep).run_test(size=SIZE) as pilot:
+        app = await started(pilot)
+        await pilot.press("j")  # channel 1 gives its drives up
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "output") == "suspended")
+        assert await c.read(suspended.format(0)) is True
+        assert app.message.text == "ch1: axis output suspended (jog of path)"
+        await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "link") == "1 requested")
+
+        await pilot.press("c", "j")  # channel 2 takes them
+        await wait_until(pilot, lambda: app.channels.cell("ch2", "output") == "active")
+        assert await c.read(suspended.format(1)) is False
+        await wait_until(pilot, lambda: app.axes.cell("ch2.ax1", "link") == "0 linked → ax1")
+        assert await c.read("ch2.ax1.link_state") == 0
+
+        await pilot.press("j", "c", "j")  # and back to channel 1
+        await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "link") == "0 linked → ax1")
+        assert app.channels.cell("ch2", "output") == "suspended"
+
+
+async def test_lookahead_shows_the_elements_of_a_held_program(service: RunningService) -> None:
+    ep = service.endpoint
+    async with AsyncClient(ep) as c, HmiApp(ep).run_test(size=SIZE) as pilot:
+        await c.upload("long.nc", LONG_PROGRAM)
+        app = await started(pilot)
+        await c.run_program("long.nc")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "ACTIVE")
+        await pilot.press("h", "l")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "HOLD")
+        table = app.lookahead.table
+
+        def numbers() -> list[str]:
+            return [str(table.get_row_at(k)[1]) for k in range(table.row_count)]
+
+        # Mode 2: the elements ahead of the held tool, blocks of the program.
+        await wait_until(pilot, lambda: table.row_count > 3, what="elements ahead")
+        assert set(numbers()) <= {str(10 * k) for k in range(1, 21)}
+        assert "200" in numbers()  # the last block is prepared long before it runs
+        assert "mode 2" in app.lookahead.border_title
+
+        await pilot.press("m")  # mode 1: the marked area from its LOG ON entry
+        await wait_until(pilot, lambda: "mode 1" in app.lookahead.border_title
+                         and table.row_count > 0)
+        assert str(table.get_row_at(0)[0]) == "LOG ON" and str(table.get_row_at(0)[4]) == "7"
+        assert numbers()[1:3] == ["10", "20"]
+
+        await pilot.press("c")  # channel 2 has no FCT_CONTOUR_LAH: the panel says why
+        await wait_until(pilot, lambda: "0x701" in str(app.lookahead.summary.render()))
+        await pilot.press("l")
+        assert not app.lookahead.display
+
+
+async def test_refused_command_shows_the_ads_code(service: RunningService) -> None:
+    async with HmiApp(service.endpoint).run_test(size=SIZE) as pilot:
+        app = await started(pilot)
+        await pilot.press("s")  # nothing selected: the channel refuses START
+        await wait_until(pilot, lambda: app.message.is_error)
+        assert app.message.text.startswith("START refused: ADS 0x707 NOTREADY: channel 1 is ")
+        await pilot.press("p")
+        await wait_until(pilot, lambda: isinstance(app.screen, ProgramPicker))
+        await pilot.press("n", "o", "p", "e", "enter")
+        await wait_until(pilot, lambda: "0x70c" in app.message.text)
+        assert app.message.text.startswith("select program refused: ADS 0x70c NOTFOUND")
+        assert app.is_running
+
+
+async def test_channel_errors_are_listed(service: RunningService) -> None:
+    ep = service.endpoint
+    async with AsyncClient(ep) as c, HmiApp(ep).run_test(size=SIZE) as pilot:
+        await c.upload("bad.nc", b"G1 X1 F600\nG1 Y2 Q7\nM30\n")
+        app = await started(pilot)
+        await c.run_program("bad.nc")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "ERROR")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "errors") == "1")
+        await wait_until(pilot, lambda: "Q7" in str(app.errors.render()))
+        assert app.errors.errors["ch1"] == await c.channel_errors(1)
+        assert app.errors.errors["ch1"][0].startswith("error 21220: bad.nc:2:7: ")
+        await pilot.press("j")  # no suspension in ERROR: the service refuses, the HMI says so
+        await wait_until(pilot, lambda: app.message.is_error)
+        assert app.message.text.startswith("suspend axis output refused: ADS 0x707 NOTREADY")
+        await pilot.press("r")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "errors") == "0")
+        await wait_until(pilot, lambda: str(app.errors.render()) == "no errors")
+
+
+async def test_unreachable_service_shows_a_clear_message(free_endpoint: str) -> None:
+    async with HmiApp(free_endpoint, timeout_s=0.3).run_test(size=SIZE) as pilot:
+        app = pilot.app
+        line = f"service at {free_endpoint} not reachable — retrying"
+        await wait_until(pilot, lambda: app.message.text == line)
+        assert app.message.is_error and app.client is None
+        await pilot.press("s")  # a key without a service: a message, no crash
+        await wait_until(pilot, lambda: app.message.text == f"START: {line}")
+        assert app.is_running
+
+
+async def test_reconnects_when_the_service_comes_back(free_endpoint: str) -> None:
+    first = start_service("--endpoint", free_endpoint)
+    try:
+        async with HmiApp(free_endpoint, timeout_s=0.3).run_test(size=SIZE) as pilot:
+            app = await started(pilot)
+            assert first.stop() == 0
+            await wait_until(pilot, lambda: "not reachable" in app.message.text)
+            assert "stale" in app.channels.classes
+            second = start_service("--endpoint", free_endpoint)
+            try:
+                await wait_until(pilot, lambda: app.message.text.startswith("connected"))
+                await wait_until(pilot, lambda: filled(app))
+                await pilot.press("minus")  # the new session's subscriptions work
+                await wait_until(pilot, lambda: app.channels.cell("ch1", "override") == "90.0 %")
+            finally:
+                assert second.stop() == 0
+    finally:
+        first.stop()
