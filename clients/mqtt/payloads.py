@@ -1,0 +1,176 @@
+"""The bridge's JSON payloads: encode values and replies, decode and check write requests.
+
+Pure functions, no I/O. A value message is
+
+    {"value": 750, "unit": "0.1 %", "ts": "2026-11-21T10:00:00.123456Z", "seq": 17}
+
+a write request ``{"value": 750, "id": "abc"}`` and its reply ``{"ok": true}`` or
+``{"ok": false, "code": "0x704", "error": "ADS 0x704 INVALIDACCESS: ..."}``. Everything
+wrong with a request becomes a ``RequestError`` carrying an ADS code, so that the bridge
+answers it like any refused write and never stops on it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from typing import Any
+
+from protocol.datatypes import DataType
+from protocol.errors import AdsReturnCode, describe_code
+
+from .topics import MAX_ID_CHARS, check_level
+
+#: A request that is not a JSON object with a "value" (ADS: invalid parameter).
+MALFORMED = AdsReturnCode.DEVICE_INVALIDPARM
+#: A value of the wrong JSON type or out of the object's range (as the client says it).
+BAD_VALUE = AdsReturnCode.DEVICE_INVALIDDATA
+#: Not writable through this bridge (not in --writable), or a retained request.
+REFUSED = AdsReturnCode.DEVICE_INVALIDACCESS
+
+_NO_UNIT = "-"  # what ObjectInfo.unit says for a unitless object
+
+
+class RequestError(Exception):
+    """A write request refused before it reached the service. ``request_id`` is the
+    request's id when it could be read (the reply goes there), else None."""
+
+    def __init__(self, code: int, message: str, request_id: str | None = None) -> None:
+        super().__init__(f"ADS {describe_code(code)}: {message}")
+        self.code = int(code)
+        self.request_id = request_id
+
+
+@dataclass(frozen=True, slots=True)
+class SetRequest:
+    """A decoded write request: the JSON value as sent, and its id (None: no id)."""
+
+    value: Any
+    request_id: str | None
+
+
+# ------------------------------------------------------------------ values out
+
+
+def iso_utc(timestamp: datetime) -> str:
+    """ISO 8601 in UTC with microseconds and a ``Z``: ``2026-11-21T10:00:00.123456Z``."""
+    return timestamp.astimezone(UTC).strftime("%Y-%m-%dT%H:%M:%S.%fZ")
+
+
+def json_value(value: Any) -> Any:
+    """``value`` as JSON can carry it: non-finite reals (which JSON lacks) become null."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def encode_value(value: Any, unit: str, timestamp: datetime, seq: int) -> bytes:
+    """The value message of one sample; ``unit`` as the service describes it ("-": null)."""
+    message = {
+        "value": json_value(value),
+        "unit": None if unit in ("", _NO_UNIT) else unit,
+        "ts": iso_utc(timestamp),
+        "seq": seq,
+    }
+    return json.dumps(message, ensure_ascii=False, allow_nan=False).encode()
+
+
+def encode_ok(topic: str | None = None) -> bytes:
+    """The reply to a write the service applied; ``topic`` (the request's) for replies
+    without id."""
+    if topic is None:
+        return b'{"ok": true}'
+    return json.dumps({"ok": True, "topic": topic}, ensure_ascii=False).encode()
+
+
+def format_code(code: int) -> str:
+    """An ADS code as the replies carry it: ``0x704``."""
+    return f"0x{code:x}"
+
+
+def encode_error(code: int, error: str, topic: str | None = None) -> bytes:
+    """The reply to a refused write; ``topic`` (the request's) for replies without id."""
+    message: dict[str, Any] = {"ok": False, "code": format_code(code), "error": error}
+    if topic is not None:
+        message["topic"] = topic
+    return json.dumps(message, ensure_ascii=False).encode()
+
+
+# ------------------------------------------------------------------ requests in
+
+
+def _request_id(document: dict[str, Any]) -> str | None:
+    if "id" not in document:
+        return None
+    request_id = document["id"]
+    if not isinstance(request_id, str) or len(request_id) > MAX_ID_CHARS:
+        raise RequestError(MALFORMED, f'"id" must be a string of 1..{MAX_ID_CHARS} characters')
+    try:
+        return check_level(request_id, '"id"')
+    except ValueError as exc:
+        raise RequestError(MALFORMED, f"{exc}: it must fit one topic level") from None
+
+
+def decode_set(payload: bytes) -> SetRequest:
+    """Decode a write request; ``RequestError`` (with the id once known) when malformed.
+    Keys other than "value" and "id" are ignored."""
+    try:
+        document = json.loads(payload.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise RequestError(MALFORMED, f"the request is not JSON: {exc}") from None
+    if not isinstance(document, dict):
+        raise RequestError(MALFORMED, 'the request must be a JSON object {"value": ..., "id": ...}')
+    request_id = _request_id(document)
+    if "value" not in document:
+        raise RequestError(MALFORMED, 'the request has no "value"', request_id)
+    return SetRequest(document["value"], request_id)
+
+
+def _integral(value: Any) -> int | None:
+    """``value`` as an int when it is a JSON integer (750 or 750.0), else None."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, int):
+        return value
+    if isinstance(value, float) and value.is_integer():
+        return int(value)
+    return None
+
+
+def _show(value: Any) -> str:
+    """A request's value for an error message, cut short: requests come from anyone."""
+    text = json.dumps(value, ensure_ascii=False)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def coerce(dtype: DataType, value: Any, what: str) -> Any:
+    """The JSON ``value`` as the Python value of ``dtype``: a bool (or 0/1) for BOOLEAN,
+    an integer for the integer types, a number for REAL, a string for STRING. Range and
+    string length are checked as the client would; ``RequestError`` (0x706) otherwise."""
+    match dtype.kind:
+        case "bool":
+            number = _integral(value)
+            converted = value if isinstance(value, bool) else (
+                bool(number) if number in (0, 1) else None
+            )
+        case "int":
+            converted = _integral(value)
+        case "float":
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+            converted = float(value) if ok else None
+        case _:
+            converted = value if isinstance(value, str) else None
+    if converted is None:
+        expected = {"bool": "true/false", "int": "an integer", "float": "a number"}
+        raise RequestError(
+            BAD_VALUE,
+            f"{what} ({dtype.name}) takes {expected.get(dtype.kind, 'a string')}, "
+            f"not {_show(value)}",
+        )
+    try:
+        dtype.encode(converted)  # range, string length and encoding, as the client checks
+    except (TypeError, ValueError) as exc:
+        raise RequestError(BAD_VALUE, f"{what}: {exc}") from None
+    return converted
