@@ -33,7 +33,10 @@ log = logging.getLogger(__name__)
 
 _NOBLOCK = int(zmq.NOBLOCK)
 SAMPLE_BUFFER = 1000  # samples kept per subscription; a full buffer drops the oldest
-_EARLY_HANDLES = 64  # samples of handles not yet claimed (they can overtake the reply)
+# Samples of handles not yet claimed: they can overtake the reply that names the handle,
+# for as many subscriptions as are opened at once. The oldest unclaimed handle (most
+# likely a deleted subscription's last samples) makes room for a new one.
+EARLY_HANDLES = 4096
 
 
 def _new_socket(context: zmq.Context, endpoint: str) -> zmq.Socket:
@@ -82,8 +85,8 @@ class _Transport:
             if buffer is None:
                 buffer = self._early.get(sample.handle)
                 if buffer is None:
-                    if len(self._early) >= _EARLY_HANDLES:
-                        continue  # a deleted subscription's last samples: drop
+                    if len(self._early) >= EARLY_HANDLES:
+                        del self._early[next(iter(self._early))]  # the oldest (dicts keep order)
                     buffer = self._early[sample.handle] = deque(maxlen=SAMPLE_BUFFER)
             buffer.append(sample)
 

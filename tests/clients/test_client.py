@@ -16,7 +16,10 @@ from typing import Any
 import pytest
 
 from clients import AdsError, AdsTimeoutError, AsyncClient, Client
+from clients.transport import EARLY_HANDLES, _Transport
 from protocol.constants import AdsState
+from protocol.frames import Notification
+from protocol.frames import Sample as FrameSample
 from tests.support.service import RunningService
 
 GEO, COM = 551, 553
@@ -238,6 +241,43 @@ async def test_subscribe_cyclic_samples_on_the_kernel_time_grid(service: Running
     assert all(t % 10 == 0 for t in ticks[1:])  # later samples fall on 10-cycle marks
     # Timestamps are kernel time: 10 cycles of 1 ms apart once on the grid.
     assert got[3].timestamp - got[2].timestamp == dt.timedelta(milliseconds=10 * (ticks[3] - ticks[2]) // 10)
+
+
+async def test_many_subscriptions_opened_at_once_all_get_their_first_sample(
+    service: RunningService,
+) -> None:
+    """Opened together, the first samples of many subscriptions overtake the replies that
+    name their handles; every one must still reach its subscriber (an MQTT bridge opens
+    a hundred and more at start)."""
+    async with AsyncClient(service.endpoint) as c:
+        names = [o.name for o in await c.browse("*")
+                 if "r" in o.access.lower() and not o.type.startswith("STRING")][:300]
+        assert len(names) == 300
+
+        async def first(name: str) -> object:
+            samples = c.subscribe(name)
+            async with contextlib.aclosing(samples):
+                return (await anext(samples)).name
+
+        got = await asyncio.wait_for(asyncio.gather(*(first(n) for n in names)), 30)
+    assert list(got) == names
+
+
+def test_early_samples_of_many_handles_wait_for_their_subscriber() -> None:
+    """Samples routed before their handle is claimed (the reply not yet processed) are
+    kept for hundreds of handles, not only the first 64; the oldest unclaimed ones (of
+    subscriptions deleted meanwhile) make room."""
+    transport = _Transport("tcp://127.0.0.1:9", 1.0)
+    handles = range(1, 501)
+    transport._route(Notification(0, tuple(FrameSample(h, 1, 0, b"x") for h in handles)))
+    for h in handles:
+        transport.open_samples(h)
+        assert [s.handle for s in transport._samples[h]] == [h]
+    stale = range(10_000, 10_000 + 2 * EARLY_HANDLES)
+    transport._route(Notification(0, tuple(FrameSample(h, 1, 0, b"x") for h in stale)))
+    assert len(transport._early) == EARLY_HANDLES  # bounded
+    transport.open_samples(stale[-1])  # the newest early handle is still there
+    assert len(transport._samples[stale[-1]]) == 1
 
 
 def test_blocking_subscribe_deletes_its_notification_on_close(service: RunningService) -> None:
