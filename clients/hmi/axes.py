@@ -6,9 +6,9 @@ from collections.abc import Callable
 from typing import Any
 
 from rich.text import Text
-from textual.widgets import DataTable
 
 from . import text
+from .fixed_table import FixedColumnsTable
 from .machine import AxisView, Machine
 from .session import Feed
 
@@ -23,30 +23,25 @@ COLUMNS: tuple[tuple[str, str, int], ...] = (
 POSITION_CYCLE_MS = 20  # positions are checked for a change every 20 ms (50 Hz) of kernel time
 
 
-class AxesTable(DataTable):
+class AxesTable(FixedColumnsTable):
     """Command position (``ch<c>.ax<a>.command_position_acs``), actual position of its drive
     (``ax<A>.actual_position_acs``), position offset (``position_offset``) and link state
     (``link_state`` with ``actual_link_to_physical_axis``) of each channel axis."""
 
     DEFAULT_CSS = "AxesTable { height: auto; max-height: 16; }"
+    COLUMNS = COLUMNS
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(cursor_type="none", **kwargs)
         self.can_focus = False  # the keys belong to the channel table and the app
         self._link: dict[str, list[int]] = {}  # per row: [link_state, actual drive]
 
-    def on_mount(self) -> None:
-        """Columns are fixed: widths do not jump while values change."""
-        for key, label, width in COLUMNS:
-            self.add_column(label, key=key, width=width)
-
     def load(self, machine: Machine) -> None:
         """One row per channel axis of ``machine``, values to come from the feeds."""
         self.clear()
         for channel in machine.channels:
             for axis in channel.axes:
-                self.add_row(f"ch{axis.channel}.{axis.name}", *("…" for _ in COLUMNS[1:]),
-                             key=axis.key)
+                self.add_waiting_row(f"ch{axis.channel}.{axis.name}", axis.key)
                 self._link[axis.key] = [0, 0]
 
     def feeds(self, machine: Machine) -> list[Feed]:

@@ -6,11 +6,12 @@ from collections.abc import Callable
 from typing import Any
 
 from rich.text import Text
-from textual.widgets import DataTable, Static
+from textual.widgets import Static
 
 from clients.client import AsyncClient
 
 from . import text
+from .fixed_table import FixedColumnsTable
 from .machine import ChannelView, Machine
 from .session import Feed
 
@@ -28,26 +29,22 @@ COLUMNS: tuple[tuple[str, str, int], ...] = (
 )
 
 
-class ChannelTable(DataTable):
+class ChannelTable(FixedColumnsTable):
     """Mode, state, program, block, override, single block, axis output and error count of
     every channel. The cursor row is the current channel, the one the keys act on."""
 
     DEFAULT_CSS = "ChannelTable { height: auto; max-height: 12; }"
+    COLUMNS = COLUMNS
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(cursor_type="row", zebra_stripes=False, **kwargs)
         self._block: dict[str, dict[str, Any]] = {}  # parts of the block cell per channel
 
-    def on_mount(self) -> None:
-        """Columns are fixed: widths do not jump while values change."""
-        for key, label, width in COLUMNS:
-            self.add_column(label, key=key, width=width)
-
     def load(self, machine: Machine) -> None:
         """One row per channel of ``machine``, values to come from the feeds."""
         self.clear()
         for channel in machine.channels:
-            self.add_row(str(channel.id), *("…" for _ in COLUMNS[1:]), key=channel.key)
+            self.add_waiting_row(str(channel.id), channel.key)
             self._block[channel.key] = {"number": -1, "file": "", "line": 0}
 
     def feeds(self, machine: Machine) -> list[Feed]:
