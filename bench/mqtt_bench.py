@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import contextlib
 import json
 import os
 import statistics
@@ -37,6 +38,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import AsyncIterator
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -82,31 +84,44 @@ async def receive(mqtt: aiomqtt.Client, inbox: asyncio.Queue) -> None:
         inbox.put_nowait((time.perf_counter(), message.topic.value, message.payload))
 
 
-async def latency(endpoint: str, broker: Broker, cycle_ms: int, changes: int) -> list[float]:
-    """Seconds from a write to the subscriber's message with the new value, per change."""
-    bridge = start_bridge(endpoint, broker, "--objects", "ch1.mc_active_feed_override_r",
-                          "--cycle-ms", str(cycle_ms))
+@contextlib.asynccontextmanager
+async def bridged(
+    endpoint: str, broker: Broker, *bridge_args: str
+) -> AsyncIterator[tuple[AsyncClient, asyncio.Queue, subprocess.Popen]]:
+    """A ``cnc-mqtt`` process with ``bridge_args``, a subscriber to all its topics whose
+    messages land in the queue (stamped on arrival), and a client of the service; the
+    bridge is online when this yields and is stopped afterwards."""
+    bridge = start_bridge(endpoint, broker, *bridge_args)
     inbox: asyncio.Queue = asyncio.Queue()
     try:
         async with aiomqtt.Client(broker.host, broker.port) as mqtt, AsyncClient(endpoint) as cnc:
             await mqtt.subscribe(f"cnc/{MACHINE}/#", qos=1)
             reader = asyncio.create_task(receive(mqtt, inbox))
-            await wait_online(mqtt, inbox)
-            result = []
-            for k in range(changes):
-                value = 100 + 10 * (k % 80) + (k // 80)  # a new value every time, 0.1 %
-                t0 = time.perf_counter()
-                await cnc.write("ch1.mc_command_feed_override_w", value)
-                while True:
-                    arrived, topic, payload = await asyncio.wait_for(inbox.get(), 10)
-                    if topic == FEED_R and json.loads(payload)["value"] == value:
-                        result.append(arrived - t0)
-                        break
-            reader.cancel()
-            return result
+            try:
+                await wait_online(mqtt, inbox)
+                yield cnc, inbox, bridge
+            finally:
+                reader.cancel()
     finally:
         bridge.terminate()
         bridge.wait(10)
+
+
+async def latency(endpoint: str, broker: Broker, cycle_ms: int, changes: int) -> list[float]:
+    """Seconds from a write to the subscriber's message with the new value, per change."""
+    async with bridged(endpoint, broker, "--objects", "ch1.mc_active_feed_override_r",
+                       "--cycle-ms", str(cycle_ms)) as (cnc, inbox, _):
+        result = []
+        for k in range(changes):
+            value = 100 + 10 * (k % 80) + (k // 80)  # a new value every time, 0.1 %
+            t0 = time.perf_counter()
+            await cnc.write("ch1.mc_command_feed_override_w", value)
+            while True:
+                arrived, topic, payload = await asyncio.wait_for(inbox.get(), 10)
+                if topic == FEED_R and json.loads(payload)["value"] == value:
+                    result.append(arrived - t0)
+                    break
+        return result
 
 
 def motion_program(seconds: float) -> bytes:
@@ -119,31 +134,21 @@ def motion_program(seconds: float) -> bytes:
 
 async def throughput(endpoint: str, broker: Broker, seconds: float) -> tuple[float, float]:
     """(value messages/s at the subscriber, bridge CPU %) while the axes move."""
-    bridge = start_bridge(endpoint, broker, "--cycle-ms", "0")
-    inbox: asyncio.Queue = asyncio.Queue()
-    try:
-        async with aiomqtt.Client(broker.host, broker.port) as mqtt, AsyncClient(endpoint) as cnc:
-            await mqtt.subscribe(f"cnc/{MACHINE}/#", qos=1)
-            reader = asyncio.create_task(receive(mqtt, inbox))
-            await wait_online(mqtt, inbox)
-            await cnc.reset()
-            await cnc.write("ch1.mc_command_feed_override_w", 1000)  # the latency run lowered it
-            await cnc.upload(PROGRAM, motion_program(seconds + 1))
-            await cnc.run_program(PROGRAM)
-            await asyncio.sleep(0.5)  # let the motion get going: measure the steady part
-            while not inbox.empty():
-                inbox.get_nowait()
-            cpu0, t0 = cpu_s(bridge.pid), time.perf_counter()
-            await asyncio.sleep(seconds)  # the measurement window
-            cpu1, t1 = cpu_s(bridge.pid), time.perf_counter()
-            seen = list(inbox._queue)  # noqa: SLF001
-            count = sum(1 for _, topic, _ in seen if not topic.endswith("/status"))
-            reader.cancel()
-            await cnc.reset()
-            return count / (t1 - t0), 100 * (cpu1 - cpu0) / (t1 - t0)
-    finally:
-        bridge.terminate()
-        bridge.wait(10)
+    async with bridged(endpoint, broker, "--cycle-ms", "0") as (cnc, inbox, bridge):
+        await cnc.reset()
+        await cnc.write("ch1.mc_command_feed_override_w", 1000)  # the latency run lowered it
+        await cnc.upload(PROGRAM, motion_program(seconds + 1))
+        await cnc.run_program(PROGRAM)
+        await asyncio.sleep(0.5)  # let the motion get going: measure the steady part
+        while not inbox.empty():
+            inbox.get_nowait()
+        cpu0, t0 = cpu_s(bridge.pid), time.perf_counter()
+        await asyncio.sleep(seconds)  # the measurement window
+        cpu1, t1 = cpu_s(bridge.pid), time.perf_counter()
+        seen = list(inbox._queue)  # noqa: SLF001
+        count = sum(1 for _, topic, _ in seen if not topic.endswith("/status"))
+        await cnc.reset()
+        return count / (t1 - t0), 100 * (cpu1 - cpu0) / (t1 - t0)
 
 
 async def publish_ceiling(broker: Broker, seconds: float, objects: int = 100) -> float:

@@ -25,6 +25,7 @@ import typer
 
 from .channel_ops import CONTOUR_BLOCK_TYPES, CheckError, CheckResult
 from .cli import EXIT_USAGE, Settings, _emit, _fail, app, err, out
+from .client import Client
 from .errors import AdsError, AdsTimeoutError, ChannelError
 
 EXIT_CHANNEL_ERROR = 4
@@ -45,6 +46,12 @@ def _finish_wait(exc: Exception) -> None:
         err.print(f"error: {exc}")
         raise typer.Exit(EXIT_WAIT_TIMEOUT)
     _fail(exc)
+
+
+def store_local(c: Client, name: str, data: bytes | None) -> None:
+    """Upload a local program (``data`` from ``local_program``) before it is used."""
+    if data is not None:
+        c.upload(name, data)
 
 
 def local_program(program: str) -> tuple[str, bytes | None]:
@@ -125,8 +132,7 @@ def run(
     name, data = local_program(program)
     try:
         with settings.client() as c:
-            if data is not None:
-                c.upload(name, data)
+            store_local(c, name, data)
             c.run_program(name, channel)
             if not wait:
                 _emit(settings, {"channel": channel, "program": name, "started": True},
@@ -287,8 +293,7 @@ def check(
     name, data = local_program(program)
     try:
         with settings.client() as c:
-            if data is not None:
-                c.upload(name, data)
+            store_local(c, name, data)
             result: CheckResult = c.syntax_check(name, channel, errors_total, timeout_s)
     except (AdsError, ChannelError) as exc:
         err.print(f"error: {exc}", markup=False, emoji=False)

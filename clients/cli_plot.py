@@ -14,7 +14,9 @@ from pathlib import Path
 import typer
 
 from .cli import EXIT_USAGE, Settings, _emit, app, err
-from .cli_machine import EXIT_CHANNEL_ERROR, ChannelOption, _finish_wait, local_program
+from .cli_machine import (
+    EXIT_CHANNEL_ERROR, ChannelOption, _finish_wait, local_program, store_local,
+)
 from .errors import AdsError, ChannelError
 from .path_plot import plot_trace
 from .path_trace import PathTrace
@@ -42,8 +44,7 @@ def plot(
     target = output if output is not None else Path(Path(name).stem + ".png")
     try:
         with settings.client() as c:
-            if data is not None:
-                c.upload(name, data)
+            store_local(c, name, data)
             trace: PathTrace = c.trace_run(name, channel, timeout_s)
     except (AdsError, ChannelError) as exc:
         _finish_wait(exc)

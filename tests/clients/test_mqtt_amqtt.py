@@ -5,14 +5,13 @@ writes, the last will, a clean stop)."""
 from __future__ import annotations
 
 import json
-import signal
 from collections.abc import AsyncIterator
 
 import pytest
 
-from tests.clients.test_mqtt_bridge import ONLINE, OFFLINE, bridge_config, bridging, values_of
-from tests.clients.test_mqtt_cli import exit_code, start_bridge
-from tests.support.broker import Broker, Watcher, running_broker
+from tests.clients.test_mqtt_bridge import bridge_config, bridging, values_of
+from tests.clients.test_mqtt_cli import kill_and_see_the_last_will
+from tests.support.broker import OFFLINE, ONLINE, Broker, Watcher, running_broker
 from tests.support.service import RunningService
 
 
@@ -48,12 +47,4 @@ async def test_bridge_on_amqtt(service: RunningService, amqtt_broker: Broker) ->
 
 
 async def test_last_will_on_amqtt(endpoint: str, amqtt_broker: Broker) -> None:
-    async with Watcher(amqtt_broker, "cnc/a2/status") as watcher:
-        process = start_bridge(endpoint, amqtt_broker, "a2", "--objects", "ch1.mc_active_state_r")
-        try:
-            await watcher.wait_for("cnc/a2/status", ONLINE, timeout_s=30)
-            mark = watcher.mark()
-        finally:
-            process.kill()
-            assert await exit_code(process) == -signal.SIGKILL
-        await watcher.wait_for("cnc/a2/status", OFFLINE, since=mark)
+    await kill_and_see_the_last_will(endpoint, amqtt_broker, "a2")

@@ -18,18 +18,9 @@ import pytest
 
 from clients import AsyncClient
 from clients.mqtt import Bridge, BridgeConfig
-from tests.support.broker import Broker, Watcher, free_port, running_broker
+from tests.support.broker import OFFLINE, ONLINE, Broker, Watcher, free_port
 from tests.support.service import RunningService, start_service
 
-ONLINE = lambda payload: payload == b"online"  # noqa: E731
-OFFLINE = lambda payload: payload == b"offline"  # noqa: E731
-
-
-@pytest.fixture
-async def broker() -> AsyncIterator[Broker]:
-    """A broker of this test only: Mosquitto when installed, else amqtt."""
-    async with running_broker() as running:
-        yield running
 
 
 def bridge_config(endpoint: str, broker: Broker, machine: str = "m1", **options) -> BridgeConfig:

@@ -10,7 +10,6 @@ import ssl
 import subprocess
 import sys
 import tempfile
-from collections.abc import AsyncIterator
 from pathlib import Path
 
 import aiomqtt
@@ -18,18 +17,9 @@ import pytest
 from typer.testing import CliRunner
 
 from clients.mqtt.cli import app
-from tests.support.broker import Broker, Watcher, running_broker
+from tests.support.broker import OFFLINE, ONLINE, Broker, Watcher, running_broker
 from tests.support.service import ROOT
 
-ONLINE = lambda payload: payload == b"online"  # noqa: E731
-OFFLINE = lambda payload: payload == b"offline"  # noqa: E731
-
-
-@pytest.fixture
-async def broker() -> AsyncIterator[Broker]:
-    """A broker of this test only: Mosquitto when installed, else amqtt."""
-    async with running_broker() as running:
-        yield running
 
 
 def start_bridge(endpoint: str, broker: Broker, machine: str, *args: str) -> subprocess.Popen:
@@ -51,18 +41,25 @@ async def exit_code(process: subprocess.Popen, timeout_s: float = 10.0) -> int:
     return await asyncio.to_thread(process.wait, timeout_s)
 
 
-async def test_the_last_will_says_offline_when_the_bridge_is_killed(
-    endpoint: str, broker: Broker
-) -> None:
-    async with Watcher(broker, "cnc/p1/status") as watcher:
-        process = start_bridge(endpoint, broker, "p1", "--objects", "ch1.mc_active_state_r")
+async def kill_and_see_the_last_will(endpoint: str, broker: Broker, machine: str) -> None:
+    """Start a bridge of ``machine``, wait for ``online``, SIGKILL it and wait for the
+    broker's last will (``offline``)."""
+    status = f"cnc/{machine}/status"
+    async with Watcher(broker, status) as watcher:
+        process = start_bridge(endpoint, broker, machine, "--objects", "ch1.mc_active_state_r")
         try:
-            await watcher.wait_for("cnc/p1/status", ONLINE, timeout_s=30)
+            await watcher.wait_for(status, ONLINE, timeout_s=30)
             mark = watcher.mark()
         finally:
             process.kill()  # SIGKILL: no DISCONNECT, no "offline" of its own
             assert await exit_code(process) == -signal.SIGKILL
-        await watcher.wait_for("cnc/p1/status", OFFLINE, since=mark)
+        await watcher.wait_for(status, OFFLINE, since=mark)
+
+
+async def test_the_last_will_says_offline_when_the_bridge_is_killed(
+    endpoint: str, broker: Broker
+) -> None:
+    await kill_and_see_the_last_will(endpoint, broker, "p1")
     async with Watcher(broker, "cnc/p1/status") as late:  # retained
         assert (await late.wait_for("cnc/p1/status")).payload == b"offline"
 
