@@ -43,7 +43,7 @@ from pathlib import Path
 import msgpack
 import zmq
 
-from clients import AsyncClient, Client
+from cnc_objects.clients import AsyncClient, Client
 from tests.support.service import start_service
 
 from .raw_echo import serve_echo

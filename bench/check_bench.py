@@ -19,8 +19,8 @@ import statistics
 import sys
 import time
 
-from service.kernel.channel_mode import ChannelState
-from service.kernel.commands import SetExecutionMode
+from cnc_objects.service.kernel.channel_mode import ChannelState
+from cnc_objects.service.kernel.commands import SetExecutionMode
 from tests.support.kernel import KernelHarness
 
 from .decoder_bench import generate_program, split_tokenizer

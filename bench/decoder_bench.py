@@ -21,7 +21,7 @@ import statistics
 import sys
 import time
 
-from service.kernel.nc import Decoder
+from cnc_objects.service.kernel.nc import Decoder
 
 AXES = ("X", "Y", "Z")
 

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from service.config import MachineConfig, build_config
+from cnc_objects.service.config import MachineConfig, build_config
 from tests.support.kernel import KernelHarness, Run
 
 from .lookahead_programs import BenchProgram, all_programs, spiral, with_la_on
@@ -157,7 +157,7 @@ def _length(element) -> float:
 
 def speed_plot(path: str, program: BenchProgram | None = None) -> None:
     """PNG of the path speed over the path distance: optimum and LA_OFF/LA_ON runs."""
-    from clients.png_chart import Series, write_line_chart
+    from cnc_objects.clients.png_chart import Series, write_line_chart
 
     program = program or spiral()
     config = machine(LA_ON_BUFFER)

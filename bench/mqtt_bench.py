@@ -44,8 +44,8 @@ from pathlib import Path
 
 import aiomqtt
 
-from clients import AsyncClient, ObjectInfo, Sample
-from clients.mqtt import Bridge, BridgeConfig
+from cnc_objects.clients import AsyncClient, ObjectInfo, Sample
+from cnc_objects.clients.mqtt import Bridge, BridgeConfig
 from tests.support.broker import Broker, make_broker
 from tests.support.service import ROOT, start_service
 
@@ -57,7 +57,7 @@ PROGRAM = "mqtt-bench.nc"
 def start_bridge(endpoint: str, broker: Broker, *args: str) -> subprocess.Popen:
     """``cnc-mqtt`` in a subprocess, its log in a temporary file."""
     return subprocess.Popen(
-        [sys.executable, "-m", "clients.mqtt.cli", "--endpoint", endpoint, "--broker",
+        [sys.executable, "-m", "cnc_objects.clients.mqtt.cli", "--endpoint", endpoint, "--broker",
          f"{broker.host}:{broker.port}", "--machine", MACHINE, "--log-level", "WARNING", *args],
         cwd=ROOT, stdout=subprocess.DEVNULL, stderr=tempfile.TemporaryFile(mode="w+"),
     )

@@ -32,8 +32,8 @@ import statistics
 import sys
 import time
 
-from service.kernel.nc.blocks import Block, Motion, MotionKind, SourceRef, StopKind
-from service.kernel.path import AxisDynamics, PathExecutor, plan_time_optimal
+from cnc_objects.service.kernel.nc.blocks import Block, Motion, MotionKind, SourceRef, StopKind
+from cnc_objects.service.kernel.path import AxisDynamics, PathExecutor, plan_time_optimal
 
 DYNAMICS = [AxisDynamics(vel_max_mm_s=500.0, acc_max_mm_s2=5000.0, vel_jump_mm_s=50.0)] * 3
 CYCLE_S = 0.001

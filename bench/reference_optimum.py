@@ -1,7 +1,7 @@
 """Reference: the time-optimal machining time of a program under the kernel's planning model.
 
 Written separately from the planner it checks (it imports nothing from
-``service.kernel``), from this statement of the model:
+``cnc_objects.service.kernel``), from this statement of the model:
 
 Axes i have the limits V_i (velocity, mm/s), A_i (acceleration, mm/s^2) and dV_i
 (velocity jump permitted at a block junction, mm/s). The programmed feed F is in
@@ -37,7 +37,7 @@ from dataclasses import KW_ONLY, dataclass
 
 import numpy as np
 
-from service.config import MachineConfig, build_config
+from cnc_objects.service.config import MachineConfig, build_config
 
 SQRT2 = math.sqrt(2.0)
 FULL_CIRCLE_TOLERANCE_MM = 1e-9  # an arc whose end is this close to its start is a full circle

@@ -17,10 +17,10 @@ import time
 from dataclasses import dataclass, fields
 from typing import Any
 
-from protocol.constants import MAX_DATA_BYTES, PROGRAM_MAX_BYTES, PROGRAM_STORE_GROUP, CncPort
-from protocol.constants import ProgramStoreOffset as Op
-from protocol.datatypes import STRING_ENCODING
-from protocol.errors import AdsReturnCode
+from cnc_objects.protocol.constants import MAX_DATA_BYTES, PROGRAM_MAX_BYTES, PROGRAM_STORE_GROUP, CncPort
+from cnc_objects.protocol.constants import ProgramStoreOffset as Op
+from cnc_objects.protocol.datatypes import STRING_ENCODING
+from cnc_objects.protocol.errors import AdsReturnCode
 
 from .errors import AdsError, AdsTimeoutError, ChannelError
 

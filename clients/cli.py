@@ -22,8 +22,8 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from protocol.datatypes import DataType, parse_type, parse_value
-from protocol.errors import AdsReturnCode
+from cnc_objects.protocol.datatypes import DataType, parse_type, parse_value
+from cnc_objects.protocol.errors import AdsReturnCode
 
 from .client import DEFAULT_ENDPOINT, AsyncClient, Client, ObjectInfo
 from .errors import AdsError, AdsTimeoutError

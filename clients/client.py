@@ -23,12 +23,12 @@ from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 from typing import Any
 
-from protocol import sum as sums
-from protocol.constants import AdsState, CncPort, TransmissionMode
-from protocol.constants import ReservedIndexGroup as RIG
-from protocol.datatypes import STRING_ENCODING, DataType, parse_type
-from protocol.errors import AdsReturnCode
-from protocol.frames import (
+from cnc_objects.protocol import sum as sums
+from cnc_objects.protocol.constants import AdsState, CncPort, TransmissionMode
+from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
+from cnc_objects.protocol.datatypes import STRING_ENCODING, DataType, parse_type
+from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.frames import (
     AddNotificationRequest,
     BrowseRequest,
     DeleteNotificationRequest,

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from protocol.errors import AdsReturnCode, describe_code
+from cnc_objects.protocol.errors import AdsReturnCode, describe_code
 
 
 class AdsError(Exception):

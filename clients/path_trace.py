@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from protocol.errors import AdsReturnCode
+from cnc_objects.protocol.errors import AdsReturnCode
 
 from .errors import AdsError, AdsTimeoutError, ChannelError
 

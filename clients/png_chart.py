@@ -1,6 +1,6 @@
 """Dependency-light PNG line charts: speed-over-distance plots and XY path plots.
 
-    from clients.png_chart import PALETTE, Series, write_line_chart
+    from cnc_objects.clients.png_chart import PALETTE, Series, write_line_chart
 
     write_line_chart(
         "speed.png",

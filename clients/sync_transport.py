@@ -14,8 +14,8 @@ from typing import Any
 
 import zmq
 
-from protocol.errors import ProtocolError
-from protocol.frames import Response, Sample, decode_incoming
+from cnc_objects.protocol.errors import ProtocolError
+from cnc_objects.protocol.frames import Response, Sample, decode_incoming
 
 from .errors import AdsConnectionError
 from .transport import _NOBLOCK, _new_socket, _Transport

@@ -17,9 +17,9 @@ from typing import Any
 
 import zmq
 
-from protocol.constants import AdsCommand
-from protocol.errors import ProtocolError
-from protocol.frames import (
+from cnc_objects.protocol.constants import AdsCommand
+from cnc_objects.protocol.errors import ProtocolError
+from cnc_objects.protocol.frames import (
     Notification,
     Response,
     Sample,

@@ -14,7 +14,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from protocol.errors import AdsReturnCode
+from cnc_objects.protocol.errors import AdsReturnCode
 
 from .model import CncObject
 

@@ -15,8 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
-from protocol.constants import CncPort
-from protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16, UNS32, DataType
+from cnc_objects.protocol.constants import CncPort
+from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16, UNS32, DataType
 
 from .addressing import GroupBase, axis_offset, channel_group
 from .model import Access, CncObject

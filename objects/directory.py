@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import struct
 
-from protocol.datatypes import STRING
-from protocol.errors import AdsReturnCode
+from cnc_objects.protocol.datatypes import STRING
+from cnc_objects.protocol.errors import AdsReturnCode
 
 from .model import CncObject
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
-from protocol.datatypes import DataType
+from cnc_objects.protocol.datatypes import DataType
 
 
 class Access(str, Enum):

@@ -10,12 +10,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from objects import AddressSpace, ChannelLayout, CncObject, MachineLayout, build_objects
-from objects.addressing import LOGICAL_BIT, GroupBase, index_based
-from objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS, MACHINING_FIELDS
-from objects.directory import ObjectDirectory
-from protocol.constants import CncPort
-from protocol.errors import AdsReturnCode
+from cnc_objects.objects import AddressSpace, ChannelLayout, CncObject, MachineLayout, build_objects
+from cnc_objects.objects.addressing import LOGICAL_BIT, GroupBase, index_based
+from cnc_objects.objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS, MACHINING_FIELDS
+from cnc_objects.objects.directory import ObjectDirectory
+from cnc_objects.protocol.constants import CncPort
+from cnc_objects.protocol.errors import AdsReturnCode
 
 from . import __version__
 from .config import MachineConfig

@@ -18,9 +18,9 @@ import struct
 from collections.abc import Callable
 from typing import Any
 
-from objects import AddressSpace, Entry
-from protocol import sum as sums
-from protocol.constants import (
+from cnc_objects.objects import AddressSpace, Entry
+from cnc_objects.protocol import sum as sums
+from cnc_objects.protocol.constants import (
     MAX_DATA_BYTES,
     PROGRAM_STORE_GROUP,
     SUM_COMMAND_MAX_ITEMS,
@@ -28,10 +28,10 @@ from protocol.constants import (
     AdsState,
     CncPort,
 )
-from protocol.constants import ReservedIndexGroup as RIG
-from protocol.datatypes import STRING_ENCODING
-from protocol.errors import AdsReturnCode, ProtocolError
-from protocol.frames import (
+from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
+from cnc_objects.protocol.datatypes import STRING_ENCODING
+from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
+from cnc_objects.protocol.frames import (
     AddNotificationRequest,
     BrowseRequest,
     DeleteNotificationRequest,

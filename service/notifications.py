@@ -18,9 +18,9 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from protocol.constants import TransmissionMode
-from protocol.errors import AdsReturnCode
-from protocol.frames import AddNotificationRequest, encode_notification
+from cnc_objects.protocol.constants import TransmissionMode
+from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.frames import AddNotificationRequest, encode_notification
 
 from .kernel.state import Snapshot
 

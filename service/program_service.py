@@ -10,9 +10,9 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 
-from protocol.constants import ProgramStoreOffset as Op
-from protocol.datatypes import STRING_ENCODING
-from protocol.errors import AdsReturnCode
+from cnc_objects.protocol.constants import ProgramStoreOffset as Op
+from cnc_objects.protocol.datatypes import STRING_ENCODING
+from cnc_objects.protocol.errors import AdsReturnCode
 
 from .program_store import ProgramStore, StoreError, StoreFault
 

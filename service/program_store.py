@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from enum import IntEnum
 from pathlib import Path
 
-from protocol.constants import PROGRAM_MAX_BYTES, PROGRAM_NAME_MAX_CHARS
+from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES, PROGRAM_NAME_MAX_CHARS
 
 _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*")
 _TEMP_PREFIX = ".upload-"

@@ -17,8 +17,8 @@ import logging
 
 import zmq
 
-from objects import AddressSpace
-from protocol.constants import MAX_DATA_BYTES
+from cnc_objects.objects import AddressSpace
+from cnc_objects.protocol.constants import MAX_DATA_BYTES
 
 from .program_service import ProgramStoreService
 from .dispatch import Dispatcher, Envelope

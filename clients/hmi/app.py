@@ -21,8 +21,8 @@ from textual.binding import Binding
 from textual.containers import VerticalScroll
 from textual.widgets import DataTable, Footer, Header, Label
 
-from clients.client import DEFAULT_ENDPOINT, AsyncClient, DeviceInfo
-from clients.errors import AdsError
+from cnc_objects.clients.client import DEFAULT_ENDPOINT, AsyncClient, DeviceInfo
+from cnc_objects.clients.errors import AdsError
 
 from . import control, text
 from .axes import AxesTable

@@ -8,7 +8,7 @@ from typing import Any
 from rich.text import Text
 from textual.widgets import Static
 
-from clients.client import AsyncClient
+from cnc_objects.clients.client import AsyncClient
 
 from . import text
 from .fixed_table import FixedColumnsTable

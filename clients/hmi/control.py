@@ -6,7 +6,7 @@ refused write raises ``AdsError`` (the app shows its code and text).
 
 from __future__ import annotations
 
-from clients.client import AsyncClient
+from cnc_objects.clients.client import AsyncClient
 
 from . import text
 from .machine import ChannelView

@@ -1,6 +1,6 @@
 """Update latency of the HMI: from an object's change in the service to the widget.
 
-    python -m clients.hmi.latency --endpoint tcp://127.0.0.1:5598 [--count 50] [--moving]
+    python -m cnc_objects.clients.hmi.latency --endpoint tcp://127.0.0.1:5598 [--count 50] [--moving]
 
 A second client writes ``ch1.mc_command_feed_override_w`` alternately to two values; the
 HMI runs headless (``App.run_test``) in the same process. Each change is timed from the
@@ -17,7 +17,7 @@ import asyncio
 import statistics
 import time
 
-from clients.client import DEFAULT_ENDPOINT, AsyncClient
+from cnc_objects.clients.client import DEFAULT_ENDPOINT, AsyncClient
 
 from . import text
 from .app import HmiApp
@@ -63,7 +63,7 @@ async def _until(predicate: object, timeout_s: float) -> None:
 
 def main() -> None:
     """Print median, 90th percentile and maximum in ms."""
-    parser = argparse.ArgumentParser(prog="python -m clients.hmi.latency")
+    parser = argparse.ArgumentParser(prog="python -m cnc_objects.clients.hmi.latency")
     parser.add_argument("--endpoint", default=DEFAULT_ENDPOINT)
     parser.add_argument("--count", type=int, default=50)
     parser.add_argument("--moving", action="store_true", help="run a program meanwhile")

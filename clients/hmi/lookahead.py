@@ -16,8 +16,8 @@ from rich.text import Text
 from textual.containers import Vertical
 from textual.widgets import DataTable, Static
 
-from clients.channel_ops import ContourReply
-from clients.client import AsyncClient
+from cnc_objects.clients.channel_ops import ContourReply
+from cnc_objects.clients.client import AsyncClient
 
 from . import text
 from .machine import ChannelView

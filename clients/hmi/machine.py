@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from clients.client import AsyncClient
+from cnc_objects.clients.client import AsyncClient
 
 _CHANNEL = re.compile(r"ch(\d+)\.mc_active_state_r", re.IGNORECASE)
 _AXIS = re.compile(r"ch(\d+)\.ax(\d+)\.axis_name", re.IGNORECASE)

@@ -16,8 +16,8 @@ from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, NoReturn, Protocol
 
-from clients.client import AsyncClient, DeviceInfo
-from clients.errors import AdsConnectionError, AdsError, AdsTimeoutError
+from cnc_objects.clients.client import AsyncClient, DeviceInfo
+from cnc_objects.clients.errors import AdsConnectionError, AdsError, AdsTimeoutError
 
 from . import text
 from .machine import Machine, discover

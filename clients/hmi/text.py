@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from clients.channel_ops import CONTOUR_BLOCK_TYPES, MODES, STATES
-from clients.errors import AdsConnectionError, AdsError, AdsTimeoutError
+from cnc_objects.clients.channel_ops import CONTOUR_BLOCK_TYPES, MODES, STATES
+from cnc_objects.clients.errors import AdsConnectionError, AdsError, AdsTimeoutError
 
 UM01_PER_MM = 10_000  # positions and distances travel in 0.1 um
 PERMILLE_PER_PERCENT = 10  # override travels in 0.1 %

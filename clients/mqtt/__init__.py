@@ -1,6 +1,6 @@
 """``cnc-mqtt``: publish CNC objects to an MQTT broker and take writes from it.
 
-    from clients.mqtt import Bridge, BridgeConfig
+    from cnc_objects.clients.mqtt import Bridge, BridgeConfig
     await Bridge(BridgeConfig("tcp://127.0.0.1:5555", "localhost", "mill1")).run()
 
 Topics and payloads: ``topics`` and ``payloads``; usage: docs/mqtt.md.

@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 
-from protocol.errors import AdsReturnCode
+from cnc_objects.protocol.errors import AdsReturnCode
 
 from ..errors import AdsConnectionError, AdsError
 from . import payloads

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
 
-from protocol.datatypes import DataType
-from protocol.errors import AdsReturnCode, describe_code
+from cnc_objects.protocol.datatypes import DataType
+from cnc_objects.protocol.errors import AdsReturnCode, describe_code
 
 from .topics import MAX_ID_CHARS, check_level
 

@@ -15,7 +15,7 @@ does. The last cycle is always in the file, so the trace ends at the program's e
 
 from __future__ import annotations
 
-from protocol.constants import PROGRAM_MAX_BYTES
+from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES
 
 TRACE_ROWS_MAX = 20_000  # rows kept at most while the run goes (a plot is ~1,200 px wide)
 

@@ -33,7 +33,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
-from protocol.constants import PROGRAM_MAX_BYTES
+from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES
 
 from ..config import SyntaxCheckConfig
 from .nc import Decoder, ModalState, NcError, NcErrorId

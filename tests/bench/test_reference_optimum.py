@@ -16,10 +16,10 @@ from bench import lookahead_programs as lp
 from bench.reference_optimum import (
     Arc, AxisLimit, Line, axis_limits, optimum_time_s, plan, speed_at,
 )
-from service.kernel.nc import Decoder
-from service.kernel.nc.blocks import Block, Motion, MotionKind, SourceRef
-from service.kernel.path import AxisDynamics, plan_time_optimal
-from service.kernel.path.planner import plan_profile
+from cnc_objects.service.kernel.nc import Decoder
+from cnc_objects.service.kernel.nc.blocks import Block, Motion, MotionKind, SourceRef
+from cnc_objects.service.kernel.path import AxisDynamics, plan_time_optimal
+from cnc_objects.service.kernel.path.planner import plan_profile
 
 DEFAULT = (AxisLimit(500.0, 5000.0, 20.0),) * 3
 O = (0.0, 0.0, 0.0)

@@ -16,7 +16,7 @@ def cnc(
 ) -> subprocess.CompletedProcess:
     """Run ``cnc`` as a user would (module entry point of the installed script), in
     ``cwd`` (default: the project root)."""
-    argv = [sys.executable, "-c", "from clients.cli import main; main()"]
+    argv = [sys.executable, "-c", "from cnc_objects.clients.cli import main; main()"]
     if endpoint is not None:
         argv += ["--endpoint", endpoint]
     return subprocess.run(

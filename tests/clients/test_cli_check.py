@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from clients import Client
-from clients.channel_ops import CheckError, CheckResult, parse_check_log
+from cnc_objects.clients import Client
+from cnc_objects.clients.channel_ops import CheckError, CheckResult, parse_check_log
 from tests.clients.test_cli import cnc, json_lines
 from tests.support.service import RunningService
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from clients import AdsError, Client
+from cnc_objects.clients import AdsError, Client
 from tests.clients.test_cli import cnc, json_lines
 from tests.clients.test_png_chart import decode_png
 from tests.support.service import RunningService

@@ -15,11 +15,11 @@ from typing import Any
 
 import pytest
 
-from clients import AdsError, AdsTimeoutError, AsyncClient, Client
-from clients.transport import EARLY_HANDLES, _Transport
-from protocol.constants import AdsState
-from protocol.frames import Notification
-from protocol.frames import Sample as FrameSample
+from cnc_objects.clients import AdsError, AdsTimeoutError, AsyncClient, Client
+from cnc_objects.clients.transport import EARLY_HANDLES, _Transport
+from cnc_objects.protocol.constants import AdsState
+from cnc_objects.protocol.frames import Notification
+from cnc_objects.protocol.frames import Sample as FrameSample
 from tests.support.service import RunningService
 
 GEO, COM = 551, 553

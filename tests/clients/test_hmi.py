@@ -13,10 +13,10 @@ from collections.abc import Callable
 import pytest
 from textual.pilot import Pilot
 
-from clients.client import AsyncClient
-from clients.hmi import text
-from clients.hmi.app import HmiApp
-from clients.hmi.program_picker import ProgramPicker
+from cnc_objects.clients.client import AsyncClient
+from cnc_objects.clients.hmi import text
+from cnc_objects.clients.hmi.app import HmiApp
+from cnc_objects.clients.hmi.program_picker import ProgramPicker
 from tests.support.service import RunningService, start_service
 
 SIZE = (110, 48)  # the HMI's tables want about 110 columns

@@ -16,8 +16,8 @@ from datetime import UTC, datetime, timedelta
 import aiomqtt
 import pytest
 
-from clients import AsyncClient
-from clients.mqtt import Bridge, BridgeConfig
+from cnc_objects.clients import AsyncClient
+from cnc_objects.clients.mqtt import Bridge, BridgeConfig
 from tests.support.broker import OFFLINE, ONLINE, Broker, Watcher, free_port
 from tests.support.service import RunningService, start_service
 

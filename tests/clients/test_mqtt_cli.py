@@ -16,7 +16,7 @@ import aiomqtt
 import pytest
 from typer.testing import CliRunner
 
-from clients.mqtt.cli import app
+from cnc_objects.clients.mqtt.cli import app
 from tests.support.broker import OFFLINE, ONLINE, Broker, Watcher, running_broker
 from tests.support.service import ROOT
 
@@ -30,7 +30,7 @@ def start_bridge(endpoint: str, broker: Broker, machine: str, *args: str) -> sub
     if broker.cert_file is not None:
         env["SSL_CERT_FILE"] = str(broker.cert_file)
     return subprocess.Popen(
-        [sys.executable, "-m", "clients.mqtt.cli", "--endpoint", endpoint,
+        [sys.executable, "-m", "cnc_objects.clients.mqtt.cli", "--endpoint", endpoint,
          "--broker", f"{broker.host}:{broker.port}", "--machine", machine, *args],
         cwd=ROOT, stdout=subprocess.DEVNULL, stderr=log, env=env,
     )
@@ -149,7 +149,7 @@ def test_empty_password_file_and_missing_options(tmp_path: Path) -> None:
 
 def test_entry_point_exit_code_as_a_process() -> None:
     result = subprocess.run(
-        [sys.executable, "-m", "clients.mqtt.cli", "--broker", "h:x", "--machine", "m"],
+        [sys.executable, "-m", "cnc_objects.clients.mqtt.cli", "--broker", "h:x", "--machine", "m"],
         cwd=ROOT, capture_output=True, text=True, timeout=60,
     )
     assert result.returncode == 2

@@ -9,14 +9,14 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from clients import ObjectInfo, Sample
-from clients.mqtt import payloads
-from clients.mqtt.config import DEFAULT_OBJECTS, BridgeConfig, expand_patterns, parse_broker
-from clients.mqtt.outbox import OFFLINE, ONLINE, Outbox
-from clients.mqtt.payloads import RequestError, SetRequest
-from clients.mqtt.retry import Backoff
-from clients.mqtt.topics import Topics
-from protocol.datatypes import parse_type
+from cnc_objects.clients import ObjectInfo, Sample
+from cnc_objects.clients.mqtt import payloads
+from cnc_objects.clients.mqtt.config import DEFAULT_OBJECTS, BridgeConfig, expand_patterns, parse_broker
+from cnc_objects.clients.mqtt.outbox import OFFLINE, ONLINE, Outbox
+from cnc_objects.clients.mqtt.payloads import RequestError, SetRequest
+from cnc_objects.clients.mqtt.retry import Backoff
+from cnc_objects.clients.mqtt.topics import Topics
+from cnc_objects.protocol.datatypes import parse_type
 
 TS = datetime(2026, 11, 21, 10, 0, 0, 123456, tzinfo=UTC)
 

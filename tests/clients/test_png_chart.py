@@ -14,7 +14,7 @@ import zlib
 import numpy as np
 import pytest
 
-from clients.png_chart import Series, _axis, encode_png, line_chart, write_line_chart
+from cnc_objects.clients.png_chart import Series, _axis, encode_png, line_chart, write_line_chart
 
 RED = (230, 20, 20)
 BLUE = (20, 20, 230)

@@ -94,7 +94,7 @@ def test_image_command_and_health_check_run(tmp_path: Path) -> None:
     cmd[cmd.index("--endpoint") + 1] = "tcp://127.0.0.1:*"  # a free port for the test
     cmd[cmd.index("--program-dir") + 1] = str(tmp_path)
     health = _exec_form(dict(steps)["HEALTHCHECK"].split("CMD", 1)[1].strip())
-    check = [sys.executable, "-c", "from clients.cli import main; main()", *health[1:]]
+    check = [sys.executable, "-c", "from cnc_objects.clients.cli import main; main()", *health[1:]]
     with serving(*cmd) as service:
         env = {**os.environ, "CNC_ENDPOINT": service.endpoint}
         healthy = subprocess.run(check, env=env, capture_output=True, text=True, timeout=30)
@@ -127,7 +127,7 @@ def test_compose_bridge_options_are_the_bridges() -> None:
     args = _compose()["services"]["mqtt-bridge"]["command"]
     options = {a for a in args if a.startswith("--")}
     help_text = subprocess.run(
-        [sys.executable, "-c", "from clients.mqtt.cli import main; main()", "--help"],
+        [sys.executable, "-c", "from cnc_objects.clients.mqtt.cli import main; main()", "--help"],
         capture_output=True, text=True, timeout=30, env={**os.environ, "COLUMNS": "200"},
     ).stdout
     for option in options:

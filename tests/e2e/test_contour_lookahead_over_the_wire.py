@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from clients import AdsError, Client
-from protocol.constants import CncPort
+from cnc_objects.clients import AdsError, Client
+from cnc_objects.protocol.constants import CncPort
 from tests.clients.test_cli import cnc, json_lines
 from tests.support.service import serving
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from clients import Client
+from cnc_objects.clients import Client
 from tests.support.service import serving
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "docs" / "examples"

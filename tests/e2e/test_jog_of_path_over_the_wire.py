@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from clients import AdsError, ChannelError, Client
-from protocol.constants import CncPort
+from cnc_objects.clients import AdsError, ChannelError, Client
+from cnc_objects.protocol.constants import CncPort
 from tests.clients.test_cli import cnc, json_lines
 from tests.service.test_entry_point import run_service
 from tests.support.service import serving

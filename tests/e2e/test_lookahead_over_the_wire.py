@@ -9,7 +9,7 @@ import math
 
 import pytest
 
-from clients import AdsError, Client
+from cnc_objects.clients import AdsError, Client
 from tests.support.service import serving
 
 FEED_MM_MIN = 6000.0

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from clients import AdsError, ChannelError, Client
-from protocol.constants import PROGRAM_MAX_BYTES, PROGRAM_STORE_GROUP, CncPort
+from cnc_objects.clients import AdsError, ChannelError, Client
+from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES, PROGRAM_STORE_GROUP, CncPort
 from tests.clients.test_cli import cnc, json_lines
 from tests.support.service import RunningService, start_service
 

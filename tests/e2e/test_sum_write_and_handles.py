@@ -8,9 +8,9 @@ import struct
 import pytest
 import zmq
 
-from protocol import sum as sums
-from protocol.constants import ReservedIndexGroup as RIG
-from protocol.frames import ReadRequest, ReadWriteRequest, Response, WriteRequest, decode_incoming
+from cnc_objects.protocol import sum as sums
+from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
+from cnc_objects.protocol.frames import ReadRequest, ReadWriteRequest, Response, WriteRequest, decode_incoming
 from tests.support.service import RunningService
 
 COM, GEO = 553, 551

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from clients import AdsError, Client
-from protocol.constants import CncPort
+from cnc_objects.clients import AdsError, Client
+from cnc_objects.protocol.constants import CncPort
 from tests.support.service import serving
 
 PROGRAM = b"N10 G1 X10 F1000\nN20 G1 Q5 X20\nN30 G00 G01 X0\nM30\n"
@@ -61,7 +61,7 @@ def test_mode_objects_plc_unit_flags_and_log_over_the_wire() -> None:
 def test_prod_time_on_the_realtime_clock_waits_for_a_slow_decoder() -> None:
     """A computation before the motion must not count as machining time: the calculation
     waits for the decoder and gives the virtual-clock run's time exactly."""
-    from service.kernel.commands import SetExecutionMode
+    from cnc_objects.service.kernel.commands import SetExecutionMode
     from tests.support.kernel import KernelHarness
 
     program = ("#VAR\nV.L.I = 0\n#ENDVAR\n$WHILE V.L.I < 20000\nV.L.I = V.L.I + 1\n$ENDWHILE\n"

@@ -14,11 +14,11 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from objects.address_space import AddressSpace, Entry
-from objects.directory import DESCRIPTOR_SIZE, ObjectDirectory, encode_descriptor
-from objects.model import Access, CncObject
-from protocol.datatypes import BOOLEAN, REAL32, REAL64, SGN16, STRING, UNS16, UNS32, DataType
-from protocol.errors import AdsReturnCode
+from cnc_objects.objects.address_space import AddressSpace, Entry
+from cnc_objects.objects.directory import DESCRIPTOR_SIZE, ObjectDirectory, encode_descriptor
+from cnc_objects.objects.model import Access, CncObject
+from cnc_objects.protocol.datatypes import BOOLEAN, REAL32, REAL64, SGN16, STRING, UNS16, UNS32, DataType
+from cnc_objects.protocol.errors import AdsReturnCode
 
 GEO, COM = 551, 553
 E = AdsReturnCode

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 
-from objects.addressing import (
+from cnc_objects.objects.addressing import (
     LOGICAL_BIT,
     GroupBase,
     axis_offset,
@@ -17,7 +17,7 @@ from objects.addressing import (
     index_based,
     split_axis_offset,
 )
-from objects.catalog import (
+from cnc_objects.objects.catalog import (
     PLC_GROUP,
     TEMPLATES,
     ChannelLayout,
@@ -25,9 +25,9 @@ from objects.catalog import (
     Scope,
     build_objects,
 )
-from objects.model import Access, CncObject
-from protocol.constants import CncPort
-from protocol.datatypes import REAL64, SGN32, UNS16, UNS32, DataType
+from cnc_objects.objects.model import Access, CncObject
+from cnc_objects.protocol.constants import CncPort
+from cnc_objects.protocol.datatypes import REAL64, SGN32, UNS16, UNS32, DataType
 
 PLC = CncPort.PLC
 

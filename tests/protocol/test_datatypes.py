@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from protocol.datatypes import (
+from cnc_objects.protocol.datatypes import (
     BOOLEAN,
     REAL32,
     REAL64,

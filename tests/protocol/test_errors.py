@@ -7,14 +7,14 @@ from __future__ import annotations
 
 import pytest
 
-from protocol.constants import (
+from cnc_objects.protocol.constants import (
     AdsCommand,
     AdsState,
     CncPort,
     ReservedIndexGroup,
     TransmissionMode,
 )
-from protocol.errors import AdsReturnCode, ProtocolError, describe_code
+from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError, describe_code
 
 #: Beckhoff's ADS return codes (ADSERR_ names without the prefix).
 BECKHOFF_CODES = {

@@ -12,9 +12,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from protocol.constants import AdsCommand
-from protocol.errors import AdsReturnCode, ProtocolError
-from protocol.frames import (
+from cnc_objects.protocol.constants import AdsCommand
+from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
+from cnc_objects.protocol.frames import (
     REQUEST_TYPES,
     U32_MAX,
     AddNotificationRequest,
@@ -438,7 +438,7 @@ def test_decode_incoming_only_ever_raises_protocol_error(raw: bytes) -> None:
 
 
 def test_encode_request_matches_the_request_types() -> None:
-    from protocol.frames import ReadRequest, WriteRequest, encode_request
+    from cnc_objects.protocol.frames import ReadRequest, WriteRequest, encode_request
 
     assert encode_request(7, 2, 551, (0x121301, 0x10018, 4)) == ReadRequest(
         7, 551, 0x121301, 0x10018, 4

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from protocol.sum import (
+from cnc_objects.protocol.sum import (
     SumItem,
     decode_codes,
     decode_sum_read,

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from service.config import ConfigError, build_config, load_config
+from cnc_objects.service.config import ConfigError, build_config, load_config
 
 
 def test_default_machine() -> None:

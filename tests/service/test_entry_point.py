@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from clients import Client
+from cnc_objects.clients import Client
 from tests.support.service import ROOT, start_service
 
 
@@ -41,7 +41,7 @@ def test_realtime_clock_counts_cycles_and_reports_statistics() -> None:
 
 def run_service(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-m", "service.main", *args], cwd=ROOT, capture_output=True,
+        [sys.executable, "-m", "cnc_objects.service.main", *args], cwd=ROOT, capture_output=True,
         text=True, timeout=30,
     )
 

@@ -9,11 +9,11 @@ from dataclasses import dataclass
 
 import pytest
 
-from service.config import build_config
-from service.kernel.clock import RealtimeClock, VirtualClock
-from service.kernel.commands import Refusal, RefusalReason, SetExecutionMode, SetFeedOverride
-from service.kernel.kernel import Control, ControlCommand, Kernel
-from service.kernel.state import KernelState, LinkState
+from cnc_objects.service.config import build_config
+from cnc_objects.service.kernel.clock import RealtimeClock, VirtualClock
+from cnc_objects.service.kernel.commands import Refusal, RefusalReason, SetExecutionMode, SetFeedOverride
+from cnc_objects.service.kernel.kernel import Control, ControlCommand, Kernel
+from cnc_objects.service.kernel.state import KernelState, LinkState
 
 
 class Applied:

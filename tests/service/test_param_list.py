@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from service.param_list import (
+from cnc_objects.service.param_list import (
     ParamListError,
     Problem,
     parse_axis_list,

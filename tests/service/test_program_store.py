@@ -6,7 +6,7 @@ import threading
 
 import pytest
 
-from service.program_store import ProgramStore, StoreError, StoreFault, check_name
+from cnc_objects.service.program_store import ProgramStore, StoreError, StoreFault, check_name
 
 
 @pytest.fixture

@@ -11,12 +11,12 @@ import threading
 from dataclasses import dataclass, field
 from typing import Any
 
-from service.config import MachineConfig, build_config
-from service.kernel.channel_mode import ChannelState
-from service.kernel.clock import VirtualClock
-from service.kernel.commands import ManualBlock, Refusal, SelectProgram, StartProgram
-from service.kernel.kernel import Kernel
-from service.kernel.state import Snapshot
+from cnc_objects.service.config import MachineConfig, build_config
+from cnc_objects.service.kernel.channel_mode import ChannelState
+from cnc_objects.service.kernel.clock import VirtualClock
+from cnc_objects.service.kernel.commands import ManualBlock, Refusal, SelectProgram, StartProgram
+from cnc_objects.service.kernel.kernel import Kernel
+from cnc_objects.service.kernel.state import Snapshot
 
 _DONE_STATES = (ChannelState.READY, ChannelState.ERROR, ChannelState.SELECTED)
 

@@ -65,7 +65,7 @@ def serving(*args: str) -> Iterator[RunningService]:
 def start_service(*args: str, timeout_s: float = 20.0) -> RunningService:
     """Start ``cnc-service --clock virtual`` (unless args say otherwise) and wait until
     it listens. Raises with the service's log when it does not come up."""
-    argv = [sys.executable, "-m", "service.main", "--endpoint", "tcp://127.0.0.1:*"]
+    argv = [sys.executable, "-m", "cnc_objects.service.main", "--endpoint", "tcp://127.0.0.1:*"]
     if "--clock" not in args:
         argv += ["--clock", "virtual"]
     if "--program-dir" not in args:  # every test service gets an empty store of its own

@@ -1,7 +1,7 @@
 """What the decoder hands to path preparation: decoded blocks in absolute coordinates.
 
-This is the contract between the SDA task (``service.kernel.nc``) and the GEO task
-(``service.kernel.path``). Positions are in mm in the channel's axis order (index 0 is
+This is the contract between the SDA task (``cnc_objects.service.kernel.nc``) and the GEO task
+(``cnc_objects.service.kernel.path``). Positions are in mm in the channel's axis order (index 0 is
 the channel's first axis); every value is already evaluated (no variables, no
 expressions, no incremental coordinates).
 """
@@ -136,7 +136,7 @@ class LookAheadMark:
     """A block decoded inside ``LA_ON`` .. ``LA_OFF`` (enhanced look-ahead, MTC200).
 
     The decoder sets the parameters in effect for the block; the section planner of the
-    SDA task (``service.kernel.path.section_plan``) adds what it planned:
+    SDA task (``cnc_objects.service.kernel.path.section_plan``) adds what it planned:
 
     * ``metb_s``: METB, the shortest execution time of a sub-block the planner creates;
     * ``vfbt``: VFBT, factor on the permitted speed of a non-tangential transition

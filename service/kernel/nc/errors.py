@@ -8,7 +8,7 @@ Ids marked "ISG" are the documented ids of the ISG kernel for the same problem; 
 others are this kernel's own and stay stable.
 
 21309 (warning: SYNCHK without MACHINE_LOCK) is ISG's id and raised by the kernel when a
-syntax check starts (``service.kernel.syntax_check``). 22073 (``#CONTOUR LOOKAHEAD LOG CLEAR`` inside ``#RT WHILE``) is ISG's id
+syntax check starts (``cnc_objects.service.kernel.syntax_check``). 22073 (``#CONTOUR LOOKAHEAD LOG CLEAR`` inside ``#RT WHILE``) is ISG's id
 and used for that.
 """
 

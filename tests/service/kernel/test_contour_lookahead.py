@@ -14,9 +14,9 @@ from typing import NamedTuple
 
 import pytest
 
-from service.config import build_config
-from service.kernel.channel_mode import ChannelState
-from service.kernel.commands import (
+from cnc_objects.service.config import build_config
+from cnc_objects.service.kernel.channel_mode import ChannelState
+from cnc_objects.service.kernel.commands import (
     Feedhold,
     RefusalReason,
     ResetChannel,
@@ -25,8 +25,8 @@ from service.kernel.commands import (
     SetSingleBlock,
     StartProgram,
 )
-from service.kernel.contour_lookahead import RESPONSE_BLOCKS
-from service.kernel.state import ContourElement
+from cnc_objects.service.kernel.contour_lookahead import RESPONSE_BLOCKS
+from cnc_objects.service.kernel.state import ContourElement
 from tests.support.kernel import KernelHarness
 
 INCR = 10_000.0  # 0.1 um per mm
@@ -403,9 +403,9 @@ def test_the_marked_area_is_there_before_it_runs_and_through_feedhold(kernel):
 
 
 def test_response_size_and_fields_match_the_catalog_and_the_client():
-    from clients.channel_ops import CONTOUR_BLOCK_FIELDS as CLIENT_FIELDS
-    from clients.channel_ops import CONTOUR_RESPONSE_BLOCKS as CLIENT_BLOCKS
-    from objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS
+    from cnc_objects.clients.channel_ops import CONTOUR_BLOCK_FIELDS as CLIENT_FIELDS
+    from cnc_objects.clients.channel_ops import CONTOUR_RESPONSE_BLOCKS as CLIENT_BLOCKS
+    from cnc_objects.objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS
 
     assert RESPONSE_BLOCKS == CONTOUR_RESPONSE_BLOCKS == CLIENT_BLOCKS
     names = tuple(name for name, *_ in CONTOUR_BLOCK_FIELDS)

@@ -22,20 +22,20 @@ import pytest
 
 from bench.lookahead_programs import circle_chords, with_la_on
 from bench.reference_optimum import axis_limits, optimum_time_s
-from service.config import build_config
-from service.kernel.channel_mode import ChannelState
-from service.kernel.commands import (
+from cnc_objects.service.config import build_config
+from cnc_objects.service.kernel.channel_mode import ChannelState
+from cnc_objects.service.kernel.commands import (
     ResetChannel,
     SetFeedOverride,
     SetSingleBlock,
     StartProgram,
 )
-from service.kernel.decoder_feed import SectionCollector
-from service.kernel.nc import Decoder, NcError, NcErrorId
-from service.kernel.nc.blocks import Block, MotionKind
-from service.kernel.path.errors import PathErrorId
-from service.kernel.path.limits import AxisDynamics
-from service.kernel.path.section_plan import plan_section
+from cnc_objects.service.kernel.decoder_feed import SectionCollector
+from cnc_objects.service.kernel.nc import Decoder, NcError, NcErrorId
+from cnc_objects.service.kernel.nc.blocks import Block, MotionKind
+from cnc_objects.service.kernel.path.errors import PathErrorId
+from cnc_objects.service.kernel.path.limits import AxisDynamics
+from cnc_objects.service.kernel.path.section_plan import plan_section
 from tests.support.kernel import KernelHarness
 
 CONFIG = build_config()

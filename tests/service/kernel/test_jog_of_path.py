@@ -9,10 +9,10 @@ from typing import Any
 
 import pytest
 
-from service.config import build_config
-from service.kernel.axis_params import AxisErrorId
-from service.kernel.channel_mode import ChannelState
-from service.kernel.commands import (
+from cnc_objects.service.config import build_config
+from cnc_objects.service.kernel.axis_params import AxisErrorId
+from cnc_objects.service.kernel.channel_mode import ChannelState
+from cnc_objects.service.kernel.commands import (
     ManualBlock,
     RefusalReason,
     ResetChannel,
@@ -21,7 +21,7 @@ from service.kernel.commands import (
     SetSuspendEnable,
     UpdateAxisParameters,
 )
-from service.kernel.state import LinkState, Snapshot
+from cnc_objects.service.kernel.state import LinkState, Snapshot
 from tests.support.kernel import KernelHarness
 
 EXTENDED_MDI = 0x80

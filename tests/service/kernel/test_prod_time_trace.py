@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from clients.path_trace import parse_trace
-from service.kernel.prod_time_trace import ProdTimeTrace, trace_file_name
+from cnc_objects.clients.path_trace import parse_trace
+from cnc_objects.service.kernel.prod_time_trace import ProdTimeTrace, trace_file_name
 
 
 def _trace(cycles: int, rows_max: int) -> ProdTimeTrace:

@@ -11,8 +11,8 @@ import math
 
 import pytest
 
-from service.kernel.channel_mode import ChannelMode, ChannelState
-from service.kernel.commands import (
+from cnc_objects.service.kernel.channel_mode import ChannelMode, ChannelState
+from cnc_objects.service.kernel.commands import (
     Feedhold,
     ManualBlock,
     RefusalReason,

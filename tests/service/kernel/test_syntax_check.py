@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from bench.decoder_bench import generate_program
-from service.kernel.channel_mode import ChannelState
-from service.kernel.commands import (
+from cnc_objects.service.kernel.channel_mode import ChannelState
+from cnc_objects.service.kernel.commands import (
     Feedhold,
     ResetChannel,
     SetExecutionMode,
@@ -20,7 +20,7 @@ from service.kernel.commands import (
     SetSyntaxCheckParameter,
     StartProgram,
 )
-from service.kernel.state import DecoderFlag
+from cnc_objects.service.kernel.state import DecoderFlag
 from tests.support.kernel import KernelHarness
 
 SYNCHK, MACHINE_LOCK, PROD_TIME = 0x8, 0x40, 0x10

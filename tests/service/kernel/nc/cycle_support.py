@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import pytest
 
-from service.kernel.nc import Decoder, NcError, NcErrorId
-from service.kernel.nc.blocks import Block
-from service.kernel.nc.technology import Surroundings
+from cnc_objects.service.kernel.nc import Decoder, NcError, NcErrorId
+from cnc_objects.service.kernel.nc.blocks import Block
+from cnc_objects.service.kernel.nc.technology import Surroundings
 
 AXES = ("X", "Y", "Z")
 TOOLS = {1: 2.5, 9: 4.0}

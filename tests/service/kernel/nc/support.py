@@ -6,7 +6,7 @@ from collections.abc import Mapping
 
 import pytest
 
-from service.kernel.nc import Block, Decoder, ModalState, NcError
+from cnc_objects.service.kernel.nc import Block, Decoder, ModalState, NcError
 
 AXES = ("X", "Y", "Z")
 TOOLS = {1: 2.5, 2: 1.0}

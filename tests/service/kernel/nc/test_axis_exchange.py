@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import pytest
 
-from service.kernel.nc import (
+from cnc_objects.service.kernel.nc import (
     AxisExchange, AxisExchangeKind, Block, ModalState, NcError, NcErrorId, SourceRef,
     StopKind, check_syntax,
 )

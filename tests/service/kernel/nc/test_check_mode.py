@@ -11,11 +11,11 @@ from itertools import islice
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from service.kernel.nc import (
+from cnc_objects.service.kernel.nc import (
     AxisExchange, AxisExchangeKind, Block, Decoder, MotionKind, NcError, NcErrorId, StopKind,
     control,
 )
-from service.kernel.nc.check import CheckAborted, ErrorCategory, PointBatch
+from cnc_objects.service.kernel.nc.check import CheckAborted, ErrorCategory, PointBatch
 
 from .support import AXES, TOOLS, loader_of
 from .test_robustness import nc_text, plain_programs
@@ -573,7 +573,7 @@ def test_line_by_line_sends_every_line_through_line():
 
 
 def test_batches_are_bounded():
-    from service.kernel.nc.check import BATCH_LINES
+    from cnc_objects.service.kernel.nc.check import BATCH_LINES
 
     text = "G1 F100\n" + "\n".join(f"G1 X{k % 97}.5 Y{k % 13}" for k in range(5000)) + "\nM30"
     run = check_run(text)

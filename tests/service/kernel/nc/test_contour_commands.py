@@ -8,10 +8,10 @@ from itertools import islice
 
 import pytest
 
-from service.kernel.nc import (
+from cnc_objects.service.kernel.nc import (
     Block, ContourCommand, ContourKind, LogArea, ModalState, NcError, NcErrorId, check_syntax,
 )
-from service.kernel.nc import control
+from cnc_objects.service.kernel.nc import control
 
 from .support import AXES, decode, decoder, error_of, slow
 

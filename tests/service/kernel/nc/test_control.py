@@ -6,8 +6,8 @@ from itertools import islice
 
 import pytest
 
-from service.kernel.nc import NcErrorId
-from service.kernel.nc import control
+from cnc_objects.service.kernel.nc import NcErrorId
+from cnc_objects.service.kernel.nc import control
 
 from .support import decoder, ends, error_of
 

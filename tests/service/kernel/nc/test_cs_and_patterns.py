@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from service.kernel.nc import MotionKind, NcError, NcErrorId, StopKind
+from cnc_objects.service.kernel.nc import MotionKind, NcError, NcErrorId, StopKind
 
 from .cycle_support import Channel, assert_at
 

@@ -13,10 +13,10 @@ from itertools import islice
 import numpy as np
 import pytest
 
-from service.kernel.nc import MotionKind, NcErrorId
-from service.kernel.nc.check import ErrorCategory
-from service.kernel.nc.modal import DistanceMode, Plane
-from service.kernel.nc.technology import HscProgram
+from cnc_objects.service.kernel.nc import MotionKind, NcErrorId
+from cnc_objects.service.kernel.nc.check import ErrorCategory
+from cnc_objects.service.kernel.nc.modal import DistanceMode, Plane
+from cnc_objects.service.kernel.nc.technology import HscProgram
 
 from .cycle_support import Channel, assert_at, where
 from .test_check_mode import Recorder, Run

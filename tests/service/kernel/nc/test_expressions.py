@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from service.kernel.nc import NcErrorId
+from cnc_objects.service.kernel.nc import NcErrorId
 
 from .support import decode, error_of
 

@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from service.kernel.nc.cycles.fitting import (
+from cnc_objects.service.kernel.nc.cycles.fitting import (
     MAX_POINTS, Circle3dFit, CircleFit, Degeneracy, FitError, LineFit, PlaneFit, SphereFit,
     fit_circle_2d, fit_circle_3d, fit_line, fit_plane, fit_sphere,
 )

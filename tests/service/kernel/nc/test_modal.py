@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from service.kernel.nc import (
+from cnc_objects.service.kernel.nc import (
     Compensation, DistanceMode, ModalState, MotionKind, NcError, NcErrorId, Plane,
 )
 

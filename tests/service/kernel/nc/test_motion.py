@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from service.kernel.nc import Compensation, MotionKind, NcErrorId
+from cnc_objects.service.kernel.nc import Compensation, MotionKind, NcErrorId
 
 from .support import decode, error_of, motions, slow
 

@@ -9,8 +9,8 @@ from itertools import islice
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from service.kernel.nc import NcError, NcErrorId
-from service.kernel.nc import control
+from cnc_objects.service.kernel.nc import NcError, NcErrorId
+from cnc_objects.service.kernel.nc import control
 
 from .support import decoder, slow
 
@@ -139,7 +139,7 @@ def test_valid_arcs_of_the_strategy_decode(lines):
 def test_loop_without_fast_constructors_gives_the_same_blocks(monkeypatch):
     """The generated loop also works with the ordinary dataclass constructors (used
     on interpreters where the construct twins are not available)."""
-    from service.kernel.nc import fastpath
+    from cnc_objects.service.kernel.nc import fastpath
 
     program = "N1 G1 X1 Y2 F600\nG2 X3 Y2 I1\nG0 Z5 ; up\nM30"
     expected = _outcome(program)

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from service.kernel.nc.cycles.rotation import (
+from cnc_objects.service.kernel.nc.cycles.rotation import (
     IDENTITY, Matrix, RotationError, RotationOrder, Vector, angles_from_rotation, apply,
     apply_transposed, axis_rotation, is_rotation, multiply, rotation_from_angles,
     rotation_from_points, transpose,

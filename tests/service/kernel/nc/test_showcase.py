@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from service.kernel.nc import NcError, NcErrorId
+from cnc_objects.service.kernel.nc import NcError, NcErrorId
 
 from .support import decoder
 
@@ -48,7 +48,7 @@ def test_every_line_alone_gives_blocks_or_an_nc_error(skip_levels, manual):
 
 
 def test_syntax_check_reports_every_parse_error_and_goes_through():
-    from service.kernel.nc import check_syntax
+    from cnc_objects.service.kernel.nc import check_syntax
 
     errors = check_syntax(TEXT, "s.nc", axes=("X", "Y", "Z"))
     found = [(e.line, e.column, e.id) for e in errors]
@@ -65,7 +65,7 @@ def test_syntax_check_reports_every_parse_error_and_goes_through():
 
 
 def test_syntax_check_of_a_clean_program():
-    from service.kernel.nc import check_syntax
+    from cnc_objects.service.kernel.nc import check_syntax
 
     program = "%P\n#VAR\nV.L.A[2] = [1,\n 2]\n#ENDVAR\nG1 X[V.L.A[0]] F100\nLL S\nM30\n%L S\nM17\n"
     assert check_syntax(program, "p.nc", axes=("X", "Y", "Z")) == []

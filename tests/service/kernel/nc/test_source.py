@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from service.kernel.nc import NcErrorId
+from cnc_objects.service.kernel.nc import NcErrorId
 
 from .support import decode, ends, error_of
 

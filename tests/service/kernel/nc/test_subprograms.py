@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from service.kernel.nc import NcErrorId, StopKind
+from cnc_objects.service.kernel.nc import NcErrorId, StopKind
 
 from .support import decode, ends, error_of
 
@@ -53,7 +53,7 @@ def test_file_subprogram_is_loaded_once():
         calls.append(name)
         return files[name]
 
-    from service.kernel.nc import Decoder
+    from cnc_objects.service.kernel.nc import Decoder
     program = "$FOR V.P.I = 1, 3\nL s.nc\n$ENDFOR\nM30"
     d = Decoder("#VAR\nV.P.I\n#ENDVAR\n" + program, "p.nc", axes=("X", "Y", "Z"),
                 loader=loader, tools={})

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from service.kernel.nc import ModalState, NcErrorId
+from cnc_objects.service.kernel.nc import ModalState, NcErrorId
 
 from .support import decode, decoder, ends, error_of
 

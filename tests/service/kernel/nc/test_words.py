@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from service.kernel.nc import NcErrorId, SourceRef, StopKind
+from cnc_objects.service.kernel.nc import NcErrorId, SourceRef, StopKind
 
 from .support import decode, error_of, slow
 

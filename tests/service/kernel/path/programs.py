@@ -10,8 +10,8 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from service.kernel.nc.blocks import Block, Compensation, Motion, MotionKind, SourceRef, StopKind
-from service.kernel.path import AxisDynamics, PathExecutor, StepResult
+from cnc_objects.service.kernel.nc.blocks import Block, Compensation, Motion, MotionKind, SourceRef, StopKind
+from cnc_objects.service.kernel.path import AxisDynamics, PathExecutor, StepResult
 
 DT = 0.001
 DYN = (AxisDynamics(500.0, 5000.0, 50.0),) * 3

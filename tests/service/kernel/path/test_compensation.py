@@ -6,10 +6,10 @@ import math
 
 import pytest
 
-from service.kernel.nc.blocks import Compensation
-from service.kernel.path import AxisDynamics, PathError, PathErrorId, PathExecutor
-from service.kernel.path.geometry import Arc, Line
-from service.kernel.path.segments import PathPreparation, Segment
+from cnc_objects.service.kernel.nc.blocks import Compensation
+from cnc_objects.service.kernel.path import AxisDynamics, PathError, PathErrorId, PathExecutor
+from cnc_objects.service.kernel.path.geometry import Arc, Line
+from cnc_objects.service.kernel.path.segments import PathPreparation, Segment
 
 from .programs import DT, DYN, arc, distance_to_contour, line, run, technology
 

@@ -7,11 +7,11 @@ import random
 
 import pytest
 
-from service.kernel.nc.blocks import MotionKind
-from service.kernel.path.endpoints import first_violation
-from service.kernel.path.errors import PathError, PathErrorId
-from service.kernel.path.geometry import Arc, Line
-from service.kernel.path.limits import check_software_limits
+from cnc_objects.service.kernel.nc.blocks import MotionKind
+from cnc_objects.service.kernel.path.endpoints import first_violation
+from cnc_objects.service.kernel.path.errors import PathError, PathErrorId
+from cnc_objects.service.kernel.path.geometry import Arc, Line
+from cnc_objects.service.kernel.path.limits import check_software_limits
 
 LIMITS = [(-50.0, 50.0), (-50.0, 50.0), (-20.0, 20.0)]
 

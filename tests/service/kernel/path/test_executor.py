@@ -8,8 +8,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from service.kernel.nc.blocks import StopKind
-from service.kernel.path import (AxisDynamics, PathError, PathErrorId, PathExecutor,
+from cnc_objects.service.kernel.nc.blocks import StopKind
+from cnc_objects.service.kernel.path import (AxisDynamics, PathError, PathErrorId, PathExecutor,
                                  Waiting, plan_time_optimal)
 
 from .programs import (DT, DYN, DYN_MIXED, arc, check_axis_limits, dwell, line, polyline, run,

@@ -8,8 +8,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from service.kernel.path.errors import PathError, PathErrorId
-from service.kernel.path.geometry import Arc, Line
+from cnc_objects.service.kernel.path.errors import PathError, PathErrorId
+from cnc_objects.service.kernel.path.geometry import Arc, Line
 
 PLANES = [(0, 1), (2, 0), (1, 2)]  # G17, G18, G19
 

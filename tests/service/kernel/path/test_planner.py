@@ -7,11 +7,11 @@ import random
 
 import pytest
 
-from service.kernel.path import plan_profile, plan_time_optimal
-from service.kernel.path.geometry import Arc, Line
-from service.kernel.path.limits import corner_limit_mm_s, element_limits
-from service.kernel.path.planner import LookAhead
-from service.kernel.path.segments import PathPreparation, Segment
+from cnc_objects.service.kernel.path import plan_profile, plan_time_optimal
+from cnc_objects.service.kernel.path.geometry import Arc, Line
+from cnc_objects.service.kernel.path.limits import corner_limit_mm_s, element_limits
+from cnc_objects.service.kernel.path.planner import LookAhead
+from cnc_objects.service.kernel.path.segments import PathPreparation, Segment
 
 from .programs import DYN, DYN_MIXED, dwell, line, polyline, trapezoid_time
 

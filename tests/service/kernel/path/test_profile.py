@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from service.kernel.path.profile import advance
+from cnc_objects.service.kernel.path.profile import advance
 
 from .programs import trapezoid_time
 
