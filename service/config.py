@@ -271,7 +271,12 @@ class MachineConfig(_Strict):
     channels: tuple[ChannelConfig, ...] = Field(min_length=1, max_length=12)
     tools: tuple[ToolConfig, ...] = Field((), description="tool table (D number -> radius)")
     program_store_dir: str | None = Field(
-        None, description="directory of the program store; default: per-user data directory"
+        None, description="directory of the program store; default: programs/ in the data "
+        "directory (service/data_location.py)"
+    )
+    data_dir: str | None = Field(
+        None, description="the service's data directory (the program store is its programs/); "
+        "default: cnc-data in the working directory at start"
     )
 
     @model_validator(mode="after")

@@ -1,27 +1,31 @@
 """``cnc-service``: the composition root. Builds kernel, address space and server, runs them.
 
     cnc-service [--config FILE] [--endpoint URL] [--clock realtime|virtual] [--speed X]
-                [--cycle-ms MS] [--program-dir DIR] [--log-level L]
+                [--cycle-ms MS] [--program-dir DIR | --data-dir DIR] [--log-level L]
 
-Logs the endpoint it listens on (``listening on tcp://...``); SIGINT and SIGTERM stop it
-cleanly (sockets closed, cycle thread joined) with exit code 0. A bad configuration or
-an endpoint that cannot be bound exits with code 2 and one line that says why.
+Logs where its program store is (``program store: /abs/path (why)``, see
+``data_location``) and the endpoint it listens on (``listening on tcp://...``); SIGINT and
+SIGTERM stop it cleanly (sockets closed, cycle thread joined) with exit code 0. Bad usage,
+a bad configuration or an endpoint that cannot be bound exits with code 2 and says why
+(one line, or one line per configuration problem).
 """
 
 from __future__ import annotations
 
-import argparse
 import asyncio
 import logging
-import os
 import signal
 import sys
+from enum import StrEnum
 from pathlib import Path
+from typing import NoReturn, Optional
 
+import typer
 import zmq
 
 from .binding import build_address_space
 from .config import ConfigError, MachineConfig, load_config
+from .data_location import StoreLocation, program_store_location
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
 from .program_service import ProgramStoreService
@@ -32,42 +36,38 @@ from .store_writer import StoreWriter
 log = logging.getLogger("cnc-service")
 
 DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
+EXIT_USAGE = 2
 
 
-def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
-        prog="cnc-service", description="CNC kernel serving its objects over ZeroMQ (ADS frames)."
-    )
-    p.add_argument("--config", type=Path, help="TOML machine configuration laid over the default")
-    p.add_argument("--endpoint", default=DEFAULT_ENDPOINT, help="ZeroMQ endpoint to bind "
-                   "(tcp://127.0.0.1:* picks a free port)")
-    p.add_argument("--clock", choices=("realtime", "virtual"), default="realtime")
-    p.add_argument("--speed", type=float, help="virtual clock: times real time (default: as fast "
-                   "as the CPU allows while busy)")
-    p.add_argument("--cycle-ms", type=float, help="cycle time in ms (overrides the configuration)")
-    p.add_argument("--program-dir", type=Path, help="directory of the program store (default: "
-                   "program_store_dir of the configuration, else "
-                   "$XDG_DATA_HOME/cnc-objects/programs)")
-    p.add_argument("--log-level", default="INFO",
-                   choices=("DEBUG", "INFO", "WARNING", "ERROR"))
-    return p
+class ClockKind(StrEnum):
+    """What the cycle task runs on."""
+
+    REALTIME = "realtime"  # sleep to each cycle deadline
+    VIRTUAL = "virtual"  # no sleeping: kernel time runs as fast as the CPU allows (or --speed)
 
 
-def make_clock(kind: str, cycle_s: float, speed: float | None) -> Clock:
+class LogLevel(StrEnum):
+    """The levels ``--log-level`` accepts."""
+
+    DEBUG = "DEBUG"  # everything
+    INFO = "INFO"  # start, stop, what the service listens on (the default)
+    WARNING = "WARNING"  # problems the service survives
+    ERROR = "ERROR"  # problems only
+
+
+app = typer.Typer(add_completion=False)
+
+
+def _usage(message: str) -> NoReturn:
+    print(f"cnc-service: {message}", file=sys.stderr)
+    raise typer.Exit(EXIT_USAGE)
+
+
+def make_clock(kind: ClockKind, cycle_s: float, speed: float | None) -> Clock:
     """The clock the cycle task runs on."""
-    if kind == "realtime":
+    if kind is ClockKind.REALTIME:
         return RealtimeClock(cycle_s)
     return VirtualClock(cycle_s, speed)
-
-
-def program_dir(arg: Path | None, config: MachineConfig) -> Path:
-    """Where the program store lives: the option, the configuration, the user's data dir."""
-    if arg is not None:
-        return arg
-    if config.program_store_dir:
-        return Path(config.program_store_dir).expanduser()
-    data_home = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
-    return Path(data_home) / "cnc-objects" / "programs"
 
 
 def _kernel_loader(store: ProgramStore):
@@ -83,7 +83,8 @@ def _kernel_loader(store: ProgramStore):
 
 
 async def serve(
-    config: MachineConfig, endpoint: str, clock_kind: str, speed: float | None, store: ProgramStore
+    config: MachineConfig, endpoint: str, clock_kind: ClockKind, speed: float | None,
+    store: ProgramStore,
 ) -> int:
     """Run kernel and server until SIGINT or SIGTERM."""
     loop = asyncio.get_running_loop()
@@ -101,18 +102,18 @@ async def serve(
             space, kernel, endpoint, loop, programs=ProgramStoreService(store, writer.flush)
         )
     except zmq.ZMQError as exc:
-        print(f"cnc-service: cannot listen on {endpoint}: {exc}", file=sys.stderr)
-        return 2
+        print(f"cnc-service: cannot listen on {endpoint}: {zmq.strerror(exc.errno)}",
+              file=sys.stderr)
+        return EXIT_USAGE
     stop = asyncio.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
     kernel.start()
     server.start()
     log.info(
-        "listening on %s (machine %s, %d channels, %d objects, %s clock, cycle %g ms, "
-        "programs in %s)",
+        "listening on %s (machine %s, %d channels, %d objects, %s clock, cycle %g ms)",
         server.endpoint, config.name, len(config.channels), len(space), clock_kind,
-        config.cycle_ms, store.root,
+        config.cycle_ms,
     )
     try:
         await stop.wait()
@@ -125,36 +126,81 @@ async def serve(
     return 0
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of ``cnc-service``; returns the exit code."""
-    args = _parser().parse_args(argv)
+@app.command(
+    epilog="Exit codes: 0 stopped by SIGINT or SIGTERM; 2 bad usage, bad configuration, "
+    "unusable program store or endpoint in use."
+)
+def run(
+    config_file: Optional[Path] = typer.Option(
+        None, "--config", metavar="FILE",
+        help="TOML machine configuration laid over the default.",
+    ),
+    endpoint: str = typer.Option(
+        DEFAULT_ENDPOINT, "--endpoint", metavar="URL",
+        help="ZeroMQ endpoint to bind (tcp://127.0.0.1:* picks a free port).",
+    ),
+    clock: ClockKind = typer.Option(ClockKind.REALTIME, "--clock", help="Clock of the cycle task."),
+    speed: Optional[float] = typer.Option(
+        None, "--speed", metavar="X",
+        help="Virtual clock: times real time (default: as fast as the CPU allows while busy).",
+    ),
+    cycle_ms: Optional[float] = typer.Option(
+        None, "--cycle-ms", metavar="MS", help="Cycle time in ms (overrides the configuration).",
+    ),
+    program_dir: Optional[Path] = typer.Option(
+        None, "--program-dir", metavar="DIR",
+        help="Directory of the program store (default: programs/ in --data-dir, else "
+        "program_store_dir or data_dir/programs of the configuration, else "
+        "./cnc-data/programs in the working directory).",
+    ),
+    data_dir: Optional[Path] = typer.Option(
+        None, "--data-dir", metavar="DIR",
+        help="Data directory of this service: its programs/ is the program store.",
+    ),
+    log_level: LogLevel = typer.Option(LogLevel.INFO, "--log-level", help="Lowest level logged."),
+) -> None:
+    """CNC kernel serving its objects over ZeroMQ (ADS frames)."""
     logging.basicConfig(
-        level=args.log_level, format="%(asctime)s %(levelname)s %(name)s: %(message)s",
+        level=log_level.value, format="%(asctime)s %(levelname)s %(name)s: %(message)s",
         stream=sys.stderr,
     )
-    if args.speed is not None and (args.clock != "virtual" or args.speed <= 0):
-        print("cnc-service: --speed takes a positive factor and needs --clock virtual",
-              file=sys.stderr)
-        return 2
+    if speed is not None and (clock is not ClockKind.VIRTUAL or speed <= 0):
+        _usage("--speed takes a positive factor and needs --clock virtual")
+    config = _machine_config(config_file, cycle_ms)
+    location = program_store_location(
+        program_dir, data_dir, config.program_store_dir, config.data_dir
+    )
+    store = _open_store(location)
+    raise typer.Exit(asyncio.run(serve(config, endpoint, clock, speed, store)))
+
+
+def _machine_config(path: Path | None, cycle_ms: float | None) -> MachineConfig:
+    """The configuration file over the default machine, ``--cycle-ms`` over both."""
     try:
-        config = load_config(args.config)
-        if args.cycle_ms is not None:
-            config = MachineConfig.model_validate({**config.model_dump(), "cycle_ms": args.cycle_ms})
+        config = load_config(path)
+        if cycle_ms is not None:
+            config = MachineConfig.model_validate({**config.model_dump(), "cycle_ms": cycle_ms})
     except ConfigError as exc:
-        print(f"cnc-service: bad configuration:\n{exc}", file=sys.stderr)
-        return 2
+        _usage(f"bad configuration:\n{exc}")
     except ValueError as exc:  # --cycle-ms out of range
-        print(f"cnc-service: bad --cycle-ms: {exc}", file=sys.stderr)
-        return 2
-    directory = program_dir(args.program_dir, config)
+        _usage(f"bad --cycle-ms: {exc}")
+    return config
+
+
+def _open_store(location: StoreLocation) -> ProgramStore:
+    """The program store at ``location`` (created when absent), announced in the log."""
     try:
-        store = ProgramStore(directory)
+        store = ProgramStore(location.path)
     except OSError as exc:
-        print(f"cnc-service: cannot use program directory {directory}: {exc.strerror}",
-              file=sys.stderr)
-        return 2
-    return asyncio.run(serve(config, args.endpoint, args.clock, args.speed, store))
+        _usage(f"cannot use program directory {location.path}: {exc.strerror}")
+    log.info("program store: %s (%s)", store.root, location.source)
+    return store
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of ``cnc-service`` (``argv``: the options, default the command line)."""
+    app(args=argv, prog_name="cnc-service")
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -2,6 +2,8 @@
 
     .venv/bin/cnc-hmi --endpoint tcp://127.0.0.1:5555
 
+Bad usage (an option that does not parse) exits with code 2 and says which option.
+
 The app owns no machine state: tables are filled by subscriptions (``session``), keys
 write objects (``control``), the look-ahead panel re-requests (``lookahead``). Key
 bindings are in ``HmiApp.BINDINGS`` and in docs/hmi.md.
@@ -9,13 +11,12 @@ bindings are in ``HmiApp.BINDINGS`` and in docs/hmi.md.
 
 from __future__ import annotations
 
-import argparse
 import asyncio
 import contextlib
-import os
 from collections.abc import Awaitable, Callable, Sequence
 from typing import Any
 
+import typer
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import VerticalScroll
@@ -210,7 +211,7 @@ class HmiApp(App[None]):
         self._command("suspend axis output", control.toggle_suspend)
 
     def action_select_program(self) -> None:
-        """Ask for a program (the store's list) and select it in the current channel."""
+        """Ask for a program (the store's NC programs) and select it in the current channel."""
 
         async def pick(client: AsyncClient, channel: ChannelView) -> str:
             names = [p.name for p in await client.programs()]
@@ -263,16 +264,27 @@ class HmiApp(App[None]):
                     await self._lookahead_wake.wait()
 
 
-def main(argv: Sequence[str] | None = None) -> None:
-    """Entry point of ``cnc-hmi``."""
-    parser = argparse.ArgumentParser(prog="cnc-hmi",
-                                     description="Terminal HMI of a cnc-objects service.")
-    parser.add_argument("--endpoint", default=os.environ.get("CNC_ENDPOINT", DEFAULT_ENDPOINT),
-                        help="service endpoint (default: $CNC_ENDPOINT, else %(default)s)")
-    parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S",
-                        help="seconds without a reply before the service counts as unreachable")
-    args = parser.parse_args(argv)
-    HmiApp(args.endpoint, args.timeout).run()
+cli = typer.Typer(add_completion=False)
+
+
+@cli.command()
+def run(
+    endpoint: str = typer.Option(
+        DEFAULT_ENDPOINT, "--endpoint", metavar="URL", envvar="CNC_ENDPOINT",
+        help="Service endpoint (default: $CNC_ENDPOINT, else tcp://127.0.0.1:5555).",
+    ),
+    timeout_s: float = typer.Option(
+        DEFAULT_TIMEOUT_S, "--timeout", metavar="S", min=0.01,
+        help="Seconds without a reply before the service counts as unreachable.",
+    ),
+) -> None:
+    """Terminal HMI of a cnc-objects service (keys: docs/hmi.md)."""
+    HmiApp(endpoint, timeout_s).run()
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of ``cnc-hmi`` (``argv``: the options, default the command line)."""
+    cli(args=argv, prog_name="cnc-hmi")
 
 
 if __name__ == "__main__":

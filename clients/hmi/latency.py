@@ -1,6 +1,7 @@
 """Update latency of the HMI: from an object's change in the service to the widget.
 
-    python -m cnc_objects.clients.hmi.latency --endpoint tcp://127.0.0.1:5598 [--count 50] [--moving]
+    python -m cnc_objects.clients.hmi.latency --endpoint tcp://127.0.0.1:5598 \
+        [--count 50] [--moving]
 
 A second client writes ``ch1.mc_command_feed_override_w`` alternately to two values; the
 HMI runs headless (``App.run_test``) in the same process. Each change is timed from the
@@ -12,10 +13,11 @@ in channel 1 meanwhile, so the HMI is also busy with position samples.
 
 from __future__ import annotations
 
-import argparse
 import asyncio
 import statistics
 import time
+
+import typer
 
 from cnc_objects.clients.client import DEFAULT_ENDPOINT, AsyncClient
 
@@ -61,19 +63,30 @@ async def _until(predicate: object, timeout_s: float) -> None:
         await asyncio.sleep(POLL_S)
 
 
-def main() -> None:
-    """Print median, 90th percentile and maximum in ms."""
-    parser = argparse.ArgumentParser(prog="python -m cnc_objects.clients.hmi.latency")
-    parser.add_argument("--endpoint", default=DEFAULT_ENDPOINT)
-    parser.add_argument("--count", type=int, default=50)
-    parser.add_argument("--moving", action="store_true", help="run a program meanwhile")
-    args = parser.parse_args()
-    result = asyncio.run(measure(args.endpoint, args.count, args.moving))
+cli = typer.Typer(add_completion=False)
+
+
+@cli.command()
+def run(
+    endpoint: str = typer.Option(
+        DEFAULT_ENDPOINT, "--endpoint", metavar="URL", help="The cnc-service to measure against."
+    ),
+    count: int = typer.Option(50, "--count", min=1, help="Changes to time."),
+    moving: bool = typer.Option(False, "--moving", help="Run a program in channel 1 meanwhile."),
+) -> None:
+    """Time an object change from the service to the HMI's widget; print median, 90th
+    percentile and maximum in ms."""
+    result = asyncio.run(measure(endpoint, count, moving))
     for name, samples in result.items():
         ms = sorted(s * 1000 for s in samples)
         p90 = ms[int(0.9 * (len(ms) - 1))]
         print(f"{name:>5} -> shown: median {statistics.median(ms):.2f} ms, "
               f"p90 {p90:.2f} ms, max {ms[-1]:.2f} ms ({len(ms)} changes)")
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of ``python -m cnc_objects.clients.hmi.latency``."""
+    cli(args=argv, prog_name="python -m cnc_objects.clients.hmi.latency")
 
 
 if __name__ == "__main__":

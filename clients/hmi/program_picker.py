@@ -1,13 +1,30 @@
-"""The program selection dialog: type a name, or pick one of the program store."""
+"""The program selection dialog: type a name, or pick one of the program store's NC programs.
+
+The store also holds the files the kernel writes (``errors-ch<c>.log``, ``dec0<c>.sc``,
+``prodtime0<c>.csv``, ``msg_save.txt``, cycle results) and user cycles (``*.ecy``, called
+by a program, never selected). The list shows what a channel can run: names ending in
+``.nc`` (any case) and names without a suffix. A name typed into the input is selected
+as typed, listed or not.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from pathlib import PurePath
 from typing import Any
 
 from textual.binding import Binding
 from textual.containers import Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Input, Label, OptionList
+
+
+NC_PROGRAM_SUFFIXES = frozenset({".nc", ""})  # "" = no suffix (``SUB``, ``L SUB``)
+
+
+def nc_programs(names: Iterable[str]) -> list[str]:
+    """The NC programs among the store's file names, in the given order."""
+    return [n for n in names if PurePath(n).suffix.lower() in NC_PROGRAM_SUFFIXES]
 
 
 class ProgramPicker(ModalScreen[str | None]):
@@ -22,13 +39,13 @@ class ProgramPicker(ModalScreen[str | None]):
     ProgramPicker OptionList { height: auto; max-height: 16; }
     """
 
-    def __init__(self, channel_id: int, programs: list[str]) -> None:
+    def __init__(self, channel_id: int, files: Iterable[str]) -> None:
         super().__init__()
         self.channel_id = channel_id
-        self.programs = programs
+        self.programs = nc_programs(files)
 
     def compose(self) -> Any:
-        """A prompt, the name input and the store's programs (filtered by the input)."""
+        """A prompt, the name input and the store's NC programs (filtered by the input)."""
         with Vertical():
             yield Label(f"Program for channel {self.channel_id} (enter selects, esc cancels)")
             yield Input(placeholder="program name", id="program-name")

@@ -6,12 +6,16 @@ reach the widgets by subscription, commands by the keys a user presses.
 
 from __future__ import annotations
 
+import os
 import socket
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 
 import pytest
 from textual.pilot import Pilot
+from textual.widgets import OptionList
 
 from cnc_objects.clients.client import AsyncClient
 from cnc_objects.clients.hmi import text
@@ -122,6 +126,39 @@ async def test_program_keys_select_start_hold_resume_reset(service: RunningServi
         await wait_until(pilot, lambda: app.channels.cell("ch1", "state") not in ("ACTIVE", "HOLD"))
         assert app.channels.cell("ch1", "state") == text.state(await c.read(state))
         assert app.message.text == "ch1: RESET"
+
+
+async def test_program_dialog_lists_the_nc_programs_only(service: RunningService) -> None:
+    """The store also holds what the kernel writes there (a run's error log and #MSG SAVE
+    file, a syntax check's dec01.sc, a PROD_TIME trace) and user cycles: not programs."""
+    ep = service.endpoint
+    async with AsyncClient(ep) as c, HmiApp(ep).run_test(size=SIZE) as pilot:
+        await c.upload("Part.NC", b"G1 X1 F600\nM30\n")
+        await c.upload("SUB", b"G1 X2 F600\nM17\n")
+        await c.upload("drill.ecy", b"G1 X3 F600\nM17\n")
+        await c.upload("bad.nc", b'#MSG SAVE ["tool %d", 3]\nG1 X1 F600\nG1 Y2 Q7\nM30\n')
+        await c.syntax_check("Part.NC")
+        await c.trace_run("Part.NC")
+        await c.run_program("bad.nc")
+        app = await started(pilot)
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "ERROR")
+        stored = [p.name for p in await c.programs()]
+        assert stored == ["Part.NC", "SUB", "bad.nc", "dec01.sc", "drill.ecy",
+                          "errors-ch1.log", "msg_save.txt", "prodtime01.csv"]
+
+        await pilot.press("p")
+        await wait_until(pilot, lambda: isinstance(app.screen, ProgramPicker), what="dialog")
+        options = app.screen.query_one(OptionList)
+
+        def listed() -> list[str]:
+            return [str(options.get_option_at_index(k).prompt)
+                    for k in range(options.option_count)]
+
+        assert listed() == ["Part.NC", "SUB", "bad.nc"]
+        await pilot.press("s")  # typing narrows the NC programs only (not msg_save.txt)
+        await wait_until(pilot, lambda: listed() == ["SUB"], what="filtered to SUB")
+        await pilot.press("escape")
+        await wait_until(pilot, lambda: app.message.text == "ch1: no program selected")
 
 
 async def test_override_and_single_block_keys(service: RunningService) -> None:
@@ -264,3 +301,40 @@ async def test_reconnects_when_the_service_comes_back(free_endpoint: str) -> Non
                 assert second.stop() == 0
     finally:
         first.stop()
+
+
+def _cli(module: str, *args: str) -> subprocess.CompletedProcess:
+    """``python -m <module> *args`` to its end; a wide terminal keeps rich's error box
+    on one line per message."""
+    return subprocess.run([sys.executable, "-m", module, *args], capture_output=True,
+                          text=True, timeout=30, env={**os.environ, "COLUMNS": "200"})
+
+
+def test_cnc_hmi_options_in_the_style_of_cnc() -> None:
+    """Help with defaults and the environment variable; bad usage exits 2 naming the
+    option (the HMI itself never starts: it needs a terminal)."""
+    shown = _cli("cnc_objects.clients.hmi.app", "--help")
+    assert shown.returncode == 0
+    assert "Usage: cnc-hmi [OPTIONS]" in shown.stdout
+    assert "[env var: CNC_ENDPOINT]" in shown.stdout
+    assert "[default: tcp://127.0.0.1:5555]" in shown.stdout and "[default: 2.0]" in shown.stdout
+    for args, message in [(["--timeout", "soon"], "Invalid value for '--timeout'"),
+                          (["--timeout", "0"], "Invalid value for '--timeout'"),
+                          (["--endpoint"], "Option '--endpoint' requires an argument"),
+                          (["--endpont", "x"], "No such option: --endpont")]:
+        result = _cli("cnc_objects.clients.hmi.app", *args)
+        assert result.returncode == 2, args
+        assert message in result.stderr and "Traceback" not in result.stderr
+
+
+def test_latency_options_in_the_style_of_cnc() -> None:
+    module = "cnc_objects.clients.hmi.latency"
+    shown = _cli(module, "--help")
+    assert shown.returncode == 0
+    assert f"Usage: python -m {module} [OPTIONS]" in shown.stdout
+    assert "--moving" in shown.stdout and "[default: 50]" in shown.stdout
+    for args, message in [(["--count", "0"], "Invalid value for '--count'"),
+                          (["--count", "many"], "Invalid value for '--count'")]:
+        result = _cli(module, *args)
+        assert result.returncode == 2, args
+        assert message in result.stderr and "Traceback" not in result.stderr

@@ -104,6 +104,16 @@ def test_repeated_tools_are_refused() -> None:
         build_config({"tools": [{"d": 1, "radius_mm": 1}, {"d": 1, "radius_mm": 2}]})
 
 
+def test_data_directory_keys(tmp_path: Path) -> None:
+    path = tmp_path / "machine.toml"
+    path.write_text('data_dir = "~/mill-1"\nprogram_store_dir = "/srv/programs"\n')
+    config = load_config(path)
+    assert config.data_dir == "~/mill-1" and config.program_store_dir == "/srv/programs"
+    assert build_config().data_dir is None  # the service's default: ./cnc-data
+    with pytest.raises(ConfigError, match="data_dir: Input should be a valid string"):
+        build_config({"data_dir": 5})
+
+
 # ------------------------------------------------------------------ parameter lists
 
 PARAMS = Path(__file__).parent.parent / "data" / "params"

@@ -1,15 +1,24 @@
-"""``cnc-service`` as a process: start-up log, clean stop on signals, bad start-up input."""
+"""``cnc-service`` as a process: start-up log, clean stop on signals, bad start-up input,
+where its program store is."""
 
 from __future__ import annotations
 
+import os
+import re
 import signal
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
 from cnc_objects.clients import Client
-from tests.support.service import ROOT, start_service
+from cnc_objects.testing.process import service_command
+from tests.support.service import RunningService, start_service
+
+# Rich draws usage errors in a box as wide as the terminal: wide enough for one line.
+_WIDE = {**os.environ, "COLUMNS": "200"}
+_STORE_LOG = re.compile(r"program store: (/\S+) \((.+)\)$")
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
@@ -39,11 +48,45 @@ def test_realtime_clock_counts_cycles_and_reports_statistics() -> None:
         assert service.stop() == 0
 
 
+@pytest.fixture(autouse=True)
+def _in_tmp_path(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Services run without --program-dir here would make ./cnc-data: not in the checkout."""
+    monkeypatch.chdir(tmp_path)
+
+
 def run_service(*args: str) -> subprocess.CompletedProcess:
+    """``cnc-service *args`` in the working directory, to its end."""
     return subprocess.run(
-        [sys.executable, "-m", "cnc_objects.service.main", *args], cwd=ROOT, capture_output=True,
-        text=True, timeout=30,
+        [sys.executable, "-m", "cnc_objects.service.main", *args], capture_output=True,
+        text=True, timeout=30, env=_WIDE,
     )
+
+
+def start_in(cwd: Path, *args: str) -> RunningService:
+    """``cnc-service *args`` (virtual clock, free port) started in ``cwd``, listening.
+    Unlike ``start_service`` it leaves the program store to the service's own rule;
+    ``program_dir`` is then the store the service logged."""
+    process = subprocess.Popen(
+        service_command(*args), cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE, text=True,
+    )
+    service = RunningService(process, cwd)
+    try:
+        line = service.wait_for_log(r"listening on tcp://")
+        service.program_dir = store_of(service)[0]
+    except BaseException:
+        process.kill()
+        service.stop()
+        raise
+    service.endpoint = line.split("listening on ", 1)[1].split()[0]
+    return service
+
+
+def store_of(service: RunningService) -> tuple[Path, str]:
+    """The program store the service logged at start, and why it is there."""
+    match = _STORE_LOG.search(service.wait_for_log("program store: "))
+    assert match, service.log
+    return Path(match.group(1)), match.group(2)
 
 
 def test_bad_configuration_is_refused_naming_the_key(tmp_path) -> None:
@@ -68,14 +111,45 @@ def test_unreadable_configuration_is_refused(tmp_path) -> None:
     assert result.returncode == 2 and "not valid TOML" in result.stderr
 
 
-def test_endpoint_in_use_is_refused() -> None:
+def test_endpoint_in_use_is_refused_with_one_line() -> None:
     service = start_service()
     try:
-        result = run_service("--endpoint", service.endpoint, "--clock", "virtual")
+        result = run_service("--endpoint", service.endpoint, "--clock", "virtual",
+                             "--log-level", "WARNING")
         assert result.returncode == 2
-        assert "cannot listen on" in result.stderr
+        assert result.stderr.splitlines() == [
+            f"cnc-service: cannot listen on {service.endpoint}: Address already in use"
+        ]
     finally:
         assert service.stop() == 0
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--clock", "sundial"], "Invalid value for '--clock': "),
+        (["--cycle-ms", "fast"], "Invalid value for '--cycle-ms': "),
+        (["--log-level", "LOUD"], "Invalid value for '--log-level': "),
+        (["--program-dirr", "x"], "No such option: --program-dirr"),
+        (["extra"], "unexpected extra argument"),
+    ],
+)
+def test_bad_usage_exits_2_naming_the_option(args: list[str], message: str) -> None:
+    result = run_service(*args)
+    assert result.returncode == 2
+    assert "Usage: cnc-service [OPTIONS]" in result.stderr  # the style of cnc and cnc-mqtt
+    assert message in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_help_lists_every_option_with_its_default() -> None:
+    result = run_service("--help")
+    assert result.returncode == 0
+    for option in ("--config", "--endpoint", "--clock", "--speed", "--cycle-ms",
+                   "--program-dir", "--data-dir", "--log-level"):
+        assert option in result.stdout
+    assert "[default: tcp://127.0.0.1:5555]" in result.stdout
+    assert "realtime|virtual" in result.stdout and "[default: realtime]" in result.stdout
 
 
 def test_speed_needs_virtual_clock() -> None:
@@ -99,3 +173,69 @@ def test_configuration_file_is_laid_over_the_default(tmp_path) -> None:
             assert c.browse("ch2.*") == []
     finally:
         assert service.stop() == 0
+
+
+def test_default_program_store_belongs_to_the_working_directory(tmp_path: Path) -> None:
+    """Two services started in different directories do not share programs; one started
+    again where it was started finds its programs again."""
+    first_dir, second_dir = tmp_path / "first", tmp_path / "second"
+    first_dir.mkdir()
+    second_dir.mkdir()
+    first, second = start_in(first_dir), start_in(second_dir)
+    try:
+        first_store, why = store_of(first)
+        assert first_store == first_dir.resolve() / "cnc-data" / "programs"
+        assert why == "default: cnc-data/programs in the working directory"
+        assert store_of(second)[0] == second_dir.resolve() / "cnc-data" / "programs"
+        with Client(first.endpoint) as a, Client(second.endpoint) as b:
+            a.upload("part.nc", b"G1 X1 F600\nM30\n")
+            assert [p.name for p in a.programs()] == ["part.nc"]
+            assert b.programs() == []
+    finally:
+        assert first.stop() == 0 and second.stop() == 0
+    assert (first_store / "part.nc").read_bytes() == b"G1 X1 F600\nM30\n"
+    again = start_in(first_dir)
+    try:
+        with Client(again.endpoint) as a:
+            assert [p.name for p in a.programs()] == ["part.nc"]
+    finally:
+        assert again.stop() == 0
+
+
+def test_data_dir_option_and_configuration_key(tmp_path: Path) -> None:
+    config = tmp_path / "machine.toml"
+    config.write_text('data_dir = "from-config"\n')
+    by_key = start_in(tmp_path, "--config", str(config))
+    by_option = start_in(tmp_path, "--config", str(config), "--data-dir", "mill-1")
+    try:
+        assert store_of(by_key) == (tmp_path.resolve() / "from-config" / "programs",
+                                    "data_dir of the configuration")
+        assert store_of(by_option) == (tmp_path.resolve() / "mill-1" / "programs",
+                                       "--data-dir")
+        with Client(by_option.endpoint) as c:
+            c.upload("part.nc", b"M30\n")
+        assert (tmp_path / "mill-1" / "programs" / "part.nc").is_file()
+    finally:
+        assert by_key.stop() == 0 and by_option.stop() == 0
+
+
+def test_program_dir_option_and_key_still_choose_the_store(tmp_path: Path) -> None:
+    config = tmp_path / "machine.toml"
+    config.write_text('program_store_dir = "progs"\ndata_dir = "data"\n')
+    by_key = start_in(tmp_path, "--config", str(config))
+    by_option = start_in(tmp_path, "--config", str(config), "--data-dir", "d",
+                         "--program-dir", str(tmp_path / "explicit"))
+    try:
+        assert store_of(by_key) == (tmp_path.resolve() / "progs",
+                                    "program_store_dir of the configuration")
+        assert store_of(by_option) == (tmp_path.resolve() / "explicit", "--program-dir")
+    finally:
+        assert by_key.stop() == 0 and by_option.stop() == 0
+
+
+def test_unusable_program_store_is_refused(tmp_path: Path) -> None:
+    (tmp_path / "taken").write_text("a file where the data directory should be")
+    result = run_service("--data-dir", "taken")
+    assert result.returncode == 2
+    assert f"cannot use program directory {tmp_path.resolve() / 'taken' / 'programs'}" in (
+        result.stderr)
