@@ -44,7 +44,10 @@ from enum import IntEnum
 from typing import Protocol
 
 from .errors import NcError, NcErrorId
+from .expressions import ExpressionParser
+from .lexer import Cursor
 from .source import LogicalLine, SourceText
+from .statements import Assign, Control, NcBlock, StmtKind
 
 BATCH_LINES = 2048  # plain lines per PointBatch (bounds the memory of one batch)
 CHECK_FEED_MM_MIN = 1000.0  # the feed the check assumes after a missing or bad F
@@ -253,9 +256,6 @@ def term_end(text: str, pos: int) -> int:
 def assignment_end(line: LogicalLine, pos: int) -> int:
     """End of the assignment whose target starts at ``pos``: after its right-hand
     expression, or the end of the line when that cannot be parsed either."""
-    from .expressions import ExpressionParser  # noqa: PLC0415 - expressions imports errors
-    from .lexer import Cursor  # noqa: PLC0415
-
     m = _ASSIGN_TARGET.match(line.upper, pos)
     if m is None:
         return len(line.text)
@@ -288,8 +288,6 @@ def without_error(line: LogicalLine, error: NcError, category: ErrorCategory
 def item_at(line: LogicalLine, items: list, pos: int) -> int | None:
     """Index of the item (word or assignment) of an NC block whose text holds ``pos``
     (an error in ``X[1/0]`` or ``V.L.A = 1/0`` is that item's), or None."""
-    from .statements import Assign  # noqa: PLC0415 - statements imports expressions
-
     found = None
     for k, item in enumerate(items):
         if item.pos <= pos and (found is None or item.pos > items[found].pos):
@@ -314,8 +312,6 @@ def after_command(line: LogicalLine, error: NcError, parse) -> object | None:
         stmt = parse(blanked(line, error.pos, len(line.text)))
     except NcError:
         return None
-    from .statements import NcBlock  # noqa: PLC0415
-
     return None if isinstance(stmt, NcBlock) else stmt
 
 
@@ -344,8 +340,6 @@ def dropped_control(line: LogicalLine, errors: int):
     expressions raise ``ErrorReported``, so the control flow keeps its structure (a
     dropped $IF skips its block, a dropped $CASE never matches, ...); else None.
     ``errors``: the errors reported in the line."""
-    from .statements import Control, StmtKind  # noqa: PLC0415
-
     start = command_position(line)
     if start < 0:
         return None

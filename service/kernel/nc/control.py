@@ -12,8 +12,8 @@ until the program is reset; the decoder is lazy, so it produces blocks as long a
 caller pulls them.
 
 A real-time loop entered while the contour look-ahead's marked area is open gets
-marker Blocks at its passes (``contour.RtLoopMarkers``): ``run`` returns them. They do
-not count as blocks for the endless-loop guard.
+marker Blocks at its passes (``rt_loop_markers.RtLoopMarkers``): ``run`` returns them.
+They do not count as blocks for the endless-loop guard.
 
 A decode-time loop that runs ``MAX_IDLE_LOOP_PASSES`` passes without producing a
 single block is stopped with ENDLESS_LOOP (``$WHILE TRUE`` without motion would
@@ -22,18 +22,14 @@ otherwise hang the SDA task).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from .blocks import Block
-from .contour import RtLoopMarkers
 from .errors import NcErrorId
 from .expressions import number, truth
 from .frames import ControlEntry, Frame
+from .rt_loop_markers import RtLoopMarkers
+from .running_decoder import RunningDecoder
 from .statements import LOOPS, SPELLING, Control, Goto, StmtKind
 from .variables import Value
-
-if TYPE_CHECKING:
-    from .decoder import Decoder
 
 MAX_IDLE_LOOP_PASSES = 1_000_000  # loop passes without a block before ENDLESS_LOOP
 
@@ -41,7 +37,7 @@ MAX_IDLE_LOOP_PASSES = 1_000_000  # loop passes without a block before ENDLESS_L
 class ControlFlow:
     """The handlers of the control statements, one per kind (dispatch table)."""
 
-    def __init__(self, decoder: Decoder) -> None:
+    def __init__(self, decoder: RunningDecoder) -> None:
         self.decoder = decoder
         self.idle_passes = 0
         self.blocks_at_last_pass = -1

@@ -24,13 +24,13 @@ this module writes for the call, as ISG's cycle package does.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from decimal import Decimal
 from typing import Any
 
 from .check import ErrorReported, categorize
 from .errors import NcError, NcErrorId
 from .evaluation import number
 from .frames import Frame, FrameKind
+from .literals import nc_number
 from .program import Program
 from .statements import Call, NcBlock
 from .variables import Scope, Value, VariableFault
@@ -104,7 +104,10 @@ def call_cycle(decoder: Any, frame: Frame, stmt: NcBlock) -> None:
 def run_cycle(decoder: Any, cycle_call: CycleCall) -> None:
     """Start the cycle of ``cycle_call``: a built-in one runs (and may push its motion
     body), a user cycle's frame is pushed."""
-    from .cycles.registry import BUILTIN_CYCLES, builtin_problems
+    # Deferred, and no circle (cycles/ imports nothing above it): the built-in cycles
+    # load numpy (~150 ms), which a service that never calls a cycle need not pay at
+    # its start. tests/test_import_graph.py counts this import as an edge all the same.
+    from .cycles.registry import BUILTIN_CYCLES, builtin_problems  # noqa: PLC0415
 
     call = cycle_call.call
     line = cycle_call.line
@@ -192,8 +195,3 @@ def pattern_wrapper(positions, retract_mm: float) -> str:
                   "#PATTERN CALL", "#CS OFF"]
     lines += [f"G90 G00 Z{r}", "M17"]
     return "\n".join(lines) + "\n"
-
-
-def nc_number(value: float) -> str:
-    """``value`` as an NC number literal that reads back exactly (no exponent)."""
-    return format(Decimal(repr(float(value))), "f")

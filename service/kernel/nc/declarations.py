@@ -18,20 +18,17 @@ from __future__ import annotations
 
 import math
 import re
-from typing import TYPE_CHECKING
 
 from .errors import NcErrorId
 from .expressions import ExpressionParser, Node
 from .frames import Frame, FrameKind
 from .lexer import IDENT, VARIABLE, Cursor
+from .running_decoder import RunningDecoder
 from .source import LogicalLine, join_lines
 from .statements import Control, Declaration
 from .variables import (
     Scope, Value, Variable, VariableFault, VarType, convert, default_value,
 )
-
-if TYPE_CHECKING:
-    from .decoder import Decoder
 
 _ENDVAR = re.compile(r"[ \t]*#[ \t]*ENDVAR\b")
 _UINT = re.compile(r"[0-9]+")
@@ -39,7 +36,8 @@ _STRING_LENGTH = re.compile(r"\[[ \t]*[0-9]+[ \t]*\]")
 _DECL_SCOPES = {"L": Scope.L, "P": Scope.P, "G": Scope.G, "CYC": Scope.CYC}
 
 
-def read_block(decoder: Decoder, frame: Frame, stmt: Control, after: int) -> tuple[list, int]:
+def read_block(decoder: RunningDecoder, frame: Frame, stmt: Control,
+               after: int) -> tuple[list, int]:
     """The declarations of the ``#VAR`` block at ``frame.index`` and the index after it."""
     program = frame.program
     cached = program.var_blocks.get(frame.index)
@@ -145,7 +143,7 @@ def _open_brackets(text: str) -> int:
     return text.count("[") - text.count("]")
 
 
-def declare(decoder: Decoder, frame: Frame, decl: Declaration) -> None:
+def declare(decoder: RunningDecoder, frame: Frame, decl: Declaration) -> None:
     """Create (or re-initialise) the variable of one declaration."""
     modal = decoder.modal
     line = decl.line
@@ -179,7 +177,7 @@ def declare(decoder: Decoder, frame: Frame, decl: Declaration) -> None:
     decoder.own_variables.add(id(variable))
 
 
-def _create(decoder: Decoder, decl: Declaration, full: str, site) -> Variable:
+def _create(decoder: RunningDecoder, decl: Declaration, full: str, site) -> Variable:
     line = decl.line
     init = decl.init
     dims = decl.dims

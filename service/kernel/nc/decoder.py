@@ -28,7 +28,7 @@ from .check import (
     CHECK_FEED_MM_MIN, CheckAborted, ErrorCategory, ErrorReported, SyntaxCheck, categorize,
     item_at,
 )
-from .contour import execute_contour
+from .contour_run import execute_contour
 from .control import ControlFlow
 from .declarations import declare, read_block
 from .errors import NcError, NcErrorId

@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import Any
 
 from .coordinates import CoordinateSystem, placement_of
+from .cycle_run import run_cycle
 from .errors import NcErrorId
 from .evaluation import evaluate_number
 from .instructions import Instruction, InstructionKind
@@ -158,8 +159,6 @@ def _at(stmt: Instruction, decoder: Any) -> None:
 
 
 def _pattern_call(stmt: Instruction, decoder: Any) -> None:
-    from .cycle_run import run_cycle
-
     cycle_call = decoder.frames[-1].pattern_call
     if cycle_call is None:
         raise stmt.line.error(NcErrorId.PATTERN_SYNTAX,

@@ -36,8 +36,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from ..cycle_run import nc_number
 from ..errors import NcErrorId
+from ..literals import nc_number
 from ..variables import Value
 from .rotation import (
     RotationError, RotationOrder, angles_from_rotation, rotation_from_angles, rotation_from_points,

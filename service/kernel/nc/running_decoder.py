@@ -1,0 +1,37 @@
+"""The running decoder as the statement runners see it.
+
+The control flow (``control``), the ``#VAR`` blocks (``declarations``) and the contour
+commands (``contour_run``, ``rt_loop_markers``) act on the decoder that runs them: its
+frames, its modal state, its variables. They are below ``decoder`` (which imports them),
+so they name the decoder by this protocol instead of importing the ``Decoder`` class;
+``decoder.Decoder`` satisfies it.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+from .evaluation import Env
+from .frames import Frame
+from .modal import ModalState
+from .statements import Control
+
+
+class RunningDecoder(Env, Protocol):
+    """What a statement runner reads and changes of the decoder running it.
+
+    As an ``Env`` it also evaluates expressions (``find_variable``).
+    """
+
+    frames: list[Frame]  # the call frames, the running one last
+    manual: bool  # decoding a manual block (MDI), not a program
+    contour_lookahead: bool  # the channel has FCT_CONTOUR_LAH (P-CHAN-00650)
+    emitted: int  # grows whenever blocks were yielded (the endless-loop guard watches it)
+    own_variables: set[int]  # ids of the variables this decoder declared
+
+    @property
+    def modal(self) -> ModalState:
+        """The modal state, changed as decoding goes."""
+
+    def declare_block(self, frame: Frame, stmt: Control, after: int) -> None:
+        """Run the ``#VAR`` block at ``frame.index``."""
