@@ -13,10 +13,11 @@ stable and found by name through the COM object directory, as ISG tools do.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Enum
+from enum import Enum, IntEnum
 
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16, UNS32, DataType
+from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockType, LinkState
 
 from .addressing import GroupBase, axis_offset, channel_group
 from .model import Access, CncObject
@@ -36,7 +37,8 @@ class Scope(Enum):
 
 @dataclass(frozen=True, slots=True)
 class ObjectTemplate:
-    """One object of the tables, before channel and axis are filled in."""
+    """One object of the tables, before channel and axis are filled in. ``values``:
+    the value set of an enumeration object (its value names go out with browse)."""
 
     element: str
     scope: Scope
@@ -47,6 +49,7 @@ class ObjectTemplate:
     access: Access
     unit: str
     description: str
+    values: type[IntEnum] | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,6 +93,8 @@ CONTOUR_BLOCK_FIELDS: tuple[tuple[str, int, DataType, str, str], ...] = (
     ("length_min", 0x38, REAL64, "0.1 um", "length on the scaled contour (die sinking): 0"),
     ("tangent_variation", 0x40, REAL64, "rad", "angle to the previous motion element"),
 )
+#: The enumeration fields of a contour reply entry and their value sets.
+CONTOUR_BLOCK_VALUES: dict[str, type[IntEnum]] = {"block_type": ContourBlockType}
 
 
 R, W, RW = Access.READ, Access.WRITE, Access.READ_WRITE
@@ -126,7 +131,7 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
     ObjectTemplate(
         "link_state", Scope.CHANNEL_AXIS, GEO, IPO, 0x18, UNS32, R, "-",
         "Axis request state: 0 link exists, 1 physical axis requested, "
-        "2 waiting for acknowledgement",
+        "2 waiting for acknowledgement", LinkState,
     ),
     ObjectTemplate(
         "command_position_acs", Scope.CHANNEL_AXIS, GEO, IPO, 0x02, SGN32, R, "0.1 um",
@@ -217,15 +222,17 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
     # --- COM channel control (project offsets; HLI mode_and_state values) ----------------
     ObjectTemplate(
         "mc_active_mode_r", Scope.CHANNEL, COM, COM_CH, 0x3001, UNS32, R, "-",
-        "Operation mode: 1 STANDBY, 2 AUTOMATIC, 3 MDI, 4 MANUAL (project)",
+        "Operation mode: 1 STANDBY, 2 AUTOMATIC, 3 MDI, 4 MANUAL (project)", ChannelMode,
     ),
     ObjectTemplate(
         "mc_active_state_r", Scope.CHANNEL, COM, COM_CH, 0x3002, UNS32, R, "-",
         "State: 1 DESELECTED, 2 SELECTED, 3 READY, 4 ACTIVE, 5 HOLD, 6 ERROR (project)",
+        ChannelState,
     ),
     ObjectTemplate(
         "mc_command_mode_w", Scope.CHANNEL, COM, COM_CH, 0x3003, UNS32, W, "-",
         "Select the operation mode (1..4); only while the channel is not working (project)",
+        ChannelMode,
     ),
     ObjectTemplate(
         "mc_command_program_name_w", Scope.CHANNEL, COM, COM_CH, 0x3004, STRING(84), W, "-",
@@ -521,7 +528,7 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         ObjectTemplate(
             f"contour_lookahead.response.block[{k}].{name}", Scope.PLC_CHANNEL, PLC,
             PLC_GROUP, CONTOUR_RESPONSE_OFFSET + k * CONTOUR_BLOCK_STRIDE + offset, dtype, R,
-            unit, f"Reply entry {k}: {text}",
+            unit, f"Reply entry {k}: {text}", CONTOUR_BLOCK_VALUES.get(name),
         )
         for k in range(CONTOUR_RESPONSE_BLOCKS)
         for name, offset, dtype, unit, text in CONTOUR_BLOCK_FIELDS
@@ -576,7 +583,7 @@ def _instantiate(
             )
     return CncObject(
         name, t.element, t.port, group, offset, t.dtype, t.access, t.unit, t.description,
-        channel, axis,
+        channel, axis, t.values,
     )
 
 

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Enum
+from enum import Enum, IntEnum
 
 from cnc_objects.protocol.datatypes import DataType
+from cnc_objects.protocol.values import value_names
 
 
 class Access(str, Enum):
@@ -34,7 +35,8 @@ class CncObject:
     object in the ISG tables (``link_state``). ``group`` is the logical index group (bit
     0x100000 set); ``channel`` and ``axis`` are the logical channel id and the axis
     number (axis index in the channel, or physical axis number) the instance belongs to,
-    0 where they do not apply.
+    0 where they do not apply. ``values`` is the value set of an enumeration object
+    (``ChannelState`` for ``mc_active_state_r``), None for every other object.
     """
 
     name: str
@@ -48,15 +50,23 @@ class CncObject:
     description: str
     channel: int = 0
     axis: int = 0
+    values: type[IntEnum] | None = None
 
     @property
     def length(self) -> int:
         """Size of the value in bytes."""
         return self.dtype.size
 
+    @property
+    def value_names(self) -> dict[int, str]:
+        """``{3: "READY", ...}`` for an enumeration object; empty for any other."""
+        return value_names(self.values) if self.values is not None else {}
+
     def describe(self) -> list:
         """The browse descriptor: [name, port, group, offset, type, length, access, unit,
-        description]."""
+        description, value names]. The value names are ``[[value, name], ...]`` (empty
+        for an object that is not an enumeration): pairs, because msgpack maps with
+        integer keys are refused by the frame decoder (string keys only)."""
         return [
             self.name,
             self.port,
@@ -67,4 +77,5 @@ class CncObject:
             self.access.value,
             self.unit,
             self.description,
+            [[value, name] for value, name in self.value_names.items()],
         ]

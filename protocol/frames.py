@@ -19,10 +19,14 @@ Layout (every integer unsigned unless noted; ``data`` is raw bytes)::
     9 READ_WRITE               group, offset, read_length, data       data
     0x100 BROWSE (extension)   pattern                                [descriptor, ...]
 
-A descriptor is ``[name, port, group, offset, type, length, access, unit, description]``.
+A descriptor is ``[name, port, group, offset, type, length, access, unit, description,
+values]``; ``values`` names the numbers of an enumeration object as ``[[value, name],
+...]`` (``[[1, "DESELECTED"], [2, "SELECTED"], ...]``) and is ``[]`` for every other
+object (pairs, not a map: frames allow string map keys only). Services before the value
+names sent the first nine fields; a reader takes a missing tenth as ``[]``.
 The ``message`` of an error reply is a project extension: a sentence that says why, next
 to the ADS code. Notification timestamps are Windows FILETIME (100 ns since 1601-01-01),
-as in ADS. Invoke id 0 is reserved for notifications; requests use 1..2**32-1.
+as in ADS: the wall-clock time at which the kernel cycle that produced the value ended. Invoke id 0 is reserved for notifications; requests use 1..2**32-1.
 """
 
 from __future__ import annotations

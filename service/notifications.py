@@ -4,7 +4,12 @@ ADS semantics: SERVER_CYCLE sends the value every ``cycle_time_ms`` of kernel ti
 SERVER_ON_CHANGE checks every ``cycle_time_ms`` and sends only when the bytes changed.
 Both send the current value at once after the subscription is acknowledged. Each sample
 carries the handle, a per-subscription sequence number (a gap means a sample was
-dropped because the client did not keep up) and the FILETIME timestamp of the cycle.
+dropped because the client did not keep up) and a timestamp.
+
+The timestamp is wall-clock time as a FILETIME: the instant the kernel cycle that
+produced the value published its snapshot (``Snapshot.wall_ns``). Samples of one cycle
+share it, and it never runs ahead of the wall clock, also not under the virtual clock
+(where kernel time does): kernel time stays readable as ``cnc_kernel_time_r``.
 
 The kernel thread only looks at one number per cycle (when the next sample is due) and
 wakes the event loop when it is; all sampling and sending happens on the loop.
@@ -14,7 +19,6 @@ from __future__ import annotations
 
 import asyncio
 import logging
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -36,6 +40,11 @@ MAX_TOTAL = 20000
 
 #: FILETIME (100 ns since 1601-01-01) of the Unix epoch.
 _FILETIME_UNIX_EPOCH = 116444736000000000
+
+
+def filetime(wall_ns: int) -> int:
+    """A wall-clock time (ns since the Unix epoch) as a FILETIME (100 ns since 1601)."""
+    return _FILETIME_UNIX_EPOCH + wall_ns // 100
 
 
 @dataclass(slots=True)
@@ -76,8 +85,6 @@ class NotificationHub:
         self._next_due_ns: int | None = None
         self._scheduled = False
         self._last_snapshot: Snapshot | None = None
-        # Kernel time 0 is this wall-clock instant; timestamps are kernel time after it.
-        self._base_filetime = _FILETIME_UNIX_EPOCH + time.time_ns() // 100
         self.dropped = 0
 
     def __len__(self) -> int:
@@ -141,8 +148,7 @@ class NotificationHub:
     def _first_sample(self, sub: Subscription) -> None:
         if sub.handle not in self._subs:
             return
-        now_ns = self._current().time_ns
-        self._emit({(sub.envelope, sub.port): [self._take(sub, now_ns, force=True)]})
+        self._emit({(sub.envelope, sub.port): [self._take(sub, force=True)]})
         self._update_due()
 
     def _sample(self) -> None:
@@ -155,24 +161,33 @@ class NotificationHub:
         for sub in list(self._subs.values()):
             if sub.next_due_ns > now_ns:
                 continue
-            sample = self._take(sub, now_ns, force=False)
+            sample = self._take(sub, force=False)
             if sample is not None:
                 batches.setdefault((sub.envelope, sub.port), []).append(sample)
         self._emit(batches)
         self._update_due()
 
-    def _take(self, sub: Subscription, now_ns: int, force: bool) -> list | None:
+    def _take(self, sub: Subscription, force: bool) -> list | None:
         """Read one subscription; a sample list or None when on-change saw no change."""
+        # The read serves whatever snapshot is newest. The stamp must be that snapshot's,
+        # so read again in the rare case the kernel published one meanwhile (the cycle
+        # thread may take the GIL between any two lines here).
+        current = self._current
+        while True:
+            snapshot = current()
+            code, data = self._read(sub.port, sub.group, sub.offset, sub.length)
+            if current() is snapshot:
+                break
+        now_ns = snapshot.time_ns
         # Next due time on the subscription's own grid, never in the past.
         sub.next_due_ns = now_ns - now_ns % sub.cycle_ns + sub.cycle_ns
-        code, data = self._read(sub.port, sub.group, sub.offset, sub.length)
         if code:
             return None  # the object went away (cannot happen with a fixed catalog)
         if sub.on_change and not force and data == sub.last:
             return None
         sub.last = data  # type: ignore[assignment]
         sub.sequence += 1
-        return [sub.handle, sub.sequence, self._base_filetime + now_ns // 100, data]
+        return [sub.handle, sub.sequence, filetime(snapshot.wall_ns), data]
 
     def _emit(self, batches: dict[tuple[tuple[bytes, ...], int], list]) -> None:
         """One frame per client and port with all its samples of this cycle."""

@@ -3,8 +3,10 @@
 Pure functions, no I/O. A value message is
 
     {"value": 750, "unit": "0.1 %", "ts": "2026-11-21T10:00:00.123456Z", "seq": 17}
+    {"value": 3, "name": "READY", "ts": "2026-11-21T10:00:00.123456Z", "seq": 2}
 
-a write request ``{"value": 750, "id": "abc"}`` and its reply ``{"ok": true}`` or
+("name" for enumeration objects only, "unit" for objects that have one only), a write
+request ``{"value": 750, "id": "abc"}`` and its reply ``{"ok": true}`` or
 ``{"ok": false, "code": "0x704", "error": "ADS 0x704 INVALIDACCESS: ..."}``. Everything
 wrong with a request becomes a ``RequestError`` carrying an ADS code, so that the bridge
 answers it like any refused write and never stops on it.
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
@@ -66,14 +69,19 @@ def json_value(value: Any) -> Any:
     return value
 
 
-def encode_value(value: Any, unit: str, timestamp: datetime, seq: int) -> bytes:
-    """The value message of one sample; ``unit`` as the service describes it ("-": null)."""
-    message = {
-        "value": json_value(value),
-        "unit": None if unit in ("", _NO_UNIT) else unit,
-        "ts": iso_utc(timestamp),
-        "seq": seq,
-    }
+def encode_value(
+    value: Any, unit: str, timestamp: datetime, seq: int, enum: Mapping[int, str] | None = None
+) -> bytes:
+    """The value message of one sample. ``unit`` as the service describes it: a unitless
+    object ("-") gets no "unit" key. ``enum``: the object's value names (``ObjectInfo.enum``);
+    an enumeration object gets a "name" key, null for a number the set does not name."""
+    message: dict[str, Any] = {"value": json_value(value)}
+    if enum:
+        message["name"] = enum.get(value)
+    if unit not in ("", _NO_UNIT):
+        message["unit"] = unit
+    message["ts"] = iso_utc(timestamp)
+    message["seq"] = seq
     return json.dumps(message, ensure_ascii=False, allow_nan=False).encode()
 
 

@@ -17,28 +17,10 @@ them (docs/kernel.md has the diagram):
 
 from __future__ import annotations
 
-from enum import IntEnum
+# The value sets are part of the wire contract: defined in protocol, used here.
+from cnc_objects.protocol.values import ChannelMode, ChannelState
 
-
-class ChannelMode(IntEnum):
-    """Operation mode of a channel (HLI values)."""
-
-    STANDBY = 1  # no operation mode selected
-    AUTOMATIC = 2  # programs from the program store
-    MDI = 3  # manual data input: manual blocks
-    MANUAL = 4  # jog / handwheel (manual mode; no NC program)
-    REFERENCE = 5  # homing (not offered by this kernel's commands)
-
-
-class ChannelState(IntEnum):
-    """State of the channel within its mode (HLI values)."""
-
-    DESELECTED = 1  # the mode is not selected
-    SELECTED = 2  # the mode is selected, nothing to run yet
-    READY = 3  # a program (or manual block) is ready to start
-    ACTIVE = 4  # running
-    HOLD = 5  # feedhold: the path is stopped and resumes on START
-    ERROR = 6  # an error stopped the channel; RESET clears it
+__all__ = ["IDLE_STATES", "SELECTABLE_MODES", "ChannelMode", "ChannelState", "describe"]
 
 
 #: States in which the channel is not working: a mode or program may be chosen.

@@ -79,7 +79,7 @@ class Kernel:
         self._changed: list[bool] | None = None  # channels the cycle touched; None = all
         self.state = self._initial_state()
         self.stats = CycleStats(cycle_us=round(config.cycle_ms * 1000))
-        self.snapshot: Snapshot = self.state.snapshot(0, 0, self.stats)
+        self.snapshot: Snapshot = self.state.snapshot(0, 0, time.time_ns(), self.stats)
         self.on_cycle_end: Callable[[Snapshot], None] | None = None
         self._queue: queue.SimpleQueue = queue.SimpleQueue()
         self._waiting: deque = deque()
@@ -253,8 +253,12 @@ class Kernel:
 
     def _publish(self) -> None:
         cycle = self.stats.cycles
+        # One wall-clock reading per cycle: the time the cycle's values were produced,
+        # which notifications carry as their timestamp (kernel time is not wall time
+        # under the virtual clock, nor under load).
         self.snapshot = self.state.snapshot(
-            cycle, cycle * self.cycle_ns, self.stats, self.snapshot, self._changed
+            cycle, cycle * self.cycle_ns, time.time_ns(), self.stats, self.snapshot,
+            self._changed,
         )
         self._changed = None
         hook = self.on_cycle_end

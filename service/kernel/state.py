@@ -8,21 +8,16 @@ consistent within one cycle and never waits for the kernel.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from enum import IntEnum, IntFlag
+from enum import IntFlag
 from typing import Any, NamedTuple
+
+# Defined with the wire's value sets; the kernel's modules import them from here.
+from cnc_objects.protocol.values import ExecutionMode, LinkState
 
 from ..config import ChannelConfig, MachineConfig
 from .nc.technology import MachiningSettings
 
 MESSAGES_KEPT = 8  # #MSG texts a channel shows (ch<c>.mc_message_<k>_text_r)
-
-
-class LinkState(IntEnum):
-    """State of a logical axis's link to its physical axis (FCT-C15 ``link_state``)."""
-
-    LINKED = 0  # the link exists: this logical axis drives the physical axis
-    REQUESTED = 1  # the physical axis is requested from the position controller
-    WAITING_ACK = 2  # waiting for the position controller's acknowledgement
 
 
 class DecoderFlag(IntFlag):
@@ -33,24 +28,6 @@ class DecoderFlag(IntFlag):
     SYNTAX_CHECK_RELEASE_CLEARED = 0x4  # X_SyntaxCheckReleaseNextBlockCleared
     WAIT_CONTINUE = 0x8  # X_WaitContinue: decoding interrupted (single step, STOP)
     WAIT_RELEASE_CLEARED = 0x10  # X_WaitReleaseNextBlockCleared
-
-
-class ExecutionMode(IntEnum):
-    """Execution mode bits of a channel (``mc_command_execution_mode_w``)."""
-
-    ISG_STANDARD = 0x0  # normal machining
-    BLOCK_SEARCH = 0x1  # SV: block search
-    SOLLKON = 0x2  # contour visualisation with output
-    ON_LINE = 0x4  # online
-    SYNCHK = 0x8  # syntax check
-    PROD_TIME = 0x10  # production time calculation
-    ONLINE_PROD_TIME = 0x20  # online production time calculation
-    MACHINE_LOCK = 0x40  # dry run: no axis motion
-    ADD_MDI_BLOCK = 0x80  # additional MDI block
-    KIN_TRAFO_OFF = 0x100  # kinematic transformation off
-    SOLLKON_NO_OUTPUT = 0x800  # with SOLLKON: contour visualisation without output
-    BEARB_MODE_SCENE = 0x1000  # machining scene mode
-    SUPPRESS_TECHNO_OUTPUT = 0x2000  # no M/H/T output
 
 
 @dataclass(slots=True)
@@ -267,10 +244,16 @@ class CycleStats:
 
 @dataclass(frozen=True, slots=True)
 class Snapshot:
-    """Everything readable, as it was at the end of one cycle."""
+    """Everything readable, as it was at the end of one cycle.
+
+    ``time_ns`` is kernel time (cycles x cycle time); ``wall_ns`` the wall-clock time
+    (``time.time_ns()``, ns since the Unix epoch) at which the cycle published it. With
+    the virtual clock the two drift apart; samples are stamped with ``wall_ns``.
+    """
 
     cycle: int
     time_ns: int
+    wall_ns: int
     stats: CycleStats
     channels: tuple[Channel, ...]
     physical_axes: tuple[PhysicalAxis, ...]
@@ -332,6 +315,7 @@ class KernelState:
         self,
         cycle: int,
         time_ns: int,
+        wall_ns: int,
         stats: CycleStats,
         previous: Snapshot | None = None,
         changed: list[bool] | None = None,
@@ -340,7 +324,8 @@ class KernelState:
 
         With ``previous`` and ``changed`` (one flag per channel), a channel that did not
         change this cycle keeps its frozen copy from ``previous``: an idle channel costs
-        nothing per cycle. Without them every channel is copied.
+        nothing per cycle. Without them every channel is copied. ``time_ns`` and
+        ``wall_ns``: kernel time and wall-clock time of the cycle (see ``Snapshot``).
         """
         if previous is None or changed is None:
             channels = tuple(c.frozen() for c in self.channels)
@@ -350,7 +335,7 @@ class KernelState:
                 for c, touched, old in zip(self.channels, changed, previous.channels, strict=True)
             )
         return Snapshot(
-            cycle, time_ns, stats.frozen(), channels,
+            cycle, time_ns, wall_ns, stats.frozen(), channels,
             tuple(p.frozen() for p in self.physical_axes),
         )
 

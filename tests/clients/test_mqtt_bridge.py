@@ -18,6 +18,7 @@ import pytest
 
 from cnc_objects.clients import AsyncClient
 from cnc_objects.clients.mqtt import Bridge, BridgeConfig
+from cnc_objects.protocol.values import ChannelMode, ChannelState, LinkState
 from tests.support.broker import OFFLINE, ONLINE, Broker, Watcher, free_port
 from tests.support.service import RunningService, start_service
 
@@ -78,7 +79,15 @@ async def test_publishes_every_object_then_online_and_offline_on_stop(
             ts = datetime.fromisoformat(position["ts"].replace("Z", "+00:00"))
             assert ts.tzinfo is not None and abs(datetime.now(UTC) - ts) < timedelta(minutes=1)
             program = values["ch1.mc_active_program_name_r"]
-            assert isinstance(program["value"], str) and program["unit"] is None
+            assert isinstance(program["value"], str) and "unit" not in program  # unitless
+            assert "name" not in program and "name" not in position  # not enumerations
+            # Enumeration objects carry the name of their value next to the number.
+            enumerations = {"ch1.mc_active_state_r": ChannelState,
+                            "ch2.mc_active_mode_r": ChannelMode, "ch1.ax1.link_state": LinkState}
+            for name, value_set in enumerations.items():
+                message = values[name]
+                assert message["name"] == value_set(message["value"]).name, message
+                assert list(message) == ["value", "name", "ts", "seq"]  # no unit: unitless
             assert isinstance(values["ch1.mc_error_1_warning_r"]["value"], bool)
 
             # The broker connection has TCP_NODELAY (read back from the bridge's socket).

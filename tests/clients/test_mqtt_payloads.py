@@ -42,7 +42,29 @@ def test_value_message_fields() -> None:
 )
 def test_value_types_and_units(value, unit, expected_value, expected_unit) -> None:
     message = json.loads(payloads.encode_value(value, unit, TS, 1))
-    assert message["value"] == expected_value and message["unit"] == expected_unit
+    assert message["value"] == expected_value and message.get("unit") == expected_unit
+    # A unitless object's message has no "unit" key at all (not null).
+    assert ("unit" in message) == (expected_unit is not None)
+    assert "name" not in message  # not an enumeration
+
+
+STATES = {1: "DESELECTED", 2: "SELECTED", 3: "READY", 4: "ACTIVE", 5: "HOLD", 6: "ERROR"}
+
+
+def test_enumeration_values_carry_their_name() -> None:
+    raw = payloads.encode_value(3, "-", TS, 2, STATES)
+    # The exact payload of docs/mqtt.md, key order included.
+    assert raw == b'{"value": 3, "name": "READY", "ts": "2026-11-21T10:00:00.123456Z", "seq": 2}'
+
+
+def test_enumeration_value_without_a_name_has_a_null_name() -> None:
+    message = json.loads(payloads.encode_value(9, "-", TS, 1, STATES))
+    assert message == {"value": 9, "name": None, "ts": "2026-11-21T10:00:00.123456Z", "seq": 1}
+
+
+def test_enumeration_with_a_unit_keeps_both() -> None:
+    message = json.loads(payloads.encode_value(0, "mode", TS, 1, {0: "OFF"}))
+    assert (message["name"], message["unit"]) == ("OFF", "mode")
 
 
 def test_timestamp_is_utc_whatever_the_zone() -> None:

@@ -28,6 +28,7 @@ from cnc_objects.objects.catalog import (
 from cnc_objects.objects.model import Access, CncObject
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.datatypes import REAL64, SGN32, UNS16, UNS32, DataType
+from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockType, LinkState
 
 PLC = CncPort.PLC
 
@@ -255,8 +256,48 @@ def test_describe_is_the_browse_descriptor(by_name: dict[str, CncObject]) -> Non
         "w",
         "0.1 %",
         obj.description,
+        [],  # not an enumeration: no value names
     ]
     assert obj.description
+
+
+# --------------------------------------------------------------------------- value names
+
+# Every enumeration object of the catalog (element name) and its value set.
+ENUMERATIONS = {
+    "mc_active_mode_r": ChannelMode,
+    "mc_command_mode_w": ChannelMode,
+    "mc_active_state_r": ChannelState,
+    "link_state": LinkState,
+    "block_type": ContourBlockType,
+}
+
+
+def test_enumeration_objects_name_their_values(by_name: dict[str, CncObject]) -> None:
+    state = by_name["ch2.mc_active_state_r"]
+    assert state.value_names == {
+        1: "DESELECTED", 2: "SELECTED", 3: "READY", 4: "ACTIVE", 5: "HOLD", 6: "ERROR",
+    }
+    assert by_name["ch1.ax3.link_state"].value_names == {
+        0: "LINKED", 1: "REQUESTED", 2: "WAITING_ACK",
+    }
+    assert by_name["ch1.mc_command_mode_w"].value_names[2] == "AUTOMATIC"
+    assert by_name["gpCh[1].contour_lookahead.response.block[31].block_type"].value_names[6] == (
+        "POLYNOMIAL"
+    )
+    assert state.describe()[9] == [[1, "DESELECTED"], [2, "SELECTED"], [3, "READY"],
+                                   [4, "ACTIVE"], [5, "HOLD"], [6, "ERROR"]]
+
+
+def test_only_enumerations_carry_value_names(by_name: dict[str, CncObject]) -> None:
+    """Bit sets (execution mode), booleans, counters and sentinels ("-1 = none") are not
+    enumerations: their value names are empty."""
+    for obj in by_name.values():
+        element = obj.element.rsplit(".", 1)[-1]
+        assert obj.values is ENUMERATIONS.get(element), obj.name
+        assert bool(obj.value_names) == (element in ENUMERATIONS), obj.name
+    assert by_name["ch1.mc_active_execution_mode_r"].value_names == {}
+    assert by_name["gpCh[0].decoder_mc_control.execution_mode.state_r"].value_names == {}
 
 
 def test_cnc_objects_are_frozen(by_name: dict[str, CncObject]) -> None:

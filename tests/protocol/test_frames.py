@@ -261,9 +261,17 @@ def test_reply_without_fields() -> None:
 
 
 def test_browse_reply_keeps_descriptors() -> None:
-    descriptor = ["ch1.dist_prog_start", 551, 0x121301, 0x56, "REAL64", 8, "r", "0.1 um", "d"]
-    reply = decode_incoming(encode_response(3, AdsCommand.BROWSE, [descriptor]))
-    assert tuple(reply.fields) == ([descriptor],)
+    descriptor = ["ch1.dist_prog_start", 551, 0x121301, 0x56, "REAL64", 8, "r", "0.1 um", "d", []]
+    state = ["ch1.mc_active_state_r", 553, 0x120101, 0x3002, "UNS32", 4, "r", "-", "d",
+             [[1, "DESELECTED"], [3, "READY"]]]
+    reply = decode_incoming(encode_response(3, AdsCommand.BROWSE, [descriptor, state]))
+    assert tuple(reply.fields) == ([descriptor, state],)
+
+
+def test_value_names_travel_as_pairs_because_integer_map_keys_are_refused() -> None:
+    """Why a descriptor's value names are [[value, name], ...] and not a map."""
+    with pytest.raises(ProtocolError):
+        decode_incoming(encode_response(3, AdsCommand.BROWSE, [{3: "READY"}]))
 
 
 def test_encode_error_round_trips_code_and_message() -> None:

@@ -1,0 +1,80 @@
+"""What the numbers of the enumeration objects mean: the documented value sets.
+
+An object such as ``ch1.mc_active_state_r`` carries a plain UNS32 on the wire; its
+meaning (3 = READY) is part of the contract between the service and every client, like
+an ADS state. The sets are defined once here: the kernel works with them, the catalog
+names them in browse replies (``ObjectInfo.enum`` on the client side), and clients may
+use them directly.
+
+Execution mode is a bit set, not an enumeration: its objects carry no value names (a
+value such as 0x48 is a combination); ``ExecutionMode`` names the single bits.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+
+class ChannelMode(IntEnum):
+    """Operation mode of a channel (HLI ``mode_and_state`` values)."""
+
+    STANDBY = 1  # no operation mode selected
+    AUTOMATIC = 2  # programs from the program store
+    MDI = 3  # manual data input: manual blocks
+    MANUAL = 4  # jog / handwheel (manual mode; no NC program)
+    REFERENCE = 5  # homing (not offered by this kernel's commands)
+
+
+class ChannelState(IntEnum):
+    """State of the channel within its mode (HLI ``mode_and_state`` values)."""
+
+    DESELECTED = 1  # the mode is not selected
+    SELECTED = 2  # the mode is selected, nothing to run yet
+    READY = 3  # a program (or manual block) is ready to start
+    ACTIVE = 4  # running
+    HOLD = 5  # feedhold: the path is stopped and resumes on START
+    ERROR = 6  # an error stopped the channel; RESET clears it
+
+
+class LinkState(IntEnum):
+    """State of a logical axis's link to its physical axis (FCT-C15 ``link_state``)."""
+
+    LINKED = 0  # the link exists: this logical axis drives the physical axis
+    REQUESTED = 1  # the physical axis is requested from the position controller
+    WAITING_ACK = 2  # waiting for the position controller's acknowledgement
+
+
+class ContourBlockType(IntEnum):
+    """``block_type`` of a contour look-ahead reply entry (FCT-C40)."""
+
+    NONE = 0  # no entry: ends the list
+    LINEAR = 1  # straight line
+    CIRCULAR = 2  # circular arc
+    LOG_ON = 3  # #CONTOUR LOOKAHEAD LOG ON: start of the marked area
+    LOG_PARAM = 4  # #CONTOUR LOOKAHEAD LOG [PARAM=..] inside the area
+    LOG_OFF = 5  # #CONTOUR LOOKAHEAD LOG OFF: end of the marked area
+    POLYNOMIAL = 6  # polynomial contour element
+
+
+class ExecutionMode(IntEnum):
+    """Execution mode bits of a channel (``mc_command_execution_mode_w``); a value is
+    their OR."""
+
+    ISG_STANDARD = 0x0  # normal machining
+    BLOCK_SEARCH = 0x1  # SV: block search
+    SOLLKON = 0x2  # contour visualisation with output
+    ON_LINE = 0x4  # online
+    SYNCHK = 0x8  # syntax check
+    PROD_TIME = 0x10  # production time calculation
+    ONLINE_PROD_TIME = 0x20  # online production time calculation
+    MACHINE_LOCK = 0x40  # dry run: no axis motion
+    ADD_MDI_BLOCK = 0x80  # additional MDI block
+    KIN_TRAFO_OFF = 0x100  # kinematic transformation off
+    SOLLKON_NO_OUTPUT = 0x800  # with SOLLKON: contour visualisation without output
+    BEARB_MODE_SCENE = 0x1000  # machining scene mode
+    SUPPRESS_TECHNO_OUTPUT = 0x2000  # no M/H/T output
+
+
+def value_names(values: type[IntEnum]) -> dict[int, str]:
+    """``{3: "READY", ...}``: the names of an enumeration's values."""
+    return {int(member): member.name for member in values}
