@@ -1,31 +1,32 @@
-"""Fixtures: real services over real sockets, on free ports, with the virtual clock."""
+"""Fixtures: real services over real sockets, on free ports, with the virtual clock.
+
+The services come from our own pytest plugin (``cnc_objects.testing``, loaded through its
+entry point); ``service`` and ``shared_service`` are the names our tests have used for
+its ``cnc_service`` and ``cnc_shared_service``.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import pytest
 
-from tests.support.service import RunningService, start_service
+from cnc_objects.testing import ServiceProcess
+
+pytest_plugins = ["pytester"]  # the plugin's own tests run pytest on small test files
+
+
+@pytest.fixture
+def service(cnc_service: ServiceProcess) -> ServiceProcess:
+    """A fresh service for one test: its writes do not leak into other tests."""
+    return cnc_service
 
 
 @pytest.fixture(scope="session")
-def shared_service() -> Iterator[RunningService]:
+def shared_service(cnc_shared_service: ServiceProcess) -> ServiceProcess:
     """One service for tests that only read (or restore what they write)."""
-    service = start_service()
-    yield service
-    assert service.stop() == 0, "\n".join(service.log)
+    return cnc_shared_service
 
 
 @pytest.fixture
-def service() -> Iterator[RunningService]:
-    """A fresh service for one test: its writes do not leak into other tests."""
-    service = start_service()
-    yield service
-    assert service.stop() == 0, "\n".join(service.log)
-
-
-@pytest.fixture
-def endpoint(shared_service: RunningService) -> str:
+def endpoint(shared_service: ServiceProcess) -> str:
     """Endpoint of the shared service."""
     return shared_service.endpoint

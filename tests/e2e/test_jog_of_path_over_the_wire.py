@@ -10,9 +10,9 @@ import pytest
 
 from cnc_objects.clients import AdsError, ChannelError, Client
 from cnc_objects.protocol.constants import CncPort
+from cnc_objects.testing import ServiceProcess, serving
 from tests.clients.test_cli import cnc, json_lines
 from tests.service.test_entry_point import run_service
-from tests.support.service import serving
 
 PARAMS = Path(__file__).parent.parent / "data" / "params"
 SUSPEND = "gpCh[{}].bahn_mc_control.suspend_axis_output.command_w"
@@ -29,34 +29,33 @@ def ok(endpoint: str, *args: str) -> None:
     assert result.returncode == 0, (args, result.stdout, result.stderr)
 
 
-def test_the_table_with_the_cli_only() -> None:
+def test_the_table_with_the_cli_only(cnc_service: ServiceProcess) -> None:
     """docs/jog-of-path.md, "Walkthrough": the same commands, the same numbers."""
-    with serving() as service:
-        e = service.endpoint
-        columns = ("ch1.ax1.command_position_acs", "ch2.ax1.command_position_acs",
-                   "ax1.command_position_acs", "ch1.ax1.position_offset",
-                   "ch2.ax1.position_offset")
-        ok(e, "write", "ch1.mc_command_execution_mode_w", "0x80")
-        ok(e, "write", "ch2.mc_command_execution_mode_w", "0x80")
-        ok(e, "mdi", "--wait", "G01 G90 X50 F6000")
-        assert read_mm(e, *columns) == [50, 0, 50, 0, 0]
-        ok(e, "write", SUSPEND.format(0), "1")
-        ok(e, "write", SUSPEND.format(1), "0")
-        ok(e, "mdi", "-c", "2", "--wait", "G01 G90 X15 F6000")
-        assert read_mm(e, *columns) == [50, 15, 15, 0, 0]
-        ok(e, "write", SUSPEND.format(1), "1")
-        ok(e, "write", SUSPEND.format(0), "0")
-        ok(e, "mdi", "--wait", "X80")
-        assert read_mm(e, *columns) == [80, 15, 45, 35, -30]
-        ok(e, "write", SUSPEND.format(0), "1")
-        ok(e, "write", SUSPEND.format(1), "0")
-        ok(e, "mdi", "-c", "2", "--wait", "X0")
-        assert read_mm(e, *columns) == [80, 0, 30, 50, -30]
-        # PLC side: drive X (slot 0) is driven by axis 11 with offset -30 mm.
-        plc = cnc("--json", "read", "gpAx[0].lr_state.position_offset_r",
-                  "gpAx[0].lr_state.link_to_ipo_r", "gpAx[3].ipo_state.link_to_lr",
-                  "gpAx[0].ipo_state.link_to_lr", endpoint=e)
-        assert [r["value"] for r in json_lines(plc)] == [-300_000, 11, 1, 0]
+    e = cnc_service.endpoint
+    columns = ("ch1.ax1.command_position_acs", "ch2.ax1.command_position_acs",
+               "ax1.command_position_acs", "ch1.ax1.position_offset",
+               "ch2.ax1.position_offset")
+    ok(e, "write", "ch1.mc_command_execution_mode_w", "0x80")
+    ok(e, "write", "ch2.mc_command_execution_mode_w", "0x80")
+    ok(e, "mdi", "--wait", "G01 G90 X50 F6000")
+    assert read_mm(e, *columns) == [50, 0, 50, 0, 0]
+    ok(e, "write", SUSPEND.format(0), "1")
+    ok(e, "write", SUSPEND.format(1), "0")
+    ok(e, "mdi", "-c", "2", "--wait", "G01 G90 X15 F6000")
+    assert read_mm(e, *columns) == [50, 15, 15, 0, 0]
+    ok(e, "write", SUSPEND.format(1), "1")
+    ok(e, "write", SUSPEND.format(0), "0")
+    ok(e, "mdi", "--wait", "X80")
+    assert read_mm(e, *columns) == [80, 15, 45, 35, -30]
+    ok(e, "write", SUSPEND.format(0), "1")
+    ok(e, "write", SUSPEND.format(1), "0")
+    ok(e, "mdi", "-c", "2", "--wait", "X0")
+    assert read_mm(e, *columns) == [80, 0, 30, 50, -30]
+    # PLC side: drive X (slot 0) is driven by axis 11 with offset -30 mm.
+    plc = cnc("--json", "read", "gpAx[0].lr_state.position_offset_r",
+              "gpAx[0].lr_state.link_to_ipo_r", "gpAx[3].ipo_state.link_to_lr",
+              "gpAx[0].ipo_state.link_to_lr", endpoint=e)
+    assert [r["value"] for r in json_lines(plc)] == [-300_000, 11, 1, 0]
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,10 @@ import math
 import pytest
 
 from cnc_objects.clients import AdsError, Client
-from tests.support.service import serving
+from cnc_objects.testing import run_program
+
+# The machine of every test here: channel 1 with the low look-ahead buffer (30 blocks).
+pytestmark = pytest.mark.cnc_service(config="data/low-buffer-machine.toml")
 
 FEED_MM_MIN = 6000.0
 
@@ -28,49 +31,30 @@ def _chords(radius_mm: float, chord_mm: float = 0.005, la_on: bool = False) -> b
     return "\n".join(lines).encode()
 
 
-@pytest.fixture
-def low_buffer_machine(tmp_path):
-    config = tmp_path / "machine.toml"
-    config.write_text(
-        '[[channels]]\nid = 1\nname = "main"\n'
-        'interpolator_function = "FCT_LOOK_AHEAD_LOW"\n'
-        'la = {metb_s = 0.02, vfbt = 1.0, bbtrc = 8}\n'
-        'axes = [{name = "X", logical_number = 1}, {name = "Y", logical_number = 2},'
-        ' {name = "Z", logical_number = 3}]\n'
-    )
-    return config
+def test_limits_and_buffer_size_are_read_only_objects(cnc_client: Client) -> None:
+    api = cnc_client
+    assert api.read_many(["ch1.lookahead_blocks", "ch1.ax1.vel_max", "ch1.ax2.acc_max",
+                          "ch1.ax3.vel_jump_max"]) == {
+        "ch1.lookahead_blocks": 30, "ch1.ax1.vel_max": 500.0, "ch1.ax2.acc_max": 5000.0,
+        "ch1.ax3.vel_jump_max": 20.0}
+    with pytest.raises(AdsError) as info:
+        api.write("ch1.lookahead_blocks", 190)
+    assert info.value.code == 0x704
+    assert api.read("ch1.lookahead_blocks") == 30
 
 
-def test_limits_and_buffer_size_are_read_only_objects(low_buffer_machine) -> None:
-    with serving("--config", str(low_buffer_machine)) as service, \
-            Client(service.endpoint) as api:
-        assert api.read_many(["ch1.lookahead_blocks", "ch1.ax1.vel_max", "ch1.ax2.acc_max",
-                              "ch1.ax3.vel_jump_max"]) == {
-            "ch1.lookahead_blocks": 30, "ch1.ax1.vel_max": 500.0, "ch1.ax2.acc_max": 5000.0,
-            "ch1.ax3.vel_jump_max": 20.0}
-        with pytest.raises(AdsError) as info:
-            api.write("ch1.lookahead_blocks", 190)
-        assert info.value.code == 0x704
-        assert api.read("ch1.lookahead_blocks") == 30
-
-
-def test_la_on_runs_short_blocks_at_speed_the_buffer_alone_cannot(low_buffer_machine) -> None:
-    with serving("--config", str(low_buffer_machine)) as service, \
-            Client(service.endpoint) as api:
-        api.upload("chords.nc", _chords(2.0))
-        api.upload("chords-la.nc", _chords(2.0, la_on=True))
-        api.run_program("chords.nc")
-        api.wait_program(timeout_s=60)
-        slow_s = api.read("ch1.program_time")
-        warnings = api.channel_errors(1)
-        assert len(warnings) == 1 and warnings[0].startswith("warning 50301"), warnings
-        assert "buffer of 30 blocks limits the path speed" in warnings[0]
-        api.run_program("chords-la.nc")
-        api.wait_program(timeout_s=60)
-        fast_s = api.read("ch1.program_time")
-        assert api.read("ch1.mc_error_count_r") == 0, api.channel_errors(1)
-        # ends exactly at the programmed end point (the origin)
-        assert [api.read(f"ch1.ax{a}.command_position_acs") for a in (1, 2)] == [0, 0]
+def test_la_on_runs_short_blocks_at_speed_the_buffer_alone_cannot(cnc_client: Client) -> None:
+    api = cnc_client
+    api.upload("chords.nc", _chords(2.0))
+    api.upload("chords-la.nc", _chords(2.0, la_on=True))
+    slow_s = run_program(api, "chords.nc", timeout_s=60).program_time_s
+    warnings = api.channel_errors(1)
+    assert len(warnings) == 1 and warnings[0].startswith("warning 50301"), warnings
+    assert "buffer of 30 blocks limits the path speed" in warnings[0]
+    fast_s = run_program(api, "chords-la.nc", timeout_s=60).program_time_s
+    assert api.read("ch1.mc_error_count_r") == 0, api.channel_errors(1)
+    # ends exactly at the programmed end point (the origin)
+    assert [api.read(f"ch1.ax{a}.command_position_acs") for a in (1, 2)] == [0, 0]
     # 2513 chords of 5 um = 12.57 mm at F6000 (100 mm/s): 126 ms of cruise plus 20 ms
     # of ramps; with 30 blocks (150 um) ahead the path may not exceed
     # sqrt(2 a 150 um) ~ 39 mm/s; LA_ON's block rate allows 29 blocks/ms = 145 mm/s

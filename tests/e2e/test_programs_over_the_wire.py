@@ -2,21 +2,23 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import pytest
 
-from cnc_objects.clients import AdsError, ChannelError, Client
+from cnc_objects.clients import AdsError, ChannelError, Client, ClientValueError
 from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES, PROGRAM_STORE_GROUP, CncPort
 from tests.clients.test_cli import cnc, json_lines
-from tests.support.service import RunningService, start_service
+from cnc_objects.testing import ServiceProcess, run_program, serving, wait_for
 
 SQUARE = "N10 G1 X10 F6000\nN20 Y10\nN30 X0\nN40 Y0\nN50 M30\n"
 
 
 @pytest.fixture(scope="module")
-def machine() -> RunningService:
-    service = start_service()
-    yield service
-    assert service.stop() == 0, "\n".join(service.log)
+def machine() -> Iterator[ServiceProcess]:
+    """One service for this module's tests (each starts from RESET)."""
+    with serving() as service:
+        yield service
 
 
 @pytest.fixture
@@ -49,9 +51,9 @@ def test_bad_names_are_refused_and_change_nothing(c, name, code):
 
 def test_oversized_upload_is_refused_and_keeps_the_old_version(c):
     c.upload("big.nc", b"M30\n")
-    with pytest.raises(AdsError) as info:
+    with pytest.raises(ClientValueError) as info:  # refused before it is sent
         c.upload("big.nc", b";" * (PROGRAM_MAX_BYTES + 1))
-    assert info.value.code == 0x705
+    assert "the store takes at most" in str(info.value)
     assert c.download("big.nc") == b"M30\n"
 
 
@@ -72,9 +74,7 @@ def test_unknown_store_offset(c):
 
 def test_run_square_and_read_the_objects(c):
     c.upload("square.nc", SQUARE.encode())
-    c.run_program("square.nc")
-    c.wait_program(1, timeout_s=30)
-    s = c.status(1)
+    s = run_program(c, "square.nc", timeout_s=30)
     assert (s.mode, s.state, s.program) == ("AUTOMATIC", "READY", "square.nc")
     assert s.positions_mm == {"X": 0.0, "Y": 0.0, "Z": 0.0}
     assert s.block_number == 50 and s.line == 5
@@ -122,9 +122,7 @@ def test_hold_and_resume_over_the_wire(c):
     c.run_program("long.nc")
     c.hold(1)
     assert c.read("ch1.mc_active_state_r") == 5
-    for sample in c.subscribe("ch1.actual_path_velocity"):
-        if sample.value == 0.0:
-            break
+    wait_for(c, "ch1.actual_path_velocity", 0.0)
     x = c.read("ch1.ax1.command_position_acs")
     assert c.read("ch1.ax1.command_position_acs") == x  # standing
     c.start(1)

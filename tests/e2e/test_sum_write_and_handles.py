@@ -11,7 +11,7 @@ import zmq
 from cnc_objects.protocol import sum as sums
 from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
 from cnc_objects.protocol.frames import ReadRequest, ReadWriteRequest, Response, WriteRequest, decode_incoming
-from tests.support.service import RunningService
+from cnc_objects.testing import ServiceProcess
 
 COM, GEO = 553, 551
 CH1_COM, CH2_COM = 0x120101, 0x120102
@@ -19,10 +19,10 @@ _ids = itertools.count(1)
 
 
 @pytest.fixture
-def sock(service: RunningService):
+def sock(cnc_service: ServiceProcess):
     s = zmq.Context.instance().socket(zmq.DEALER)
     s.setsockopt(zmq.LINGER, 0)
-    s.connect(service.endpoint)
+    s.connect(cnc_service.endpoint)
     yield s
     s.close()
 

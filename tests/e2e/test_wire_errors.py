@@ -15,7 +15,6 @@ No sleeps: every wait is a poll with a timeout.
 from __future__ import annotations
 
 import itertools
-import queue
 import struct
 import uuid
 from collections.abc import Iterator
@@ -25,7 +24,7 @@ import pytest
 import zmq
 from zmq.utils.monitor import recv_monitor_message
 
-from tests.support.service import RunningService
+from cnc_objects.testing import ServiceProcess
 
 # --------------------------------------------------------------------------- constants
 
@@ -117,9 +116,9 @@ def connect(endpoint: str) -> zmq.Socket:
 
 
 @pytest.fixture
-def client(endpoint: str) -> Iterator[zmq.Socket]:
+def client(cnc_shared_service: ServiceProcess) -> Iterator[zmq.Socket]:
     """A raw DEALER socket on the shared service."""
-    sock = connect(endpoint)
+    sock = connect(cnc_shared_service.endpoint)
     yield sock
     sock.close(linger=0)
 
@@ -264,24 +263,15 @@ def sum_read_frame(invoke_id: int, port: int, items: list[tuple[int, int, int]])
     return read_write_frame(invoke_id, port, 0xF080, len(items), read_length, data)
 
 
-def log_barrier(service: RunningService, sock: zmq.Socket) -> None:
+def log_barrier(service: ServiceProcess, sock: zmq.Socket) -> None:
     """Make the service log a unique line and wait for it: every line the service wrote
     before it is then in ``service.log`` (its stderr is one ordered stream)."""
     marker = f"barrier-{uuid.uuid4().hex}"
     sock.send(pack(marker, READ, COM, 0, 0, 0))  # unreadable invoke id: logged, dropped
-    wait_for_log(service, marker)
+    service.wait_for_log(marker)
 
 
-def wait_for_log(service: RunningService, pattern: str, timeout_s: float = 10.0) -> str:
-    """``service.wait_for_log`` that fails with the log when the line does not come."""
-    try:
-        return service.wait_for_log(pattern, timeout_s)
-    except queue.Empty:
-        log = "\n".join(service.log)
-        raise AssertionError(f"service did not log {pattern!r} in {timeout_s} s:\n{log}") from None
-
-
-def assert_no_traceback(service: RunningService) -> None:
+def assert_no_traceback(service: ServiceProcess) -> None:
     text = "\n".join(service.log)
     assert "Traceback" not in text, text
 
@@ -332,8 +322,8 @@ def test_read_with_wrong_length_is_0x705(client: zmq.Socket) -> None:
     read_error(client, (port, group, offset, 0), INVALIDSIZE)
 
 
-def test_write_with_wrong_data_length_is_0x705(service: RunningService) -> None:
-    sock = connect(service.endpoint)
+def test_write_with_wrong_data_length_is_0x705(cnc_service: ServiceProcess) -> None:
+    sock = connect(cnc_service.endpoint)
     try:
         before = read(sock, FEED_OVERRIDE_R)
         for data in (b"\x01", struct.pack("<I", 500), b""):
@@ -372,8 +362,8 @@ def test_data_over_the_data_limit_but_under_the_frame_limit_is_0x705(
 # --------------------------------------------------------------------------- values
 
 
-def test_out_of_range_feed_override_is_0x706_and_not_applied(service: RunningService) -> None:
-    sock = connect(service.endpoint)
+def test_out_of_range_feed_override_is_0x706_and_not_applied(cnc_service: ServiceProcess) -> None:
+    sock = connect(cnc_service.endpoint)
     try:
         # A valid value lands (so "unchanged" below is not a value that cannot change).
         assert write(sock, FEED_OVERRIDE_W, struct.pack("<H", 500))[2] == 0
@@ -408,9 +398,9 @@ def test_out_of_range_feed_override_is_0x706_and_not_applied(service: RunningSer
     ],
 )
 def test_invalid_execution_mode_is_0x706_and_not_applied(
-    service: RunningService, mode: int
+    cnc_service: ServiceProcess, mode: int
 ) -> None:
-    sock = connect(service.endpoint)
+    sock = connect(cnc_service.endpoint)
     try:
         before = read(sock, EXEC_MODE_R)
         port, group, offset, _ = EXEC_MODE_W
@@ -705,9 +695,9 @@ def test_add_notification_on_unknown_address_is_0x703(client: zmq.Socket) -> Non
     assert receive(client, SILENCE_MS) is None, "a refused subscription sent samples"
 
 
-def test_subscriber_that_vanishes_does_not_hurt_the_service(service: RunningService) -> None:
-    subscriber = connect(service.endpoint)
-    other = connect(service.endpoint)
+def test_subscriber_that_vanishes_does_not_hurt_the_service(cnc_service: ServiceProcess) -> None:
+    subscriber = connect(cnc_service.endpoint)
+    other = connect(cnc_service.endpoint)
     try:
         port, group, offset, length = address_of(subscriber, "cnc_tick_counter_r")
         invoke_id = next_id()
@@ -730,14 +720,14 @@ def test_subscriber_that_vanishes_does_not_hurt_the_service(service: RunningServ
 
         subscriber.close(linger=0)  # gone without DeleteDeviceNotification
 
-        # The service notices and forgets the subscription, and serves others meanwhile.
-        wait_for_log(service, r"client gone: dropped 1 notification")
+        # The cnc_service notices and forgets the subscription, and serves others meanwhile.
+        cnc_service.wait_for_log(r"client gone: dropped 1 notification")
         for _ in range(3):
             assert_serves(other)
         assert tick(other) > ticks[-1]
-        log_barrier(service, other)
-        assert_no_traceback(service)
-        assert service.process.poll() is None
+        log_barrier(cnc_service, other)
+        assert_no_traceback(cnc_service)
+        assert cnc_service.process.poll() is None
     finally:
         subscriber.close(linger=0)
         other.close(linger=0)
@@ -746,8 +736,8 @@ def test_subscriber_that_vanishes_does_not_hurt_the_service(service: RunningServ
 # --------------------------------------------------------------------------- survival
 
 
-def test_service_survives_everything_and_exits_cleanly(service: RunningService) -> None:
-    sock = connect(service.endpoint)
+def test_service_survives_everything_and_exits_cleanly(cnc_service: ServiceProcess) -> None:
+    sock = connect(cnc_service.endpoint)
     try:
         # Every malformed frame, then a valid Read: whatever comes back before the Read's
         # reply is an error reply to a malformed frame (the dedicated tests above check
@@ -764,7 +754,7 @@ def test_service_survives_everything_and_exits_cleanly(service: RunningService) 
                 break
             assert_error(reply, READABLE_ID, None, None)
         assert assert_ok(reply, invoke_id, READ) == [STATIC_VALUES[NUMBER_OF_CHANNELS]]
-        assert_silent_then_serves(sock, service.endpoint)
+        assert_silent_then_serves(sock, cnc_service.endpoint)
 
         read_error(sock, (GEO, 0x7E0000, 0x1, 4), INVALIDGRP)
         read_error(sock, (GEO, CH1_GEO, 0x7777, 4), INVALIDOFFSET)
@@ -781,7 +771,7 @@ def test_service_survives_everything_and_exits_cleanly(service: RunningService) 
         )
 
         # A subscriber that vanishes.
-        subscriber = connect(service.endpoint)
+        subscriber = connect(cnc_service.endpoint)
         invoke_id = next_id()
         frame = add_notification_frame(invoke_id, COM, PLATFORM, 0x1011, 4, 3, 10)
         reply = request(subscriber, frame)
@@ -789,17 +779,17 @@ def test_service_survives_everything_and_exits_cleanly(service: RunningService) 
         subscriber.close(linger=0)
 
         # An oversized frame from yet another client.
-        big = connect(service.endpoint)
+        big = connect(cnc_service.endpoint)
         big.send(bytes(MAXMSGSIZE + 1))
         assert receive(big, SILENCE_MS) is None
         big.close(linger=0)
 
         for address, value in STATIC_VALUES.items():
             assert read(sock, address) == value
-        log_barrier(service, sock)
-        assert_no_traceback(service)
+        log_barrier(cnc_service, sock)
+        assert_no_traceback(cnc_service)
     finally:
         sock.close(linger=0)
 
-    assert service.process.poll() is None, "the service died"
-    assert service.stop() == 0, "\n".join(service.log)
+    assert cnc_service.process.poll() is None, "the service died"
+    assert cnc_service.stop() == 0, cnc_service.log_text

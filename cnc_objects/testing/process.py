@@ -1,0 +1,176 @@
+"""A real ``cnc-service`` in a subprocess on a free port, for integration tests.
+
+    with serving("--config", "machine.toml") as service:   # virtual clock, own program store
+        with Client(service.endpoint) as cnc:
+            ...
+
+The service binds ``tcp://127.0.0.1:*`` (ZeroMQ picks a free port: no race between
+choosing a port and binding it) and logs the endpoint it got; the start waits for that
+log line, never for a fixed time. Standard library only: the pytest plugin imports this
+at every pytest start.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+_LISTENING = re.compile(r"listening on (tcp://\S+)")
+START_TIMEOUT_S = 20.0  # a cold start imports numpy and pydantic: seconds on a busy CI
+STOP_TIMEOUT_S = 10.0
+
+
+class ServiceProcess:
+    """A running ``cnc-service``: its process, endpoint and everything it logged so far.
+
+    ``log`` grows while the service runs (a thread reads its stderr line by line, so the
+    pipe never fills up); ``stop`` ends it with SIGINT, as Ctrl-C would.
+    """
+
+    def __init__(self, process: subprocess.Popen[str], program_dir: Path,
+                 owned_dir: tempfile.TemporaryDirectory[str] | None = None) -> None:
+        self.process = process
+        self.program_dir = program_dir  # the service's program store
+        self.endpoint = ""  # set once the service has logged it
+        self.log: list[str] = []
+        self._changed = threading.Condition()
+        self._ended = False  # stderr closed: the process is gone
+        self._owned_dir = owned_dir
+        threading.Thread(target=self._pump, name=f"cnc-service-{process.pid}-log",
+                         daemon=True).start()
+
+    def _pump(self) -> None:
+        for line in self.process.stderr:  # type: ignore[union-attr]
+            with self._changed:
+                self.log.append(line.rstrip("\n"))
+                self._changed.notify_all()
+        with self._changed:
+            self._ended = True
+            self._changed.notify_all()
+
+    @property
+    def log_text(self) -> str:
+        """The log so far as one text."""
+        return "\n".join(self.log)
+
+    def wait_for_log(self, pattern: str, timeout_s: float = 10.0) -> str:
+        """The first log line (already logged or still to come) that matches the regular
+        expression ``pattern``. Raises ``TimeoutError`` (with the log) when none comes
+        within ``timeout_s``, ``RuntimeError`` when the service ends without it."""
+        regex = re.compile(pattern)
+        deadline = time.monotonic() + timeout_s
+        seen = 0
+        with self._changed:
+            while True:
+                for line in self.log[seen:]:
+                    if regex.search(line):
+                        return line
+                seen = len(self.log)
+                if self._ended:
+                    raise RuntimeError(
+                        f"cnc-service ended without logging {pattern!r}:\n{self.log_text}")
+                left_s = deadline - time.monotonic()
+                if left_s <= 0:
+                    raise TimeoutError(f"cnc-service did not log {pattern!r} within "
+                                       f"{timeout_s:g} s:\n{self.log_text}")
+                self._changed.wait(left_s)
+
+    def stop(self, timeout_s: float = STOP_TIMEOUT_S) -> int:
+        """SIGINT, then the exit code (0: stopped cleanly). A service that has not ended
+        ``timeout_s`` after SIGINT is killed; its code is then negative and the log says
+        so. Removes the program store the service was started with, if it made one."""
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+        try:
+            code = self.process.wait(timeout_s)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            code = self.process.wait()
+            self._join_log()
+            with self._changed:
+                self.log.append(f"(cnc-service did not stop within {timeout_s:g} s of "
+                                "SIGINT: killed)")
+        self._join_log()
+        if self._owned_dir is not None:
+            self._owned_dir.cleanup()
+            self._owned_dir = None
+        return code
+
+    def _join_log(self) -> None:
+        """Wait until the last lines the service wrote are in ``log``."""
+        with self._changed:
+            self._changed.wait_for(lambda: self._ended, STOP_TIMEOUT_S)
+
+
+def service_command(*args: str) -> list[str]:
+    """The command line ``start_service(*args)`` runs: ``cnc-service`` on a free loopback
+    port with the virtual clock, unless ``args`` name another endpoint or clock (the
+    last occurrence of an option wins)."""
+    argv = [sys.executable, "-m", "cnc_objects.service.main", "--endpoint", "tcp://127.0.0.1:*"]
+    if "--clock" not in args:
+        argv += ["--clock", "virtual"]
+    return [*argv, *args]
+
+
+def start_service(
+    *args: str,
+    program_dir: str | os.PathLike[str] | None = None,
+    cwd: str | os.PathLike[str] | None = None,
+    timeout_s: float = START_TIMEOUT_S,
+) -> ServiceProcess:
+    """Start ``cnc-service`` (see ``service_command``) and return once it listens.
+
+    ``program_dir``: the program store; by default an empty directory of this service
+    only, removed by ``stop``. ``args`` are further ``cnc-service`` options (``--config
+    FILE``, ``--speed 1``, ...). Raises ``RuntimeError`` with the service's log when it
+    exits before listening, ``TimeoutError`` when it has not listened after ``timeout_s``
+    (the process is killed then).
+    """
+    owned = None
+    if "--program-dir" in args:
+        store = Path(args[args.index("--program-dir") + 1])
+    elif program_dir is not None:
+        store = Path(program_dir)
+        args = (*args, "--program-dir", str(store))
+    else:
+        owned = tempfile.TemporaryDirectory(prefix="cnc-programs-")
+        store = Path(owned.name)
+        args = (*args, "--program-dir", str(store))
+    process = subprocess.Popen(
+        service_command(*args), cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE, text=True, errors="replace",
+    )
+    service = ServiceProcess(process, store, owned)
+    try:
+        line = service.wait_for_log(_LISTENING.pattern, timeout_s)
+    except BaseException as exc:  # not listening: no process may be left behind
+        if process.poll() is None:
+            process.kill()
+        code = service.stop()
+        if isinstance(exc, RuntimeError):  # it ended by itself: say with which code
+            raise RuntimeError(f"cnc-service exited with {code} before listening:\n"
+                               f"{service.log_text}") from None
+        raise
+    service.endpoint = _LISTENING.search(line).group(1)  # type: ignore[union-attr]
+    return service
+
+
+@contextlib.contextmanager
+def serving(*args: str, **options: object) -> Iterator[ServiceProcess]:
+    """``start_service(*args, **options)`` for a ``with`` block. On leaving, the service
+    must stop cleanly (exit code 0); otherwise ``AssertionError`` with its log."""
+    service = start_service(*args, **options)  # type: ignore[arg-type]
+    try:
+        yield service
+    finally:
+        code = service.stop()
+        assert code == 0, f"cnc-service exited with {code}:\n{service.log_text}"
