@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -10,11 +12,10 @@ import pytest
 
 from cnc_objects.clients import AdsError, Client
 from tests.clients.test_cli import cnc, json_lines
-from tests.clients.test_png_chart import decode_png
+from tests.clients.test_path_plot import FEED_RGB, PROGRAM, TOP_SPEED_RGB, png_pixels
 from tests.support.service import RunningService
 
-# a line, a half circle (G2, r 10) and a line at a lower feed: 20 + 10*pi + 20 mm
-PROGRAM = b"G01 X0 Y0 F6000\nG01 X20 Y0\nG02 X20 Y20 I0 J10\nG01 X0 Y20 F3000\nM30\n"
+# PROGRAM: a line, a half circle (G2, r 10) and a line at a lower feed: 20 + 10*pi + 20 mm
 LENGTH_MM = 40.0 + 10.0 * math.pi
 
 
@@ -92,11 +93,11 @@ def test_cnc_plot_writes_the_png(endpoint: str, tmp_path: Path) -> None:
     assert record["output"] == str(target) and record["ended"] == "READY"
     assert record["path_mm"] == pytest.approx(LENGTH_MM, abs=1e-6)
     assert record["v_max_mm_s"] == pytest.approx(100.0)
-    img = decode_png(target.read_bytes())
+    img = png_pixels(target.read_bytes())
     assert img.shape == (800 + 600, 1200, 3)
-    # the path (blue) and the feed limit (red) are drawn
-    assert np.any(np.all(img == (31, 119, 180), axis=2))
-    assert np.any(np.all(img == (214, 39, 40), axis=2))
+    # the path at F6000 (the top of the speed colours) and the feed limit (red) are drawn
+    assert np.any(np.all(img == TOP_SPEED_RGB, axis=2))
+    assert np.any(np.all(img == FEED_RGB, axis=2))
 
 
 def test_cnc_plot_default_output_and_human_line(endpoint: str, tmp_path: Path) -> None:
@@ -106,7 +107,7 @@ def test_cnc_plot_default_output_and_human_line(endpoint: str, tmp_path: Path) -
                  cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert "arc.png: arc.nc in channel 1" in result.stdout and "READY" in result.stdout
-    assert decode_png((tmp_path / "arc.png").read_bytes()).shape[1] == 600
+    assert png_pixels((tmp_path / "arc.png").read_bytes()).shape[1] == 600
 
 
 def test_cnc_plot_of_a_failing_program_draws_up_to_the_error(
@@ -137,3 +138,32 @@ def test_cnc_plot_unknown_program_and_no_service(endpoint: str, tmp_path: Path) 
     assert missing.returncode == 1 and "0x70c" in missing.stderr and "no-such.nc" in missing.stderr
     nobody = cnc("--timeout", "0.3", "plot", "x.nc", endpoint="tcp://127.0.0.1:9")
     assert nobody.returncode == 3
+
+
+def test_cnc_starts_without_importing_matplotlib() -> None:
+    code = ("import sys; import cnc_objects.clients.cli; "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'matplotlib'))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[]"
+
+
+def test_cnc_plot_without_matplotlib_names_the_extra(service: RunningService,
+                                                     tmp_path: Path) -> None:
+    source = tmp_path / "part.nc"
+    source.write_bytes(PROGRAM)
+    target = tmp_path / "out.png"
+    # None in sys.modules makes every "import matplotlib" fail, as when it is not installed
+    code = ("import sys; sys.modules['matplotlib'] = None; "
+            "from cnc_objects.clients.cli import main; main()")
+    result = subprocess.run(
+        [sys.executable, "-c", code, "--endpoint", service.endpoint, "plot", str(source),
+         "-o", str(target)], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    assert result.stderr.splitlines() == [
+        "error: plots need matplotlib, which is not installed: pip install "
+        "'cnc-objects[plot]'"]
+    assert not target.exists()
+    with Client(service.endpoint) as c:  # refused before anything reached the service
+        assert [p.name for p in c.programs()] == []
