@@ -1,9 +1,19 @@
 """Clients of a cnc-objects service: async and blocking library, ``cnc`` CLI.
 
+    from cnc_objects.clients import AdsState, Client
+
+    with Client("tcp://127.0.0.1:5555") as c:
+        c.write_control(AdsState.STOP)   # or "stop"
+
 Imports protocol and objects, never service.
 """
 
+from cnc_objects.protocol.constants import AdsState
+from cnc_objects.protocol.errors import AdsReturnCode
+
+from .channel_ops import ContourBlock, ContourReply
 from .client import (
+    DEFAULT_ENDPOINT,
     AsyncClient,
     ChannelStatus,
     CheckError,
@@ -13,12 +23,25 @@ from .client import (
     ObjectInfo,
     ProgramEntry,
     Sample,
+    filetime_to_datetime,
 )
-from .errors import AdsConnectionError, AdsError, AdsTimeoutError, ChannelError
+from .errors import (
+    AdsConnectionError,
+    AdsError,
+    AdsTimeoutError,
+    ChannelError,
+    ClientValueError,
+    NoReplyError,
+)
+from .execution_mode import ExecutionMode, describe_execution_mode
+from .path_trace import PathTrace
 
 __all__ = [
+    "DEFAULT_ENDPOINT",
     "AdsConnectionError",
     "AdsError",
+    "AdsReturnCode",
+    "AdsState",
     "AdsTimeoutError",
     "AsyncClient",
     "ChannelError",
@@ -26,8 +49,16 @@ __all__ = [
     "CheckError",
     "CheckResult",
     "Client",
+    "ClientValueError",
+    "ContourBlock",
+    "ContourReply",
     "DeviceInfo",
+    "ExecutionMode",
+    "NoReplyError",
     "ObjectInfo",
+    "PathTrace",
     "ProgramEntry",
     "Sample",
+    "describe_execution_mode",
+    "filetime_to_datetime",
 ]

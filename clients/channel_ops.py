@@ -5,9 +5,12 @@
     status = await c.wait_program(channel=1, timeout_s=60)
     await c.mdi("G1 X10 F600", channel=1)
     result = await c.syntax_check("part.nc", channel=1)   # SYNCHK: nothing moves
+    await c.reset_to_standard(channel=1)               # RESET, standard execution mode
 
 Everything goes through objects and the program-store index group; nothing here knows
-the kernel. Waiting polls the channel's objects every ``POLL_S`` of wall time.
+the kernel. Waiting polls the channel's objects every ``POLL_S`` of wall time. A command
+the channel refuses because it is in ERROR says so, with the channel's errors and that
+RESET clears them (a CNC does not start in ERROR).
 """
 
 from __future__ import annotations
@@ -22,7 +25,8 @@ from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
 
-from .errors import AdsError, AdsTimeoutError, ChannelError
+from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError
+from .execution_mode import ExecutionMode, describe_execution_mode
 
 POLL_S = 0.01  # how often waiting re-reads the channel state (wall time)
 
@@ -30,7 +34,7 @@ MODES = {1: "STANDBY", 2: "AUTOMATIC", 3: "MDI", 4: "MANUAL", 5: "REFERENCE"}
 STATES = {1: "DESELECTED", 2: "SELECTED", 3: "READY", 4: "ACTIVE", 5: "HOLD", 6: "ERROR"}
 _ACTIVE, _HOLD, _ERROR = 4, 5, 6
 _ERROR_SLOTS = 8
-SYNCHK, MACHINE_LOCK = 0x8, 0x40  # execution mode bits (FCT-C9)
+SYNCHK, MACHINE_LOCK = int(ExecutionMode.SYNCHK), int(ExecutionMode.MACHINE_LOCK)
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,7 +83,9 @@ class ContourReply:
 
 @dataclass(frozen=True, slots=True)
 class ChannelStatus:
-    """What ``cnc status`` shows of a channel."""
+    """What ``cnc status`` shows of a channel. ``execution_mode``: the mode in effect
+    (the names of its bits, ``SYNCHK|MACHINE_LOCK``, or ``standard``); it stays after a
+    program ends; ``commanded_execution_mode``: the mode the next program start takes."""
 
     channel: int
     mode: str
@@ -92,6 +98,8 @@ class ChannelStatus:
     path_velocity_mm_s: float
     program_time_s: float
     errors: list[str]
+    execution_mode: str = "standard"
+    commanded_execution_mode: str = "standard"
 
 
 @dataclass(frozen=True, slots=True)
@@ -202,9 +210,8 @@ class ProgramOps:
         larger than the store takes is refused here (ADS 0x705): sent, its frame would
         exceed the wire's limit and the service would drop it without a reply."""
         if len(data) > PROGRAM_MAX_BYTES:
-            raise AdsError(AdsReturnCode.DEVICE_INVALIDSIZE,
-                           f"program {name!r} has {len(data):,} bytes; the store takes at most "
-                           f"{PROGRAM_MAX_BYTES:,}")
+            raise ClientValueError(f"program {name!r} has {len(data):,} bytes; the store "
+                                   f"takes at most {PROGRAM_MAX_BYTES:,}")
         await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD, _name_bytes(name) + data)
 
     async def download(self, name: str) -> bytes:
@@ -231,13 +238,36 @@ class ChannelOps:
     """Select, start, hold, resume, reset, manual blocks, status, waiting."""
 
     async def run_program(self, name: str, channel: int = 1) -> None:
-        """Select ``name`` (AUTOMATIC) and START it; returns once the channel is ACTIVE."""
-        await self.write(f"ch{channel}.mc_command_program_name_w", name)
-        await self.write(f"ch{channel}.mc_command_start_w", True)
+        """Select ``name`` (AUTOMATIC) and START it; returns once the channel is ACTIVE.
+        A channel in ERROR refuses (ADS 0x707, naming its errors) until RESET."""
+        what = f"start {name!r}"
+        await self._command(channel, what, f"ch{channel}.mc_command_program_name_w", name)
+        await self._command(channel, what, f"ch{channel}.mc_command_start_w", True)
 
     async def start(self, channel: int = 1) -> None:
         """START: run the selected program, or resume after feedhold, M0 or single block."""
-        await self.write(f"ch{channel}.mc_command_start_w", True)
+        await self._command(channel, "START", f"ch{channel}.mc_command_start_w", True)
+
+    async def _command(self, channel: int, what: str, name: str, value: Any) -> None:
+        """Write a channel command. The service refuses a channel in ERROR as not ready
+        (0x707) in the words of a working channel; that refusal is told as what it is:
+        the channel's errors, and that RESET clears them."""
+        try:
+            await self.write(name, value)
+        except AdsError as exc:
+            if exc.code != AdsReturnCode.DEVICE_NOTREADY:
+                raise
+            if await self.read(f"ch{channel}.mc_active_state_r") != _ERROR:
+                raise
+            message = await self._in_error(channel, what)
+            raise AdsError(exc.code, message) from None
+
+    async def _in_error(self, channel: int, what: str) -> str:
+        """Why ``what`` cannot be done in a channel in ERROR, with its errors."""
+        errors = await self.channel_errors(channel)
+        listed = "; ".join(errors) if errors else "no error text"
+        return (f"channel {channel} is in ERROR ({listed}); {what} needs a RESET first, "
+                "which clears the error (cnc reset)")
 
     async def hold(self, channel: int = 1) -> None:
         """Feedhold: the path decelerates and stops (HOLD)."""
@@ -247,11 +277,24 @@ class ChannelOps:
         """RESET the channel from any state."""
         await self.write(f"ch{channel}.mc_command_reset_w", True)
 
+    async def reset_to_standard(self, channel: int = 1) -> None:
+        """RESET the channel and command standard execution: execution mode ISG_STANDARD
+        (no bit: no SYNCHK, MACHINE_LOCK, PROD_TIME, ...) and ``syn_chk.record_result``
+        FALSE, which a syntax check set up by hand leaves behind. Like any execution
+        mode, standard takes effect at the next program start. A PLC that commands the
+        mode itself (``gpCh[i].decoder_mc_control.execution_mode.enable_w`` TRUE) keeps
+        its command."""
+        ch = f"ch{channel}"
+        await self.reset(channel)
+        await self.write(f"{ch}.mc_command_execution_mode_w", 0)
+        await self.write(f"{ch}.syn_chk.record_result", False)
+
     async def mdi(self, blocks: str, channel: int = 1) -> int:
         """Run ``blocks`` as manual blocks; returns the count of finished manual blocks
         before this one (``wait_mdi`` waits until it has grown)."""
         before = await self.read(f"ch{channel}.mc_manual_blocks_done_r")
-        await self.write(f"ch{channel}.mc_command_manual_block_w", blocks)
+        await self._command(channel, "a manual block", f"ch{channel}.mc_command_manual_block_w",
+                            blocks)
         return before
 
     async def channel_errors(self, channel: int = 1) -> list[str]:
@@ -281,7 +324,8 @@ class ChannelOps:
             for n in (
                 "mc_active_mode_r", "mc_active_state_r", "mc_active_program_name_r",
                 "mc_active_file_name_r", "mc_active_line_r", "actual_block_number",
-                "actual_path_velocity", "program_time",
+                "actual_path_velocity", "program_time", "mc_active_execution_mode_r",
+                "mc_command_execution_mode_r",
             )
         ]
         axis_names = [o.name.replace("command_position_acs", "axis_name") for o in axes]
@@ -294,6 +338,8 @@ class ChannelOps:
             channel, MODES.get(v[0], str(v[0])), STATES.get(v[1], str(v[1])), v[2], v[3], v[4],
             v[5], positions, v[6] / 1000, v[7],
             await self.channel_errors(channel) if v[1] == _ERROR else [],
+            execution_mode=describe_execution_mode(v[8]),
+            commanded_execution_mode=describe_execution_mode(v[9]),
         )
 
     async def contour_lookahead(
@@ -424,7 +470,9 @@ class ChannelOps:
         state_names = [f"{ch}.mc_active_mode_r", f"{ch}.mc_active_state_r"]
         before = await self.read_many([*state_names, *(readback[name] for name in wanted)])
         mode, state = (before[n] for n in state_names)
-        if state in (_ACTIVE, _HOLD, _ERROR):  # before anything changes (the last log)
+        if state == _ERROR:  # before anything changes (the last log)
+            raise AdsError(AdsReturnCode.DEVICE_NOTREADY, await self._in_error(channel, what))
+        if state in (_ACTIVE, _HOLD):
             raise AdsError(
                 AdsReturnCode.DEVICE_NOTREADY,
                 f"channel {channel} is {MODES.get(mode, mode)}/{STATES.get(state, state)}: "

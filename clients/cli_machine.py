@@ -3,12 +3,17 @@
     cnc upload FILE [--name NAME]        cnc download NAME [-o FILE]      cnc programs
     cnc run FILE|NAME [--channel N] [--wait] [--timeout S]
     cnc mdi "BLOCKS" [--channel N] [--wait] [--timeout S]
-    cnc hold|resume|reset [--channel N]  cnc status [--channel N]
+    cnc hold|resume [--channel N]        cnc reset [--channel N] [--standard]
+    cnc status [--channel N]
     cnc lookahead [START] [--length L] [--index I]
     cnc check FILE|NAME [--channel N] [--errors-total K] [--log] [--timeout S]
 
 ``--wait`` exits 0 when the program (or manual block) has finished, 4 with the channel's
-error text when the channel went to ERROR, 5 when ``--timeout`` passed first.
+error text when the channel went to ERROR, 5 when ``--timeout`` passed first. A channel
+in ERROR refuses ``run``, ``mdi`` and ``resume`` (exit 1, naming its errors) until
+``cnc reset``, as a CNC does; ``cnc reset --standard`` also commands standard execution
+(no SYNCHK, MACHINE_LOCK, PROD_TIME bit; ``syn_chk.record_result`` off). ``status`` shows
+the execution mode in effect and, when it differs, the one the next start takes.
 ``check`` exits 0 when the program is clean, 1 when the check found errors or was
 aborted, 2 when there is no result (bad usage, no service, an ADS error, ``--timeout``).
 """
@@ -24,9 +29,9 @@ from pathlib import Path
 import typer
 
 from .channel_ops import CONTOUR_BLOCK_TYPES, CheckError, CheckResult
-from .cli import EXIT_USAGE, Settings, _emit, _fail, app, err, out
+from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
 from .client import Client
-from .errors import AdsError, AdsTimeoutError, ChannelError
+from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
 
 EXIT_CHANNEL_ERROR = 4
 EXIT_WAIT_TIMEOUT = 5
@@ -38,14 +43,16 @@ WaitTimeoutOption = typer.Option(
 )
 
 
-def _finish_wait(exc: Exception) -> None:
+def finish_wait(exc: Exception) -> None:
+    """End a waiting command for ``exc``: 4 channel ERROR, 5 the wait's own timeout, else
+    as ``fail`` (a request without reply is 3, not 5)."""
     if isinstance(exc, ChannelError):
-        err.print(f"error: {exc}")
+        say_error(str(exc))
         raise typer.Exit(EXIT_CHANNEL_ERROR)
-    if isinstance(exc, AdsTimeoutError) and "still" in str(exc):
-        err.print(f"error: {exc}")
+    if isinstance(exc, AdsTimeoutError) and not isinstance(exc, NoReplyError):
+        say_error(str(exc))
         raise typer.Exit(EXIT_WAIT_TIMEOUT)
-    _fail(exc)
+    fail(exc)
 
 
 def store_local(c: Client, name: str, data: bytes | None) -> None:
@@ -63,11 +70,11 @@ def local_program(program: str) -> tuple[str, bytes | None]:
     try:
         return local.name, local.read_bytes()
     except OSError as exc:
-        err.print(f"error: cannot read {local}: {exc.strerror}", markup=False, emoji=False)
+        say_error(f"cannot read {local}: {exc.strerror}")
         raise typer.Exit(EXIT_USAGE) from None
 
 
-@app.command()
+@command()
 def upload(
     ctx: typer.Context,
     file: Path = typer.Argument(..., help="Local NC file."),
@@ -78,15 +85,15 @@ def upload(
     try:
         data = file.read_bytes()
     except OSError as exc:
-        err.print(f"error: cannot read {file}: {exc.strerror}")
+        say_error(f"cannot read {file}: {exc.strerror}")
         raise typer.Exit(EXIT_USAGE) from None
     target = name or file.name
-    settings.call(lambda c: c.upload(target, data))
-    _emit(settings, {"name": target, "size_bytes": len(data), "ok": True},
+    settings.call(lambda c: c.upload(target, data), f"upload of {target}")
+    emit(settings, {"name": target, "size_bytes": len(data), "ok": True},
           f"uploaded {target} ({len(data)} bytes)")
 
 
-@app.command()
+@command()
 def download(
     ctx: typer.Context,
     name: str = typer.Argument(..., help="Name in the store."),
@@ -94,7 +101,7 @@ def download(
 ) -> None:
     """Download a file of the program store (programs, result files, logs)."""
     settings: Settings = ctx.obj
-    data = settings.call(lambda c: c.download(name))
+    data = settings.call(lambda c: c.download(name), f"download of {name}")
     if output is None:
         sys.stdout.buffer.write(data)
         sys.stdout.flush()
@@ -102,24 +109,24 @@ def download(
     try:
         output.write_bytes(data)
     except OSError as exc:
-        err.print(f"error: cannot write {output}: {exc.strerror}")
+        say_error(f"cannot write {output}: {exc.strerror}")
         raise typer.Exit(EXIT_USAGE) from None
-    _emit(settings, {"name": name, "size_bytes": len(data), "output": str(output)},
+    emit(settings, {"name": name, "size_bytes": len(data), "output": str(output)},
           f"downloaded {name} ({len(data)} bytes) to {output}")
 
 
-@app.command()
+@command()
 def programs(ctx: typer.Context) -> None:
     """List the program store."""
     settings: Settings = ctx.obj
-    entries = settings.call(lambda c: c.programs())
+    entries = settings.call(lambda c: c.programs(), "the program list")
     for e in entries:
-        _emit(settings, asdict(e), f"{e.name:40} {e.size_bytes:10d} bytes")
+        emit(settings, asdict(e), f"{e.name:40} {e.size_bytes:10d} bytes")
     if not settings.as_json:
         out.print(f"{len(entries)} files")
 
 
-@app.command()
+@command()
 def run(
     ctx: typer.Context,
     program: str = typer.Argument(..., help="A local file (uploaded first) or a stored name."),
@@ -131,23 +138,23 @@ def run(
     settings: Settings = ctx.obj
     name, data = local_program(program)
     try:
-        with settings.client() as c:
+        with settings.session(f"run of {name} in channel {channel}") as c:
             store_local(c, name, data)
             c.run_program(name, channel)
             if not wait:
-                _emit(settings, {"channel": channel, "program": name, "started": True},
+                emit(settings, {"channel": channel, "program": name, "started": True},
                       f"channel {channel}: {name} started")
                 return
             c.wait_program(channel, timeout_s)
             status = c.status(channel)
-    except (AdsError, ChannelError) as exc:
-        _finish_wait(exc)
-    _emit(settings, {"channel": channel, "program": name, "finished": True,
+    except (AdsError, ChannelError, ClientValueError) as exc:
+        finish_wait(exc)
+    emit(settings, {"channel": channel, "program": name, "finished": True,
                      "program_time_s": status.program_time_s},
           f"channel {channel}: {name} finished in {status.program_time_s:.3f} s")
 
 
-@app.command()
+@command()
 def mdi(
     ctx: typer.Context,
     blocks: str = typer.Argument(..., help="NC blocks; separate blocks with newlines or a "
@@ -160,53 +167,86 @@ def mdi(
     settings: Settings = ctx.obj
     text = blocks.replace("\\n", "\n")
     try:
-        with settings.client() as c:
+        with settings.session(f"manual block in channel {channel}") as c:
             before = c.mdi(text, channel)
             if wait:
                 c.wait_mdi(before, channel, timeout_s)
-    except (AdsError, ChannelError) as exc:
-        _finish_wait(exc)
-    _emit(settings, {"channel": channel, "ok": True, "finished": wait},
+    except (AdsError, ChannelError, ClientValueError) as exc:
+        finish_wait(exc)
+    emit(settings, {"channel": channel, "ok": True, "finished": wait},
           f"channel {channel}: manual block {'finished' if wait else 'started'}")
 
 
-def _channel_command(method: str, done: str):
+def _channel_command(method: str, done: str, request: str):
     def command(ctx: typer.Context, channel: int = ChannelOption) -> None:
         settings: Settings = ctx.obj
-        settings.call(lambda c: getattr(c, method)(channel))
-        _emit(settings, {"channel": channel, "ok": True}, f"channel {channel}: {done}")
+        settings.call(lambda c: getattr(c, method)(channel), f"{request} of channel {channel}")
+        emit(settings, {"channel": channel, "ok": True}, f"channel {channel}: {done}")
 
     return command
 
 
 app.command("hold", help="Feedhold: the path decelerates and stops (HOLD).")(
-    _channel_command("hold", "feedhold")
+    _channel_command("hold", "feedhold", "HOLD")
 )
 app.command("resume", help="START again after feedhold, M0/M1 or a single-block stop.")(
-    _channel_command("start", "resumed")
-)
-app.command("reset", help="RESET the channel from any state.")(
-    _channel_command("reset", "reset")
+    _channel_command("start", "resumed", "START")
 )
 
 
-@app.command()
-def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
-    """Mode, state, program, block and axis positions (mm) of a channel."""
+@command()
+def reset(
+    ctx: typer.Context,
+    channel: int = ChannelOption,
+    standard: bool = typer.Option(
+        False, "--standard",
+        help="Also command standard execution: execution mode ISG_STANDARD (clears SYNCHK, "
+             "MACHINE_LOCK, PROD_TIME, ... set by hand) and syn_chk.record_result off; "
+             "from the next program start."),
+) -> None:
+    """RESET the channel from any state (clears ERROR and its error list).
+
+    With --standard the next program start also runs in standard execution, not as a
+    syntax check or dry run: the execution mode bits are cleared and
+    syn_chk.record_result is switched off.
+    """
     settings: Settings = ctx.obj
-    s = settings.call(lambda c: c.status(channel))
+    if not standard:
+        settings.call(lambda c: c.reset(channel), f"RESET of channel {channel}")
+        emit(settings, {"channel": channel, "ok": True}, f"channel {channel}: reset")
+        return
+    settings.call(lambda c: c.reset_to_standard(channel), f"RESET of channel {channel}")
+    emit(settings, {"channel": channel, "ok": True, "execution_mode": "standard"},
+         f"channel {channel}: reset, standard execution from the next start")
+
+
+@command()
+def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
+    """Mode, state, execution mode, program, block and axis positions of a channel.
+
+    The execution mode is shown by the names of its bits (SYNCHK|MACHINE_LOCK) or as
+    standard; when the commanded mode differs (it takes effect at the next start), that
+    one follows as "next start". In ERROR the channel's errors follow.
+    """
+    settings: Settings = ctx.obj
+    s = settings.call(lambda c: c.status(channel), f"status of channel {channel}")
     positions = "  ".join(f"{n}={v:.4f}" for n, v in s.positions_mm.items())
+    mode = f"execution mode {s.execution_mode}"
+    if s.commanded_execution_mode != s.execution_mode:  # a mode takes effect at a start
+        mode += f" (next start: {s.commanded_execution_mode})"
     lines = [
         f"channel {s.channel}: {s.mode}/{s.state}  program {s.program or '-'}",
+        mode,
         (f"block N{s.block_number if s.block_number >= 0 else '-'} {s.file or '-'}:{s.line}  "
          f"v={s.path_velocity_mm_s:.3f} mm/s  t={s.program_time_s:.3f} s"),
         f"positions (mm): {positions}",
         *s.errors,
+        *(["RESET clears the error (cnc reset)"] if s.state == "ERROR" else []),
     ]
-    _emit(settings, asdict(s), "\n".join(lines))
+    emit(settings, asdict(s), "\n".join(lines))
 
 
-@app.command()
+@command()
 def lookahead(
     ctx: typer.Context,
     start: float = typer.Argument(
@@ -219,7 +259,8 @@ def lookahead(
 ) -> None:
     """Contour look-ahead (FCT-C40): the contour elements ahead, as the PLC gets them."""
     settings: Settings = ctx.obj
-    reply = settings.call(lambda c: c.contour_lookahead(start, length, plc_channel=index))
+    reply = settings.call(lambda c: c.contour_lookahead(start, length, plc_channel=index),
+                          f"contour look-ahead of gpCh[{index}]")
     if settings.as_json:
         out.print(json.dumps({
             "max_dist_prog_start": reply.max_dist_prog_start,
@@ -274,7 +315,7 @@ def _check_summary(result: CheckResult, channel: int) -> str:
     return text
 
 
-@app.command()
+@command()
 def check(
     ctx: typer.Context,
     program: str = typer.Argument(..., help="A local file (uploaded first) or a stored name."),
@@ -287,16 +328,19 @@ def check(
     timeout_s: float = typer.Option(
         None, "--timeout", min=0.0, help="Give up after S seconds (the check is RESET; exit 2)."),
 ) -> None:
-    """Syntax check (SYNCHK | MACHINE_LOCK): decode the program, report every error, move
-    nothing. Exit 0 clean, 1 errors or aborted, 2 no result."""
+    """Syntax check (SYNCHK | MACHINE_LOCK): report every error, move nothing.
+
+    The program is decoded as in a run; the execution mode and the syn_chk settings are
+    restored afterwards. Exit 0 clean, 1 errors or aborted, 2 no result.
+    """
     settings: Settings = ctx.obj
     name, data = local_program(program)
     try:
-        with settings.client() as c:
+        with settings.session(f"syntax check of {name} in channel {channel}") as c:
             store_local(c, name, data)
             result: CheckResult = c.syntax_check(name, channel, errors_total, timeout_s)
-    except (AdsError, ChannelError) as exc:
-        err.print(f"error: {exc}", markup=False, emoji=False)
+    except (AdsError, ChannelError, ClientValueError) as exc:
+        say_error(str(exc))
         raise typer.Exit(EXIT_CHECK_TROUBLE) from None
     if show_log and not settings.as_json:
         out.print(result.log, end="", markup=False, emoji=False, highlight=False)

@@ -13,16 +13,17 @@ from pathlib import Path
 
 import typer
 
-from .cli import EXIT_USAGE, Settings, _emit, app, err
+from .cli_app import EXIT_USAGE, Settings, command, emit, err
 from .cli_machine import (
-    EXIT_CHANNEL_ERROR, ChannelOption, _finish_wait, local_program, store_local,
+    EXIT_CHANNEL_ERROR, ChannelOption, finish_wait, local_program, store_local,
 )
-from .errors import AdsError, ChannelError
+from .errors import AdsError, ChannelError, ClientValueError
+from .figure_png import PlotExtraMissing, require_matplotlib
 from .path_plot import plot_trace
 from .path_trace import PathTrace
 
 
-@app.command()
+@command()
 def plot(
     ctx: typer.Context,
     program: str = typer.Argument(..., help="A local file (uploaded first) or a stored name."),
@@ -34,20 +35,28 @@ def plot(
     timeout_s: float = typer.Option(
         None, "--timeout", min=0.0, help="Give up after S seconds (the run is RESET; exit 5)."),
 ) -> None:
-    """Dry run (PROD_TIME, nothing moves) in kernel time; draw the XY path and the path
-    speed over the path distance with the feed limit into a PNG."""
+    """Dry run (PROD_TIME, nothing moves) drawn into a PNG.
+
+    The run goes in kernel time; the PNG shows the XY path and the path speed over the
+    path distance with the feed limit.
+    """
     settings: Settings = ctx.obj
     if len(axes) != 2:
         err.print(f"error: --axes takes two axis letters such as XY, not {axes!r}")
         raise typer.Exit(EXIT_USAGE)
+    try:
+        require_matplotlib()  # before the dry run, which would be for nothing without it
+    except PlotExtraMissing as exc:
+        err.print(f"error: {exc}", markup=False)
+        raise typer.Exit(EXIT_USAGE) from None
     name, data = local_program(program)
     target = output if output is not None else Path(Path(name).stem + ".png")
     try:
-        with settings.client() as c:
+        with settings.session(f"dry run of {name} in channel {channel}") as c:
             store_local(c, name, data)
             trace: PathTrace = c.trace_run(name, channel, timeout_s)
-    except (AdsError, ChannelError) as exc:
-        _finish_wait(exc)
+    except (AdsError, ChannelError, ClientValueError) as exc:
+        finish_wait(exc)
     try:
         png = plot_trace(trace, width_px=width_px, x_axis=axes[0], y_axis=axes[1])
     except KeyError as exc:
@@ -59,7 +68,7 @@ def plot(
         err.print(f"error: cannot write {target}: {exc.strerror}", markup=False)
         raise typer.Exit(EXIT_USAGE) from None
     length_mm = float(trace.path_mm[-1]) if len(trace.path_mm) else 0.0
-    _emit(settings, {
+    emit(settings, {
         "program": name, "channel": channel, "output": str(target), "ended": trace.ended,
         "program_time_s": trace.program_time_s, "path_mm": length_mm,
         "v_max_mm_s": float(trace.v_mm_s.max()) if len(trace.v_mm_s) else 0.0,

@@ -10,16 +10,22 @@
         c.read_address(551, 0x121301, 0x10018, "UNS32")
 
 Objects are found by name through one browse of the service's catalog, cached for the
-life of the connection. Every failure raises ``AdsError`` naming its ADS code.
+life of the connection; an unknown name fails with ADS 0x710 and the nearest names
+("did you mean ..."). What the service refuses raises ``AdsError`` naming its ADS code;
+a request without reply raises ``NoReplyError`` (an ``AdsTimeoutError``) naming what was
+asked (``no reply to READ ch1.x within 5 s from tcp://...``). What the client refuses
+before sending anything (a value out of its type's range, an unknown state name) raises
+``ClientValueError`` (a ``ValueError``), which claims no ADS code.
 """
 
 from __future__ import annotations
 
 import contextlib
+import difflib
 import functools
 import inspect
 from collections.abc import AsyncIterator, Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from datetime import UTC, datetime, timedelta
 from typing import Any
 
@@ -45,7 +51,7 @@ from cnc_objects.protocol.frames import (
 from .channel_ops import (
     ChannelOps, ChannelStatus, CheckError, CheckResult, ProgramEntry, ProgramOps,
 )
-from .errors import AdsConnectionError, AdsError
+from .errors import AdsConnectionError, AdsError, ClientValueError, NoReplyError
 from .path_trace import PathTrace, TraceOps
 from .sync_transport import SyncTransport, drive
 from .transport import AsyncTransport
@@ -54,11 +60,17 @@ DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
 DEFAULT_TIMEOUT_S = 5.0
 _FILETIME_EPOCH = datetime(1601, 1, 1, tzinfo=UTC)
 _HANDLE_PORT = CncPort.COM  # handles are global in the service; any CNC port serves them
+SUGGESTIONS = 3  # nearest names offered for an unknown one
+_BROWSE_FIELDS = 9  # name .. description: what every service sends
 
 
 @dataclass(frozen=True, slots=True)
 class ObjectInfo:
-    """What the service says about one object (a browse row)."""
+    """What the service says about one object (a browse row).
+
+    ``enum`` names the values of an enumeration object (``{3: "READY", ...}`` for
+    ``ch1.mc_active_state_r``); it is empty for every other object, bit sets included.
+    """
 
     name: str
     port: int
@@ -69,11 +81,28 @@ class ObjectInfo:
     access: str
     unit: str
     description: str
+    # Not hashed: a dict is not hashable, and the name identifies the object anyway.
+    enum: dict[int, str] = field(default_factory=dict, hash=False)
 
     @property
     def dtype(self) -> DataType:
         """The object's data type."""
         return parse_type(self.type)
+
+    @classmethod
+    def from_row(cls, row: Any) -> ObjectInfo:
+        """The info of one browse descriptor (protocol/frames.py). A row of a service
+        without value names (nine fields) has an empty ``enum``; fields after the ones
+        known here are ignored, so a later service may add more."""
+        try:
+            if len(row) < _BROWSE_FIELDS:
+                raise ValueError(f"{len(row)} fields, at least {_BROWSE_FIELDS} expected")
+            names = row[_BROWSE_FIELDS] if len(row) > _BROWSE_FIELDS else []
+            return cls(*row[:_BROWSE_FIELDS], {int(v): str(n) for v, n in names})
+        except (TypeError, ValueError) as exc:
+            raise AdsError(
+                AdsReturnCode.CLIENT_SYNCRESINVALID, f"malformed browse row {row!r:.80}: {exc}"
+            ) from None
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,15 +137,45 @@ def _coerce_type(dtype: DataType | str) -> DataType:
     try:
         known = _TYPES_BY_NAME[dtype] = parse_type(dtype)
     except ValueError as exc:
-        raise AdsError(AdsReturnCode.CLIENT_INVALIDPARM, str(exc)) from None
+        raise ClientValueError(str(exc)) from None
     return known
 
 
 def _encode(dtype: DataType, value: Any, what: str) -> bytes:
+    """``value`` as ``dtype``'s bytes; a value the type cannot hold is refused here,
+    before anything is sent (``ClientValueError``)."""
     try:
         return dtype.encode(value)
     except (TypeError, ValueError) as exc:
-        raise AdsError(AdsReturnCode.DEVICE_INVALIDDATA, f"{what}: {exc} (checked by the client)") from None
+        if dtype.kind == "int" and type(value) is int:  # the common mistake: say the range
+            reason = (f"value {value} out of range for {dtype.name} "
+                      f"({dtype.minimum}..{dtype.maximum})")
+        else:
+            reason = str(exc)
+        raise ClientValueError(f"{what}: {reason}") from None
+
+
+def _ads_state(state: AdsState | int | str) -> int:
+    """An ADS state given as ``AdsState``, its number or its name (any case)."""
+    if isinstance(state, str):
+        try:
+            return int(AdsState[state.strip().upper()])
+        except KeyError:
+            names = ", ".join(s.name for s in AdsState)
+            raise ClientValueError(
+                f"unknown ADS state {state!r}; the ADS states are {names} "
+                "(the service takes RUN, STOP and RESET)") from None
+    return int(state)
+
+
+def _suggest(name: str, known: Iterable[str]) -> str:
+    """ ``; did you mean a, b or c?`` for the names nearest to ``name``, else ``""``."""
+    names = {k.lower(): k for k in known}
+    nearest = [names[k] for k in difflib.get_close_matches(name.lower(), names, SUGGESTIONS)]
+    if not nearest:
+        return ""
+    listed = nearest[0] if len(nearest) == 1 else f"{', '.join(nearest[:-1])} or {nearest[-1]}"
+    return f"; did you mean {listed}?"
 
 
 def _decode(dtype: DataType, data: bytes, what: str) -> Any:
@@ -177,7 +236,8 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
             self._objects = {o.name.lower(): o for o in await self.browse("*")}
         info = self._objects.get(name.lower())
         if info is None:
-            raise AdsError(AdsReturnCode.DEVICE_SYMBOLNOTFOUND, f"no object is named {name!r}")
+            hint = _suggest(name, (o.name for o in self._objects.values()))
+            raise AdsError(AdsReturnCode.DEVICE_SYMBOLNOTFOUND, f"no object {name!r}{hint}")
         return info
 
     # ------------------------------------------------------------ API
@@ -194,14 +254,16 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
         reply = await self._call(ReadStateRequest, CncPort.COM)
         return AdsState(reply.fields[0]), reply.fields[1]
 
-    async def write_control(self, ads_state: AdsState | int, device_state: int = 0) -> None:
-        """Command the kernel's ADS state: RUN, STOP or RESET."""
-        await self._call(WriteControlRequest, CncPort.COM, int(ads_state), device_state, b"")
+    async def write_control(self, ads_state: AdsState | int | str, device_state: int = 0) -> None:
+        """Command the kernel's ADS state: RUN, STOP or RESET, as ``AdsState.STOP``, its
+        number or its name in any case (``"stop"``); an unknown name raises
+        ``ClientValueError`` listing the names."""
+        await self._call(WriteControlRequest, CncPort.COM, _ads_state(ads_state), device_state, b"")
 
     async def browse(self, pattern: str = "*") -> list[ObjectInfo]:
         """Descriptions of the objects whose names match the glob ``pattern``."""
         reply = await self._call(BrowseRequest, CncPort.COM, pattern)
-        return [ObjectInfo(*row) for row in self._payload(reply)]
+        return [ObjectInfo.from_row(row) for row in self._payload(reply)]
 
     async def read_address(
         self, port: int, group: int, offset: int, dtype: DataType | str
@@ -222,8 +284,11 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
 
     async def read(self, name: str) -> Any:
         """Read the object ``name``."""
-        info = await self._object(name)
-        reply = await self._call(ReadRequest, info.port, info.group, info.offset, info.length)
+        try:
+            info = await self._object(name)
+            reply = await self._call(ReadRequest, info.port, info.group, info.offset, info.length)
+        except NoReplyError as exc:  # the first read of a name browses: name the READ
+            raise exc.asking(f"READ {name}") from None
         return _decode(info.dtype, self._payload(reply), info.name)
 
     async def write_address(
@@ -246,13 +311,25 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
         await self._call(WriteRequest, port, group, offset, data)
 
     async def write(self, name: str, value: Any) -> None:
-        """Write the object ``name``; returns once the kernel has applied it."""
-        info = await self._object(name)
-        data = _encode(info.dtype, value, info.name)
-        await self._call(WriteRequest, info.port, info.group, info.offset, data)
+        """Write the object ``name``; returns once the kernel has applied it. A value its
+        type cannot hold raises ``ClientValueError`` before anything is sent."""
+        try:
+            info = await self._object(name)
+            data = _encode(info.dtype, value, info.name)
+            await self._call(WriteRequest, info.port, info.group, info.offset, data)
+        except NoReplyError as exc:
+            raise exc.asking(f"WRITE {name}") from None
 
     async def read_many(self, names: Iterable[str]) -> dict[str, Any]:
         """Read several objects in one sum-read round trip (handles cached per name)."""
+        names = list(names)
+        try:
+            return await self._read_many(names)
+        except NoReplyError as exc:
+            shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+            raise exc.asking(f"READ {shown}") from None
+
+    async def _read_many(self, names: list[str]) -> dict[str, Any]:
         infos = [await self._object(n) for n in names]
         missing = list(dict.fromkeys(i.name for i in infos if i.name not in self._handles))
         if missing:
@@ -298,13 +375,16 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
         time. The first sample is the current value. Leaving the loop deletes the
         subscription.
         """
-        info = await self._object(name)
         mode = TransmissionMode.SERVER_ON_CHANGE if on_change else TransmissionMode.SERVER_CYCLE
         cycle = cycle_ms if cycle_ms is not None else (0 if on_change else 100)
-        reply = await self._call(
-            AddNotificationRequest, info.port, info.group, info.offset, info.length,
-            int(mode), 0, int(cycle),
-        )
+        try:
+            info = await self._object(name)
+            reply = await self._call(
+                AddNotificationRequest, info.port, info.group, info.offset, info.length,
+                int(mode), 0, int(cycle),
+            )
+        except NoReplyError as exc:
+            raise exc.asking(f"SUBSCRIBE {name}") from None
         handle = self._payload(reply)
         self._t.open_samples(handle)
         try:

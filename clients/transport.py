@@ -27,7 +27,7 @@ from cnc_objects.protocol.frames import (
     encode_request,
 )
 
-from .errors import AdsConnectionError, AdsTimeoutError
+from .errors import AdsConnectionError, NoReplyError
 
 log = logging.getLogger(__name__)
 
@@ -90,11 +90,10 @@ class _Transport:
                     buffer = self._early[sample.handle] = deque(maxlen=SAMPLE_BUFFER)
             buffer.append(sample)
 
-    def _timeout(self, command: int) -> AdsTimeoutError:
-        return AdsTimeoutError(
-            f"no reply to {AdsCommand(command).name} within {self.timeout_s:g} s "
-            f"from {self.endpoint} (is cnc-service running?)"
-        )
+    def _timeout(self, command: int) -> NoReplyError:
+        """The error of a request that got no reply; the client names it after what its
+        caller asked for (``NoReplyError.asking``)."""
+        return NoReplyError(AdsCommand(command).name, self.timeout_s, self.endpoint)
 
 
 # --------------------------------------------------------------------------- async
@@ -106,7 +105,7 @@ class AsyncTransport(_Transport):
     Timeouts are enforced by one sweeper task (every quarter of the timeout) rather than
     a timer per request: with many requests in flight a timer each costs more than the
     request itself. A request therefore fails between 1 and 1.25 timeouts after it was
-    sent, with ``AdsTimeoutError``.
+    sent, with ``NoReplyError`` (an ``AdsTimeoutError``).
     """
 
     def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context | None = None) -> None:

@@ -145,15 +145,16 @@ def parse_type(name: str) -> DataType:
 def parse_value(dtype: DataType, text: str) -> Any:
     """Parse a value typed by a person (CLI, MQTT) for ``dtype``.
 
-    Integers in decimal or hex (``0x1f``), booleans as 0/1/true/false, reals as floats,
+    Integers in decimal or hex (``0x1f``), booleans as exactly 0/1/true/false (any case;
+    the message of a refusal lists these and nothing else is taken), reals as floats,
     strings as given. Raises ``ValueError`` with a readable message.
     """
     match dtype.kind:
         case "bool":
             lowered = text.strip().lower()
-            if lowered in ("1", "true", "on", "yes"):
+            if lowered in ("1", "true"):
                 return True
-            if lowered in ("0", "false", "off", "no"):
+            if lowered in ("0", "false"):
                 return False
             raise ValueError(f"{text!r} is not a boolean (0/1/true/false)")
         case "int":

@@ -155,7 +155,8 @@ def test_software_limit_violation_aborts(service: RunningService, tmp_path: Path
     assert "error 50101: far.nc:1:1:" in status.stdout  # in the channel's error list
     again = cnc("check", "far.nc", endpoint=ep)  # refused in ERROR; the log stays
     assert again.returncode == 2
-    assert "ADS 0x707 NOTREADY: channel 1 is AUTOMATIC/ERROR" in again.stderr
+    assert "ADS 0x707 NOTREADY: channel 1 is in ERROR (error 50101: far.nc:1:1:" in again.stderr
+    assert "a syntax check needs a RESET first" in again.stderr
     log = cnc("download", "dec01.sc", endpoint=ep).stdout
     assert log.splitlines()[-2:] == [
         "error 50101 (abort) at far.nc:1:1: " + abort["message"],

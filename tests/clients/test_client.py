@@ -15,7 +15,10 @@ from typing import Any
 
 import pytest
 
-from cnc_objects.clients import AdsError, AdsTimeoutError, AsyncClient, Client
+import cnc_objects.clients
+from cnc_objects.clients import (
+    AdsError, AdsTimeoutError, AsyncClient, Client, ClientValueError, NoReplyError,
+)
 from cnc_objects.clients.transport import EARLY_HANDLES, _Transport
 from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.frames import Notification
@@ -111,12 +114,33 @@ async def test_error_names_code_and_reason(api: Any) -> None:
 
 
 async def test_value_of_wrong_type_is_refused_by_the_client(api: Any) -> None:
-    with pytest.raises(AdsError) as caught:
+    # Refused before anything is sent: a ValueError, no ADS code (no device answered).
+    with pytest.raises(ClientValueError) as caught:
         await api.write("ch1.mc_command_feed_override_w", "fast")
-    assert caught.value.code == 0x706
-    with pytest.raises(AdsError) as caught:
+    assert not isinstance(caught.value, AdsError)
+    assert str(caught.value) == "ch1.mc_command_feed_override_w: UNS16 takes an integer, not 'fast'"
+    with pytest.raises(ClientValueError) as caught:
         await api.write("ch1.mc_command_feed_override_w", 70000)
-    assert caught.value.code == 0x706
+    assert str(caught.value) == (
+        "ch1.mc_command_feed_override_w: value 70000 out of range for UNS16 (0..65535)")
+    with pytest.raises(ValueError, match="value -1 out of range for UNS16"):
+        await api.write_address(COM, 0x120101, 9, "UNS16", -1)
+    with pytest.raises(ClientValueError, match="FLOAT9"):
+        await api.read_address(COM, 0x120101, 9, "FLOAT9")
+    assert await api.read("ch1.mc_command_feed_override_r") == 1000  # nothing was written
+
+
+async def test_an_unknown_name_suggests_the_nearest(api: Any) -> None:
+    with pytest.raises(AdsError) as caught:
+        await api.read("ch1.mc_command_feed_overide_w")
+    assert caught.value.code == 0x710
+    assert str(caught.value) == (
+        "ADS 0x710 SYMBOLNOTFOUND: no object 'ch1.mc_command_feed_overide_w'; did you mean "
+        "ch1.mc_command_feed_override_w, ch2.mc_command_feed_override_w or "
+        "ch1.mc_command_feed_override_r?")
+    with pytest.raises(AdsError) as caught:
+        await api.read("zzzz")
+    assert str(caught.value) == "ADS 0x710 SYMBOLNOTFOUND: no object 'zzzz'"  # none near
 
 
 async def test_read_many_in_one_sum_read(api: Any) -> None:
@@ -196,6 +220,29 @@ async def test_write_control_stop_refuses_writes_until_run(api: Any) -> None:
     assert await api.read("ch1.mc_active_feed_override_r") == 100
 
 
+async def test_write_control_takes_state_names(api: Any) -> None:
+    await api.write_control("stop")
+    assert (await api.read_state())[0] is cnc_objects.clients.AdsState.STOP
+    await api.write_control(" Run ")
+    assert (await api.read_state())[0] is AdsState.RUN
+    with pytest.raises(ClientValueError) as caught:
+        await api.write_control("STOPP")
+    assert str(caught.value).startswith(
+        "unknown ADS state 'STOPP'; the ADS states are INVALID, IDLE, RESET, INIT, START, RUN, "
+        "STOP,")
+    assert str(caught.value).endswith("(the service takes RUN, STOP and RESET)")
+    assert (await api.read_state())[0] is AdsState.RUN
+
+
+def test_the_package_exports_what_users_need() -> None:
+    exported = cnc_objects.clients.__all__
+    for name in ("AdsState", "AdsReturnCode", "ClientValueError", "NoReplyError",
+                 "ExecutionMode", "DEFAULT_ENDPOINT", "Client", "AsyncClient"):
+        assert name in exported and hasattr(cnc_objects.clients, name), name
+    assert cnc_objects.clients.describe_execution_mode(0x48) == "SYNCHK|MACHINE_LOCK"
+    assert cnc_objects.clients.describe_execution_mode(0) == "standard"
+
+
 async def test_write_control_reset_restores_the_configuration(api: Any) -> None:
     await api.write("ch1.mc_command_feed_override_w", 250)
     await api.write_control(AdsState.RESET)
@@ -239,8 +286,10 @@ async def test_subscribe_cyclic_samples_on_the_kernel_time_grid(service: Running
     assert [s.sequence for s in got] == [1, 2, 3, 4]
     assert ticks == sorted(ticks)
     assert all(t % 10 == 0 for t in ticks[1:])  # later samples fall on 10-cycle marks
-    # Timestamps are kernel time: 10 cycles of 1 ms apart once on the grid.
-    assert got[3].timestamp - got[2].timestamp == dt.timedelta(milliseconds=10 * (ticks[3] - ticks[2]) // 10)
+    # Timestamps are the wall-clock times of the cycles (not kernel time): later cycles,
+    # later stamps (tests/e2e/test_values_over_the_wire.py checks them against the wall).
+    stamps = [s.timestamp for s in got]
+    assert stamps == sorted(stamps) and len(set(stamps)) == len(stamps)
 
 
 async def test_many_subscriptions_opened_at_once_all_get_their_first_sample(
@@ -300,6 +349,23 @@ async def test_timeout_raises_the_library_error() -> None:
             c.info()
 
 
+@pytest.mark.parametrize("kind", ["async", "blocking"])
+async def test_a_read_without_reply_names_the_read_not_its_browse(kind: str) -> None:
+    endpoint = "tcp://127.0.0.1:9"  # nothing answers
+    if kind == "async":
+        async with AsyncClient(endpoint, timeout_s=0.2) as c:
+            with pytest.raises(NoReplyError) as caught:
+                await c.read("ch1.mc_active_state_r")
+    else:
+        with Client(endpoint, timeout_s=0.2) as c:
+            with pytest.raises(NoReplyError) as caught:
+                c.read_many(["a", "b", "c", "d", "e"])
+    expected = "READ ch1.mc_active_state_r" if kind == "async" else "READ a, b, c and 2 more"
+    assert caught.value.request == expected
+    assert str(caught.value) == (f"ADS 0x745 SYNCTIMEOUT: no reply to {expected} within 0.2 s "
+                                 f"from {endpoint} (is cnc-service running?)")
+
+
 async def test_many_requests_in_flight_are_matched_by_invoke_id(service: RunningService) -> None:
     async with AsyncClient(service.endpoint) as c:
         names = ["ch1.ax1.actual_link_to_physical_axis", "ch1.ax2.actual_link_to_physical_axis",
@@ -309,7 +375,7 @@ async def test_many_requests_in_flight_are_matched_by_invoke_id(service: Running
 
 
 async def test_a_program_larger_than_the_store_is_refused_before_it_is_sent(api: Any) -> None:
-    with pytest.raises(AdsError) as caught:
+    with pytest.raises(ClientValueError) as caught:
         await api.upload("big.nc", b"G1 X1 F100\n" * 100_000)  # 1.1 MB
-    assert caught.value.code == 0x705 and "at most 1,000,000" in str(caught.value)
+    assert "at most 1,000,000" in str(caught.value)
     assert "big.nc" not in [p.name for p in await api.programs()]

@@ -431,6 +431,13 @@ def test_parse_value_booleans(text: str, expected: bool) -> None:
     assert parse_value(BOOLEAN, text) is expected
 
 
+@pytest.mark.parametrize("text", ["yes", "no", "on", "off", "Y", "t"])
+def test_parse_value_booleans_are_only_what_the_message_lists(text: str) -> None:
+    with pytest.raises(ValueError) as caught:
+        parse_value(BOOLEAN, text)
+    assert str(caught.value) == f"{text!r} is not a boolean (0/1/true/false)"
+
+
 @pytest.mark.parametrize(
     ("dtype", "text", "expected"),
     [(REAL64, "1.5", 1.5), (REAL64, "-2", -2.0), (REAL64, "1e3", 1000.0), (REAL32, " 0.25 ", 0.25)],

@@ -1,0 +1,110 @@
+"""What every ``cnc`` command shares: the typer app, the consoles, the global options,
+output (``emit``) and errors to exit codes (``fail``).
+
+The command modules (``cli_objects``, ``cli_machine``, ``cli_plot``) import this module
+and register their commands on ``app``; the entry module ``cli`` imports them. Nothing
+here imports a command module, so the package reads top-down without an import circle.
+
+Exit codes: 0 done; 1 the service answered with an ADS error; 2 bad usage, or a value the
+client refused before sending it; 3 the service did not answer (timeout, not reachable).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import inspect
+import json
+from collections.abc import Callable, Iterator
+from typing import Any, NoReturn, TypeVar
+
+import typer
+from rich.console import Console
+
+from .client import Client
+from .errors import AdsError, AdsTimeoutError, ClientValueError, NoReplyError
+
+T = TypeVar("T")
+
+EXIT_ADS_ERROR = 1
+EXIT_USAGE = 2
+EXIT_UNREACHABLE = 3
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="Read, write, browse and watch the objects of a cnc-objects service; run and "
+         "check NC programs.",
+)
+out = Console(highlight=False, soft_wrap=True)
+err = Console(stderr=True, highlight=False, soft_wrap=True)
+
+
+def command(*args: Any, **kwargs: Any) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """``app.command`` with the function's docstring as help, each paragraph on one line:
+    typer keeps a docstring's line breaks, which breaks lines mid-sentence in --help.
+    The first paragraph is the line of the command list."""
+
+    def register(function: Callable[..., Any]) -> Callable[..., Any]:
+        text = inspect.cleandoc(function.__doc__ or "")
+        help_text = "\n\n".join(" ".join(p.split()) for p in text.split("\n\n"))
+        return app.command(*args, help=help_text, **kwargs)(function)
+
+    return register
+
+
+class Settings:
+    """Global options, shared by every command."""
+
+    def __init__(self, endpoint: str, as_json: bool, timeout_s: float) -> None:
+        self.endpoint = endpoint
+        self.as_json = as_json
+        self.timeout_s = timeout_s
+
+    def client(self) -> Client:
+        """A blocking client for one command."""
+        return Client(self.endpoint, timeout_s=self.timeout_s)
+
+    @contextlib.contextmanager
+    def session(self, request: str | None = None) -> Iterator[Client]:
+        """A blocking client for one command; a request without reply is told as no
+        reply to ``request`` (what the user asked for), not to the ADS command that
+        happened to be unanswered first."""
+        try:
+            with self.client() as c:
+                yield c
+        except NoReplyError as exc:
+            if request is None:
+                raise
+            raise exc.asking(request) from None
+
+    def call(self, operation: Callable[[Client], T], request: str | None = None) -> T:
+        """``operation`` on a client of its own (``session``); an error ends the command
+        (``fail``)."""
+        try:
+            with self.session(request) as c:
+                return operation(c)
+        except (AdsError, ClientValueError) as exc:
+            fail(exc)
+
+
+def say_error(text: str) -> None:
+    """One ``error: ...`` line on stderr, printed as is (names hold brackets: gpCh[0])."""
+    err.print(f"error: {text}", markup=False, emoji=False)
+
+
+def fail(exc: Exception) -> NoReturn:
+    """End the command for ``exc``: one line on stderr and the exit code of its kind."""
+    say_error(str(exc))
+    if isinstance(exc, AdsTimeoutError):
+        raise typer.Exit(EXIT_UNREACHABLE)
+    if isinstance(exc, AdsError):
+        raise typer.Exit(EXIT_ADS_ERROR)
+    raise typer.Exit(EXIT_USAGE)  # refused by the client: nothing was sent
+
+
+def emit(settings: Settings, record: dict[str, Any], human: str) -> None:
+    """Print one result: ``record`` as a JSON line with ``--json``, else ``human``."""
+    if settings.as_json:
+        out.print(json.dumps(record, default=str), markup=False, emoji=False)
+    else:
+        out.print(human, markup=False, emoji=False)

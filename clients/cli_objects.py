@@ -1,0 +1,300 @@
+"""``cnc`` commands on objects: info, browse, read, write, watch.
+
+    cnc info                             cnc browse [PATTERN]
+    cnc read NAME... | --port P --group G --offset O --type T
+    cnc write NAME VALUE | VALUE --port P --group G --offset O --type T
+    cnc watch NAME... [--count N] [--timeout S] [--cyclic] [--cycle-ms MS]
+
+A value is printed with its unit or the name of an enumeration value in parentheses
+(``ch1.mc_active_feed_override_r = 500 (0.1 %)``, ``ch1.mc_active_state_r = 3 (READY)``);
+``--json`` keeps the raw value and adds ``"unit"`` (and ``"value_name"`` for a named
+value). Negative values need no ``--``: ``cnc write ch1.x -1``. A misspelt name fails with
+ADS 0x710 and the nearest names (``did you mean ...?``).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+from dataclasses import asdict
+from typing import Annotated, Any, Optional
+
+import typer
+
+from cnc_objects.protocol.datatypes import DataType, parse_type, parse_value
+
+from .cli_app import EXIT_USAGE, Settings, command, emit, fail, out, say_error
+from .client import AsyncClient, ObjectInfo
+from .errors import AdsError, ClientValueError, NoReplyError
+
+EXIT_WATCH_TIMEOUT = 5  # watch --count N --timeout S: a name got fewer than N samples
+
+# The address options of read and write, declared once.
+PortOption = Annotated[
+    Optional[str], typer.Option("--port", help="ADS port (with --group, --offset, --type).")
+]
+GroupOption = Annotated[Optional[str], typer.Option("--group", help="Index group, decimal or 0x hex.")]
+OffsetOption = Annotated[
+    Optional[str], typer.Option("--offset", help="Index offset, decimal or 0x hex.")
+]
+TypeOption = Annotated[
+    Optional[str], typer.Option("--type", help="Data type: UNS16, REAL64, STRING(84), ...")
+]
+_NO_UNIT = ("", "-")  # the catalog's spellings of "no unit"
+_BROWSE_COLUMNS = ("name", "port", "group", "offset", "type", "access", "unit", "description")
+
+
+def value_name(info: ObjectInfo, value: Any) -> str | None:
+    """The name of ``value`` when ``info`` is an enumeration (``3`` -> ``READY``)."""
+    names = getattr(info, "enum", None) or {}  # services before value names send none
+    return names.get(value) if isinstance(value, int) else None
+
+
+def show_value(info: ObjectInfo, value: Any) -> str:
+    """``value`` for people: ``3 (READY)``, ``500 (0.1 %)``, or the bare value."""
+    named = value_name(info, value)
+    if named is not None:
+        return f"{value} ({named})"
+    return f"{value} ({info.unit})" if info.unit not in _NO_UNIT else str(value)
+
+
+def value_record(info: ObjectInfo, value: Any) -> dict[str, Any]:
+    """``value`` for ``--json``: raw, with the unit and, for a named value, its name."""
+    record = {"name": info.name, "value": value, "unit": info.unit}
+    named = value_name(info, value)
+    if named is not None:
+        record["value_name"] = named
+    return record
+
+
+def _number(text: str, what: str) -> int:
+    try:
+        return int(text, 0)
+    except ValueError:
+        say_error(f"{what} {text!r} is not a number (decimal or 0x hex)")
+        raise typer.Exit(EXIT_USAGE) from None
+
+
+def _address(port: str | None, group: str | None, offset: str | None, dtype: str | None):
+    given = [x is not None for x in (port, group, offset, dtype)]
+    if not any(given):
+        return None
+    if not all(given):
+        say_error("an address needs all of --port, --group, --offset and --type")
+        raise typer.Exit(EXIT_USAGE)
+    try:
+        parsed_type = parse_type(dtype)  # type: ignore[arg-type]
+    except ValueError as exc:
+        say_error(str(exc))
+        raise typer.Exit(EXIT_USAGE) from None
+    return (
+        _number(port, "port"),  # type: ignore[arg-type]
+        _number(group, "group"),  # type: ignore[arg-type]
+        _number(offset, "offset"),  # type: ignore[arg-type]
+        parsed_type,
+    )
+
+
+def _parse(dtype: DataType, text: str, what: str) -> Any:
+    """The value typed for ``what``; text that does not parse exits 2 (nothing is sent)."""
+    try:
+        return parse_value(dtype, text)
+    except ValueError as exc:
+        say_error(f"{what}: {exc}")
+        raise typer.Exit(EXIT_USAGE) from None
+
+
+@command()
+def info(ctx: typer.Context) -> None:
+    """Device name, version and ADS state of the service."""
+    settings: Settings = ctx.obj
+    device = settings.call(lambda c: c.info(), "device info")
+    record = {
+        "name": device.name,
+        "version": device.version,
+        "ads_state": device.ads_state.name,
+        "device_state": device.device_state,
+        "endpoint": settings.endpoint,
+    }
+    emit(settings, record, f"{device.name} {device.version} at {settings.endpoint}: "
+         f"ADS state {device.ads_state.name}")
+
+
+@command()
+def browse(
+    ctx: typer.Context, pattern: str = typer.Argument("*", help="Glob over object names.")
+) -> None:
+    """List the objects whose names match PATTERN.
+
+    On a terminal: aligned columns, description last, nothing cut (a long line wraps).
+    Piped: a header line, then one tab-separated line per object, for grep, cut and awk.
+    """
+    settings: Settings = ctx.obj
+    found = settings.call(lambda c: c.browse(pattern), f"BROWSE {pattern}")
+    if settings.as_json:
+        for o in found:
+            emit(settings, asdict(o), "")
+        return
+    rows = [tuple(" ".join(field.split()) for field in (  # one line per object
+        o.name, str(o.port), f"0x{o.group:x}", f"0x{o.offset:x}", o.type, o.access, o.unit,
+        o.description)) for o in found]
+    if not out.is_terminal:  # for grep, cut, awk: full rows, one per line
+        for row in (_BROWSE_COLUMNS, *rows):
+            print("\t".join(row))  # not through rich, which would expand the tabs
+        return
+    # Aligned columns, description last: nothing is cut at any terminal width (a long
+    # line wraps in the terminal), unlike a table that fits its cells to the width.
+    widths = [max(len(r[k]) for r in (_BROWSE_COLUMNS, *rows)) for k in range(7)]
+    for k, row in enumerate((_BROWSE_COLUMNS, *rows)):
+        line = "  ".join(field.ljust(width) for field, width in zip(row, widths)) + "  " + row[7]
+        out.print(line, markup=False, emoji=False, style="bold" if k == 0 else None)
+    out.print(f"{len(found)} objects")
+
+
+@command()
+def read(
+    ctx: typer.Context,
+    names: list[str] = typer.Argument(None, help="Object names."),
+    port: PortOption = None,
+    group: GroupOption = None,
+    offset: OffsetOption = None,
+    dtype: TypeOption = None,
+) -> None:
+    """Read objects by name, or one value by address.
+
+    A value is shown with its unit or its name in parentheses: 500 (0.1 %), 3 (READY).
+    With --json the value stays raw; "unit" and, for a named value, "value_name" are
+    fields of their own.
+    """
+    settings: Settings = ctx.obj
+    address = _address(port, group, offset, dtype)
+    if (address is None) == (not names):
+        say_error("give object names or an address (--port --group --offset --type)")
+        raise typer.Exit(EXIT_USAGE)
+    try:
+        with settings.client() as c:
+            if address is not None:
+                value = c.read_address(*address)
+                p, g, o, t = address
+                emit(settings, {"port": p, "group": g, "offset": o, "type": t.name, "value": value},
+                     f"{p}:0x{g:x}:0x{o:x} = {value}")
+                return
+            values = c.read_many(names) if len(names) > 1 else {names[0]: c.read(names[0])}
+            infos = {n: c.describe(n) for n in values}
+    except (AdsError, ClientValueError) as exc:
+        fail(exc)
+    for name, value in values.items():
+        emit(settings, value_record(infos[name], value), f"{name} = {show_value(infos[name], value)}")
+
+
+# A negative value ("-1") is a value, not an unknown option.
+@command(context_settings={"ignore_unknown_options": True})
+def write(
+    ctx: typer.Context,
+    args: list[str] = typer.Argument(..., help="NAME VALUE, or VALUE with an address. "
+                                     "Negative values as they are: write ch1.x -1."),
+    port: PortOption = None,
+    group: GroupOption = None,
+    offset: OffsetOption = None,
+    dtype: TypeOption = None,
+) -> None:
+    """Write an object by name (NAME VALUE) or a value by address (VALUE).
+
+    Integers in decimal or 0x hex, negative ones as they are (write ch1.x -1); booleans
+    0/1/true/false. A value its type cannot hold is refused before anything is sent
+    (exit 2).
+    """
+    settings: Settings = ctx.obj
+    address = _address(port, group, offset, dtype)
+    if len(args) != (1 if address is not None else 2):
+        say_error("write takes NAME VALUE, or VALUE with --port --group --offset --type")
+        raise typer.Exit(EXIT_USAGE)
+    try:
+        with settings.client() as c:
+            if address is not None:
+                p, g, o, t = address
+                value = _parse(t, args[0], f"{p}:0x{g:x}:0x{o:x}")
+                c.write_address(p, g, o, t, value)
+                emit(settings, {"port": p, "group": g, "offset": o, "value": value, "ok": True},
+                     f"{p}:0x{g:x}:0x{o:x} := {value}")
+                return
+            name, text = args
+            try:
+                info_: ObjectInfo = c.describe(name)
+            except NoReplyError as exc:  # describing is a BROWSE; the user asked to write
+                raise exc.asking(f"WRITE {name}") from None
+            value = _parse(info_.dtype, text, info_.name)
+            c.write(name, value)
+    except (AdsError, ClientValueError) as exc:
+        fail(exc)
+    emit(settings, {"name": info_.name, "value": value, "ok": True}, f"{info_.name} := {value}")
+
+
+@command()
+def watch(
+    ctx: typer.Context,
+    names: list[str] = typer.Argument(..., help="Object names."),
+    count: int = typer.Option(
+        0, min=0, help="Stop after COUNT samples of each object (0: never). The first "
+        "sample is the current value; on change, the next ones come only when it changes."),
+    timeout_s: float = typer.Option(
+        None, "--timeout", min=0.0, help="Stop after S seconds; with --count, exit 5 when "
+        "an object got fewer than COUNT samples by then."),
+    cycle_ms: int = typer.Option(None, "--cycle-ms", min=0, help="Sampling cycle in kernel ms."),
+    cyclic: bool = typer.Option(False, help="Send every cycle, not only on change."),
+) -> None:
+    """Print samples of objects as the service sends them (until Ctrl-C, COUNT, --timeout).
+
+    Each object's first sample is its current value, sent at subscription. On change
+    (the default) the next sample comes only when the value changes, so --count 2 of a
+    value that stays waits for a change: bound the wait with --timeout (exit 5 when
+    COUNT was not reached), or use --cyclic for a sample every cycle.
+    """
+    settings: Settings = ctx.obj
+    seen = dict.fromkeys(names, 0)
+
+    async def one(c: AsyncClient, name: str, info_: ObjectInfo) -> None:
+        samples = c.subscribe(name, on_change=not cyclic, cycle_ms=cycle_ms)
+        async with contextlib.aclosing(samples):  # deletes the notification on the way out
+            async for s in samples:
+                emit(
+                    settings,
+                    {**value_record(info_, s.value), "ts": s.timestamp.isoformat(),
+                     "seq": s.sequence},
+                    f"{s.timestamp.isoformat(timespec='milliseconds')} #{s.sequence} "
+                    f"{s.name} = {show_value(info_, s.value)}",
+                )
+                seen[name] += 1
+                if count and seen[name] >= count:
+                    return
+
+    async def run() -> bool:
+        """True when every object got its samples (or no COUNT), False at --timeout."""
+        async with AsyncClient(settings.endpoint, timeout_s=settings.timeout_s) as c:
+            infos = {}
+            for name in names:  # fail on a bad name before printing anything
+                try:
+                    infos[name] = await c.describe(name)
+                except NoReplyError as exc:
+                    raise exc.asking(f"SUBSCRIBE {name}") from None
+            timer = asyncio.timeout(timeout_s)
+            try:
+                async with timer:
+                    await asyncio.gather(*(one(c, name, infos[name]) for name in names))
+            except TimeoutError:
+                if not timer.expired():
+                    raise  # a request without reply, not --timeout
+                return not count or all(n >= count for n in seen.values())
+        return True
+
+    try:
+        complete = asyncio.run(run())
+    except KeyboardInterrupt:
+        raise typer.Exit(0) from None
+    except AdsError as exc:
+        fail(exc)
+    if not complete:
+        short = ", ".join(f"{n} {seen[n]} of {count}" for n in names if seen[n] < count)
+        say_error(f"watch ended after {timeout_s:g} s with fewer samples than --count: "
+                  f"{short} (on change, a sample comes only when the value changes)")
+        raise typer.Exit(EXIT_WATCH_TIMEOUT)
