@@ -24,15 +24,16 @@ from cnc_objects.protocol.constants import MAX_DATA_BYTES, PROGRAM_MAX_BYTES, PR
 from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockType, value_names
 
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError
 from .execution_mode import ExecutionMode, describe_execution_mode
 
 POLL_S = 0.01  # how often waiting re-reads the channel state (wall time)
 
-MODES = {1: "STANDBY", 2: "AUTOMATIC", 3: "MDI", 4: "MANUAL", 5: "REFERENCE"}
-STATES = {1: "DESELECTED", 2: "SELECTED", 3: "READY", 4: "ACTIVE", 5: "HOLD", 6: "ERROR"}
-_ACTIVE, _HOLD, _ERROR = 4, 5, 6
+MODES = value_names(ChannelMode)
+STATES = value_names(ChannelState)
+_ACTIVE, _HOLD, _ERROR = ChannelState.ACTIVE, ChannelState.HOLD, ChannelState.ERROR
 _ERROR_SLOTS = 8
 SYNCHK, MACHINE_LOCK = int(ExecutionMode.SYNCHK), int(ExecutionMode.MACHINE_LOCK)
 
@@ -47,8 +48,10 @@ class ProgramEntry:
 
 
 CONTOUR_RESPONSE_BLOCKS = 32  # gpCh[i].contour_lookahead.response.block[0..31]
-CONTOUR_BLOCK_TYPES = {
-    1: "linear", 2: "circular", 3: "LOG ON", 4: "LOG PARAM", 5: "LOG OFF", 6: "polynomial",
+CONTOUR_BLOCK_TYPES = {  # as the HMI and `cnc lookahead` show them
+    ContourBlockType.LINEAR: "linear", ContourBlockType.CIRCULAR: "circular",
+    ContourBlockType.LOG_ON: "LOG ON", ContourBlockType.LOG_PARAM: "LOG PARAM",
+    ContourBlockType.LOG_OFF: "LOG OFF", ContourBlockType.POLYNOMIAL: "polynomial",
 }
 
 

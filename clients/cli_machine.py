@@ -3,7 +3,7 @@
     cnc upload FILE [--name NAME]        cnc download NAME [-o FILE]      cnc programs
     cnc run FILE|NAME [--channel N] [--wait] [--timeout S]
     cnc mdi "BLOCKS" [--channel N] [--wait] [--timeout S]
-    cnc hold|resume [--channel N]        cnc reset [--channel N] [--standard]
+    cnc hold [--channel N]               cnc resume [--channel N] [--wait] [--timeout S]        cnc reset [--channel N] [--standard]
     cnc status [--channel N]
     cnc lookahead [START] [--length L] [--index I]
     cnc check FILE|NAME [--channel N] [--errors-total K] [--log] [--timeout S]
@@ -97,12 +97,13 @@ def upload(
 def download(
     ctx: typer.Context,
     name: str = typer.Argument(..., help="Name in the store."),
-    output: Path = typer.Option(None, "--output", "-o", help="Write here (default: stdout)."),
+    output: Path = typer.Option(None, "--output", "-o",
+                                help="Write here (default, or '-': stdout)."),
 ) -> None:
     """Download a file of the program store (programs, result files, logs)."""
     settings: Settings = ctx.obj
     data = settings.call(lambda c: c.download(name), f"download of {name}")
-    if output is None:
+    if output is None or str(output) == "-":
         sys.stdout.buffer.write(data)
         sys.stdout.flush()
         return
@@ -126,6 +127,14 @@ def programs(ctx: typer.Context) -> None:
         out.print(f"{len(entries)} files")
 
 
+def show_warnings(c: Client, channel: int) -> None:
+    """The warnings a finished program raised (the channel kept running), on stderr:
+    a waited run that only printed "finished" would hide them."""
+    for line in c.channel_errors(channel):
+        if line.startswith("warning"):
+            err.print(line, markup=False, emoji=False)
+
+
 @command()
 def run(
     ctx: typer.Context,
@@ -147,6 +156,7 @@ def run(
                 return
             c.wait_program(channel, timeout_s)
             status = c.status(channel)
+            show_warnings(c, channel)
     except (AdsError, ChannelError, ClientValueError) as exc:
         finish_wait(exc)
     emit(settings, {"channel": channel, "program": name, "finished": True,
@@ -189,9 +199,29 @@ def _channel_command(method: str, done: str, request: str):
 app.command("hold", help="Feedhold: the path decelerates and stops (HOLD).")(
     _channel_command("hold", "feedhold", "HOLD")
 )
-app.command("resume", help="START again after feedhold, M0/M1 or a single-block stop.")(
-    _channel_command("start", "resumed", "START")
-)
+@command()
+def resume(
+    ctx: typer.Context,
+    channel: int = ChannelOption,
+    wait: bool = WaitOption,
+    timeout_s: float = WaitTimeoutOption,
+) -> None:
+    """START again after feedhold, M0/M1 or a single-block stop."""
+    settings: Settings = ctx.obj
+    try:
+        with settings.session(f"START of channel {channel}") as c:
+            c.start(channel)
+            if not wait:
+                emit(settings, {"channel": channel, "ok": True}, f"channel {channel}: resumed")
+                return
+            c.wait_program(channel, timeout_s)
+            status = c.status(channel)
+            show_warnings(c, channel)
+    except (AdsError, ChannelError, ClientValueError) as exc:
+        finish_wait(exc)
+    emit(settings, {"channel": channel, "program": status.program, "finished": True,
+                    "program_time_s": status.program_time_s},
+         f"channel {channel}: {status.program} finished in {status.program_time_s:.3f} s")
 
 
 @command()

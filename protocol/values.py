@@ -12,7 +12,7 @@ value such as 0x48 is a combination); ``ExecutionMode`` names the single bits.
 
 from __future__ import annotations
 
-from enum import IntEnum
+from enum import IntEnum, IntFlag
 
 
 class ChannelMode(IntEnum):
@@ -56,7 +56,7 @@ class ContourBlockType(IntEnum):
     POLYNOMIAL = 6  # polynomial contour element
 
 
-class ExecutionMode(IntEnum):
+class ExecutionMode(IntFlag):
     """Execution mode bits of a channel (``mc_command_execution_mode_w``); a value is
     their OR."""
 

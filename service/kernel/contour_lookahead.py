@@ -43,6 +43,8 @@ import math
 from collections import deque
 from collections.abc import Iterable, Sequence
 
+from cnc_objects.protocol.values import ContourBlockType
+
 from .nc.blocks import Block, ContourCommand, ContourKind, LogArea, MotionKind, next_log_area
 from .path.geometry import Arc
 from .path.segments import Segment
@@ -51,7 +53,7 @@ from .state import ContourElement
 RESPONSE_BLOCKS = 32  # entries of gpCh[i].contour_lookahead.response.block[0..31]
 LOG_FULL_WARNING = 22074  # warning id: the marked area has more entries than the log keeps
 
-LINEAR, CIRCULAR = 1, 2  # block_type of motion elements
+LINEAR, CIRCULAR = ContourBlockType.LINEAR, ContourBlockType.CIRCULAR  # motion elements
 _INCR_PER_MM = 10_000.0  # 0.1 um per mm
 _SAME_CENTRE_MM = 1e-6  # an offset arc keeps the centre of its programmed arc
 # mode 2 window edges: start positions are exact sums of the lengths in 0.1 um, as a
