@@ -1,9 +1,9 @@
-"""The README's guided tour, run as a user types it: every ``$ cnc ...`` line of the tour
-sections, in order, in a fresh directory against a fresh service.
+"""The README's tour, run as a user types it: every ``$ cnc ...`` line from "## 1." up to
+"What runs", in order, in a fresh directory against a fresh service started as `make run`
+starts it (realtime clock), and each prints what the README shows under it.
 
-Lines that need a terminal or a broker (``cnc-hmi``, ``cnc watch``, the MQTT step, which
-has its own tests) or files the README only names (``long.nc``, ``prog.nc``) are left out;
-everything else must exit 0 (the lines that show a failure end in ``echo $?``).
+Left out (``readme_tour.NOT_RUN``): the terminal HMI, the lines that need a broker or
+containers in the background; their own tests cover them.
 """
 
 from __future__ import annotations
@@ -14,39 +14,91 @@ import subprocess
 import sys
 from pathlib import Path
 
-from tests.support.service import ROOT, RunningService
+import pytest
 
-ILLUSTRATIVE = ("cnc watch", "cnc-hmi", "long.nc", "prog.nc", "mosquitto", "cnc-mqtt")
-_COMMENT = re.compile(r"\s+#\s.*$")
+from cnc_objects.testing import serving
+from tests.e2e.readme_tour import (
+    README_ENDPOINT,
+    output_matches,
+    python_example,
+    tour_steps,
+)
+from tests.support.service import ROOT
+
+README = ROOT / "README.md"
+EXAMPLES = ROOT / "docs" / "examples"
 
 
-def tour_commands() -> list[str]:
-    """The ``$ `` lines of the README from "## 1." up to the first section after the tour."""
-    text = (ROOT / "README.md").read_text()
-    start = text.index("\n## 1. ")
-    end = text.index("\n## ", text.index("\n## 7. ") + 1)
-    commands = []
-    for line in text[start:end].splitlines():
-        if line.startswith("$ "):
-            command = _COMMENT.sub("", line[2:]).strip()
-            if not any(word in command for word in ILLUSTRATIVE):
-                commands.append(command)
-    return commands
+def _env(endpoint: str) -> dict[str, str]:
+    return {**os.environ, "CNC_ENDPOINT": endpoint, "COLUMNS": "100",
+            "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
 
 
 def test_the_tour_has_its_steps() -> None:
-    commands = tour_commands()
-    for expected in ("cnc info", "cnc run part.nc --wait", "cnc plot part.nc -o part.png",
-                     "cnc lookahead", "cnc mdi -c 2 --wait"):
+    commands = [s.command for s in tour_steps(README)]
+    for expected in ("cnc info", "cnc run docs/examples/part.nc --wait", "cnc status",
+                     "cnc plot part.nc -o part.png", "cnc lookahead", "cnc mdi -c 2 --wait",
+                     "cnc check docs/examples/check-syntax.nc", "cnc reset --standard",
+                     "cnc run docs/examples/chords.nc --wait"):
         assert any(c.startswith(expected) for c in commands), expected
+    assert all(s.expected or s.command.startswith("cnc-hmi") for s in tour_steps(README)), \
+        [s.command for s in tour_steps(README) if not s.expected]
 
 
-def test_every_tour_command_works(service: RunningService, tmp_path: Path) -> None:
+def test_every_file_the_tour_uses_is_in_docs_examples() -> None:
+    """A program named in the tour is a file of docs/examples, given by its path, or the
+    store name of one the tour has uploaded (or run) before."""
+    stored: set[str] = set()
+    for step in tour_steps(README):
+        for word in re.findall(r"[\w./-]+\.(?:nc|ecy)\b", step.command):
+            if word.startswith("docs/examples/"):
+                assert (ROOT / word).is_file(), f"{step.command}: {word} does not exist"
+                stored.add(Path(word).name)
+            else:
+                assert word in stored or word == "copy.nc", \
+                    f"{step.command}: {word} was never uploaded before"
+
+
+@pytest.mark.parametrize(("expected", "actual", "same"), [
+    (("a = 1",), ["a = 1"], True),
+    (("a = 1",), ["a = 2"], False),
+    (("t = 0.306 s",), ["t = 0.309 s"], True),  # a few cycles later
+    (("t = 0.306 s",), ["t = 0.318 s"], False),
+    (("n = 306",), ["n = 307"], False),  # whole numbers are exact
+    (("name  type",), ["name\ttype"], True),
+    (("... #1 x = 5",), ["2026-11-25T10:00:00.000+00:00 #1 x = 5"], True),
+    (("head", "...", "tail"), ["head", "1", "2", "tail"], True),
+    (("head", "...", "tail"), ["head", "1", "2"], False),
+    (("x",), ["x", "more"], False),
+    ((), ["printed"], False),
+])
+def test_the_matcher(expected: tuple[str, ...], actual: list[str], same: bool) -> None:
+    assert output_matches(expected, actual) is same
+
+
+def test_every_tour_command_prints_what_the_readme_shows(tmp_path: Path) -> None:
     (tmp_path / "docs").symlink_to(ROOT / "docs")
-    env = {**os.environ, "CNC_ENDPOINT": service.endpoint,
-           "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
-    for command in tour_commands():
-        done = subprocess.run(["bash", "-c", command], cwd=tmp_path, env=env,
-                              capture_output=True, text=True, timeout=60)
-        assert done.returncode == 0, f"$ {command}\n{done.stdout}{done.stderr}"
+    with serving("--clock", "realtime", cwd=tmp_path) as service:
+        env = _env(service.endpoint)
+        failures = []
+        for step in tour_steps(README):
+            done = subprocess.run(["bash", "-c", step.command], cwd=tmp_path, env=env, text=True,
+                                  stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=120)
+            printed = done.stdout.replace(service.endpoint, README_ENDPOINT)
+            if not output_matches(step.expected, printed.splitlines()):
+                failures.append(f"$ {step.command}\nREADME shows:\n" + "\n".join(step.expected)
+                                + f"\nprinted (exit {done.returncode}):\n{printed}")
+        assert not failures, f"{len(failures)} command(s) print otherwise:\n\n" + \
+            "\n\n".join(failures)
     assert (tmp_path / "part.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_python_example_prints_what_the_readme_shows(tmp_path: Path) -> None:
+    code, shown = python_example(README)
+    with serving("--clock", "realtime", cwd=tmp_path) as service:
+        script = tmp_path / "example.py"
+        script.write_text(code.replace(README_ENDPOINT, service.endpoint))
+        done = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=_env(service.endpoint),
+                              capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert output_matches(shown, done.stdout.splitlines()), done.stdout

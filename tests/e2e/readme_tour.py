@@ -1,0 +1,127 @@
+"""The README's tour as data: the ``$ `` commands of its shell blocks, each with the output
+the README shows under it, and a matcher that decides whether a real output is that one.
+
+What the README shows is what a user sees, with three allowances a reader expects:
+
+- ``...`` on a line of its own stands for any number of lines (a long table cut short);
+- ``...`` inside a line stands for any text (a timestamp, a path);
+- a decimal number may differ by up to five units in its last digit: with the realtime
+  clock of `make run`, a run time includes the few 1 ms cycles the decoder needs to
+  deliver the first block, and those vary with the machine's load.
+
+Runs of white space compare equal (tables piped through ``cnc`` are tab-separated).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+ELLIPSIS = "..."
+TOLERANCE_UNITS = 5.5  # of a decimal number's last digit (see above)
+# Commands a test cannot run as a user types them: a terminal UI, a broker in the
+# background, containers. Their own tests cover them.
+NOT_RUN = ("cnc-hmi", "mosquitto", "cnc-mqtt", "docker")
+README_ENDPOINT = "tcp://127.0.0.1:5555"
+_COMMENT = re.compile(r"\s+#\s.*$")
+_NUMBER = re.compile(r"-?\d+(?:\.\d+)?")
+
+
+@dataclass(frozen=True)
+class TourStep:
+    """One ``$ command`` of the README and the lines shown under it."""
+
+    section: str
+    command: str
+    expected: tuple[str, ...]
+
+
+def tour_text(readme: Path) -> str:
+    """The README from the tour's first section up to "## What runs"."""
+    text = readme.read_text()
+    return text[text.index("\n## 1. "):text.index("\n## What runs")]
+
+
+def _blocks(text: str, language: str) -> list[tuple[str, list[str]]]:
+    """(section title, lines) of every fenced block of ``language``."""
+    blocks, section, inside, lines = [], "", False, []
+    for line in text.splitlines():
+        if not inside and line.startswith("## "):
+            section = line[3:]
+        if line.startswith("```"):
+            if inside:
+                blocks.append((section, lines))
+                inside, lines = False, []
+            elif line[3:].strip() == language:
+                inside = True
+            continue
+        if inside:
+            lines.append(line)
+    return blocks
+
+
+def tour_steps(readme: Path) -> list[TourStep]:
+    """Every ``$ `` command of the tour's shell blocks that a test can run, in order."""
+    steps = []
+    for section, lines in _blocks(tour_text(readme), "sh"):
+        command, expected = None, []
+        for line in [*lines, "$ "]:
+            if line.startswith("$ "):
+                if command and not any(word in command for word in NOT_RUN):
+                    steps.append(TourStep(section, command, tuple(expected)))
+                command, expected = _COMMENT.sub("", line[2:]).strip(), []
+            else:
+                expected.append(line)
+    return steps
+
+
+def python_example(readme: Path) -> tuple[str, tuple[str, ...]]:
+    """The tour's Python example and the output shown in the ``text`` block after it."""
+    text = tour_text(readme)
+    (_, code), = _blocks(text, "python")[:1]
+    after = text[text.index("```python"):]
+    (_, shown), = _blocks(after, "text")[:1]
+    return "\n".join(code) + "\n", tuple(shown)
+
+
+def _normal(line: str) -> str:
+    return " ".join(line.split())
+
+
+def _line_matches(expected: str, actual: str) -> bool:
+    expected, actual = _normal(expected), _normal(actual)
+    numbers = _NUMBER.findall(expected.replace(ELLIPSIS, " "))
+    pattern = ""
+    for k, part in enumerate(expected.split(ELLIPSIS)):
+        if k:
+            pattern += ".*?"
+        last = 0
+        for m in _NUMBER.finditer(part):
+            pattern += re.escape(part[last:m.start()]) + r"(-?\d+(?:\.\d+)?)"
+            last = m.end()
+        pattern += re.escape(part[last:])
+    found = re.fullmatch(pattern, actual)
+    if found is None:
+        return False
+    for want, got in zip(numbers, found.groups()):
+        if "." not in want:
+            if want != got:
+                return False
+            continue
+        unit = 10 ** -len(want.split(".")[1])
+        if abs(float(want) - float(got)) > unit * TOLERANCE_UNITS:
+            return False
+    return True
+
+
+def output_matches(expected: tuple[str, ...], actual: list[str]) -> bool:
+    """Whether ``actual`` lines are what the README shows (see the module docstring)."""
+    expected = tuple(e for e in expected if e.strip())
+    actual = [a for a in actual if a.strip()]
+    if not expected:
+        return not actual
+    head, rest = expected[0], expected[1:]
+    if head.strip() == ELLIPSIS:
+        return any(output_matches(rest, actual[k:]) for k in range(len(actual) + 1))
+    return bool(actual) and _line_matches(head, actual[0]) and output_matches(rest, actual[1:])
