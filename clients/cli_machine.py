@@ -28,7 +28,7 @@ from pathlib import Path
 
 import typer
 
-from .channel_ops import CONTOUR_BLOCK_TYPES, CheckError, CheckResult
+from .channel_ops import CONTOUR_BLOCK_TYPES, ChannelStatus, CheckError, CheckResult
 from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
 from .client import Client
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
@@ -127,12 +127,23 @@ def programs(ctx: typer.Context) -> None:
         out.print(f"{len(entries)} files")
 
 
-def show_warnings(c: Client, channel: int) -> None:
-    """The warnings a finished program raised (the channel kept running), on stderr:
-    a waited run that only printed "finished" would hide them."""
+def wait_to_end(c: Client, channel: int, timeout_s: float | None) -> ChannelStatus:
+    """Wait until the channel's program has ended; print the warnings it raised (the
+    channel kept running) on stderr, since a run that only said "finished" would hide
+    them; return the channel's status."""
+    c.wait_program(channel, timeout_s)
     for line in c.channel_errors(channel):
         if line.startswith("warning"):
             err.print(line, markup=False, emoji=False)
+    return c.status(channel)
+
+
+def report_finished(settings: Settings, status: ChannelStatus) -> None:
+    """The one line (or JSON object) of a program that ran to its end."""
+    emit(settings, {"channel": status.channel, "program": status.program, "finished": True,
+                    "program_time_s": status.program_time_s},
+         f"channel {status.channel}: {status.program} finished in "
+         f"{status.program_time_s:.3f} s")
 
 
 @command()
@@ -154,14 +165,10 @@ def run(
                 emit(settings, {"channel": channel, "program": name, "started": True},
                       f"channel {channel}: {name} started")
                 return
-            c.wait_program(channel, timeout_s)
-            status = c.status(channel)
-            show_warnings(c, channel)
+            status = wait_to_end(c, channel, timeout_s)
     except (AdsError, ChannelError, ClientValueError) as exc:
         finish_wait(exc)
-    emit(settings, {"channel": channel, "program": name, "finished": True,
-                     "program_time_s": status.program_time_s},
-          f"channel {channel}: {name} finished in {status.program_time_s:.3f} s")
+    report_finished(settings, status)
 
 
 @command()
@@ -199,6 +206,8 @@ def _channel_command(method: str, done: str, request: str):
 app.command("hold", help="Feedhold: the path decelerates and stops (HOLD).")(
     _channel_command("hold", "feedhold", "HOLD")
 )
+
+
 @command()
 def resume(
     ctx: typer.Context,
@@ -214,14 +223,10 @@ def resume(
             if not wait:
                 emit(settings, {"channel": channel, "ok": True}, f"channel {channel}: resumed")
                 return
-            c.wait_program(channel, timeout_s)
-            status = c.status(channel)
-            show_warnings(c, channel)
+            status = wait_to_end(c, channel, timeout_s)
     except (AdsError, ChannelError, ClientValueError) as exc:
         finish_wait(exc)
-    emit(settings, {"channel": channel, "program": status.program, "finished": True,
-                    "program_time_s": status.program_time_s},
-         f"channel {channel}: {status.program} finished in {status.program_time_s:.3f} s")
+    report_finished(settings, status)
 
 
 @command()
