@@ -10,6 +10,10 @@ on the kernel against the time-optimal limit of a separate reference implementat
 LA_OFF with 30/120/190 blocks and LA_ON (``bench/lookahead_bench.py``); it writes the
 spiral's speed plot to ``lookahead-spiral.png``.
 
+ADS part (``--part ads``): pyads sequential reads against a minimal asyncio AMS/TCP
+echo server and against the service, and ``read_list_by_name`` of 100 symbols
+(``bench/ads_bench.py``).
+
 Dispatch part (``--part dispatch``):
 
 Baseline: a raw pyzmq ROUTER in a second process that answers each msgpack frame with a
@@ -37,7 +41,6 @@ import statistics
 import sys
 import tempfile
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import msgpack
@@ -46,48 +49,11 @@ import zmq
 from cnc_objects.clients import AsyncClient, Client
 from tests.support.service import start_service
 
+from .common import BENCH_MACHINE, Figure, figure, median_figure
 from .raw_echo import serve_echo
 
 ADDRESS = (551, 0x121301, 0x10018, "UNS32")  # ch1.ax1.link_state
 IN_FLIGHT = 64
-
-BENCH_MACHINE = """
-name = "bench"
-physical_axes = [
-  {number = 1, name = "X"}, {number = 2, name = "Y"}, {number = 3, name = "Z"},
-  {number = 4, name = "A"}, {number = 5, name = "B"}, {number = 6, name = "C"},
-]
-""" + "".join(
-    f"""
-[[channels]]
-id = {c}
-name = "ch{c}"
-suspend_output_at_start = {"false" if c == 1 else "true"}
-axes = [{", ".join(
-        f'{{name = "{n}", logical_number = {10 * c + k}, link_to = {k}}}'
-        for k, n in enumerate("XYZABC", start=1))}]
-"""
-    for c in (1, 2, 3)
-)
-
-
-@dataclass
-class Figure:
-    """Throughput and latency of one measurement."""
-
-    reads_s: float
-    median_us: float
-    p99_us: float
-
-
-def _figure(count: int, elapsed_s: float, latencies_s: list[float]) -> Figure:
-    lat = sorted(latencies_s)
-    return Figure(
-        count / elapsed_s,
-        statistics.median(lat) * 1e6,
-        lat[min(len(lat) - 1, int(len(lat) * 0.99))] * 1e6,
-    )
-
 
 def _frame(invoke_id: int) -> bytes:
     return msgpack.packb([invoke_id, 2, *ADDRESS[:3], 4])
@@ -111,7 +77,7 @@ def raw_sequential(endpoint: str, count: int) -> Figure:
     elapsed = time.perf_counter() - start
     sock.close(linger=0)
     ctx.term()
-    return _figure(count, elapsed, lat)
+    return figure(count, elapsed, lat)
 
 
 def raw_pipelined(endpoint: str, count: int) -> Figure:
@@ -140,7 +106,7 @@ def raw_pipelined(endpoint: str, count: int) -> Figure:
     elapsed = time.perf_counter() - start
     sock.close(linger=0)
     ctx.term()
-    return _figure(count, elapsed, lat)
+    return figure(count, elapsed, lat)
 
 
 def client_sequential(endpoint: str, count: int) -> Figure:
@@ -155,7 +121,7 @@ def client_sequential(endpoint: str, count: int) -> Figure:
             c.read_address(*ADDRESS)
             lat.append(time.perf_counter() - t0)
         elapsed = time.perf_counter() - start
-    return _figure(count, elapsed, lat)
+    return figure(count, elapsed, lat)
 
 
 async def _client_in_flight(endpoint: str, count: int) -> Figure:
@@ -174,7 +140,7 @@ async def _client_in_flight(endpoint: str, count: int) -> Figure:
         start = time.perf_counter()
         await asyncio.gather(*(worker() for _ in range(IN_FLIGHT)))
         elapsed = time.perf_counter() - start
-    return _figure(per_worker * IN_FLIGHT, elapsed, lat)
+    return figure(per_worker * IN_FLIGHT, elapsed, lat)
 
 
 def client_in_flight(endpoint: str, count: int) -> Figure:
@@ -193,16 +159,7 @@ async def _client_read_many(endpoint: str, count: int) -> tuple[Figure, int]:
             await c.read_many(names)
             lat.append(time.perf_counter() - t0)
         elapsed = time.perf_counter() - start
-    return _figure(count, elapsed, lat), len(names)
-
-
-def median_figure(figures: list[Figure]) -> Figure:
-    """Median of each number over the runs."""
-    return Figure(
-        statistics.median(f.reads_s for f in figures),
-        statistics.median(f.median_us for f in figures),
-        statistics.median(f.p99_us for f in figures),
-    )
+    return figure(count, elapsed, lat), len(names)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -210,13 +167,18 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__.split("\n")[0])
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
-    parser.add_argument("--part", choices=("all", "dispatch", "kernel", "lookahead"),
+    parser.add_argument("--part", choices=("all", "dispatch", "ads", "kernel", "lookahead"),
                         default="all",
-                        help="dispatch: request dispatch; kernel: decoder, interpolator, "
-                        "planner; lookahead: machining time against the optimum")
+                        help="dispatch: request dispatch (ZeroMQ); ads: pyads over AMS/TCP; "
+                        "kernel: decoder, interpolator, planner; lookahead: machining time "
+                        "against the optimum")
     args = parser.parse_args(argv)
     if args.part in ("all", "dispatch"):
         dispatch(args)
+    if args.part in ("all", "ads"):
+        from . import ads_bench
+
+        ads_bench.main(args.runs, args.count // 4)
     if args.part in ("all", "kernel"):
         kernel(args.runs)
     if args.part in ("all", "lookahead"):

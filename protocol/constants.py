@@ -70,9 +70,22 @@ class ReservedIndexGroup(IntEnum):
     SYM_VALUE_BY_NAME = 0xF004  # ReadWrite: name in, value out
     SYM_VALUE_BY_HANDLE = 0xF005  # Read/Write with offset = handle
     SYM_RELEASE_HANDLE = 0xF006  # Write the UNS32 handle to release it
+    SYM_VERSION = 0xF008  # Read: the symbol table's version (one byte)
+    SYM_INFO_BY_NAME_EX = 0xF009  # ReadWrite: name in, AdsSymbolEntry out
+    SYM_UPLOAD = 0xF00B  # Read: every AdsSymbolEntry, one after the other
+    SYM_UPLOAD_INFO = 0xF00C  # Read: symbol count and upload length (8 bytes)
+    SYM_DT_UPLOAD = 0xF00E  # Read: every AdsDatatypeEntry, one after the other
+    SYM_UPLOAD_INFO2 = 0xF00F  # Read: AdsSymbolUploadInfo2 (24 bytes; 64 with TwinCAT 3 fields)
+    SYM_DT_INFO_BY_NAME_EX = 0xF011  # ReadWrite: type name in, AdsDatatypeEntry out
     SUM_READ = 0xF080  # ReadWrite: N x (group, offset, length) in, N codes + data out
     SUM_WRITE = 0xF081  # ReadWrite: N x (group, offset, length) + data in, N codes out
     SUM_READ_WRITE = 0xF082  # ReadWrite: N x (group, offset, rlen, wlen) + data in
+    DEVICE_DATA = 0xF100  # Read: offset 0 ADS state (UINT), offset 2 device state (UINT)
+
+
+#: Offsets in ``ReservedIndexGroup.DEVICE_DATA`` (ADSIOFFS_DEVDATA_*).
+DEVICE_DATA_ADS_STATE = 0x0  # UINT: the ADS state of the port's device
+DEVICE_DATA_DEVICE_STATE = 0x2  # UINT: its device state
 
 
 class CncPort(IntEnum):
@@ -82,6 +95,28 @@ class CncPort(IntEnum):
     SDA = 552  # decoder: NC variables
     COM = 553  # HMI-facing mc_*, cnc_*, ac_* objects
     PLC = 851  # TwinCAT PLC runtime 1: the HLI elements, served as symbols
+
+
+class AmsPort(IntEnum):
+    """AMS ports beside the CNC tasks that an ADS router answers on."""
+
+    SYSTEM_SERVICE = 10000  # the TwinCAT system service: ReadState, ReadDeviceInfo
+
+
+class AmsStateFlag(IntEnum):
+    """Bits of the AMS header's state flags."""
+
+    RESPONSE = 0x0001  # set in replies, clear in requests
+    ADS_COMMAND = 0x0004  # an ADS command (every frame this server handles)
+    UDP = 0x0040  # the frame came over UDP (never here: AMS/TCP only)
+
+
+#: TCP port of AMS/TCP (ADS routers listen here; AdsLib always dials it).
+AMS_TCP_PORT = 48898
+
+#: Largest AMS/TCP frame a connection may send by default (bytes after the 6-byte
+#: AMS/TCP header); a longer one closes that connection.
+AMS_MAX_FRAME_BYTES = 1 << 20
 
 
 #: The most sub-requests one sum command may carry (TwinCAT allows 500).

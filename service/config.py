@@ -7,6 +7,7 @@ default's array whole. Every mistake is refused at start with a message naming t
 
 from __future__ import annotations
 
+import ipaddress
 import tomllib
 from enum import StrEnum
 from pathlib import Path
@@ -15,6 +16,9 @@ from typing import Any, Literal
 from pydantic import (
     AliasChoices, BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator,
 )
+
+from cnc_objects.protocol.ams import parse_net_id
+from cnc_objects.protocol.constants import AMS_MAX_FRAME_BYTES, AMS_TCP_PORT
 
 from .param_list import ParamListError, read_axis_list, read_channel_list
 
@@ -262,6 +266,92 @@ class ChannelConfig(_Strict):
         return self
 
 
+def parse_ads_endpoint(text: str) -> tuple[str, int] | None:
+    """``HOST[:PORT]`` of the ADS listener as (host, port), port 48898 when left out;
+    None for ``off``. IPv6 hosts in brackets (``[::1]:48898``). Port 0 takes any free
+    port. ``ValueError`` says what is wrong."""
+    text = text.strip()
+    if text.lower() == "off":
+        return None
+    port_text = ""
+    if text.startswith("["):
+        host, sep, rest = text[1:].partition("]")
+        if not sep or (rest and not rest.startswith(":")):
+            raise ValueError(f"{text!r}: write an IPv6 host as [addr] or [addr]:port")
+        port_text = rest[1:]
+    else:
+        host, _, port_text = text.partition(":")
+        if ":" in port_text:
+            raise ValueError(f"{text!r}: write an IPv6 host in brackets, [addr]:port")
+    if not host:
+        raise ValueError(f"{text!r}: the host is missing (HOST[:PORT], or off)")
+    if not port_text:
+        return host, AMS_TCP_PORT
+    if not port_text.isdigit() or int(port_text) > 0xFFFF:
+        raise ValueError(f"{text!r}: the port must be a number 0..65535")
+    return host, int(port_text)
+
+
+class AdsRouteConfig(_Strict):
+    """A route of the ADS front end: a peer that may connect from ``address``."""
+
+    name: str = Field(min_length=1, max_length=63, description="name of the route")
+    net_id: str = Field(description="AMS Net ID the peer sends from (a.b.c.d.e.f)")
+    address: str = Field(description="IP address the peer connects from")
+
+    @field_validator("net_id")
+    @classmethod
+    def _net_id(cls, value: str) -> str:
+        parse_net_id(value)
+        return value.strip()
+
+    @field_validator("address")
+    @classmethod
+    def _address(cls, value: str) -> str:
+        try:
+            return str(ipaddress.ip_address(value.strip()))
+        except ValueError:
+            raise ValueError(f"{value!r} is not an IP address") from None
+
+
+class AdsConfig(_Strict):
+    """The ADS front end (AMS/TCP): where it listens, its AMS Net ID, its routes."""
+
+    endpoint: str = Field(
+        f"127.0.0.1:{AMS_TCP_PORT}",
+        description="HOST[:PORT] to listen on for ADS (AMS/TCP), or off",
+    )
+    net_id: str | None = Field(
+        None, description="AMS Net ID of the service (default: the bound IPv4 address + .1.1)"
+    )
+    routes: tuple[AdsRouteConfig, ...] = Field(
+        (), description="peers served besides loopback (name, net_id, address)"
+    )
+    max_frame_bytes: int = Field(
+        AMS_MAX_FRAME_BYTES, ge=1024, le=64 << 20,
+        description="longest AMS/TCP frame a client may send (bytes); longer closes it",
+    )
+
+    @field_validator("endpoint")
+    @classmethod
+    def _endpoint(cls, value: str) -> str:
+        parse_ads_endpoint(value)
+        return value.strip()
+
+    @field_validator("net_id")
+    @classmethod
+    def _net_id(cls, value: str | None) -> str | None:
+        if value is not None:
+            parse_net_id(value)
+            return value.strip()
+        return value
+
+    @property
+    def address(self) -> tuple[str, int] | None:
+        """(host, port) to listen on, None when ADS is off."""
+        return parse_ads_endpoint(self.endpoint)
+
+
 class MachineConfig(_Strict):
     """The whole machine: platform axes, channels, cycle time."""
 
@@ -277,6 +367,9 @@ class MachineConfig(_Strict):
     data_dir: str | None = Field(
         None, description="the service's data directory (the program store is its programs/); "
         "default: cnc-data in the working directory at start"
+    )
+    ads: AdsConfig = Field(
+        default_factory=AdsConfig, description="the ADS front end ([ads] endpoint, net_id, routes)"
     )
 
     @model_validator(mode="after")

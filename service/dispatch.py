@@ -1,24 +1,23 @@
-"""Dispatch of ADS requests: decoded frame in, reply frame out, by command id.
+"""Dispatch of ADS requests: a decoded request in, the reply frame out, by command id.
 
-Transport-neutral: the ZeroMQ server hands every frame to ``Dispatcher.handle`` and sends
-what it returns; replies that must wait for the kernel (writes, run control) are sent
-later through the ``send`` callback the server supplies. Reads are answered at once from
-the kernel's snapshot; writes are queued for the kernel and answered when the cycle
-thread has applied them (an acknowledged write is never lost).
+Transport-neutral: each front end decodes its frames into the request tuples of
+``protocol.frames`` (ZeroMQ from msgpack, ADS over AMS/TCP from the AMS payload) and
+hands them to its own ``Dispatcher``; the dispatcher answers through the front end's
+``FrontEnd`` (how a reply, an error and a notification are encoded and sent), so the
+command logic exists once for both wires. Reads are answered at once from the kernel's
+snapshot; writes are queued for the kernel and answered when the cycle thread has
+applied them (an acknowledged write is never lost), through ``FrontEnd.send``.
 
-Nothing a client sends raises out of here: frames that do not decode get an error reply
-(or None, logged, when not even the invoke id can be read), handler faults become 0x700.
+Nothing a client sends raises out of here: handler faults become 0x700.
 """
 
 from __future__ import annotations
 
-import asyncio
 import logging
-import struct
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Protocol
 
-from cnc_objects.objects import AddressSpace, Entry
+from cnc_objects.objects import Entry
 from cnc_objects.protocol import sum as sums
 from cnc_objects.protocol.constants import (
     MAX_DATA_BYTES,
@@ -29,10 +28,8 @@ from cnc_objects.protocol.constants import (
     CncPort,
 )
 from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
-from cnc_objects.protocol.datatypes import STRING_ENCODING
-from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
+from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.frames import (
-    AddNotificationRequest,
     BrowseRequest,
     DeleteNotificationRequest,
     ReadRequest,
@@ -40,51 +37,69 @@ from cnc_objects.protocol.frames import (
     Request,
     WriteControlRequest,
     WriteRequest,
-    decode_request,
-    encode_error,
-    encode_response,
 )
 
 from . import __version__
+from .backend import Backend, ValueResult
 from .binding import refusal_code
 from .kernel.commands import Refusal
-from .kernel.kernel import Control, ControlCommand, Kernel
-from .notifications import NotificationHub, SendFn
-from .program_service import ProgramStoreService
+from .kernel.kernel import Control, ControlCommand
+from .notifications import Envelope
 
 log = logging.getLogger(__name__)
 
 _E = AdsReturnCode
-_U32 = struct.Struct("<I")
 _RESERVED_GROUPS = 0xF000  # index groups from here on are ADS services, not objects
 DEVICE_NAME = "cnc-objects"
 _CONTROLS = {AdsState.RUN: Control.RUN, AdsState.STOP: Control.STOP, AdsState.RESET: Control.RESET}
 
-Envelope = tuple[bytes, ...]
 Reply = bytes | None
-ValueResult = tuple[int, Any]  # (0, payload) or (code, message)
+
+
+class FrontEnd(Protocol):
+    """A front end's wire, as the dispatcher needs it."""
+
+    def ok(self, envelope: Envelope, req: Any, *fields: Any) -> bytes:
+        """The successful reply to ``req`` with the command's response fields."""
+        ...
+
+    def error(self, envelope: Envelope, req: Any, code: int, message: str) -> bytes:
+        """The error reply to ``req``: ADS ``code`` and a sentence saying why."""
+        ...
+
+    def send(self, envelope: Envelope, payload: bytes) -> bool:
+        """Send a reply later (after the kernel applied a write); False if undelivered."""
+        ...
+
+    def notify(self, envelope: Envelope, port: int, samples: list[list[Any]]) -> bool:
+        """Encode and send notification samples ``[handle, sequence, FILETIME, data]``."""
+        ...
+
+    def cycle_ns(self, req: Any) -> int:
+        """The cycle time of an AddDeviceNotification request, in ns (its wire's unit
+        converted)."""
+        ...
+
+    #: Wall time between the reply to AddDeviceNotification and the first sample (s).
+    first_sample_delay_s: float
 
 
 class Dispatcher:
-    """Answers ADS requests against an address space and a kernel."""
+    """Answers one front end's ADS requests against the shared ``Backend``."""
 
-    def __init__(
-        self,
-        space: AddressSpace,
-        kernel: Kernel,
-        loop: asyncio.AbstractEventLoop,
-        send: SendFn,
-        programs: ProgramStoreService | None = None,
-    ) -> None:
-        self.space = space
-        self.programs = programs
-        self.kernel = kernel
-        self._loop = loop
-        self._send = send
-        self._space_read = space.read
-        self.hub = NotificationHub(
-            self._read_value, send, loop, kernel.cycle_ns, lambda: kernel.snapshot
-        )
+    def __init__(self, backend: Backend, front: FrontEnd) -> None:
+        self.backend = backend
+        self.space = backend.space
+        self.kernel = backend.kernel
+        self.programs = backend.programs
+        self.hub = backend.hub
+        self._loop = backend.loop
+        self._front = front
+        self._ok = front.ok
+        self._error = front.error
+        self._send = front.send
+        self._space_read = backend.space.read
+        self._read_value = backend.read_value
         self._handlers: dict[int, Callable[[Envelope, Any], Reply]] = {
             AdsCommand.READ_DEVICE_INFO: self._read_device_info,
             AdsCommand.READ: self._read,
@@ -102,87 +117,28 @@ class Dispatcher:
             RIG.SUM_READ_WRITE: self._sum_read_write,
         }
 
-    def handle(self, envelope: Envelope, raw: bytes) -> Reply:
-        """The reply to one frame from ``envelope``, or None (sent later, or dropped)."""
-        try:
-            request = decode_request(raw)
-        except ProtocolError as exc:
-            if exc.invoke_id is None:
-                log.warning("dropped a frame with no readable invoke id: %s", exc)
-                return None
-            return encode_error(exc.invoke_id, exc.command or 0, exc.code, str(exc))
+    def dispatch(self, envelope: Envelope, request: Request) -> Reply:
+        """The reply to ``request`` from ``envelope``, or None (sent later through
+        ``FrontEnd.send``)."""
         try:
             return self._handlers[request.COMMAND](envelope, request)
         except Exception:
             log.exception("handling %r failed", request)
-            return encode_error(
-                request.invoke_id, request.COMMAND, _E.DEVICE_ERROR, "internal error; see log"
-            )
+            return self._error(envelope, request, _E.DEVICE_ERROR, "internal error; see log")
 
-    @staticmethod
-    def _reply(request: Request, result: ValueResult) -> bytes:
+    def _reply(self, envelope: Envelope, req: Any, result: ValueResult) -> bytes:
         code, payload = result
         if code:
-            return encode_error(request.invoke_id, request.COMMAND, code, payload)
+            return self._error(envelope, req, code, payload)
         if payload is None:  # a write: the reply carries no data
-            return encode_response(request.invoke_id, request.COMMAND)
-        return encode_response(request.invoke_id, request.COMMAND, payload)
-
-    # ------------------------------------------------------------ values
-
-    def _read_value(self, port: int, group: int, offset: int, length: int) -> ValueResult:
-        """Read at an address, reserved groups included: (0, data) or (code, message)."""
-        if length > MAX_DATA_BYTES:
-            return _E.DEVICE_INVALIDSIZE, f"read length {length} exceeds {MAX_DATA_BYTES} bytes"
-        if group == RIG.SYM_VALUE_BY_HANDLE:
-            entry = self.space.by_handle(offset)
-            if entry is None:
-                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown"
-            return self.space.read_entry(entry, length)
-        return self.space.read(port, group, offset, length)
-
-    def _decode_write(self, port: int, group: int, offset: int, data: bytes) -> tuple:
-        """(0, entry, value), (0, None, None) for a handle release, or (code, message, None)."""
-        if group == RIG.SYM_VALUE_BY_HANDLE:
-            entry = self.space.by_handle(offset)
-            if entry is None:
-                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown", None
-            return self.space.decode_entry_write(entry, data)
-        if group == RIG.SYM_RELEASE_HANDLE:
-            if len(data) != 4:
-                return _E.DEVICE_INVALIDSIZE, "release a handle by writing its 4 bytes", None
-            handle = _U32.unpack(data)[0]
-            if self.space.by_handle(handle) is None:
-                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {handle} is unknown", None
-            return 0, None, None  # handles are stable per object: nothing to free
-        return self.space.decode_write(port, group, offset, data)
-
-    def _apply_writes(
-        self, items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None]
-    ) -> None:
-        """Queue the writes for the kernel; ``finish`` gets (code, message) per item on the
-        loop once the cycle thread has applied all of them."""
-        results: list[tuple[int, str]] = [(0, "")] * len(items)
-        remaining = [len(items)]
-        if not items:
-            finish(results)
-            return
-
-        def applied(k: int, refusal: Refusal | None) -> None:  # runs on the cycle thread
-            if refusal is not None:
-                results[k] = (refusal_code(refusal), refusal.message)
-            remaining[0] -= 1
-            if remaining[0] == 0:
-                self._loop.call_soon_threadsafe(finish, results)
-
-        for k, (entry, value) in enumerate(items):
-            self.kernel.submit(entry.write(value), lambda r, k=k: applied(k, r))
+            return self._ok(envelope, req)
+        return self._ok(envelope, req, payload)
 
     # ------------------------------------------------------------ commands
 
-    def _read_device_info(self, envelope: Envelope, req: Request) -> Reply:
+    def _read_device_info(self, envelope: Envelope, req: Any) -> Reply:
         major, minor, build = (int(p) for p in __version__.split("."))
-        return encode_response(req.invoke_id, req.COMMAND, major, minor, build, DEVICE_NAME)
+        return self._ok(envelope, req, major, minor, build, DEVICE_NAME)
 
     def _is_store(self, port: int, group: int) -> bool:
         return group == PROGRAM_STORE_GROUP and port == CncPort.COM and self.programs is not None
@@ -190,107 +146,94 @@ class Dispatcher:
     def _read(self, envelope: Envelope, req: ReadRequest) -> Reply:
         # The hot path: an object address goes straight to the address space.
         if req.group == PROGRAM_STORE_GROUP and self._is_store(req.port, req.group):
-            return self._reply(req, self.programs.read(req.offset, req.length))
+            return self._reply(envelope, req, self.programs.read(req.offset, req.length))
         if req.group < _RESERVED_GROUPS:
             code, payload = self._space_read(req.port, req.group, req.offset, req.length)
         else:
             code, payload = self._read_value(req.port, req.group, req.offset, req.length)
         if code:
-            return encode_error(req.invoke_id, AdsCommand.READ, code, payload)
-        return encode_response(req.invoke_id, AdsCommand.READ, payload)
+            if code == _E.DEVICE_INVALIDSIZE:  # a string may be read with any length
+                cut = self.backend.read_string(req.port, req.group, req.offset, req.length)
+                if cut is not None:
+                    return self._reply(envelope, req, cut)
+            return self._error(envelope, req, code, payload)
+        return self._ok(envelope, req, payload)
 
     def _write(self, envelope: Envelope, req: WriteRequest) -> Reply:
         if self._is_store(req.port, req.group):
-            return self._reply(req, self.programs.write(req.offset, req.data))
-        code, target, value = self._decode_write(req.port, req.group, req.offset, req.data)
+            return self._reply(envelope, req, self.programs.write(req.offset, req.data))
+        code, target, value = self.backend.decode_write(req.port, req.group, req.offset, req.data)
         if code:
-            return encode_error(req.invoke_id, req.COMMAND, code, target)
+            return self._error(envelope, req, code, target)
         if target is None:
-            return encode_response(req.invoke_id, req.COMMAND)
+            return self._ok(envelope, req)
 
         def finish(results: list[tuple[int, str]]) -> None:
             code, message = results[0]
             if code:
-                self._send(envelope, encode_error(req.invoke_id, req.COMMAND, code, message))
+                self._send(envelope, self._error(envelope, req, code, message))
             else:
-                self._send(envelope, encode_response(req.invoke_id, req.COMMAND))
+                self._send(envelope, self._ok(envelope, req))
 
-        self._apply_writes([(target, value)], finish)
+        self.backend.apply_writes([(target, value)], finish)
         return None
 
-    def _read_state(self, envelope: Envelope, req: Request) -> Reply:
-        state = AdsState.RUN if self.kernel.running else AdsState.STOP
-        return encode_response(req.invoke_id, req.COMMAND, state, 0)
+    def _read_state(self, envelope: Envelope, req: Any) -> Reply:
+        return self._ok(envelope, req, self.backend.ads_state(req.port), 0)
 
     def _write_control(self, envelope: Envelope, req: WriteControlRequest) -> Reply:
         control = _CONTROLS.get(req.ads_state)  # type: ignore[call-overload]
         if control is None:
             allowed = ", ".join(f"{s.value} {s.name}" for s in _CONTROLS)
-            return encode_error(
-                req.invoke_id, req.COMMAND, _E.DEVICE_INVALIDDATA,
+            return self._error(
+                envelope, req, _E.DEVICE_INVALIDDATA,
                 f"ADS state {req.ads_state} cannot be commanded; use {allowed}",
             )
 
         def done(refusal: Refusal | None) -> None:  # cycle thread
-            reply = (
-                encode_response(req.invoke_id, req.COMMAND)
-                if refusal is None
-                else encode_error(req.invoke_id, req.COMMAND, refusal_code(refusal), refusal.message)
-            )
-            self._loop.call_soon_threadsafe(self._send, envelope, reply)
+            self._loop.call_soon_threadsafe(self._finish_control, envelope, req, refusal)
 
         self.kernel.submit(ControlCommand(control), done)
         return None
 
-    def _add_notification(self, envelope: Envelope, req: AddNotificationRequest) -> Reply:
-        return self._reply(req, self.hub.add(envelope, req))
+    def _finish_control(self, envelope: Envelope, req: Any, refusal: Refusal | None) -> None:
+        if refusal is None:
+            self._send(envelope, self._ok(envelope, req))
+        else:
+            self._send(envelope, self._error(envelope, req, refusal_code(refusal), refusal.message))
+
+    def _add_notification(self, envelope: Envelope, req: Any) -> Reply:
+        front = self._front
+        return self._reply(envelope, req, self.hub.add(
+            envelope, req, front.cycle_ns(req), front.notify, front.first_sample_delay_s))
 
     def _delete_notification(self, envelope: Envelope, req: DeleteNotificationRequest) -> Reply:
         code, message = self.hub.delete(envelope, req.handle)
         if code:
-            return encode_error(req.invoke_id, req.COMMAND, code, message)
-        return encode_response(req.invoke_id, req.COMMAND)
+            return self._error(envelope, req, code, message)
+        return self._ok(envelope, req)
 
     def _browse(self, envelope: Envelope, req: BrowseRequest) -> Reply:
         found = [obj.describe() for obj in self.space.match(req.pattern)]
-        return encode_response(req.invoke_id, req.COMMAND, found)
+        return self._ok(envelope, req, found)
 
     # ------------------------------------------------------------ read-write
 
     def _read_write(self, envelope: Envelope, req: ReadWriteRequest) -> Reply:
         if req.read_length > MAX_DATA_BYTES:
-            return encode_error(
-                req.invoke_id, req.COMMAND, _E.DEVICE_INVALIDSIZE,
+            return self._error(
+                envelope, req, _E.DEVICE_INVALIDSIZE,
                 f"read length {req.read_length} exceeds {MAX_DATA_BYTES} bytes",
             )
         handler = self._read_write_groups.get(req.group)
         if handler is not None:  # a sum command
             return handler(envelope, req)
         if self._is_store(req.port, req.group):
-            return self._reply(req, self.programs.read_write(req.offset, req.data, req.read_length))
-        return self._reply(
-            req, self._rw_value(req.port, req.group, req.offset, req.read_length, req.data)
-        )
-
-    def _rw_value(self, port: int, group: int, offset: int, read_length: int, data: bytes) -> ValueResult:
-        """ReadWrite at one address: handle by name, value by name; others refused."""
-        if group in (RIG.SYM_HANDLE_BY_NAME, RIG.SYM_VALUE_BY_NAME):
-            try:
-                name = data.split(b"\x00", 1)[0].decode(STRING_ENCODING)
-            except UnicodeDecodeError:
-                return _E.DEVICE_INVALIDDATA, "a symbol name must be CP1252 text"
-            entry = self.space.by_name(name)
-            if entry is None:
-                return _E.DEVICE_SYMBOLNOTFOUND, f"no object is named {name!r}"
-            if group == RIG.SYM_VALUE_BY_NAME:
-                return self.space.read_entry(entry, read_length)
-            if read_length != 4:
-                return _E.DEVICE_INVALIDSIZE, "a handle is 4 bytes: read length must be 4"
-            return 0, _U32.pack(entry.handle)
-        found = self.space.find(port, group, offset)
-        if isinstance(found, tuple):
-            return found
-        return _E.DEVICE_SRVNOTSUPP, f"{found.obj.name} does not take ReadWrite; use Read or Write"
+            return self._reply(
+                envelope, req, self.programs.read_write(req.offset, req.data, req.read_length)
+            )
+        return self._reply(envelope, req, self.backend.read_write_value(
+            req.port, req.group, req.offset, req.read_length, req.data))
 
     def _sum_items(self, req: ReadWriteRequest, decode: Callable) -> tuple[int, Any]:
         if not 0 < req.offset <= SUM_COMMAND_MAX_ITEMS:
@@ -303,28 +246,35 @@ class Dispatcher:
     def _sum_read(self, envelope: Envelope, req: ReadWriteRequest) -> Reply:
         code, items = self._sum_items(req, sums.decode_sum_read)
         if code:
-            return encode_error(req.invoke_id, req.COMMAND, code, items)
+            return self._error(envelope, req, code, items)
         needed = 4 * len(items) + sum(i.read_length for i in items)
         if req.read_length < needed or needed > MAX_DATA_BYTES:
-            return encode_error(
-                req.invoke_id, req.COMMAND, _E.DEVICE_INVALIDSIZE,
+            return self._error(
+                envelope, req, _E.DEVICE_INVALIDSIZE,
                 f"sum read of these items returns {needed} bytes; read length is {req.read_length}",
             )
+        read, port = self._read_value, req.port
         results = []
         for item in items:
-            code, data = self._read_value(req.port, item.group, item.offset, item.read_length)
-            results.append((code, bytes(item.read_length)) if code else (0, data))
-        return encode_response(req.invoke_id, req.COMMAND, sums.encode_sum_read_reply(results))
+            length = item.read_length
+            code, data = read(port, item.group, item.offset, length)
+            if code:
+                data = bytes(length)
+            elif len(data) != length:  # a service answer shorter than asked: keep the slots
+                data = data[:length].ljust(length, b"\x00")
+            results.append((code, data))
+        return self._ok(envelope, req, sums.encode_sum_read_reply(results))
 
     def _sum_write(self, envelope: Envelope, req: ReadWriteRequest) -> Reply:
         code, items = self._sum_items(req, sums.decode_sum_write)
         if code:
-            return encode_error(req.invoke_id, req.COMMAND, code, items)
+            return self._error(envelope, req, code, items)
         codes: list[int] = [0] * len(items)
         writes: list[tuple[Entry, Any]] = []
         slots: list[int] = []
         for k, item in enumerate(items):
-            code, target, value = self._decode_write(req.port, item.group, item.offset, item.data)
+            code, target, value = self.backend.decode_write(
+                req.port, item.group, item.offset, item.data)
             if code:
                 codes[k] = code
             elif target is not None:
@@ -334,18 +284,18 @@ class Dispatcher:
         def finish(results: list[tuple[int, str]]) -> None:
             for k, (code, _) in zip(slots, results):
                 codes[k] = code
-            reply = encode_response(req.invoke_id, req.COMMAND, sums.encode_codes(codes))
-            self._send(envelope, reply)
+            self._send(envelope, self._ok(envelope, req, sums.encode_codes(codes)))
 
-        self._apply_writes(writes, finish)
+        self.backend.apply_writes(writes, finish)
         return None
 
     def _sum_read_write(self, envelope: Envelope, req: ReadWriteRequest) -> Reply:
         code, items = self._sum_items(req, sums.decode_sum_read_write)
         if code:
-            return encode_error(req.invoke_id, req.COMMAND, code, items)
+            return self._error(envelope, req, code, items)
         results = []
         for item in items:
-            code, data = self._rw_value(req.port, item.group, item.offset, item.read_length, item.data)
+            code, data = self.backend.read_write_value(
+                req.port, item.group, item.offset, item.read_length, item.data)
             results.append((code, b"") if code else (0, data))
-        return encode_response(req.invoke_id, req.COMMAND, sums.encode_sum_read_write_reply(results))
+        return self._ok(envelope, req, sums.encode_sum_read_write_reply(results))

@@ -1,21 +1,27 @@
-"""``cnc-service``: the composition root. Builds kernel, address space and server, runs them.
+"""``cnc-service``: the composition root. Builds kernel, address space and servers, runs them.
 
-    cnc-service [--config FILE] [--endpoint URL] [--clock realtime|virtual] [--speed X]
-                [--cycle-ms MS] [--program-dir DIR | --data-dir DIR] [--log-level L]
+    cnc-service [--config FILE] [--endpoint URL] [--ads HOST[:PORT]|off] [--ams-net-id ID]
+                [--clock realtime|virtual] [--speed X] [--cycle-ms MS]
+                [--program-dir DIR | --data-dir DIR] [--log-level L]
 
-Logs where its program store is (``program store: /abs/path (why)``, see
-``data_location``) and the endpoint it listens on (``listening on tcp://...``); SIGINT and
-SIGTERM stop it cleanly (sockets closed, cycle thread joined) with exit code 0. Bad usage,
-a bad configuration or an endpoint that cannot be bound exits with code 2 and says why
-(one line, or one line per configuration problem).
+Two front ends over one dispatcher: ZeroMQ (``--endpoint``) and ADS over AMS/TCP
+(``--ads``, default 127.0.0.1:48898, for pyads and every other ADS client). Logs where
+its program store is (``program store: /abs/path (why)``, see ``data_location``), where
+ADS listens (``ADS on 127.0.0.1:48898, AMS Net ID 127.0.0.1.1.1 ...``) and then the
+ZeroMQ endpoint (``listening on tcp://...``, the last start-up line); SIGINT and SIGTERM
+stop it cleanly (sockets closed, cycle thread joined) with exit code 0. Bad usage, a bad
+configuration or an address that cannot be bound exits with code 2 and says why (one
+line, or one line per configuration problem).
 """
 
 from __future__ import annotations
 
 import asyncio
 import logging
+import os
 import signal
 import sys
+from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
 from typing import NoReturn, Optional
@@ -23,14 +29,20 @@ from typing import NoReturn, Optional
 import typer
 import zmq
 
+from cnc_objects.protocol.ams import parse_net_id
+
+from .ads_routes import Route, RouteTable
+from .ads_server import AdsTcpServer
+from .ads_symbols import SymbolService
+from .backend import Backend
 from .binding import build_address_space
-from .config import ConfigError, MachineConfig, load_config
+from .config import ConfigError, MachineConfig, load_config, parse_ads_endpoint
 from .data_location import StoreLocation, program_store_location
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
 from .program_service import ProgramStoreService
 from .program_store import ProgramStore, StoreError
-from .server import AdsServer
+from .server import ZmqServer
 from .store_writer import StoreWriter
 
 log = logging.getLogger("cnc-service")
@@ -82,11 +94,20 @@ def _kernel_loader(store: ProgramStore):
     return load, store.exists
 
 
+@dataclass(frozen=True)
+class AdsListen:
+    """Where the ADS front end listens and as which AMS Net ID (None: the default)."""
+
+    host: str
+    port: int
+    net_id: str | None
+
+
 async def serve(
     config: MachineConfig, endpoint: str, clock_kind: ClockKind, speed: float | None,
-    store: ProgramStore,
+    store: ProgramStore, ads: AdsListen | None = None,
 ) -> int:
-    """Run kernel and server until SIGINT or SIGTERM."""
+    """Run kernel and both front ends until SIGINT or SIGTERM (ADS when ``ads`` is given)."""
     loop = asyncio.get_running_loop()
     # The cycle thread must get the GIL soon after it wakes, even while the server is busy.
     sys.setswitchinterval(min(0.005, config.cycle_ms / 1000.0 / 4))
@@ -97,19 +118,31 @@ async def serve(
         writer.append,
     )
     space = build_address_space(kernel)
+    backend = Backend(space, kernel, loop, ProgramStoreService(store, writer.flush),
+                      SymbolService(space))
+    kernel.on_cycle_end = backend.hub.kernel_cycle_end  # one hub serves both front ends
     try:
-        server = AdsServer(
-            space, kernel, endpoint, loop, programs=ProgramStoreService(store, writer.flush)
-        )
+        server = ZmqServer(backend, endpoint)
     except zmq.ZMQError as exc:
         print(f"cnc-service: cannot listen on {endpoint}: {zmq.strerror(exc.errno)}",
               file=sys.stderr)
         return EXIT_USAGE
+    ads_server = None
+    if ads is not None:
+        ads_server = await _start_ads(backend, config, ads)
+        if ads_server is None:
+            server.close()
+            return EXIT_USAGE
     stop = asyncio.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
     kernel.start()
     server.start()
+    if ads_server is not None:
+        host, port = ads_server.address
+        log.info("ADS on %s:%d, AMS Net ID %s (AMS ports %s; %d routes besides loopback)",
+                 f"[{host}]" if ":" in host else host, port, ads_server.net_id_text,
+                 ", ".join(str(p) for p in sorted(ads_server.ports)), len(ads_server.routes))
     log.info(
         "listening on %s (machine %s, %d channels, %d objects, %s clock, cycle %g ms)",
         server.endpoint, config.name, len(config.channels), len(space), clock_kind,
@@ -119,16 +152,36 @@ async def serve(
         await stop.wait()
     finally:
         log.info("stopping")
+        if ads_server is not None:
+            ads_server.close()
         server.close()
+        kernel.on_cycle_end = None
         kernel.close()
         writer.close()
     log.info("stopped")
     return 0
 
 
+async def _start_ads(
+    backend: Backend, config: MachineConfig, ads: AdsListen
+) -> AdsTcpServer | None:
+    """The listening ADS front end, or None after saying in one line why it cannot be."""
+    routes = RouteTable(Route.parse(r.name, r.net_id, r.address) for r in config.ads.routes)
+    ads_server = AdsTcpServer(backend, routes, config.ads.max_frame_bytes)
+    try:
+        await ads_server.start(ads.host, ads.port, ads.net_id)
+    except OSError as exc:
+        # errno for a bind failure; a host name that does not resolve has its own text
+        reason = os.strerror(exc.errno) if exc.errno and exc.errno > 0 else exc.strerror or str(exc)
+        print(f"cnc-service: cannot listen for ADS on {ads.host}:{ads.port}: {reason}",
+              file=sys.stderr)
+        return None
+    return ads_server
+
+
 @app.command(
     epilog="Exit codes: 0 stopped by SIGINT or SIGTERM; 2 bad usage, bad configuration, "
-    "unusable program store or endpoint in use."
+    "unusable program store, endpoint or ADS address in use."
 )
 def run(
     config_file: Optional[Path] = typer.Option(
@@ -157,9 +210,19 @@ def run(
         None, "--data-dir", metavar="DIR",
         help="Data directory of this service: its programs/ is the program store.",
     ),
+    ads: Optional[str] = typer.Option(
+        None, "--ads", metavar="HOST[:PORT]",
+        help="Where ADS clients (pyads, TwinCAT tools) connect: AMS/TCP address, port 48898 "
+        "when left out; off disables ADS (default: [ads] endpoint of the configuration, "
+        "else 127.0.0.1:48898).",
+    ),
+    ams_net_id: Optional[str] = typer.Option(
+        None, "--ams-net-id", metavar="NETID",
+        help="AMS Net ID of the service (default: [ads] net_id, else the ADS address + .1.1).",
+    ),
     log_level: LogLevel = typer.Option(LogLevel.INFO, "--log-level", help="Lowest level logged."),
 ) -> None:
-    """CNC kernel serving its objects over ZeroMQ (ADS frames)."""
+    """CNC kernel serving its objects over ZeroMQ and ADS (AMS/TCP)."""
     logging.basicConfig(
         level=log_level.value, format="%(asctime)s %(levelname)s %(name)s: %(message)s",
         stream=sys.stderr,
@@ -170,8 +233,25 @@ def run(
     location = program_store_location(
         program_dir, data_dir, config.program_store_dir, config.data_dir
     )
+    listen = _ads_listen(config, ads, ams_net_id)
     store = _open_store(location)
-    raise typer.Exit(asyncio.run(serve(config, endpoint, clock, speed, store)))
+    raise typer.Exit(asyncio.run(serve(config, endpoint, clock, speed, store, listen)))
+
+
+def _ads_listen(config: MachineConfig, ads: str | None, net_id: str | None) -> AdsListen | None:
+    """Where ADS listens: ``--ads``/``--ams-net-id`` over the configuration's [ads]."""
+    try:
+        address = parse_ads_endpoint(ads) if ads is not None else config.ads.address
+    except ValueError as exc:
+        _usage(f"bad --ads: {exc}")
+    if net_id is not None:
+        try:
+            parse_net_id(net_id)
+        except ValueError as exc:
+            _usage(f"bad --ams-net-id: {exc}")
+    if address is None:
+        return None
+    return AdsListen(address[0], address[1], net_id or config.ads.net_id)
 
 
 def _machine_config(path: Path | None, cycle_ms: float | None) -> MachineConfig:

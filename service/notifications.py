@@ -1,10 +1,11 @@
 """Device notifications: subscriptions sampled in kernel time, sent on the event loop.
 
-ADS semantics: SERVER_CYCLE sends the value every ``cycle_time_ms`` of kernel time;
-SERVER_ON_CHANGE checks every ``cycle_time_ms`` and sends only when the bytes changed.
-Both send the current value at once after the subscription is acknowledged. Each sample
-carries the handle, a per-subscription sequence number (a gap means a sample was
-dropped because the client did not keep up) and a timestamp.
+ADS semantics: SERVER_CYCLE sends the value every cycle time of kernel time;
+SERVER_ON_CHANGE checks every cycle time and sends only when the bytes changed. Both
+send the current value at once after the subscription is acknowledged; a sample is sent
+in the pass that takes it, so the max delay a client asks for is always kept. Each
+sample carries the handle, a per-subscription sequence number (a gap means a sample was
+dropped because the client did not keep up; ADS frames leave it out) and a timestamp.
 
 The timestamp is wall-clock time as a FILETIME: the instant the kernel cycle that
 produced the value published its snapshot (``Snapshot.wall_ns``). Samples of one cycle
@@ -13,6 +14,10 @@ share it, and it never runs ahead of the wall clock, also not under the virtual 
 
 The kernel thread only looks at one number per cycle (when the next sample is due) and
 wakes the event loop when it is; all sampling and sending happens on the loop.
+
+One hub serves every front end: a subscription remembers the front end's ``notify``
+function, which turns samples into that front end's frames (msgpack for ZeroMQ, a
+DeviceNotification for ADS over AMS/TCP). The limits count both front ends together.
 """
 
 from __future__ import annotations
@@ -21,17 +26,22 @@ import asyncio
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from cnc_objects.protocol.constants import TransmissionMode
 from cnc_objects.protocol.errors import AdsReturnCode
-from cnc_objects.protocol.frames import AddNotificationRequest, encode_notification
 
 from .kernel.state import Snapshot
 
 log = logging.getLogger(__name__)
 
 ReadFn = Callable[[int, int, int, int], tuple[int, bytes | str]]
-SendFn = Callable[[tuple[bytes, ...], bytes], bool]
+#: Where a front end sends to: its own address of one client (hashable, compared by value).
+Envelope = tuple[Any, ...]
+SendFn = Callable[[Envelope, bytes], bool]
+#: A front end's sender of samples: (envelope, port, [[handle, sequence, FILETIME, data],
+#: ...]) -> delivered. It encodes them in its own wire format.
+NotifyFn = Callable[[Envelope, int, list[list[Any]]], bool]
 
 CYCLIC_MODES = {TransmissionMode.SERVER_CYCLE, TransmissionMode.SERVER_CYCLE2}
 ON_CHANGE_MODES = {TransmissionMode.SERVER_ON_CHANGE, TransmissionMode.SERVER_ON_CHANGE2}
@@ -52,7 +62,8 @@ class Subscription:
     """One client's subscription to one address."""
 
     handle: int
-    envelope: tuple[bytes, ...]
+    envelope: Envelope
+    notify: NotifyFn
     port: int
     group: int
     offset: int
@@ -70,14 +81,12 @@ class NotificationHub:
     def __init__(
         self,
         read: ReadFn,
-        send: SendFn,
         loop: asyncio.AbstractEventLoop,
         kernel_cycle_ns: int,
         current: Callable[[], Snapshot],
     ) -> None:
         self._read = read
         self._current = current
-        self._send = send
         self._loop = loop
         self._kernel_cycle_ns = kernel_cycle_ns
         self._subs: dict[int, Subscription] = {}
@@ -92,8 +101,15 @@ class NotificationHub:
 
     # ------------------------------------------------------------ requests
 
-    def add(self, envelope: tuple[bytes, ...], req: AddNotificationRequest) -> tuple[int, int | str]:
-        """Subscribe; (0, handle) or (code, message). The first sample follows the reply."""
+    def add(
+        self, envelope: Envelope, req: Any, cycle_ns: int, notify: NotifyFn,
+        first_delay_s: float = 0.0,
+    ) -> tuple[int, int | str]:
+        """Subscribe ``envelope`` to ``req`` (port, group, offset, length and
+        transmission_mode of an AddDeviceNotification), checked every ``cycle_ns`` of
+        kernel time (at least every kernel cycle); (0, handle) or (code, message). The
+        first sample follows the reply through ``notify``, ``first_delay_s`` of wall
+        time after it."""
         mode = req.transmission_mode
         if mode not in CYCLIC_MODES and mode not in ON_CHANGE_MODES:
             return (
@@ -108,16 +124,18 @@ class NotificationHub:
             return AdsReturnCode.DEVICE_NOMOREHDLS, "too many notifications; delete some first"
         handle = self._next_handle
         self._next_handle += 1
-        cycle_ns = max(req.cycle_time_ms * 1_000_000, self._kernel_cycle_ns)
         sub = Subscription(
-            handle, envelope, req.port, req.group, req.offset, req.length,
-            mode in ON_CHANGE_MODES, cycle_ns, 0,
+            handle, envelope, notify, req.port, req.group, req.offset, req.length,
+            mode in ON_CHANGE_MODES, max(cycle_ns, self._kernel_cycle_ns), 0,
         )
         self._subs[handle] = sub
-        self._loop.call_soon(self._first_sample, sub)
+        if first_delay_s > 0:
+            self._loop.call_later(first_delay_s, self._first_sample, sub)
+        else:
+            self._loop.call_soon(self._first_sample, sub)
         return 0, handle
 
-    def delete(self, envelope: tuple[bytes, ...], handle: int) -> tuple[int, str]:
+    def delete(self, envelope: Envelope, handle: int) -> tuple[int, str]:
         """End a subscription of this client; 0x714 when it has no such handle."""
         sub = self._subs.get(handle)
         if sub is None or sub.envelope != envelope:
@@ -126,7 +144,7 @@ class NotificationHub:
         self._update_due()
         return 0, ""
 
-    def drop_client(self, envelope: tuple[bytes, ...]) -> None:
+    def drop_client(self, envelope: Envelope) -> None:
         """Forget every subscription of a client that is gone."""
         gone = [h for h, s in self._subs.items() if s.envelope == envelope]
         for handle in gone:
@@ -148,7 +166,7 @@ class NotificationHub:
     def _first_sample(self, sub: Subscription) -> None:
         if sub.handle not in self._subs:
             return
-        self._emit({(sub.envelope, sub.port): [self._take(sub, force=True)]})
+        self._emit({(sub.envelope, sub.port): (sub.notify, [self._take(sub, force=True)])})
         self._update_due()
 
     def _sample(self) -> None:
@@ -157,13 +175,13 @@ class NotificationHub:
         if snapshot is None:
             return
         now_ns = snapshot.time_ns
-        batches: dict[tuple[tuple[bytes, ...], int], list] = {}
+        batches: dict[tuple[Envelope, int], tuple[NotifyFn, list]] = {}
         for sub in list(self._subs.values()):
             if sub.next_due_ns > now_ns:
                 continue
             sample = self._take(sub, force=False)
             if sample is not None:
-                batches.setdefault((sub.envelope, sub.port), []).append(sample)
+                batches.setdefault((sub.envelope, sub.port), (sub.notify, []))[1].append(sample)
         self._emit(batches)
         self._update_due()
 
@@ -189,11 +207,11 @@ class NotificationHub:
         sub.sequence += 1
         return [sub.handle, sub.sequence, filetime(snapshot.wall_ns), data]
 
-    def _emit(self, batches: dict[tuple[tuple[bytes, ...], int], list]) -> None:
+    def _emit(self, batches: dict[tuple[Envelope, int], tuple[NotifyFn, list]]) -> None:
         """One frame per client and port with all its samples of this cycle."""
-        for (envelope, port), samples in batches.items():
+        for (envelope, port), (notify, samples) in batches.items():
             samples = [s for s in samples if s is not None]
-            if samples and not self._send(envelope, encode_notification(port, samples)):
+            if samples and not notify(envelope, port, samples):
                 self.dropped += len(samples)
 
     def _update_due(self) -> None:

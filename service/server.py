@@ -1,12 +1,15 @@
-"""The ZeroMQ ADS server: a ROUTER socket on the event loop, in front of the dispatcher.
+"""The ZeroMQ front end: a ROUTER socket on the event loop, in front of the dispatcher.
 
 Batched pattern: the socket's file descriptor wakes the loop once, then every waiting
 frame is drained without blocking and answered in the same pass, so a client with many
 requests in flight costs one wake-up per batch, not one await per message.
 
 Nothing a client sends can stop the server: frames over the size limit cut that client
-off (ZeroMQ's MAXMSGSIZE), everything else gets an answer from the dispatcher, a
-vanished client's notifications are dropped.
+off (ZeroMQ's MAXMSGSIZE), frames that do not decode get an error reply (or are dropped,
+logged, when not even the invoke id can be read), everything else gets an answer from
+the dispatcher, a vanished client's notifications are dropped.
+
+The envelope of a client is its ROUTER identity frames (a tuple of bytes).
 """
 
 from __future__ import annotations
@@ -14,15 +17,17 @@ from __future__ import annotations
 import asyncio
 import errno
 import logging
+from typing import Any
 
+import msgpack
 import zmq
 
-from cnc_objects.objects import AddressSpace
 from cnc_objects.protocol.constants import MAX_DATA_BYTES
+from cnc_objects.protocol.errors import ProtocolError
+from cnc_objects.protocol.frames import decode_request, encode_error, encode_notification
 
-from .program_service import ProgramStoreService
-from .dispatch import Dispatcher, Envelope
-from .kernel.kernel import Kernel
+from .backend import Backend
+from .dispatch import Dispatcher
 
 log = logging.getLogger(__name__)
 
@@ -32,23 +37,24 @@ _NOBLOCK = int(zmq.NOBLOCK)
 _SNDMORE_NOBLOCK = int(zmq.SNDMORE | zmq.NOBLOCK)
 _EVENTS = int(zmq.EVENTS)
 _POLLIN = int(zmq.POLLIN)
+_packb = msgpack.Packer(use_bin_type=True, autoreset=True).pack  # as protocol.frames packs
 
 
-class AdsServer:
-    """Serves an address space and a kernel on a ZeroMQ ROUTER socket."""
+Envelope = tuple[bytes, ...]
+
+
+class ZmqServer:
+    """Serves a ``Backend`` on a ZeroMQ ROUTER socket (msgpack frames, ``protocol.frames``)."""
+
+    first_sample_delay_s = 0.0  # the first sample follows the acknowledgement at once
 
     def __init__(
         self,
-        space: AddressSpace,
-        kernel: Kernel,
+        backend: Backend,
         endpoint: str,
-        loop: asyncio.AbstractEventLoop,
         context: zmq.Context | None = None,
-        programs: ProgramStoreService | None = None,
     ) -> None:
-        self.space = space
-        self.kernel = kernel
-        self._loop = loop
+        self._loop = backend.loop
         self._context = context or zmq.Context()
         self._owns_context = context is None
         sock = self._context.socket(zmq.ROUTER)
@@ -71,10 +77,9 @@ class AdsServer:
         self._raw_recv = raw.recv.__get__(sock)
         self._raw_get = raw.get.__get__(sock)
         self.endpoint = sock.getsockopt_string(zmq.LAST_ENDPOINT)
-        self.dispatcher = Dispatcher(space, kernel, loop, self._send, programs)
-        self.hub = self.dispatcher.hub
-        kernel.on_cycle_end = self.hub.kernel_cycle_end
-        self._handle = self.dispatcher.handle
+        self.hub = backend.hub
+        self.dispatcher = Dispatcher(backend, self)
+        self._dispatch = self.dispatcher.dispatch
         self._drain_scheduled = False
 
     # ------------------------------------------------------------ life cycle
@@ -86,7 +91,6 @@ class AdsServer:
 
     def close(self) -> None:
         """Stop serving and close the socket."""
-        self.kernel.on_cycle_end = None
         self._loop.remove_reader(self._sock.FD)
         self._sock.close(linger=0)
         if self._owns_context:
@@ -103,7 +107,7 @@ class AdsServer:
         """Handle every waiting frame (up to a batch); each reply goes out at once so a
         pipelining client overlaps its work with ours."""
         self._drain_scheduled = False
-        recv, deliver = self._raw_recv, self._deliver
+        recv, deliver, dispatch = self._raw_recv, self._deliver, self._dispatch
         for _ in range(DRAIN_BATCH):
             try:
                 part = recv(_NOBLOCK, False)  # a zmq.Frame: .more is cheaper than RCVMORE
@@ -114,12 +118,25 @@ class AdsServer:
                 part = recv(_NOBLOCK, False)
                 frames.append(part.bytes)
             envelope = tuple(frames[:-1])
-            reply = self._handle(envelope, frames[-1])
+            try:
+                request = decode_request(frames[-1])
+            except ProtocolError as exc:
+                reply = self._refuse(exc)
+            else:
+                reply = dispatch(envelope, request)
             if reply is not None:
                 deliver(envelope, reply)
         else:
             self._schedule_drain()  # more may wait: come back after other callbacks ran
         self._look_for_input()
+
+    @staticmethod
+    def _refuse(exc: ProtocolError) -> bytes | None:
+        """The error reply to a frame that did not decode; None when it has no invoke id."""
+        if exc.invoke_id is None:
+            log.warning("dropped a frame with no readable invoke id: %s", exc)
+            return None
+        return encode_error(exc.invoke_id, exc.command or 0, exc.code, str(exc))
 
     def _look_for_input(self) -> None:
         # ZeroMQ's fd is edge-triggered and a send can consume the edge: look again.
@@ -140,8 +157,30 @@ class AdsServer:
             return False
         return True
 
-    def _send(self, envelope: Envelope, payload: bytes) -> bool:
+    # ------------------------------------------------------------ FrontEnd (dispatch.py)
+
+    @staticmethod
+    def ok(envelope: Envelope, req: Any, *fields: Any) -> bytes:
+        """``[invoke_id, command, 0, *fields]``: ``frames.encode_response``, packed here
+        without its own call (the dispatch hot path)."""
+        return _packb([req.invoke_id, req.COMMAND, 0, *fields])
+
+    @staticmethod
+    def error(envelope: Envelope, req: Any, code: int, message: str) -> bytes:
+        """``[invoke_id, command, code, message]``."""
+        return encode_error(req.invoke_id, req.COMMAND, code, message)
+
+    def send(self, envelope: Envelope, payload: bytes) -> bool:
         """Send a frame outside a drain pass; False when it could not be delivered."""
         delivered = self._deliver(envelope, payload)
         self._look_for_input()
         return delivered
+
+    def notify(self, envelope: Envelope, port: int, samples: list[list[Any]]) -> bool:
+        """One notification frame with ``samples``."""
+        return self.send(envelope, encode_notification(port, samples))
+
+    @staticmethod
+    def cycle_ns(req: Any) -> int:
+        """Frames carry the cycle time in ms."""
+        return req.cycle_time_ms * 1_000_000

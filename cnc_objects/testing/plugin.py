@@ -23,9 +23,10 @@ MARKER = "cnc_service"
 MARKER_HELP = (
     "cnc_service(config=None, programs=(), args=()): how the cnc_service fixture starts "
     "its cnc-service: a TOML machine configuration and NC programs to upload (paths "
-    "relative to the test file), further command-line options"
+    "relative to the test file), further command-line options; ads=True serves ADS on a "
+    "loopback address of its own (service.ads_address, service.ams_net_id)"
 )
-_OPTIONS = frozenset({"config", "programs", "args"})
+_OPTIONS = frozenset({"config", "programs", "args", "ads"})
 CLIENT_TIMEOUT_S = 10.0  # per request; generous for a busy CI machine
 LOG_LINES_ON_FAILURE = 200  # the end of the service's log shown with a failed test
 
@@ -53,14 +54,16 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) ->
 def cnc_service(request: pytest.FixtureRequest,
                 tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceProcess]:
     """A ``cnc-service`` of this test only: virtual clock, a free loopback port, an empty
-    program store of its own. ``@pytest.mark.cnc_service(config=..., programs=[...],
-    args=[...])`` on the test, its class or its module (``pytestmark``) configures it;
-    the programs are uploaded over the wire before the test starts. At teardown the
-    service is stopped; a service that does not exit with code 0 fails the test with
-    its log."""
+    program store of its own, ADS off. ``@pytest.mark.cnc_service(config=...,
+    programs=[...], args=[...], ads=True)`` on the test, its class or its module
+    (``pytestmark``) configures it; the programs are uploaded over the wire before the
+    test starts. At teardown the service is stopped; a service that does not exit with
+    code 0 fails the test with its log."""
     config, programs, args = _marker_options(request)
+    marker = request.node.get_closest_marker(MARKER)
+    ads = bool(marker.kwargs.get("ads", False)) if marker is not None else False
     service = start_service(*args, *(("--config", str(config)) if config else ()),
-                            program_dir=tmp_path_factory.mktemp("cnc-programs"))
+                            program_dir=tmp_path_factory.mktemp("cnc-programs"), ads=ads)
     try:
         if programs:
             _upload(service, programs)

@@ -8,14 +8,22 @@ The service binds ``tcp://127.0.0.1:*`` (ZeroMQ picks a free port: no race betwe
 choosing a port and binding it) and logs the endpoint it got; the start waits for that
 log line, never for a fixed time. Standard library only: the pytest plugin imports this
 at every pytest start.
+
+ADS (AMS/TCP) is off unless asked for, so that services started side by side never
+compete for 127.0.0.1:48898: ``start_service(ads=True)`` gives the service a loopback
+address of its own, ``127.0.0.<n>:48898`` (ADS clients such as pyads always dial port
+48898 and tell servers apart by IP address), and ``ads="127.0.0.1:0"`` any free port;
+``ServiceProcess.ads_address`` and ``.ams_net_id`` say what it got.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import random
 import re
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -25,8 +33,12 @@ from collections.abc import Iterator
 from pathlib import Path
 
 _LISTENING = re.compile(r"listening on (tcp://\S+)")
+_ADS_LISTENING = re.compile(r"ADS on \[?([^\s\]]+?)\]?:(\d+), AMS Net ID (\S+)")
+_ADS_BUSY = "cannot listen for ADS"
 START_TIMEOUT_S = 20.0  # a cold start imports numpy and pydantic: seconds on a busy CI
 STOP_TIMEOUT_S = 10.0
+AMS_TCP_PORT = 48898  # ADS clients dial this port; a service of its own needs its own IP
+ADS_START_ATTEMPTS = 20  # loopback addresses tried before giving up (another took it)
 
 
 class ServiceProcess:
@@ -41,6 +53,8 @@ class ServiceProcess:
         self.process = process
         self.program_dir = program_dir  # the service's program store
         self.endpoint = ""  # set once the service has logged it
+        self.ads_address: tuple[str, int] | None = None  # (host, port) when ADS is on
+        self.ams_net_id: str | None = None  # the service's AMS Net ID when ADS is on
         self.log: list[str] = []
         self._changed = threading.Condition()
         self._ended = False  # stderr closed: the process is gone
@@ -113,12 +127,30 @@ class ServiceProcess:
 
 def service_command(*args: str) -> list[str]:
     """The command line ``start_service(*args)`` runs: ``cnc-service`` on a free loopback
-    port with the virtual clock, unless ``args`` name another endpoint or clock (the
-    last occurrence of an option wins)."""
+    port with the virtual clock and ADS off, unless ``args`` name another endpoint,
+    clock or ``--ads`` address (the last occurrence of an option wins)."""
     argv = [sys.executable, "-m", "cnc_objects.service.main", "--endpoint", "tcp://127.0.0.1:*"]
     if "--clock" not in args:
         argv += ["--clock", "virtual"]
+    if "--ads" not in args:
+        argv += ["--ads", "off"]
     return [*argv, *args]
+
+
+def free_loopback_ads_address() -> str:
+    """``127.0.0.<n>:48898`` that nothing listens on right now (n in 2..254, chosen at
+    random, so that parallel test runs rarely pick the same)."""
+    candidates = list(range(2, 255))
+    random.shuffle(candidates)
+    for n in candidates:
+        host = f"127.0.0.{n}"
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+            try:
+                probe.bind((host, AMS_TCP_PORT))
+            except OSError:
+                continue
+        return f"{host}:{AMS_TCP_PORT}"
+    raise RuntimeError(f"no loopback address 127.0.0.2..254 has port {AMS_TCP_PORT} free")
 
 
 def start_service(
@@ -126,15 +158,33 @@ def start_service(
     program_dir: str | os.PathLike[str] | None = None,
     cwd: str | os.PathLike[str] | None = None,
     timeout_s: float = START_TIMEOUT_S,
+    ads: bool | str = False,
 ) -> ServiceProcess:
     """Start ``cnc-service`` (see ``service_command``) and return once it listens.
 
     ``program_dir``: the program store; by default an empty directory of this service
     only, removed by ``stop``. ``args`` are further ``cnc-service`` options (``--config
-    FILE``, ``--speed 1``, ...). Raises ``RuntimeError`` with the service's log when it
-    exits before listening, ``TimeoutError`` when it has not listened after ``timeout_s``
-    (the process is killed then).
+    FILE``, ``--speed 1``, ...). ``ads``: False leaves ADS off (unless ``args`` give
+    ``--ads``); True serves ADS on a loopback address of this service's own,
+    ``127.0.0.<n>:48898`` (another is tried when a parallel service took it first); a
+    string is the ``--ads`` address. Raises ``RuntimeError`` with the service's log when
+    it exits before listening, ``TimeoutError`` when it has not listened after
+    ``timeout_s`` (the process is killed then).
     """
+    if ads is False or "--ads" in args:
+        return _start(args, program_dir, cwd, timeout_s)
+    for _ in range(ADS_START_ATTEMPTS if ads is True else 1):
+        address = free_loopback_ads_address() if ads is True else str(ads)
+        try:
+            return _start((*args, "--ads", address), program_dir, cwd, timeout_s)
+        except RuntimeError as exc:
+            if ads is not True or _ADS_BUSY not in str(exc):
+                raise
+    raise RuntimeError(f"cnc-service found no free ADS address in {ADS_START_ATTEMPTS} tries")
+
+
+def _start(args: tuple[str, ...], program_dir: str | os.PathLike[str] | None,
+           cwd: str | os.PathLike[str] | None, timeout_s: float) -> ServiceProcess:
     owned = None
     if "--program-dir" in args:
         store = Path(args[args.index("--program-dir") + 1])
@@ -161,6 +211,11 @@ def start_service(
                                f"{service.log_text}") from None
         raise
     service.endpoint = _LISTENING.search(line).group(1)  # type: ignore[union-attr]
+    for logged in service.log:  # the ADS line comes before the ZeroMQ one
+        found = _ADS_LISTENING.search(logged)
+        if found:
+            service.ads_address = (found.group(1), int(found.group(2)))
+            service.ams_net_id = found.group(3)
     return service
 
 

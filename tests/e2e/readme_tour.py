@@ -24,6 +24,7 @@ TOLERANCE_UNITS = 5.5  # of a decimal number's last digit (see above)
 # background, containers. Their own tests cover them.
 NOT_RUN = ("cnc-hmi", "mosquitto", "cnc-mqtt", "docker")
 README_ENDPOINT = "tcp://127.0.0.1:5555"
+README_AMS_NET_ID, README_ADS_HOST = "127.0.0.1.1.1", "127.0.0.1"  # what `make run` serves
 _COMMENT = re.compile(r"\s+#\s.*$")
 _NUMBER = re.compile(r"-?\d+(?:\.\d+)?")
 
@@ -76,13 +77,15 @@ def tour_steps(readme: Path) -> list[TourStep]:
     return steps
 
 
-def python_example(readme: Path) -> tuple[str, tuple[str, ...]]:
-    """The tour's Python example and the output shown in the ``text`` block after it."""
+def python_examples(readme: Path) -> list[tuple[str, tuple[str, ...]]]:
+    """Each Python example of the tour and the output shown in the ``text`` block after it."""
     text = tour_text(readme)
-    (_, code), = _blocks(text, "python")[:1]
-    after = text[text.index("```python"):]
-    (_, shown), = _blocks(after, "text")[:1]
-    return "\n".join(code) + "\n", tuple(shown)
+    examples = []
+    for part in text.split("```python\n")[1:]:
+        code, _, rest = part.partition("\n```\n")
+        shown = rest.split("```text\n", 1)[1].split("\n```", 1)[0]
+        examples.append((code + "\n", tuple(shown.splitlines())))
+    return examples
 
 
 def _normal(line: str) -> str:

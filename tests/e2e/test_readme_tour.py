@@ -18,9 +18,11 @@ import pytest
 
 from cnc_objects.testing import serving
 from tests.e2e.readme_tour import (
+    README_ADS_HOST,
+    README_AMS_NET_ID,
     README_ENDPOINT,
     output_matches,
-    python_example,
+    python_examples,
     tour_steps,
 )
 from tests.support.service import ROOT
@@ -93,12 +95,21 @@ def test_every_tour_command_prints_what_the_readme_shows(tmp_path: Path) -> None
     assert (tmp_path / "part.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_the_python_example_prints_what_the_readme_shows(tmp_path: Path) -> None:
-    code, shown = python_example(README)
-    with serving("--clock", "realtime", cwd=tmp_path) as service:
-        script = tmp_path / "example.py"
-        script.write_text(code.replace(README_ENDPOINT, service.endpoint))
-        done = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=_env(service.endpoint),
-                              capture_output=True, text=True, timeout=60)
-    assert done.returncode == 0, done.stderr
-    assert output_matches(shown, done.stdout.splitlines()), done.stdout
+def test_the_python_examples_print_what_the_readme_shows(tmp_path: Path) -> None:
+    """The ZeroMQ client and the pyads example, each run as a script as written, with the
+    addresses of `make run` replaced by those of the test's service (ADS on a loopback
+    address of its own: AdsLib dials port 48898 of the address it is given)."""
+    examples = python_examples(README)
+    assert len(examples) == 2 and "pyads" in examples[1][0]
+    with serving("--clock", "realtime", cwd=tmp_path, ads=True) as service:
+        host = service.ads_address[0]  # type: ignore[index]
+        for k, (code, shown) in enumerate(examples):
+            script = tmp_path / f"example{k}.py"
+            script.write_text(code.replace(README_ENDPOINT, service.endpoint)
+                              .replace(f'"{README_AMS_NET_ID}"', f'"{service.ams_net_id}"')
+                              .replace(f'"{README_ADS_HOST}"', f'"{host}"'))
+            done = subprocess.run([sys.executable, str(script)], cwd=tmp_path,
+                                  env=_env(service.endpoint), capture_output=True, text=True,
+                                  timeout=60)
+            assert done.returncode == 0, done.stderr
+            assert output_matches(shown, done.stdout.splitlines()), done.stdout

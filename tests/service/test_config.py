@@ -181,3 +181,49 @@ def test_link_to_defaults_to_the_own_drive_or_the_masters() -> None:
     with pytest.raises(ConfigError, match="no physical axis 7"):
         build_config({"channels": [
             {"id": 1, "name": "a", "axes": [{"name": "X", "logical_number": 7}]}]})
+
+
+# --------------------------------------------------------------------------- [ads]
+
+
+def test_ads_defaults() -> None:
+    ads = build_config().ads
+    assert ads.endpoint == "127.0.0.1:48898" and ads.address == ("127.0.0.1", 48898)
+    assert ads.net_id is None and ads.routes == () and ads.max_frame_bytes == 1 << 20
+
+
+def test_ads_table_from_toml(tmp_path: Path) -> None:
+    path = tmp_path / "machine.toml"
+    path.write_text(
+        '[ads]\nendpoint = "0.0.0.0"\nnet_id = "192.0.2.2.1.1"\nmax_frame_bytes = 65536\n'
+        '[[ads.routes]]\nname = "hmi"\nnet_id = "192.0.2.7.1.1"\naddress = "192.0.2.7"\n'
+        '[[ads.routes]]\nname = "v6"\nnet_id = "10.0.0.1.1.1"\naddress = "2001:db8::0:1"\n'
+    )
+    ads = load_config(path).ads
+    assert ads.address == ("0.0.0.0", 48898) and ads.net_id == "192.0.2.2.1.1"
+    assert ads.max_frame_bytes == 65536
+    assert [(r.name, r.net_id, r.address) for r in ads.routes] == [
+        ("hmi", "192.0.2.7.1.1", "192.0.2.7"), ("v6", "10.0.0.1.1.1", "2001:db8::1")]
+    assert build_config({"ads": {"endpoint": "off"}}).ads.address is None
+    assert build_config({"ads": {"endpoint": "[::1]:4000"}}).ads.address == ("::1", 4000)
+
+
+@pytest.mark.parametrize(
+    ("ads", "message"),
+    [
+        ({"endpoint": "host:port"}, "ads.endpoint: 'host:port': the port must be a number"),
+        ({"endpoint": ":48898"}, "ads.endpoint: ':48898': the host is missing"),
+        ({"net_id": "1.2.3"}, "ads.net_id: '1.2.3' is not an AMS Net ID"),
+        ({"routes": [{"name": "a", "net_id": "1.2.3.4.1.1", "address": "nowhere"}]},
+         "ads.routes.0.address: 'nowhere' is not an IP address"),
+        ({"routes": [{"name": "a", "net_id": "1.2.3.4.1", "address": "192.0.2.7"}]},
+         "ads.routes.0.net_id"),
+        ({"routes": [{"net_id": "1.2.3.4.1.1", "address": "192.0.2.7"}]}, "ads.routes.0.name"),
+        ({"max_frame_bytes": 10}, "ads.max_frame_bytes"),
+        ({"port": 48898}, "ads.port"),
+    ],
+)
+def test_bad_ads_settings_name_the_key(ads: dict, message: str) -> None:
+    with pytest.raises(ConfigError) as caught:
+        build_config({"ads": ads}, "machine.toml")
+    assert message in str(caught.value)

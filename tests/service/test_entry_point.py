@@ -6,6 +6,8 @@ from __future__ import annotations
 import os
 import re
 import signal
+import socket
+import struct
 import subprocess
 import sys
 from pathlib import Path
@@ -146,7 +148,7 @@ def test_help_lists_every_option_with_its_default() -> None:
     result = run_service("--help")
     assert result.returncode == 0
     for option in ("--config", "--endpoint", "--clock", "--speed", "--cycle-ms",
-                   "--program-dir", "--data-dir", "--log-level"):
+                   "--program-dir", "--data-dir", "--log-level", "--ads", "--ams-net-id"):
         assert option in result.stdout
     assert "[default: tcp://127.0.0.1:5555]" in result.stdout
     assert "realtime|virtual" in result.stdout and "[default: realtime]" in result.stdout
@@ -239,3 +241,94 @@ def test_unusable_program_store_is_refused(tmp_path: Path) -> None:
     assert result.returncode == 2
     assert f"cannot use program directory {tmp_path.resolve() / 'taken' / 'programs'}" in (
         result.stderr)
+
+
+# --------------------------------------------------------------------------- ADS front end
+
+
+def _read_state(address: tuple[str, int], net_id: str) -> tuple[int, int, int]:
+    """ADS ReadState on port 851 over a raw AMS/TCP connection: (result, ads, device)."""
+    target = bytes(int(p) for p in net_id.split("."))
+    header = struct.pack("<6sH6sHHHIII", target, 851, bytes([10, 0, 0, 1, 1, 1]), 30000,
+                         4, 0x0004, 0, 0, 1)
+    with socket.create_connection(address, timeout=10) as sock:
+        sock.sendall(struct.pack("<HI", 0, 32) + header)
+        reply = b""
+        while len(reply) < 6 + 32 + 8:
+            chunk = sock.recv(4096)
+            assert chunk, "the service closed the connection"
+            reply += chunk
+    return struct.unpack_from("<IHH", reply, 38)
+
+
+def test_ads_is_on_by_default_beside_zeromq() -> None:
+    from cnc_objects.service.config import build_config
+    from cnc_objects.service.main import AdsListen, _ads_listen
+
+    assert _ads_listen(build_config(), None, None) == AdsListen("127.0.0.1", 48898, None)
+    assert _ads_listen(build_config(), "off", None) is None
+    config = build_config({"ads": {"endpoint": "off", "net_id": "1.2.3.4.5.6"}})
+    assert _ads_listen(config, None, None) is None
+    assert _ads_listen(config, "127.0.0.9", None) == AdsListen("127.0.0.9", 48898, "1.2.3.4.5.6")
+    assert _ads_listen(config, "127.0.0.9:1", "9.9.9.9.1.1") == AdsListen(
+        "127.0.0.9", 1, "9.9.9.9.1.1")
+
+
+def test_both_front_ends_serve_and_say_where(tmp_path: Path) -> None:
+    config = tmp_path / "machine.toml"
+    config.write_text('[ads]\nnet_id = "5.6.7.8.1.1"\n')
+    service = start_service("--config", str(config), ads="127.0.0.1:0")
+    try:
+        ads_line = service.wait_for_log(r"ADS on ")
+        assert service.log.index(ads_line) < service.log.index(
+            service.wait_for_log(r"listening on tcp://"))  # ready means both are
+        host, port = service.ads_address  # type: ignore[misc]
+        assert host == "127.0.0.1" and port > 0
+        assert service.ams_net_id == "5.6.7.8.1.1"  # from the configuration
+        assert _read_state((host, port), "5.6.7.8.1.1") == (0, 5, 0)  # RUN
+        with Client(service.endpoint) as c:
+            assert c.read("ch1.ax1.link_state") == 0
+    finally:
+        assert service.stop() == 0
+    service = start_service("--config", str(config), "--ams-net-id", "9.9.9.9.1.1",
+                            ads="127.0.0.1:0")
+    try:
+        assert service.ams_net_id == "9.9.9.9.1.1"  # the option wins
+    finally:
+        assert service.stop() == 0
+
+
+def test_the_default_net_id_is_the_ads_address_and_1_1() -> None:
+    from cnc_objects.service.ads_server import default_net_id
+
+    assert default_net_id("127.0.0.5") == "127.0.0.5.1.1"
+    assert default_net_id("192.0.2.7") == "192.0.2.7.1.1"
+    wildcard = default_net_id("0.0.0.0")  # this host's own address instead
+    assert wildcard.endswith(".1.1") and not wildcard.startswith("0.0.0.0")
+
+
+def test_ads_address_in_use_is_refused_with_one_line() -> None:
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        result = run_service("--ads", f"127.0.0.1:{port}", "--endpoint", "tcp://127.0.0.1:*",
+                             "--clock", "virtual", "--log-level", "WARNING")
+    assert result.returncode == 2
+    assert result.stderr.splitlines() == [
+        f"cnc-service: cannot listen for ADS on 127.0.0.1:{port}: Address already in use"
+    ]
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--ads", "localhost:port"], "cnc-service: bad --ads: 'localhost:port': the port"),
+        (["--ads", "::1"], "write an IPv6 host in brackets"),
+        (["--ams-net-id", "1.2.3"], "cnc-service: bad --ams-net-id: '1.2.3' is not an AMS Net ID"),
+    ],
+)
+def test_bad_ads_options_exit_2(args: list[str], message: str) -> None:
+    result = run_service(*args)
+    assert result.returncode == 2 and message in result.stderr
+    assert "Traceback" not in result.stderr

@@ -1,0 +1,245 @@
+"""The symbol and data type information services that ADS clients use to browse a device.
+
+Every object of the address space is a symbol under its name, with the TwinCAT type
+name, ADS data type id and size of its ISG type and its description as the comment.
+What a symbol entry gives as the value's address:
+
+* PLC (HLI) symbols (port 851): their own address, group 0x4020 and the offset in the
+  PLC memory area, as a TwinCAT PLC gives its variables.
+* Every other object (ports 551, 552, 553): group 0xF005 (value by handle) with the
+  object's handle as offset. Handles are global in this service and stable for its
+  life, and the dispatcher serves 0xF005 on every port, so a client connected to port
+  851 (where ADS clients upload symbols) reads and subscribes to a GEO or COM object
+  with the entry's iGroup/iOffs as they stand.
+
+The catalog is fixed for the life of the service, so every answer is encoded once, when
+the service is built; a request is a dictionary lookup. Answers are ``(0, bytes)`` or
+``(code, message)`` with ADS codes, never exceptions:
+
+====== ========= ==============================================================
+group  command   answer
+====== ========= ==============================================================
+0xF007 ReadWrite name in, AdsSymbolInfoByName out (group, offset, size: 12 bytes)
+0xF008 Read      symbol version, one byte
+0xF009 ReadWrite name in, AdsSymbolEntry out
+0xF00B Read      every AdsSymbolEntry, back to back
+0xF00C Read      AdsSymbolUploadInfo, 8 bytes (count and size of 0xF00B)
+0xF00E Read      an AdsDatatypeEntry per type the symbols use (base types)
+0xF00F Read      upload info, 64 bytes if the read length allows, else 24
+0xF011 ReadWrite type name in, AdsDatatypeEntry out (any elementary type, STRING(n))
+====== ========= ==============================================================
+
+Bad input: an unknown symbol or type 0x710 (what TwinCAT answers for both), a read
+length below the answer's size 0x705, a name that is not CP1252 0x706, an index offset
+other than 0 on an upload 0x703 (the high bit, which TwinCAT's .NET client sets, is
+ignored), Read of a ReadWrite service or ReadWrite with data of a Read service 0x701,
+and any Write 0x704 (the information is read-only).
+"""
+
+from __future__ import annotations
+
+import logging
+import struct
+import sys
+import time
+import zlib
+from collections.abc import Callable
+
+from cnc_objects.objects import AddressSpace
+from cnc_objects.objects.address_space import Entry
+from cnc_objects.protocol.ads_symbols import (
+    AdsSymbolFlag,
+    TwinCatType,
+    DataTypeEntry,
+    SymbolEntry,
+    SymbolGroup,
+    SymbolUploadFlag,
+    UploadInfo,
+    encode_datatype_entry,
+    encode_symbol_entry,
+    encode_symbol_version,
+    encode_upload_info,
+    parse_twincat_type,
+    twincat_type,
+)
+from cnc_objects.protocol.constants import CncPort
+from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
+from cnc_objects.protocol.datatypes import STRING_ENCODING
+from cnc_objects.protocol.errors import AdsReturnCode
+
+log = logging.getLogger(__name__)
+
+_E = AdsReturnCode
+Result = tuple[int, bytes | str]
+
+#: The symbol version: changes when the symbols change, which they never do here.
+SYMBOL_VERSION = 1
+#: CP1252, the code page of every name, type and comment (64-byte upload info).
+CODE_PAGE = 1252
+_OFFSET_HIGH_BIT = 0x8000_0000  # set by TwinCAT.Ads in the offset of its upload reads
+_INFO_BY_NAME = struct.Struct("<III")
+
+
+def symbol_address(entry: Entry) -> tuple[int, int]:
+    """Where a client reads ``entry``'s value: its own PLC address on port 851, value by
+    handle (0xF005, handle) for every other port."""
+    obj = entry.obj
+    if obj.port == CncPort.PLC:
+        return obj.group, obj.offset
+    return RIG.SYM_VALUE_BY_HANDLE, entry.handle
+
+
+def symbol_entry(entry: Entry) -> SymbolEntry:
+    """The AdsSymbolEntry of an address-space entry."""
+    obj = entry.obj
+    tc = twincat_type(obj.dtype)
+    group, offset = symbol_address(entry)
+    flags = AdsSymbolFlag(0) if obj.access.writable else AdsSymbolFlag.READONLY
+    return SymbolEntry(group, offset, tc.size, tc.data_type, flags, obj.name, tc.name, obj.description)
+
+
+def datatype_entry(tc: TwinCatType) -> DataTypeEntry:
+    """The AdsDatatypeEntry of a base type: TwinCAT name, size, ADST id; the hash is the
+    CRC-32 of the name, so that clients comparing types by hash tell them apart."""
+    return DataTypeEntry(tc.name, tc.size, tc.data_type, hash_value=zlib.crc32(tc.name.encode()))
+
+
+def _name(data: bytes) -> str | None:
+    """The name a client wrote (up to the first NUL, CP1252), or None if not CP1252."""
+    try:
+        return data.split(b"\x00", 1)[0].decode(STRING_ENCODING)
+    except UnicodeDecodeError:
+        return None
+
+
+def _fits(answer: bytes, length: int, what: str) -> Result:
+    if length < len(answer):
+        return _E.DEVICE_INVALIDSIZE, f"{what} is {len(answer)} bytes; read length is {length}"
+    return 0, answer
+
+
+class SymbolService:
+    """Symbol version, symbol and data type uploads and lookups over an address space."""
+
+    def __init__(self, space: AddressSpace, version: int = SYMBOL_VERSION) -> None:
+        started_ns = time.perf_counter_ns()
+        self._version = encode_symbol_version(version)
+        entries = [e for obj in space.objects() if (e := space.by_name(obj.name)) is not None]
+        symbols = [symbol_entry(e) for e in entries]
+        encoded = [encode_symbol_entry(s) for s in symbols]
+        self._by_name = {s.name.lower(): blob for s, blob in zip(symbols, encoded)}
+        self._info_by_name = {
+            s.name.lower(): _INFO_BY_NAME.pack(s.group, s.offset, s.size) for s in symbols
+        }
+        self._upload = b"".join(encoded)
+        types = {twincat_type(e.obj.dtype) for e in entries}
+        type_blobs = {
+            tc.name: encode_datatype_entry(datatype_entry(tc))
+            for tc in sorted(types, key=lambda tc: (tc.data_type, tc.size))
+        }
+        self._types_by_name = {name.upper(): blob for name, blob in type_blobs.items()}
+        self._datatype_upload = b"".join(type_blobs.values())
+        info = UploadInfo(
+            symbol_count=len(symbols),
+            symbol_size=len(self._upload),
+            datatype_count=len(type_blobs),
+            datatype_size=len(self._datatype_upload),
+            encoding_code_page=CODE_PAGE,
+            flags=SymbolUploadFlag.INCLUDES_BASE_TYPES
+            | (SymbolUploadFlag.IS_64BIT_PLATFORM if sys.maxsize > 2**32 else 0),
+        )
+        self.info = info
+        self._infos = {size: encode_upload_info(info, size) for size in (8, 24, 64)}
+        self.build_ns = time.perf_counter_ns() - started_ns
+        # Read services: what they answer and what to call it in a refusal
+        self._reads: dict[int, tuple[bytes, str]] = {
+            SymbolGroup.VERSION: (self._version, "the symbol version"),
+            SymbolGroup.UPLOAD: (self._upload, "the symbol upload"),
+            SymbolGroup.UPLOAD_INFO: (self._infos[8], "the upload info"),
+            SymbolGroup.DT_UPLOAD: (self._datatype_upload, "the data type upload"),
+            SymbolGroup.UPLOAD_INFO2: (self._infos[24], "the upload info"),  # or 64 bytes
+        }
+        self._read_writes: dict[int, Callable[[str, int], Result]] = {
+            SymbolGroup.INFO_BY_NAME: self._info_by_name_answer,
+            SymbolGroup.INFO_BY_NAME_EX: self._symbol_by_name,
+            SymbolGroup.DT_INFO_BY_NAME_EX: self._type_by_name,
+        }
+        log.debug(
+            "symbol service: %d symbols (%d bytes), %d types (%d bytes), built in %.1f ms",
+            info.symbol_count, info.symbol_size, info.datatype_count, info.datatype_size,
+            self.build_ns / 1e6,
+        )
+
+    # ------------------------------------------------------------------ entry points
+
+    def handles(self, group: int) -> bool:
+        """True for the index groups this service answers."""
+        return group in self._reads or group in self._read_writes
+
+    def read(self, group: int, offset: int, length: int) -> Result:
+        """ADS Read of ``group``: (0, data) or (code, message)."""
+        answer = self._reads.get(group)
+        if answer is None:
+            if group in self._read_writes:
+                return _E.DEVICE_SRVNOTSUPP, f"index group 0x{group:x} takes ReadWrite with a name"
+            return _E.DEVICE_INVALIDGRP, f"index group 0x{group:x} is not a symbol service"
+        if offset & ~_OFFSET_HIGH_BIT:
+            return _E.DEVICE_INVALIDOFFSET, f"index group 0x{group:x} is read at offset 0"
+        if group == SymbolGroup.UPLOAD_INFO2 and length >= len(self._infos[64]):
+            return 0, self._infos[64]  # the TwinCAT 3 form, to whoever has room for it
+        blob, what = answer
+        return _fits(blob, length, what)
+
+    def read_write(self, group: int, offset: int, data: bytes, read_length: int) -> Result:
+        """ADS ReadWrite of ``group`` with write ``data``: (0, data) or (code, message)."""
+        answer = self._read_writes.get(group)
+        if answer is None:
+            if group in self._reads and not data:  # a ReadWrite that writes nothing reads
+                return self.read(group, offset, read_length)
+            if group in self._reads:
+                return _E.DEVICE_SRVNOTSUPP, f"index group 0x{group:x} takes Read, not data"
+            return _E.DEVICE_INVALIDGRP, f"index group 0x{group:x} is not a symbol service"
+        name = _name(data)
+        if name is None:
+            return _E.DEVICE_INVALIDDATA, "a symbol or type name must be CP1252 text"
+        return answer(name, read_length)
+
+    def write(self, group: int, offset: int, data: bytes) -> Result:
+        """ADS Write of ``group``: always refused, the information is read-only."""
+        return _E.DEVICE_INVALIDACCESS, f"index group 0x{group:x} is read-only"
+
+    # ------------------------------------------------------------------ services
+
+    def _symbol_by_name(self, name: str, length: int) -> Result:
+        blob = self._by_name.get(name.lower())
+        if blob is None:
+            return _E.DEVICE_SYMBOLNOTFOUND, f"no symbol is named {name!r}"
+        return _fits(blob, length, f"the symbol entry of {name}")
+
+    def _info_by_name_answer(self, name: str, length: int) -> Result:
+        blob = self._info_by_name.get(name.lower())
+        if blob is None:
+            return _E.DEVICE_SYMBOLNOTFOUND, f"no symbol is named {name!r}"
+        return _fits(blob, length, f"the symbol info of {name}")
+
+    def _type_by_name(self, name: str, length: int) -> Result:
+        blob = self._types_by_name.get(name.strip().upper())
+        if blob is None:  # an elementary type no symbol uses, or another STRING(n)
+            try:
+                blob = encode_datatype_entry(datatype_entry(parse_twincat_type(name)))
+            except ValueError:
+                return _E.DEVICE_SYMBOLNOTFOUND, f"no data type is named {name!r}"
+        return _fits(blob, length, f"the data type entry of {name}")
+
+    # ------------------------------------------------------------------ measures
+
+    @property
+    def upload_bytes(self) -> int:
+        """Size of the symbol upload (0xF00B) in bytes."""
+        return len(self._upload)
+
+    @property
+    def datatype_upload_bytes(self) -> int:
+        """Size of the data type upload (0xF00E) in bytes."""
+        return len(self._datatype_upload)
+

@@ -1,0 +1,217 @@
+"""What both front ends serve: the address space, the kernel, the program store, the
+symbol services and the notification hub, with the value operations they share.
+
+One ``Backend`` per service; each front end (ZeroMQ, ADS over AMS/TCP) wraps it in a
+``Dispatcher`` of its own. Everything here answers ADS codes, never raises: ``(0,
+payload)`` on success, ``(code, message)`` otherwise.
+
+A STRING object may be read with any length (the buffer cut to it); every other object
+must be read with exactly its size (0x705 otherwise).
+
+Reserved index groups served here, on every port unless noted:
+
+- 0xF005 value by handle (the handle is the offset), 0xF006 release handle (write),
+  0xF003 handle by name and 0xF004 value by name (ReadWrite with the name);
+- 0xF100 device data on port 851: offset 0 the ADS state, offset 2 the device state
+  (UINT each; both at once with length 4), so ADS clients can watch the PLC state;
+- the symbol and data-type services (0xF008 ... 0xF011) of ``symbols``, when given.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import struct
+from collections.abc import Callable
+from typing import Any, Protocol
+
+from cnc_objects.objects import AddressSpace, Entry
+from cnc_objects.protocol.constants import (
+    DEVICE_DATA_ADS_STATE,
+    DEVICE_DATA_DEVICE_STATE,
+    MAX_DATA_BYTES,
+    AdsState,
+    AmsPort,
+    CncPort,
+)
+from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
+from cnc_objects.protocol.datatypes import STRING_ENCODING
+from cnc_objects.protocol.errors import AdsReturnCode
+
+from .binding import refusal_code
+from .kernel.commands import Refusal
+from .kernel.kernel import Kernel
+from .notifications import NotificationHub
+from .program_service import ProgramStoreService
+
+_E = AdsReturnCode
+_U16 = struct.Struct("<H")
+_U32 = struct.Struct("<I")
+ValueResult = tuple[int, Any]  # (0, payload) or (code, message)
+
+
+class SymbolServices(Protocol):
+    """The symbol and data-type information groups (TwinCAT's 0xF008 ... 0xF011)."""
+
+    def handles(self, group: int) -> bool:
+        """True for the index groups this service answers."""
+        ...
+
+    def read(self, group: int, offset: int, length: int) -> tuple[int, bytes | str]:
+        """ADS Read of ``group``: (0, data) or (code, message)."""
+        ...
+
+    def read_write(
+        self, group: int, offset: int, data: bytes, read_length: int
+    ) -> tuple[int, bytes | str]:
+        """ADS ReadWrite of ``group``: (0, data) or (code, message)."""
+        ...
+
+    def write(self, group: int, offset: int, data: bytes) -> tuple[int, bytes | str]:
+        """ADS Write of ``group``: (0, b"") or (code, message)."""
+        ...
+
+
+class Backend:
+    """The state both front ends serve, and the value operations they share."""
+
+    def __init__(
+        self,
+        space: AddressSpace,
+        kernel: Kernel,
+        loop: asyncio.AbstractEventLoop,
+        programs: ProgramStoreService | None = None,
+        symbols: SymbolServices | None = None,
+    ) -> None:
+        self.space = space
+        self.kernel = kernel
+        self.loop = loop
+        self.programs = programs
+        self.symbols = symbols
+        self.hub = NotificationHub(
+            self.read_value, loop, kernel.cycle_ns, lambda: kernel.snapshot
+        )
+
+    # ------------------------------------------------------------ reads
+
+    def read_value(self, port: int, group: int, offset: int, length: int) -> ValueResult:
+        """Read at an address, reserved groups included: (0, data) or (code, message)."""
+        if length > MAX_DATA_BYTES:
+            return _E.DEVICE_INVALIDSIZE, f"read length {length} exceeds {MAX_DATA_BYTES} bytes"
+        if group == RIG.SYM_VALUE_BY_HANDLE:
+            entry = self.space.by_handle(offset)
+            if entry is None:
+                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown"
+            return self.space.read_entry(entry, length)
+        if group == RIG.DEVICE_DATA and port == CncPort.PLC:
+            return self._device_data(offset, length)
+        symbols = self.symbols
+        if symbols is not None and symbols.handles(group):
+            return symbols.read(group, offset, length)
+        return self.space.read(port, group, offset, length)
+
+    def read_string(self, port: int, group: int, offset: int, length: int) -> ValueResult | None:
+        """A STRING object read with another length than its buffer: the buffer cut to
+        ``length`` (or whole, when ``length`` is longer), as a TwinCAT PLC answers; None
+        for any other object. ADS clients read strings with a buffer of their own size
+        (pyads: 1024 characters, or the type name's length without the NUL)."""
+        if group == RIG.SYM_VALUE_BY_HANDLE:
+            entry = self.space.by_handle(offset)
+        else:
+            found = self.space.find(port, group, offset)
+            entry = None if isinstance(found, tuple) else found
+        if entry is None or entry.obj.dtype.kind != "str":
+            return None
+        code, data = self.space.read_entry(entry, entry.obj.dtype.size)
+        return (code, data) if code else (0, data[:length])
+
+    def ads_state(self, port: int) -> AdsState:
+        """The ADS state of a port's device: RUN while the cycle task runs, else STOP; the
+        system service (port 10000) is RUN as long as the service answers at all."""
+        if port == AmsPort.SYSTEM_SERVICE or self.kernel.running:
+            return AdsState.RUN
+        return AdsState.STOP
+
+    def _device_data(self, offset: int, length: int) -> ValueResult:
+        state = self.ads_state(CncPort.PLC)
+        if offset == DEVICE_DATA_ADS_STATE and length == 4:
+            return 0, _U16.pack(state) + _U16.pack(0)
+        if offset not in (DEVICE_DATA_ADS_STATE, DEVICE_DATA_DEVICE_STATE):
+            return (_E.DEVICE_INVALIDOFFSET,
+                    f"device data has offset 0 (ADS state) and 2 (device state), not {offset}")
+        if length != 2:
+            return (_E.DEVICE_INVALIDSIZE,
+                    f"device data fields are UINT, 2 bytes; read asked {length}")
+        return 0, _U16.pack(state if offset == DEVICE_DATA_ADS_STATE else 0)
+
+    def read_write_value(
+        self, port: int, group: int, offset: int, read_length: int, data: bytes
+    ) -> ValueResult:
+        """ReadWrite at one address: handle by name, value by name, the symbol services;
+        object addresses take Read or Write only."""
+        if group in (RIG.SYM_HANDLE_BY_NAME, RIG.SYM_VALUE_BY_NAME):
+            try:
+                name = data.split(b"\x00", 1)[0].decode(STRING_ENCODING)
+            except UnicodeDecodeError:
+                return _E.DEVICE_INVALIDDATA, "a symbol name must be CP1252 text"
+            entry = self.space.by_name(name)
+            if entry is None:
+                return _E.DEVICE_SYMBOLNOTFOUND, f"no object is named {name!r}"
+            if group == RIG.SYM_VALUE_BY_NAME:
+                return self.space.read_entry(entry, read_length)
+            if read_length != 4:
+                return _E.DEVICE_INVALIDSIZE, "a handle is 4 bytes: read length must be 4"
+            return 0, _U32.pack(entry.handle)
+        symbols = self.symbols
+        if symbols is not None and symbols.handles(group):
+            return symbols.read_write(group, offset, data, read_length)
+        found = self.space.find(port, group, offset)
+        if isinstance(found, tuple):
+            return found
+        return _E.DEVICE_SRVNOTSUPP, f"{found.obj.name} does not take ReadWrite; use Read or Write"
+
+    # ------------------------------------------------------------ writes
+
+    def decode_write(self, port: int, group: int, offset: int, data: bytes) -> tuple:
+        """(0, entry, value), (0, None, None) for a handle release, or (code, message, None)."""
+        if group == RIG.SYM_VALUE_BY_HANDLE:
+            entry = self.space.by_handle(offset)
+            if entry is None:
+                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown", None
+            return self.space.decode_entry_write(entry, data)
+        if group == RIG.SYM_RELEASE_HANDLE:
+            if len(data) != 4:
+                return _E.DEVICE_INVALIDSIZE, "release a handle by writing its 4 bytes", None
+            handle = _U32.unpack(data)[0]
+            if self.space.by_handle(handle) is None:
+                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {handle} is unknown", None
+            return 0, None, None  # handles are stable per object: nothing to free
+        if group == RIG.DEVICE_DATA and port == CncPort.PLC:
+            return (_E.DEVICE_INVALIDACCESS,
+                    "device data is read-only; change the state with WriteControl", None)
+        symbols = self.symbols
+        if symbols is not None and symbols.handles(group):
+            code, message = symbols.write(group, offset, data)
+            return (code, message, None) if code else (0, None, None)
+        return self.space.decode_write(port, group, offset, data)
+
+    def apply_writes(
+        self, items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None]
+    ) -> None:
+        """Queue the writes for the kernel; ``finish`` gets (code, message) per item on the
+        loop once the cycle thread has applied all of them."""
+        results: list[tuple[int, str]] = [(0, "")] * len(items)
+        remaining = [len(items)]
+        if not items:
+            finish(results)
+            return
+        loop = self.loop
+
+        def applied(k: int, refusal: Refusal | None) -> None:  # runs on the cycle thread
+            if refusal is not None:
+                results[k] = (refusal_code(refusal), refusal.message)
+            remaining[0] -= 1
+            if remaining[0] == 0:
+                loop.call_soon_threadsafe(finish, results)
+
+        for k, (entry, value) in enumerate(items):
+            self.kernel.submit(entry.write(value), lambda r, k=k: applied(k, r))
