@@ -9,6 +9,7 @@ the message layer answers with the code and a sentence that says why.
 from __future__ import annotations
 
 import logging
+import fnmatch
 import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
@@ -49,30 +50,14 @@ _INDEX = re.compile(r"\[\d+\]")
 
 def _glob(pattern: str) -> re.Pattern[str]:
     """A regex for a glob: ``*``, ``?`` and ``[...]`` classes as in fnmatch, except that
-    a bracketed number (``[0]``) is literal, as the index in a PLC name."""
-    out, k = [], 0
-    while k < len(pattern):
-        c = pattern[k]
-        index = _INDEX.match(pattern, k)
-        if index:
-            out.append(re.escape(index.group()))
-            k = index.end()
-            continue
-        if c == "*":
-            out.append(".*")
-        elif c == "?":
-            out.append(".")
-        elif c == "[" and (end := pattern.find("]", k + 2)) > 0:
-            body = pattern[k + 1:end]
-            negate = body.startswith("!")
-            body = re.escape(body[1:] if negate else body).replace("\\-", "-")
-            out.append(f"[{'^' if negate else ''}{body}]")
-            k = end + 1
-            continue
-        else:
-            out.append(re.escape(c))
-        k += 1
-    return re.compile(f"(?s:{''.join(out)})\\Z")
+    a bracketed number (``[0]``) is literal, as the index in a PLC name.
+
+    ``fnmatch.translate`` does the translation: it folds runs of ``*`` and matches the
+    text between stars without backtracking into earlier stars, so a pattern of many
+    stars costs linear time instead of stalling the event loop (a hand-made ``.*`` per
+    star took minutes for twelve stars)."""
+    literal_indices = _INDEX.sub(lambda m: "[[]" + m.group()[1:], pattern)
+    return re.compile(fnmatch.translate(literal_indices))
 
 
 class AddressSpace:

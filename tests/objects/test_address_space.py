@@ -175,13 +175,18 @@ def test_misses_answer_port_group_or_offset(
         ("ch1.[fm]*", [FEED_W, MODE, FLAG]),
         ("ch1", []),  # a glob matches whole names
         ("ch2.*", []),
+        ("**ch1.**feed***", [FEED_W]),  # runs of stars are one star
+        ("*" * 40 + "q", []),  # many stars: answered (linear), nothing matches
+        ("*?*?*?*?*?*?*?*?*?*?*?*?*?*_w", [FEED_W]),
+        ("ch1.[!f]*", [LINK, DIST, FEED_W, MODE, NAME, BROKEN]),
     ],
 )
 def test_match_globs(space: AddressSpace, pattern: str, expected: list[CncObject]) -> None:
     assert space.match(pattern) == expected
 
 
-@pytest.mark.parametrize("pattern", ["gpch*", "GPCH*", "gpCh?0?.*", "*.COUNT_LOGGED_BLOCKS"])
+@pytest.mark.parametrize("pattern", ["gpch*", "GPCH*", "gpCh?0?.*", "*.COUNT_LOGGED_BLOCKS",
+                                     "gpCh[0].*", "*[0]*"])
 def test_match_ignores_the_case_of_mixed_case_names(pattern: str) -> None:
     hli = make("gpCh[0].count_logged_blocks", 851, 0x4020, 0, UNS32, Access.READ)
     space = AddressSpace()
