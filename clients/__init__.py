@@ -28,6 +28,7 @@ from .client import (
 from .errors import (
     AdsConnectionError,
     AdsError,
+    AuthenticationError,
     AdsTimeoutError,
     ChannelError,
     ClientValueError,
@@ -44,6 +45,7 @@ __all__ = [
     "AdsState",
     "AdsTimeoutError",
     "AsyncClient",
+    "AuthenticationError",
     "ChannelError",
     "ChannelStatus",
     "CheckError",

@@ -1,15 +1,20 @@
 """``cnc``: read, write, browse and watch CNC objects; run, check and plot NC programs.
 
-    cnc [--endpoint URL] [--json] [--timeout S] COMMAND ...
+    cnc [--endpoint URL] [--key FILE [--server-key FILE]] [--json] [--timeout S] COMMAND ...
 
 The entry module: the global options and ``main``. The commands live in ``cli_objects``
 (info, browse, read, write, watch), ``cli_machine`` (program store, run, MDI, hold,
-resume, reset, status, lookahead, check) and ``cli_plot`` (plot); what they share is in
-``cli_app``. Importing them here registers them on the app, in this order.
+resume, reset, status, lookahead, check), ``cli_plot`` (plot) and ``cli_keys`` (keys new);
+what they share is in ``cli_app``. Importing them here registers them on the app, in this order.
+
+A service started with ``--keys`` needs this client's key (``--key FILE`` or
+``CNC_KEY``) and its own public key (``--server-key FILE`` or ``CNC_SERVER_KEY``, by
+default ``server.key`` beside the key file); docs/security.md.
 
 Exit codes: 0 done; 1 the service answered with an ADS error; 2 bad usage, or a value the
-client refused before sending it (out of range, does not parse); 3 the service did not
-answer (timeout, not reachable); commands that wait add their own (see their help).
+client refused before sending it (out of range, does not parse, a key file it cannot
+use); 3 the service did not answer (timeout, not reachable) or refused this client's key;
+commands that wait add their own (see their help).
 Every error is one line on stderr: ``error: ADS 0x710 SYMBOLNOTFOUND: ...`` when the
 service refused, ``error: ch1.x: value -5 out of range for UNS16 (0..65535)`` when the
 client did, ``error: ADS 0x745 SYNCTIMEOUT: no reply to READ ch1.x within 5 s from ...``
@@ -30,6 +35,7 @@ from .client import DEFAULT_ENDPOINT
 from . import cli_objects  # noqa: E402,F401,I001  (info, browse, read, write, watch)
 from . import cli_machine  # noqa: E402,F401,I001  (programs, channel commands, check)
 from . import cli_plot  # noqa: E402,F401,I001  (plot)
+from . import cli_keys  # noqa: E402,F401,I001  (keys new)
 
 __all__ = ["app", "main"]
 
@@ -43,9 +49,19 @@ def main_options(
     ),
     as_json: bool = typer.Option(False, "--json", help="One JSON object per line."),
     timeout_s: float = typer.Option(5.0, "--timeout", min=0.01, help="Seconds to wait for a reply."),
+    key_file: str = typer.Option(
+        None, "--key", metavar="FILE", envvar="CNC_KEY", show_envvar=False,
+        help="This client's CURVE secret key file, for a service with --keys (default: "
+        "$CNC_KEY).",
+    ),
+    server_key: str = typer.Option(
+        None, "--server-key", metavar="FILE", envvar="CNC_SERVER_KEY", show_envvar=False,
+        help="The service's public key file (default: $CNC_SERVER_KEY, else server.key "
+        "beside --key).",
+    ),
 ) -> None:
     """Global options."""
-    ctx.obj = Settings(endpoint, as_json, timeout_s)
+    ctx.obj = Settings(endpoint, as_json, timeout_s, key_file or None, server_key or None)
 
 
 def main() -> None:

@@ -6,7 +6,9 @@ and register their commands on ``app``; the entry module ``cli`` imports them. N
 here imports a command module, so the package reads top-down without an import circle.
 
 Exit codes: 0 done; 1 the service answered with an ADS error; 2 bad usage, or a value the
-client refused before sending it; 3 the service did not answer (timeout, not reachable).
+client refused before sending it (a key file that cannot be read, too); 3 the service did
+not answer (timeout, not reachable) or would not let this client in (its CURVE key
+refused).
 """
 
 from __future__ import annotations
@@ -20,8 +22,8 @@ from typing import Any, NoReturn, TypeVar
 import typer
 from rich.console import Console
 
-from .client import Client
-from .errors import AdsError, AdsTimeoutError, ClientValueError, NoReplyError
+from .client import AsyncClient, Client
+from .errors import AdsError, AdsTimeoutError, AuthenticationError, ClientValueError, NoReplyError
 
 T = TypeVar("T")
 
@@ -55,14 +57,23 @@ def command(*args: Any, **kwargs: Any) -> Callable[[Callable[..., Any]], Callabl
 class Settings:
     """Global options, shared by every command."""
 
-    def __init__(self, endpoint: str, as_json: bool, timeout_s: float) -> None:
+    def __init__(self, endpoint: str, as_json: bool, timeout_s: float,
+                 key_file: str | None = None, server_key: str | None = None) -> None:
         self.endpoint = endpoint
         self.as_json = as_json
         self.timeout_s = timeout_s
+        self.key_file = key_file  # CURVE: this client's secret key file (--key, CNC_KEY)
+        self.server_key = server_key  # the service's public key (--server-key, CNC_SERVER_KEY)
 
     def client(self) -> Client:
-        """A blocking client for one command."""
-        return Client(self.endpoint, timeout_s=self.timeout_s)
+        """A blocking client for one command (``ClientValueError`` for a bad key file)."""
+        return Client(self.endpoint, timeout_s=self.timeout_s, key_file=self.key_file,
+                      server_key=self.server_key)
+
+    def async_client(self) -> AsyncClient:
+        """An asyncio client for one command (``ClientValueError`` for a bad key file)."""
+        return AsyncClient(self.endpoint, timeout_s=self.timeout_s, key_file=self.key_file,
+                           server_key=self.server_key)
 
     @contextlib.contextmanager
     def session(self, request: str | None = None) -> Iterator[Client]:
@@ -95,7 +106,7 @@ def say_error(text: str) -> None:
 def fail(exc: Exception) -> NoReturn:
     """End the command for ``exc``: one line on stderr and the exit code of its kind."""
     say_error(str(exc))
-    if isinstance(exc, AdsTimeoutError):
+    if isinstance(exc, (AdsTimeoutError, AuthenticationError)):
         raise typer.Exit(EXIT_UNREACHABLE)
     if isinstance(exc, AdsError):
         raise typer.Exit(EXIT_ADS_ERROR)

@@ -270,7 +270,7 @@ def watch(
 
     async def run() -> bool:
         """True when every object got its samples (or no COUNT), False at --timeout."""
-        async with AsyncClient(settings.endpoint, timeout_s=settings.timeout_s) as c:
+        async with settings.async_client() as c:
             infos = {}
             for name in names:  # fail on a bad name before printing anything
                 try:
@@ -291,7 +291,7 @@ def watch(
         complete = asyncio.run(run())
     except KeyboardInterrupt:
         raise typer.Exit(0) from None
-    except AdsError as exc:
+    except (AdsError, ClientValueError) as exc:
         fail(exc)
     if not complete:
         short = ", ".join(f"{n} {seen[n]} of {count}" for n in names if seen[n] < count)

@@ -9,13 +9,20 @@
     with Client("tcp://127.0.0.1:5555") as c:
         c.read_address(551, 0x121301, 0x10018, "UNS32")
 
+    # a service started with --keys (docs/security.md): this client's key pair, and the
+    # service's public key (default: server.key beside the key file)
+    with Client("tcp://cnc:5555", key_file="alice.key_secret", server_key="server.key") as c:
+        ...
+
 Objects are found by name through one browse of the service's catalog, cached for the
 life of the connection; an unknown name fails with ADS 0x710 and the nearest names
 ("did you mean ..."). What the service refuses raises ``AdsError`` naming its ADS code;
 a request without reply raises ``NoReplyError`` (an ``AdsTimeoutError``) naming what was
 asked (``no reply to READ ch1.x within 5 s from tcp://...``). What the client refuses
 before sending anything (a value out of its type's range, an unknown state name) raises
-``ClientValueError`` (a ``ValueError``), which claims no ADS code.
+``ClientValueError`` (a ``ValueError``), which claims no ADS code. A service that will not
+let the client in (its key refused, or keys that do not fit) raises
+``AuthenticationError`` (an ``AdsConnectionError``, ADS 0x723) as soon as it says so.
 """
 
 from __future__ import annotations
@@ -24,6 +31,7 @@ import contextlib
 import difflib
 import functools
 import inspect
+import os
 from collections.abc import AsyncIterator, Iterable, Iterator
 from dataclasses import dataclass, field
 from datetime import UTC, datetime, timedelta
@@ -51,6 +59,7 @@ from cnc_objects.protocol.frames import (
 from .channel_ops import (
     ChannelOps, ChannelStatus, CheckError, CheckResult, ProgramEntry, ProgramOps,
 )
+from .curve import client_curve
 from .errors import AdsConnectionError, AdsError, ClientValueError, NoReplyError
 from .path_trace import PathTrace, TraceOps
 from .sync_transport import SyncTransport, drive
@@ -190,18 +199,32 @@ def filetime_to_datetime(filetime: int) -> datetime:
     return _FILETIME_EPOCH + timedelta(microseconds=filetime // 10)
 
 
+PathText = str | os.PathLike[str]
+
+
 class AsyncClient(ProgramOps, ChannelOps, TraceOps):
-    """Asyncio client of a cnc-objects service. Use with ``async with``."""
+    """Asyncio client of a cnc-objects service. Use with ``async with``.
+
+    ``key_file``: this client's CURVE secret key file (``NAME.key_secret``, or ``NAME.key``
+    with the secret beside it), for a service started with ``--keys``; ``server_key``: the
+    service's public key file (default: ``server.key`` beside ``key_file``). A key file
+    that cannot be used raises ``ClientValueError`` here.
+    """
 
     def __init__(
         self,
         endpoint: str = DEFAULT_ENDPOINT,
         *,
         timeout_s: float = DEFAULT_TIMEOUT_S,
+        key_file: PathText | None = None,
+        server_key: PathText | None = None,
         _transport: AsyncTransport | SyncTransport | None = None,
     ) -> None:
         self.endpoint = endpoint
-        self._t = _transport or AsyncTransport(endpoint, timeout_s)
+        if _transport is None:
+            curve = client_curve(key_file, server_key)
+            _transport = AsyncTransport(endpoint, timeout_s, curve=curve)
+        self._t = _transport
         self._objects: dict[str, ObjectInfo] | None = None
         self._handles: dict[str, int] = {}
 
@@ -430,10 +453,19 @@ def _blocking(method: Any) -> Any:
 class Client:
     """Blocking client: the same methods as ``AsyncClient``. Use with ``with``."""
 
-    def __init__(self, endpoint: str = DEFAULT_ENDPOINT, *, timeout_s: float = DEFAULT_TIMEOUT_S) -> None:
+    def __init__(
+        self,
+        endpoint: str = DEFAULT_ENDPOINT,
+        *,
+        timeout_s: float = DEFAULT_TIMEOUT_S,
+        key_file: PathText | None = None,
+        server_key: PathText | None = None,
+    ) -> None:
+        """See ``AsyncClient`` (``key_file``, ``server_key``: CURVE keys)."""
         self.endpoint = endpoint
+        curve = client_curve(key_file, server_key)
         self._core = AsyncClient(
-            endpoint, _transport=SyncTransport(endpoint, timeout_s)
+            endpoint, _transport=SyncTransport(endpoint, timeout_s, curve=curve)
         )
 
     def __enter__(self) -> Client:

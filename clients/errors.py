@@ -52,6 +52,15 @@ class AdsConnectionError(AdsError, ConnectionError):
     """The client is not connected (ADS 0x748 PORTNOTOPEN) or got an unreadable reply."""
 
 
+class AuthenticationError(AdsConnectionError):
+    """The service would not let this client in (ADS 0x723 ACCESSDENIED): its CURVE key
+    was refused, or the keys do not fit the service (``clients.curve``). The connection
+    is closed; the message says what to change."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(AdsReturnCode.DEVICE_ACCESSDENIED, message)
+
+
 class ClientValueError(ValueError):
     """The client refused a value before sending anything: outside its type's range, of
     the wrong Python type, an unknown type or ADS state name. Not an ``AdsError``: no

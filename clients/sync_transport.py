@@ -17,6 +17,7 @@ import zmq
 from cnc_objects.protocol.errors import ProtocolError
 from cnc_objects.protocol.frames import Response, Sample, decode_incoming
 
+from .curve import ClientCurve, HandshakeWatch
 from .errors import AdsConnectionError
 from .transport import _NOBLOCK, _new_socket, _Transport
 
@@ -68,15 +69,21 @@ class _Pause:
 class SyncTransport(_Transport):
     """DEALER socket used by blocking calls; no event loop, no thread."""
 
-    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context | None = None) -> None:
-        super().__init__(endpoint, timeout_s)
+    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context | None = None,
+                 curve: ClientCurve | None = None) -> None:
+        super().__init__(endpoint, timeout_s, curve)
         self._context = context or zmq.Context.instance()
         self._sock: zmq.Socket | None = None
+        self._watch: HandshakeWatch | None = None
+        self._shaken = False  # a handshake succeeded: requests go straight out
 
     async def open(self) -> None:
         """Connect. Replies are awaited by a blocking receive with a timeout (cheaper
-        than polling first)."""
-        self._sock = sock = _new_socket(self._context, self.endpoint)
+        than polling first); the first request waits for the handshake instead, so that
+        a refusal is told at once (``HandshakeWatch``)."""
+        sock, self._watch = _new_socket(self._context, self.endpoint, self.curve)
+        self._sock = sock
+        self._shaken = self.endpoint.startswith("inproc://")  # inproc has no handshake
         self._timeout_ms = max(1, int(self.timeout_s * 1000))
         sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
         raw = zmq.Socket.__mro__[1]  # the Cython methods, without pyzmq's Python wrappers
@@ -85,6 +92,9 @@ class SyncTransport(_Transport):
 
     async def close(self) -> None:
         """Disconnect."""
+        if self._watch is not None:
+            self._watch.close()
+            self._watch = None
         if self._sock is not None:
             self._sock.close(linger=0)
             self._sock = None
@@ -117,12 +127,18 @@ class SyncTransport(_Transport):
             finally:
                 sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
             return buffer.popleft()
+        deadline = time.monotonic() + self.timeout_s
+        shortened = False
+        if not self._shaken:
+            self._handshake(pending.command)
+            sock.setsockopt(zmq.RCVTIMEO, max(1, int((deadline - time.monotonic()) * 1000)))
+            shortened = True  # the reply gets what the handshake left of the timeout
         try:
             self._raw_send(pending.frame, _NOBLOCK)
         except zmq.Again:
+            if shortened:
+                sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
             raise AdsConnectionError(0x748, "send queue full; the service is not reading") from None
-        deadline = time.monotonic() + self.timeout_s
-        shortened = False
         try:
             message = self._receive(sock)
             while message is None or message.invoke_id != invoke_id:
@@ -135,10 +151,26 @@ class SyncTransport(_Transport):
                 message = self._receive(sock)
             return message
         except zmq.Again:
+            self._handshake_failure()  # a refusal explains the silence: say it instead
             raise self._timeout(pending.command) from None
         finally:
             if shortened:
                 sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
+
+    def _handshake(self, command: int) -> None:
+        """Wait (up to the timeout) until the connection's handshake has ended; raise
+        ``AuthenticationError`` when the service refused it, ``NoReplyError`` when none
+        ended (no service)."""
+        watch = self._watch
+        if watch is None or not watch.wait(self.timeout_s):
+            raise self._timeout(command)
+        self._handshake_failure()
+        self._shaken = True
+
+    def _handshake_failure(self) -> None:
+        if self._watch is not None and self._watch.check() is not None:
+            self._shaken = False
+            raise self._watch.failure  # type: ignore[misc]
 
     def _receive(self, sock: zmq.Socket) -> Response | None:
         raw = self._raw_recv(0)

@@ -5,6 +5,11 @@ their transport: ``exchange(command, port, fields)`` (a reply) and ``next_sample
 notification sample). ``AsyncTransport`` (here) answers them on the event loop, with many
 requests in flight matched by invoke id; ``SyncTransport`` (``sync_transport``) answers
 them by blocking on the socket.
+
+With ``curve`` (``clients.curve``) the socket is a CURVE client; either way a
+``HandshakeWatch`` reads the socket's handshake events, so a service that refuses the
+client (its key, or its lack of one) fails the requests with ``AuthenticationError``
+instead of letting them time out.
 """
 
 from __future__ import annotations
@@ -27,7 +32,8 @@ from cnc_objects.protocol.frames import (
     encode_request,
 )
 
-from .errors import AdsConnectionError, NoReplyError
+from .curve import ClientCurve, HandshakeWatch
+from .errors import AdsConnectionError, AuthenticationError, NoReplyError
 
 log = logging.getLogger(__name__)
 
@@ -39,25 +45,33 @@ SAMPLE_BUFFER = 1000  # samples kept per subscription; a full buffer drops the o
 EARLY_HANDLES = 4096
 
 
-def _new_socket(context: zmq.Context, endpoint: str) -> zmq.Socket:
+def _new_socket(
+    context: zmq.Context, endpoint: str, curve: ClientCurve | None = None
+) -> tuple[zmq.Socket, HandshakeWatch]:
+    """A connected DEALER socket and the watch on its handshakes."""
     sock = context.socket(zmq.DEALER)
     sock.setsockopt(zmq.LINGER, 0)
     sock.setsockopt(zmq.SNDHWM, 100_000)
     sock.setsockopt(zmq.RCVHWM, 100_000)
+    if curve is not None:
+        curve.secure(sock)
+    watch = HandshakeWatch(sock, endpoint, curve)  # before connect: no event is missed
     try:
         sock.connect(endpoint)
     except zmq.ZMQError as exc:
+        watch.close()
         sock.close()
         raise AdsConnectionError(0x748, f"cannot connect to {endpoint}: {exc}") from None
-    return sock
+    return sock, watch
 
 
 class _Transport:
     """What both transports share: invoke ids and per-subscription sample buffers."""
 
-    def __init__(self, endpoint: str, timeout_s: float) -> None:
+    def __init__(self, endpoint: str, timeout_s: float, curve: ClientCurve | None = None) -> None:
         self.endpoint = endpoint
         self.timeout_s = timeout_s
+        self.curve = curve
         self._ids = itertools.count(1)
         self._samples: dict[int, deque[Sample]] = {}
         self._early: dict[int, deque[Sample]] = {}
@@ -108,10 +122,15 @@ class AsyncTransport(_Transport):
     sent, with ``NoReplyError`` (an ``AdsTimeoutError``).
     """
 
-    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context | None = None) -> None:
-        super().__init__(endpoint, timeout_s)
+    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context | None = None,
+                 curve: ClientCurve | None = None) -> None:
+        super().__init__(endpoint, timeout_s, curve)
         self._context = context or zmq.Context.instance()
         self._sock: zmq.Socket | None = None
+        self._watch: HandshakeWatch | None = None
+        # what a request on a closed transport raises: not connected, or refused
+        self._closed: AdsConnectionError = AdsConnectionError(
+            0x748, "the client is not connected; use 'async with'")
         self._loop: asyncio.AbstractEventLoop | None = None
         # invoke id -> (future, sweep generation when sent, command id)
         self._pending: dict[int, tuple[asyncio.Future[Response], int, int]] = {}
@@ -124,24 +143,43 @@ class AsyncTransport(_Transport):
     async def open(self) -> None:
         """Connect (ZeroMQ connects in the background; requests queue until it has)."""
         self._loop = asyncio.get_running_loop()
-        self._sock = sock = _new_socket(self._context, self.endpoint)
+        sock, watch = _new_socket(self._context, self.endpoint, self.curve)
+        self._sock, self._watch = sock, watch
         raw = zmq.Socket.__mro__[1]  # the Cython methods, without pyzmq's Python wrappers
         self._raw_send = raw.send.__get__(sock)
         self._raw_recv = raw.recv.__get__(sock)
         self._raw_get = raw.get.__get__(sock)
         self._loop.add_reader(sock.FD, self._drain)
+        self._loop.add_reader(watch.fd, self._check_handshake)
+        self._loop.call_soon(self._check_handshake)  # the edge-triggered fd may not say
         self._sweeper = self._loop.create_task(self._sweep(), name="cnc-client-timeouts")
 
     async def close(self) -> None:
         """Disconnect; requests still waiting fail with AdsConnectionError."""
+        self._shut(AdsConnectionError(0x748, "the client was closed"))
+
+    def _check_handshake(self) -> None:
+        """A handshake the service refused closes the transport: every request fails
+        with the reason, now and later (ZeroMQ would not retry a refused key anyway)."""
+        if self._watch is not None and self._watch.check() is not None:
+            self._shut(self._watch.failure)  # type: ignore[arg-type]
+
+    def _shut(self, closed: AdsConnectionError) -> None:
+        """Close the socket; pending requests and sample waits fail with ``closed``."""
         if self._sock is None:
             return
         if self._sweeper is not None:
             self._sweeper.cancel()
-        self._loop.remove_reader(self._sock.FD)  # type: ignore[union-attr]
+        loop = self._loop
+        loop.remove_reader(self._sock.FD)  # type: ignore[union-attr]
+        if self._watch is not None:
+            loop.remove_reader(self._watch.fd)  # type: ignore[union-attr]
+            self._watch.close()
+            self._watch = None
         self._sock.close(linger=0)
         self._sock = None
-        closed = AdsConnectionError(0x748, "the client was closed")
+        if isinstance(closed, AuthenticationError):  # later requests say why, too
+            self._closed = closed
         for fut, _, _ in self._pending.values():
             if not fut.done():
                 fut.set_exception(closed)
@@ -158,7 +196,7 @@ class AsyncTransport(_Transport):
         """Send a request; the future is its reply, or fails after ``timeout_s`` (see the
         class doc). A plain function, so that awaiting a reply costs one frame less."""
         if self._sock is None:
-            raise AdsConnectionError(0x748, "the client is not connected; use 'async with'")
+            raise self._closed
         fut = self._loop.create_future()  # type: ignore[union-attr]
         invoke_id, frame = self._frame(command, port, fields)
         self._pending[invoke_id] = (fut, self._generation, command)
@@ -190,6 +228,9 @@ class AsyncTransport(_Transport):
         while True:
             await asyncio.sleep(period)
             self._generation += 1
+            self._check_handshake()  # a refusal explains the timeouts: say it instead
+            if self._sock is None:
+                return
             expired = self._generation - 5
             pending = self._pending
             for invoke_id, (fut, generation, command) in list(pending.items()):

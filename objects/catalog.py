@@ -366,6 +366,15 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "cnc_kernel_running_r", Scope.PLATFORM, COM, COM_CH, 0x1016, BOOLEAN, R, "-",
         "TRUE while the cycle task runs (ADS state RUN), FALSE after STOP (project)",
     ),
+    ObjectTemplate(
+        "cnc_notifications_r", Scope.PLATFORM, COM, COM_CH, 0x1017, UNS32, R, "-",
+        "Device notifications open, of all clients of both front ends; a client that is "
+        "gone is no longer counted (project)",
+    ),
+    ObjectTemplate(
+        "cnc_notification_clients_r", Scope.PLATFORM, COM, COM_CH, 0x1018, UNS32, R, "-",
+        "Clients that hold at least one device notification (project)",
+    ),
     # --- COM platform axes (offsets as TwinSharp, 0x120200 / 0x<ANo>00xx) ---------------
     ObjectTemplate(
         "command_position_acs", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x02, SGN32, R, "0.1 um",

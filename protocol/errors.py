@@ -28,6 +28,7 @@ class AdsReturnCode(IntEnum):
     PORTNOTCONNECTED = 0xD  # port not connected
     INVALIDAMSLENGTH = 0xE  # invalid AMS length
     INVALIDAMSNETID = 0xF  # invalid AMS net id
+    ROUTER_MAILBOXFULL = 0x502  # the port's mailbox is full: the request was rejected
     DEVICE_ERROR = 0x700  # general device error
     DEVICE_SRVNOTSUPP = 0x701  # service not supported by the server
     DEVICE_INVALIDGRP = 0x702  # invalid index group

@@ -6,6 +6,8 @@ An asyncio ``Protocol`` on the service's event loop. Frames are cut from the str
 - a peer without a route is closed as soon as it connects (logged with its address); a
   routed peer that sends from a Net ID that is not its route's is closed at that frame
   (logged with address and Net ID);
+- every request is served with the role of the frame's Net ID (its route's, or the
+  loopback role; ``ads_routes``): beyond it, ADS 0x704 from the dispatcher;
 - a frame for another AMS Net ID gets AMS error 0x7 (target machine not found), one for
   a port nobody serves AMS error 0x6 (target port not found), both in the AMS header with
   no data, as a router answers;
@@ -18,6 +20,10 @@ An asyncio ``Protocol`` on the service's event loop. Frames are cut from the str
   the client expects for that command.
 
 Frames with the response flag (0x0001) are not answered: a client never asks with one.
+A connection over its request rate (``[limits] requests_per_s_per_client``, a token
+bucket per connection, ``rate_limit``) is not read until it has a token again: its
+frames wait (at most those of one read from the socket), nothing is refused, and TCP
+slows the client down as a busy router would.
 A peer that does not read what it is sent is not read either, until it catches up; its
 notifications are dropped meanwhile, so a slow client cannot grow the service's memory.
 """
@@ -26,6 +32,8 @@ from __future__ import annotations
 
 import asyncio
 import logging
+from collections import deque
+from time import perf_counter
 from typing import Any, Protocol
 
 from cnc_objects.protocol.ads_commands import decode_request, encode_error_response
@@ -40,16 +48,20 @@ from cnc_objects.protocol.ams import (
 )
 from cnc_objects.protocol.constants import AdsCommand, AmsStateFlag
 from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
+from cnc_objects.protocol.roles import Role
 
 from .ads_routes import Admission, RouteTable
 from .dispatch import Dispatcher
 from .notifications import NotificationHub
+from .rate_limit import BYTES_PER_TOKEN, RateLimiter, extra_tokens
 
 log = logging.getLogger(__name__)
 
 _E = AdsReturnCode
 _RESPONSE = AmsStateFlag.RESPONSE
 _ADD = AdsCommand.ADD_DEVICE_NOTIFICATION
+_READ_WRITE = AdsCommand.READ_WRITE
+_ADMIN = Role.ADMIN
 
 
 class Listener(Protocol):
@@ -62,6 +74,7 @@ class Listener(Protocol):
     dispatcher: Dispatcher
     hub: NotificationHub
     connections: set[AmsConnection]  # the open connections, for closing them all
+    rate: RateLimiter | None  # requests per connection; None: no limit
 
 
 class AmsConnection(asyncio.Protocol):
@@ -72,12 +85,16 @@ class AmsConnection(asyncio.Protocol):
         self._net_id = server.net_id
         self._ports = server.ports
         self._dispatch = server.dispatcher.dispatch
+        self._dispatch_as = server.dispatcher.dispatch_as
         self._parser = AmsStreamParser(server.max_frame_bytes)
         self._transport: asyncio.Transport | None = None
         self._admission = Admission(False)
         self._envelopes: set[tuple[Any, ...]] = set()  # clients with notifications
         self.peer = "?"
         self.paused = False  # the peer does not read: notifications are dropped
+        self._rate = server.rate
+        self._held: deque[AmsFrame | FrameError] | None = None  # waiting for the rate
+        self._held_timer: asyncio.TimerHandle | None = None
 
     # ------------------------------------------------------------ asyncio.Protocol
 
@@ -96,16 +113,53 @@ class AmsConnection(asyncio.Protocol):
 
     def data_received(self, data: bytes) -> None:
         """Answer every frame ``data`` completes, in order."""
-        for item in self._parser.feed(data):
+        items = self._parser.feed(data)
+        if self._held is not None:  # earlier frames wait for the rate: these behind them
+            self._held.extend(items)
+            return
+        self._answer(items)
+
+    def _answer(self, items: list[AmsFrame | FrameError]) -> None:
+        """Answer ``items`` in order while the rate allows; hold the rest."""
+        rate = self._rate
+        now_s = perf_counter() if rate is not None else 0.0
+        for k, item in enumerate(items):
             if self._transport is None or self._transport.is_closing():
+                return
+            if rate is not None and not rate.admit(self, now_s):
+                self._hold(items[k:], rate.wait_s(self, now_s))
                 return
             if type(item) is AmsFrame:
                 self._frame(item)
             else:
                 self._bad_frame(item)  # type: ignore[arg-type]
 
+    def _hold(self, items: list[AmsFrame | FrameError], wait_s: float) -> None:
+        """Over the rate: keep ``items`` and stop reading until a token is due."""
+        self._held = deque(items)
+        if self._transport is not None:
+            self._transport.pause_reading()
+        loop = asyncio.get_running_loop()
+        self._held_timer = loop.call_later(max(wait_s, 0.001), self._release)
+
+    def _release(self) -> None:
+        """A token is due: answer the frames that waited, then read again."""
+        self._held_timer = None
+        held, self._held = self._held, None
+        self._answer(list(held or ()))
+        transport = self._transport
+        if self._held is None and not self.paused and transport is not None \
+                and not transport.is_closing():
+            transport.resume_reading()
+
     def connection_lost(self, exc: Exception | None) -> None:
         """Forget the connection and delete its notifications."""
+        if self._held_timer is not None:
+            self._held_timer.cancel()
+            self._held_timer = None
+        self._held = None
+        if self._rate is not None:
+            self._rate.forget(self)
         self._server.connections.discard(self)
         hub = self._server.hub
         for envelope in self._envelopes:
@@ -127,8 +181,9 @@ class AmsConnection(asyncio.Protocol):
     def resume_writing(self) -> None:
         """The peer reads again: take its requests again."""
         self.paused = False
-        if self._transport is not None and not self._transport.is_closing():
-            self._transport.resume_reading()
+        if self._held is None and self._transport is not None \
+                and not self._transport.is_closing():
+            self._transport.resume_reading()  # unless frames wait for the rate
 
     # ------------------------------------------------------------ sending
 
@@ -153,7 +208,8 @@ class AmsConnection(asyncio.Protocol):
             log.debug("ADS %s sent a response frame (command %d); ignored",
                       self.peer, header.command_id)
             return
-        if not self._admission.accepts(header.source_net_id):
+        role = self._admission.role_of(header.source_net_id)
+        if role is None:
             log.warning("ADS connection from %s (AMS Net ID %s) closed: no route for this "
                         "Net ID from this address", self.peer, format_net_id(header.source_net_id))
             self.close()
@@ -175,9 +231,17 @@ class AmsConnection(asyncio.Protocol):
         envelope = (self, header.source_net_id, header.source_port)
         if header.command_id == _ADD:
             self._envelopes.add(envelope)
-        reply = self._dispatch(envelope, request)
+        if role is _ADMIN:
+            reply = self._dispatch(envelope, request)
+        else:
+            reply = self._dispatch_as(envelope, request, role)
         if reply is not None:
             self.write(reply)
+        rate = self._rate
+        if rate is not None:  # a big or a sum request costs more than one token
+            size = len(frame.data) if reply is None else len(frame.data) + len(reply)
+            if size >= BYTES_PER_TOKEN or request.COMMAND == _READ_WRITE:
+                rate.charge(self, extra_tokens(request, size))
 
     def _router_error(self, header: AmsHeader, code: int) -> None:
         """The AMS error a router answers: in the header, no data."""

@@ -1,8 +1,12 @@
-"""Which ADS peers are served, as a TwinCAT router decides it: by route.
+"""Which ADS peers are served, and with which role, as a TwinCAT router decides it: by route.
 
-A peer on the loopback interface is always served, from any AMS Net ID. Any other peer
-needs a route whose address is the peer's IP address; it may then send from the Net IDs
-of its routes only. A peer without a route is refused as soon as it connects.
+A peer on the loopback interface is always served, from any AMS Net ID, with the
+loopback role (``[ads] loopback_role``: admin by default, monitor when the service runs
+with ``--keys``). Any other peer needs a route whose address is the peer's IP address;
+it may then send from the Net IDs of its routes only, each with its route's role
+(``role`` of ``[[ads.routes]]``, operator by default). A peer without a route is refused
+as soon as it connects, unless the table is open (``--insecure`` with no routes: every
+peer is served as if on loopback).
 """
 
 from __future__ import annotations
@@ -12,37 +16,54 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from cnc_objects.protocol.ams import format_net_id, parse_net_id
+from cnc_objects.protocol.roles import Role
 
 IpAddress = ipaddress.IPv4Address | ipaddress.IPv6Address
 
 
+ROUTE_ROLE = Role.OPERATOR  # a route's role when its configuration names none
+LOOPBACK_ROLE = Role.ADMIN  # loopback peers' role without --keys (with keys: monitor)
+
+
 @dataclass(frozen=True, slots=True)
 class Route:
-    """A configured route: a name, the peer's AMS Net ID and its IP address."""
+    """A configured route: a name, the peer's AMS Net ID, its IP address and its role."""
 
     name: str
     net_id: bytes
     address: IpAddress
+    role: Role = ROUTE_ROLE
 
     @classmethod
-    def parse(cls, name: str, net_id: str, address: str) -> Route:
+    def parse(cls, name: str, net_id: str, address: str, role: str | None = None) -> Route:
         """A route from its configuration text; ``ValueError`` names what is wrong."""
-        return cls(name, parse_net_id(net_id), ipaddress.ip_address(address))
+        return cls(name, parse_net_id(net_id), ipaddress.ip_address(address),
+                   Role.parse(role) if role else ROUTE_ROLE)
 
     def __str__(self) -> str:
-        return f"{self.name} ({format_net_id(self.net_id)} at {self.address})"
+        return f"{self.name} ({format_net_id(self.net_id)} at {self.address}, {self.role.label})"
 
 
 @dataclass(frozen=True, slots=True)
 class Admission:
-    """The decision for one peer: refused, or served from ``net_ids`` (None: any)."""
+    """The decision for one peer: refused, or served with ``role`` from any Net ID
+    (``roles`` None), or from the Net IDs of ``roles`` with each one's role."""
 
     allowed: bool
-    net_ids: frozenset[bytes] | None = None
+    roles: dict[bytes, Role] | None = None
+    role: Role = Role.MONITOR
+
+    def role_of(self, net_id: bytes) -> Role | None:
+        """The role of frames from ``net_id``; None: this peer may not send from it."""
+        if not self.allowed:
+            return None
+        if self.roles is None:
+            return self.role
+        return self.roles.get(net_id)
 
     def accepts(self, net_id: bytes) -> bool:
         """May this peer send frames from ``net_id``?"""
-        return self.allowed and (self.net_ids is None or net_id in self.net_ids)
+        return self.role_of(net_id) is not None
 
 
 def peer_ip(host: str) -> IpAddress | None:
@@ -60,8 +81,13 @@ def peer_ip(host: str) -> IpAddress | None:
 class RouteTable:
     """The routes of the configuration, and the admission of peers by them."""
 
-    def __init__(self, routes: Iterable[Route] = ()) -> None:
+    def __init__(self, routes: Iterable[Route] = (), loopback_role: Role = LOOPBACK_ROLE,
+                 open_to_all: bool = False) -> None:
+        """``open_to_all``: serve peers without a route too, with the loopback role (the
+        ``--insecure`` case of a service without routes on a non-loopback address)."""
         self.routes = tuple(routes)
+        self.loopback_role = loopback_role
+        self.open_to_all = open_to_all
 
     def __len__(self) -> int:
         return len(self.routes)
@@ -71,7 +97,11 @@ class RouteTable:
         ip = peer_ip(host)
         if ip is None:
             return Admission(False)
-        if ip.is_loopback:
-            return Admission(True)
-        net_ids = frozenset(r.net_id for r in self.routes if r.address == ip)
-        return Admission(True, net_ids) if net_ids else Admission(False)
+        if ip.is_loopback or self.open_to_all:
+            return Admission(True, None, self.loopback_role)
+        # several routes of one address: the highest role of each Net ID
+        roles: dict[bytes, Role] = {}
+        for route in self.routes:
+            if route.address == ip:
+                roles[route.net_id] = max(route.role, roles.get(route.net_id, Role.MONITOR))
+        return Admission(True, roles) if roles else Admission(False)

@@ -43,6 +43,7 @@ from .ads_connection import AmsConnection
 from .ads_routes import RouteTable
 from .backend import Backend
 from .dispatch import Dispatcher
+from .rate_limit import RateLimiter
 
 log = logging.getLogger(__name__)
 
@@ -88,12 +89,14 @@ class AdsTcpServer:
         backend: Backend,
         routes: RouteTable | None = None,
         max_frame_bytes: int = AMS_MAX_FRAME_BYTES,
+        rate: RateLimiter | None = None,
     ) -> None:
         self.backend = backend
         self.hub = backend.hub
         self.net_id = b""  # set by start
-        self.routes = routes or RouteTable()
+        self.routes = routes if routes is not None else RouteTable()  # empty is falsy
         self.max_frame_bytes = max_frame_bytes
+        self.rate = rate  # requests per connection ([limits]); None: no limit
         self.ports = SERVED_PORTS
         self.dispatcher = Dispatcher(backend, self)
         self.connections: set[AmsConnection] = set()

@@ -40,7 +40,7 @@ from cnc_objects.protocol.errors import AdsReturnCode
 from .binding import refusal_code
 from .kernel.commands import Refusal
 from .kernel.kernel import Kernel
-from .notifications import NotificationHub
+from .notifications import MAX_PER_CLIENT, MAX_TOTAL, NotificationCounts, NotificationHub
 from .program_service import ProgramStoreService
 
 _E = AdsReturnCode
@@ -81,14 +81,20 @@ class Backend:
         loop: asyncio.AbstractEventLoop,
         programs: ProgramStoreService | None = None,
         symbols: SymbolServices | None = None,
+        notification_limits: tuple[int, int] = (MAX_PER_CLIENT, MAX_TOTAL),
+        notification_counts: NotificationCounts | None = None,
     ) -> None:
+        """``notification_limits``: (per client, in total), ``[limits]``
+        notifications_per_client and notifications_total; ``notification_counts``: where
+        the hub keeps its counts (the address space serves them)."""
         self.space = space
         self.kernel = kernel
         self.loop = loop
         self.programs = programs
         self.symbols = symbols
         self.hub = NotificationHub(
-            self.read_value, loop, kernel.cycle_ns, lambda: kernel.snapshot
+            self.read_value, loop, kernel.cycle_ns, lambda: kernel.snapshot,
+            *notification_limits, notification_counts,
         )
 
     # ------------------------------------------------------------ reads

@@ -44,6 +44,7 @@ from .kernel.commands import (
 )
 from .kernel.kernel import Kernel
 from .kernel.state import DecoderFlag
+from .notifications import NotificationCounts
 from .param_list import ParamListError, parse_axis_list
 
 Getter = Callable[[], Any]
@@ -360,6 +361,13 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
 }
 
 
+#: Objects of the service around the kernel: bound to the notification hub's counts.
+SERVICE_READERS: dict[str, Callable[[NotificationCounts], Getter]] = {
+    "cnc_notifications_r": lambda counts: lambda: counts.total,
+    "cnc_notification_clients_r": lambda counts: lambda: counts.clients,
+}
+
+
 def _channel_command(
     make: Callable[[int, Any], Command],
 ) -> Callable[[Kernel, CncObject], CommandFactory]:
@@ -438,12 +446,20 @@ def _aliases(kernel: Kernel, obj: CncObject) -> list[int]:
     return aliases
 
 
-def build_address_space(kernel: Kernel) -> AddressSpace:
-    """Every catalog object bound to ``kernel``, plus the COM object directories."""
+def build_address_space(
+    kernel: Kernel, notifications: NotificationCounts | None = None
+) -> AddressSpace:
+    """Every catalog object bound to ``kernel``, plus the COM object directories; the
+    service's own figures read ``notifications`` (the hub's counts; zero without one)."""
     space = AddressSpace()
     objects = build_objects(machine_layout(kernel))
+    counts = notifications if notifications is not None else NotificationCounts()
     for obj in objects:
-        read = READERS[obj.element](kernel, obj) if obj.access.readable else None
+        service = SERVICE_READERS.get(obj.element)
+        if service is not None:
+            read = service(counts)
+        else:
+            read = READERS[obj.element](kernel, obj) if obj.access.readable else None
         write = WRITERS[obj.element](kernel, obj) if obj.access.writable else None
         space.add(obj, read, write, _aliases(kernel, obj))
     # Platform-axis objects (ac_*) are left out: their element names repeat per axis.

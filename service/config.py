@@ -20,6 +20,7 @@ from pydantic import (
 from cnc_objects.protocol.ams import parse_net_id
 from cnc_objects.protocol.constants import AMS_MAX_FRAME_BYTES, AMS_TCP_PORT
 
+from .limits import LimitsConfig
 from .param_list import ParamListError, read_axis_list, read_channel_list
 
 
@@ -292,12 +293,22 @@ def parse_ads_endpoint(text: str) -> tuple[str, int] | None:
     return host, int(port_text)
 
 
+RoleName = Literal["monitor", "operator", "admin"]  # protocol.roles.Role, as written
+_Z85_KEY_CHARS = 40  # a CURVE key (32 bytes) in Z85 text
+_Z85_ALPHABET = frozenset(
+    "0123456789abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ.-:+=^!/*?&<>()[]{}@%$#")
+
+
 class AdsRouteConfig(_Strict):
     """A route of the ADS front end: a peer that may connect from ``address``."""
 
     name: str = Field(min_length=1, max_length=63, description="name of the route")
     net_id: str = Field(description="AMS Net ID the peer sends from (a.b.c.d.e.f)")
     address: str = Field(description="IP address the peer connects from")
+    role: RoleName = Field(
+        "operator",
+        description="what the peer may do: monitor, operator or admin (docs/security.md)",
+    )
 
     @field_validator("net_id")
     @classmethod
@@ -331,6 +342,10 @@ class AdsConfig(_Strict):
         AMS_MAX_FRAME_BYTES, ge=1024, le=64 << 20,
         description="longest AMS/TCP frame a client may send (bytes); longer closes it",
     )
+    loopback_role: RoleName | None = Field(
+        None, description="role of ADS peers on loopback (default: admin; monitor when the "
+        "service runs with keys)"
+    )
 
     @field_validator("endpoint")
     @classmethod
@@ -352,6 +367,46 @@ class AdsConfig(_Strict):
         return parse_ads_endpoint(self.endpoint)
 
 
+class ClientKeyConfig(_Strict):
+    """A client of the allow-list given in the configuration instead of a key file."""
+
+    name: str = Field(min_length=1, max_length=63, description="name of the client (logs)")
+    public_key: str = Field(description="the client's CURVE public key, 40 Z85 characters")
+    role: RoleName = Field(description="what the client may do: monitor, operator or admin")
+
+    @field_validator("public_key")
+    @classmethod
+    def _z85_key(cls, value: str) -> str:
+        value = value.strip()
+        if len(value) != _Z85_KEY_CHARS or not set(value) <= _Z85_ALPHABET:
+            raise ValueError(f"must be the {_Z85_KEY_CHARS} Z85 characters of a CURVE public "
+                             "key (the public-key line of NAME.key)")
+        return value
+
+
+class SecurityConfig(_Strict):
+    """CURVE keys of the ZeroMQ front end (docs/security.md); ``--keys DIR`` beats
+    ``keys_dir``. Relative paths are taken from the working directory at start."""
+
+    keys_dir: str | None = Field(
+        None, description="directory of server.key_secret and clients/<role>/*.key: CURVE on"
+    )
+    server_secret_key_file: str | None = Field(
+        None, description="the service's secret key file (default: keys_dir/server.key_secret)"
+    )
+    clients_dir: str | None = Field(
+        None, description="allow-list directory clients/<role>/*.key (default: keys_dir/clients)"
+    )
+    clients: tuple[ClientKeyConfig, ...] = Field(
+        (), description="allow-list entries besides the directory's (name, public_key, role)"
+    )
+
+    @property
+    def curve(self) -> bool:
+        """True when the configuration turns CURVE on."""
+        return bool(self.keys_dir or self.server_secret_key_file)
+
+
 class MachineConfig(_Strict):
     """The whole machine: platform axes, channels, cycle time."""
 
@@ -370,6 +425,13 @@ class MachineConfig(_Strict):
     )
     ads: AdsConfig = Field(
         default_factory=AdsConfig, description="the ADS front end ([ads] endpoint, net_id, routes)"
+    )
+    limits: LimitsConfig = Field(
+        default_factory=LimitsConfig,
+        description="what one client may cost the service ([limits]; docs/limits.md)",
+    )
+    security: SecurityConfig = Field(
+        default_factory=SecurityConfig, description="CURVE keys and allow-list ([security])"
     )
 
     @model_validator(mode="after")

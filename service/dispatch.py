@@ -8,6 +8,13 @@ command logic exists once for both wires. Reads are answered at once from the ke
 snapshot; writes are queued for the kernel and answered when the cycle thread has
 applied them (an acknowledged write is never lost), through ``FrontEnd.send``.
 
+Access is decided here, once for both wires (``protocol.roles``): a front end that knows
+who its peer is calls ``dispatch_as`` with the peer's role (ZeroMQ: the role of its CURVE
+key; ADS: the role of its route); a request beyond the role gets ADS 0x704 naming the
+role, each item of a sum write in its own slot, and the connection stays. ``dispatch``
+serves everything: front ends without access control (no keys, loopback only) call it,
+so their hot path pays nothing for the policy.
+
 Nothing a client sends raises out of here: handler faults become 0x700.
 """
 
@@ -38,6 +45,7 @@ from cnc_objects.protocol.frames import (
     WriteControlRequest,
     WriteRequest,
 )
+from cnc_objects.protocol.roles import COMMAND_ROLES, Role, role_to_write, roles_that_may
 
 from . import __version__
 from .backend import Backend, ValueResult
@@ -52,6 +60,8 @@ _E = AdsReturnCode
 _RESERVED_GROUPS = 0xF000  # index groups from here on are ADS services, not objects
 DEVICE_NAME = "cnc-objects"
 _CONTROLS = {AdsState.RUN: Control.RUN, AdsState.STOP: Control.STOP, AdsState.RESET: Control.RESET}
+_ADMIN = Role.ADMIN
+_READ_WRITE = AdsCommand.READ_WRITE
 
 Reply = bytes | None
 
@@ -125,6 +135,47 @@ class Dispatcher:
         except Exception:
             log.exception("handling %r failed", request)
             return self._error(envelope, request, _E.DEVICE_ERROR, "internal error; see log")
+
+    def dispatch_as(self, envelope: Envelope, request: Request, role: Role) -> Reply:
+        """``dispatch`` for a peer of ``role``: a request beyond the role is answered ADS
+        0x704 with a sentence naming the role (a sum write: 0x704 in each slot beyond it)."""
+        if role is _ADMIN:  # may everything
+            return self.dispatch(envelope, request)
+        try:
+            command = request.COMMAND
+            if command == _READ_WRITE:  # reads, but for a sum write's items
+                return self._read_write(envelope, request, role)  # type: ignore[arg-type]
+            needed = COMMAND_ROLES.get(command)
+            if needed is None:  # a Write: by its address
+                needed = role_to_write(request.port, request.group)  # type: ignore[attr-defined]
+            if role >= needed:
+                return self._handlers[command](envelope, request)
+            return self._error(envelope, request, _E.DEVICE_INVALIDACCESS,
+                               self._refusal(role, needed, request))
+        except Exception:
+            log.exception("handling %r failed", request)
+            return self._error(envelope, request, _E.DEVICE_ERROR, "internal error; see log")
+
+    def _refusal(self, role: Role, needed: Role, req: Any) -> str:
+        """``role monitor may not write ch1.x; operator or admin may``."""
+        if req.COMMAND == AdsCommand.WRITE_CONTROL:
+            what = "command the ADS state (WriteControl)"
+        elif needed is Role.ADMIN:
+            what = "change the program store (upload, delete)"
+        else:
+            what = f"write {self._target(req.port, req.group, req.offset)}"
+        return f"role {role.label} may not {what}; {roles_that_may(needed)} may"
+
+    def _target(self, port: int, group: int, offset: int) -> str:
+        """The name of the object at an address, else the address (refusal messages)."""
+        if group == RIG.SYM_VALUE_BY_HANDLE:
+            entry = self.space.by_handle(offset)
+        else:
+            found = self.space.find(port, group, offset)
+            entry = None if isinstance(found, tuple) else found
+        if entry is not None:
+            return entry.obj.name
+        return f"port {port} 0x{group:x}/0x{offset:x}"
 
     def _reply(self, envelope: Envelope, req: Any, result: ValueResult) -> bytes:
         code, payload = result
@@ -219,7 +270,7 @@ class Dispatcher:
 
     # ------------------------------------------------------------ read-write
 
-    def _read_write(self, envelope: Envelope, req: ReadWriteRequest) -> Reply:
+    def _read_write(self, envelope: Envelope, req: ReadWriteRequest, role: Role = _ADMIN) -> Reply:
         if req.read_length > MAX_DATA_BYTES:
             return self._error(
                 envelope, req, _E.DEVICE_INVALIDSIZE,
@@ -227,6 +278,8 @@ class Dispatcher:
             )
         handler = self._read_write_groups.get(req.group)
         if handler is not None:  # a sum command
+            if req.group == RIG.SUM_WRITE and role is not _ADMIN:
+                return self._sum_write(envelope, req, role)
             return handler(envelope, req)
         if self._is_store(req.port, req.group):
             return self._reply(
@@ -265,7 +318,7 @@ class Dispatcher:
             results.append((code, data))
         return self._ok(envelope, req, sums.encode_sum_read_reply(results))
 
-    def _sum_write(self, envelope: Envelope, req: ReadWriteRequest) -> Reply:
+    def _sum_write(self, envelope: Envelope, req: ReadWriteRequest, role: Role = _ADMIN) -> Reply:
         code, items = self._sum_items(req, sums.decode_sum_write)
         if code:
             return self._error(envelope, req, code, items)
@@ -273,6 +326,9 @@ class Dispatcher:
         writes: list[tuple[Entry, Any]] = []
         slots: list[int] = []
         for k, item in enumerate(items):
+            if role < _ADMIN and role < role_to_write(req.port, item.group):  # admin: no call
+                codes[k] = _E.DEVICE_INVALIDACCESS  # beyond the peer's role: this slot only
+                continue
             code, target, value = self.backend.decode_write(
                 req.port, item.group, item.offset, item.data)
             if code:

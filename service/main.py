@@ -1,6 +1,7 @@
 """``cnc-service``: the composition root. Builds kernel, address space and servers, runs them.
 
     cnc-service [--config FILE] [--endpoint URL] [--ads HOST[:PORT]|off] [--ams-net-id ID]
+                [--keys DIR] [--insecure]
                 [--clock realtime|virtual] [--speed X] [--cycle-ms MS]
                 [--program-dir DIR | --data-dir DIR] [--log-level L]
 
@@ -12,6 +13,12 @@ ZeroMQ endpoint (``listening on tcp://...``, the last start-up line); SIGINT and
 stop it cleanly (sockets closed, cycle thread joined) with exit code 0. Bad usage, a bad
 configuration or an address that cannot be bound exits with code 2 and says why (one
 line, or one line per configuration problem).
+
+Access (docs/security.md): ``--keys DIR`` (or ``[security]``) turns CURVE on for ZeroMQ,
+each client key with a role. Without keys the ZeroMQ endpoint must be a loopback
+address, and without ``[[ads.routes]]`` so must the ADS address: anything else is
+refused (exit 2) unless ``--insecure`` says that the network is trusted (inside a
+container, where the published port is the boundary).
 """
 
 from __future__ import annotations
@@ -30,8 +37,9 @@ import typer
 import zmq
 
 from cnc_objects.protocol.ams import parse_net_id
+from cnc_objects.protocol.roles import Role
 
-from .ads_routes import Route, RouteTable
+from .ads_routes import LOOPBACK_ROLE, Route, RouteTable
 from .ads_server import AdsTcpServer
 from .ads_symbols import SymbolService
 from .backend import Backend
@@ -40,8 +48,13 @@ from .config import ConfigError, MachineConfig, load_config, parse_ads_endpoint
 from .data_location import StoreLocation, program_store_location
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
+from .limits import rate_limiter
+from .notifications import NotificationCounts
 from .program_service import ProgramStoreService
 from .program_store import ProgramStore, StoreError
+from .security import (
+    SecurityError, ServerCurve, endpoint_is_local, host_is_loopback, load_server_curve,
+)
 from .server import ZmqServer
 from .store_writer import StoreWriter
 
@@ -101,13 +114,16 @@ class AdsListen:
     host: str
     port: int
     net_id: str | None
+    loopback_role: Role = LOOPBACK_ROLE  # of peers on loopback (and of all, when open)
+    open_to_all: bool = False  # --insecure without routes: peers need no route
 
 
 async def serve(
     config: MachineConfig, endpoint: str, clock_kind: ClockKind, speed: float | None,
-    store: ProgramStore, ads: AdsListen | None = None,
+    store: ProgramStore, ads: AdsListen | None = None, curve: ServerCurve | None = None,
 ) -> int:
-    """Run kernel and both front ends until SIGINT or SIGTERM (ADS when ``ads`` is given)."""
+    """Run kernel and both front ends until SIGINT or SIGTERM (ADS when ``ads`` is given;
+    ZeroMQ with CURVE when ``curve`` is given)."""
     loop = asyncio.get_running_loop()
     # The cycle thread must get the GIL soon after it wakes, even while the server is busy.
     sys.setswitchinterval(min(0.005, config.cycle_ms / 1000.0 / 4))
@@ -117,12 +133,15 @@ async def serve(
         config, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists,
         writer.append,
     )
-    space = build_address_space(kernel)
+    limits = config.limits
+    counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows
+    space = build_address_space(kernel, counts)
     backend = Backend(space, kernel, loop, ProgramStoreService(store, writer.flush),
-                      SymbolService(space))
+                      SymbolService(space),
+                      (limits.notifications_per_client, limits.notifications_total), counts)
     kernel.on_cycle_end = backend.hub.kernel_cycle_end  # one hub serves both front ends
     try:
-        server = ZmqServer(backend, endpoint)
+        server = ZmqServer(backend, endpoint, curve=curve, limits=limits)
     except zmq.ZMQError as exc:
         print(f"cnc-service: cannot listen on {endpoint}: {zmq.strerror(exc.errno)}",
               file=sys.stderr)
@@ -140,9 +159,15 @@ async def serve(
     server.start()
     if ads_server is not None:
         host, port = ads_server.address
-        log.info("ADS on %s:%d, AMS Net ID %s (AMS ports %s; %d routes besides loopback)",
+        log.info("ADS on %s:%d, AMS Net ID %s (AMS ports %s; %d routes besides loopback, "
+                 "%s role %s)",
                  f"[{host}]" if ":" in host else host, port, ads_server.net_id_text,
-                 ", ".join(str(p) for p in sorted(ads_server.ports)), len(ads_server.routes))
+                 ", ".join(str(p) for p in sorted(ads_server.ports)), len(ads_server.routes),
+                 "every peer's" if ads.open_to_all else "loopback",  # type: ignore[union-attr]
+                 ads.loopback_role.label)  # type: ignore[union-attr]
+    if curve is not None:
+        log.info("CURVE on: server public key %s; allow-list %s (%s)",
+                 curve.public_key.decode(), curve.allow_list.origin, curve.allow_list.census())
     log.info(
         "listening on %s (machine %s, %d channels, %d objects, %s clock, cycle %g ms)",
         server.endpoint, config.name, len(config.channels), len(space), clock_kind,
@@ -166,8 +191,12 @@ async def _start_ads(
     backend: Backend, config: MachineConfig, ads: AdsListen
 ) -> AdsTcpServer | None:
     """The listening ADS front end, or None after saying in one line why it cannot be."""
-    routes = RouteTable(Route.parse(r.name, r.net_id, r.address) for r in config.ads.routes)
-    ads_server = AdsTcpServer(backend, routes, config.ads.max_frame_bytes)
+    routes = RouteTable(
+        (Route.parse(r.name, r.net_id, r.address, r.role) for r in config.ads.routes),
+        ads.loopback_role, ads.open_to_all,
+    )
+    ads_server = AdsTcpServer(backend, routes, config.ads.max_frame_bytes,
+                              rate_limiter(config.limits))
     try:
         await ads_server.start(ads.host, ads.port, ads.net_id)
     except OSError as exc:
@@ -220,6 +249,17 @@ def run(
         None, "--ams-net-id", metavar="NETID",
         help="AMS Net ID of the service (default: [ads] net_id, else the ADS address + .1.1).",
     ),
+    keys: Optional[Path] = typer.Option(
+        None, "--keys", metavar="DIR",
+        help="CURVE for ZeroMQ: DIR holds server.key_secret and the allow-list "
+        "clients/<monitor|operator|admin>/*.key (default: [security] of the configuration; "
+        "docs/security.md).",
+    ),
+    insecure: bool = typer.Option(
+        False, "--insecure",
+        help="Serve a non-loopback address without keys (ZeroMQ) or routes (ADS): anyone "
+        "who reaches it may do everything. Only where the network is the boundary.",
+    ),
     log_level: LogLevel = typer.Option(LogLevel.INFO, "--log-level", help="Lowest level logged."),
 ) -> None:
     """CNC kernel serving its objects over ZeroMQ and ADS (AMS/TCP)."""
@@ -233,13 +273,44 @@ def run(
     location = program_store_location(
         program_dir, data_dir, config.program_store_dir, config.data_dir
     )
-    listen = _ads_listen(config, ads, ams_net_id)
-    store = _open_store(location)
-    raise typer.Exit(asyncio.run(serve(config, endpoint, clock, speed, store, listen)))
+    curve = _server_curve(config, keys)
+    if curve is None and not insecure and not endpoint_is_local(endpoint):
+        _usage(f"{endpoint} is not a loopback address and no keys are given: anyone who "
+               "reaches it could write every object; give --keys DIR (docs/security.md), "
+               "bind 127.0.0.1, or --insecure")
+    listen = _ads_listen(config, ads, ams_net_id, curve is not None, insecure)
+    store = _open_store(location, config)
+    raise typer.Exit(asyncio.run(serve(config, endpoint, clock, speed, store, listen, curve)))
 
 
-def _ads_listen(config: MachineConfig, ads: str | None, net_id: str | None) -> AdsListen | None:
-    """Where ADS listens: ``--ads``/``--ams-net-id`` over the configuration's [ads]."""
+def _server_curve(config: MachineConfig, keys: Path | None) -> ServerCurve | None:
+    """The CURVE keys of ``--keys`` or ``[security]``, None when neither turns CURVE on."""
+    security = config.security
+    if keys is None and not security.curve:
+        return None
+    try:
+        return load_server_curve(
+            keys if keys is not None else _path(security.keys_dir),
+            None if keys is not None else _path(security.server_secret_key_file),
+            _path(security.clients_dir),
+            [(c.name, c.public_key, c.role) for c in security.clients],
+        )
+    except SecurityError as exc:
+        _usage(f"bad keys: {exc}")
+
+
+def _path(text: str | None) -> Path | None:
+    return Path(text).expanduser() if text else None
+
+
+def _ads_listen(
+    config: MachineConfig, ads: str | None, net_id: str | None, keys: bool = False,
+    insecure: bool = False,
+) -> AdsListen | None:
+    """Where ADS listens: ``--ads``/``--ams-net-id`` over the configuration's [ads]; and
+    whom it serves: a non-loopback address needs routes (or ``insecure``: then every peer
+    is served as if on loopback); loopback peers get ``[ads] loopback_role``, by default
+    admin, monitor when the service runs with ``keys``."""
     try:
         address = parse_ads_endpoint(ads) if ads is not None else config.ads.address
     except ValueError as exc:
@@ -251,7 +322,17 @@ def _ads_listen(config: MachineConfig, ads: str | None, net_id: str | None) -> A
             _usage(f"bad --ams-net-id: {exc}")
     if address is None:
         return None
-    return AdsListen(address[0], address[1], net_id or config.ads.net_id)
+    local = host_is_loopback(address[0])
+    if not local and not config.ads.routes and not insecure:
+        _usage(f"ADS address {address[0]}:{address[1]} is not a loopback address and [ads] "
+               "has no routes: only loopback peers could be served; add [[ads.routes]] "
+               "(docs/security.md), bind 127.0.0.1 (--ads 127.0.0.1), or --insecure")
+    if config.ads.loopback_role is not None:
+        loopback_role = Role.parse(config.ads.loopback_role)
+    else:
+        loopback_role = Role.MONITOR if keys else LOOPBACK_ROLE
+    return AdsListen(address[0], address[1], net_id or config.ads.net_id, loopback_role,
+                     open_to_all=insecure and not local and not config.ads.routes)
 
 
 def _machine_config(path: Path | None, cycle_ms: float | None) -> MachineConfig:
@@ -267,10 +348,11 @@ def _machine_config(path: Path | None, cycle_ms: float | None) -> MachineConfig:
     return config
 
 
-def _open_store(location: StoreLocation) -> ProgramStore:
+def _open_store(location: StoreLocation, config: MachineConfig) -> ProgramStore:
     """The program store at ``location`` (created when absent), announced in the log."""
     try:
-        store = ProgramStore(location.path)
+        store = ProgramStore(location.path, config.limits.program_max_bytes,
+                             config.limits.program_max_files)
     except OSError as exc:
         _usage(f"cannot use program directory {location.path}: {exc.strerror}")
     log.info("program store: %s (%s)", store.root, location.source)

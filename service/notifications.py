@@ -17,7 +17,11 @@ wakes the event loop when it is; all sampling and sending happens on the loop.
 
 One hub serves every front end: a subscription remembers the front end's ``notify``
 function, which turns samples into that front end's frames (msgpack for ZeroMQ, a
-DeviceNotification for ADS over AMS/TCP). The limits count both front ends together.
+DeviceNotification for ADS over AMS/TCP). The limits (``[limits]
+notifications_per_client`` and ``notifications_total``) count both front ends together;
+``counts`` (served as the objects ``cnc_notifications_r`` and
+``cnc_notification_clients_r``) says how many are open and for how many clients, so a
+test can watch a vanished client's notifications being freed.
 """
 
 from __future__ import annotations
@@ -45,8 +49,8 @@ NotifyFn = Callable[[Envelope, int, list[list[Any]]], bool]
 
 CYCLIC_MODES = {TransmissionMode.SERVER_CYCLE, TransmissionMode.SERVER_CYCLE2}
 ON_CHANGE_MODES = {TransmissionMode.SERVER_ON_CHANGE, TransmissionMode.SERVER_ON_CHANGE2}
-MAX_PER_CLIENT = 1000
-MAX_TOTAL = 20000
+MAX_PER_CLIENT = 1000  # default of [limits] notifications_per_client
+MAX_TOTAL = 20000  # default of [limits] notifications_total
 
 #: FILETIME (100 ns since 1601-01-01) of the Unix epoch.
 _FILETIME_UNIX_EPOCH = 116444736000000000
@@ -55,6 +59,15 @@ _FILETIME_UNIX_EPOCH = 116444736000000000
 def filetime(wall_ns: int) -> int:
     """A wall-clock time (ns since the Unix epoch) as a FILETIME (100 ns since 1601)."""
     return _FILETIME_UNIX_EPOCH + wall_ns // 100
+
+
+@dataclass(slots=True)
+class NotificationCounts:
+    """Open notifications of all clients, and the clients that hold any (read by the
+    address space on the event loop, written by the hub on it)."""
+
+    total: int = 0
+    clients: int = 0
 
 
 @dataclass(slots=True)
@@ -84,12 +97,22 @@ class NotificationHub:
         loop: asyncio.AbstractEventLoop,
         kernel_cycle_ns: int,
         current: Callable[[], Snapshot],
+        max_per_client: int = MAX_PER_CLIENT,
+        max_total: int = MAX_TOTAL,
+        counts: NotificationCounts | None = None,
     ) -> None:
         self._read = read
         self._current = current
         self._loop = loop
         self._kernel_cycle_ns = kernel_cycle_ns
         self._subs: dict[int, Subscription] = {}
+        # Open notifications by client: by connection (an envelope's first part, ZeroMQ's
+        # routing id or the ADS connection), so that the parts a client adds to its
+        # envelope do not make it several clients.
+        self._per_client: dict[Any, int] = {}
+        self.max_per_client = max_per_client
+        self.max_total = max_total
+        self.counts = counts if counts is not None else NotificationCounts()
         self._next_handle = 1
         self._next_due_ns: int | None = None
         self._scheduled = False
@@ -119,9 +142,15 @@ class NotificationHub:
         code, data = self._read(req.port, req.group, req.offset, req.length)
         if code:
             return code, data  # type: ignore[return-value]
-        mine = sum(1 for s in self._subs.values() if s.envelope == envelope)
-        if mine >= MAX_PER_CLIENT or len(self._subs) >= MAX_TOTAL:
-            return AdsReturnCode.DEVICE_NOMOREHDLS, "too many notifications; delete some first"
+        mine = self._per_client.get(envelope[0], 0)
+        if mine >= self.max_per_client:
+            return (AdsReturnCode.DEVICE_NOMOREHDLS,
+                    f"this client holds {mine} notifications, the most one client may "
+                    "([limits] notifications_per_client); delete some first")
+        if len(self._subs) >= self.max_total:
+            return (AdsReturnCode.DEVICE_NOMOREHDLS,
+                    f"the service holds {len(self._subs)} notifications, the most it takes "
+                    "([limits] notifications_total); delete some first")
         handle = self._next_handle
         self._next_handle += 1
         sub = Subscription(
@@ -129,6 +158,8 @@ class NotificationHub:
             mode in ON_CHANGE_MODES, max(cycle_ns, self._kernel_cycle_ns), 0,
         )
         self._subs[handle] = sub
+        self._per_client[envelope[0]] = mine + 1
+        self._count()
         if first_delay_s > 0:
             self._loop.call_later(first_delay_s, self._first_sample, sub)
         else:
@@ -141,17 +172,43 @@ class NotificationHub:
         if sub is None or sub.envelope != envelope:
             return AdsReturnCode.DEVICE_NOTIFYHNDINVALID, f"notification handle {handle} is unknown"
         del self._subs[handle]
+        self._forget_one(envelope)
+        self._count()
         self._update_due()
         return 0, ""
 
     def drop_client(self, envelope: Envelope) -> None:
         """Forget every subscription of a client that is gone."""
+        if envelope[0] not in self._per_client:
+            return
         gone = [h for h, s in self._subs.items() if s.envelope == envelope]
         for handle in gone:
             del self._subs[handle]
-        if gone:
-            log.info("client gone: dropped %d notifications", len(gone))
-            self._update_due()
+            self._forget_one(envelope)
+        if not gone:
+            return
+        self._count()
+        log.info("client gone: dropped %d notifications", len(gone))
+        self._update_due()
+
+    def clients(self) -> list[tuple[Envelope, NotifyFn]]:
+        """Every client that holds notifications, with the ``notify`` of its front end."""
+        seen: dict[Envelope, NotifyFn] = {}
+        for sub in self._subs.values():
+            seen.setdefault(sub.envelope, sub.notify)
+        return list(seen.items())
+
+    def _forget_one(self, envelope: Envelope) -> None:
+        key = envelope[0]
+        left = self._per_client[key] - 1
+        if left:
+            self._per_client[key] = left
+        else:
+            del self._per_client[key]
+
+    def _count(self) -> None:
+        self.counts.total = len(self._subs)
+        self.counts.clients = len(self._per_client)
 
     # ------------------------------------------------------------ sampling
 

@@ -4,12 +4,28 @@ Batched pattern: the socket's file descriptor wakes the loop once, then every wa
 frame is drained without blocking and answered in the same pass, so a client with many
 requests in flight costs one wake-up per batch, not one await per message.
 
-Nothing a client sends can stop the server: frames over the size limit cut that client
-off (ZeroMQ's MAXMSGSIZE), frames that do not decode get an error reply (or are dropped,
-logged, when not even the invoke id can be read), everything else gets an answer from
-the dispatcher, a vanished client's notifications are dropped.
+Nothing a client sends can stop the server (``[limits]``, ``limits``): a frame over
+``max_frame_bytes`` is answered 0x70B and dropped, one over twice that cuts its client
+off before it is buffered (ZeroMQ's MAXMSGSIZE); requests over a client's rate wait in
+its mailbox (``rate_limit``), a full mailbox is answered 0x502; frames that do not
+decode get an error reply (or are dropped, logged, when not even the invoke id can be
+read), everything else gets an answer from the dispatcher. Replies to a client that
+does not read wait up to the send high-water mark, then are dropped (counted, logged
+now and then). A vanished client's notifications are dropped: ZeroMQ says a client is
+gone when a send to it fails, so clients with notifications get an empty notification
+frame every ``PROBE_S`` (a client that only subscribed on change to a value that never
+changes would otherwise never be sent anything).
 
-The envelope of a client is its ROUTER identity frames (a tuple of bytes).
+The envelope of a client is its ROUTER identity frames (a tuple of bytes): the routing
+id ZeroMQ gives the connection, then whatever parts the client put before its frame,
+echoed back with the reply. Limits count per connection (the routing id): extra parts
+do not make a client several.
+
+With CURVE (``curve``, ``cnc-service --keys``) the ZAP handler of ``security`` admits
+clients by public key and names each connection's role in its User-Id, which ZeroMQ
+attaches to every message; the server reads it per message and the dispatcher decides
+(``Dispatcher.dispatch_as``). Without CURVE every peer may everything (``main`` binds
+loopback only then, unless told ``--insecure``).
 """
 
 from __future__ import annotations
@@ -17,27 +33,39 @@ from __future__ import annotations
 import asyncio
 import errno
 import logging
+from time import perf_counter
 from typing import Any
 
 import msgpack
 import zmq
 
-from cnc_objects.protocol.constants import MAX_DATA_BYTES
-from cnc_objects.protocol.errors import ProtocolError
+from cnc_objects.protocol.constants import AdsCommand, CncPort
+from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
 from cnc_objects.protocol.frames import decode_request, encode_error, encode_notification
+from cnc_objects.protocol.roles import Role
 
 from .backend import Backend
 from .dispatch import Dispatcher
+from .limits import LimitsConfig, oversized_reply, rate_limiter, request_head
+from .rate_limit import BYTES_PER_TOKEN as _BYTES_PER_TOKEN
+from .rate_limit import RateLimiter, extra_tokens
+from .security import ServerCurve
 
 log = logging.getLogger(__name__)
 
 DRAIN_BATCH = 256  # frames handled per wake-up before yielding to other callbacks
+PROBE_S = 2.0  # clients with notifications are sent an empty notification this often
+RELEASE_MIN_S = 0.001  # waiting requests are released in batches at most this often
+RELEASE_BUDGET_S = 0.005  # loop time one release pass may take before it yields
+DROP_LOG_S = 10.0  # dropped replies are logged at most this often (with their count)
 
 _NOBLOCK = int(zmq.NOBLOCK)
 _SNDMORE_NOBLOCK = int(zmq.SNDMORE | zmq.NOBLOCK)
 _EVENTS = int(zmq.EVENTS)
 _POLLIN = int(zmq.POLLIN)
 _packb = msgpack.Packer(use_bin_type=True, autoreset=True).pack  # as protocol.frames packs
+_USER_ID = "User-Id"  # message property: the ZAP handler's name for the connection
+_READ_WRITE = AdsCommand.READ_WRITE
 
 
 Envelope = tuple[bytes, ...]
@@ -53,20 +81,39 @@ class ZmqServer:
         backend: Backend,
         endpoint: str,
         context: zmq.Context | None = None,
+        curve: ServerCurve | None = None,
+        limits: LimitsConfig | None = None,
     ) -> None:
+        limits = limits or LimitsConfig()
         self._loop = backend.loop
         self._context = context or zmq.Context()
         self._owns_context = context is None
         sock = self._context.socket(zmq.ROUTER)
         sock.setsockopt(zmq.LINGER, 0)
         sock.setsockopt(zmq.ROUTER_MANDATORY, 1)  # a vanished client raises, not blackholes
-        sock.setsockopt(zmq.MAXMSGSIZE, 2 * MAX_DATA_BYTES)  # huge frames cut the peer off
-        sock.setsockopt(zmq.SNDHWM, 100_000)
-        sock.setsockopt(zmq.RCVHWM, 100_000)
+        # Frames over the hard cap cut the peer off before they are buffered.
+        sock.setsockopt(zmq.MAXMSGSIZE, limits.frame_hard_cap_bytes)
+        sock.setsockopt(zmq.SNDHWM, limits.send_hwm_messages)
+        sock.setsockopt(zmq.RCVHWM, limits.receive_hwm_messages)
+        self._max_frame_bytes = limits.max_frame_bytes
+        self.rate = rate_limiter(limits)
+        self._release_timer: asyncio.TimerHandle | None = None
+        self._probe_timer: asyncio.TimerHandle | None = None
+        self.dropped_replies = 0  # replies not sent: the client's queue was full
+        self._drop_logged_s = -DROP_LOG_S
+        self._auth = None
+        self._roles: dict[str, Role] | None = None  # User-Id -> role; None: no CURVE
+        if curve is not None:  # the ZAP handler must answer before the first client comes
+            self._auth = curve.authenticator(self._context)
+            self._auth.start()
+            curve.secure(sock)
+            self._roles = curve.allow_list.roles_by_user
         try:
             sock.bind(endpoint)
         except zmq.ZMQError:
             sock.close()
+            if self._auth is not None:
+                self._auth.stop()
             if self._owns_context:
                 self._context.term()
             raise
@@ -88,11 +135,17 @@ class ZmqServer:
         """Begin serving on the loop."""
         self._loop.add_reader(self._sock.FD, self._drain)
         self._schedule_drain()  # frames may already wait; the edge-triggered fd won't say
+        self._probe_timer = self._loop.call_later(PROBE_S, self._probe)
 
     def close(self) -> None:
         """Stop serving and close the socket."""
         self._loop.remove_reader(self._sock.FD)
+        for timer in (self._release_timer, self._probe_timer):
+            if timer is not None:
+                timer.cancel()
         self._sock.close(linger=0)
+        if self._auth is not None:
+            self._auth.stop()
         if self._owns_context:
             self._context.term()
 
@@ -108,27 +161,132 @@ class ZmqServer:
         pipelining client overlaps its work with ours."""
         self._drain_scheduled = False
         recv, deliver, dispatch = self._raw_recv, self._deliver, self._dispatch
+        roles, dispatch_as = self._roles, self.dispatcher.dispatch_as
+        max_frame_bytes, rate, now_s = self._max_frame_bytes, self.rate, perf_counter()
         for _ in range(DRAIN_BATCH):
             try:
                 part = recv(_NOBLOCK, False)  # a zmq.Frame: .more is cheaper than RCVMORE
             except zmq.Again:
                 break
+            # every frame of a CURVE connection carries its User-Id; none: the lowest role
+            role = None if roles is None else roles.get(part.get(_USER_ID), Role.MONITOR)
             frames = [part.bytes]
             while part.more:
                 part = recv(_NOBLOCK, False)
                 frames.append(part.bytes)
-            envelope = tuple(frames[:-1])
+            envelope, raw = tuple(frames[:-1]), frames[-1]
+            # Limits count per connection: its routing id, not the parts a client adds.
+            if len(raw) > max_frame_bytes or (
+                    rate is not None and not rate.admit(frames[0], now_s)):
+                self._limit(envelope, raw, role, now_s)
+                continue
             try:
-                request = decode_request(frames[-1])
+                request = decode_request(raw)
             except ProtocolError as exc:
                 reply = self._refuse(exc)
             else:
-                reply = dispatch(envelope, request)
+                reply = (dispatch(envelope, request) if role is None
+                         else dispatch_as(envelope, request, role))
+                if rate is not None:  # a big or a sum request costs more than one token
+                    size = len(raw) if reply is None else len(raw) + len(reply)
+                    if size >= _BYTES_PER_TOKEN or request.COMMAND == _READ_WRITE:
+                        rate.charge(frames[0], extra_tokens(request, size))
             if reply is not None:
                 deliver(envelope, reply)
         else:
             self._schedule_drain()  # more may wait: come back after other callbacks ran
         self._look_for_input()
+
+    def _serve(self, envelope: Envelope, raw: bytes, role: Role | None) -> None:
+        """Answer one frame that waited for its turn, and charge what it cost (as
+        ``_drain`` does)."""
+        try:
+            request = decode_request(raw)
+        except ProtocolError as exc:
+            reply = self._refuse(exc)
+        else:
+            reply = (self._dispatch(envelope, request) if role is None
+                     else self.dispatcher.dispatch_as(envelope, request, role))
+            if self.rate is not None:
+                size = len(raw) if reply is None else len(raw) + len(reply)
+                self.rate.charge(envelope[0], extra_tokens(request, size))
+        if reply is not None:
+            self._deliver(envelope, reply)
+
+    # ------------------------------------------------------------ limits
+
+    def _limit(self, envelope: Envelope, raw: bytes, role: Role | None, now_s: float) -> None:
+        """A frame over the size limit, or over its client's rate."""
+        if len(raw) > self._max_frame_bytes:
+            reply = oversized_reply(raw, self._max_frame_bytes)
+            log.debug("frame of %d bytes over max_frame_bytes %d%s", len(raw),
+                      self._max_frame_bytes, "" if reply else " (no invoke id: dropped)")
+        else:
+            rate = self.rate
+            assert rate is not None
+            if rate.hold(envelope[0], (envelope, raw, role), len(raw)):
+                self._schedule_release(now_s)
+                return
+            reply = self._mailbox_full(raw, rate)
+        if reply is not None:
+            self._deliver(envelope, reply)
+
+    @staticmethod
+    def _mailbox_full(raw: bytes, rate: RateLimiter) -> bytes | None:
+        head = request_head(raw)
+        if head is None:
+            return None
+        return encode_error(
+            *head, AdsReturnCode.ROUTER_MAILBOXFULL,
+            f"the mailbox of this client is full: its requests over its rate of "
+            f"{rate.rate_per_s:g}/s wait there ([limits] requests_per_s_per_client, "
+            "request_mailbox); wait for replies before sending more",
+        )
+
+    def _schedule_release(self, now_s: float) -> None:
+        if self._release_timer is None and self.rate is not None:
+            delay_s = self.rate.next_release_s(now_s)
+            if delay_s is not None:
+                self._release_timer = self._loop.call_later(
+                    max(delay_s, RELEASE_MIN_S), self._release)
+
+    def _release(self) -> None:
+        """Serve the waiting requests whose clients have tokens again."""
+        self._release_timer = None
+        assert self.rate is not None
+        now_s = perf_counter()
+        for envelope, raw, role in self.rate.release(now_s):
+            self._serve(envelope, raw, role)  # charges its client before the next is taken
+            if perf_counter() - now_s > RELEASE_BUDGET_S:
+                break  # the rest in a later pass: other callbacks (and clients) go first
+        self._schedule_release(perf_counter())
+        self._look_for_input()
+
+    def _probe(self) -> None:
+        """Send clients with notifications an empty notification: a send to a client
+        that is gone fails, and its notifications are dropped (``_deliver``)."""
+        probe = encode_notification(CncPort.COM, [])
+        for envelope, notify in self.hub.clients():
+            if notify == self.notify:
+                self._deliver(envelope, probe)
+        self._look_for_input()
+        self._probe_timer = self._loop.call_later(PROBE_S, self._probe)
+
+    def _gone(self, envelope: Envelope) -> None:
+        """Forget a client ZeroMQ says is gone: its notifications, its waiting requests."""
+        self.hub.drop_client(envelope)
+        if self.rate is not None:
+            self.rate.forget(envelope[0])
+
+    def _dropped(self, exc: zmq.ZMQError) -> None:
+        """Count a reply that could not be sent; log now and then, not for every one (a
+        client that does not read would flood the log)."""
+        self.dropped_replies += 1
+        now_s = perf_counter()
+        if now_s - self._drop_logged_s >= DROP_LOG_S:
+            self._drop_logged_s = now_s
+            log.warning("replies to clients dropped (%s): %d since start; a client does not "
+                        "read its replies (send_hwm_messages)", exc, self.dropped_replies)
 
     @staticmethod
     def _refuse(exc: ProtocolError) -> bytes | None:
@@ -151,9 +309,9 @@ class ZmqServer:
             send(payload, _NOBLOCK)
         except zmq.ZMQError as exc:
             if exc.errno == errno.EHOSTUNREACH:
-                self.hub.drop_client(envelope)
+                self._gone(envelope)
             else:
-                log.warning("reply to a client dropped: %s", exc)
+                self._dropped(exc)
             return False
         return True
 

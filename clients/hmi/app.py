@@ -1,8 +1,11 @@
-"""``cnc-hmi [--endpoint URL] [--timeout S]``: the terminal HMI of a cnc-objects service.
+"""``cnc-hmi [--endpoint URL] [--timeout S] [--key FILE [--server-key FILE]]``: the
+terminal HMI of a cnc-objects service.
 
     .venv/bin/cnc-hmi --endpoint tcp://127.0.0.1:5555
 
-Bad usage (an option that does not parse) exits with code 2 and says which option.
+Bad usage (an option that does not parse, a key file it cannot use) exits with code 2
+and says which option. A service started with ``--keys`` needs the HMI's key (``--key``
+or ``CNC_KEY``; docs/security.md); a refused key is shown on the message line.
 
 The app owns no machine state: tables are filled by subscriptions (``session``), keys
 write objects (``control``), the look-ahead panel re-requests (``lookahead``). Key
@@ -13,8 +16,9 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import sys
 from collections.abc import Awaitable, Callable, Sequence
-from typing import Any
+from typing import Any, Optional
 
 import typer
 from textual.app import App, ComposeResult
@@ -23,7 +27,8 @@ from textual.containers import VerticalScroll
 from textual.widgets import DataTable, Footer, Header, Label
 
 from cnc_objects.clients.client import DEFAULT_ENDPOINT, AsyncClient, DeviceInfo
-from cnc_objects.clients.errors import AdsError
+from cnc_objects.clients.curve import client_curve
+from cnc_objects.clients.errors import AdsError, ClientValueError
 
 from . import control, text
 from .axes import AxesTable
@@ -65,10 +70,13 @@ class HmiApp(App[None]):
     ]
     _DIALOG_ACTIONS = {"quit"}  # what the keys may still do while the program dialog is open
 
-    def __init__(self, endpoint: str = DEFAULT_ENDPOINT, timeout_s: float = DEFAULT_TIMEOUT_S):
+    def __init__(self, endpoint: str = DEFAULT_ENDPOINT, timeout_s: float = DEFAULT_TIMEOUT_S,
+                 key_file: str | None = None, server_key: str | None = None):
         super().__init__()
         self.endpoint = endpoint
         self.timeout_s = timeout_s
+        self.key_file = key_file  # CURVE keys, for a service with --keys
+        self.server_key = server_key
         self.client: AsyncClient | None = None  # None while the service does not answer
         self.machine: Machine | None = None
         self.lookahead_mode = LookaheadMode.AHEAD
@@ -97,8 +105,9 @@ class HmiApp(App[None]):
         self.sub_title = f"connecting to {self.endpoint}"
         self.message.say(f"connecting to {self.endpoint} …")
         self.channels.focus()
-        self.run_worker(run_sessions(self.endpoint, self.timeout_s, self), name="session",
-                        group="session", exclusive=True)
+        self.run_worker(run_sessions(self.endpoint, self.timeout_s, self, self.key_file,
+                                     self.server_key),
+                        name="session", group="session", exclusive=True)
 
     # ------------------------------------------------------------ session events
 
@@ -277,9 +286,23 @@ def run(
         DEFAULT_TIMEOUT_S, "--timeout", metavar="S", min=0.01,
         help="Seconds without a reply before the service counts as unreachable.",
     ),
+    key_file: Optional[str] = typer.Option(
+        None, "--key", metavar="FILE", envvar="CNC_KEY",
+        help="The HMI's CURVE secret key file, for a service with --keys (default $CNC_KEY).",
+    ),
+    server_key: Optional[str] = typer.Option(
+        None, "--server-key", metavar="FILE", envvar="CNC_SERVER_KEY",
+        help="The service's public key file (default $CNC_SERVER_KEY, else server.key "
+        "beside --key).",
+    ),
 ) -> None:
     """Terminal HMI of a cnc-objects service (keys: docs/hmi.md)."""
-    HmiApp(endpoint, timeout_s).run()
+    try:
+        client_curve(key_file or None, server_key or None)  # refused now, not in every retry
+    except ClientValueError as exc:
+        print(f"cnc-hmi: {exc}", file=sys.stderr)
+        raise typer.Exit(2) from None
+    HmiApp(endpoint, timeout_s, key_file or None, server_key or None).run()
 
 
 def main(argv: list[str] | None = None) -> None:

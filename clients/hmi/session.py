@@ -17,7 +17,9 @@ from dataclasses import dataclass
 from typing import Any, NoReturn, Protocol
 
 from cnc_objects.clients.client import AsyncClient, DeviceInfo
-from cnc_objects.clients.errors import AdsConnectionError, AdsError, AdsTimeoutError
+from cnc_objects.clients.errors import (
+    AdsConnectionError, AdsError, AdsTimeoutError, AuthenticationError,
+)
 
 from . import text
 from .machine import Machine, discover
@@ -57,10 +59,15 @@ class SessionListener(Protocol):
         """The service refused one subscription; the others go on."""
 
 
-async def run_sessions(endpoint: str, timeout_s: float, listener: SessionListener) -> NoReturn:
-    """Keep a session with the service at ``endpoint`` open, reconnecting for ever."""
+async def run_sessions(
+    endpoint: str, timeout_s: float, listener: SessionListener,
+    key_file: str | None = None, server_key: str | None = None,
+) -> NoReturn:
+    """Keep a session with the service at ``endpoint`` open, reconnecting for ever
+    (``key_file``, ``server_key``: CURVE keys for a service with ``--keys``)."""
     while True:
-        client = AsyncClient(endpoint, timeout_s=timeout_s)
+        client = AsyncClient(endpoint, timeout_s=timeout_s, key_file=key_file,
+                             server_key=server_key)
         await client.__aenter__()
         try:
             info = await client.info()
@@ -71,8 +78,10 @@ async def run_sessions(endpoint: str, timeout_s: float, listener: SessionListene
                     group.create_task(_follow(client, feed, listener), name=f"feed {feed.name}")
                 group.create_task(_heartbeat(client), name="heartbeat")
         except* _LOST as lost:
-            log.info("session with %s lost: %s", endpoint, lost.exceptions[0])
-            listener.session_lost(text.unreachable(endpoint))
+            reason = lost.exceptions[0]
+            log.info("session with %s lost: %s", endpoint, reason)
+            refused = isinstance(reason, AuthenticationError)  # its key: say so, not "unreachable"
+            listener.session_lost(f"{reason} — retrying" if refused else text.unreachable(endpoint))
         except* AdsError as refused:  # it answers, but not as an HMI needs: say so, retry
             listener.session_lost(
                 f"service at {endpoint} refused the HMI: {refused.exceptions[0]} — retrying"

@@ -2,10 +2,13 @@
 
     cnc-mqtt --endpoint URL --broker HOST[:PORT] --machine NAME [--objects PATTERN ...]
              [--writable PATTERN ...] [--username U --password-file F] [--tls]
+             [--key FILE [--server-key FILE]]
 
 Runs until SIGINT or SIGTERM (exit code 0, after publishing ``offline``). Bad usage (an
 unreadable password file, a broker that is not HOST[:PORT], ...) exits with code 2 and
-one line on stderr. Topics, payloads and behaviour: docs/mqtt.md.
+one line on stderr. Topics, payloads and behaviour: docs/mqtt.md. A service started with
+``--keys`` needs the bridge's key (``--key``/``CNC_KEY``; docs/security.md): a key it
+refuses is logged as such and retried with the usual backoff.
 """
 
 from __future__ import annotations
@@ -23,6 +26,8 @@ import typer
 import zmq
 
 from ..client import DEFAULT_ENDPOINT
+from ..curve import client_curve
+from ..errors import ClientValueError
 from .bridge import Bridge
 from .config import DEFAULT_OBJECTS, BridgeConfig, parse_broker
 
@@ -106,6 +111,15 @@ def run(
         5.0, "--reconnect-max-s", min=0.001, help="... up to this."
     ),
     keepalive_s: int = typer.Option(30, "--keepalive", min=1, help="MQTT keepalive in seconds."),
+    key_file: Optional[str] = typer.Option(
+        None, "--key", metavar="FILE", envvar="CNC_KEY",
+        help="The bridge's CURVE secret key file, for a service with --keys (default $CNC_KEY).",
+    ),
+    server_key: Optional[str] = typer.Option(
+        None, "--server-key", metavar="FILE", envvar="CNC_SERVER_KEY",
+        help="The service's public key file (default $CNC_SERVER_KEY, else server.key "
+        "beside --key).",
+    ),
     log_level: str = typer.Option("INFO", "--log-level", help="DEBUG, INFO, WARNING or ERROR."),
 ) -> None:
     """Publish CNC objects to MQTT when they change; write the ones allowed on request."""
@@ -120,6 +134,10 @@ def run(
     password = _read_password(password_file) if password_file is not None else None
     _check_endpoint(endpoint)
     try:
+        client_curve(key_file or None, server_key or None)  # better now than in every retry
+    except ClientValueError as exc:
+        _usage(str(exc))
+    try:
         config = BridgeConfig(
             endpoint, host, machine, broker_port=port,
             objects=tuple(objects or DEFAULT_OBJECTS), writable=tuple(writable or ()),
@@ -128,6 +146,7 @@ def run(
             client_id=client_id, cycle_ms=cycle_ms, service_timeout_s=timeout_s,
             probe_s=probe_s, reconnect_initial_s=reconnect_initial_s,
             reconnect_max_s=reconnect_max_s, keepalive_s=keepalive_s,
+            key_file=key_file or None, server_key=server_key or None,
         )
     except ValueError as exc:
         _usage(str(exc))

@@ -81,6 +81,8 @@ class BridgeConfig:
     reconnect_max_s: float = 5.0  # ... up to this
     keepalive_s: int = 30  # MQTT keepalive: the broker sends the will this much later
     # (x 1.5) when the bridge's host vanishes without closing the connection
+    key_file: str | None = None  # CURVE: the bridge's secret key file (service with --keys)
+    server_key: str | None = None  # the service's public key (default: beside key_file)
 
     def __post_init__(self) -> None:
         check_level(self.machine, "machine name")

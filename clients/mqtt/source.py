@@ -80,7 +80,8 @@ class ServiceSource:
     async def _session(self, backoff: Backoff) -> None:
         async with contextlib.AsyncExitStack() as stack:
             client = await stack.enter_async_context(
-                AsyncClient(self._config.endpoint, timeout_s=self._config.service_timeout_s)
+                AsyncClient(self._config.endpoint, timeout_s=self._config.service_timeout_s,
+                            key_file=self._config.key_file, server_key=self._config.server_key)
             )
             try:
                 # On a stop the client is closed first: the subscriptions then end at once

@@ -14,6 +14,12 @@ compete for 127.0.0.1:48898: ``start_service(ads=True)`` gives the service a loo
 address of its own, ``127.0.0.<n>:48898`` (ADS clients such as pyads always dial port
 48898 and tell servers apart by IP address), and ``ads="127.0.0.1:0"`` any free port;
 ``ServiceProcess.ads_address`` and ``.ams_net_id`` say what it got.
+
+CURVE (docs/security.md): ``start_service(keys=True)`` makes a key directory of this
+service's own (removed by ``stop``) with one client key per role and starts the service
+with ``--keys``; ``service.keys.client("operator")`` is the operator's key file (the
+service's ``server.key`` lies beside it), for ``Client(..., key_file=...)`` or ``cnc
+--key``. ``keys=DIR`` starts it with ``--keys DIR``.
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ import tempfile
 import threading
 import time
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 _LISTENING = re.compile(r"listening on (tcp://\S+)")
@@ -39,6 +46,49 @@ START_TIMEOUT_S = 20.0  # a cold start imports numpy and pydantic: seconds on a 
 STOP_TIMEOUT_S = 10.0
 AMS_TCP_PORT = 48898  # ADS clients dial this port; a service of its own needs its own IP
 ADS_START_ATTEMPTS = 20  # loopback addresses tried before giving up (another took it)
+KEY_ROLES = ("monitor", "operator", "admin")  # a client key of each is made by keys=True
+
+
+@dataclass(frozen=True)
+class ServiceKeys:
+    """The CURVE keys of a service started with ``keys=True``."""
+
+    directory: Path  # the service's --keys DIR: server.key_secret, clients/<role>/*.key
+    clients: dict[str, Path]  # role -> that client's secret key file (server.key beside it)
+
+    def client(self, role: str) -> Path:
+        """The secret key file of the client of ``role`` (monitor, operator, admin)."""
+        return self.clients[role]
+
+    @property
+    def server_key(self) -> Path:
+        """The service's public key file."""
+        return self.directory / "server.key"
+
+
+def make_keys(root: str | os.PathLike[str], roles: tuple[str, ...] = KEY_ROLES) -> ServiceKeys:
+    """A service key directory ``root/service`` with one client per role in its
+    allow-list, each client's key pair in ``root/<role>/`` beside a copy of the service's
+    public key (pyzmq's ``zmq.auth.create_certificates``, as ``cnc keys new`` writes)."""
+    import shutil
+
+    import zmq.auth  # here: the plugin imports this module at every pytest start
+
+    service = Path(root) / "service"
+    service.mkdir(parents=True)
+    zmq.auth.create_certificates(service, "server")
+    (service / "server.key_secret").chmod(0o600)
+    clients = {}
+    for role in roles:
+        own = Path(root) / role
+        own.mkdir()
+        public, secret = zmq.auth.create_certificates(own, role)
+        allowed = service / "clients" / role
+        allowed.mkdir(parents=True)
+        shutil.copyfile(public, allowed / Path(public).name)
+        shutil.copyfile(service / "server.key", own / "server.key")
+        clients[role] = Path(secret)
+    return ServiceKeys(service, clients)
 
 
 class ServiceProcess:
@@ -55,6 +105,8 @@ class ServiceProcess:
         self.endpoint = ""  # set once the service has logged it
         self.ads_address: tuple[str, int] | None = None  # (host, port) when ADS is on
         self.ams_net_id: str | None = None  # the service's AMS Net ID when ADS is on
+        self.keys: ServiceKeys | None = None  # set by start_service(keys=True)
+        self._owned_keys: tempfile.TemporaryDirectory[str] | None = None
         self.log: list[str] = []
         self._changed = threading.Condition()
         self._ended = False  # stderr closed: the process is gone
@@ -117,6 +169,9 @@ class ServiceProcess:
         if self._owned_dir is not None:
             self._owned_dir.cleanup()
             self._owned_dir = None
+        if self._owned_keys is not None:
+            self._owned_keys.cleanup()
+            self._owned_keys = None
         return code
 
     def _join_log(self) -> None:
@@ -159,6 +214,7 @@ def start_service(
     cwd: str | os.PathLike[str] | None = None,
     timeout_s: float = START_TIMEOUT_S,
     ads: bool | str = False,
+    keys: bool | str | os.PathLike[str] = False,
 ) -> ServiceProcess:
     """Start ``cnc-service`` (see ``service_command``) and return once it listens.
 
@@ -167,10 +223,25 @@ def start_service(
     FILE``, ``--speed 1``, ...). ``ads``: False leaves ADS off (unless ``args`` give
     ``--ads``); True serves ADS on a loopback address of this service's own,
     ``127.0.0.<n>:48898`` (another is tried when a parallel service took it first); a
-    string is the ``--ads`` address. Raises ``RuntimeError`` with the service's log when
-    it exits before listening, ``TimeoutError`` when it has not listened after
-    ``timeout_s`` (the process is killed then).
+    string is the ``--ads`` address. ``keys``: True makes CURVE keys of this service's
+    own (``ServiceProcess.keys``, ``make_keys``); a path starts it with ``--keys PATH``.
+    Raises ``RuntimeError`` with the service's log when it exits before listening,
+    ``TimeoutError`` when it has not listened after ``timeout_s`` (the process is killed
+    then).
     """
+    if keys is True:
+        owned = tempfile.TemporaryDirectory(prefix="cnc-keys-")
+        made = make_keys(owned.name)
+        try:
+            service = start_service(*args, "--keys", str(made.directory), program_dir=program_dir,
+                                    cwd=cwd, timeout_s=timeout_s, ads=ads)
+        except BaseException:
+            owned.cleanup()
+            raise
+        service.keys, service._owned_keys = made, owned
+        return service
+    if keys is not False:
+        args = (*args, "--keys", os.fspath(keys))
     if ads is False or "--ads" in args:
         return _start(args, program_dir, cwd, timeout_s)
     for _ in range(ADS_START_ATTEMPTS if ads is True else 1):

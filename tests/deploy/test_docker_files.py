@@ -110,6 +110,24 @@ def test_dockerfile_copies_every_package_the_project_installs() -> None:
         assert f"!{source}" in ignore or f"!{source}/**" in ignore, source
 
 
+def _service_exit(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "cnc_objects.service.main", *args],
+                          capture_output=True, text=True, timeout=60)
+
+
+def test_image_command_needs_insecure_for_its_wildcard_endpoint(tmp_path: Path) -> None:
+    """Without keys the service refuses 0.0.0.0 (docs/security.md): the image's command
+    says --insecure, because inside a container the published port is the boundary."""
+    cmd = _exec_form(dict(_instructions())["CMD"])
+    assert "--insecure" in cmd and "--keys" not in cmd
+    cmd[cmd.index("--program-dir") + 1] = str(tmp_path)
+    without = [a for a in cmd if a != "--insecure"]
+    refused = _service_exit(*without, "--ads", "off")
+    assert refused.returncode == 2
+    assert "tcp://0.0.0.0:5555 is not a loopback address" in refused.stderr
+    assert "--insecure" in refused.stderr and len(refused.stderr.strip().splitlines()) == 1
+
+
 def test_image_command_and_health_check_run(tmp_path: Path) -> None:
     """The CMD's options start the service; the HEALTHCHECK's command finds it healthy
     (with the image's CNC_ENDPOINT pointing at it) and unhealthy when it is gone."""
@@ -130,7 +148,7 @@ def test_image_command_and_health_check_run(tmp_path: Path) -> None:
 
 
 def test_compose_runs_service_broker_and_bridge(compose: dict) -> None:
-    services = compose["services"]
+    services = {name: s for name, s in compose["services"].items() if not s.get("profiles")}
     assert set(services) == {"cnc", "mosquitto", "mqtt-bridge"}
     cnc, bridge = services["cnc"], services["mqtt-bridge"]
     assert Path(cnc["build"]["dockerfile"]).name == "Dockerfile"
@@ -143,6 +161,75 @@ def test_compose_runs_service_broker_and_bridge(compose: dict) -> None:
     args = shlex.split(args) if isinstance(args, str) else args
     assert args[args.index("--endpoint") + 1] == "tcp://cnc:5555"
     assert args[args.index("--broker") + 1] == "mosquitto:1883"
+
+
+def _secure_service(compose: dict) -> dict:
+    secure = [s for s in compose["services"].values() if "secure" in s.get("profiles", [])]
+    assert len(secure) == 1, "one service in the secure profile"
+    return secure[0]
+
+
+def _mounts(service: dict) -> dict[str, tuple[str, bool]]:
+    """Container path -> (host source, read-only) of a service's volumes, either form."""
+    mounts = {}
+    for volume in service.get("volumes", []):
+        if isinstance(volume, dict):
+            mounts[volume["target"]] = (volume["source"], bool(volume.get("read_only")))
+        else:  # SOURCE:TARGET[:MODE]; the source may hold ${VAR:-default}
+            head, _, last = volume.rpartition(":")
+            if last in ("ro", "rw"):
+                source, _, target = head.rpartition(":")
+                mounts[target] = (source, last == "ro")
+            else:
+                mounts[last] = (head, False)
+    return mounts
+
+
+def test_compose_secure_profile_runs_the_service_with_mounted_keys(compose: dict) -> None:
+    cnc, secure = compose["services"]["cnc"], _secure_service(compose)
+    assert secure["image"] == cnc["image"]
+    args = secure["command"]
+    args = shlex.split(args) if isinstance(args, str) else args
+    assert "--insecure" not in args
+    keys = args[args.index("--keys") + 1]
+    source, read_only = _mounts(secure)[keys]
+    assert read_only and source
+    environment = secure["environment"]
+    if isinstance(environment, list):
+        environment = dict(item.split("=", 1) for item in environment)
+    assert environment["CNC_KEY"].startswith(keys + "/")  # the health check's key
+    assert 5555 in _container_ports(secure)
+
+
+def test_secure_profile_command_and_health_check_run(tmp_path: Path) -> None:
+    """The secure profile's options start the service on keys made as docs/security.md
+    says (``cnc keys new``); the image's health check passes with the profile's CNC_KEY
+    and fails without a key."""
+    secure = _secure_service(_compose_from_yaml())
+    args = list(secure["command"])
+    keys_dir = tmp_path / "keys"
+    cnc_cli = [sys.executable, "-c", "from cnc_objects.clients.cli import main; main()"]
+    for command in (["keys", "new", "server", "--dir", str(keys_dir)],
+                    ["keys", "new", "health", "--dir", str(keys_dir), "--role", "monitor",
+                     "--allow-in", str(keys_dir)]):
+        made = subprocess.run([*cnc_cli, *command], capture_output=True, text=True, timeout=60)
+        assert made.returncode == 0, made.stderr
+    container_keys = args[args.index("--keys") + 1]
+    args[args.index("--keys") + 1] = str(keys_dir)
+    args[args.index("--endpoint") + 1] = "tcp://127.0.0.1:*"
+    args[args.index("--program-dir") + 1] = str(tmp_path / "programs")
+    health = _exec_form(dict(_instructions())["HEALTHCHECK"].split("CMD", 1)[1].strip())
+    check = [*cnc_cli, *health[1:]]
+    key = secure["environment"]["CNC_KEY"].replace(container_keys, str(keys_dir), 1)
+    with serving(*args) as service:
+        env = {**os.environ, "CNC_ENDPOINT": service.endpoint, "CNC_KEY": key}
+        env.pop("CNC_SERVER_KEY", None)
+        healthy = subprocess.run(check, env=env, capture_output=True, text=True, timeout=30)
+        assert healthy.returncode == 0, healthy.stderr
+        assert "ADS state RUN" in healthy.stdout
+        env.pop("CNC_KEY")
+        keyless = subprocess.run(check, env=env, capture_output=True, text=True, timeout=30)
+        assert keyless.returncode == 3 and "requires a CURVE key" in keyless.stderr
 
 
 def test_compose_bridge_options_are_the_bridges(compose: dict) -> None:

@@ -300,7 +300,12 @@ def test_a_peer_without_a_route_is_refused_and_a_routed_one_served(tmp_path: Pat
     config = tmp_path / "routes.toml"
     config.write_text(f'[[ads.routes]]\nname = "hmi"\nnet_id = "{routed_net_id}"\n'
                       f'address = "{address}"\n')
-    plain = start_service(program_dir=tmp_path / "a", ads=f"{address}:0")
+    # A route for another peer only: a non-loopback address needs routes to be served.
+    elsewhere = tmp_path / "elsewhere.toml"
+    elsewhere.write_text('[[ads.routes]]\nname = "other"\nnet_id = "198.51.100.7.1.1"\n'
+                         'address = "198.51.100.7"\n')
+    plain = start_service("--config", str(elsewhere), program_dir=tmp_path / "a",
+                          ads=f"{address}:0")
     try:
         refused = RawAds(plain)
         assert refused.closed_by_peer()

@@ -24,6 +24,7 @@ import pytest
 import zmq
 from zmq.utils.monitor import recv_monitor_message
 
+from cnc_objects.service.limits import LimitsConfig
 from cnc_objects.testing import ServiceProcess
 
 # --------------------------------------------------------------------------- constants
@@ -68,7 +69,9 @@ STATIC_VALUES = {
 
 REPLY_TIMEOUT_MS = 5000
 SILENCE_MS = 300  # how long "no reply" is waited for
-MAXMSGSIZE = 2 * (1 << 20)  # the server's ZMQ_MAXMSGSIZE (2 x MAX_DATA_BYTES)
+#: The server's ZMQ_MAXMSGSIZE: twice [limits] max_frame_bytes (frames between the two
+#: are answered 0x70B, tests/limits/test_frame_size.py).
+MAXMSGSIZE = LimitsConfig().frame_hard_cap_bytes
 
 _invoke_ids = itertools.count(1)
 _context = zmq.Context.instance()

@@ -1,0 +1,168 @@
+"""Limits that keep one client from hurting the others: the ``[limits]`` configuration
+table, and what the ZeroMQ front end does with a frame over the size limit.
+
+Each limit is a key with a default (docs/limits.md lists them with what happens at the
+limit and the figures measured):
+
+- ``max_frame_bytes``: the longest ZeroMQ request frame served. A longer frame up to
+  ``frame_hard_cap_bytes`` (twice the limit) is answered ADS 0x70B and dropped; a frame
+  over the hard cap is never buffered: ZeroMQ (``MAXMSGSIZE``) closes that client's
+  connection when it reads the frame's length (its DEALER reconnects by itself).
+  ADS over AMS/TCP has its own ``[ads] max_frame_bytes``, with the same meaning on its
+  wire (an AMS/TCP frame longer than that closes the connection).
+- ``notifications_per_client`` and ``notifications_total``: AddDeviceNotification beyond
+  either is answered 0x716 (no more handles).
+- ``send_hwm_messages`` / ``receive_hwm_messages``: ZeroMQ's high-water marks per client:
+  replies and notifications queued for a client that does not read them (beyond: the
+  reply is dropped, the notification counted as dropped), and requests read from the
+  network but not yet served.
+- ``requests_per_s_per_client``, ``request_burst`` and ``request_mailbox``: the token
+  bucket of each client (``rate_limit``); requests over the rate wait in the client's
+  mailbox, a full mailbox is answered ADS 0x502. The ADS front end stops reading a
+  connection over the rate instead (TCP holds the rest).
+- ``program_max_bytes`` and ``program_max_files``: the program store.
+
+Handles (0xF003 handle by name) are not a per-client resource: a handle is the stable
+number of an object, the same for every client, and releasing one frees nothing, so
+there is nothing to limit.
+"""
+
+from __future__ import annotations
+
+import msgpack
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from cnc_objects.protocol.constants import (
+    MAX_DATA_BYTES,
+    PROGRAM_MAX_BYTES,
+    PROGRAM_NAME_MAX_CHARS,
+)
+from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.frames import U32_MAX, encode_error
+
+from .rate_limit import RateLimiter
+
+#: Room for a request's fields around its data (a Write's header is about 30 bytes).
+FRAME_FIELDS_BYTES = 4096
+#: A program upload's frame: name, NUL and fields around the program.
+_UPLOAD_OVERHEAD_BYTES = PROGRAM_NAME_MAX_CHARS + 1 + 64
+#: Bytes a client's waiting requests may hold (at least two frames of the largest size).
+MAILBOX_BYTES = 16 << 20
+#: How many bytes of a frame are looked at for its invoke id and command.
+_HEAD_BYTES = 16
+
+
+class LimitsConfig(BaseModel):
+    """The ``[limits]`` table: what one client may cost the service."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    max_frame_bytes: int = Field(
+        MAX_DATA_BYTES + FRAME_FIELDS_BYTES, ge=4096, le=64 << 20,
+        description="longest ZeroMQ request frame served (bytes); longer ones up to twice "
+        "this are answered ADS 0x70B and dropped, longer still close the client's connection "
+        "before they are buffered",
+    )
+    notifications_per_client: int = Field(
+        1000, ge=1, le=1_000_000,
+        description="notifications (AddDeviceNotification) one client may hold; more: 0x716",
+    )
+    notifications_total: int = Field(
+        20_000, ge=1, le=10_000_000,
+        description="notifications all clients of both front ends may hold; more: 0x716",
+    )
+    send_hwm_messages: int = Field(
+        10_000, ge=1, le=1_000_000,
+        description="ZeroMQ send high-water mark per client: replies and notification frames "
+        "queued for a client that does not read; beyond it they are dropped",
+    )
+    receive_hwm_messages: int = Field(
+        1000, ge=1, le=1_000_000,
+        description="ZeroMQ receive high-water mark per client: requests read from the "
+        "network and not yet served; beyond it ZeroMQ stops reading that client",
+    )
+    requests_per_s_per_client: float = Field(
+        20_000.0, ge=0, le=10_000_000,
+        description="requests per second one client may send on average (0: no limit); "
+        "requests over it wait, a client's own order kept",
+    )
+    request_burst: int = Field(
+        1000, ge=1, le=1_000_000,
+        description="requests a client may send at once above its rate (its bucket's size)",
+    )
+    request_mailbox: int = Field(
+        5000, ge=1, le=1_000_000,
+        description="requests of a client over its rate that wait for their turn (at most "
+        "16 MiB of them); more are answered ADS 0x502 (mailbox full)",
+    )
+    program_max_bytes: int = Field(
+        PROGRAM_MAX_BYTES, ge=1, le=MAX_DATA_BYTES - _UPLOAD_OVERHEAD_BYTES,
+        description="largest program the store takes in one upload (bytes; one frame "
+        "carries it whole); larger: 0x705",
+    )
+    program_max_files: int = Field(
+        1000, ge=1, le=1_000_000,
+        description="files the program store holds; an upload of one more: 0x70A",
+    )
+
+    @model_validator(mode="after")
+    def _upload_fits_a_frame(self) -> LimitsConfig:
+        needed = self.program_max_bytes + _UPLOAD_OVERHEAD_BYTES
+        if self.max_frame_bytes < needed:
+            raise ValueError(
+                f"max_frame_bytes {self.max_frame_bytes} cannot carry an upload of "
+                f"program_max_bytes {self.program_max_bytes}: make it at least {needed}"
+            )
+        return self
+
+    @property
+    def frame_hard_cap_bytes(self) -> int:
+        """ZeroMQ's MAXMSGSIZE: frames over it are never buffered (the peer is cut off)."""
+        return frame_hard_cap_bytes(self.max_frame_bytes)
+
+    @property
+    def mailbox_bytes(self) -> int:
+        """Bytes a client's waiting requests may hold (besides ``request_mailbox``)."""
+        return max(MAILBOX_BYTES, 2 * self.max_frame_bytes)
+
+
+def rate_limiter(limits: LimitsConfig) -> RateLimiter | None:
+    """The token buckets of ``limits`` for one front end; None without a rate limit."""
+    if limits.requests_per_s_per_client <= 0:
+        return None
+    return RateLimiter(limits.requests_per_s_per_client, limits.request_burst,
+                       limits.request_mailbox, limits.mailbox_bytes)
+
+
+def frame_hard_cap_bytes(max_frame_bytes: int) -> int:
+    """The hard cap on a ZeroMQ frame for a frame limit: twice the limit."""
+    return 2 * max_frame_bytes
+
+
+def request_head(raw: bytes) -> tuple[int, int] | None:
+    """(invoke id, command) of a request frame, read from its first bytes only (the
+    frame is never unpacked whole); None when they do not name a valid invoke id."""
+    unpacker = msgpack.Unpacker(raw=False)
+    unpacker.feed(raw[:_HEAD_BYTES])
+    try:
+        if unpacker.read_array_header() < 2:
+            return None
+        invoke_id, command = unpacker.unpack(), unpacker.unpack()
+    except (ValueError, msgpack.UnpackException, msgpack.OutOfData, TypeError):
+        return None
+    if type(invoke_id) is not int or not 0 < invoke_id <= U32_MAX or type(command) is not int:
+        return None
+    return invoke_id, command
+
+
+def oversized_reply(raw: bytes, max_frame_bytes: int) -> bytes | None:
+    """The 0x70B reply to a frame over ``max_frame_bytes``; None when its head does not
+    name an invoke id (the frame is then dropped unanswered, as any unreadable frame)."""
+    head = request_head(raw)
+    if head is None:
+        return None
+    return encode_error(
+        *head, AdsReturnCode.DEVICE_INVALIDPARM,
+        f"frame of {len(raw)} bytes exceeds the limit of {max_frame_bytes} bytes "
+        "([limits] max_frame_bytes); not served",
+    )
