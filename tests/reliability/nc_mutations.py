@@ -1,0 +1,233 @@
+"""Mutated NC programs: the example programs and test data, changed the ways a careless
+editor, a broken transfer or a hostile user change them.
+
+Each mutation is a pure function of (text, random generator); ``mutate`` applies one to
+three of them and names what it did, so that a failure names its program. Endless loops
+are inserted on purpose (with and without motion): the test stops those with RESET after
+a bounded time.
+"""
+
+from __future__ import annotations
+
+import random
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES
+
+ROOT = Path(__file__).resolve().parents[2]
+#: Programs the mutations start from: every example of the docs and the syntax showcase.
+SOURCE_GLOBS = ("docs/examples/*.nc", "docs/examples/cycles/*.nc", "docs/examples/hsc/*.nc",
+                "tests/data/*.nc")
+#: Files the examples call (cycles): uploaded next to the mutants, never mutated.
+SUPPORT_GLOBS = ("docs/examples/cycles/*.ecy",)
+
+NC_CHARACTERS = "GXYZFIJKRNMSTDLP$#%;()[]=<>+-*/.,:@\"'\\ \t0123456789"
+HUGE_NUMBERS = [
+    "9" * 400, "1" + "0" * 30, "-" + "9" * 40, "0." + "0" * 300 + "1", "1.7976931348623157E308",
+    "4294967296", "-2147483649", "18446744073709551616", "-0", "0000000000000000000001",
+]
+TOKENS = [
+    "$IF", "$ELSE", "$ENDIF", "$WHILE", "$ENDWHILE", "$FOR", "$ENDFOR", "$SWITCH", "$CASE",
+    "$ENDSWITCH", "$GOTO [X]", "#VAR", "#ENDVAR", "#RT WHILE [TRUE]", "#RT ENDWHILE",
+    "%L SUB", "LL SUB", "L missing.nc", "L CYCLE [NAME=none.ecy]", "G2 R0", "G3 I0 J0",
+    "G41 D99", "F0", "F-1", "M30", "M17", "V.L.X = 1/0", "V.P.Y = SQRT[-1]",
+    "#CONTOUR LOOKAHEAD LOG ON", "#MSG SAVE [\"%f\", 1]", "(", ")", "[", "]", "\x1a", "\x7f",
+]
+#: Characters a STRING object cannot carry (NUL, and all that CP1252 lacks) are left out
+#: of the mutants (replaced by "?") until the service serves an error text that quotes
+#: them: ``test_every_error_text_is_readable`` (such a text makes
+#: ``ch<c>.mc_error_<k>_text_r`` unreadable, 0x700). Set False to put them back.
+LEAVE_OUT_UNSERVABLE = True
+
+
+def servable(char: str) -> bool:
+    """True for a character a STRING object (CP1252, NUL-terminated) can carry."""
+    if char == "\x00":
+        return False
+    try:
+        char.encode("cp1252")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+def store_text(data: bytes) -> str:
+    """The text the service reads from ``data`` (UTF-8, else CP1252 with replacement)."""
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        return data.decode("cp1252", errors="replace")
+MOTION = ["G1 X10 F6000", "G1 X0 F6000", "G0 Y5", "G2 X0 Y0 I5 J0 F3000"]
+
+
+@dataclass(frozen=True)
+class Mutant:
+    """A mutated program: its bytes, where it came from, what was done, and whether an
+    endless loop was put in (its run is ended by RESET, not awaited)."""
+
+    name: str
+    data: bytes
+    source: str
+    changes: tuple[str, ...]
+    endless: bool
+
+
+def _lines(text: str) -> list[str]:
+    return text.split("\n")
+
+
+def flip_characters(text: str, rnd: random.Random) -> tuple[str, str]:
+    """Replace 1..8 characters by NC-significant or arbitrary ones."""
+    chars = list(text) or [" "]
+    count = rnd.randint(1, 8)
+    for _ in range(count):
+        k = rnd.randrange(len(chars))
+        chars[k] = rnd.choice(NC_CHARACTERS) if rnd.random() < 0.8 else chr(rnd.randint(1, 0x2FFF))
+    return "".join(chars), f"flipped {count} characters"
+
+
+def delete_lines(text: str, rnd: random.Random) -> tuple[str, str]:
+    """Delete 1..5 lines."""
+    lines = _lines(text)
+    count = min(rnd.randint(1, 5), len(lines))
+    for _ in range(count):
+        del lines[rnd.randrange(len(lines))]
+    return "\n".join(lines), f"deleted {count} lines"
+
+
+def duplicate_lines(text: str, rnd: random.Random) -> tuple[str, str]:
+    """Repeat a line 1..50 times in place."""
+    lines = _lines(text)
+    k = rnd.randrange(len(lines))
+    times = rnd.randint(1, 50)
+    lines[k:k + 1] = [lines[k]] * (times + 1)
+    return "\n".join(lines), f"line {k + 1} repeated {times} times"
+
+
+def swap_lines(text: str, rnd: random.Random) -> tuple[str, str]:
+    """Swap two lines (an $ENDIF before its $IF, M30 before the motion)."""
+    lines = _lines(text)
+    a, b = rnd.randrange(len(lines)), rnd.randrange(len(lines))
+    lines[a], lines[b] = lines[b], lines[a]
+    return "\n".join(lines), f"lines {a + 1} and {b + 1} swapped"
+
+
+def huge_numbers(text: str, rnd: random.Random) -> tuple[str, str]:
+    """Replace 1..4 numbers by huge, tiny or out-of-range ones."""
+    spans = [m.span() for m in re.finditer(r"\d+(\.\d*)?", text)]
+    if not spans:
+        return text + "\nG1 X" + rnd.choice(HUGE_NUMBERS) + " F600\n", "a huge move appended"
+    chosen = sorted(rnd.sample(spans, min(len(spans), rnd.randint(1, 4))), reverse=True)
+    for start, end in chosen:
+        text = text[:start] + rnd.choice(HUGE_NUMBERS) + text[end:]
+    return text, f"{len(chosen)} numbers made huge"
+
+
+def deep_nesting(text: str, rnd: random.Random) -> tuple[str, str]:
+    """Wrap a line in 50..400 levels of $IF or $WHILE (sometimes one end too few)."""
+    lines = _lines(text)
+    k = rnd.randrange(len(lines))
+    depth = rnd.randint(50, 400)
+    kind = rnd.choice(["if", "while", "for"])
+    opener, closer = {
+        "if": ("$IF 1 == 1", "$ENDIF"),
+        "while": ("$WHILE V.L.NEST < 1", "V.L.NEST = 1\n$ENDWHILE"),
+        "for": ("$FOR V.L.NEST = 0, 0, 1", "$ENDFOR"),
+    }[kind]
+    unbalanced = rnd.random() < 0.3
+    body = [opener] * depth + [lines[k]] + [closer] * (depth - unbalanced)
+    lines[k:k + 1] = body
+    head = ["#VAR", "V.L.NEST = 0", "#ENDVAR"] if kind != "if" else []
+    return "\n".join(head + lines), f"{depth} levels of ${kind.upper()}" + (
+        ", one end missing" if unbalanced else "")
+
+
+def endless_loop(text: str, rnd: random.Random) -> tuple[str, str]:
+    """Put an endless loop at the start: $WHILE 1 with or without motion, or #RT WHILE."""
+    lines = _lines(text)
+    kind = rnd.choice(["motion", "idle", "variable", "rt"])
+    loop = {
+        "motion": ["$WHILE 1", rnd.choice(MOTION), rnd.choice(MOTION), "$ENDWHILE"],
+        "idle": ["$WHILE 1", "$ENDWHILE"],
+        "variable": ["#VAR", "V.L.LOOP = 0", "#ENDVAR", "$WHILE 1", "V.L.LOOP = V.L.LOOP + 1",
+                     "$ENDWHILE"],
+        "rt": ["#RT WHILE [TRUE]", rnd.choice(MOTION), "#RT ENDWHILE"],
+    }[kind]
+    return "\n".join(loop + lines), f"endless loop ({kind})"
+
+
+def truncate(text: str, rnd: random.Random) -> tuple[str, str]:
+    """Cut the file anywhere (a transfer that broke off)."""
+    cut = rnd.randrange(len(text) + 1)
+    return text[:cut], f"cut at byte {cut}"
+
+
+def insert_tokens(text: str, rnd: random.Random) -> tuple[str, str]:
+    """Insert 1..6 control-flow words, calls and oddities at random places."""
+    count = rnd.randint(1, 6)
+    for _ in range(count):
+        k = rnd.randrange(len(text) + 1)
+        text = text[:k] + rnd.choice([" ", "\n"]) + rnd.choice(TOKENS) + " " + text[k:]
+    return text, f"{count} tokens inserted"
+
+
+def long_line(text: str, rnd: random.Random) -> tuple[str, str]:
+    """A line of 20 000..200 000 characters: a comment, a number or a string. (Many
+    faulty words in one line, or a faulty word after a long run of blanks, are the known
+    slow cases of the syntax check: ``test_a_faulty_line_does_not_stall_the_cycle``.)"""
+    length = rnd.randint(20_000, 200_000)
+    line = rnd.choice([";" + "x" * length, "G1 X" + "1" * length, "(" + "y" * length,
+                       '#MSG ["' + "z" * length + '"]'])
+    lines = _lines(text)
+    lines.insert(rnd.randrange(len(lines) + 1), line)
+    return "\n".join(lines), f"a line of {len(line)} characters"
+
+
+MUTATIONS: list[Callable[[str, random.Random], tuple[str, str]]] = [
+    flip_characters, flip_characters, delete_lines, duplicate_lines, swap_lines,
+    huge_numbers, huge_numbers, deep_nesting, truncate, insert_tokens, insert_tokens, long_line,
+]
+ENDLESS_SHARE = 0.08  # of the mutants get an endless loop (each costs the run timeout)
+BINARY_SHARE = 0.05  # of the mutants get bytes that are not text
+
+
+def sources() -> list[Path]:
+    """The programs mutations start from, in a stable order."""
+    return sorted(p for pattern in SOURCE_GLOBS for p in ROOT.glob(pattern))
+
+
+def support_files() -> list[Path]:
+    """Files the sources call (uploaded unchanged)."""
+    return sorted(p for pattern in SUPPORT_GLOBS for p in ROOT.glob(pattern))
+
+
+def mutate(index: int, path: Path, rnd: random.Random) -> Mutant:
+    """Mutant number ``index`` of ``path``: one to three mutations, sometimes an endless
+    loop, sometimes bytes that are not UTF-8."""
+    text = path.read_text(encoding="utf-8", errors="replace")
+    changes = []
+    for _ in range(rnd.randint(1, 3)):
+        text, change = rnd.choice(MUTATIONS)(text, rnd)
+        changes.append(change)
+    endless = rnd.random() < ENDLESS_SHARE
+    if endless:
+        text, change = endless_loop(text, rnd)
+        changes.append(change)
+    if LEAVE_OUT_UNSERVABLE:
+        text = "".join(c if servable(c) else "?" for c in text)
+    data = text.encode("utf-8", errors="surrogatepass")
+    if rnd.random() < BINARY_SHARE:
+        k = rnd.randrange(len(data) + 1)
+        junk = bytes(rnd.randrange(256) for _ in range(rnd.randint(1, 64)))
+        mixed = data[:k] + junk + data[k:]
+        if not LEAVE_OUT_UNSERVABLE or all(map(servable, store_text(mixed))):
+            data = mixed
+            changes.append(f"{len(junk)} raw bytes at {k}")
+    if len(data) > PROGRAM_MAX_BYTES:  # what the store takes
+        data = data[:PROGRAM_MAX_BYTES]
+        changes.append(f"cut at the store's limit of {PROGRAM_MAX_BYTES} bytes")
+    return Mutant(f"mutant-{index:05d}.nc", data, path.relative_to(ROOT).as_posix(),
+                  tuple(changes), endless)

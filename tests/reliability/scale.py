@@ -1,0 +1,53 @@
+"""How much each reliability test does: the quick scale of ``make test`` or the soak scale.
+
+The soak scale is chosen by ``pytest tests/reliability --soak`` or by the environment
+variable ``CNC_SOAK=1`` (which works from any directory, where ``--soak`` is known only
+when pytest starts in ``tests/reliability``). Every count is a bound: the soak run ends
+by itself.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Scale:
+    """The counts of one scale; ``name`` says which one in the printed figures."""
+
+    name: str
+    wire_frames: int  # malformed frames sent to the ZeroMQ front end
+    wire_batch: int  # frames between two health checks (a fresh client reads)
+    nc_mutations: int  # mutated NC programs, each syntax-checked and run
+    nc_cli_programs: int  # of those, how many also go through `cnc check` / `cnc run`
+    load_clients: int  # concurrent clients of the load test
+    load_rounds: int  # rounds per client: a handle-by-name read, a write, its read-back
+    killed_clients: int  # client processes killed with SIGKILL with subscriptions open
+    store_kills: int  # SIGTERMs during uploads (and as many during runs)
+    restarts: int  # stop-and-start-again cycles on one endpoint
+    broker_restarts: int  # MQTT broker stop/start cycles under the bridge
+
+
+QUICK = Scale(
+    "make test", wire_frames=10_000, wire_batch=500, nc_mutations=64, nc_cli_programs=3,
+    load_clients=50, load_rounds=1_000, killed_clients=1, store_kills=3, restarts=3,
+    broker_restarts=2,
+)
+SOAK = Scale(
+    "make soak", wire_frames=100_000, wire_batch=500, nc_mutations=640, nc_cli_programs=12,
+    load_clients=50, load_rounds=10_000, killed_clients=5, store_kills=20, restarts=20,
+    broker_restarts=10,
+)
+
+soak_option = False  # set by conftest.py from --soak
+
+
+def soak() -> bool:
+    """True when the soak scale was asked for (``--soak`` or ``CNC_SOAK=1``)."""
+    return soak_option or os.environ.get("CNC_SOAK", "") not in ("", "0")
+
+
+def current() -> Scale:
+    """The scale of this run."""
+    return SOAK if soak() else QUICK
