@@ -45,6 +45,8 @@ PRUNE_AT_PEERS = 1024
 BYTES_PER_TOKEN = 1024
 #: Items of a sum command one token pays for.
 SUM_ITEMS_PER_TOKEN = 16
+#: The least bytes one item of a sum command takes in the request (group, offset, length).
+SUM_ITEM_MIN_BYTES = 12
 _SUM_GROUPS = frozenset({RIG.SUM_READ, RIG.SUM_WRITE, RIG.SUM_READ_WRITE})
 _READ_WRITE = AdsCommand.READ_WRITE
 
@@ -55,7 +57,11 @@ def extra_tokens(request: Any, size_bytes: int) -> int:
     whose index offset is the item count)."""
     extra = size_bytes // BYTES_PER_TOKEN
     if request.COMMAND == _READ_WRITE and request.group in _SUM_GROUPS:
-        extra += request.offset // SUM_ITEMS_PER_TOKEN
+        # The offset only claims a count: no more items are served than the data holds
+        # (every item takes 12 bytes or more), so 0xFFFFFFFF items in a short frame cost
+        # nothing extra (they are refused as they are).
+        items = min(request.offset, len(request.data) // SUM_ITEM_MIN_BYTES)
+        extra += items // SUM_ITEMS_PER_TOKEN
     return extra
 
 
@@ -120,10 +126,11 @@ class RateLimiter:
     def charge(self, peer: Hashable, tokens: float) -> None:
         """Take ``tokens`` more from ``peer`` (a request that cost more than one; see
         ``extra_tokens``). The bucket may go below zero: the peer's next requests then
-        wait until it has refilled."""
+        wait until it has refilled. One request takes at most a full bucket (``burst``):
+        however much it claimed, its client waits no longer than a refill."""
         bucket = self._buckets.get(peer)
         if bucket is not None:
-            bucket.tokens -= tokens
+            bucket.tokens -= min(tokens, self.burst)
 
     def hold(self, peer: Hashable, item: Any, size_bytes: int) -> bool:
         """Put a request ``admit`` refused into the peer's mailbox; False when the

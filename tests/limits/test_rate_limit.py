@@ -79,12 +79,22 @@ def test_peers_take_turns_when_released() -> None:
 
 
 def test_an_expensive_request_is_charged_more() -> None:
-    rate = limiter(rate_per_s=1000.0, burst=10, mailbox=5)
+    rate = limiter(rate_per_s=1000.0, burst=200, mailbox=5)
     rate.admit("a", 0.0)
     rate.charge("a", 99)  # cost 100 tokens; it had paid one
+    assert rate.wait_s("a", 0.0) == 0.0  # 100 left of 200
+    rate.charge("a", 150)
     assert not rate.admit("a", 0.0)
-    assert rate.wait_s("a", 0.0) == pytest.approx((1 + 99 - 9) / 1000.0)
+    assert rate.wait_s("a", 0.0) == pytest.approx((1 + 50) / 1000.0)
     rate.charge("nobody", 5)  # a client never seen: nothing to charge
+
+
+def test_one_request_takes_at_most_a_full_bucket() -> None:
+    """Whatever a request claims to cost, its client waits at most one refill."""
+    rate = limiter(rate_per_s=1000.0, burst=10, mailbox=5)
+    rate.admit("a", 0.0)
+    rate.charge("a", 268_435_455)  # a sum command that claims 0xFFFFFFFF items
+    assert rate.wait_s("a", 0.0) == pytest.approx((1 + 10 - 9) / 1000.0)
 
 
 @pytest.mark.parametrize(("request_", "size_bytes", "tokens"), [
@@ -94,6 +104,8 @@ def test_an_expensive_request_is_charged_more() -> None:
     (BrowseRequest(1, CncPort.COM, "*"), 144_507, 141),  # every object of the default machine
     (ReadWriteRequest(1, CncPort.COM, 0xF080, 500, 4000, b"x" * 6000), 10_020, 9 + 31),
     (ReadWriteRequest(1, CncPort.COM, 0xF003, 0, 4, b"name"), 40, 0),  # handle by name
+    # the offset claims 0xFFFFFFFF items; 300 bytes hold 25 at most (12 bytes each)
+    (ReadWriteRequest(1, CncPort.COM, 0xF082, 0xFFFF_FFFF, 1466, b"x" * 300), 2000, 1 + 1),
 ])
 def test_what_a_request_costs(request_: object, size_bytes: int, tokens: int) -> None:
     assert extra_tokens(request_, size_bytes) == tokens
@@ -142,9 +154,9 @@ def test_idle_clients_are_pruned_so_reconnecting_clients_cost_nothing() -> None:
 
 
 def test_a_charged_client_is_not_pruned_before_it_has_paid() -> None:
-    rate = limiter(rate_per_s=10.0, burst=1)
+    rate = limiter(rate_per_s=0.01, burst=1)
     rate.admit("charged", 0.0)
-    rate.charge("charged", 1000)  # 100 s to pay
+    rate.charge("charged", 1000)  # a full bucket (the most one request takes): 100 s to pay
     for k in range(2 * PRUNE_AT_PEERS):
         rate.admit(("peer", k), 10.0 + k * 0.001)
     assert not rate.admit("charged", 20.0)

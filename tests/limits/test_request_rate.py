@@ -10,6 +10,9 @@ from pathlib import Path
 import msgpack
 import pytest
 
+from cnc_objects.protocol.constants import CncPort
+from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
+from cnc_objects.protocol.frames import ReadWriteRequest
 from cnc_objects.service.limits import LimitsConfig
 from tests.e2e.test_ads_raw import READ, RawAds
 from tests.e2e.test_ads_raw import read as ads_read
@@ -55,6 +58,28 @@ def test_parts_a_client_puts_before_its_frames_share_its_rate(tmp_path: Path) ->
         elapsed_s = time.monotonic() - started_s
     assert all(r[2] == 0 for r in replies)
     assert elapsed_s >= 0.9 * (REQUESTS - BURST) / RATE_PER_S
+
+
+def test_a_sum_command_claiming_four_billion_items_does_not_shut_its_client_out(
+        tmp_path: Path) -> None:
+    """The index offset of a sum command is its item count. A short frame that claims
+    0xFFFFFFFF items is refused as it is, and costs its client no more than what it
+    holds: the client's next request is answered at once (it waited 268 million
+    tokens' worth, for ever, when the claim was charged; found by the wire fuzz)."""
+    with limited_service(tmp_path, requests_per_s_per_client=RATE_PER_S,
+                         request_burst=BURST) as service, Raw(service.endpoint) as client:
+        claim = ReadWriteRequest(next_id(), CncPort.COM, RIG.SUM_READ_WRITE, 0xFFFF_FFFF,
+                                 1466, b"\x01" * 300)
+        client.send(claim.encode())
+        refused = client.receive()
+        assert refused is not None and refused[0] == claim.invoke_id and refused[2] != 0
+        invoke_id = next_id()
+        started_s = time.monotonic()
+        client.send(read_frame(CHANNELS, 2, invoke_id))
+        reply = client.receive()
+        waited_s = time.monotonic() - started_s
+    assert reply is not None and reply[0] == invoke_id and reply[2] == 0
+    assert waited_s < BURST / RATE_PER_S + 0.5, waited_s  # at most one refill of the bucket
 
 
 def test_a_full_mailbox_is_answered_0x502_at_once(tmp_path: Path) -> None:
