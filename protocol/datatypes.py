@@ -91,6 +91,21 @@ class DataType:
         return raw.ljust(self.size, b"\x00")
 
 
+ELLIPSIS = "\u2026"  # CP1252 0x85: marks a text cut to fit its buffer
+
+
+def fit_string(text: str, size: int) -> str:
+    """``text`` made to fit a STRING(``size``) buffer, for values the CNC itself produces
+    (error and message texts, names): a NUL or a character CP1252 lacks becomes "?", and
+    a text longer than ``size - 1`` bytes is cut and ends in an ellipsis. ``encode`` still
+    refuses such values from a client; this is for showing what the kernel has to say."""
+    fitted = text.encode(STRING_ENCODING, errors="replace").replace(b"\x00", b"?")
+    if len(fitted) > size - 1:
+        fitted = fitted[: max(size - 2, 0)] + ELLIPSIS.encode(STRING_ENCODING)
+        fitted = fitted[: size - 1]
+    return fitted.decode(STRING_ENCODING)
+
+
 def _integer(name: str, size: int, signed: bool, iec: str) -> DataType:
     fmt = {1: "b", 2: "h", 4: "i", 8: "q"}[size]
     fmt = fmt if signed else fmt.upper()

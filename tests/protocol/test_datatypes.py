@@ -29,6 +29,7 @@ from cnc_objects.protocol.datatypes import (
     UNS32,
     UNS64,
     DataType,
+    fit_string,
     parse_type,
     parse_value,
 )
@@ -326,6 +327,25 @@ def test_string_refuses_characters_cp1252_cannot_encode() -> None:
 def test_string_refuses_other_python_types(value: object) -> None:
     with pytest.raises(TypeError):
         STRING(16).encode(value)
+
+
+@pytest.mark.parametrize(("text", "size", "fitted"), [
+    ("G1 X1", 256, "G1 X1"),  # what fits is kept as it is
+    ("unknown word '\x00'", 256, "unknown word '?'"),
+    ("unknown word '\u0fc2'", 256, "unknown word '?'"),
+    ("y" * 300, 256, "y" * 254 + "\u2026"),  # 255 bytes, the last one the ellipsis
+    ("abcd", 5, "abcd"),
+    ("abcde", 5, "abc\u2026"),
+    ("abc", 1, ""),
+])
+def test_a_kernel_text_is_fitted_to_its_string_buffer(text: str, size: int, fitted: str) -> None:
+    assert fit_string(text, size) == fitted
+    STRING(size).encode(fitted)  # and encodes
+
+
+@given(st.text(max_size=400), st.integers(1, 300))
+def test_every_fitted_text_encodes(text: str, size: int) -> None:
+    STRING(size).encode(fit_string(text, size))
 
 
 def test_string_decode_stops_at_the_first_nul() -> None:

@@ -141,15 +141,6 @@ def wait_for_tick_after(endpoint: str, tick: int, timeout_s: float = TICK_TIMEOU
 _RECORD_START = re.compile(r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d")
 
 
-@dataclass(frozen=True)
-class KnownFault:
-    """A fault the service is known to log, proven by a strict-xfail test: the suite
-    tolerates it elsewhere until that test passes (then the entry goes)."""
-
-    pattern: re.Pattern[str]  # searched in the whole log record (message and traceback)
-    test: str  # the test that proves the bug
-
-
 def log_records(service: ServiceProcess) -> list[str]:
     """The service's log as records: a line with a time stamp and the lines after it
     (a traceback) up to the next stamped line."""
@@ -162,29 +153,22 @@ def log_records(service: ServiceProcess) -> list[str]:
     return records
 
 
-def fault_records(service: ServiceProcess, known: tuple[KnownFault, ...] = ()) -> list[str]:
-    """Log records that say a thread died or a request failed inside the service, except
-    the ``known`` ones."""
-    return [r for r in log_records(service)
-            if FAULT_LINES.search(r) and not any(k.pattern.search(r) for k in known)]
+def fault_records(service: ServiceProcess) -> list[str]:
+    """Log records that say a thread died or a request failed inside the service."""
+    return [r for r in log_records(service) if FAULT_LINES.search(r)]
 
 
-def known_fault_count(service: ServiceProcess, fault: KnownFault) -> int:
-    """How many log records show the known ``fault``."""
-    return sum(1 for r in log_records(service) if fault.pattern.search(r))
-
-
-def assert_well(service: ServiceProcess, since_tick: int, baseline: Vitals | None = None,
-                known: tuple[KnownFault, ...] = ()) -> Vitals:
+def assert_well(service: ServiceProcess, since_tick: int, baseline: Vitals | None = None
+                ) -> Vitals:
     """A fresh client gets the same device info as ``baseline``, the ADS state RUN, a
-    cycle that advances past ``since_tick``; the log holds no fault (but the ``known``
-    ones). Returns the vitals."""
+    cycle that advances past ``since_tick``; the log holds no fault. Returns the
+    vitals."""
     now = vitals(service.endpoint)
     if baseline is not None:
         assert now.device == baseline.device, (now, baseline)
     assert now.ads_state == AdsState.RUN, f"ADS state {now.ads_state}, not RUN"
     wait_for_tick_after(service.endpoint, max(since_tick, now.tick))
-    faults = fault_records(service, known)
+    faults = fault_records(service)
     assert not faults, "the service logged faults:\n" + "\n".join(faults[:5])
     return now
 

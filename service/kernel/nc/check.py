@@ -149,8 +149,11 @@ _INCOMPLETE = frozenset({
     NcErrorId.UNDECLARED_VARIABLE, NcErrorId.UNKNOWN_VARIABLE, NcErrorId.LABEL_NOT_FOUND,
 })
 
-# the $ or # that starts the command of a line (after an N number and a label)
-_COMMAND_START = re.compile(r"[ \t]*(?:N[ \t]*[0-9]*[ \t]*:?[ \t]*)?(?:\[[^\]]*\][ \t]*)?([$#])")
+# the $ or # that starts the command of a line (after an N number and a label). Every
+# run is possessive: blanks next to blanks ("N  :  ") must not be split up in all ways
+# when there is no command, which made a line of thousands of blanks take minutes.
+_COMMAND_START = re.compile(
+    r"[ \t]*+(?:N[ \t]*+[0-9]*+[ \t]*+:?[ \t]*+)?(?:\[[^\]]*+\][ \t]*+)?([$#])")
 # "V.x.name[...] =" (not "==") at a position: the target of an assignment
 _ASSIGN_TARGET = re.compile(r"V\.[A-Z]+\.[A-Z_][A-Z0-9_]*(?:\[[^\]=]*\])*[ \t]*=(?!=)")
 

@@ -11,6 +11,7 @@ Unknown letters and characters are errors, never ignored.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping
 
@@ -278,7 +279,7 @@ class LineParser:
                                             ExpressionParser(cur).parse(), pos))
                     continue
                 if kind == WordKind.G and isinstance(value, float):
-                    if value != int(value) or int(value) not in G_CODES:
+                    if not value.is_integer() or int(value) not in G_CODES:
                         raise cur.error(
                             NcErrorId.UNSUPPORTED_G_CODE, f"G{value:g} is not supported", pos
                         )
@@ -324,7 +325,12 @@ class LineParser:
         cur.skip_ws()
         m = cur.match(SIGNED_NUMBER)
         if m is not None:
-            return float(m.group())
+            number = float(m.group())
+            if not math.isfinite(number):  # digits beyond the float range: 1e309, G9...9
+                raise cur.error(NcErrorId.VALUE_OUT_OF_RANGE,
+                                f"the value of '{letter}' ({len(m.group())} characters) is "
+                                "beyond the range of a number", m.start())
+            return number
         pos = cur.pos
         negative = False
         if cur.peek() in ("-", "+") and (cur.peek(1) == "[" or cur.up.startswith("V.", pos + 1)):

@@ -40,9 +40,10 @@ CACHE_LINES = 20_000
 _LOCAL_HEADER = re.compile(r"[ \t]*%[ \t]*L[ \t]+(\S+)", re.I)
 _MAIN_HEADER = re.compile(r"[ \t]*%[ \t]*(\S*)")
 # the statement keyword of a line, without parsing it: $WORD or #RT WHILE/ENDWHILE
+# (possessive runs: blanks next to blanks must not be split up in every way on a miss)
 _KEYWORD_SCAN = re.compile(
-    r"[ \t]*(?:N[ \t]*[0-9]+[ \t]*:?[ \t]*)?(?:\[[ \t]*[A-Z0-9_]+[ \t]*\][ \t]*)?"
-    r"(?:\$([A-Z]+)|#[ \t]*RT[ \t]+(WHILE|ENDWHILE)\b)"
+    r"[ \t]*+(?:N[ \t]*+[0-9]++[ \t]*+:?[ \t]*+)?(?:\[[ \t]*+[A-Z0-9_]++[ \t]*+\][ \t]*+)?"
+    r"(?:\$([A-Z]+)|#[ \t]*+RT[ \t]++(WHILE|ENDWHILE)\b)"
 )
 _LABEL_SCAN = re.compile(
     r"[ \t]*(?:N[ \t]*([0-9]+)[ \t]*(:)?[ \t]*)?(?:\[[ \t]*([A-Z0-9_]+)[ \t]*\])?"
