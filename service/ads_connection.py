@@ -52,6 +52,7 @@ from cnc_objects.protocol.roles import Role
 
 from .ads_routes import Admission, RouteTable
 from .dispatch import Dispatcher
+from .log_throttle import ThrottledWarning
 from .notifications import NotificationHub
 from .rate_limit import BYTES_PER_TOKEN, RateLimiter, extra_tokens
 
@@ -91,6 +92,7 @@ class AmsConnection(asyncio.Protocol):
         self._admission = Admission(False)
         self._envelopes: set[tuple[Any, ...]] = set()  # clients with notifications
         self.peer = "?"
+        self._skipped = ThrottledWarning(log, "ADS frame skipped")
         self.paused = False  # the peer does not read: notifications are dropped
         self._rate = server.rate
         self._held: deque[AmsFrame | FrameError] | None = None  # waiting for the rate
@@ -103,6 +105,7 @@ class AmsConnection(asyncio.Protocol):
         self._transport = transport  # type: ignore[assignment]
         peername = transport.get_extra_info("peername") or ("?", 0)
         self.peer = f"{peername[0]}:{peername[1]}"
+        self._skipped = ThrottledWarning(log, f"ADS {self.peer}: frame skipped")
         self._admission = self._server.routes.admit(str(peername[0]))
         if not self._admission.allowed:
             log.warning("ADS connection from %s refused: no route for this address", self.peer)
@@ -255,6 +258,6 @@ class AmsConnection(asyncio.Protocol):
                         self._parser.max_frame_bytes)
             self.close()
             return
-        log.warning("ADS %s: frame skipped: %s", self.peer, error)
+        self._skipped.note(error)
         if error.header is not None and not error.header.state_flags & _RESPONSE:
             self._router_error(error.header, _E.INVALIDAMSLENGTH)

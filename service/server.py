@@ -48,6 +48,7 @@ from .backend import Backend
 from .dispatch import Dispatcher
 from .limits import LimitsConfig, oversized_reply, rate_limiter, request_head
 from .rate_limit import BYTES_PER_TOKEN as _BYTES_PER_TOKEN
+from .log_throttle import ThrottledWarning
 from .rate_limit import RateLimiter, extra_tokens
 from .security import ServerCurve
 
@@ -57,7 +58,7 @@ DRAIN_BATCH = 256  # frames handled per wake-up before yielding to other callbac
 PROBE_S = 2.0  # clients with notifications are sent an empty notification this often
 RELEASE_MIN_S = 0.001  # waiting requests are released in batches at most this often
 RELEASE_BUDGET_S = 0.005  # loop time one release pass may take before it yields
-DROP_LOG_S = 10.0  # dropped replies are logged at most this often (with their count)
+DROP_LOG_S = 10.0  # dropped replies and frames are logged at most this often (with a count)
 
 _NOBLOCK = int(zmq.NOBLOCK)
 _SNDMORE_NOBLOCK = int(zmq.SNDMORE | zmq.NOBLOCK)
@@ -99,8 +100,14 @@ class ZmqServer:
         self.rate = rate_limiter(limits)
         self._release_timer: asyncio.TimerHandle | None = None
         self._probe_timer: asyncio.TimerHandle | None = None
-        self.dropped_replies = 0  # replies not sent: the client's queue was full
-        self._drop_logged_s = -DROP_LOG_S
+        # replies not sent (the client's queue was full), and frames without a readable
+        # invoke id (no reply possible): a client causes them at will, so they are
+        # counted and logged now and then
+        self._replies_dropped = ThrottledWarning(
+            log, "replies to clients dropped; a client does not read its replies "
+            "(send_hwm_messages)", DROP_LOG_S)
+        self._unreadable = ThrottledWarning(log, "dropped a frame with no readable invoke id",
+                                            DROP_LOG_S)
         self._auth = None
         self._roles: dict[str, Role] | None = None  # User-Id -> role; None: no CURVE
         if curve is not None:  # the ZAP handler must answer before the first client comes
@@ -281,18 +288,12 @@ class ZmqServer:
     def _dropped(self, exc: zmq.ZMQError) -> None:
         """Count a reply that could not be sent; log now and then, not for every one (a
         client that does not read would flood the log)."""
-        self.dropped_replies += 1
-        now_s = perf_counter()
-        if now_s - self._drop_logged_s >= DROP_LOG_S:
-            self._drop_logged_s = now_s
-            log.warning("replies to clients dropped (%s): %d since start; a client does not "
-                        "read its replies (send_hwm_messages)", exc, self.dropped_replies)
+        self._replies_dropped.note(exc)
 
-    @staticmethod
-    def _refuse(exc: ProtocolError) -> bytes | None:
+    def _refuse(self, exc: ProtocolError) -> bytes | None:
         """The error reply to a frame that did not decode; None when it has no invoke id."""
         if exc.invoke_id is None:
-            log.warning("dropped a frame with no readable invoke id: %s", exc)
+            self._unreadable.note(exc)
             return None
         return encode_error(exc.invoke_id, exc.command or 0, exc.code, str(exc))
 

@@ -15,6 +15,7 @@ No sleeps: every wait is a poll with a timeout.
 from __future__ import annotations
 
 import itertools
+import re
 import struct
 import uuid
 from collections.abc import Iterator
@@ -24,6 +25,7 @@ import pytest
 import zmq
 from zmq.utils.monitor import recv_monitor_message
 
+from cnc_objects.clients import Client
 from cnc_objects.service.limits import LimitsConfig
 from cnc_objects.testing import ServiceProcess
 
@@ -266,12 +268,14 @@ def sum_read_frame(invoke_id: int, port: int, items: list[tuple[int, int, int]])
     return read_write_frame(invoke_id, port, 0xF080, len(items), read_length, data)
 
 
-def log_barrier(service: ServiceProcess, sock: zmq.Socket) -> None:
+def log_barrier(service: ServiceProcess) -> None:
     """Make the service log a unique line and wait for it: every line the service wrote
     before it is then in ``service.log`` (its stderr is one ordered stream)."""
-    marker = f"barrier-{uuid.uuid4().hex}"
-    sock.send(pack(marker, READ, COM, 0, 0, 0))  # unreadable invoke id: logged, dropped
-    service.wait_for_log(marker)
+    marker = f"barrier-{uuid.uuid4().hex}.nc"
+    with Client(service.endpoint) as client:  # an upload is logged, each one
+        client.upload(marker, b"M30\n")
+        service.wait_for_log(re.escape(marker))
+        client.delete_program(marker)
 
 
 def assert_no_traceback(service: ServiceProcess) -> None:
@@ -507,6 +511,23 @@ def test_malformed_frame_without_invoke_id_is_dropped_and_service_still_serves(
     assert_silent_then_serves(client, endpoint)
 
 
+def test_a_flood_of_frames_without_invoke_id_logs_a_line_not_one_per_frame(
+    cnc_service: ServiceProcess,
+) -> None:
+    """A client causes such frames at will: the first is logged with its detail, the
+    rest are counted into a line at most every 10 s (the log held one line per frame)."""
+    sock = connect(cnc_service.endpoint)
+    try:
+        for _ in range(1000):
+            sock.send(MALFORMED_WITHOUT_ID["not-msgpack"])
+        assert_serves(sock)  # behind the flood: every frame of it was read
+    finally:
+        sock.close(linger=0)
+    lines = [line for line in cnc_service.log if "no readable invoke id" in line]
+    assert len(lines) == 1, lines[:5]
+    assert "frame is not valid msgpack" in lines[0]
+
+
 def test_frame_over_maxmsgsize_cuts_off_only_its_sender(endpoint: str) -> None:
     big = connect(endpoint)
     monitor = big.get_monitor_socket(zmq.EVENT_CONNECTED | zmq.EVENT_DISCONNECTED)
@@ -728,7 +749,7 @@ def test_subscriber_that_vanishes_does_not_hurt_the_service(cnc_service: Service
         for _ in range(3):
             assert_serves(other)
         assert tick(other) > ticks[-1]
-        log_barrier(cnc_service, other)
+        log_barrier(cnc_service)
         assert_no_traceback(cnc_service)
         assert cnc_service.process.poll() is None
     finally:
@@ -789,7 +810,7 @@ def test_service_survives_everything_and_exits_cleanly(cnc_service: ServiceProce
 
         for address, value in STATIC_VALUES.items():
             assert read(sock, address) == value
-        log_barrier(cnc_service, sock)
+        log_barrier(cnc_service)
         assert_no_traceback(cnc_service)
     finally:
         sock.close(linger=0)

@@ -51,4 +51,4 @@ def test_a_client_that_never_reads_costs_bounded_memory(tmp_path: Path) -> None:
                   f"(+{growth_kib} KiB; bound {bound_kib} KiB)")
             assert growth_kib < bound_kib
             assert bystander.read(FEED_OVERRIDE_R, 2) == struct.pack("<H", 500)
-        service.wait_for_log(r"replies to clients dropped .*send_hwm_messages")
+        service.wait_for_log(r"replies to clients dropped; .*send_hwm_messages")
