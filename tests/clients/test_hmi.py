@@ -44,14 +44,23 @@ def free_endpoint() -> str:
 
 
 async def wait_until(
-    pilot: Pilot, predicate: Callable[[], bool], timeout_s: float = WAIT_S, what: str = ""
+    pilot: Pilot, predicate: Callable[[], bool], timeout_s: float = WAIT_S,
+    what: str | Callable[[], str] = "",
 ) -> None:
-    """Let the app run until ``predicate()`` holds; fail after ``timeout_s``."""
+    """Let the app run until ``predicate()`` holds; fail after ``timeout_s``, saying
+    ``what`` (a callable: what the app shows at that moment)."""
     deadline = time.monotonic() + timeout_s
     while not predicate():
         if time.monotonic() > deadline:
-            raise AssertionError(f"not within {timeout_s:g} s: {what or predicate}")
+            said = what() if callable(what) else what
+            raise AssertionError(f"not within {timeout_s:g} s: {said or predicate}")
         await pilot.pause()
+
+
+def shown(app: HmiApp) -> Callable[[], str]:
+    """What the app shows of channel 1 and its message line, for a failure message."""
+    return lambda: (f"ch1 {app.channels.cell('ch1', 'state')} at block "
+                    f"{app.channels.cell('ch1', 'block')!r}; message {app.message.text!r}")
 
 
 def filled(app: HmiApp) -> bool:
@@ -118,12 +127,15 @@ async def test_program_keys_select_start_hold_resume_reset(service: RunningServi
         assert app.channels.cell("ch1", "block").startswith("N")
 
         await pilot.press("h")
-        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "HOLD")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "HOLD",
+                         what=shown(app))
         assert text.state(await c.read(state)) == "HOLD"
         await pilot.press("s")  # resume
-        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "ACTIVE")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "ACTIVE",
+                         what=shown(app))
         await pilot.press("r")
-        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") not in ("ACTIVE", "HOLD"))
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "state") not in ("ACTIVE", "HOLD"),
+                         what=shown(app))
         assert app.channels.cell("ch1", "state") == text.state(await c.read(state))
         assert app.message.text == "ch1: RESET"
 
