@@ -23,8 +23,10 @@ from __future__ import annotations
 import json
 import math
 import sys
+from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
+from typing import Any
 
 import typer
 
@@ -146,6 +148,25 @@ def report_finished(settings: Settings, status: ChannelStatus) -> None:
          f"{status.program_time_s:.3f} s")
 
 
+def start_and_report(
+    settings: Settings, request: str, channel: int, start: Callable[[Client], None],
+    wait: bool, timeout_s: float | None, started: tuple[dict[str, Any], str],
+) -> None:
+    """``start`` the channel in one session for ``request``; without ``wait`` emit
+    ``started`` (record, text), with it wait for the program's end and report it (ERROR,
+    the wait's timeout and refusals end through ``finish_wait``)."""
+    try:
+        with settings.session(request) as c:
+            start(c)
+            if not wait:
+                emit(settings, *started)
+                return
+            status = wait_to_end(c, channel, timeout_s)
+    except (AdsError, ChannelError, ClientValueError) as exc:
+        finish_wait(exc)
+    report_finished(settings, status)
+
+
 @command()
 def run(
     ctx: typer.Context,
@@ -155,20 +176,15 @@ def run(
     timeout_s: float = WaitTimeoutOption,
 ) -> None:
     """Select a program in AUTOMATIC and START it (a local file is uploaded first)."""
-    settings: Settings = ctx.obj
     name, data = local_program(program)
-    try:
-        with settings.session(f"run of {name} in channel {channel}") as c:
-            store_local(c, name, data)
-            c.run_program(name, channel)
-            if not wait:
-                emit(settings, {"channel": channel, "program": name, "started": True},
-                      f"channel {channel}: {name} started")
-                return
-            status = wait_to_end(c, channel, timeout_s)
-    except (AdsError, ChannelError, ClientValueError) as exc:
-        finish_wait(exc)
-    report_finished(settings, status)
+
+    def start(c: Client) -> None:
+        store_local(c, name, data)
+        c.run_program(name, channel)
+
+    start_and_report(ctx.obj, f"run of {name} in channel {channel}", channel, start, wait,
+                     timeout_s, ({"channel": channel, "program": name, "started": True},
+                                 f"channel {channel}: {name} started"))
 
 
 @command()
@@ -216,17 +232,9 @@ def resume(
     timeout_s: float = WaitTimeoutOption,
 ) -> None:
     """START again after feedhold, M0/M1 or a single-block stop."""
-    settings: Settings = ctx.obj
-    try:
-        with settings.session(f"START of channel {channel}") as c:
-            c.start(channel)
-            if not wait:
-                emit(settings, {"channel": channel, "ok": True}, f"channel {channel}: resumed")
-                return
-            status = wait_to_end(c, channel, timeout_s)
-    except (AdsError, ChannelError, ClientValueError) as exc:
-        finish_wait(exc)
-    report_finished(settings, status)
+    start_and_report(ctx.obj, f"START of channel {channel}", channel,
+                     lambda c: c.start(channel), wait, timeout_s,
+                     ({"channel": channel, "ok": True}, f"channel {channel}: resumed"))
 
 
 @command()

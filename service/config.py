@@ -299,6 +299,12 @@ _Z85_ALPHABET = frozenset(
     "0123456789abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ.-:+=^!/*?&<>()[]{}@%$#")
 
 
+def _checked_net_id(value: str) -> str:
+    """An AMS Net ID of the configuration, stripped (``ValueError`` when it is none)."""
+    parse_net_id(value)
+    return value.strip()
+
+
 class AdsRouteConfig(_Strict):
     """A route of the ADS front end: a peer that may connect from ``address``."""
 
@@ -313,8 +319,7 @@ class AdsRouteConfig(_Strict):
     @field_validator("net_id")
     @classmethod
     def _net_id(cls, value: str) -> str:
-        parse_net_id(value)
-        return value.strip()
+        return _checked_net_id(value)
 
     @field_validator("address")
     @classmethod
@@ -356,10 +361,7 @@ class AdsConfig(_Strict):
     @field_validator("net_id")
     @classmethod
     def _net_id(cls, value: str | None) -> str | None:
-        if value is not None:
-            parse_net_id(value)
-            return value.strip()
-        return value
+        return None if value is None else _checked_net_id(value)
 
     @property
     def address(self) -> tuple[str, int] | None:

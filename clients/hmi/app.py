@@ -29,6 +29,7 @@ from textual.widgets import DataTable, Footer, Header, Label
 from cnc_objects.clients.client import DEFAULT_ENDPOINT, AsyncClient, DeviceInfo
 from cnc_objects.clients.curve import client_curve
 from cnc_objects.clients.errors import AdsError, ClientValueError
+from cnc_objects.clients.key_options import key_option, server_key_option
 
 from . import control, text
 from .axes import AxesTable
@@ -286,15 +287,8 @@ def run(
         DEFAULT_TIMEOUT_S, "--timeout", metavar="S", min=0.01,
         help="Seconds without a reply before the service counts as unreachable.",
     ),
-    key_file: Optional[str] = typer.Option(
-        None, "--key", metavar="FILE", envvar="CNC_KEY",
-        help="The HMI's CURVE secret key file, for a service with --keys (default $CNC_KEY).",
-    ),
-    server_key: Optional[str] = typer.Option(
-        None, "--server-key", metavar="FILE", envvar="CNC_SERVER_KEY",
-        help="The service's public key file (default $CNC_SERVER_KEY, else server.key "
-        "beside --key).",
-    ),
+    key_file: Optional[str] = key_option("The HMI's"),
+    server_key: Optional[str] = server_key_option(),
 ) -> None:
     """Terminal HMI of a cnc-objects service (keys: docs/hmi.md)."""
     try:

@@ -28,6 +28,7 @@ import zmq
 from ..client import DEFAULT_ENDPOINT
 from ..curve import client_curve
 from ..errors import ClientValueError
+from ..key_options import key_option, server_key_option
 from .bridge import Bridge
 from .config import DEFAULT_OBJECTS, BridgeConfig, parse_broker
 
@@ -111,15 +112,8 @@ def run(
         5.0, "--reconnect-max-s", min=0.001, help="... up to this."
     ),
     keepalive_s: int = typer.Option(30, "--keepalive", min=1, help="MQTT keepalive in seconds."),
-    key_file: Optional[str] = typer.Option(
-        None, "--key", metavar="FILE", envvar="CNC_KEY",
-        help="The bridge's CURVE secret key file, for a service with --keys (default $CNC_KEY).",
-    ),
-    server_key: Optional[str] = typer.Option(
-        None, "--server-key", metavar="FILE", envvar="CNC_SERVER_KEY",
-        help="The service's public key file (default $CNC_SERVER_KEY, else server.key "
-        "beside --key).",
-    ),
+    key_file: Optional[str] = key_option("The bridge's"),
+    server_key: Optional[str] = server_key_option(),
     log_level: str = typer.Option("INFO", "--log-level", help="DEBUG, INFO, WARNING or ERROR."),
 ) -> None:
     """Publish CNC objects to MQTT when they change; write the ones allowed on request."""

@@ -66,9 +66,11 @@ class Reply:
 
 
 def frame(command: int, data: bytes = b"", *, port: int, target: bytes, invoke_id: int,
-          flags: int = REQUEST, length: int | None = None) -> bytes:
-    """A request frame; ``length`` overrides the AMS header's data length."""
-    header = struct.pack("<6sH6sHHHIII", target, port, CLIENT_NET_ID, CLIENT_PORT, command,
+          flags: int = REQUEST, length: int | None = None,
+          source: bytes = CLIENT_NET_ID) -> bytes:
+    """A request frame from the Net ID ``source``; ``length`` overrides the AMS header's
+    data length."""
+    header = struct.pack("<6sH6sHHHIII", target, port, source, CLIENT_PORT, command,
                          flags, len(data) if length is None else length, 0, invoke_id)
     return struct.pack("<HI", 0, 32 + len(data)) + header + data
 
@@ -76,12 +78,16 @@ def frame(command: int, data: bytes = b"", *, port: int, target: bytes, invoke_i
 class RawAds:
     """A TCP connection speaking AMS frames built by hand."""
 
-    def __init__(self, service: ServiceProcess, receive_buffer_bytes: int | None = None) -> None:
+    def __init__(self, service: ServiceProcess, receive_buffer_bytes: int | None = None,
+                 source_address: str | None = None) -> None:
+        """``source_address``: the local IP address to connect from (default: any)."""
         host, port = service.ads_address  # type: ignore[misc]
         self.net_id = bytes(int(p) for p in service.ams_net_id.split("."))  # type: ignore[union-attr]
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         if receive_buffer_bytes is not None:  # before connecting: it sets the TCP window
             self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, receive_buffer_bytes)
+        if source_address is not None:
+            self.sock.bind((source_address, 0))
         self.sock.settimeout(TIMEOUT_S)
         self.sock.connect((host, port))
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)

@@ -4,102 +4,64 @@ ADS peers are told apart by route (``[[ads.routes]] role = ...``, operator by de
 loopback peers get ``[ads] loopback_role``: admin by default, monitor when the service
 runs with keys. The same dispatcher decides as for ZeroMQ: a request beyond the role is
 answered ADS 0x704 and the connection stays. Frames are built by hand from Beckhoff's
-layout (AMS/TCP header, 32-byte AMS header, the command's data).
+layout (AMS/TCP header, 32-byte AMS header, the command's data) by the raw client of
+tests/e2e/test_ads_raw.py.
 """
 
 from __future__ import annotations
 
-import itertools
-import socket
 import struct
 from pathlib import Path
 
 import pytest
 
 from cnc_objects.testing import ServiceProcess, serving
+from tests.e2e.test_ads_raw import COM, READ, READ_WRITE, WRITE, RawAds, read, read_write, write
+from tests.e2e.test_ads_raw import _own_non_loopback_ipv4 as own_non_loopback_ipv4
 
-READ, WRITE, READ_WRITE = 2, 3, 9
-REQUEST, RESPONSE = 0x0004, 0x0005
-COM = 553
 CH1_COM = 0x120101
 FEED_W, FEED_R = 0x09, 0x0C  # ch1 feed override, commanded and active (UNS16)
 PROGRAM_STORE, UPLOAD = 0x150000, 2
 SUM_WRITE = 0xF081
 INVALIDACCESS = 0x704
-TIMEOUT_S = 10.0
-_ids = itertools.count(1)
 
 
 def net_id(text: str) -> bytes:
     return bytes(int(p) for p in text.split("."))
 
 
-class Ams:
-    """One TCP connection to the service's ADS port, sending from any Net ID."""
+class Ams(RawAds):
+    """One TCP connection to the service's ADS port (from the local address ``source``),
+    sending to the COM port from any Net ID."""
 
     def __init__(self, service: ServiceProcess, source: str = "127.0.0.1") -> None:
-        host, port = service.ads_address  # type: ignore[misc]
-        self.target = net_id(service.ams_net_id)  # type: ignore[arg-type]
-        self.sock = socket.create_connection((host, port), TIMEOUT_S, (source, 0))
-        self._buffer = b""
+        super().__init__(service, source_address=source)
 
-    def close(self) -> None:
-        self.sock.close()
-
-    def call(self, source: bytes, command: int, data: bytes) -> tuple[int, bytes]:
-        """(ADS result, the reply's data after the result)."""
-        invoke_id = next(_ids)
-        header = struct.pack("<6sH6sHHHIII", self.target, COM, source, 32905, command,
-                             REQUEST, len(data), 0, invoke_id)
-        self.sock.sendall(struct.pack("<HI", 0, 32 + len(data)) + header + data)
-        _, length = struct.unpack("<HI", self._read(6))
-        body = self._read(length)
-        fields = struct.unpack_from("<6sH6sHHHIII", body)
-        assert fields[5] == RESPONSE and fields[8] == invoke_id and fields[7] == 0
-        result = struct.unpack_from("<I", body, 32)[0]
-        return result, body[36:]
-
-    def _read(self, size: int) -> bytes:
-        while len(self._buffer) < size:
-            chunk = self.sock.recv(65536)
-            if not chunk:
-                raise ConnectionError("the service closed the connection")
-            self._buffer += chunk
-        out, self._buffer = self._buffer[:size], self._buffer[size:]
-        return out
+    def call_from(self, source: bytes, command: int, data: bytes) -> tuple[int, bytes]:
+        """(ADS result, the reply's data after the result) of a request from ``source``."""
+        got = self.call(command, data, COM, source=source)
+        assert got.error == 0
+        return got.result, got.data[4:]
 
     def read_feed(self, source: bytes) -> int:
-        result, data = self.call(source, READ, struct.pack("<III", CH1_COM, FEED_R, 2))
+        result, data = self.call_from(source, READ, read(CH1_COM, FEED_R, 2))
         assert result == 0
         return struct.unpack("<IH", data)[1]
 
     def write_feed(self, source: bytes, value: int) -> int:
-        return self.call(source, WRITE, struct.pack("<III", CH1_COM, FEED_W, 2)
-                         + struct.pack("<H", value))[0]
+        return self.call_from(source, WRITE, write(CH1_COM, FEED_W, struct.pack("<H", value)))[0]
 
     def upload(self, source: bytes, name: bytes) -> int:
-        content = name + b"\x00" + b"N10 M30\n"
-        return self.call(source, WRITE, struct.pack("<III", PROGRAM_STORE, UPLOAD,
-                                                    len(content)) + content)[0]
+        return self.call_from(source, WRITE,
+                              write(PROGRAM_STORE, UPLOAD, name + b"\x00" + b"N10 M30\n"))[0]
 
     def sum_write_feeds(self, source: bytes, values: list[int]) -> list[int]:
         head = b"".join(struct.pack("<III", CH1_COM, FEED_W, 2) for _ in values)
         data = head + b"".join(struct.pack("<H", v) for v in values)
-        result, reply = self.call(source, READ_WRITE, struct.pack(
-            "<IIII", SUM_WRITE, len(values), 4 * len(values), len(data)) + data)
+        result, reply = self.call_from(
+            source, READ_WRITE, read_write(SUM_WRITE, len(values), 4 * len(values), data))
         assert result == 0
         return list(struct.unpack_from(f"<{len(values)}I", reply, 4))
-
-
-def own_non_loopback_ipv4() -> str | None:
-    """An IPv4 address of this machine that is not loopback, if it has one."""
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        try:
-            probe.connect(("192.0.2.1", 9))  # no packet is sent: only a route is looked up
-        except OSError:
-            return None
-        address = probe.getsockname()[0]
-    return None if address.startswith("127.") else address
 
 
 def test_each_route_has_its_role(tmp_path: Path) -> None:
