@@ -329,7 +329,7 @@ class LineParser:
             if not math.isfinite(number):  # digits beyond the float range: 1e309, G9...9
                 raise cur.error(NcErrorId.VALUE_OUT_OF_RANGE,
                                 f"the value of '{letter}' ({len(m.group())} characters) is "
-                                "beyond the range of a number", m.start())
+                                "beyond the range of a number", letter_pos)
             return number
         pos = cur.pos
         negative = False

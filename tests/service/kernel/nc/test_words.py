@@ -94,9 +94,9 @@ def test_dwell_x_word_without_an_x_axis():
         ("BBTRC=0\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 1),
         ("METB 0.01\nM30", NcErrorId.EXPRESSION_SYNTAX, 1, 1),
         # numbers beyond the float range (G9...9 raised OverflowError: a decoder fault)
-        ("G" + "9" * 400 + " X1 F600\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 2),
-        ("G1 X" + "9" * 400 + " F600\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 5),
-        ("M" + "9" * 400 + "\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 2),
+        ("G" + "9" * 400 + " X1 F600\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 1),
+        ("G1 X" + "9" * 400 + " F600\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 4),
+        ("M" + "9" * 400 + "\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 1),
     ],
 )
 def test_word_errors(program, err, line, column):
