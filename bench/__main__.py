@@ -22,7 +22,9 @@ sequential round trips, and 64 frames in flight. Then the real ``cnc-service``
 (realtime clock, 1 ms cycle, in a second process) driven by:
 
 * ``Client.read_address`` sequentially,
-* ``AsyncClient.read_address`` from 64 coroutines (64 reads in flight),
+* ``AsyncClient.read_address`` from 64 coroutines (64 reads in flight, a sliding
+  window), and in bursts (``asyncio.gather`` of 64, then the next burst); both also
+  against the raw echo, which shows the client's own share (the service's is the rest),
 * ``AsyncClient.read_many`` of 100 objects (one sum read each).
 
 Every figure is the median over ``--runs`` runs (default 5). Each run measures the
@@ -144,8 +146,29 @@ async def _client_in_flight(endpoint: str, count: int) -> Figure:
 
 
 def client_in_flight(endpoint: str, count: int) -> Figure:
-    """AsyncClient with IN_FLIGHT reads outstanding."""
+    """AsyncClient with IN_FLIGHT reads outstanding (a sliding window: each of IN_FLIGHT
+    coroutines sends its next read when its last one is answered)."""
     return asyncio.run(_client_in_flight(endpoint, count))
+
+
+async def _client_bursts(endpoint: str, count: int) -> Figure:
+    async with AsyncClient(endpoint) as c:
+        await asyncio.gather(*(c.read_address(*ADDRESS) for _ in range(200)))
+        lat: list[float] = []
+        bursts = count // IN_FLIGHT
+        clock = time.perf_counter
+        start = clock()
+        for _ in range(bursts):
+            t0 = clock()
+            await asyncio.gather(*(c.read_address(*ADDRESS) for _ in range(IN_FLIGHT)))
+            lat.append((clock() - t0))  # a burst's latency: its last reply
+        elapsed = clock() - start
+    return figure(bursts * IN_FLIGHT, elapsed, lat)
+
+
+def client_bursts(endpoint: str, count: int) -> Figure:
+    """AsyncClient reading in bursts: ``asyncio.gather`` of IN_FLIGHT reads, then the next."""
+    return asyncio.run(_client_bursts(endpoint, count))
 
 
 async def _client_read_many(endpoint: str, count: int) -> tuple[Figure, int]:
@@ -235,24 +258,33 @@ def dispatch(args: argparse.Namespace) -> None:
         machine.write_text(BENCH_MACHINE)
         service = start_service("--clock", "realtime", "--config", str(machine))
     try:
-        runs: dict[str, list[Figure]] = {k: [] for k in
-                                         ("raw_seq", "raw_pipe", "seq", "flight", "many")}
+        keys = ("raw_seq", "raw_pipe", "seq", "flight", "bursts", "echo_flight",
+                "echo_bursts", "many")
+        runs: dict[str, list[Figure]] = {k: [] for k in keys}
         n_objects = 0
-        ratios: dict[str, list[float]] = {"seq": [], "flight": [], "many": []}
+        ratios: dict[str, list[float]] = {k: [] for k in keys[2:]}
         for run in range(args.runs):
             raw_seq = raw_sequential(echo_endpoint, args.count // 4)
             seq = client_sequential(service.endpoint, args.count // 4)
             raw_pipe = raw_pipelined(echo_endpoint, args.count * 2)
             flight = client_in_flight(service.endpoint, args.count * 2)
+            bursts = client_bursts(service.endpoint, args.count * 2)
+            # the client alone: the same reads answered by the raw echo
+            echo_flight = client_in_flight(echo_endpoint, args.count * 2)
+            echo_bursts = client_bursts(echo_endpoint, args.count * 2)
             many, n_objects = asyncio.run(_client_read_many(service.endpoint, args.count // 20))
             for key, fig_, base in (("raw_seq", raw_seq, None), ("seq", seq, raw_seq),
                                     ("raw_pipe", raw_pipe, None), ("flight", flight, raw_pipe),
+                                    ("bursts", bursts, raw_pipe),
+                                    ("echo_flight", echo_flight, raw_pipe),
+                                    ("echo_bursts", echo_bursts, raw_pipe),
                                     ("many", many, raw_seq)):
                 runs[key].append(fig_)
                 if base is not None:
                     ratios[key].append(fig_.reads_s / base.reads_s)
             print(f"run {run + 1}/{args.runs}: sequential {ratios['seq'][-1]:.2f}, "
-                  f"64 in flight {ratios['flight'][-1]:.2f} of the raw echo", file=sys.stderr)
+                  f"64 in flight {ratios['flight'][-1]:.2f} (bursts {ratios['bursts'][-1]:.2f}) "
+                  "of the raw echo", file=sys.stderr)
         with Client(service.endpoint) as c:
             overruns = c.read_many(
                 ["cnc_cycle_overruns_r", "cnc_cycle_jitter_max_r", "cnc_tick_counter_r"]
@@ -274,6 +306,9 @@ def _report(
         ("raw echo, 64 in flight (baseline)", "raw_pipe", None),
         ("Client.read_address, sequential", "seq", 0.6),
         ("AsyncClient, 64 reads in flight", "flight", 0.8),
+        ("AsyncClient, bursts of 64 (gather)", "bursts", 0.8),
+        ("  the client alone (raw echo): window", "echo_flight", None),
+        ("  the client alone (raw echo): bursts", "echo_bursts", None),
         (f"AsyncClient.read_many({n_objects}) calls", "many", None),
     ]
     print(f"\nmedian of {runs} runs; ratio: median of the per-run ratios to the raw echo "
