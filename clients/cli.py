@@ -70,3 +70,7 @@ def main() -> None:
         app()
     except KeyboardInterrupt:
         sys.exit(130)
+
+
+if __name__ == "__main__":  # python -m cnc_objects.clients.cli, as the cnc script
+    main()

@@ -289,3 +289,12 @@ def test_browse_on_a_terminal_cuts_nothing(endpoint: str) -> None:
     assert lines[1].endswith("Execution mode the PLC commands (evaluated at program start "
                              "while enable_w)")
     assert lines[-1] == "2 objects"
+
+
+def test_the_module_runs_as_the_cnc_script() -> None:
+    """``python -m cnc_objects.clients.cli`` is ``cnc`` (it did nothing: no main guard)."""
+    result = subprocess.run([sys.executable, "-m", "cnc_objects.clients.cli", "--help"],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert "Usage: python -m cnc_objects.clients.cli" in result.stdout
+    assert "browse" in result.stdout
