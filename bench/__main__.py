@@ -14,6 +14,9 @@ ADS part (``--part ads``): pyads sequential reads against a minimal asyncio AMS/
 echo server and against the service, and ``read_list_by_name`` of 100 symbols
 (``bench/ads_bench.py``).
 
+Jitter part (``--part jitter``): the realtime cycle's lateness (p50, p99, max) and
+overruns while the service answers 5 000 reads/s and feeds 20 on-change subscriptions
+during a run (``bench/jitter_bench.py``).
 Dispatch part (``--part dispatch``):
 
 Baseline: a raw pyzmq ROUTER in a second process that answers each msgpack frame with a
@@ -190,11 +193,14 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__.split("\n")[0])
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
-    parser.add_argument("--part", choices=("all", "dispatch", "ads", "kernel", "lookahead"),
+    parser.add_argument("--part", choices=("all", "dispatch", "ads", "kernel", "jitter",
+                                           "lookahead"),
                         default="all",
                         help="dispatch: request dispatch (ZeroMQ); ads: pyads over AMS/TCP; "
-                        "kernel: decoder, interpolator, planner; lookahead: machining time "
-                        "against the optimum")
+                        "kernel: decoder, interpolator, planner; jitter: the realtime cycle "
+                        "under load; lookahead: machining time against the optimum")
+    parser.add_argument("--jitter-s", type=float, default=20.0,
+                        help="seconds of load per jitter run (issue 22 asks 60)")
     args = parser.parse_args(argv)
     if args.part in ("all", "dispatch"):
         dispatch(args)
@@ -204,6 +210,10 @@ def main(argv: list[str] | None = None) -> int:
         ads_bench.main(args.runs, args.count // 4)
     if args.part in ("all", "kernel"):
         kernel(args.runs)
+    if args.part in ("all", "jitter"):
+        from . import jitter_bench
+
+        jitter_bench.main(min(args.runs, 3), args.jitter_s)
     if args.part in ("all", "lookahead"):
         from . import lookahead_bench
 

@@ -375,6 +375,21 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "cnc_notification_clients_r", Scope.PLATFORM, COM, COM_CH, 0x1018, UNS32, R, "-",
         "Clients that hold at least one device notification (project)",
     ),
+    ObjectTemplate(
+        "cnc_cycle_jitter_p50_r", Scope.PLATFORM, COM, COM_CH, 0x1019, UNS32, R, "us",
+        "Median lateness of a cycle start against its deadline, to 10 us, since start or "
+        "cnc_cycle_stats_reset_w; 0 with the virtual clock (project)",
+    ),
+    ObjectTemplate(
+        "cnc_cycle_jitter_p99_r", Scope.PLATFORM, COM, COM_CH, 0x101A, UNS32, R, "us",
+        "99th percentile of the lateness of a cycle start, to 10 us, since start or "
+        "cnc_cycle_stats_reset_w; 0 with the virtual clock (project)",
+    ),
+    ObjectTemplate(
+        "cnc_cycle_stats_reset_w", Scope.PLATFORM, COM, COM_CH, 0x101B, BOOLEAN, W, "-",
+        "TRUE: the cycle figures (overruns, jitter max/p50/p99, longest execution) start "
+        "again from zero, for a measurement (project)",
+    ),
     # --- COM platform axes (offsets as TwinSharp, 0x120200 / 0x<ANo>00xx) ---------------
     ObjectTemplate(
         "command_position_acs", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x02, SGN32, R, "0.1 um",

@@ -43,7 +43,7 @@ from .kernel.commands import (
     StartProgram,
     UpdateAxisParameters,
 )
-from .kernel.kernel import Kernel
+from .kernel.kernel import Kernel, ResetCycleStats
 from .kernel.state import DecoderFlag
 from .notifications import NotificationCounts
 from .param_list import ParamListError, parse_axis_list
@@ -92,6 +92,18 @@ def _physical_axis(attr: str) -> Callable[[Kernel, CncObject], Getter]:
 def _stats(attr: str, wrap: Callable[[Any], Any] = lambda v: v) -> Callable[..., Getter]:
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
         return lambda: wrap(getattr(kernel.snapshot.stats, attr))
+
+    return bind
+
+
+def _lateness(fraction: float) -> Callable[[Kernel, CncObject], Getter]:
+    """A percentile of the cycle lateness. Read live from the clock's histogram, not from
+    the snapshot: a figure of the cycle task about itself, summed over many cycles."""
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        lateness = kernel.lateness
+        if lateness is None:  # the virtual clock has no deadlines
+            return lambda: 0
+        return lambda: min(lateness.percentile_us(fraction), 0xFFFFFFFF)
 
     return bind
 
@@ -300,6 +312,8 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "cnc_cycle_exec_time_max_r": _stats("exec_time_max_us", lambda v: min(v, 0xFFFFFFFF)),
     "cnc_kernel_time_r": _kernel_time,
     "cnc_kernel_running_r": _stats("running"),
+    "cnc_cycle_jitter_p50_r": _lateness(0.5),
+    "cnc_cycle_jitter_p99_r": _lateness(0.99),
     "command_position_acs": _per_scope(
         _physical_axis("command_position_incr"), _channel_axis("command_position_incr")
     ),
@@ -398,6 +412,7 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
     "bahn_mc_control.suspend_axis_output.command_w": _channel_command(SetSuspendCommand),
     "bahn_mc_control.suspend_axis_output.enable_w": _channel_command(SetSuspendEnable),
     "axis_parameter_update_w": lambda kernel, obj: _axis_parameter_update,
+    "cnc_cycle_stats_reset_w": lambda kernel, obj: ResetCycleStats,
     "contour_lookahead.request.start_position": _channel_command(
         lambda ci, value: SetContourRequest(ci, "start_position", value)
     ),

@@ -32,12 +32,50 @@ class WakeSource(Protocol):
         """Return when a command is queued or ``timeout_s`` has passed."""
 
 
+#: Width of one bucket of the lateness histogram, and how far it reaches (later: the last).
+LATENESS_BUCKET_US = 10
+LATENESS_RANGE_US = 100_000
+
+
+class LatenessHistogram:
+    """How late cycles started against their deadlines: counts per ``LATENESS_BUCKET_US``
+    (one list index per cycle: cheap enough for every cycle), percentiles on demand."""
+
+    def __init__(self) -> None:
+        self.counts = [0] * (LATENESS_RANGE_US // LATENESS_BUCKET_US + 1)
+        self.total = 0
+
+    def add(self, late_us: int) -> None:
+        """One cycle that started ``late_us`` after its deadline."""
+        self.counts[min(max(late_us, 0) // LATENESS_BUCKET_US, len(self.counts) - 1)] += 1
+        self.total += 1
+
+    def percentile_us(self, fraction: float) -> int:
+        """The lateness ``fraction`` (0.5, 0.99) of the cycles kept to: the upper edge of
+        the bucket it falls in (so at most ``LATENESS_BUCKET_US`` above the exact one);
+        0 before the first cycle."""
+        wanted = fraction * self.total
+        seen = 0
+        for index, count in enumerate(self.counts):
+            seen += count
+            if count and seen >= wanted:
+                return (index + 1) * LATENESS_BUCKET_US
+        return 0
+
+    def reset(self) -> None:
+        """Forget every cycle so far."""
+        self.counts = [0] * len(self.counts)
+        self.total = 0
+
+
 class RealtimeClock:
-    """Sleep to each deadline; a cycle that ends after the next deadline is an overrun."""
+    """Sleep to each deadline; a cycle that ends after the next deadline is an overrun.
+    Every cycle's lateness goes into ``lateness``."""
 
     def __init__(self, cycle_s: float) -> None:
         self.cycle_s = cycle_s
         self._deadline = 0.0
+        self.lateness = LatenessHistogram()
 
     def start(self) -> None:
         self._deadline = time.perf_counter() + self.cycle_s
@@ -56,6 +94,7 @@ class RealtimeClock:
         late_us = int((time.perf_counter() - self._deadline) * 1e6)
         if late_us > stats.jitter_max_us:
             stats.jitter_max_us = late_us
+        self.lateness.add(late_us)
         self._deadline += self.cycle_s
 
 

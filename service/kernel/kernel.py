@@ -20,7 +20,7 @@ from enum import Enum
 from ..config import MachineConfig
 from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
-from .clock import Clock, VirtualClock
+from .clock import Clock, LatenessHistogram, VirtualClock
 from .commands import Command, Refusal, RefusalReason
 from .state import ChannelError, CycleStats, KernelState, Snapshot
 from .switchover import Switchover
@@ -48,6 +48,15 @@ class ControlCommand:
     """A run-control request, applied by the cycle thread like any command."""
 
     control: Control
+
+
+@dataclass(frozen=True, slots=True)
+class ResetCycleStats:
+    """``cnc_cycle_stats_reset_w``: TRUE forgets the cycle task's figures (overruns,
+    lateness, longest execution), so that a measurement starts there; FALSE does nothing
+    (a PLC may write the bit back). Applied by the cycle thread like any command."""
+
+    value: bool
 
 
 _SHUTDOWN = object()
@@ -79,6 +88,8 @@ class Kernel:
         self._changed: list[bool] | None = None  # channels the cycle touched; None = all
         self.state = self._initial_state()
         self.stats = CycleStats(cycle_us=round(config.cycle_ms * 1000))
+        # cycle lateness per cycle (realtime clock only): kept by the clock, read live
+        self.lateness: LatenessHistogram | None = getattr(clock, "lateness", None)
         self.snapshot: Snapshot = self.state.snapshot(0, 0, time.time_ns(), self.stats)
         self.on_cycle_end: Callable[[Snapshot], None] | None = None
         self._queue: queue.SimpleQueue = queue.SimpleQueue()
@@ -224,6 +235,8 @@ class Kernel:
         try:
             if isinstance(command, ControlCommand):
                 return self._control(command.control)
+            if isinstance(command, ResetCycleStats):
+                return self._reset_cycle_stats() if command.value else None
             return command.apply(self.state)
         except Exception:
             log.exception("command %r failed", command)
@@ -241,6 +254,12 @@ class Kernel:
                 self.state = self._initial_state()
                 self.stats.running = True
         return None
+
+    def _reset_cycle_stats(self) -> None:
+        stats = self.stats
+        stats.overruns = stats.jitter_max_us = stats.exec_time_max_us = 0
+        if self.lateness is not None:
+            self.lateness.reset()
 
     def _refuse_queued(self) -> None:
         while True:

@@ -12,7 +12,7 @@ import pytest
 from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.clock import RealtimeClock, VirtualClock
 from cnc_objects.service.kernel.commands import Refusal, RefusalReason, SetExecutionMode, SetFeedOverride
-from cnc_objects.service.kernel.kernel import Control, ControlCommand, Kernel
+from cnc_objects.service.kernel.kernel import Control, ControlCommand, Kernel, ResetCycleStats
 from cnc_objects.service.kernel.state import KernelState, LinkState
 
 
@@ -161,3 +161,33 @@ def test_realtime_clock_counts_overruns_and_jitter() -> None:
         assert stats.cycles > 0
     finally:
         k.close()
+
+
+def test_cycle_lateness_is_kept_per_cycle_and_reset_on_command() -> None:
+    """The realtime clock puts every cycle's lateness into a histogram: the p50/p99
+    objects read it; cnc_cycle_stats_reset_w (ResetCycleStats) starts the figures again."""
+    k = Kernel(build_config(), RealtimeClock(0.001))
+    k.start()
+    try:
+        lateness = k.lateness
+        assert lateness is not None
+        deadline = time.monotonic() + 5
+        while lateness.total < 20:
+            assert time.monotonic() < deadline, "no cycles counted"
+            time.sleep(0.01)
+        for _ in range(100 * lateness.total):  # as if nearly every cycle had been 50 ms late
+            lateness.add(50_000)
+        k.stats.overruns, k.stats.jitter_max_us = 1000, 50_000
+        assert lateness.percentile_us(0.5) == 50_010
+        assert submit(k, ResetCycleStats(False)) is None  # FALSE: nothing happens
+        assert lateness.percentile_us(0.5) == 50_010
+        assert submit(k, ResetCycleStats(True)) is None
+        assert lateness.total < 20 and lateness.percentile_us(0.99) < 50_000
+        assert k.stats.overruns < 1000 and k.stats.jitter_max_us < 50_000
+    finally:
+        k.close()
+
+
+def test_the_virtual_clock_keeps_no_lateness(kernel: Kernel) -> None:
+    assert kernel.lateness is None
+    assert submit(kernel, ResetCycleStats(True)) is None
