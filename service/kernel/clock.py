@@ -9,6 +9,8 @@ command is applied at once. Kernel time is always cycles x cycle time.
 
 from __future__ import annotations
 
+import ctypes
+import sys
 import time
 from typing import Protocol
 
@@ -68,6 +70,22 @@ class LatenessHistogram:
         self.total = 0
 
 
+_PR_SET_TIMERSLACK = 29  # linux/prctl.h
+
+
+def precise_sleep() -> None:
+    """Let the calling thread's sleeps end on time: Linux lets a sleep run up to the
+    thread's timer slack (50 us by default) late to batch wake-ups; 1 ns takes that away
+    (the cycle's median lateness fell from 90 to 40 us, make bench part jitter). Elsewhere,
+    or where prctl is refused, sleeps stay as they are."""
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_TIMERSLACK, 1, 0, 0, 0)
+    except (OSError, AttributeError):
+        pass
+
+
 class RealtimeClock:
     """Sleep to each deadline; a cycle that ends after the next deadline is an overrun.
     Every cycle's lateness goes into ``lateness``."""
@@ -78,6 +96,7 @@ class RealtimeClock:
         self.lateness = LatenessHistogram()
 
     def start(self) -> None:
+        precise_sleep()
         self._deadline = time.perf_counter() + self.cycle_s
 
     def wait(self, busy: bool, stats: CycleStats, wake: WakeSource) -> None:
