@@ -162,6 +162,8 @@ class ChannelRunner:
     def select_program(self, name: str) -> Refusal | None:
         """Select ``name`` from the program store: AUTOMATIC/READY."""
         ch = self.channel
+        if ch.state == ChannelState.ERROR:
+            return _not_ready(ch, f"cannot select {name!r} before RESET, which clears the error")
         if ch.state not in IDLE_STATES:
             return _not_ready(ch, f"cannot select {name!r} while it works; hold and RESET first")
         if not name or not self._exists(name):

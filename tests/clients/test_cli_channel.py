@@ -77,6 +77,12 @@ def test_run_in_error_is_refused_naming_the_error_until_reset(
                                "far.nc:1:1: axis 1 would reach 5000.0000 mm"), line
         assert "needs a RESET first, which clears the error (cnc reset)" in line
         assert "works" not in line and "working" not in line
+    # the service's own words, without the client's rewording: a plain write of the name
+    plain = cnc("write", "ch1.mc_command_program_name_w", "good.nc", endpoint=ep)
+    assert plain.returncode == 1, plain.stdout
+    assert "ADS 0x707" in plain.stderr and "ERROR" in plain.stderr, plain.stderr
+    assert "before RESET, which clears the error" in plain.stderr, plain.stderr
+    assert "works" not in plain.stderr, plain.stderr
     status = cnc("status", endpoint=ep).stdout.splitlines()
     assert status[-1] == "RESET clears the error (cnc reset)"
     assert cnc("reset", endpoint=ep).returncode == 0
