@@ -17,6 +17,9 @@ echo server and against the service, and ``read_list_by_name`` of 100 symbols
 Jitter part (``--part jitter``): the realtime cycle's lateness (p50, p99, max) and
 overruns while the service answers 5 000 reads/s and feeds 20 on-change subscriptions
 during a run (``bench/jitter_bench.py``).
+Virtual part (``--part virtual``): simulated seconds per wall second of the whole service
+on the virtual clock for the pocket, a 10 000-block spiral and a one-hour part, with no
+and with 20 on-change subscriptions (``bench/virtual_bench.py``).
 Dispatch part (``--part dispatch``):
 
 Baseline: a raw pyzmq ROUTER in a second process that answers each msgpack frame with a
@@ -194,11 +197,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
     parser.add_argument("--part", choices=("all", "dispatch", "ads", "kernel", "jitter",
-                                           "lookahead"),
+                                           "virtual", "lookahead"),
                         default="all",
                         help="dispatch: request dispatch (ZeroMQ); ads: pyads over AMS/TCP; "
                         "kernel: decoder, interpolator, planner; jitter: the realtime cycle "
-                        "under load; lookahead: machining time against the optimum")
+                        "under load; virtual: whole-service virtual time speed; lookahead: "
+                        "machining time against the optimum")
     parser.add_argument("--jitter-s", type=float, default=20.0,
                         help="seconds of load per jitter run (issue 22 asks 60)")
     args = parser.parse_args(argv)
@@ -214,6 +218,10 @@ def main(argv: list[str] | None = None) -> int:
         from . import jitter_bench
 
         jitter_bench.main(min(args.runs, 3), args.jitter_s)
+    if args.part in ("all", "virtual"):
+        from . import virtual_bench
+
+        virtual_bench.main(min(args.runs, 3))
     if args.part in ("all", "lookahead"):
         from . import lookahead_bench
 
