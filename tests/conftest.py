@@ -10,6 +10,7 @@ from __future__ import annotations
 import pytest
 
 from cnc_objects.testing import ServiceProcess
+from tests.support.network import own_non_loopback_ipv4
 
 pytest_plugins = ["pytester"]  # the plugin's own tests run pytest on small test files
 
@@ -30,3 +31,13 @@ def shared_service(cnc_shared_service: ServiceProcess) -> ServiceProcess:
 def endpoint(shared_service: ServiceProcess) -> str:
     """Endpoint of the shared service."""
     return shared_service.endpoint
+
+
+@pytest.fixture
+def non_loopback_ipv4() -> str:
+    """This machine's IPv4 address that is not loopback (a peer the loopback rule does
+    not cover); the test is skipped, saying why, on a machine that has none."""
+    address = own_non_loopback_ipv4()
+    if address is None:
+        pytest.skip("this machine has no IPv4 address besides loopback")
+    return address

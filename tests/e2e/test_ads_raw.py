@@ -286,22 +286,11 @@ def test_the_route_decision() -> None:
     assert not routes.admit("not an address").allowed
 
 
-def _own_non_loopback_ipv4() -> str | None:
-    """An IPv4 address of this machine that is not loopback, if it has one."""
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        try:
-            probe.connect(("192.0.2.1", 9))  # no packet is sent: only a route is looked up
-        except OSError:
-            return None
-        address = probe.getsockname()[0]
-    return None if address.startswith("127.") else address
-
-
-def test_a_peer_without_a_route_is_refused_and_a_routed_one_served(tmp_path: Path) -> None:
+def test_a_peer_without_a_route_is_refused_and_a_routed_one_served(
+    tmp_path: Path, non_loopback_ipv4: str
+) -> None:
     """A real non-loopback peer: this machine's own network address, bound on both ends."""
-    address = _own_non_loopback_ipv4()
-    if address is None:
-        pytest.skip("this machine has no IPv4 address besides loopback")
+    address = non_loopback_ipv4
     routed_net_id = f"{address}.1.1"
     config = tmp_path / "routes.toml"
     config.write_text(f'[[ads.routes]]\nname = "hmi"\nnet_id = "{routed_net_id}"\n'

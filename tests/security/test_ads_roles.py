@@ -13,11 +13,8 @@ from __future__ import annotations
 import struct
 from pathlib import Path
 
-import pytest
-
 from cnc_objects.testing import ServiceProcess, serving
 from tests.e2e.test_ads_raw import COM, READ, READ_WRITE, WRITE, RawAds, read, read_write, write
-from tests.e2e.test_ads_raw import _own_non_loopback_ipv4 as own_non_loopback_ipv4
 
 CH1_COM = 0x120101
 FEED_W, FEED_R = 0x09, 0x0C  # ch1 feed override, commanded and active (UNS16)
@@ -64,10 +61,8 @@ class Ams(RawAds):
         return list(struct.unpack_from(f"<{len(values)}I", reply, 4))
 
 
-def test_each_route_has_its_role(tmp_path: Path) -> None:
-    address = own_non_loopback_ipv4()
-    if address is None:
-        pytest.skip("this machine has no IPv4 address besides loopback")
+def test_each_route_has_its_role(tmp_path: Path, non_loopback_ipv4: str) -> None:
+    address = non_loopback_ipv4
     config = tmp_path / "routes.toml"
     config.write_text(
         f'[[ads.routes]]\nname = "panel"\nnet_id = "{address}.1.1"\naddress = "{address}"\n'
@@ -120,10 +115,8 @@ def test_the_loopback_role_is_configurable(tmp_path: Path) -> None:
             ams.close()
 
 
-def test_insecure_serves_every_peer_as_loopback(tmp_path: Path) -> None:
-    address = own_non_loopback_ipv4()
-    if address is None:
-        pytest.skip("this machine has no IPv4 address besides loopback")
+def test_insecure_serves_every_peer_as_loopback(non_loopback_ipv4: str) -> None:
+    address = non_loopback_ipv4
     with serving("--insecure", ads=f"{address}:0") as service:
         ams = Ams(service, source=address)
         try:
