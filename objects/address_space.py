@@ -175,7 +175,10 @@ class AddressSpace:
         getter, dtype = entry.read, entry.obj.dtype
         if getter is not None and length == dtype.size:
             try:
-                return 0, dtype.encode(getter())
+                value = getter()
+                if dtype.kind == "str":  # a text of the CNC's own is made to fit, not refused
+                    return 0, dtype.encode_fitted(value)
+                return 0, dtype.encode(value)
             except Exception:  # a getter fault must not take the service down
                 log.exception("reading %s failed", entry.obj.name)
                 return _E.DEVICE_ERROR, f"reading {entry.obj.name} failed inside the service"

@@ -75,6 +75,11 @@ class DataType:
             case _:
                 return self._struct.unpack(data)[0]  # type: ignore[union-attr]
 
+    def encode_fitted(self, text: str) -> bytes:
+        """A STRING value the CNC produced, made to fit (``fit_string``) and encoded: what
+        a read of a kernel text answers, where ``encode`` would refuse it."""
+        return _fitted(text, self.size).ljust(self.size, b"\x00")
+
     def _encode_string(self, value: Any) -> bytes:
         if not isinstance(value, str):
             raise TypeError(f"{self.name} takes a string, not {value!r}")
@@ -99,11 +104,16 @@ def fit_string(text: str, size: int) -> str:
     (error and message texts, names): a NUL or a character CP1252 lacks becomes "?", and
     a text longer than ``size - 1`` bytes is cut and ends in an ellipsis. ``encode`` still
     refuses such values from a client; this is for showing what the kernel has to say."""
+    return _fitted(text, size).decode(STRING_ENCODING)
+
+
+def _fitted(text: str, size: int) -> bytes:
+    """The CP1252 bytes of ``fit_string`` (without the NUL padding)."""
     fitted = text.encode(STRING_ENCODING, errors="replace").replace(b"\x00", b"?")
     if len(fitted) > size - 1:
         fitted = fitted[: max(size - 2, 0)] + ELLIPSIS.encode(STRING_ENCODING)
         fitted = fitted[: size - 1]
-    return fitted.decode(STRING_ENCODING)
+    return fitted
 
 
 def _integer(name: str, size: int, signed: bool, iec: str) -> DataType:

@@ -15,7 +15,6 @@ from cnc_objects.objects.addressing import LOGICAL_BIT, GroupBase, index_based
 from cnc_objects.objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS, MACHINING_FIELDS
 from cnc_objects.objects.directory import ObjectDirectory
 from cnc_objects.protocol.constants import CncPort
-from cnc_objects.protocol.datatypes import fit_string
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from . import __version__
@@ -462,15 +461,6 @@ def _aliases(kernel: Kernel, obj: CncObject) -> list[int]:
     return aliases
 
 
-def _fitted(read: Getter, size: int) -> Getter:
-    """``read`` with its text made to fit the object's STRING buffer: a kernel text (an NC
-    error that quotes a NUL, a name of 300 characters) stays readable, cut or with "?"."""
-    def get() -> str:
-        return fit_string(read(), size)
-
-    return get
-
-
 def build_address_space(
     kernel: Kernel, notifications: NotificationCounts | None = None
 ) -> AddressSpace:
@@ -485,8 +475,6 @@ def build_address_space(
             read = service(counts)
         else:
             read = READERS[obj.element](kernel, obj) if obj.access.readable else None
-        if read is not None and obj.dtype.kind == "str":
-            read = _fitted(read, obj.dtype.size)
         write = WRITERS[obj.element](kernel, obj) if obj.access.writable else None
         space.add(obj, read, write, _aliases(kernel, obj))
     # Platform-axis objects (ac_*) are left out: their element names repeat per axis.

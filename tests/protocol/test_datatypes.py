@@ -343,6 +343,14 @@ def test_a_kernel_text_is_fitted_to_its_string_buffer(text: str, size: int, fitt
     STRING(size).encode(fitted)  # and encodes
 
 
+def test_a_kernel_text_is_encoded_fitted_where_encode_refuses_it() -> None:
+    """What a read of a kernel text answers: the fitted text, NUL-padded to the size."""
+    assert STRING(8).encode_fitted("a\x00b") == b"a?b\x00\x00\x00\x00\x00"
+    assert STRING(5).encode_fitted("abcdef") == b"abc\x85\x00"
+    with pytest.raises(ValueError):
+        STRING(5).encode("abcdef")
+
+
 @given(st.text(max_size=400), st.integers(1, 300))
 def test_every_fitted_text_encodes(text: str, size: int) -> None:
     STRING(size).encode(fit_string(text, size))
