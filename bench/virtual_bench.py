@@ -51,13 +51,12 @@ async def _run(endpoint: str, name: str, data: bytes, subscriptions: int) -> tup
         await c.wait_mdi(await c.mdi("G90 G0 X0 Y0 Z0"))  # every run from the origin
         tasks = []
         opened = asyncio.Event()
-        count = 0
+        sampled: set[str] = set()
 
         async def watch(obj: str) -> None:
-            nonlocal count
             async for _ in watcher.subscribe(obj):
-                count += 1
-                if count >= subscriptions:
+                sampled.add(obj)
+                if len(sampled) >= subscriptions:
                     opened.set()
 
         for obj in WATCHED[:subscriptions]:

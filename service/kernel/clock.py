@@ -18,7 +18,10 @@ from .state import CycleStats
 
 
 class Clock(Protocol):
-    """Decides when the next cycle starts."""
+    """Decides when the next cycle starts; ``lateness`` of the cycle starts against their
+    deadlines, where there are deadlines (None: virtual time has none)."""
+
+    lateness: LatenessHistogram | None
 
     def start(self) -> None:
         """Called once before the first cycle."""
@@ -130,6 +133,7 @@ class VirtualClock:
     def __init__(self, cycle_s: float, speed: float | None = None) -> None:
         self.cycle_s = cycle_s
         self.speed = speed
+        self.lateness: LatenessHistogram | None = None  # no deadlines in virtual time
         self._deadline = 0.0
         self._busy_cycles = 0
 

@@ -89,7 +89,7 @@ class Kernel:
         self.state = self._initial_state()
         self.stats = CycleStats(cycle_us=round(config.cycle_ms * 1000))
         # cycle lateness per cycle (realtime clock only): kept by the clock, read live
-        self.lateness: LatenessHistogram | None = getattr(clock, "lateness", None)
+        self.lateness: LatenessHistogram | None = clock.lateness
         self.snapshot: Snapshot = self.state.snapshot(0, 0, time.time_ns(), self.stats)
         self.on_cycle_end: Callable[[Snapshot], None] | None = None
         self._queue: queue.SimpleQueue = queue.SimpleQueue()
