@@ -21,8 +21,8 @@ from tests.limits.wire import (
     Raw,
     limited_service,
     next_id,
-    rss_kib,
 )
+from tests.support.resources import rss_kib
 
 LIMIT_BYTES = 64 << 10
 HARD_CAP_BYTES = 2 * LIMIT_BYTES

@@ -16,9 +16,9 @@ from tests.limits.wire import (
     limited_service,
     next_id,
     read_frame,
-    rss_kib,
     wait_until,
 )
+from tests.support.resources import rss_kib
 
 READS = 100_000
 #: What one queued reply of a 256-byte read costs the service (measured: about 270 bytes

@@ -65,14 +65,6 @@ def limited_service(tmp_path: Path, *args: str, ads: bool | str = False,
         yield service
 
 
-def rss_kib(pid: int) -> int:
-    """Resident memory of process ``pid`` in KiB."""
-    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-        if line.startswith("VmRSS:"):
-            return int(line.split()[1])
-    raise RuntimeError(f"/proc/{pid}/status has no VmRSS line")
-
-
 class Raw:
     """One DEALER socket to the service, speaking raw frames."""
 

@@ -13,7 +13,6 @@ import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TypeVar
 
 import msgpack
@@ -37,14 +36,6 @@ FAULT_LINES = re.compile(r"Traceback|cycle thread failed|handling .* failed|Exce
 
 #: cnc_tick_counter_r: cycles run by the GEO task (port 553, UNS32).
 TICK_ADDRESS = (CncPort.COM, 0x120100, 0x1011)
-
-
-def rss_kib(pid: int) -> int:
-    """Resident memory of process ``pid`` in KiB (``VmRSS`` of /proc/<pid>/status)."""
-    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-        if line.startswith("VmRSS:"):
-            return int(line.split()[1])
-    raise RuntimeError(f"/proc/{pid}/status has no VmRSS line")
 
 
 class RawConnection:

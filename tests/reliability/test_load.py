@@ -34,8 +34,9 @@ from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.frames import ReadRequest, ReadWriteRequest, WriteRequest
 from cnc_objects.testing import ServiceProcess, serving
 from tests.reliability import figures
-from tests.reliability.health import assert_well, rss_kib, vitals
+from tests.reliability.health import assert_well, vitals
 from tests.reliability.scale import Scale
+from tests.support.resources import rss_kib
 
 REQUEST_TIMEOUT_S = 30.0  # one request under full load on a busy 2-core machine
 NODE = "tests/reliability/test_load.py"

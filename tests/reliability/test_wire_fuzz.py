@@ -38,7 +38,6 @@ from tests.reliability.health import (
     RawConnection,
     Vitals,
     assert_well,
-    rss_kib,
     vitals,
     wait_for_tick_after,
 )
@@ -51,6 +50,7 @@ from tests.reliability.wire_fuzz import (
     expected_reply,
     batches,
 )
+from tests.support.resources import rss_kib
 
 #: Frames per hypothesis example; a health check follows every ``Scale.wire_batch``.
 FRAMES_PER_EXAMPLE = 50

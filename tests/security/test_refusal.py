@@ -17,27 +17,17 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 import zmq.auth
 
 from cnc_objects.clients import AsyncClient, AuthenticationError, Client, ClientValueError
-from cnc_objects.testing import ServiceProcess, serving, start_service
+from cnc_objects.testing import ServiceProcess, serving
 
 TIMEOUT_S = 30.0  # the clients' timeout: every refusal must come far sooner
 QUICK_S = 5.0  # what "at once" means on a busy 2-core machine
 FEED_R = "ch1.mc_command_feed_override_r"
-
-
-@pytest.fixture(scope="module")
-def keyed() -> Iterator[ServiceProcess]:
-    service = start_service(keys=True)
-    try:
-        yield service
-    finally:
-        assert service.stop() == 0, service.log_text
 
 
 @pytest.fixture

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import asyncio
 import struct
-from collections.abc import Iterator
 
 import pytest
 
@@ -24,16 +23,6 @@ CH1_COM, CH2_COM = 0x120101, 0x120102
 FEED_W, FEED_R = "ch1.mc_command_feed_override_w", "ch1.mc_command_feed_override_r"
 PROGRAM = b"N10 G01 X1 F6000\nN20 G01 X0\nN30 M30\n"
 INVALIDACCESS = 0x704
-
-
-@pytest.fixture(scope="module")
-def keyed() -> Iterator[ServiceProcess]:
-    """One service with keys for the module: it only grows programs and feed overrides."""
-    service = start_service(keys=True)
-    try:
-        yield service
-    finally:
-        assert service.stop() == 0, service.log_text
 
 
 def client(service: ServiceProcess, role: str) -> Client:
