@@ -25,11 +25,13 @@ from tests.support.service import RunningService, start_service
 
 SIZE = (110, 48)  # the HMI's tables want about 110 columns
 WAIT_S = 15.0  # generous: the machine running the tests may be busy
-# 20 blocks of 1 mm at 6 mm/min: 200 s of kernel time, seconds of wall time even with the
-# virtual clock, so the keys act while it runs. The marked area is for look-ahead mode 1.
+# 20 blocks of 1 mm at 1 mm/min: 1200 s of kernel time, many seconds of wall time even
+# with the virtual clock (it runs 100x real time and more: 200 s once ran out before the
+# HMI showed the resumed program ACTIVE), so the keys act while it runs. The marked area
+# is for look-ahead mode 1.
 LONG_PROGRAM = "\n".join(
     ["N5 G90 G17", "N8 #CONTOUR LOOKAHEAD LOG ON [PARAM=7]"]
-    + [f"N{10 * k} G1 X{k} Y{k % 2} F6" for k in range(1, 21)]
+    + [f"N{10 * k} G1 X{k} Y{k % 2} F1" for k in range(1, 21)]
     + ["N300 #CONTOUR LOOKAHEAD LOG OFF", "N310 M30", ""]
 ).encode()
 
@@ -123,7 +125,7 @@ async def test_program_keys_select_start_hold_resume_reset(service: RunningServi
         await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "command") != "0.0000",
                          what="X moves")
         await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "actual") != "0.0000")
-        assert app.channels.cell("ch1", "state") in ("ACTIVE", "HOLD")  # not ended: 200 s
+        assert app.channels.cell("ch1", "state") in ("ACTIVE", "HOLD")  # not ended: 1200 s
         assert app.channels.cell("ch1", "block").startswith("N")
 
         await pilot.press("h")
