@@ -11,6 +11,7 @@ Imports protocol and objects, never service.
 from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.errors import AdsReturnCode
 
+from .blocking import Client
 from .channel_ops import ContourBlock, ContourReply
 from .client import (
     DEFAULT_ENDPOINT,
@@ -18,7 +19,6 @@ from .client import (
     ChannelStatus,
     CheckError,
     CheckResult,
-    Client,
     DeviceInfo,
     ObjectInfo,
     ProgramEntry,

@@ -32,7 +32,7 @@ import typer
 
 from .channel_ops import CONTOUR_BLOCK_TYPES, ChannelStatus, CheckError, CheckResult
 from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
-from .client import Client
+from .blocking import Client
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
 
 EXIT_CHANNEL_ERROR = 4

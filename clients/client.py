@@ -29,13 +29,11 @@ from __future__ import annotations
 
 import contextlib
 import difflib
-import functools
-import inspect
 import os
-from collections.abc import AsyncIterator, Iterable, Iterator
+from collections.abc import AsyncIterator, Coroutine, Iterable, Iterator
 from dataclasses import dataclass, field
 from datetime import UTC, datetime, timedelta
-from typing import Any
+from typing import Any, Self, TypeVar
 
 from cnc_objects.protocol import sum as sums
 from cnc_objects.protocol.constants import AdsState, CncPort, TransmissionMode
@@ -71,6 +69,7 @@ _FILETIME_EPOCH = datetime(1601, 1, 1, tzinfo=UTC)
 _HANDLE_PORT = CncPort.COM  # handles are global in the service; any CNC port serves them
 SUGGESTIONS = 3  # nearest names offered for an unknown one
 _BROWSE_FIELDS = 9  # name .. description: what every service sends
+T = TypeVar("T")
 
 
 @dataclass(frozen=True, slots=True)
@@ -425,33 +424,29 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
                 await self._call(DeleteNotificationRequest, info.port, handle)
 
 
-def _blocking(method: Any) -> Any:
-    """Wrap an AsyncClient method so that it runs to completion on a SyncTransport."""
-    if inspect.isasyncgenfunction(method):
+def run_blocking(coro: Coroutine[Any, Any, T]) -> T:
+    """Run one ``AsyncClient`` coroutine to completion on the blocking transport."""
+    return drive(coro)  # type: ignore[no-any-return]  # drive returns what coro returns
 
-        @functools.wraps(method)
-        def generator(self: Client, *args: Any, **kwargs: Any) -> Iterator[Any]:
-            agen = method(self._core, *args, **kwargs)
+
+def iterate_blocking(agen: AsyncIterator[T]) -> Iterator[T]:
+    """An ``AsyncClient`` async generator as a blocking iterator; leaving the loop closes
+    the generator (a subscription is deleted)."""
+    try:
+        while True:
             try:
-                while True:
-                    try:
-                        yield drive(agen.__anext__())
-                    except StopAsyncIteration:
-                        return
-            finally:
-                drive(agen.aclose())
-
-        return generator
-
-    @functools.wraps(method)
-    def call(self: Client, *args: Any, **kwargs: Any) -> Any:
-        return drive(method(self._core, *args, **kwargs))
-
-    return call
+                yield drive(agen.__anext__())
+            except StopAsyncIteration:
+                return
+    finally:
+        aclose = getattr(agen, "aclose", None)
+        if aclose is not None:
+            drive(aclose())
 
 
-class Client:
-    """Blocking client: the same methods as ``AsyncClient``. Use with ``with``."""
+class BlockingClientBase:
+    """Connection handling of the blocking ``Client`` (``clients/blocking.py``, generated
+    from ``AsyncClient``'s methods)."""
 
     def __init__(
         self,
@@ -468,7 +463,7 @@ class Client:
             endpoint, _transport=SyncTransport(endpoint, timeout_s, curve=curve)
         )
 
-    def __enter__(self) -> Client:
+    def __enter__(self) -> Self:
         drive(self._core._t.open())
         return self
 
@@ -476,11 +471,7 @@ class Client:
         drive(self._core._t.close())
 
 
-for _name, _method in inspect.getmembers(AsyncClient, inspect.isfunction):
-    if not _name.startswith("_"):
-        setattr(Client, _name, _blocking(_method))
-
 __all__ = [
-    "AsyncClient", "ChannelStatus", "CheckError", "CheckResult", "Client", "DeviceInfo",
+    "AsyncClient", "BlockingClientBase", "ChannelStatus", "CheckError", "CheckResult", "DeviceInfo",
     "ObjectInfo", "ProgramEntry", "Sample", "filetime_to_datetime",
 ]
