@@ -18,7 +18,7 @@ from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from . import __version__
-from .config import MachineConfig
+from .machine_config import MachineConfig
 from .kernel.commands import (
     Command,
     Feedhold,

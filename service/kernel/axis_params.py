@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 from enum import IntEnum
 from typing import Any
 
-from ..config import AxisConfig, AxisLimits, MachineConfig
+from ..machine_config import AxisConfig, AxisLimits, MachineConfig
 
 
 class AxisErrorId(IntEnum):

@@ -21,7 +21,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
 
-from ..config import ChannelConfig, MachineConfig
+from ..machine_config import ChannelConfig, MachineConfig
 from .axis_params import AxisErrorId, AxisParameters
 from .channel_mode import (
     IDLE_STATES,

@@ -14,7 +14,7 @@ from typing import Any, NamedTuple
 # Defined with the wire's value sets; the kernel's modules import them from here.
 from cnc_objects.protocol.values import ExecutionMode, LinkState
 
-from ..config import ChannelConfig, MachineConfig
+from ..machine_config import ChannelConfig, MachineConfig
 from .nc.technology import MachiningSettings
 
 MESSAGES_KEPT = 8  # #MSG texts a channel shows (ch<c>.mc_message_<k>_text_r)
