@@ -32,7 +32,7 @@ import difflib
 import os
 from collections.abc import AsyncIterator, Coroutine, Iterable, Iterator
 from dataclasses import dataclass, field
-from datetime import UTC, datetime, timedelta
+from datetime import datetime
 from typing import Any, Self, TypeVar
 
 from cnc_objects.protocol import sum as sums
@@ -40,6 +40,7 @@ from cnc_objects.protocol.constants import AdsState, CncPort, TransmissionMode
 from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
 from cnc_objects.protocol.datatypes import STRING_ENCODING, DataType, parse_type
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.filetime import filetime_to_datetime
 from cnc_objects.protocol.frames import (
     AddNotificationRequest,
     BrowseRequest,
@@ -59,13 +60,12 @@ from .channel_ops import (
 )
 from .curve import client_curve
 from .errors import AdsConnectionError, AdsError, ClientValueError, NoReplyError
-from .path_trace import PathTrace, TraceOps
+from .path_trace import TraceOps
 from .sync_transport import SyncTransport, drive
 from .transport import AsyncTransport
 
 DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
 DEFAULT_TIMEOUT_S = 5.0
-_FILETIME_EPOCH = datetime(1601, 1, 1, tzinfo=UTC)
 _HANDLE_PORT = CncPort.COM  # handles are global in the service; any CNC port serves them
 SUGGESTIONS = 3  # nearest names offered for an unknown one
 _BROWSE_FIELDS = 9  # name .. description: what every service sends
@@ -191,11 +191,6 @@ def _decode(dtype: DataType, data: bytes, what: str) -> Any:
         return dtype.decode(data)
     except ValueError as exc:
         raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, f"{what}: {exc}") from None
-
-
-def filetime_to_datetime(filetime: int) -> datetime:
-    """A FILETIME (100 ns since 1601) as an aware UTC datetime."""
-    return _FILETIME_EPOCH + timedelta(microseconds=filetime // 10)
 
 
 PathText = str | os.PathLike[str]
