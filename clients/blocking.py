@@ -13,14 +13,8 @@ from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.datatypes import DataType
 
 from .channel_ops import ChannelStatus, CheckResult, ContourReply, ProgramEntry
-from .client import (
-    BlockingClientBase,
-    DeviceInfo,
-    ObjectInfo,
-    Sample,
-    iterate_blocking,
-    run_blocking,
-)
+from .client import BlockingClientBase, DeviceInfo, Sample, iterate_blocking, run_blocking
+from .object_info import ObjectInfo
 from .path_trace import PathTrace
 
 

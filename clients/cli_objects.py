@@ -24,7 +24,8 @@ import typer
 from cnc_objects.protocol.datatypes import DataType, parse_type, parse_value
 
 from .cli_app import EXIT_USAGE, Settings, command, emit, fail, out, say_error
-from .client import AsyncClient, ObjectInfo
+from .client import AsyncClient
+from .object_info import ObjectInfo
 from .errors import AdsError, ClientValueError, NoReplyError
 
 EXIT_WATCH_TIMEOUT = 5  # watch --count N --timeout S: a name got fewer than N samples
@@ -75,7 +76,9 @@ def _number(text: str, what: str) -> int:
         raise typer.Exit(EXIT_USAGE) from None
 
 
-def _address(port: str | None, group: str | None, offset: str | None, dtype: str | None):
+def _address(
+    port: str | None, group: str | None, offset: str | None, dtype: str | None
+) -> tuple[int, int, int, DataType] | None:
     given = [x is not None for x in (port, group, offset, dtype)]
     if not any(given):
         return None

@@ -30,10 +30,10 @@ from __future__ import annotations
 import contextlib
 import difflib
 import os
-from collections.abc import AsyncIterator, Coroutine, Iterable, Iterator
-from dataclasses import dataclass, field
+from collections.abc import AsyncGenerator, AsyncIterator, Coroutine, Iterable, Iterator
+from dataclasses import dataclass
 from datetime import datetime
-from typing import Any, Self, TypeVar
+from typing import Any, Self, TypeVar, cast
 
 from cnc_objects.protocol import sum as sums
 from cnc_objects.protocol.constants import AdsState, CncPort, TransmissionMode
@@ -56,10 +56,14 @@ from cnc_objects.protocol.frames import (
 )
 
 from .channel_ops import (
-    ChannelOps, ChannelStatus, CheckError, CheckResult, ProgramEntry, ProgramOps,
+    ChannelStatus,
+    CheckError,
+    CheckResult,
+    ProgramEntry,
 )
 from .curve import client_curve
 from .errors import AdsConnectionError, AdsError, ClientValueError, NoReplyError
+from .object_info import ObjectInfo
 from .path_trace import TraceOps
 from .sync_transport import SyncTransport, drive
 from .transport import AsyncTransport
@@ -68,49 +72,7 @@ DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
 DEFAULT_TIMEOUT_S = 5.0
 _HANDLE_PORT = CncPort.COM  # handles are global in the service; any CNC port serves them
 SUGGESTIONS = 3  # nearest names offered for an unknown one
-_BROWSE_FIELDS = 9  # name .. description: what every service sends
 T = TypeVar("T")
-
-
-@dataclass(frozen=True, slots=True)
-class ObjectInfo:
-    """What the service says about one object (a browse row).
-
-    ``enum`` names the values of an enumeration object (``{3: "READY", ...}`` for
-    ``ch1.mc_active_state_r``); it is empty for every other object, bit sets included.
-    """
-
-    name: str
-    port: int
-    group: int
-    offset: int
-    type: str
-    length: int
-    access: str
-    unit: str
-    description: str
-    # Not hashed: a dict is not hashable, and the name identifies the object anyway.
-    enum: dict[int, str] = field(default_factory=dict, hash=False)
-
-    @property
-    def dtype(self) -> DataType:
-        """The object's data type."""
-        return parse_type(self.type)
-
-    @classmethod
-    def from_row(cls, row: Any) -> ObjectInfo:
-        """The info of one browse descriptor (protocol/frames.py). A row of a service
-        without value names (nine fields) has an empty ``enum``; fields after the ones
-        known here are ignored, so a later service may add more."""
-        try:
-            if len(row) < _BROWSE_FIELDS:
-                raise ValueError(f"{len(row)} fields, at least {_BROWSE_FIELDS} expected")
-            names = row[_BROWSE_FIELDS] if len(row) > _BROWSE_FIELDS else []
-            return cls(*row[:_BROWSE_FIELDS], {int(v): str(n) for v, n in names})
-        except (TypeError, ValueError) as exc:
-            raise AdsError(
-                AdsReturnCode.CLIENT_SYNCRESINVALID, f"malformed browse row {row!r:.80}: {exc}"
-            ) from None
 
 
 @dataclass(frozen=True, slots=True)
@@ -196,7 +158,7 @@ def _decode(dtype: DataType, data: bytes, what: str) -> Any:
 PathText = str | os.PathLike[str]
 
 
-class AsyncClient(ProgramOps, ChannelOps, TraceOps):
+class AsyncClient(TraceOps):
     """Asyncio client of a cnc-objects service. Use with ``async with``.
 
     ``key_file``: this client's CURVE secret key file (``NAME.key_secret``, or ``NAME.key``
@@ -243,6 +205,14 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
             return reply.fields[index]
         except IndexError:
             raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, "reply lacks its data") from None
+
+    def _data(self, reply: Response) -> bytes:
+        """The data bytes of a reply (a Read's or a ReadWrite's)."""
+        data = self._payload(reply)
+        if type(data) is not bytes:
+            raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID,
+                           f"reply data is {type(data).__name__}, not bytes")
+        return data
 
     async def describe(self, name: str) -> ObjectInfo:
         """What the service says about the object ``name`` (cached per connection)."""
@@ -297,7 +267,7 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
 
     async def read_raw(self, port: int, group: int, offset: int, length: int) -> bytes:
         """Read ``length`` raw bytes at an ADS address."""
-        return self._payload(await self._call(ReadRequest, port, group, offset, length))
+        return self._data(await self._call(ReadRequest, port, group, offset, length))
 
     async def read(self, name: str) -> Any:
         """Read the object ``name``."""
@@ -321,7 +291,7 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
     ) -> bytes:
         """ADS ReadWrite at an address: ``data`` in, up to ``read_length`` bytes out."""
         reply = await self._call(ReadWriteRequest, port, group, offset, read_length, data)
-        return self._payload(reply)
+        return self._data(reply)
 
     async def write_raw(self, port: int, group: int, offset: int, data: bytes) -> None:
         """Write raw bytes at an ADS address."""
@@ -384,7 +354,7 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
 
     async def subscribe(
         self, name: str, on_change: bool = True, cycle_ms: int | None = None
-    ) -> AsyncIterator[Sample]:
+    ) -> AsyncGenerator[Sample, None]:
         """Samples of ``name`` as the service sends them (server-side notification).
 
         ``on_change``: a sample when the value changed, checked every ``cycle_ms`` (default:
@@ -421,7 +391,7 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
 
 def run_blocking(coro: Coroutine[Any, Any, T]) -> T:
     """Run one ``AsyncClient`` coroutine to completion on the blocking transport."""
-    return drive(coro)  # type: ignore[no-any-return]  # drive returns what coro returns
+    return drive(coro)
 
 
 def iterate_blocking(agen: AsyncIterator[T]) -> Iterator[T]:
@@ -430,7 +400,8 @@ def iterate_blocking(agen: AsyncIterator[T]) -> Iterator[T]:
     try:
         while True:
             try:
-                yield drive(agen.__anext__())
+                # an async generator's step object has send() and throw(): a coroutine
+                yield drive(cast("Coroutine[Any, Any, T]", agen.__anext__()))
             except StopAsyncIteration:
                 return
     finally:

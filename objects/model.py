@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import Enum, IntEnum
+from typing import Any
 
 from cnc_objects.protocol.datatypes import DataType
 from cnc_objects.protocol.values import value_names
@@ -62,7 +63,7 @@ class CncObject:
         """``{3: "READY", ...}`` for an enumeration object; empty for any other."""
         return value_names(self.values) if self.values is not None else {}
 
-    def describe(self) -> list:
+    def describe(self) -> list[Any]:
         """The browse descriptor: [name, port, group, offset, type, length, access, unit,
         description, value names]. The value names are ``[[value, name], ...]`` (empty
         for an object that is not an enumeration): pairs, because msgpack maps with

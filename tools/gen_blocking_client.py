@@ -27,11 +27,11 @@ TARGET = CLIENTS / "blocking.py"
 #: The async client and its mixins, in method resolution order: (module file, class).
 CLASSES = [
     ("client.py", "AsyncClient"),
-    ("channel_ops.py", "ProgramOps"),
-    ("channel_ops.py", "ChannelOps"),
     ("path_trace.py", "TraceOps"),
+    ("channel_ops.py", "ChannelOps"),
+    ("channel_ops.py", "ProgramOps"),
 ]
-_ASYNC_ITERATOR = "AsyncIterator"
+_ASYNC_ITERATORS = ("AsyncIterator", "AsyncGenerator")
 _TYPING_NAMES = {"Any"}
 _ABC_NAMES = {"Iterable", "Iterator", "Mapping", "Sequence"}
 _LINE_MAX = 99
@@ -85,13 +85,14 @@ def _method(module: str, source: str, fn: ast.AsyncFunctionDef) -> Method:
     assert returns is not None
     iterates = any(isinstance(n, ast.Yield | ast.YieldFrom) for n in ast.walk(fn))
     if iterates:
-        if not returns.startswith(_ASYNC_ITERATOR + "["):
+        kind, _, item = returns.partition("[")
+        if kind not in _ASYNC_ITERATORS:
             raise SystemExit(f"{module}.{fn.name}: an async generator must be annotated "
-                             f"{_ASYNC_ITERATOR}[...]")
-        returns = "Iterator" + returns[len(_ASYNC_ITERATOR):]
+                             "AsyncIterator[...] or AsyncGenerator[...]")
+        returns = f"Iterator[{item.split(',')[0].removesuffix(']')}]"
     if fn.returns is not None:
         annotated.append(fn.returns)
-    names = _used_names(annotated) - {_ASYNC_ITERATOR}
+    names = _used_names(annotated) - set(_ASYNC_ITERATORS)
     if iterates:
         names.add("Iterator")
     return Method(fn.name, module, text, call, returns, iterates,
