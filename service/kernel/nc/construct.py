@@ -9,10 +9,15 @@ result *is* a ``Block`` (``type(b) is Block``, equal to one built the normal way
 from then on).
 
 ``FAST`` tells whether the twins work on this interpreter (checked once at import); if
-not, the make_* functions fall back to the ordinary constructors.
+not, the make_* functions fall back to the ordinary constructors. The environment
+variable ``CNC_PLAIN_CONSTRUCTORS=1`` turns the twins off on purpose: the test suite
+runs the decoder both ways and compares (tests/service/kernel/nc/test_fast_constructors.py),
+so an edit that breaks one of the two paths fails.
 """
 
 from __future__ import annotations
+
+import os
 
 from .blocks import (
     AxisExchange, Block, Compensation, ContourCommand, LookAheadMark, Motion, MotionKind, SourceRef,
@@ -99,7 +104,9 @@ def _check() -> bool:
     return type(block) is Block and block == expected and hash(block) == hash(expected)
 
 
-FAST = _check()
+#: Set to 1 to build with the ordinary constructors (the reference the twins must equal).
+PLAIN_CONSTRUCTORS_ENV = "CNC_PLAIN_CONSTRUCTORS"
+FAST = os.environ.get(PLAIN_CONSTRUCTORS_ENV, "") != "1" and _check()
 if FAST:
     make_source, make_motion, make_block = _fast_source, _fast_motion, _fast_block
 else:  # pragma: no cover - other interpreters
