@@ -94,12 +94,6 @@ class LogicalLine:
         error.pos = pos
         return error
 
-    def first_column(self) -> int:
-        """1-based column of the first non-blank character (1 for an empty line)."""
-        stripped = self.text.lstrip()
-        pos = len(self.text) - len(stripped) if stripped else 0
-        return self.locate(pos)[1]
-
 
 def _upper(text: str) -> str:
     """Upper case with the same length (some characters grow when upper-cased: ß)."""
