@@ -127,3 +127,22 @@ def next_state(state: int, event: ChannelEvent, mode: int, program_selected: boo
     if target is None:
         raise TransitionNotAllowed(state, event)
     return resolve(target, mode, program_selected)
+
+
+def render_table() -> str:
+    """``TRANSITIONS`` as a Markdown table (docs/kernel.md shows it; a test compares)."""
+    events = list(ChannelEvent)
+    lines = ["| state \\ event | " + " | ".join(e.name for e in events) + " |",
+             "|---" * (len(events) + 1) + "|"]
+    for state, row in TRANSITIONS.items():
+        cells = []
+        for event in events:
+            target = row.get(event)
+            if target is None:
+                cells.append("-")
+            elif isinstance(target, Target):
+                cells.append(f"*{target.value}*")
+            else:
+                cells.append(target.name)
+        lines.append(f"| {state.name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)

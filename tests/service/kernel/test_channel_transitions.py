@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -24,6 +25,7 @@ from cnc_objects.service.kernel.channel_transitions import (
     TransitionNotAllowed,
     allowed,
     next_state,
+    render_table,
     resolve,
 )
 from cnc_objects.service.kernel.commands import (
@@ -357,6 +359,11 @@ def test_an_internal_event_outside_the_table_raises(harness, state, event) -> No
 def test_the_idle_states_are_those_that_may_choose_a_mode_or_start() -> None:
     for event in (E.SELECT_MODE, E.SELECT_PROGRAM, E.START):
         assert {s for s in S if allowed(s, event)} == IDLE_STATES
+
+
+def test_docs_show_the_table_as_it_is() -> None:
+    kernel_md = (Path(__file__).parents[3] / "docs" / "kernel.md").read_text()
+    assert render_table() in kernel_md
 
 
 def test_reset_and_fail_are_allowed_in_every_state() -> None:
