@@ -97,6 +97,8 @@ class ChannelRun(Protocol):
 class ProgramRun:
     """A real run: blocks from the decoder move the channel's axes along the path."""
 
+    _waits_for_decoder = False  # PROD_TIME: every take waits for the decoder
+
     def __init__(self, host: RunHost, channel: Channel, feed: DecoderFeed,
                  executor: PathExecutor, contour: ContourLog | None, *,
                  started_at_s: float, buffer_blocks: int, deterministic: bool) -> None:
@@ -300,8 +302,6 @@ class ProgramRun:
                     if contour.end_of_data():
                         self._warn_log_full()
                     self._show_contour_state()
-
-    _waits_for_decoder = False  # PROD_TIME: every take waits for the decoder
 
     def _section_pending(self) -> int:
         """Blocks of the planned LA_ON section still to come after the last one pushed:
