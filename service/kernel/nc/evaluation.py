@@ -65,7 +65,7 @@ class VarRef:
         self.line = line
         self.pos = pos
 
-    def _resolve(self, env: Any) -> tuple[Variable, tuple[int, ...]]:
+    def _resolve(self, env: Env) -> tuple[Variable, tuple[int, ...]]:
         var = env.find_variable(self.scope, self.name)
         if var is None:
             raise self.line.error(
@@ -75,14 +75,14 @@ class VarRef:
             return var, ()
         return var, tuple(_index(node(env), self.line, self.pos) for node in self.indices)
 
-    def __call__(self, env: Any) -> Value:
+    def __call__(self, env: Env) -> Value:
         var, indices = self._resolve(env)
         try:
             return var.get(indices)
         except Fault as f:
             raise self.line.error(f.err_id, f.message, self.pos) from None
 
-    def assign(self, env: Any, value: Value) -> None:
+    def assign(self, env: Env, value: Value) -> None:
         """Store ``value`` (converted to the variable's type)."""
         var, indices = self._resolve(env)
         try:
@@ -280,7 +280,7 @@ def xor_op(a: Value, b: Value) -> Value:
     return (a != 0) != (b != 0)
 
 
-def evaluate_number(node: Node | float, env: Any, line: LogicalLine, pos: int) -> float:
+def evaluate_number(node: Node | float, env: Env, line: LogicalLine, pos: int) -> float:
     """A word value: a parsed constant or an evaluated node, as a finite float."""
     value = node if isinstance(node, float) else number(node(env), line, pos)
     if not math.isfinite(value):
