@@ -18,6 +18,7 @@ so an edit that breaks one of the two paths fails.
 from __future__ import annotations
 
 import os
+from typing import Any, cast
 
 from .blocks import (
     AxisExchange, Block, Compensation, ContourCommand, LookAheadMark, Motion, MotionKind, SourceRef,
@@ -27,7 +28,7 @@ from .blocks import (
 
 def _twin(cls: type) -> type:
     """A mutable class with the slots of ``cls``, in the same order."""
-    return type(f"_Mutable{cls.__name__}", (), {"__slots__": cls.__slots__})
+    return type(f"_Mutable{cls.__name__}", (), {"__slots__": cls.__dict__["__slots__"]})
 
 
 SourceRefTwin = _twin(SourceRef)
@@ -37,13 +38,14 @@ new = object.__new__
 
 
 def _fast_source(file: str, line: int, column: int, offset: int) -> SourceRef:
-    s = new(SourceRefTwin)
+    # a twin's attributes are its slots, unknown to the type checker: Any until cast
+    s: Any = new(SourceRefTwin)
     s.file = file
     s.line = line
     s.column = column
     s.offset = offset
     s.__class__ = SourceRef
-    return s
+    return cast(SourceRef, s)
 
 
 def _fast_motion(
@@ -51,7 +53,7 @@ def _fast_motion(
     feed_mm_s: float, plane: tuple[int, int], center_mm: tuple[float, float] | None,
     compensation: Compensation, tool_radius_mm: float,
 ) -> Motion:
-    m = new(MotionTwin)
+    m: Any = new(MotionTwin)
     m.kind = kind
     m.start_mm = start_mm
     m.end_mm = end_mm
@@ -61,7 +63,7 @@ def _fast_motion(
     m.compensation = compensation
     m.tool_radius_mm = tool_radius_mm
     m.__class__ = Motion
-    return m
+    return cast(Motion, m)
 
 
 def _fast_block(
@@ -70,7 +72,7 @@ def _fast_block(
     tool: int | None, manual: bool, axis_exchange: AxisExchange | None = None,
     contour: ContourCommand | None = None, look_ahead: LookAheadMark | None = None,
 ) -> Block:
-    b = new(BlockTwin)
+    b: Any = new(BlockTwin)
     b.source = source
     b.number = number
     b.motion = motion
@@ -84,7 +86,7 @@ def _fast_block(
     b.contour = contour
     b.look_ahead = look_ahead
     b.__class__ = Block
-    return b
+    return cast(Block, b)
 
 
 def _check() -> bool:
