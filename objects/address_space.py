@@ -189,6 +189,20 @@ class AddressSpace:
             f"{entry.obj.name} is {dtype.name}, {dtype.size} bytes; read asked {length}",
         )
 
+    @classmethod
+    def read_entry_buffer(cls, entry: Entry, length: int) -> tuple[int, bytes | str]:
+        """Read ``entry`` into a buffer of ``length`` bytes, as TwinCAT answers a read by
+        handle or by name: a buffer at least the value's size gets the value (its own
+        size, however large the buffer: clients that do not know the size send
+        0xFFFFFFFF), a smaller one 0x705, except a STRING, whose buffer is cut to it."""
+        size = entry.obj.dtype.size
+        if length >= size:
+            return cls.read_entry(entry, size)
+        if entry.obj.dtype.kind == "str":
+            code, data = cls.read_entry(entry, size)
+            return (code, data) if code else (0, data[:length])
+        return cls.read_entry(entry, length)  # the 0x705 that names the size
+
     def decode_write(
         self, port: int, group: int, offset: int, data: bytes
     ) -> tuple[int, Entry | str, Any]:

@@ -28,7 +28,6 @@ from cnc_objects.objects import AddressSpace, Entry
 from cnc_objects.protocol.constants import (
     DEVICE_DATA_ADS_STATE,
     DEVICE_DATA_DEVICE_STATE,
-    MAX_DATA_BYTES,
     AdsState,
     AmsPort,
     CncPort,
@@ -101,13 +100,11 @@ class Backend:
 
     def read_value(self, port: int, group: int, offset: int, length: int) -> ValueResult:
         """Read at an address, reserved groups included: (0, data) or (code, message)."""
-        if length > MAX_DATA_BYTES:
-            return _E.DEVICE_INVALIDSIZE, f"read length {length} exceeds {MAX_DATA_BYTES} bytes"
         if group == RIG.SYM_VALUE_BY_HANDLE:
             entry = self.space.by_handle(offset)
             if entry is None:
                 return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown"
-            return self.space.read_entry(entry, length)
+            return self.space.read_entry_buffer(entry, length)
         if group == RIG.DEVICE_DATA and port == CncPort.PLC:
             return self._device_data(offset, length)
         symbols = self.symbols
@@ -138,16 +135,17 @@ class Backend:
         return AdsState.STOP
 
     def _device_data(self, offset: int, length: int) -> ValueResult:
+        """ADS state and device state (UINT each) from ``offset`` on, as much of them as
+        the read length holds: the length is a buffer size, as in TwinCAT."""
         state = self.ads_state(CncPort.PLC)
-        if offset == DEVICE_DATA_ADS_STATE and length == 4:
-            return 0, _U16.pack(state) + _U16.pack(0)
         if offset not in (DEVICE_DATA_ADS_STATE, DEVICE_DATA_DEVICE_STATE):
             return (_E.DEVICE_INVALIDOFFSET,
                     f"device data has offset 0 (ADS state) and 2 (device state), not {offset}")
-        if length != 2:
+        fields = (_U16.pack(state) + _U16.pack(0))[offset:]
+        if length < 2:
             return (_E.DEVICE_INVALIDSIZE,
                     f"device data fields are UINT, 2 bytes; read asked {length}")
-        return 0, _U16.pack(state if offset == DEVICE_DATA_ADS_STATE else 0)
+        return 0, fields[: 2 * min(length // 2, len(fields) // 2)]
 
     def read_write_value(
         self, port: int, group: int, offset: int, read_length: int, data: bytes
@@ -163,9 +161,9 @@ class Backend:
             if entry is None:
                 return _E.DEVICE_SYMBOLNOTFOUND, f"no object is named {name!r}"
             if group == RIG.SYM_VALUE_BY_NAME:
-                return self.space.read_entry(entry, read_length)
-            if read_length != 4:
-                return _E.DEVICE_INVALIDSIZE, "a handle is 4 bytes: read length must be 4"
+                return self.space.read_entry_buffer(entry, read_length)
+            if read_length < 4:
+                return _E.DEVICE_INVALIDSIZE, f"a handle is 4 bytes; read length is {read_length}"
             return 0, _U32.pack(entry.handle)
         symbols = self.symbols
         if symbols is not None and symbols.handles(group):
@@ -173,7 +171,10 @@ class Backend:
         found = self.space.find(port, group, offset)
         if isinstance(found, tuple):
             return found
-        return _E.DEVICE_SRVNOTSUPP, f"{found.obj.name} does not take ReadWrite; use Read or Write"
+        if not data:  # a ReadWrite that writes nothing reads, the length a buffer size
+            return self.space.read_entry_buffer(found, read_length)
+        return (_E.DEVICE_SRVNOTSUPP,
+                f"{found.obj.name} takes ReadWrite without data (a read); write with Write")
 
     # ------------------------------------------------------------ writes
 

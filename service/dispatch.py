@@ -271,11 +271,8 @@ class Dispatcher:
     # ------------------------------------------------------------ read-write
 
     def _read_write(self, envelope: Envelope, req: ReadWriteRequest, role: Role = _ADMIN) -> Reply:
-        if req.read_length > MAX_DATA_BYTES:
-            return self._error(
-                envelope, req, _E.DEVICE_INVALIDSIZE,
-                f"read length {req.read_length} exceeds {MAX_DATA_BYTES} bytes",
-            )
+        # The read length is a buffer size (TwinCAT: 0xFFFFFFFF when the client does not
+        # know the size); each service answers with its data's real length.
         handler = self._read_write_groups.get(req.group)
         if handler is not None:  # a sum command
             if req.group == RIG.SUM_WRITE and role is not _ADMIN:
@@ -354,4 +351,11 @@ class Dispatcher:
             code, data = self.backend.read_write_value(
                 req.port, item.group, item.offset, item.read_length, item.data)
             results.append((code, b"") if code else (0, data))
-        return self._ok(envelope, req, sums.encode_sum_read_write_reply(results))
+        reply = sums.encode_sum_read_write_reply(results)
+        if len(reply) > min(req.read_length, MAX_DATA_BYTES):
+            return self._error(
+                envelope, req, _E.DEVICE_INVALIDSIZE,
+                f"sum read-write of these items returns {len(reply)} bytes; read length is "
+                f"{req.read_length} (at most {MAX_DATA_BYTES})",
+            )
+        return self._ok(envelope, req, reply)

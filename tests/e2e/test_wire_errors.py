@@ -344,14 +344,17 @@ def test_write_with_wrong_data_length_is_0x705(cnc_service: ServiceProcess) -> N
         sock.close(linger=0)
 
 
-def test_huge_read_length_is_0x705(client: zmq.Socket) -> None:
+def test_huge_read_length_at_an_address_is_0x705_by_name_a_buffer_size(client: zmq.Socket) -> None:
+    """An object at its address is read with its size; a read by name takes the read
+    length as a buffer size (TwinCAT: 0xFFFFFFFF when the client does not know it)."""
     port, group, offset, _ = NUMBER_OF_AXES
     read_error(client, (port, group, offset, 0xFFFFFFFF), INVALIDSIZE)
     invoke_id = next_id()
     reply = request(
-        client, read_write_frame(invoke_id, COM, 0xF003, 0, 0xFFFFFFFF, b"cnc_tick_counter_r\0")
+        client, read_write_frame(invoke_id, COM, 0xF004, 0, 0xFFFFFFFF, b"cnc_tick_counter_r\0")
     )
-    assert_error(reply, invoke_id, READ_WRITE, INVALIDSIZE)
+    (data,) = assert_ok(reply, invoke_id, READ_WRITE)
+    assert len(data) == 4  # UNS32
     assert_serves(client)
 
 
