@@ -48,6 +48,14 @@ class GroupHandler(Protocol):
 _INDEX = re.compile(r"\[\d+\]")
 
 
+def name_key(name: str) -> str:
+    """The key a name is looked up by: case-insensitive, as TwinCAT's symbol names, and
+    without the ``^`` of pointer dereferences, since ISG's HLI documentation writes
+    paths through the pointers (``gpCh[0]^.bahn_mc_control``) and the symbols are named
+    without them (``gpCh[0].bahn_mc_control``)."""
+    return name.lower().replace("^", "")
+
+
 def _glob(pattern: str) -> re.Pattern[str]:
     """A regex for a glob: ``*``, ``?`` and ``[...]`` classes as in fnmatch, except that
     a bracketed number (``[0]``) is literal, as the index in a PLC name.
@@ -123,8 +131,8 @@ class AddressSpace:
         return [e.obj for e in self._entries]
 
     def by_name(self, name: str) -> Entry | None:
-        """The entry named ``name`` (case-insensitive), or None."""
-        return self._by_name.get(name.lower())
+        """The entry named ``name`` (case-insensitive, ``^`` ignored), or None."""
+        return self._by_name.get(name_key(name))
 
     def by_handle(self, handle: int) -> Entry | None:
         """The entry whose handle is ``handle``, or None."""

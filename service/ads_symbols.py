@@ -46,7 +46,7 @@ import zlib
 from collections.abc import Callable
 
 from cnc_objects.objects import AddressSpace
-from cnc_objects.objects.address_space import Entry
+from cnc_objects.objects.address_space import Entry, name_key
 from cnc_objects.protocol.ads_symbols import (
     AdsSymbolFlag,
     TwinCatType,
@@ -127,9 +127,9 @@ class SymbolService:
         entries = [e for obj in space.objects() if (e := space.by_name(obj.name)) is not None]
         symbols = [symbol_entry(e) for e in entries]
         encoded = [encode_symbol_entry(s) for s in symbols]
-        self._by_name = {s.name.lower(): blob for s, blob in zip(symbols, encoded)}
+        self._by_name = {name_key(s.name): blob for s, blob in zip(symbols, encoded)}
         self._info_by_name = {
-            s.name.lower(): _INFO_BY_NAME.pack(s.group, s.offset, s.size) for s in symbols
+            name_key(s.name): _INFO_BY_NAME.pack(s.group, s.offset, s.size) for s in symbols
         }
         self._upload = b"".join(encoded)
         types = {twincat_type(e.obj.dtype) for e in entries}
@@ -211,13 +211,13 @@ class SymbolService:
     # ------------------------------------------------------------------ services
 
     def _symbol_by_name(self, name: str, length: int) -> Result:
-        blob = self._by_name.get(name.lower())
+        blob = self._by_name.get(name_key(name))
         if blob is None:
             return _E.DEVICE_SYMBOLNOTFOUND, f"no symbol is named {name!r}"
         return _fits(blob, length, f"the symbol entry of {name}")
 
     def _info_by_name_answer(self, name: str, length: int) -> Result:
-        blob = self._info_by_name.get(name.lower())
+        blob = self._info_by_name.get(name_key(name))
         if blob is None:
             return _E.DEVICE_SYMBOLNOTFOUND, f"no symbol is named {name!r}"
         return _fits(blob, length, f"the symbol info of {name}")

@@ -25,6 +25,7 @@ from collections.abc import Callable
 from typing import Any, Protocol
 
 from cnc_objects.objects import AddressSpace, Entry
+from cnc_objects.protocol.ads_symbols import encode_handle_info, twincat_type
 from cnc_objects.protocol.constants import (
     DEVICE_DATA_ADS_STATE,
     DEVICE_DATA_DEVICE_STATE,
@@ -162,9 +163,7 @@ class Backend:
                 return _E.DEVICE_SYMBOLNOTFOUND, f"no object is named {name!r}"
             if group == RIG.SYM_VALUE_BY_NAME:
                 return self.space.read_entry_buffer(entry, read_length)
-            if read_length < 4:
-                return _E.DEVICE_INVALIDSIZE, f"a handle is 4 bytes; read length is {read_length}"
-            return 0, _U32.pack(entry.handle)
+            return self._handle_answer(entry, read_length)
         symbols = self.symbols
         if symbols is not None and symbols.handles(group):
             return symbols.read_write(group, offset, data, read_length)
@@ -175,6 +174,19 @@ class Backend:
             return self.space.read_entry_buffer(found, read_length)
         return (_E.DEVICE_SRVNOTSUPP,
                 f"{found.obj.name} takes ReadWrite without data (a read); write with Write")
+
+    @staticmethod
+    def _handle_answer(entry: Entry, read_length: int) -> ValueResult:
+        """Handle by name: the handle alone for a 4-byte buffer (pyads, AdsLib), TwinCAT
+        3's extended answer (handle, size, type name) when the buffer holds it
+        (ads-client asks with 0xFFFFFFFF, 0xFFFF per sum item)."""
+        tc = twincat_type(entry.obj.dtype)
+        extended = encode_handle_info(entry.handle, tc.size, tc.name)
+        if read_length >= len(extended):
+            return 0, extended
+        if read_length >= 4:
+            return 0, _U32.pack(entry.handle)
+        return _E.DEVICE_INVALIDSIZE, f"a handle is 4 bytes; read length is {read_length}"
 
     # ------------------------------------------------------------ writes
 
