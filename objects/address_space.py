@@ -35,6 +35,8 @@ class Entry:
     handle: int
     read: Getter | None
     write: Setter | None
+    #: Told each value once the write is applied (a command object keeps it to read back).
+    written: Callable[[Any], None] | None = None
 
 
 class GroupHandler(Protocol):
@@ -87,8 +89,10 @@ class AddressSpace:
         read: Getter | None = None,
         write: Setter | None = None,
         aliases: Iterable[int] = (),
+        written: Callable[[Any], None] | None = None,
     ) -> Entry:
-        """Register ``obj``; ``aliases`` are other groups that address it (index-based)."""
+        """Register ``obj``; ``aliases`` are other groups that address it (index-based);
+        ``written`` is told each value written once the write has been applied."""
         key = obj.name.lower()
         if key in self._by_name:
             raise ValueError(f"object {obj.name} is registered twice")
@@ -101,7 +105,7 @@ class AddressSpace:
             if address in self._by_address:
                 other = self._by_address[address].obj.name
                 raise ValueError(f"{obj.name} and {other} share address {address}")
-        entry = Entry(obj, len(self._entries) + 1, read, write)
+        entry = Entry(obj, len(self._entries) + 1, read, write, written)
         for address in addresses:
             self._by_address[address] = entry
             self._groups.add(address[:2])

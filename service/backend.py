@@ -224,6 +224,8 @@ class Backend:
             finish(results)
             return
         loop = self.loop
+        if any(entry.written is not None for entry, _ in items):
+            finish = _telling_written(items, finish)
 
         def applied(k: int, refusal: Refusal | None) -> None:  # runs on the cycle thread
             if refusal is not None:
@@ -234,3 +236,18 @@ class Backend:
 
         for k, (entry, value) in enumerate(items):
             self.kernel.submit(entry.write(value), lambda r, k=k: applied(k, r))
+
+
+def _telling_written(
+    items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None]
+) -> Callable[[list[tuple[int, str]]], None]:
+    """``finish`` that first tells each entry that keeps its writes (a command object
+    reading back its last value) the value the kernel applied; refused ones are not."""
+
+    def told(results: list[tuple[int, str]]) -> None:
+        for (entry, value), (code, _) in zip(items, results):
+            if code == 0 and entry.written is not None:
+                entry.written(value)
+        finish(results)
+
+    return told
