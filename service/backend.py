@@ -25,6 +25,7 @@ from collections.abc import Callable
 from typing import Any, Protocol
 
 from cnc_objects.objects import AddressSpace, Entry
+from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.protocol.ads_symbols import encode_handle_info, twincat_type
 from cnc_objects.protocol.constants import (
     DEVICE_DATA_ADS_STATE,
@@ -83,11 +84,14 @@ class Backend:
         symbols: SymbolServices | None = None,
         notification_limits: tuple[int, int] = (MAX_PER_CLIENT, MAX_TOTAL),
         notification_counts: NotificationCounts | None = None,
+        structs: PlcStructs | None = None,
     ) -> None:
         """``notification_limits``: (per client, in total), ``[limits]``
         notifications_per_client and notifications_total; ``notification_counts``: where
-        the hub keeps its counts (the address space serves them)."""
+        the hub keeps its counts (the address space serves them); ``structs``: the HLI's
+        struct and array symbols, by name and by handle (none without)."""
         self.space = space
+        self.structs = structs if structs is not None else PlcStructs(AddressSpace())
         self.kernel = kernel
         self.loop = loop
         self.programs = programs
@@ -103,9 +107,12 @@ class Backend:
         """Read at an address, reserved groups included: (0, data) or (code, message)."""
         if group == RIG.SYM_VALUE_BY_HANDLE:
             entry = self.space.by_handle(offset)
-            if entry is None:
+            if entry is not None:
+                return self.space.read_entry_buffer(entry, length)
+            node = self.structs.by_handle(offset)
+            if node is None:
                 return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown"
-            return self.space.read_entry_buffer(entry, length)
+            return self.structs.read(node, length)
         if group == RIG.DEVICE_DATA and port == CncPort.PLC:
             return self._device_data(offset, length)
         symbols = self.symbols
@@ -160,10 +167,11 @@ class Backend:
                 return _E.DEVICE_INVALIDDATA, "a symbol name must be CP1252 text"
             entry = self.space.by_name(name)
             if entry is None:
-                return _E.DEVICE_SYMBOLNOTFOUND, f"no object is named {name!r}"
+                return self._struct_by_name(group, name, read_length)
             if group == RIG.SYM_VALUE_BY_NAME:
                 return self.space.read_entry_buffer(entry, read_length)
-            return self._handle_answer(entry, read_length)
+            tc = twincat_type(entry.obj.dtype)
+            return _handle_answer(entry.handle, tc.size, tc.name, read_length)
         symbols = self.symbols
         if symbols is not None and symbols.handles(group):
             return symbols.read_write(group, offset, data, read_length)
@@ -175,43 +183,44 @@ class Backend:
         return (_E.DEVICE_SRVNOTSUPP,
                 f"{found.obj.name} takes ReadWrite without data (a read); write with Write")
 
-    @staticmethod
-    def _handle_answer(entry: Entry, read_length: int) -> ValueResult:
-        """Handle by name: the handle alone for a 4-byte buffer (pyads, AdsLib), TwinCAT
-        3's extended answer (handle, size, type name) when the buffer holds it
-        (ads-client asks with 0xFFFFFFFF, 0xFFFF per sum item)."""
-        tc = twincat_type(entry.obj.dtype)
-        extended = encode_handle_info(entry.handle, tc.size, tc.name)
-        if read_length >= len(extended):
-            return 0, extended
-        if read_length >= 4:
-            return 0, _U32.pack(entry.handle)
-        return _E.DEVICE_INVALIDSIZE, f"a handle is 4 bytes; read length is {read_length}"
+    def _struct_by_name(self, group: int, name: str, read_length: int) -> ValueResult:
+        """Handle or value of a struct or array symbol (``gpCh[0].contour_lookahead``)."""
+        node = self.structs.by_name(name)
+        if node is None:
+            return _E.DEVICE_SYMBOLNOTFOUND, f"no object is named {name!r}"
+        if group == RIG.SYM_VALUE_BY_NAME:
+            return self.structs.read(node, read_length)
+        return _handle_answer(node.handle, node.size, node.type_name, read_length)
 
     # ------------------------------------------------------------ writes
 
-    def decode_write(self, port: int, group: int, offset: int, data: bytes) -> tuple:
-        """(0, entry, value), (0, None, None) for a handle release, or (code, message, None)."""
+    def decode_writes(self, port: int, group: int, offset: int, data: bytes) -> tuple:
+        """(0, "", [(entry, value), ...]): the object writes a Write makes (none for a
+        handle release or a struct written with what it holds, one per changed member
+        of a struct), or (code, message, [])."""
         if group == RIG.SYM_VALUE_BY_HANDLE:
             entry = self.space.by_handle(offset)
-            if entry is None:
-                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown", None
-            return self.space.decode_entry_write(entry, data)
+            if entry is not None:
+                return _one(self.space.decode_entry_write(entry, data))
+            node = self.structs.by_handle(offset)
+            if node is None:
+                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown", []
+            return self.structs.decode_write(node, data)
         if group == RIG.SYM_RELEASE_HANDLE:
             if len(data) != 4:
-                return _E.DEVICE_INVALIDSIZE, "release a handle by writing its 4 bytes", None
+                return _E.DEVICE_INVALIDSIZE, "release a handle by writing its 4 bytes", []
             handle = _U32.unpack(data)[0]
-            if self.space.by_handle(handle) is None:
-                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {handle} is unknown", None
-            return 0, None, None  # handles are stable per object: nothing to free
+            if self.space.by_handle(handle) is None and self.structs.by_handle(handle) is None:
+                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {handle} is unknown", []
+            return 0, "", []  # handles are stable per object: nothing to free
         if group == RIG.DEVICE_DATA and port == CncPort.PLC:
             return (_E.DEVICE_INVALIDACCESS,
-                    "device data is read-only; change the state with WriteControl", None)
+                    "device data is read-only; change the state with WriteControl", [])
         symbols = self.symbols
         if symbols is not None and symbols.handles(group):
             code, message = symbols.write(group, offset, data)
-            return (code, message, None) if code else (0, None, None)
-        return self.space.decode_write(port, group, offset, data)
+            return (code, message, []) if code else (0, "", [])
+        return _one(self.space.decode_write(port, group, offset, data))
 
     def apply_writes(
         self, items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None]
@@ -251,3 +260,21 @@ def _telling_written(
         finish(results)
 
     return told
+
+
+def _one(decoded: tuple[int, Any, Any]) -> tuple[int, str, list[tuple[Entry, Any]]]:
+    """An address-space write decoding as ``decode_writes`` answers it."""
+    code, target, value = decoded
+    return (code, target, []) if code else (0, "", [(target, value)])
+
+
+def _handle_answer(handle: int, size: int, type_name: str, read_length: int) -> ValueResult:
+    """Handle by name: the handle alone for a 4-byte buffer (pyads, AdsLib), TwinCAT 3's
+    extended answer (handle, size, type name) when the buffer holds it (ads-client asks
+    with 0xFFFFFFFF, 0xFFFF per sum item)."""
+    extended = encode_handle_info(handle, size, type_name)
+    if read_length >= len(extended):
+        return 0, extended
+    if read_length >= 4:
+        return 0, _U32.pack(handle)
+    return _E.DEVICE_INVALIDSIZE, f"a handle is 4 bytes; read length is {read_length}"

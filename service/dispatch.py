@@ -213,20 +213,21 @@ class Dispatcher:
     def _write(self, envelope: Envelope, req: WriteRequest) -> Reply:
         if self._is_store(req.port, req.group):
             return self._reply(envelope, req, self.programs.write(req.offset, req.data))
-        code, target, value = self.backend.decode_write(req.port, req.group, req.offset, req.data)
+        code, message, writes = self.backend.decode_writes(
+            req.port, req.group, req.offset, req.data)
         if code:
-            return self._error(envelope, req, code, target)
-        if target is None:
+            return self._error(envelope, req, code, message)
+        if not writes:
             return self._ok(envelope, req)
 
         def finish(results: list[tuple[int, str]]) -> None:
-            code, message = results[0]
+            code, message = next((r for r in results if r[0]), (0, ""))
             if code:
                 self._send(envelope, self._error(envelope, req, code, message))
             else:
                 self._send(envelope, self._ok(envelope, req))
 
-        self.backend.apply_writes([(target, value)], finish)
+        self.backend.apply_writes(writes, finish)
         return None
 
     def _read_state(self, envelope: Envelope, req: Any) -> Reply:
@@ -321,22 +322,21 @@ class Dispatcher:
             return self._error(envelope, req, code, items)
         codes: list[int] = [0] * len(items)
         writes: list[tuple[Entry, Any]] = []
-        slots: list[int] = []
+        slots: list[int] = []  # the item of each write (a struct item makes several)
         for k, item in enumerate(items):
             if role < _ADMIN and role < role_to_write(req.port, item.group):  # admin: no call
                 codes[k] = _E.DEVICE_INVALIDACCESS  # beyond the peer's role: this slot only
                 continue
-            code, target, value = self.backend.decode_write(
+            code, _, item_writes = self.backend.decode_writes(
                 req.port, item.group, item.offset, item.data)
             if code:
                 codes[k] = code
-            elif target is not None:
-                writes.append((target, value))
-                slots.append(k)
+            writes += item_writes
+            slots += [k] * len(item_writes)
 
         def finish(results: list[tuple[int, str]]) -> None:
             for k, (code, _) in zip(slots, results):
-                codes[k] = code
+                codes[k] = codes[k] or code
             self._send(envelope, self._ok(envelope, req, sums.encode_codes(codes)))
 
         self.backend.apply_writes(writes, finish)
