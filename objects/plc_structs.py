@@ -9,10 +9,12 @@ own: a struct starts at its first member and ends with its last, an array elemen
 takes the stride between elements (so the array is contiguous, as in PLC memory), and
 the bytes between members are padding, read as zeros.
 
-A struct or array is read as the bytes of its members at their offsets, written member
-by member (only the writable members whose bytes change; the others are left as they
-are), and is reached by handle: ``handle`` numbers start at ``HANDLE_BASE``, apart from
-the address space's.
+The PLC memory area is read as a PLC reads it: from where a symbol starts, any number of
+bytes up to the area's end, the symbols in the range at their offsets and zeros between
+them; so a struct at its own address (its first member's offset) reads as a struct. A
+struct or array is written member by member (only the writable members whose bytes
+change; the others are left as they are), at its address or by handle; ``handle``
+numbers start at ``HANDLE_BASE``, apart from the address space's.
 
 Type names: ISG's where its HLI documentation names the type (reference/cnc-objects.md
 section 6: HLI_CONTOUR_LOOKAHEAD, MC_CONTROL_BOOL_UNIT, ...), else ``ST_`` and the path
@@ -21,6 +23,7 @@ without indices (``ST_gpCh_bahn_state``); arrays ``ARRAY [0..31] OF <element typ
 
 from __future__ import annotations
 
+import bisect
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -109,6 +112,15 @@ class PlcStructs:
         self._by_name = {name_key(node.name): node for node in self.symbols}
         for k, node in enumerate(self.symbols):
             node.handle = HANDLE_BASE + k
+        # The PLC memory area: every leaf by its offset, where symbols start, its end.
+        leaves = sorted((e.obj.offset, e.handle, e) for root in self.roots.values()
+                        for e, _ in _leaves(root))
+        self._leaf_starts = [start for start, _, _ in leaves]
+        self._leaf_entries = [entry for _, _, entry in leaves]
+        self._widest_leaf = max((e.obj.dtype.size for e in self._leaf_entries), default=0)
+        self._symbol_starts = set(self._leaf_starts) | {n.start for n in self.symbols}
+        self.memory_end = max((n.start + n.size for n in self.roots.values()), default=0)
+        self._node_ranges = {(n.start, n.size) for n in self.symbols}
 
     # ------------------------------------------------------------------ building
 
@@ -182,47 +194,101 @@ class PlcStructs:
 
     # ------------------------------------------------------------------ values
 
-    @staticmethod
-    def read(node: Node, length: int) -> tuple[int, bytes | str]:
-        """The bytes of ``node`` into a buffer of ``length``: its members at their
-        offsets, zeros between them; (code, message) when the buffer is too small or a
-        member cannot be read."""
+    def read(self, node: Node, length: int) -> tuple[int, bytes | str]:
+        """The bytes of ``node`` into a buffer of ``length``: its memory, members at
+        their offsets; (code, message) when the buffer is too small or a member cannot
+        be read."""
         if length < node.size:
             return (_E.DEVICE_INVALIDSIZE,
                     f"{node.name} is {node.type_name}, {node.size} bytes; read length is {length}")
-        image = bytearray(node.size)
-        for entry, offset in node.leaves:
-            code, data = AddressSpace.read_entry(entry, entry.obj.dtype.size)
-            if code:
-                return code, data
-            image[offset : offset + len(data)] = data  # type: ignore[arg-type]
-        return 0, bytes(image)
+        return self.read_memory(node.start, node.size)  # type: ignore[return-value]
 
     def decode_write(self, node: Node, data: bytes) -> tuple[int, str, list[tuple[Entry, Any]]]:
-        """The member writes that a write of ``data`` to ``node`` makes: each writable
-        member whose bytes differ from its value now; (code, message, []) for a write of
-        the wrong size, to a struct without writable members, or of a value a member
-        refuses (nothing is written then)."""
+        """The member writes that a write of ``data`` to ``node`` makes (see
+        ``decode_memory_write``); a write of another size than the node's is 0x705."""
         if not node.writable:
             return _E.DEVICE_INVALIDACCESS, f"{node.name} has no writable member", []
         if len(data) != node.size:
             return (_E.DEVICE_INVALIDSIZE,
                     f"{node.name} is {node.type_name}, {node.size} bytes; write sent {len(data)}",
                     [])
-        code, now = self.read(node, node.size)
+        return self.decode_memory_write(node.start, data)  # type: ignore[return-value]
+
+    # ------------------------------------------------------------------ memory
+
+    def _overlapping(self, offset: int, length: int) -> Iterator[tuple[Entry, int]]:
+        """(entry, start) of the leaves that overlap ``[offset, offset + length)``."""
+        k = bisect.bisect_left(self._leaf_starts, offset - self._widest_leaf + 1)
+        end = offset + length
+        while k < len(self._leaf_starts) and self._leaf_starts[k] < end:
+            entry = self._leaf_entries[k]
+            if self._leaf_starts[k] + entry.obj.dtype.size > offset:
+                yield entry, self._leaf_starts[k]
+            k += 1
+
+    def _range_refusal(self, offset: int, length: int) -> tuple[int, str] | None:
+        if offset not in self._symbol_starts:
+            return (_E.DEVICE_INVALIDOFFSET,
+                    f"index offset 0x{offset:x} is not where a PLC symbol starts")
+        if length == 0 or offset + length > self.memory_end:
+            return (_E.DEVICE_INVALIDSIZE,
+                    f"{length} bytes from 0x{offset:x} leave the PLC memory area "
+                    f"(it ends at 0x{self.memory_end:x})")
+        return None
+
+    def read_memory(self, offset: int, length: int) -> tuple[int, bytes | str]:
+        """``length`` bytes of the PLC memory area from ``offset`` (where a symbol starts),
+        as a TwinCAT PLC reads its memory: the symbols in the range at their offsets,
+        zeros between them."""
+        refused = self._range_refusal(offset, length)
+        if refused:
+            return refused
+        image = bytearray(length)
+        for entry, start in self._overlapping(offset, length):
+            code, data = AddressSpace.read_entry(entry, entry.obj.dtype.size)
+            if code:
+                return code, data
+            lo, hi = max(start, offset), min(start + len(data), offset + length)
+            image[lo - offset : hi - offset] = data[lo - start : hi - start]  # type: ignore[index]
+        return 0, bytes(image)
+
+    def decode_memory_write(self, offset: int, data: bytes) -> tuple[int, str, list[tuple[Entry, Any]]]:
+        """The member writes that writing ``data`` into the PLC memory area at ``offset``
+        makes, where the range is exactly a struct or array symbol: each writable member
+        whose bytes differ from its value now. Read-only members and padding are left as
+        they are (a PLC would overwrite them); (code, message, []) for a range that is
+        not one symbol (a wrong size stays a clear 0x705, where a PLC would write into
+        the neighbours), holds nothing writable, or a value a member refuses: nothing is
+        written then."""
+        refused = self._range_refusal(offset, len(data))
+        if refused:
+            return (*refused, [])
+        if (offset, len(data)) not in self._node_ranges:
+            return (_E.DEVICE_INVALIDSIZE,
+                    f"a write at 0x{offset:x} covers one symbol; none there is {len(data)} bytes",
+                    [])
+        code, now = self.read_memory(offset, len(data))
         if code:
             return code, str(now), []
         writes: list[tuple[Entry, Any]] = []
-        for entry, offset in node.leaves:
+        writable = False
+        for entry, start in self._overlapping(offset, len(data)):
+            size = entry.obj.dtype.size
+            if start < offset or start + size > offset + len(data):
+                return (_E.DEVICE_INVALIDSIZE,
+                        f"a write from 0x{offset:x} of {len(data)} bytes cuts {entry.obj.name}", [])
             if entry.write is None:
                 continue
-            part = data[offset : offset + entry.obj.dtype.size]
-            if part == now[offset : offset + len(part)]:  # type: ignore[index]
+            writable = True
+            part = data[start - offset : start - offset + size]
+            if part == now[start - offset : start - offset + size]:  # type: ignore[index]
                 continue
             code, target, value = AddressSpace.decode_entry_write(entry, part)
             if code:
                 return code, str(target), []
             writes.append((entry, value))
+        if not writable:
+            return _E.DEVICE_INVALIDACCESS, f"nothing from 0x{offset:x} on may be written", []
         return 0, "", writes
 
 

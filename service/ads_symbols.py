@@ -47,6 +47,7 @@ from collections.abc import Callable
 
 from cnc_objects.objects import AddressSpace
 from cnc_objects.objects.address_space import Entry, name_key
+from cnc_objects.objects.catalog import PLC_GROUP
 from cnc_objects.objects.plc_structs import Node, PlcStructs
 from cnc_objects.protocol.ads_symbols import (
     AdsDataType,
@@ -100,10 +101,10 @@ def symbol_entry(entry: Entry) -> SymbolEntry:
 
 
 def struct_symbol_entry(node: Node) -> SymbolEntry:
-    """The AdsSymbolEntry of a struct or array: value by handle (0xF005, its handle),
-    read-only when no member below may be written."""
+    """The AdsSymbolEntry of a struct or array: its address in the PLC memory area (0x4020,
+    its first member's offset), read-only when no member below may be written."""
     flags = AdsSymbolFlag(0) if node.writable else AdsSymbolFlag.READONLY
-    return SymbolEntry(RIG.SYM_VALUE_BY_HANDLE, node.handle, node.size, AdsDataType.BIGTYPE,
+    return SymbolEntry(PLC_GROUP, node.start, node.size, AdsDataType.BIGTYPE,
                        flags, node.name, node.type_name, "")
 
 

@@ -25,6 +25,7 @@ from collections.abc import Callable
 from typing import Any, Protocol
 
 from cnc_objects.objects import AddressSpace, Entry
+from cnc_objects.objects.catalog import PLC_GROUP
 from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.protocol.ads_symbols import encode_handle_info, twincat_type
 from cnc_objects.protocol.constants import (
@@ -118,13 +119,21 @@ class Backend:
         symbols = self.symbols
         if symbols is not None and symbols.handles(group):
             return symbols.read(group, offset, length)
-        return self.space.read(port, group, offset, length)
+        code, data = self.space.read(port, group, offset, length)
+        if code == _E.DEVICE_INVALIDSIZE:
+            return self.read_other_length(port, group, offset, length) or (code, data)
+        return code, data
 
-    def read_string(self, port: int, group: int, offset: int, length: int) -> ValueResult | None:
-        """A STRING object read with another length than its buffer: the buffer cut to
-        ``length`` (or whole, when ``length`` is longer), as a TwinCAT PLC answers; None
-        for any other object. ADS clients read strings with a buffer of their own size
-        (pyads: 1024 characters, or the type name's length without the NUL)."""
+    def read_other_length(
+        self, port: int, group: int, offset: int, length: int,
+    ) -> ValueResult | None:
+        """A read at an address with another length than the object's, as a TwinCAT PLC
+        answers it: a STRING object gets its buffer cut to ``length`` (whole when longer;
+        ADS clients read strings with a buffer of their own size, pyads 1024 characters);
+        at a PLC symbol's address (port 851, 0x4020), ``length`` bytes of the PLC memory
+        area (a struct, or the symbols that follow); None for any other object."""
+        if port == CncPort.PLC and group == PLC_GROUP:
+            return self.structs.read_memory(offset, length)
         if group == RIG.SYM_VALUE_BY_HANDLE:
             entry = self.space.by_handle(offset)
         else:
@@ -220,7 +229,10 @@ class Backend:
         if symbols is not None and symbols.handles(group):
             code, message = symbols.write(group, offset, data)
             return (code, message, []) if code else (0, "", [])
-        return _one(self.space.decode_write(port, group, offset, data))
+        decoded = self.space.decode_write(port, group, offset, data)
+        if decoded[0] == _E.DEVICE_INVALIDSIZE and port == CncPort.PLC and group == PLC_GROUP:
+            return self.structs.decode_memory_write(offset, data)  # a struct at its address
+        return _one(decoded)
 
     def apply_writes(
         self, items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None]

@@ -203,10 +203,10 @@ class Dispatcher:
         else:
             code, payload = self._read_value(req.port, req.group, req.offset, req.length)
         if code:
-            if code == _E.DEVICE_INVALIDSIZE:  # a string may be read with any length
-                cut = self.backend.read_string(req.port, req.group, req.offset, req.length)
-                if cut is not None:
-                    return self._reply(envelope, req, cut)
+            if code == _E.DEVICE_INVALIDSIZE:  # a string, or PLC memory (a struct)
+                other = self.backend.read_other_length(req.port, req.group, req.offset, req.length)
+                if other is not None:
+                    return self._reply(envelope, req, other)
             return self._error(envelope, req, code, payload)
         return self._ok(envelope, req, payload)
 

@@ -158,8 +158,12 @@ def test_write_a_whole_struct_then_read_its_members(ads: RawAds) -> None:
     assert ads.call(WRITE, write(entry.group, entry.offset, data)).result == OK
     assert value(ads, REQUEST + ".start_position") == struct.pack("<d", 12.5)
     assert value(ads, REQUEST + ".length") == struct.pack("<d", 40.0)
-    assert answer(ads, READ, read(entry.group, entry.offset, ANY)) == (OK, data)
-    assert ads.call(WRITE, write(entry.group, entry.offset, data[:8])).result == INVALIDSIZE
+    assert answer(ads, READ, read(entry.group, entry.offset, entry.size)) == (OK, data)
+    # At the address, 8 bytes are the first member (same offset); a write must cover one
+    # symbol exactly.
+    assert ads.call(WRITE, write(entry.group, entry.offset, struct.pack("<d", 1.0))).result == OK
+    assert value(ads, REQUEST + ".start_position") == struct.pack("<d", 1.0)
+    assert ads.call(WRITE, write(entry.group, entry.offset, data[:12])).result == INVALIDSIZE
     state = symbol(ads, STATE)
     assert ads.call(WRITE, write(state.group, state.offset, bytes(state.size))).result == (
         INVALIDACCESS)
@@ -172,6 +176,7 @@ def test_a_struct_handle_reads_and_a_buffer_too_small_is_0x705(ads: RawAds) -> N
     assert data[14 : 14 + type_length] == b"HLI_CONTOUR_LOOKAHEAD_REQUEST"
     assert answer(ads, READ, read(0xF005, handle, 16))[0] == OK
     assert answer(ads, READ, read(0xF005, handle, 15)) == (INVALIDSIZE, b"")
+    assert ads.call(WRITE, write(0xF005, handle, bytes(8))).result == INVALIDSIZE
 
 
 def test_a_notification_on_a_struct_sends_its_bytes_when_a_member_changes(ads: RawAds) -> None:
@@ -221,3 +226,19 @@ def test_sum_read_and_sum_write_of_structs(ads: RawAds) -> None:
     result, codes = answer(ads, READ_WRITE, read_write(0xF081, 2, 8, writes))
     assert result == OK and struct.unpack("<II", codes) == (OK, INVALIDACCESS)
     assert value(ads, REQUEST) == data
+
+
+def test_the_plc_memory_area_reads_as_a_plc_reads_it(ads: RawAds) -> None:
+    """At a PLC address the read length says how many bytes of memory: a struct's
+    members share its first member's offset, and a longer read takes the symbols that
+    follow; a range past the end of the memory area is 0x705, an offset where no symbol
+    starts 0x703."""
+    request, first = symbol(ads, REQUEST), symbol(ads, REQUEST + ".start_position")
+    assert (first.group, first.offset) == (request.group, request.offset) == (0x4020, first.offset)
+    whole = answer(ads, READ, read(0x4020, first.offset, 16))
+    assert whole == (OK, value(ads, REQUEST))
+    assert answer(ads, READ, read(0x4020, first.offset, 8)) == (OK, whole[1][:8])
+    assert answer(ads, READ, read(0x4020, first.offset, ANY)) == (INVALIDSIZE, b"")
+    assert answer(ads, READ, read(0x4020, first.offset + 1, 4))[0] == 0x703
+    gpch = symbol(ads, "gpCh")
+    assert answer(ads, READ, read(0x4020, gpch.offset, gpch.size)) == (OK, value(ads, "gpCh"))

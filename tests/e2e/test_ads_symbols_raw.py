@@ -229,7 +229,7 @@ def test_symbol_upload_field_by_field(ads: RawAds, catalog: list[ObjectInfo]) ->
     structs = symbols[len(catalog):]  # the structs and arrays of the HLI follow
     assert {s.name for s in structs} == struct_names(catalog)
     for symbol in structs:
-        assert (symbol.group, symbol.data_type) == (VALUE_BY_HANDLE, BIGTYPE), symbol.name
+        assert (symbol.group, symbol.data_type) == (PLC_MEMORY, BIGTYPE), symbol.name
         assert symbol.entry_length % 8 == 0
     for symbol, info in zip(symbols, catalog):
         assert (symbol.type_name, symbol.data_type) == twincat(info), info.name

@@ -89,3 +89,15 @@ def test_elements_laid_out_unevenly_are_refused() -> None:
         space.add(leaf(name, offset, UNS16, Access.READ), lambda: 0)
     with pytest.raises(ValueError, match="not evenly laid out"):
         PlcStructs(space)
+
+
+def test_the_memory_area_reads_any_range_from_a_symbol_and_writes_whole_symbols(built) -> None:
+    structs, values = built
+    values["gpX[0].a.count"] = 0x0102
+    assert structs.read_memory(0x100, 4) == (0, b"\x00\x00\x02\x01")  # flag, padding, count
+    assert structs.read_memory(0x102, 1) == (0, b"\x02")  # the first byte of count
+    assert structs.read_memory(0x101, 1)[0] == AdsReturnCode.DEVICE_INVALIDOFFSET
+    assert structs.read_memory(0x100, 0x1000)[0] == AdsReturnCode.DEVICE_INVALIDSIZE
+    code, _, writes = structs.decode_memory_write(0x100, b"\x01\x00\x02\x01")  # gpX[0].a
+    assert code == 0 and [e.obj.name for e, _ in writes] == ["gpX[0].a.flag"]
+    assert structs.decode_memory_write(0x100, b"\x01\x00")[0] == AdsReturnCode.DEVICE_INVALIDSIZE
