@@ -14,12 +14,13 @@ class Access(str, Enum):
     """Who may do what with an object, in the ISG tables' spelling."""
 
     READ = "r"  # read-only: writes get ADS 0x704
-    WRITE = "w"  # write-only: reads get ADS 0x704
+    WRITE = "w"  # write-only, a command: the service reads back the value last written
     READ_WRITE = "rw"  # both
 
     @property
     def readable(self) -> bool:
-        """True when the object can be read."""
+        """True when the object shows a state of its own; a write-only command has none
+        (the service binds it to the value last written, as a PLC command variable)."""
         return self is not Access.WRITE
 
     @property

@@ -37,6 +37,7 @@ from typing import NoReturn, Optional
 import typer
 import zmq
 
+from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.protocol.ams import parse_net_id
 from cnc_objects.protocol.roles import Role
 
@@ -138,9 +139,11 @@ async def serve(
     limits = config.limits
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows
     space = build_address_space(kernel, counts)
+    structs = PlcStructs(space)  # the HLI's structs and arrays over the PLC symbols
     backend = Backend(space, kernel, loop, ProgramStoreService(store, writer.flush),
-                      SymbolService(space),
-                      (limits.notifications_per_client, limits.notifications_total), counts)
+                      SymbolService(space, structs),
+                      (limits.notifications_per_client, limits.notifications_total), counts,
+                      structs)
     kernel.on_cycle_end = backend.hub.kernel_cycle_end  # one hub serves both front ends
     try:
         server = ZmqServer(backend, endpoint, curve=curve, limits=limits)
