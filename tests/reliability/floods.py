@@ -107,3 +107,40 @@ def wait_until(measure: Callable[[], int], at_least: int, timeout_s: float) -> i
         time.sleep(0.05)
         value = measure()
     return value
+
+
+class AdsProbe:
+    """One ADS connection of a well-behaved client: ``read_device_info`` asks and waits
+    for its reply (the ADS result code of the response)."""
+
+    def __init__(self, address: tuple[str, int], net_id: str) -> None:
+        self.sock = socket.create_connection(address, timeout=CONNECT_TIMEOUT_S)
+        self.net_id = bytes(int(p) for p in net_id.split("."))
+        self._invoke_id = 0
+
+    def read_device_info(self, timeout_s: float = CONNECT_TIMEOUT_S) -> int:
+        """The result code of a ReadDeviceInfo to port 851; OSError when no reply."""
+        self._invoke_id += 1
+        self.sock.settimeout(timeout_s)
+        self.sock.sendall(FRAME_HEADER.pack(
+            0, AMS_HEADER_BYTES, self.net_id, 851, ADS_SOURCE, 30000,
+            AdsCommand.READ_DEVICE_INFO, REQUEST_FLAGS, 0, 0, self._invoke_id))
+        while True:
+            head = self._exactly(FRAME_HEADER.size)
+            fields = FRAME_HEADER.unpack(head)
+            data = self._exactly(fields[8])
+            if fields[10] == self._invoke_id:
+                return int.from_bytes(data[:4], "little")
+
+    def _exactly(self, count: int) -> bytes:
+        chunks = bytearray()
+        while len(chunks) < count:
+            chunk = self.sock.recv(count - len(chunks))
+            if not chunk:
+                raise ConnectionError("the service closed the connection")
+            chunks += chunk
+        return bytes(chunks)
+
+    def close(self) -> None:
+        """Close the connection."""
+        self.sock.close()
