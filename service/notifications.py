@@ -57,7 +57,7 @@ MAX_PER_CLIENT = 1000  # default of [limits] notifications_per_client
 MAX_TOTAL = 20000  # default of [limits] notifications_total
 #: Loop time one slice of a sampling pass may take before requests go first. Another
 #: client's read waits at most about this long behind the notifications of all clients.
-SAMPLE_SLICE_S = 0.001
+SAMPLE_SLICE_S = 0.0005
 SLICE_CHECK_EVERY = 32  # subscriptions sampled between two looks at the clock
 _NEVER = 1 << 64  # a due time no kernel time reaches
 
@@ -134,6 +134,9 @@ class NotificationHub:
         # routing id or the ADS connection), so that the parts a client adds to its
         # envelope do not make it several clients.
         self._per_client: dict[Any, int] = {}
+        # Subscriptions by envelope, with the front end's notify: ``clients`` without a
+        # look at every subscription (the ZeroMQ probe asks every 2 s).
+        self._envelopes: dict[Envelope, tuple[NotifyFn, int]] = {}
         self.max_per_client = max_per_client
         self.max_total = max_total
         self.counts = counts if counts is not None else NotificationCounts()
@@ -188,6 +191,8 @@ class NotificationHub:
         )
         self._subs[handle] = sub
         self._per_client[envelope[0]] = mine + 1
+        held = self._envelopes.get(envelope)
+        self._envelopes[envelope] = (notify, 1 if held is None else held[1] + 1)
         self._count()
         if first_delay_s > 0:
             self._loop.call_later(first_delay_s, self._first_sample, sub)
@@ -222,12 +227,14 @@ class NotificationHub:
 
     def clients(self) -> list[tuple[Envelope, NotifyFn]]:
         """Every client that holds notifications, with the ``notify`` of its front end."""
-        seen: dict[Envelope, NotifyFn] = {}
-        for sub in self._subs.values():
-            seen.setdefault(sub.envelope, sub.notify)
-        return list(seen.items())
+        return [(envelope, notify) for envelope, (notify, _) in self._envelopes.items()]
 
     def _forget_one(self, envelope: Envelope) -> None:
+        notify, count = self._envelopes[envelope]
+        if count > 1:
+            self._envelopes[envelope] = (notify, count - 1)
+        else:
+            del self._envelopes[envelope]
         key = envelope[0]
         left = self._per_client[key] - 1
         if left:
