@@ -4,7 +4,7 @@ bench``, part ``fairness``; issue 25).
 A realtime service (1 ms cycle) serves ``notifications_total`` cyclic notifications (20
 connections of 1 000, every 1 ms, over five objects; every sample read by a client
 process of its own, ``tests/support/cyclic_subscribers.py``) while another client reads
-one object at a time. Printed: that client's read latency p50 / p99 / max, idle and
+one object at a time; once over ZeroMQ, once over ADS (subscriptions and reads). Printed: that client's read latency p50 / p99 / max, idle and
 loaded, and the samples per second the subscribers got. Target (issue 25): p99 under
 load below 10 ms.
 """
@@ -17,7 +17,13 @@ import time
 from dataclasses import dataclass
 
 from cnc_objects.service.limits import LimitsConfig
-from tests.support.notification_load import notification_load, p99, read_latencies_s
+from tests.support.notification_load import (
+    ads_read_latencies_s,
+    ads_target,
+    notification_load,
+    p99,
+    read_latencies_s,
+)
 from tests.support.service import serving
 
 TARGET_P99_S = 0.010
@@ -33,31 +39,52 @@ class Fairness:
     samples_per_s: float
 
 
-def measure_once(reads: int) -> Fairness:
-    """A fresh realtime service, ``reads`` reads idle, then ``reads`` under the load."""
+def measure_once(reads: int, front_end: str) -> Fairness:
+    """A fresh realtime service, ``reads`` reads idle, then ``reads`` under the load,
+    subscriptions and reads on ``front_end`` (``zmq`` or ``ads``)."""
     sockets = LIMITS.notifications_total // LIMITS.notifications_per_client
-    with serving("--clock", "realtime") as service:
-        idle = read_latencies_s(service.endpoint, reads)
-        with notification_load(service.endpoint, sockets,
-                               LIMITS.notifications_per_client) as samples:
+    with serving("--clock", "realtime", ads=front_end == "ads") as service:
+        if front_end == "ads":
+            address, net_id = service.ads_address, service.ams_net_id
+            assert address is not None and net_id is not None
+            target = ads_target(address, net_id)
+
+            def timed() -> list[float]:
+                return ads_read_latencies_s(address, net_id, reads)
+        else:
+            target = service.endpoint
+
+            def timed() -> list[float]:
+                return read_latencies_s(service.endpoint, reads)
+        idle = timed()
+        with notification_load(target, sockets, LIMITS.notifications_per_client) as samples:
             started = time.monotonic()
-            loaded = read_latencies_s(service.endpoint, reads)
+            loaded = timed()
             elapsed_s = time.monotonic() - started
     return Fairness(idle, loaded, (samples[0] if samples else 0) / elapsed_s)
 
 
 def main(runs: int, reads: int) -> None:
-    """Measure ``runs`` times and print the medians."""
+    """Measure ``runs`` times on each front end and print the medians."""
+    for front_end in ("zmq", "ads"):
+        report(front_end, runs, reads)
+
+
+def report(front_end: str, runs: int, reads: int) -> None:
+    """Measure ``runs`` times on ``front_end`` and print the medians."""
     results = []
     for run in range(runs):
-        results.append(measure_once(reads))
+        results.append(measure_once(reads, front_end))
         r = results[-1]
-        print(f"fairness run {run + 1}/{runs}: loaded p99 {p99(r.loaded_s) * 1e3:.2f} ms, "
-              f"{r.samples_per_s:.0f} samples/s", file=sys.stderr)
+        print(f"fairness {front_end} run {run + 1}/{runs}: loaded p99 "
+              f"{p99(r.loaded_s) * 1e3:.2f} ms, {r.samples_per_s:.0f} samples/s",
+              file=sys.stderr)
     med = statistics.median
     loaded_p99 = med(p99(r.loaded_s) for r in results)
-    print(f"\nanother client's reads while {LIMITS.notifications_total} cyclic notifications "
-          f"(1 ms) are served; realtime clock, median of {runs} runs of {reads} reads")
+    name = {"zmq": "ZeroMQ", "ads": "ADS"}[front_end]
+    print(f"\n{name}: another client's reads while {LIMITS.notifications_total} cyclic "
+          f"notifications (1 ms, {name}) are served; realtime clock, median of {runs} runs "
+          f"of {reads} reads")
     print(f"{'measurement':44} {'value':>10}  target")
     print(f"{'reads idle p50 / p99 (ms)':44} "
           f"{med(med(r.idle_s) for r in results) * 1e3:5.2f} / "

@@ -11,6 +11,8 @@ their own, one at a time, as an HMI polls.
 from __future__ import annotations
 
 import contextlib
+import socket
+import struct
 import subprocess
 import sys
 import time
@@ -19,6 +21,7 @@ from collections.abc import Iterator
 import msgpack
 import zmq
 
+from tests.support.cyclic_subscribers import AMS_FRAME, ads_frame
 from tests.support.service import ROOT
 
 SUBSCRIBE_TIMEOUT_S = 120.0  # 20 000 AddNotifications on a loaded 2-core machine
@@ -30,7 +33,9 @@ READ = (553, 0x120101, 0x3002, 4)  # ch1.mc_active_state_r
 def notification_load(endpoint: str, sockets: int, per_socket: int,
                       cycle_ms: int = 1) -> Iterator[list[int]]:
     """``sockets`` clients of ``per_socket`` cyclic notifications each, every sample
-    read; yields a list that holds the count of samples read once the block is left."""
+    read; yields a list that holds the count of samples read once the block is left.
+    ``endpoint`` is a ZeroMQ endpoint, or ``ads:HOST:PORT:NETID`` for ADS connections
+    (``ads_target``)."""
     child = subprocess.Popen(
         [sys.executable, "-m", "tests.support.cyclic_subscribers", endpoint, str(sockets),
          str(per_socket), str(cycle_ms)],
@@ -48,6 +53,11 @@ def notification_load(endpoint: str, sockets: int, per_socket: int,
     finally:
         child.kill()
         child.wait()
+
+
+def ads_target(address: tuple[str, int], net_id: str) -> str:
+    """The ``notification_load`` endpoint of an ADS server."""
+    return f"ads:{address[0]}:{address[1]}:{net_id}"
 
 
 def _line_within(child: subprocess.Popen[str], timeout_s: float) -> str:
@@ -77,6 +87,32 @@ def read_latencies_s(endpoint: str, count: int) -> list[float]:
     finally:
         sock.close(linger=0)
         context.term()
+    return latencies
+
+
+def ads_read_latencies_s(address: tuple[str, int], net_id: str, count: int) -> list[float]:
+    """Latency of each of ``count`` ADS reads (one at a time) on a fresh connection."""
+    target = bytes(int(p) for p in net_id.split("."))
+    port, group, offset, length = READ
+    latencies = []
+    with socket.create_connection(address, timeout=READ_TIMEOUT_S) as sock:
+        buffer = bytearray()
+        for invoke_id in range(1, count + 1):
+            start = time.perf_counter()
+            sock.sendall(ads_frame(target, port, 2, invoke_id,
+                                   struct.pack("<3I", group, offset, length)))
+            while True:
+                size = 6 + int.from_bytes(buffer[2:6], "little") if len(buffer) >= 6 else 0
+                if size and len(buffer) >= size:
+                    head = AMS_FRAME.unpack_from(buffer)
+                    del buffer[:size]
+                    if head[10] == invoke_id:
+                        break
+                    continue
+                chunk = sock.recv(65536)
+                assert chunk, "the service closed the ADS connection"
+                buffer += chunk
+            latencies.append(time.perf_counter() - start)
     return latencies
 
 
