@@ -13,10 +13,11 @@ read), everything else gets an answer from the dispatcher. Replies to a client t
 does not read wait up to the send high-water mark, then are dropped (counted, logged
 now and then). Connections beyond ``connections_per_front_end`` are shut down as they
 come, and a frame (or greeting) incomplete after ``frame_timeout_s`` ends its
-connection through libzmq's heartbeat (``zmq_connections``). A vanished client's notifications are dropped: ZeroMQ says a client is
-gone when a send to it fails, so clients with notifications get an empty notification
-frame every ``PROBE_S`` (a client that only subscribed on change to a value that never
-changes would otherwise never be sent anything).
+connection through libzmq's heartbeat (``zmq_connections``). A vanished client's
+notifications are dropped: ZeroMQ says a client is gone when a send to it fails, so
+clients with notifications get an empty notification frame every ``PROBE_S`` (a client
+that only subscribed on change to a value that never changes would otherwise never be
+sent anything).
 
 The envelope of a client is its ROUTER identity frames (a tuple of bytes): the routing
 id ZeroMQ gives the connection, then whatever parts the client put before its frame,
