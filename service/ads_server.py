@@ -42,7 +42,9 @@ from cnc_objects.protocol.errors import AdsReturnCode, describe_code
 from .ads_connection import AmsConnection
 from .ads_routes import RouteTable
 from .backend import Backend
+from .connection_limits import ConnectionLimits
 from .dispatch import Dispatcher
+from .limits import LimitsConfig
 from .rate_limit import RateLimiter
 
 log = logging.getLogger(__name__)
@@ -90,6 +92,7 @@ class AdsTcpServer:
         routes: RouteTable | None = None,
         max_frame_bytes: int = AMS_MAX_FRAME_BYTES,
         rate: RateLimiter | None = None,
+        limits: LimitsConfig | None = None,
     ) -> None:
         self.backend = backend
         self.hub = backend.hub
@@ -97,6 +100,8 @@ class AdsTcpServer:
         self.routes = routes if routes is not None else RouteTable()  # empty is falsy
         self.max_frame_bytes = max_frame_bytes
         self.rate = rate  # requests per connection ([limits]); None: no limit
+        # open connections and bytes of incomplete frames ([limits])
+        self.limits = ConnectionLimits("ADS", limits or LimitsConfig())
         self.ports = SERVED_PORTS
         self.dispatcher = Dispatcher(backend, self)
         self.connections: set[AmsConnection] = set()
