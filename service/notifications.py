@@ -252,7 +252,9 @@ class NotificationHub:
     def _first_sample(self, sub: Subscription) -> None:
         if sub.handle not in self._subs:
             return
-        self._emit({(sub.envelope, sub.port): (sub.notify, [self._take(sub, force=True)])})
+        sample = self._take(sub, force=True)
+        assert sample is not None  # forced: a sample whether or not the value changed
+        self._emit({(sub.envelope, sub.port): (sub.notify, [sample])})
         # Only this subscription's due time changed: no need to look at all of them (with
         # thousands opened back to back that made opening them quadratic).
         due = self._next_due_ns
@@ -277,7 +279,7 @@ class NotificationHub:
         run = self._pass
         assert run is not None
         subs, take, now_ns = self._subs, self._take, run.now_ns
-        batches: dict[tuple[Envelope, int], tuple[NotifyFn, list]] = {}
+        batches: dict[tuple[Envelope, int], tuple[NotifyFn, list[list[Any]]]] = {}
         soonest_ns = run.soonest_ns
         deadline_s = perf_counter() + SAMPLE_SLICE_S
         finished = True
@@ -307,7 +309,7 @@ class NotificationHub:
         self._next_due_ns = None if soonest_ns == _NEVER else soonest_ns
         self._scheduled = False  # the next kernel cycle that is due starts the next pass
 
-    def _take(self, sub: Subscription, force: bool) -> list | None:
+    def _take(self, sub: Subscription, force: bool) -> list[Any] | None:
         """Read one subscription; a sample list or None when on-change saw no change."""
         snapshot, code, data = self._read_current(sub.port, sub.group, sub.offset, sub.length)
         now_ns = snapshot.time_ns
@@ -355,7 +357,7 @@ class NotificationHub:
             cache[key] = (code, data)
         return snapshot, code, data
 
-    def _emit(self, batches: dict[tuple[Envelope, int], tuple[NotifyFn, list]]) -> None:
+    def _emit(self, batches: dict[tuple[Envelope, int], tuple[NotifyFn, list[list[Any]]]]) -> None:
         """One frame per client and port with all its samples of this cycle."""
         for (envelope, port), (notify, samples) in batches.items():
             samples = [s for s in samples if s is not None]

@@ -86,7 +86,7 @@ class ZmqServer:
         self,
         backend: Backend,
         endpoint: str,
-        context: zmq.Context | None = None,
+        context: zmq.Context[zmq.Socket[bytes]] | None = None,
         curve: ServerCurve | None = None,
         limits: LimitsConfig | None = None,
     ) -> None:
@@ -138,7 +138,7 @@ class ZmqServer:
             raise
         self._sock = sock
         # The Cython socket methods: pyzmq's Python wrappers cost more than the send itself.
-        raw = zmq.Socket.__mro__[1]
+        raw: Any = zmq.Socket.__mro__[1]
         self._raw_send = raw.send.__get__(sock)
         self._raw_recv = raw.recv.__get__(sock)
         self._raw_get = raw.get.__get__(sock)
@@ -344,7 +344,8 @@ class ZmqServer:
     def ok(envelope: Envelope, req: Any, *fields: Any) -> bytes:
         """``[invoke_id, command, 0, *fields]``: ``frames.encode_response``, packed here
         without its own call (the dispatch hot path)."""
-        return _packb([req.invoke_id, req.COMMAND, 0, *fields])
+        frame: bytes = _packb([req.invoke_id, req.COMMAND, 0, *fields])
+        return frame
 
     @staticmethod
     def error(envelope: Envelope, req: Any, code: int, message: str) -> bytes:
@@ -364,4 +365,5 @@ class ZmqServer:
     @staticmethod
     def cycle_ns(req: Any) -> int:
         """Frames carry the cycle time in ms."""
-        return req.cycle_time_ms * 1_000_000
+        cycle_ms: int = req.cycle_time_ms
+        return cycle_ms * 1_000_000

@@ -41,7 +41,7 @@ class ZmqConnectionWatch:
     """Counts the connections of ``router`` (bound to ``port``) and shuts down those
     over ``limits.max_connections``."""
 
-    def __init__(self, router: zmq.Socket, port: int, limits: ConnectionLimits,
+    def __init__(self, router: zmq.Socket[bytes], port: int, limits: ConnectionLimits,
                  loop: asyncio.AbstractEventLoop) -> None:
         self._router = router
         self._port = port
