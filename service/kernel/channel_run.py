@@ -91,17 +91,19 @@ class ChannelRunner:
         *,
         params: dict[int, AxisParameters],
         switchover: Switchover,
+        save: Callable[[str, bytes, bool], None] = lambda name, data, replace: None,
     ) -> None:
         """``params`` are the kernel's effective axis parameters (read at each program
         start, so a parameter update applies from the next run); ``switchover`` links
-        the channel's axes to the drives."""
+        the channel's axes to the drives; ``files`` writes the channel's own files (logs,
+        reports), ``save`` those its NC programs write, both into the output area."""
         self.channel = channel
         self.config = config
         self._loader = loader
         self._exists = exists
         self._cycle_s = cycle_s
         self._deterministic = deterministic  # virtual clock: wait for the decoder
-        self._files = files  # appends to a file of the program store, off this thread
+        self._files = files  # the output area's writer: queues, never blocks this thread
         self.error_log_name = f"errors-ch{channel.channel_id}.log"
         self._axes = tuple(a.name for a in config.axes)
         self._axis_numbers = tuple(a.logical_number for a in config.axes)
@@ -135,7 +137,7 @@ class ChannelRunner:
         # #MSG texts from the decoder thread (deque appends are thread-safe)
         self._messages: deque[str] = deque(maxlen=MESSAGES_KEPT)
         self._surroundings = Surroundings(
-            write_file=lambda name, text, replace: files(name, text.encode(), replace=replace),
+            write_file=lambda name, text, replace: save(name, text.encode(), replace),
             show_message=self._messages.append,
             hscs={mode.upper(): HscProgram(c.prog, c.tolerance * 1e-4)  # 0.1 um -> mm
                   for mode, c in config.hscs},
@@ -869,7 +871,7 @@ class ChannelRunner:
         return False
 
     def _write_trace(self, ended: str) -> None:
-        """The end of a traced PROD_TIME run: its rows go to the program store."""
+        """The end of a traced PROD_TIME run: its rows go to the output area."""
         trace, self._trace = self._trace, None
         if trace is not None:
             # formatted by the store writer's thread, not in this cycle
