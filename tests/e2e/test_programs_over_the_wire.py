@@ -102,10 +102,12 @@ def test_error_is_readable_through_objects(c):
     assert values["ch1.mc_error_1_line_r"] == 2
     assert values["ch1.mc_error_1_column_r"] == 8  # the Q of "G1 Y10 Q7"
     assert "Q" in values["ch1.mc_error_1_text_r"]
-    # The kernel logs every error into the store, where it can be downloaded.
-    log = c.download("errors-ch1.log").decode()
+    # The kernel logs every error into its output area, where it can be downloaded at
+    # once: the download answers after the writer has written the line (no flush).
+    log = c.download_output("errors-ch1.log").decode()
     assert "bad.nc:2:8:" in log.splitlines()[-1]
-    assert "errors-ch1.log" in [p.name for p in c.programs()]
+    assert "errors-ch1.log" in [p.name for p in c.outputs()]
+    assert "errors-ch1.log" not in [p.name for p in c.programs()]
 
 
 def test_start_without_program_is_refused_with_a_reason(c):
