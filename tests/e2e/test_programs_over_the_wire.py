@@ -172,3 +172,17 @@ def test_cli_mdi_and_bad_upload(machine, tmp_path):
     assert bad.returncode == 1 and "0x706" in bad.stderr
     missing = cnc("upload", str(tmp_path / "nope.nc"), endpoint=machine.endpoint)
     assert missing.returncode == 2 and "cannot read" in missing.stderr
+
+
+def test_cli_lists_downloads_and_deletes_output_files(machine, c):
+    c.wait_mdi(c.mdi('#FILE NAME [MSG="cli-out.txt"]\n#MSG SAVE ["hello %d", 7]'), timeout_s=30)
+    ep = machine.endpoint
+    listed = cnc("outputs", endpoint=ep)
+    assert listed.returncode == 0 and "cli-out.txt" in listed.stdout, listed.stderr
+    assert "cli-out.txt" not in cnc("programs", endpoint=ep).stdout
+    assert cnc("output", "cli-out.txt", endpoint=ep).stdout == "hello 7\n"
+    deleted = cnc("delete-output", "cli-out.txt", endpoint=ep)
+    assert deleted.returncode == 0 and "deleted output cli-out.txt" in deleted.stdout
+    missing = cnc("output", "cli-out.txt", endpoint=ep)
+    assert missing.returncode == 1 and "0x70c NOTFOUND" in missing.stderr, missing.stderr
+    assert "no output file 'cli-out.txt'" in missing.stderr
