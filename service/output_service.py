@@ -18,7 +18,7 @@ from cnc_objects.protocol.errors import AdsReturnCode
 
 from .output_area import WHAT
 from .output_writer import OutputWriter
-from .program_service import FAULT_CODES, Result, _name
+from .program_service import FAULT_CODES, Result, request_name
 from .program_store import StoreError, StoreFault
 
 _E = AdsReturnCode
@@ -52,20 +52,22 @@ class OutputService:
         if offset != Op.DELETE:
             return _unknown(offset, "take a write")
         try:
-            name = _name(data)
+            name = request_name(data)
             if not self.writer.delete(name):
                 raise StoreError(StoreFault.NOT_FOUND, f"no {WHAT} {name!r}")
         except StoreError as exc:
             return FAULT_CODES[exc.fault], str(exc)
         return 0, None
 
-    def read_write(self, offset: int, data: bytes, read_length: int, answer: Answer) -> Result | None:
+    def read_write(
+        self, offset: int, data: bytes, read_length: int, answer: Answer
+    ) -> Result | None:
         """ADS ReadWrite: download. None when the answer comes later through ``answer``
         (writes to the file were still queued)."""
         if offset != Op.DOWNLOAD:
             return _unknown(offset, "answer a read-write")
         try:
-            name = _name(data)
+            name = request_name(data)
             self.writer.area.path(name)  # a bad name is refused now
         except StoreError as exc:
             return FAULT_CODES[exc.fault], str(exc)

@@ -29,7 +29,8 @@ FAULT_CODES: dict[StoreFault, AdsReturnCode] = {
 }
 
 
-def _name(data: bytes) -> str:
+def request_name(data: bytes) -> str:
+    """The file name a request carries: CP1252 text up to the first NUL."""
     try:
         return data.split(b"\x00", 1)[0].decode(STRING_ENCODING)
     except UnicodeDecodeError:
@@ -66,10 +67,10 @@ class ProgramStoreService:
                     name, sep, content = data.partition(b"\x00")
                     if not sep:
                         return _E.DEVICE_INVALIDDATA, "an upload is the name, a NUL, then the content"
-                    self.store.write(_name(name), content)
-                    log.info("program %r uploaded (%d bytes)", _name(name), len(content))
+                    self.store.write(request_name(name), content)
+                    log.info("program %r uploaded (%d bytes)", request_name(name), len(content))
                 case Op.DELETE:
-                    self.store.delete(_name(data))
+                    self.store.delete(request_name(data))
                 case _:
                     return _unknown(offset, "take a write")
         except StoreError as exc:
@@ -81,7 +82,7 @@ class ProgramStoreService:
         if offset != Op.DOWNLOAD:
             return _unknown(offset, "answer a read-write")
         try:
-            content = self.store.read(_name(data))
+            content = self.store.read(request_name(data))
         except StoreError as exc:
             return FAULT_CODES[exc.fault], str(exc)
         if len(content) > read_length:

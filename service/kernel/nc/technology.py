@@ -63,10 +63,10 @@ class Surroundings:
 
     ``write_file(name, text, replace)`` writes a file of the output area (``#MSG SAVE``,
     a cycle's result; never the program store): it queues the text and returns at once,
-    or raises ``OutputLimitReached``; ``show_message(text)`` puts a ``#MSG`` into the channel's message
-    list; ``hscs`` maps a mode of ``HSCS_MODES`` to its program and tolerance;
-    ``kinematics``: the channel has a kinematic transformation configured (needed to
-    rotate the tool). The defaults drop files and messages.
+    or raises ``OutputLimitReached``; ``show_message(text)`` puts a ``#MSG`` into the
+    channel's message list; ``hscs`` maps a mode of ``HSCS_MODES`` to its program and
+    tolerance; ``kinematics``: the channel has a kinematic transformation configured
+    (needed to rotate the tool). The defaults drop files and messages.
     """
 
     write_file: Callable[[str, str, bool], None] = _ignore
