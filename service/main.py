@@ -199,8 +199,9 @@ async def serve(
             ads_server.close()
         server.close()
         kernel.on_cycle_end = None
-        kernel.close(KERNEL_STOP_S)  # decoder threads still queueing are refused below
-        writer.close(WRITER_STOP_S)
+        writer.refuse_new()  # a program in a write loop stops now, its cycle with it
+        kernel.close(KERNEL_STOP_S)
+        writer.close(WRITER_STOP_S)  # what was queued before is written
     log.info("stopped")
     return 0
 

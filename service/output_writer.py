@@ -229,12 +229,18 @@ class OutputWriter:
             heapq.heappush(self._waiters, (target, next(self._tie), callback))
             return True
 
-    def close(self, timeout_s: float = 3.0) -> None:
-        """Refuse new writes, write what is queued, stop the thread (at most
-        ``timeout_s``); waiting downloads are answered with what is on disk."""
+    def refuse_new(self) -> None:
+        """Refuse every write from now on (the service stops): an NC program that writes
+        stops with an NC error at once, so a write loop cannot keep its decoder, or a
+        cycle waiting for that decoder, busy while the service shuts down."""
         with self._lock:
             self._closing = True
             self._wake.notify()
+
+    def close(self, timeout_s: float = 3.0) -> None:
+        """Refuse new writes, write what is queued, stop the thread (at most
+        ``timeout_s``); waiting downloads are answered with what is on disk."""
+        self.refuse_new()
         self._thread.join(timeout_s)
         if self._thread.is_alive():
             log.error("output writer did not finish within %.1f s", timeout_s)
