@@ -82,6 +82,9 @@ class CycleContext:
             except OutputLimitReached as exc:
                 raise self.error(NcErrorId.OUTPUT_LIMIT_REACHED,
                                  f"result file {name}: {exc}") from None
+            except (OSError, ValueError) as exc:  # e.g. the service is stopping
+                raise self.error(NcErrorId.FILE_WRITE_FAILED,
+                                 f"cannot write result file {name}: {exc}") from None
 
 
 def _param_pos(cycle_call: CycleCall, param: int | None) -> int:
