@@ -53,15 +53,15 @@ from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
 from .limits import rate_limiter
 from .notifications import NotificationCounts
+from .output_area import OutputArea
+from .output_service import OutputService
+from .output_writer import OutputLimits, OutputWriter
 from .program_service import ProgramStoreService
 from .program_store import ProgramStore, StoreError
 from .security import (
     SecurityError, ServerCurve, endpoint_is_local, host_is_loopback, load_server_curve,
 )
 from .server import ZmqServer
-from .output_area import OutputArea
-from .output_service import OutputService
-from .output_writer import OutputLimits, OutputWriter
 
 log = logging.getLogger("cnc-service")
 
