@@ -12,7 +12,9 @@ spiral's speed plot to ``lookahead-spiral.png``.
 
 ADS part (``--part ads``): pyads sequential reads against a minimal asyncio AMS/TCP
 echo server and against the service, and ``read_list_by_name`` of 100 symbols
-(``bench/ads_bench.py``).
+(``bench/ads_bench.py``); then by-name reads on a fresh connection with each ADS client
+the tests run, against pyads', and the time to upload and read every symbol
+(``bench/ads_clients_bench.py``).
 
 Jitter part (``--part jitter``): the realtime cycle's lateness (p50, p99, max) and
 overruns while the service answers 5 000 reads/s and feeds 20 on-change subscriptions
@@ -209,9 +211,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.part in ("all", "dispatch"):
         dispatch(args)
     if args.part in ("all", "ads"):
-        from . import ads_bench
+        from . import ads_bench, ads_clients_bench
 
         ads_bench.main(args.runs, args.count // 4)
+        ads_clients_bench.main()
     if args.part in ("all", "kernel"):
         kernel(args.runs)
     if args.part in ("all", "jitter"):

@@ -31,9 +31,15 @@ from typing import Any
 
 import typer
 
-from .channel_ops import CONTOUR_BLOCK_TYPES, ChannelStatus, CheckError, CheckResult
+from .blocking import Client
+from .channel_ops import (
+    CONTOUR_BLOCK_TYPES,
+    ChannelStatus,
+    CheckError,
+    CheckResult,
+    ProgramEntry,
+)
 from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
-from .client import Client
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
 
 EXIT_CHANNEL_ERROR = 4
@@ -131,7 +137,7 @@ def programs(ctx: typer.Context) -> None:
     list_files(settings, settings.call(lambda c: c.programs(), "the program list"))
 
 
-def list_files(settings: Settings, entries: list) -> None:
+def list_files(settings: Settings, entries: list[ProgramEntry]) -> None:
     """Print a file list (one JSON object per file with ``--json``)."""
     for e in entries:
         emit(settings, asdict(e), f"{e.name:40} {e.size_bytes:10d} bytes")
@@ -251,7 +257,7 @@ def mdi(
           f"channel {channel}: manual block {'finished' if wait else 'started'}")
 
 
-def _channel_command(method: str, done: str, request: str):
+def _channel_command(method: str, done: str, request: str) -> Callable[..., None]:
     def command(ctx: typer.Context, channel: int = ChannelOption) -> None:
         settings: Settings = ctx.obj
         settings.call(lambda c: getattr(c, method)(channel), f"{request} of channel {channel}")
@@ -363,10 +369,11 @@ def lookahead(
     first = int(start) if length == 0.0 else 0  # mode 1 numbers the entries by log index
     for k, b in enumerate(reply.blocks, start=first):
         motion = b.block_type in (1, 2, 6)
+        kind = CONTOUR_BLOCK_TYPES.get(b.block_type, str(b.block_type))
         size = f"{b.length / 10_000:.4f}" if motion else f"PARAM {b.length:g}"
         number = str(b.block_number) if b.block_number >= 0 else "-"
         out.print(
-            f"{k:>3} {CONTOUR_BLOCK_TYPES.get(b.block_type, str(b.block_type)):<10} "
+            f"{k:>3} {kind:<10} "
             f"{number:>5} {b.block_count_r:>5} {b.start_position / 10_000:>10.4f} {size:>10} "
             f"{b.programmed_radius / 10_000:>9.4f} {b.compensated_radius / 10_000:>9.4f} "
             f"{math.degrees(b.circle_angle):>9.3f} {math.degrees(b.tangent_variation):>8.3f}"
@@ -377,7 +384,7 @@ EXIT_CHECK_ERRORS = 1  # cnc check: the program has errors, or the check was abo
 EXIT_CHECK_TROUBLE = 2  # cnc check: no result (usage, connection, ADS error, timeout)
 
 
-def _check_record(e: CheckError) -> dict:
+def _check_record(e: CheckError) -> dict[str, object]:
     return {"file": e.file, "line": e.line, "column": e.column, "id": e.id,
             "category": e.category, "message": e.message}
 

@@ -18,7 +18,7 @@ from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from . import __version__
-from .config import MachineConfig
+from .machine_config import MachineConfig
 from .kernel.commands import (
     Command,
     Feedhold,
@@ -430,6 +430,28 @@ def _axis_parameter_update(text: str) -> Command:
         return UpdateAxisParameters(None, str(exc))
 
 
+class LastWritten:
+    """What a write-only command object (``mc_command_start_w``) reads: the value last
+    written to it, its type's zero before any write, as a command variable of a TwinCAT
+    PLC reads back. Every symbol of the upload is then readable, as in a PLC, and a read
+    of a glob that takes in a command object does not fail as a whole.
+
+    The value is kept once the kernel has applied the write: a write refused (0x706,
+    0x707, ...) leaves the value before it, as a PLC variable that an error reply did
+    not change. Kept and read on the event loop."""
+
+    def __init__(self, obj: CncObject) -> None:
+        self.value: Any = obj.dtype.decode(bytes(obj.dtype.size))
+
+    def read(self) -> Any:
+        """The value last written."""
+        return self.value
+
+    def keep(self, value: Any) -> None:
+        """A write of ``value`` was applied."""
+        self.value = value
+
+
 def machine_layout(kernel: Kernel) -> MachineLayout:
     """The layout the catalog is expanded over, from the kernel's configuration."""
     return MachineLayout(
@@ -476,7 +498,11 @@ def build_address_space(
         else:
             read = READERS[obj.element](kernel, obj) if obj.access.readable else None
         write = WRITERS[obj.element](kernel, obj) if obj.access.writable else None
-        space.add(obj, read, write, _aliases(kernel, obj))
+        written = None
+        if read is None and write is not None:  # a command: reads give what was written
+            echo = LastWritten(obj)
+            read, written = echo.read, echo.keep
+        space.add(obj, read, write, _aliases(kernel, obj), written)
     # Platform-axis objects (ac_*) are left out: their element names repeat per axis.
     com = [
         o for o in objects if o.port == CncPort.COM and o.group != GroupBase.COM_PLATFORM_AXIS

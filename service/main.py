@@ -31,6 +31,7 @@ import logging
 import os
 import signal
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
@@ -39,6 +40,7 @@ from typing import NoReturn, Optional
 import typer
 import zmq
 
+from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.protocol.ams import parse_net_id
 from cnc_objects.protocol.roles import Role
 
@@ -47,8 +49,9 @@ from .ads_server import AdsTcpServer
 from .ads_symbols import SymbolService
 from .backend import Backend
 from .binding import build_address_space
-from .config import ConfigError, MachineConfig, load_config, parse_ads_endpoint
+from .config import ConfigError, ServiceConfig, load_config
 from .data_location import StoreLocation, output_area_location, program_store_location
+from .frontend_config import parse_ads_endpoint
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
 from .limits import rate_limiter
@@ -102,7 +105,9 @@ def make_clock(kind: ClockKind, cycle_s: float, speed: float | None) -> Clock:
     return VirtualClock(cycle_s, speed)
 
 
-def _kernel_loader(store: ProgramStore):
+def _kernel_loader(
+    store: ProgramStore,
+) -> tuple[Callable[[str], str], Callable[[str], bool]]:
     """The store as the kernel sees it: text by name, KeyError when absent."""
 
     def load(name: str) -> str:
@@ -126,7 +131,7 @@ class AdsListen:
 
 
 async def serve(
-    config: MachineConfig, endpoint: str, clock_kind: ClockKind, speed: float | None,
+    config: ServiceConfig, endpoint: str, clock_kind: ClockKind, speed: float | None,
     store: ProgramStore, ads: AdsListen | None = None, curve: ServerCurve | None = None,
     outputs: OutputArea | None = None,
 ) -> int:
@@ -144,19 +149,21 @@ async def serve(
         limits.output_max_files, limits.output_max_file_bytes, limits.output_max_total_bytes,
         limits.output_queue_max_bytes))
     kernel = Kernel(
-        config, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists,
+        config.machine, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists,
         writer.kernel_file, writer.save,
     )
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows
     space = build_address_space(kernel, counts)
-    backend = Backend(space, kernel, loop, ProgramStoreService(store), SymbolService(space),
+    structs = PlcStructs(space)  # the HLI's structs and arrays over the PLC symbols
+    backend = Backend(space, kernel, loop, ProgramStoreService(store),
+                      SymbolService(space, structs),
                       (limits.notifications_per_client, limits.notifications_total), counts,
-                      OutputService(writer))
+                      outputs=OutputService(writer), structs=structs)
     kernel.on_cycle_end = backend.hub.kernel_cycle_end  # one hub serves both front ends
     try:
         server = ZmqServer(backend, endpoint, curve=curve, limits=limits)
     except zmq.ZMQError as exc:
-        print(f"cnc-service: cannot listen on {endpoint}: {zmq.strerror(exc.errno)}",
+        print(f"cnc-service: cannot listen on {endpoint}: {zmq.strerror(exc.errno or 0)}",
               file=sys.stderr)
         return EXIT_USAGE
     ads_server = None
@@ -207,7 +214,7 @@ async def serve(
 
 
 async def _start_ads(
-    backend: Backend, config: MachineConfig, ads: AdsListen
+    backend: Backend, config: ServiceConfig, ads: AdsListen
 ) -> AdsTcpServer | None:
     """The listening ADS front end, or None after saying in one line why it cannot be."""
     routes = RouteTable(
@@ -311,7 +318,7 @@ def run(
         serve(config, endpoint, clock, speed, store, listen, curve, outputs)))
 
 
-def _server_curve(config: MachineConfig, keys: Path | None) -> ServerCurve | None:
+def _server_curve(config: ServiceConfig, keys: Path | None) -> ServerCurve | None:
     """The CURVE keys of ``--keys`` or ``[security]``, None when neither turns CURVE on."""
     security = config.security
     if keys is None and not security.curve:
@@ -332,7 +339,7 @@ def _path(text: str | None) -> Path | None:
 
 
 def _ads_listen(
-    config: MachineConfig, ads: str | None, net_id: str | None, keys: bool = False,
+    config: ServiceConfig, ads: str | None, net_id: str | None, keys: bool = False,
     insecure: bool = False,
 ) -> AdsListen | None:
     """Where ADS listens: ``--ads``/``--ams-net-id`` over the configuration's [ads]; and
@@ -363,12 +370,12 @@ def _ads_listen(
                      open_to_all=insecure and not local and not config.ads.routes)
 
 
-def _machine_config(path: Path | None, cycle_ms: float | None) -> MachineConfig:
+def _machine_config(path: Path | None, cycle_ms: float | None) -> ServiceConfig:
     """The configuration file over the default machine, ``--cycle-ms`` over both."""
     try:
         config = load_config(path)
         if cycle_ms is not None:
-            config = MachineConfig.model_validate({**config.model_dump(), "cycle_ms": cycle_ms})
+            config = ServiceConfig.model_validate({**config.model_dump(), "cycle_ms": cycle_ms})
     except ConfigError as exc:
         _usage(f"bad configuration:\n{exc}")
     except ValueError as exc:  # --cycle-ms out of range
@@ -376,7 +383,7 @@ def _machine_config(path: Path | None, cycle_ms: float | None) -> MachineConfig:
     return config
 
 
-def _open_store(location: StoreLocation, config: MachineConfig) -> ProgramStore:
+def _open_store(location: StoreLocation, config: ServiceConfig) -> ProgramStore:
     """The program store at ``location`` (created when absent), announced in the log."""
     try:
         store = ProgramStore(location.path, config.limits.program_max_bytes,
@@ -388,7 +395,7 @@ def _open_store(location: StoreLocation, config: MachineConfig) -> ProgramStore:
 
 
 def _open_outputs(
-    output_dir: Path | None, config: MachineConfig, store: StoreLocation
+    output_dir: Path | None, config: ServiceConfig, store: StoreLocation
 ) -> OutputArea:
     """The output area (created when absent), announced in the log."""
     try:

@@ -34,6 +34,7 @@ from typing import Any
 
 from cnc_objects.protocol.constants import TransmissionMode
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.filetime import filetime_from_unix_ns
 
 from .kernel.state import Snapshot
 
@@ -53,12 +54,6 @@ MAX_PER_CLIENT = 1000  # default of [limits] notifications_per_client
 MAX_TOTAL = 20000  # default of [limits] notifications_total
 
 #: FILETIME (100 ns since 1601-01-01) of the Unix epoch.
-_FILETIME_UNIX_EPOCH = 116444736000000000
-
-
-def filetime(wall_ns: int) -> int:
-    """A wall-clock time (ns since the Unix epoch) as a FILETIME (100 ns since 1601)."""
-    return _FILETIME_UNIX_EPOCH + wall_ns // 100
 
 
 @dataclass(slots=True)
@@ -271,7 +266,7 @@ class NotificationHub:
             return None
         sub.last = data  # type: ignore[assignment]
         sub.sequence += 1
-        return [sub.handle, sub.sequence, filetime(snapshot.wall_ns), data]
+        return [sub.handle, sub.sequence, filetime_from_unix_ns(snapshot.wall_ns), data]
 
     def _emit(self, batches: dict[tuple[Envelope, int], tuple[NotifyFn, list]]) -> None:
         """One frame per client and port with all its samples of this cycle."""

@@ -31,13 +31,6 @@ _PUT_POLL_S = 0.05  # how often a decoder waiting on a full queue checks for can
 
 
 @dataclass(frozen=True, slots=True)
-class TextDone:
-    """Marker after the blocks of one text (a manual block): carried as a block."""
-
-    block: Block
-
-
-@dataclass(frozen=True, slots=True)
 class DecodeEnd:
     """No more blocks will come."""
 

@@ -17,7 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from enum import Enum
 
-from ..config import MachineConfig
+from ..machine_config import MachineConfig
 from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
@@ -59,7 +59,19 @@ class ResetCycleStats:
     value: bool
 
 
-_SHUTDOWN = object()
+class _Shutdown:
+    """The queue entry that stops the cycle thread (``Kernel.close``)."""
+
+
+_SHUTDOWN = _Shutdown()
+
+
+def _no_answer(_result: Refusal | None) -> None:
+    """The ``done`` of the shutdown entry: nobody waits for it."""
+
+
+#: a queued command and the callback that gets its answer
+Queued = tuple[Command | ControlCommand | _Shutdown, Done]
 
 
 class Kernel:
@@ -97,8 +109,8 @@ class Kernel:
         self.lateness: LatenessHistogram | None = clock.lateness
         self.snapshot: Snapshot = self.state.snapshot(0, 0, time.time_ns(), self.stats)
         self.on_cycle_end: Callable[[Snapshot], None] | None = None
-        self._queue: queue.SimpleQueue = queue.SimpleQueue()
-        self._waiting: deque = deque()
+        self._queue: queue.SimpleQueue[Queued] = queue.SimpleQueue()
+        self._waiting: deque[Queued] = deque()
         self._channel_index = {c.channel_id: k for k, c in enumerate(self.state.channels)}
         self._thread: threading.Thread | None = None
         self._closed = False
@@ -156,7 +168,7 @@ class Kernel:
         self._closed = True
         if self._thread is None:
             return
-        self._queue.put((_SHUTDOWN, None))
+        self._queue.put((_SHUTDOWN, _no_answer))
         self._thread.join(timeout_s)
         if self._thread.is_alive():
             log.error("cycle thread did not stop within %.1f s", timeout_s)
@@ -189,7 +201,7 @@ class Kernel:
             self.stats.running = False
             self._publish()
 
-    def _next_command(self, block: bool) -> tuple:
+    def _next_command(self, block: bool) -> Queued:
         if self._waiting:
             return self._waiting.popleft()
         return self._queue.get() if block else self._queue.get_nowait()
@@ -207,7 +219,7 @@ class Kernel:
                 command, done = self._next_command(block=False)
             except queue.Empty:
                 break
-            if command is _SHUTDOWN:
+            if isinstance(command, _Shutdown):
                 shutting_down = True
                 break
             applied.append((done, self._apply(command)))
@@ -226,7 +238,7 @@ class Kernel:
         """Wait in STOP until RUN or RESET; False on shutdown."""
         while not self.stats.running:
             command, done = self._next_command(block=True)
-            if command is _SHUTDOWN:
+            if isinstance(command, _Shutdown):
                 self._refuse_queued()
                 return False
             if isinstance(command, ControlCommand):
@@ -240,9 +252,12 @@ class Kernel:
     def _apply(self, command: Command | ControlCommand) -> Refusal | None:
         try:
             if isinstance(command, ControlCommand):
-                return self._control(command.control)
+                self._control(command.control)
+                return None
             if isinstance(command, ResetCycleStats):
-                return self._reset_cycle_stats() if command.value else None
+                if command.value:
+                    self._reset_cycle_stats()
+                return None
             return command.apply(self.state)
         except Exception:
             log.exception("command %r failed", command)
@@ -273,8 +288,7 @@ class Kernel:
                 command, done = self._next_command(block=False)
             except queue.Empty:
                 return
-            if done is not None:
-                done(Refusal(RefusalReason.NOT_READY, "the kernel is shutting down"))
+            done(Refusal(RefusalReason.NOT_READY, "the kernel is shutting down"))
 
     def _publish(self) -> None:
         cycle = self.stats.cycles

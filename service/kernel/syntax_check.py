@@ -35,7 +35,7 @@ from enum import IntEnum
 
 from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES
 
-from ..config import SyntaxCheckConfig
+from ..machine_config import SyntaxCheckConfig
 from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, Compensation, StopKind
 from .nc.check import CheckAborted, ErrorCategory, PointBatch

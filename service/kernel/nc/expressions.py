@@ -23,6 +23,7 @@ line of 10,000 ``[`` is an error and never exhausts Python's stack.
 from __future__ import annotations
 
 import re
+from typing import Any
 
 from .errors import NcError, NcErrorId
 from .evaluation import (
@@ -31,7 +32,7 @@ from .evaluation import (
     fold, logic, number, pow_op, truth, xor_op,
 )
 from .lexer import IDENT, NUMBER, VARIABLE, Cursor
-from .variables import Scope
+from .variables import Scope, Value
 
 _PARAM_REF = re.compile(r"@P([0-9]+)")
 # V.G. variables with members that the decoder provides (they are not declared)

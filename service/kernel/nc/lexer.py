@@ -37,7 +37,9 @@ class Cursor:
 
     def skip_ws(self) -> None:
         """Move over blanks."""
-        self.pos = _WS.match(self.up, self.pos).end()
+        m = _WS.match(self.up, self.pos)
+        assert m is not None  # the pattern matches the empty string too
+        self.pos = m.end()
 
     def at_end(self) -> bool:
         """True when only blanks are left."""

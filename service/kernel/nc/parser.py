@@ -29,6 +29,7 @@ from .statements import (
     Assign, AxisCommand, Call, ContourStatement, Control, Goto, NcBlock, StmtKind, Word,
     WordKind,
 )
+from .variables import Value
 
 _N_WORD = re.compile(r"N[ \t]*([-+]?[0-9.]*)([ \t]*:)?")
 _LABEL = re.compile(r"\[[ \t]*([A-Z0-9_]+)[ \t]*\]")
@@ -114,6 +115,7 @@ class LineParser:
             return current
         pos = cur.pos
         m = cur.match(_N_WORD)
+        assert m is not None  # at an 'N' (checked above): the rest of the pattern is optional
         digits = m.group(1)
         if current is not None:
             raise cur.error(NcErrorId.BLOCK_NUMBER_TWICE, "block number N programmed twice", pos)
@@ -129,6 +131,7 @@ class LineParser:
     def _control(self, cur: Cursor, number: int | None) -> Control:
         pos = cur.pos
         m = cur.match(_KEYWORD)
+        assert m is not None  # called at a '$': the rest of the pattern is optional
         word = m.group(1)
         kind = _CONTROL.get(word)
         if kind is None:
@@ -173,6 +176,7 @@ class LineParser:
     ) -> Control | AxisCommand | ContourStatement | Instruction:
         pos = cur.pos
         m = cur.match(_DIRECTIVE)
+        assert m is not None  # called at a '#': the rest of the pattern is optional
         word = m.group(1)
         if word == "AX":
             return parse_axis_command(cur, pos, number)
@@ -243,7 +247,9 @@ class LineParser:
             c = cur.peek()
             if c == "$":
                 if not cur.up.startswith("$GOTO", pos):
-                    word = cur.match(_KEYWORD).group(1)
+                    keyword = cur.match(_KEYWORD)
+                    assert keyword is not None  # at a '$': the rest is optional
+                    word = keyword.group(1)
                     raise cur.error(
                         NcErrorId.UNKNOWN_CONTROL_KEYWORD,
                         f"${word} must stand at the start of its line", pos,
@@ -290,7 +296,9 @@ class LineParser:
                 raise cur.error(NcErrorId.AXIS_COMMAND_NOT_ALONE,
                                 "#AX must stand alone in its NC line")
             elif c == "#" and CONTOUR_WORD.match(cur.up, pos):
-                word = _DIRECTIVE.match(cur.up, pos).group(1)
+                directive = _DIRECTIVE.match(cur.up, pos)
+                assert directive is not None  # at a '#': the rest is optional
+                word = directive.group(1)
                 raise cur.error(NcErrorId.CONTOUR_COMMAND_SYNTAX,
                                 f"#{word} must stand alone in its NC line")
             else:
@@ -339,14 +347,14 @@ class LineParser:
         c = cur.peek()
         parser = ExpressionParser(cur)
         if c == "[":
-            node = parser._primary()  # noqa: SLF001 - only the bracket, not what follows
+            node = parser._primary()  # only the bracket, not what follows
         elif c == "V" and cur.peek(1) == ".":
             node = parser.variable()
         else:
             raise cur.error(NcErrorId.MISSING_VALUE, f"value expected after '{letter}'", letter_pos)
         if negative:
             inner = node
-            node = lambda env: _negate(inner(env))  # noqa: E731
+            node = lambda env: _negate(inner(env))
         if isinstance(node, Const):
             value = node.value
             if isinstance(value, str):
@@ -396,7 +404,7 @@ def _skip(cur: Cursor) -> int:
     return cur.pos
 
 
-def _negate(value):
+def _negate(value: Value) -> Value:
     """-value; a string stays a string so that the word's evaluation reports it."""
     return value if isinstance(value, str) else -value
 
