@@ -201,7 +201,7 @@ class PlcStructs:
         if length < node.size:
             return (_E.DEVICE_INVALIDSIZE,
                     f"{node.name} is {node.type_name}, {node.size} bytes; read length is {length}")
-        return self.read_memory(node.start, node.size)  # type: ignore[return-value]
+        return self.read_memory(node.start, node.size)
 
     def decode_write(self, node: Node, data: bytes) -> tuple[int, str, list[tuple[Entry, Any]]]:
         """The member writes that a write of ``data`` to ``node`` makes (see
@@ -212,7 +212,7 @@ class PlcStructs:
             return (_E.DEVICE_INVALIDSIZE,
                     f"{node.name} is {node.type_name}, {node.size} bytes; write sent {len(data)}",
                     [])
-        return self.decode_memory_write(node.start, data)  # type: ignore[return-value]
+        return self.decode_memory_write(node.start, data)
 
     # ------------------------------------------------------------------ memory
 
@@ -246,10 +246,10 @@ class PlcStructs:
         image = bytearray(length)
         for entry, start in self._overlapping(offset, length):
             code, data = AddressSpace.read_entry(entry, entry.obj.dtype.size)
-            if code:
+            if code or not isinstance(data, bytes):  # code 0 carries the bytes
                 return code, data
             lo, hi = max(start, offset), min(start + len(data), offset + length)
-            image[lo - offset : hi - offset] = data[lo - start : hi - start]  # type: ignore[index]
+            image[lo - offset : hi - offset] = data[lo - start : hi - start]
         return 0, bytes(image)
 
     def decode_memory_write(self, offset: int, data: bytes) -> tuple[int, str, list[tuple[Entry, Any]]]:
@@ -268,7 +268,7 @@ class PlcStructs:
                     f"a write at 0x{offset:x} covers one symbol; none there is {len(data)} bytes",
                     [])
         code, now = self.read_memory(offset, len(data))
-        if code:
+        if code or not isinstance(now, bytes):  # code 0 carries the bytes
             return code, str(now), []
         writes: list[tuple[Entry, Any]] = []
         writable = False
@@ -281,7 +281,7 @@ class PlcStructs:
                 continue
             writable = True
             part = data[start - offset : start - offset + size]
-            if part == now[start - offset : start - offset + size]:  # type: ignore[index]
+            if part == now[start - offset : start - offset + size]:
                 continue
             code, target, value = AddressSpace.decode_entry_write(entry, part)
             if code:

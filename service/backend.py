@@ -22,6 +22,7 @@ from __future__ import annotations
 import asyncio
 import struct
 from collections.abc import Callable
+from functools import partial
 from typing import Any, Protocol
 
 from cnc_objects.objects import AddressSpace, Entry
@@ -207,7 +208,9 @@ class Backend:
 
     # ------------------------------------------------------------ writes
 
-    def decode_writes(self, port: int, group: int, offset: int, data: bytes) -> tuple:
+    def decode_writes(
+        self, port: int, group: int, offset: int, data: bytes
+    ) -> tuple[int, str, list[tuple[Entry, Any]]]:
         """(0, "", [(entry, value), ...]): the object writes a Write makes (none for a
         handle release or a struct written with what it holds, one per changed member
         of a struct), or (code, message, [])."""
@@ -232,7 +235,7 @@ class Backend:
         symbols = self.symbols
         if symbols is not None and symbols.handles(group):
             code, message = symbols.write(group, offset, data)
-            return (code, message, []) if code else (0, "", [])
+            return (code, str(message), []) if code else (0, "", [])
         decoded = self.space.decode_write(port, group, offset, data)
         if decoded[0] == _E.DEVICE_INVALIDSIZE and port == CncPort.PLC and group == PLC_GROUP:
             return self.structs.decode_memory_write(offset, data)  # a struct at its address
@@ -260,7 +263,8 @@ class Backend:
                 loop.call_soon_threadsafe(finish, results)
 
         for k, (entry, value) in enumerate(items):
-            self.kernel.submit(entry.write(value), lambda r, k=k: applied(k, r))
+            assert entry.write is not None  # decode_writes gives writable entries only
+            self.kernel.submit(entry.write(value), partial(applied, k))
 
 
 def _telling_written(

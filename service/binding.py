@@ -8,6 +8,7 @@ become kernel commands, applied by the cycle thread before the reply is sent.
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 from cnc_objects.objects import AddressSpace, ChannelLayout, CncObject, MachineLayout, build_objects
@@ -42,13 +43,13 @@ from .kernel.commands import (
     StartProgram,
     UpdateAxisParameters,
 )
-from .kernel.kernel import Kernel, ResetCycleStats
+from .kernel.kernel import Kernel, KernelCommand, ResetCycleStats
 from .kernel.state import DecoderFlag
 from .notifications import NotificationCounts
 from .param_list import ParamListError, parse_axis_list
 
 Getter = Callable[[], Any]
-CommandFactory = Callable[[Any], Command]
+CommandFactory = Callable[[Any], KernelCommand]
 
 REFUSAL_CODES: dict[RefusalReason, AdsReturnCode] = {
     RefusalReason.INVALID_VALUE: AdsReturnCode.DEVICE_INVALIDDATA,
@@ -382,6 +383,10 @@ SERVICE_READERS: dict[str, Callable[[NotificationCounts], Getter]] = {
 }
 
 
+def _syntax_check_parameter(name: str, ci: int, value: Any) -> Command:
+    return SetSyntaxCheckParameter(ci, name, value)
+
+
 def _channel_command(
     make: Callable[[int, Any], Command],
 ) -> Callable[[Kernel, CncObject], CommandFactory]:
@@ -397,8 +402,7 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
     "mc_command_execution_mode_w": _channel_command(SetExecutionMode),
     "decoder_mc_control.execution_mode.command_w": _channel_command(SetExecutionModePlc),
     "decoder_mc_control.execution_mode.enable_w": _channel_command(SetExecutionModeEnable),
-    **{f"syn_chk.{name}": _channel_command(
-        lambda ci, value, name=name: SetSyntaxCheckParameter(ci, name, value))
+    **{f"syn_chk.{name}": _channel_command(partial(_syntax_check_parameter, name))
        for name in ("errors_total", "errors_per_block", "interactive", "record_result")},
     "mc_command_single_block_w": _channel_command(SetSingleBlock),
     "prod_time_trace": _channel_command(SetProdTimeTrace),
@@ -493,12 +497,13 @@ def build_address_space(
     counts = notifications if notifications is not None else NotificationCounts()
     for obj in objects:
         service = SERVICE_READERS.get(obj.element)
+        read: Getter | None
         if service is not None:
             read = service(counts)
         else:
             read = READERS[obj.element](kernel, obj) if obj.access.readable else None
         write = WRITERS[obj.element](kernel, obj) if obj.access.writable else None
-        written = None
+        written: Callable[[Any], None] | None = None
         if read is None and write is not None:  # a command: reads give what was written
             echo = LastWritten(obj)
             read, written = echo.read, echo.keep

@@ -54,6 +54,7 @@ from .binding import refusal_code
 from .kernel.commands import Refusal
 from .kernel.kernel import Control, ControlCommand
 from .notifications import Envelope
+from .output_service import OutputService
 
 log = logging.getLogger(__name__)
 
@@ -198,15 +199,17 @@ class Dispatcher:
     def _is_store(self, port: int, group: int) -> bool:
         return group == PROGRAM_STORE_GROUP and port == CncPort.COM and self.programs is not None
 
-    def _is_output(self, port: int, group: int) -> bool:
-        return group == OUTPUT_AREA_GROUP and port == CncPort.COM and self.outputs is not None
+    def _output_area(self, port: int, group: int) -> OutputService | None:
+        """The output area's service when ``port`` and ``group`` address it, else None."""
+        return self.outputs if group == OUTPUT_AREA_GROUP and port == CncPort.COM else None
 
     def _read(self, envelope: Envelope, req: ReadRequest) -> Reply:
         # The hot path: an object address goes straight to the address space.
         if req.group == PROGRAM_STORE_GROUP and self._is_store(req.port, req.group):
             return self._reply(envelope, req, self.programs.read(req.offset, req.length))
-        if req.group == OUTPUT_AREA_GROUP and self._is_output(req.port, req.group):
-            return self._reply(envelope, req, self.outputs.read(req.offset, req.length))
+        if req.group == OUTPUT_AREA_GROUP and (
+                outputs := self._output_area(req.port, req.group)) is not None:
+            return self._reply(envelope, req, outputs.read(req.offset, req.length))
         if req.group < _RESERVED_GROUPS:
             code, payload = self._space_read(req.port, req.group, req.offset, req.length)
         else:
@@ -222,8 +225,8 @@ class Dispatcher:
     def _write(self, envelope: Envelope, req: WriteRequest) -> Reply:
         if self._is_store(req.port, req.group):
             return self._reply(envelope, req, self.programs.write(req.offset, req.data))
-        if self._is_output(req.port, req.group):
-            return self._reply(envelope, req, self.outputs.write(req.offset, req.data))
+        if (outputs := self._output_area(req.port, req.group)) is not None:
+            return self._reply(envelope, req, outputs.write(req.offset, req.data))
         code, message, writes = self.backend.decode_writes(
             req.port, req.group, req.offset, req.data)
         if code:
@@ -294,12 +297,14 @@ class Dispatcher:
             return self._reply(
                 envelope, req, self.programs.read_write(req.offset, req.data, req.read_length)
             )
-        if self._is_output(req.port, req.group):
-            return self._output_download(envelope, req)
+        if (outputs := self._output_area(req.port, req.group)) is not None:
+            return self._output_download(outputs, envelope, req)
         return self._reply(envelope, req, self.backend.read_write_value(
             req.port, req.group, req.offset, req.read_length, req.data))
 
-    def _output_download(self, envelope: Envelope, req: ReadWriteRequest) -> Reply:
+    def _output_download(
+        self, outputs: OutputService, envelope: Envelope, req: ReadWriteRequest
+    ) -> Reply:
         """A download from the output area: now, or once the writer has written what was
         queued for the file (answered then, from the writer thread through the loop)."""
 
@@ -311,7 +316,7 @@ class Dispatcher:
             except RuntimeError:  # the loop is closed: the service stops
                 pass
 
-        result = self.outputs.read_write(req.offset, req.data, req.read_length, answer)
+        result = outputs.read_write(req.offset, req.data, req.read_length, answer)
         return None if result is None else self._reply(envelope, req, result)
 
     def _sum_items(self, req: ReadWriteRequest, decode: Callable) -> tuple[int, Any]:

@@ -222,7 +222,7 @@ async def _start_ads(
         ads.loopback_role, ads.open_to_all,
     )
     ads_server = AdsTcpServer(backend, routes, config.ads.max_frame_bytes,
-                              rate_limiter(config.limits))
+                              rate_limiter(config.limits), config.limits)
     try:
         await ads_server.start(ads.host, ads.port, ads.net_id)
     except OSError as exc:

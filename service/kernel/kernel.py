@@ -70,8 +70,10 @@ def _no_answer(_result: Refusal | None) -> None:
     """The ``done`` of the shutdown entry: nobody waits for it."""
 
 
+#: what the kernel's queue takes from the service
+KernelCommand = Command | ControlCommand | ResetCycleStats
 #: a queued command and the callback that gets its answer
-Queued = tuple[Command | ControlCommand | _Shutdown, Done]
+Queued = tuple[KernelCommand | _Shutdown, Done]
 
 
 class Kernel:
@@ -150,7 +152,7 @@ class Kernel:
         """Position of the channel with logical id ``channel_id`` in the state."""
         return self._channel_index[channel_id]
 
-    def submit(self, command: Command | ControlCommand, done: Done) -> None:
+    def submit(self, command: KernelCommand, done: Done) -> None:
         """Queue ``command``; ``done`` is called from the cycle thread once applied
         (at once, with a refusal, when the kernel is closed)."""
         if self._closed:
@@ -249,7 +251,7 @@ class Kernel:
                 done(Refusal(RefusalReason.NOT_READY, "the kernel is stopped (ADS state STOP)"))
         return True
 
-    def _apply(self, command: Command | ControlCommand) -> Refusal | None:
+    def _apply(self, command: KernelCommand) -> Refusal | None:
         try:
             if isinstance(command, ControlCommand):
                 self._control(command.control)
