@@ -47,6 +47,10 @@ class Client(BlockingClientBase):
             plc_channel=plc_channel,
         ))
 
+    def delete_output(self, name: str) -> None:
+        """Remove ``name`` from the output area (operator or admin)."""
+        return run_blocking(self._core.delete_output(name))
+
     def delete_program(self, name: str) -> None:
         """Remove ``name`` from the store."""
         return run_blocking(self._core.delete_program(name))
@@ -58,6 +62,11 @@ class Client(BlockingClientBase):
     def download(self, name: str) -> bytes:
         """The stored content of ``name``."""
         return run_blocking(self._core.download(name))
+
+    def download_output(self, name: str) -> bytes:
+        """The content of output file ``name``, with every write the kernel queued for it
+        before this request (ADS 0x70C when there is no such file)."""
+        return run_blocking(self._core.download_output(name))
 
     def hold(self, channel: int = 1) -> None:
         """Feedhold: the path decelerates and stops (HOLD)."""
@@ -71,6 +80,12 @@ class Client(BlockingClientBase):
         """Run ``blocks`` as manual blocks; returns the count of finished manual blocks
         before this one (``wait_mdi`` waits until it has grown)."""
         return run_blocking(self._core.mdi(blocks, channel))
+
+    def outputs(self) -> list[ProgramEntry]:
+        """Every file of the output area (the files the kernel writes: ``#MSG SAVE``,
+        ``errors-ch<c>.log``, ``dec0<c>.sc``, ``prodtime0<c>.csv``, cycle results), sorted
+        by name; sizes as they will be once the kernel's queued writes are written."""
+        return run_blocking(self._core.outputs())
 
     def programs(self) -> list[ProgramEntry]:
         """Every file in the store, sorted by name."""

@@ -7,8 +7,9 @@
     result = await c.syntax_check("part.nc", channel=1)   # SYNCHK: nothing moves
     await c.reset_to_standard(channel=1)               # RESET, standard execution mode
 
-Everything goes through objects and the program-store index group; nothing here knows
-the kernel. Waiting polls the channel's objects every ``POLL_S`` of wall time. A command
+Everything goes through objects, the program-store index group and the output area's
+(the files the kernel writes: logs, check logs, ``#MSG SAVE``); nothing here knows the
+kernel. Waiting polls the channel's objects every ``POLL_S`` of wall time. A command
 the channel refuses because it is in ERROR says so, with the channel's errors and that
 RESET clears them (a CNC does not start in ERROR).
 """
@@ -22,10 +23,12 @@ from typing import Any
 
 from cnc_objects.protocol.constants import (
     MAX_DATA_BYTES,
+    OUTPUT_AREA_GROUP,
     PROGRAM_MAX_BYTES,
     PROGRAM_STORE_GROUP,
     CncPort,
 )
+from cnc_objects.protocol.constants import OutputAreaOffset as OutOp
 from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
@@ -140,7 +143,7 @@ class CheckResult:
     and ``blocks``: how many NC lines and blocks were checked; ``stopped_early``: the
     check stopped at ``syn_chk.errors_total``; ``log``: the whole log file;
     ``error_count``: all errors the check found (more than ``errors`` when the log had to
-    leave some out at the program store's file limit).
+    leave some out at the output area's file limit).
     """
 
     errors: tuple[CheckError, ...]
@@ -159,7 +162,7 @@ class CheckResult:
 
 
 def check_log_name(channel: int) -> str:
-    """The program-store file a syntax check in ``channel`` writes (``dec01.sc``)."""
+    """The output-area file a syntax check in ``channel`` writes (``dec01.sc``)."""
     return f"dec0{channel}.sc"
 
 
@@ -247,6 +250,26 @@ class ProgramOps(MixinBase):
     async def delete_program(self, name: str) -> None:
         """Remove ``name`` from the store."""
         await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.DELETE, _name_bytes(name))
+
+    async def outputs(self) -> list[ProgramEntry]:
+        """Every file of the output area (the files the kernel writes: ``#MSG SAVE``,
+        ``errors-ch<c>.log``, ``dec0<c>.sc``, ``prodtime0<c>.csv``, cycle results), sorted
+        by name; sizes as they will be once the kernel's queued writes are written."""
+        raw = await self.read_raw(CncPort.COM, OUTPUT_AREA_GROUP, OutOp.LIST, MAX_DATA_BYTES)
+        return [ProgramEntry(name, int(size), float(mtime))
+                for name, size, mtime in (line.split("\t") for line in
+                                          raw.decode("utf-8").splitlines())]
+
+    async def download_output(self, name: str) -> bytes:
+        """The content of output file ``name``, with every write the kernel queued for it
+        before this request (ADS 0x70C when there is no such file)."""
+        return await self.read_write_raw(
+            CncPort.COM, OUTPUT_AREA_GROUP, OutOp.DOWNLOAD, _name_bytes(name), MAX_DATA_BYTES
+        )
+
+    async def delete_output(self, name: str) -> None:
+        """Remove ``name`` from the output area (operator or admin)."""
+        await self.write_raw(CncPort.COM, OUTPUT_AREA_GROUP, OutOp.DELETE, _name_bytes(name))
 
 
 class ChannelOps(ProgramOps):
@@ -459,7 +482,7 @@ class ChannelOps(ProgramOps):
         log_file = check_log_name(channel)
         before = await self._prepare_simulation(
             channel, "a syntax check", wanted, readback, SYNCHK,
-            stale_file=log_file if program != log_file else None)
+            stale_file=log_file)
         changed: list[tuple[str, Any]] = []  # (object, value before), in write order
         started = finished = False
         try:
@@ -496,7 +519,7 @@ class ChannelOps(ProgramOps):
         await self._refuse_plc_execution_mode(channel, mode_bit)
         if stale_file is not None:
             try:
-                await self.delete_program(stale_file)
+                await self.delete_output(stale_file)
             except AdsError as exc:
                 if exc.code != AdsReturnCode.DEVICE_NOTFOUND:
                     raise
@@ -548,7 +571,7 @@ class ChannelOps(ProgramOps):
                 f"{timeout_s:g} s; it is cancelled (RESET)"
             ) from None
         try:
-            data = await self.download(log_file)
+            data = await self.download_output(log_file)
         except AdsError as exc:
             if exc.code != AdsReturnCode.DEVICE_NOTFOUND:
                 raise

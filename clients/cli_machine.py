@@ -1,6 +1,7 @@
 """``cnc`` commands that operate the machine: program store, run, MDI, hold, status.
 
     cnc upload FILE [--name NAME]        cnc download NAME [-o FILE]      cnc programs
+    cnc outputs                          cnc output NAME [-o FILE]        cnc delete-output NAME
     cnc run FILE|NAME [--channel N] [--wait] [--timeout S]
     cnc mdi "BLOCKS" [--channel N] [--wait] [--timeout S]
     cnc hold [--channel N]               cnc resume [--channel N] [--wait] [--timeout S]        cnc reset [--channel N] [--standard]
@@ -31,7 +32,13 @@ from typing import Any
 import typer
 
 from .blocking import Client
-from .channel_ops import CONTOUR_BLOCK_TYPES, ChannelStatus, CheckError, CheckResult
+from .channel_ops import (
+    CONTOUR_BLOCK_TYPES,
+    ChannelStatus,
+    CheckError,
+    CheckResult,
+    ProgramEntry,
+)
 from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
 
@@ -102,9 +109,14 @@ def download(
     output: Path = typer.Option(None, "--output", "-o",
                                 help="Write here (default, or '-': stdout)."),
 ) -> None:
-    """Download a file of the program store (programs, result files, logs)."""
+    """Download a program of the program store."""
     settings: Settings = ctx.obj
     data = settings.call(lambda c: c.download(name), f"download of {name}")
+    save_download(settings, name, data, output)
+
+
+def save_download(settings: Settings, name: str, data: bytes, output: Path | None) -> None:
+    """Write downloaded ``data`` to ``output`` (None or ``-``: stdout) and say so."""
     if output is None or str(output) == "-":
         sys.stdout.buffer.write(data)
         sys.stdout.flush()
@@ -122,11 +134,46 @@ def download(
 def programs(ctx: typer.Context) -> None:
     """List the program store."""
     settings: Settings = ctx.obj
-    entries = settings.call(lambda c: c.programs(), "the program list")
+    list_files(settings, settings.call(lambda c: c.programs(), "the program list"))
+
+
+def list_files(settings: Settings, entries: list[ProgramEntry]) -> None:
+    """Print a file list (one JSON object per file with ``--json``)."""
     for e in entries:
         emit(settings, asdict(e), f"{e.name:40} {e.size_bytes:10d} bytes")
     if not settings.as_json:
         out.print(f"{len(entries)} files")
+
+
+@command()
+def outputs(ctx: typer.Context) -> None:
+    """List the output area: the files the kernel writes (#MSG SAVE, cycle results,
+    errors-ch<c>.log, dec0<c>.sc, prodtime0<c>.csv)."""
+    settings: Settings = ctx.obj
+    list_files(settings, settings.call(lambda c: c.outputs(), "the output list"))
+
+
+@command()
+def output(
+    ctx: typer.Context,
+    name: str = typer.Argument(..., help="Name in the output area."),
+    output_file: Path = typer.Option(None, "--output", "-o",
+                                     help="Write here (default, or '-': stdout)."),
+) -> None:
+    """Download a file of the output area (logs, check logs, #MSG SAVE files)."""
+    settings: Settings = ctx.obj
+    data = settings.call(lambda c: c.download_output(name), f"download of output {name}")
+    save_download(settings, name, data, output_file)
+
+
+@command("delete-output")
+def delete_output(
+    ctx: typer.Context, name: str = typer.Argument(..., help="Name in the output area."),
+) -> None:
+    """Delete a file of the output area (operator or admin)."""
+    settings: Settings = ctx.obj
+    settings.call(lambda c: c.delete_output(name), f"delete of output {name}")
+    emit(settings, {"name": name, "deleted": True}, f"deleted output {name}")
 
 
 def wait_to_end(c: Client, channel: int, timeout_s: float | None) -> ChannelStatus:

@@ -7,7 +7,7 @@ The service runs the program through decoder, look-ahead and interpolator in ker
 (execution mode PROD_TIME, ``docs/syntax-check.md``): the same cycles as a real run on the
 virtual clock, as fast as the CPU allows, and no axis of the live machine moves. With
 ``ch<c>.prod_time_trace`` TRUE the channel writes each cycle's command positions, path
-distance, path speed and feed limit to ``prodtime0<c>.csv`` in the program store (thinned
+distance, path speed and feed limit to ``prodtime0<c>.csv`` in the output area (thinned
 evenly to at most 100,000 rows), which is read and parsed here.
 """
 
@@ -34,7 +34,7 @@ _HEADER = re.compile(
 
 
 def trace_file_name(channel: int) -> str:
-    """The program-store file of a traced PROD_TIME run in ``channel``."""
+    """The output-area file of a traced PROD_TIME run in ``channel``."""
     return f"prodtime0{channel}.csv"
 
 
@@ -120,7 +120,7 @@ class TraceOps(ChannelOps):
         result_file = trace_file_name(channel)
         before = await self._prepare_simulation(
             channel, "a traced dry run", wanted, readback, PROD_TIME,
-            stale_file=result_file if program != result_file else None)
+            stale_file=result_file)
         changed: list[tuple[str, Any]] = []
         started = finished = False
         ended_in_error: ChannelError | None = None
@@ -143,7 +143,7 @@ class TraceOps(ChannelOps):
             await self._end_check(channel, changed, cancel=started and not finished,
                                   quiet=not finished)
         try:
-            data = await self.download(result_file)
+            data = await self.download_output(result_file)
         except AdsError as exc:
             if exc.code != AdsReturnCode.DEVICE_NOTFOUND:
                 raise

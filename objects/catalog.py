@@ -444,12 +444,12 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
     ObjectTemplate(
         "syn_chk.record_result", Scope.CHANNEL, COM, COM_CH, 0x3103, BOOLEAN, RW, "-",
         "P-CHAN-00416: TRUE = write every checked line and error to dec0<c>.sc in the "
-        "program store (project)",
+        "output area (project)",
     ),
     ObjectTemplate(
         "prod_time_trace", Scope.CHANNEL, COM, COM_CH, 0x3110, BOOLEAN, RW, "-",
         "TRUE: the next PROD_TIME run (machining time calculation) writes its path, one "
-        "row per cycle, to prodtime0<c>.csv in the program store; cnc plot uses it (project)",
+        "row per cycle, to prodtime0<c>.csv in the output area; cnc plot uses it (project)",
     ),
     ObjectTemplate(
         "axis_parameter_update_w", Scope.PLATFORM, COM, COM_CH, 0x1100, STRING(4096), W, "-",

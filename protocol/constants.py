@@ -144,3 +144,17 @@ class ProgramStoreOffset(IntEnum):
     UPLOAD = 2  # Write: name (CP1252), NUL, content; replaces atomically
     DOWNLOAD = 3  # ReadWrite: name in, content out (read length >= size)
     DELETE = 4  # Write: name
+
+
+#: Index group of the output area on the COM port (project-defined): the files the kernel
+#: writes (#MSG SAVE, cycle results, error logs, syntax check logs, PROD_TIME traces),
+#: apart from the program store. Offsets are ``OutputAreaOffset``.
+OUTPUT_AREA_GROUP = 0x150001
+
+
+class OutputAreaOffset(IntEnum):
+    """Operations of the output area (index offsets in ``OUTPUT_AREA_GROUP``)."""
+
+    LIST = 1  # Read: one line per file, "name<TAB>size_bytes<TAB>mtime_unix_s\n" (UTF-8)
+    DOWNLOAD = 3  # ReadWrite: name in, content out (read length >= size)
+    DELETE = 4  # Write: name (operator and admin)

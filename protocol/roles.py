@@ -8,14 +8,16 @@ keeps its connection:
 request                       needs       why
 ============================  ==========  ====================================================
 ReadDeviceInfo, ReadState     monitor     reads
-Read (objects, programs list) monitor     reads
+Read (objects, program and    monitor     reads
+output lists)
 ReadWrite (by name, handles,  monitor     reads: these groups answer data, change nothing
-symbols, program download,
-sum read)
+symbols, program and output
+download, sum read)
 Add/DeleteDeviceNotification  monitor     subscribing changes nothing in the machine
 Browse                        monitor     reads the catalog
 Write 0xF006 (release handle) monitor     handles are stable per object: nothing changes
-Write (any other address)     operator    changes the machine: objects, programs run
+Write (any other address)     operator    changes the machine: objects, programs run;
+                                          deleting output files (the kernel's own)
 WriteControl                  operator    RUN, STOP, RESET of the kernel
 ReadWrite 0xF081 (sum write)  per item    each slot as a Write at its address
 Write program store (upload,  admin       the programs every operator runs

@@ -44,6 +44,7 @@ from .binding import refusal_code
 from .kernel.commands import Refusal
 from .kernel.kernel import Kernel
 from .notifications import MAX_PER_CLIENT, MAX_TOTAL, NotificationCounts, NotificationHub
+from .output_service import OutputService
 from .program_service import ProgramStoreService
 
 _E = AdsReturnCode
@@ -86,17 +87,20 @@ class Backend:
         symbols: SymbolServices | None = None,
         notification_limits: tuple[int, int] = (MAX_PER_CLIENT, MAX_TOTAL),
         notification_counts: NotificationCounts | None = None,
+        outputs: OutputService | None = None,
         structs: PlcStructs | None = None,
     ) -> None:
         """``notification_limits``: (per client, in total), ``[limits]``
         notifications_per_client and notifications_total; ``notification_counts``: where
-        the hub keeps its counts (the address space serves them); ``structs``: the HLI's
-        struct and array symbols, by name and by handle (none without)."""
+        the hub keeps its counts (the address space serves them); ``outputs``: the
+        output area (the files the kernel writes); ``structs``: the HLI's struct and
+        array symbols, by name and by handle (none without)."""
         self.space = space
         self.structs = structs if structs is not None else PlcStructs(AddressSpace())
         self.kernel = kernel
         self.loop = loop
         self.programs = programs
+        self.outputs = outputs
         self.symbols = symbols
         self.hub = NotificationHub(
             self.read_value, loop, kernel.cycle_ns, lambda: kernel.snapshot,

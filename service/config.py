@@ -31,8 +31,13 @@ class ServiceConfig(MachineConfig):
         "directory (service/data_location.py)"
     )
     data_dir: str | None = Field(
-        None, description="the service's data directory (the program store is its programs/); "
-        "default: cnc-data in the working directory at start"
+        None, description="the service's data directory (the program store is its programs/, "
+        "the output area its output/); default: cnc-data in the working directory at start"
+    )
+    output_dir: str | None = Field(
+        None, description="directory of the output area (the files the kernel writes); "
+        "default: output/ in the data directory, else <program store>-output beside the "
+        "store (service/data_location.py)"
     )
     ads: AdsConfig = Field(
         default_factory=AdsConfig, description="the ADS front end ([ads] endpoint, net_id, routes)"

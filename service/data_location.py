@@ -1,4 +1,5 @@
-"""Where a service keeps its data: the program store's directory, and why there.
+"""Where a service keeps its data: the program store's directory, the output area's, and
+why there.
 
 Each service has a store of its own. The first of these that is given decides:
 
@@ -13,6 +14,13 @@ store's own directory beats the data directory that contains it. Relative paths,
 those of the configuration, are taken from the working directory at start; ``~`` is
 expanded. Two services started from different directories therefore never share
 programs, and a service restarted where it was started finds its programs again.
+
+The output area (the files the kernel writes: ``#MSG SAVE``, logs) is a directory of its
+own, never the store: ``--output-dir DIR``, else ``output_dir`` of the configuration, else
+``<data dir>/output`` when the store is ``<data dir>/programs`` (cases 2, 4 and 5), else
+``<store>-output`` beside a store given by itself (``--program-dir /data/progs`` writes
+to ``/data/progs-output``). ``output_area_location`` refuses one that is the store, or
+inside it, or contains it.
 """
 
 from __future__ import annotations
@@ -22,6 +30,8 @@ from pathlib import Path
 
 DEFAULT_DATA_DIR = Path("cnc-data")
 PROGRAMS_SUBDIR = "programs"
+OUTPUT_SUBDIR = "output"
+OUTPUT_SUFFIX = "-output"
 
 
 @dataclass(frozen=True, slots=True)
@@ -30,6 +40,7 @@ class StoreLocation:
 
     path: Path
     source: str
+    data_dir: Path | None = None  # the data directory the store is programs/ of, if so
 
 
 def program_store_location(
@@ -50,11 +61,40 @@ def program_store_location(
     )
     for given, below, source in candidates:
         if given:  # an empty string in the configuration means "not set"
-            return StoreLocation(_absolute(base, Path(given) / below), source)
+            data_dir = _absolute(base, Path(given)) if below else None
+            return StoreLocation(_absolute(base, Path(given) / below), source, data_dir)
     return StoreLocation(
         _absolute(base, DEFAULT_DATA_DIR / PROGRAMS_SUBDIR),
         f"default: {DEFAULT_DATA_DIR / PROGRAMS_SUBDIR} in the working directory",
+        _absolute(base, DEFAULT_DATA_DIR),
     )
+
+
+def output_area_location(
+    output_dir: Path | None,
+    config_output_dir: str | None,
+    store: StoreLocation,
+    cwd: Path | None = None,
+) -> StoreLocation:
+    """The output area of a service whose program store is ``store`` (see the module
+    docstring); ``ValueError`` when it would be the store, inside it or around it."""
+    base = cwd if cwd is not None else Path.cwd()
+    if output_dir is not None:
+        found = StoreLocation(_absolute(base, output_dir), "--output-dir")
+    elif config_output_dir:
+        found = StoreLocation(_absolute(base, Path(config_output_dir)),
+                              "output_dir of the configuration")
+    elif store.data_dir is not None:
+        found = StoreLocation(store.data_dir / OUTPUT_SUBDIR,
+                              f"{OUTPUT_SUBDIR}/ in the data directory")
+    else:
+        found = StoreLocation(store.path.with_name(store.path.name + OUTPUT_SUFFIX),
+                              "beside the program store")
+    out, programs = found.path, store.path
+    if out == programs or out.is_relative_to(programs) or programs.is_relative_to(out):
+        raise ValueError(f"the output area {out} ({found.source}) must not be the program "
+                         f"store {programs}, nor inside it, nor contain it")
+    return found
 
 
 def _absolute(base: Path, path: Path) -> Path:

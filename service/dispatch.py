@@ -28,6 +28,7 @@ from cnc_objects.objects import Entry
 from cnc_objects.protocol import sum as sums
 from cnc_objects.protocol.constants import (
     MAX_DATA_BYTES,
+    OUTPUT_AREA_GROUP,
     PROGRAM_STORE_GROUP,
     SUM_COMMAND_MAX_ITEMS,
     AdsCommand,
@@ -53,6 +54,7 @@ from .binding import refusal_code
 from .kernel.commands import Refusal
 from .kernel.kernel import Control, ControlCommand
 from .notifications import Envelope
+from .output_service import OutputService
 
 log = logging.getLogger(__name__)
 
@@ -102,6 +104,7 @@ class Dispatcher:
         self.space = backend.space
         self.kernel = backend.kernel
         self.programs = backend.programs
+        self.outputs = backend.outputs
         self.hub = backend.hub
         self._loop = backend.loop
         self._front = front
@@ -162,6 +165,8 @@ class Dispatcher:
             what = "command the ADS state (WriteControl)"
         elif needed is Role.ADMIN:
             what = "change the program store (upload, delete)"
+        elif getattr(req, "group", None) == OUTPUT_AREA_GROUP:
+            what = "delete files of the output area"
         else:
             what = f"write {self._target(req.port, req.group, req.offset)}"
         return f"role {role.label} may not {what}; {roles_that_may(needed)} may"
@@ -194,10 +199,17 @@ class Dispatcher:
     def _is_store(self, port: int, group: int) -> bool:
         return group == PROGRAM_STORE_GROUP and port == CncPort.COM and self.programs is not None
 
+    def _output_area(self, port: int, group: int) -> OutputService | None:
+        """The output area's service when ``port`` and ``group`` address it, else None."""
+        return self.outputs if group == OUTPUT_AREA_GROUP and port == CncPort.COM else None
+
     def _read(self, envelope: Envelope, req: ReadRequest) -> Reply:
         # The hot path: an object address goes straight to the address space.
         if req.group == PROGRAM_STORE_GROUP and self._is_store(req.port, req.group):
             return self._reply(envelope, req, self.programs.read(req.offset, req.length))
+        if req.group == OUTPUT_AREA_GROUP and (
+                outputs := self._output_area(req.port, req.group)) is not None:
+            return self._reply(envelope, req, outputs.read(req.offset, req.length))
         if req.group < _RESERVED_GROUPS:
             code, payload = self._space_read(req.port, req.group, req.offset, req.length)
         else:
@@ -213,6 +225,8 @@ class Dispatcher:
     def _write(self, envelope: Envelope, req: WriteRequest) -> Reply:
         if self._is_store(req.port, req.group):
             return self._reply(envelope, req, self.programs.write(req.offset, req.data))
+        if (outputs := self._output_area(req.port, req.group)) is not None:
+            return self._reply(envelope, req, outputs.write(req.offset, req.data))
         code, message, writes = self.backend.decode_writes(
             req.port, req.group, req.offset, req.data)
         if code:
@@ -283,8 +297,27 @@ class Dispatcher:
             return self._reply(
                 envelope, req, self.programs.read_write(req.offset, req.data, req.read_length)
             )
+        if (outputs := self._output_area(req.port, req.group)) is not None:
+            return self._output_download(outputs, envelope, req)
         return self._reply(envelope, req, self.backend.read_write_value(
             req.port, req.group, req.offset, req.read_length, req.data))
+
+    def _output_download(
+        self, outputs: OutputService, envelope: Envelope, req: ReadWriteRequest
+    ) -> Reply:
+        """A download from the output area: now, or once the writer has written what was
+        queued for the file (answered then, from the writer thread through the loop)."""
+
+        def answer(result: ValueResult) -> None:  # the writer thread
+            def send() -> None:
+                self._send(envelope, self._reply(envelope, req, result))
+            try:
+                self._loop.call_soon_threadsafe(send)
+            except RuntimeError:  # the loop is closed: the service stops
+                pass
+
+        result = outputs.read_write(req.offset, req.data, req.read_length, answer)
+        return None if result is None else self._reply(envelope, req, result)
 
     def _sum_items(self, req: ReadWriteRequest, decode: Callable) -> tuple[int, Any]:
         if not 0 < req.offset <= SUM_COMMAND_MAX_ITEMS:

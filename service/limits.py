@@ -21,6 +21,9 @@ limit and the figures measured):
   mailbox, a full mailbox is answered ADS 0x502. The ADS front end stops reading a
   connection over the rate instead (TCP holds the rest).
 - ``program_max_bytes`` and ``program_max_files``: the program store.
+- ``output_max_files``, ``output_max_file_bytes``, ``output_max_total_bytes`` and
+  ``output_queue_max_bytes``: the output area, the files the kernel writes (NC
+  ``#MSG SAVE``, logs), and what may wait to be written (``output_writer``).
 - ``connections_per_front_end``, ``frame_timeout_s`` and ``receive_buffer_bytes_total``:
   what open connections and frames that never complete may hold. A connection beyond
   the cap, a frame still incomplete after the timeout, and (ADS) a connection whose
@@ -110,6 +113,28 @@ class LimitsConfig(BaseModel):
     program_max_files: int = Field(
         1000, ge=1, le=1_000_000,
         description="files the program store holds; an upload of one more: 0x70A",
+    )
+    output_max_files: int = Field(
+        1000, ge=1, le=1_000_000,
+        description="files the output area holds; an NC program that would create one more "
+        "(#MSG SAVE, a cycle's result file) stops with NC error 20533 naming this key",
+    )
+    output_max_file_bytes: int = Field(
+        PROGRAM_MAX_BYTES, ge=4096, le=PROGRAM_MAX_BYTES,
+        description="bytes one file of the output area may hold (at most what one download "
+        "carries); an NC program's write beyond: NC error 20533; a kernel error log keeps "
+        "its newest lines",
+    )
+    output_max_total_bytes: int = Field(
+        64 << 20, ge=4096, le=1 << 40,
+        description="bytes all files of the output area may hold together; an NC program's "
+        "write beyond: NC error 20533",
+    )
+    output_queue_max_bytes: int = Field(
+        4 << 20, ge=1 << 20, le=1 << 30,
+        description="bytes the kernel's file writes may queue for the writer thread (128 "
+        "more per write); an NC program's write beyond: NC error 20533, a kernel log line "
+        "beyond is dropped (logged, throttled)",
     )
 
     connections_per_front_end: int = Field(

@@ -3,14 +3,16 @@
     cnc-service [--config FILE] [--endpoint URL] [--ads HOST[:PORT]|off] [--ams-net-id ID]
                 [--keys DIR] [--insecure]
                 [--clock realtime|virtual] [--speed X] [--cycle-ms MS]
-                [--program-dir DIR | --data-dir DIR] [--log-level L]
+                [--program-dir DIR | --data-dir DIR] [--output-dir DIR] [--log-level L]
 
 Two front ends over one dispatcher: ZeroMQ (``--endpoint``) and ADS over AMS/TCP
 (``--ads``, default 127.0.0.1:48898, for pyads and every other ADS client). Logs where
-its program store is (``program store: /abs/path (why)``, see ``data_location``), where
+its program store is (``program store: /abs/path (why)``, see ``data_location``) and its
+output area (``output area: /abs/path (why)``: the files the kernel writes), where
 ADS listens (``ADS on 127.0.0.1:48898, AMS Net ID 127.0.0.1.1.1 ...``) and then the
 ZeroMQ endpoint (``listening on tcp://...``, the last start-up line); SIGINT and SIGTERM
-stop it cleanly (sockets closed, cycle thread joined) with exit code 0. Bad usage, a bad
+stop it cleanly (sockets closed, cycle thread joined, queued files written) with exit
+code 0 within 5 s, whatever runs (``KERNEL_STOP_S`` + ``WRITER_STOP_S``). Bad usage, a bad
 configuration or an address that cannot be bound exits with code 2 and says why (one
 line, or one line per configuration problem).
 
@@ -29,6 +31,7 @@ import logging
 import os
 import signal
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
@@ -47,24 +50,28 @@ from .ads_symbols import SymbolService
 from .backend import Backend
 from .binding import build_address_space
 from .config import ConfigError, ServiceConfig, load_config
+from .data_location import StoreLocation, output_area_location, program_store_location
 from .frontend_config import parse_ads_endpoint
-from .data_location import StoreLocation, program_store_location
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
 from .limits import rate_limiter
 from .notifications import NotificationCounts
+from .output_area import OutputArea
+from .output_service import OutputService
+from .output_writer import OutputLimits, OutputWriter
 from .program_service import ProgramStoreService
 from .program_store import ProgramStore, StoreError
 from .security import (
     SecurityError, ServerCurve, endpoint_is_local, host_is_loopback, load_server_curve,
 )
 from .server import ZmqServer
-from .store_writer import StoreWriter
 
 log = logging.getLogger("cnc-service")
 
 DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
 EXIT_USAGE = 2
+KERNEL_STOP_S = 2.0  # at SIGTERM: the cycle thread gets this long to end
+WRITER_STOP_S = 2.0  # then the output writer this long to write what is queued
 
 
 class ClockKind(StrEnum):
@@ -98,7 +105,9 @@ def make_clock(kind: ClockKind, cycle_s: float, speed: float | None) -> Clock:
     return VirtualClock(cycle_s, speed)
 
 
-def _kernel_loader(store: ProgramStore):
+def _kernel_loader(
+    store: ProgramStore,
+) -> tuple[Callable[[str], str], Callable[[str], bool]]:
     """The store as the kernel sees it: text by name, KeyError when absent."""
 
     def load(name: str) -> str:
@@ -124,31 +133,37 @@ class AdsListen:
 async def serve(
     config: ServiceConfig, endpoint: str, clock_kind: ClockKind, speed: float | None,
     store: ProgramStore, ads: AdsListen | None = None, curve: ServerCurve | None = None,
+    outputs: OutputArea | None = None,
 ) -> int:
     """Run kernel and both front ends until SIGINT or SIGTERM (ADS when ``ads`` is given;
-    ZeroMQ with CURVE when ``curve`` is given)."""
+    ZeroMQ with CURVE when ``curve`` is given). The files the kernel writes go to
+    ``outputs`` (default: ``<store>-output`` beside the store)."""
     loop = asyncio.get_running_loop()
     # The cycle thread must get the GIL soon after it wakes, even while the server is busy.
     sys.setswitchinterval(min(0.005, config.cycle_ms / 1000.0 / 4))
     load, exists = _kernel_loader(store)
-    writer = StoreWriter(store)
+    limits = config.limits
+    if outputs is None:
+        outputs = OutputArea(store.root.with_name(store.root.name + "-output"))
+    writer = OutputWriter(outputs, OutputLimits(
+        limits.output_max_files, limits.output_max_file_bytes, limits.output_max_total_bytes,
+        limits.output_queue_max_bytes))
     kernel = Kernel(
         config.machine, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists,
-        writer.append,
+        writer.kernel_file, writer.save,
     )
-    limits = config.limits
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows
     space = build_address_space(kernel, counts)
     structs = PlcStructs(space)  # the HLI's structs and arrays over the PLC symbols
-    backend = Backend(space, kernel, loop, ProgramStoreService(store, writer.flush),
+    backend = Backend(space, kernel, loop, ProgramStoreService(store),
                       SymbolService(space, structs),
                       (limits.notifications_per_client, limits.notifications_total), counts,
-                      structs)
+                      outputs=OutputService(writer), structs=structs)
     kernel.on_cycle_end = backend.hub.kernel_cycle_end  # one hub serves both front ends
     try:
         server = ZmqServer(backend, endpoint, curve=curve, limits=limits)
     except zmq.ZMQError as exc:
-        print(f"cnc-service: cannot listen on {endpoint}: {zmq.strerror(exc.errno)}",
+        print(f"cnc-service: cannot listen on {endpoint}: {zmq.strerror(exc.errno or 0)}",
               file=sys.stderr)
         return EXIT_USAGE
     ads_server = None
@@ -156,6 +171,7 @@ async def serve(
         ads_server = await _start_ads(backend, config, ads)
         if ads_server is None:
             server.close()
+            writer.close()
             return EXIT_USAGE
     stop = asyncio.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
@@ -190,8 +206,9 @@ async def serve(
             ads_server.close()
         server.close()
         kernel.on_cycle_end = None
-        kernel.close()
-        writer.close()
+        writer.refuse_new()  # a program in a write loop stops now, its cycle with it
+        kernel.close(KERNEL_STOP_S)
+        writer.close(WRITER_STOP_S)  # what was queued before is written
     log.info("stopped")
     return 0
 
@@ -246,7 +263,14 @@ def run(
     ),
     data_dir: Optional[Path] = typer.Option(
         None, "--data-dir", metavar="DIR",
-        help="Data directory of this service: its programs/ is the program store.",
+        help="Data directory of this service: its programs/ is the program store, its "
+        "output/ the output area.",
+    ),
+    output_dir: Optional[Path] = typer.Option(
+        None, "--output-dir", metavar="DIR",
+        help="Directory of the output area, the files the kernel writes (default: output_dir "
+        "of the configuration, else output/ in the data directory, else <program dir>-output "
+        "beside --program-dir).",
     ),
     ads: Optional[str] = typer.Option(
         None, "--ads", metavar="HOST[:PORT]",
@@ -289,7 +313,9 @@ def run(
                "bind 127.0.0.1, or --insecure")
     listen = _ads_listen(config, ads, ams_net_id, curve is not None, insecure)
     store = _open_store(location, config)
-    raise typer.Exit(asyncio.run(serve(config, endpoint, clock, speed, store, listen, curve)))
+    outputs = _open_outputs(output_dir, config, location)
+    raise typer.Exit(asyncio.run(
+        serve(config, endpoint, clock, speed, store, listen, curve, outputs)))
 
 
 def _server_curve(config: ServiceConfig, keys: Path | None) -> ServerCurve | None:
@@ -366,6 +392,22 @@ def _open_store(location: StoreLocation, config: ServiceConfig) -> ProgramStore:
         _usage(f"cannot use program directory {location.path}: {exc.strerror}")
     log.info("program store: %s (%s)", store.root, location.source)
     return store
+
+
+def _open_outputs(
+    output_dir: Path | None, config: ServiceConfig, store: StoreLocation
+) -> OutputArea:
+    """The output area (created when absent), announced in the log."""
+    try:
+        location = output_area_location(output_dir, config.output_dir, store)
+    except ValueError as exc:
+        _usage(str(exc))
+    try:
+        area = OutputArea(location.path)
+    except OSError as exc:
+        _usage(f"cannot use output directory {location.path}: {exc.strerror}")
+    log.info("output area: %s (%s)", area.root, location.source)
+    return area
 
 
 def main(argv: list[str] | None = None) -> None:

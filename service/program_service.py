@@ -1,6 +1,7 @@
 """The program store on the wire: ADS read, write and read-write at ``PROGRAM_STORE_GROUP``.
 
-Turns the store's operations into ADS replies: (0, payload) or (code, message). Store
+Turns the store's operations into ADS replies: (0, payload) or (code, message). Nothing
+here waits for anything but the store's own directory: the kernel writes no file here. Store
 faults map to ADS codes a pyads user knows: a bad name 0x706, a missing program 0x70C,
 an oversized upload or a short read buffer 0x705, a full store 0x70A.
 """
@@ -8,8 +9,6 @@ an oversized upload or a short read buffer 0x705, a full store 0x70A.
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
-
 from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
@@ -30,7 +29,8 @@ FAULT_CODES: dict[StoreFault, AdsReturnCode] = {
 }
 
 
-def _name(data: bytes) -> str:
+def request_name(data: bytes) -> str:
+    """The file name a request carries: CP1252 text up to the first NUL."""
     try:
         return data.split(b"\x00", 1)[0].decode(STRING_ENCODING)
     except UnicodeDecodeError:
@@ -45,16 +45,13 @@ def _unknown(offset: int, what: str) -> Result:
 class ProgramStoreService:
     """ADS operations on a ``ProgramStore``."""
 
-    def __init__(self, store: ProgramStore, flush: Callable[[], None] = lambda: None) -> None:
-        """``flush`` waits for files the kernel queued (see ``StoreWriter``)."""
+    def __init__(self, store: ProgramStore) -> None:
         self.store = store
-        self._flush = flush
 
     def read(self, offset: int, length: int) -> Result:
         """ADS Read: the program list."""
         if offset != Op.LIST:
             return _unknown(offset, "answer a read")
-        self._flush()
         listing = "".join(
             f"{p.name}\t{p.size_bytes}\t{p.mtime_s:.3f}\n" for p in self.store.list()
         ).encode("utf-8")
@@ -70,10 +67,10 @@ class ProgramStoreService:
                     name, sep, content = data.partition(b"\x00")
                     if not sep:
                         return _E.DEVICE_INVALIDDATA, "an upload is the name, a NUL, then the content"
-                    self.store.write(_name(name), content)
-                    log.info("program %r uploaded (%d bytes)", _name(name), len(content))
+                    self.store.write(request_name(name), content)
+                    log.info("program %r uploaded (%d bytes)", request_name(name), len(content))
                 case Op.DELETE:
-                    self.store.delete(_name(data))
+                    self.store.delete(request_name(data))
                 case _:
                     return _unknown(offset, "take a write")
         except StoreError as exc:
@@ -84,9 +81,8 @@ class ProgramStoreService:
         """ADS ReadWrite: download."""
         if offset != Op.DOWNLOAD:
             return _unknown(offset, "answer a read-write")
-        self._flush()
         try:
-            content = self.store.read(_name(data))
+            content = self.store.read(request_name(data))
         except StoreError as exc:
             return FAULT_CODES[exc.fault], str(exc)
         if len(content) > read_length:

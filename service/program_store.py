@@ -1,8 +1,9 @@
-"""The program store: NC programs and the files the kernel writes, in one directory.
+"""The program store: the NC programs, in one directory.
 
-Programs reach the controller over the wire (upload, list, download, delete); the kernel
-reads them from here when a program is selected and when a program calls a file
-subprogram. Writes are atomic (a temporary file in the same directory, then
+Programs reach the controller over the wire (upload, list, download, delete; upload and
+delete are admin's); the kernel reads them from here when a program is selected and when
+a program calls a file subprogram, and never writes here: the files it writes go to the
+output area (``output_area``). Writes are atomic (a temporary file in the same directory, then
 ``os.replace``): a reader sees the old content or the new, never half a file.
 
 Names are plain file names: no path separators, no ``..``, no leading dot, at most
@@ -53,20 +54,21 @@ class ProgramInfo:
     mtime_s: float
 
 
-def check_name(name: str) -> str:
-    """``name`` when it is a valid program name; StoreError otherwise."""
+def check_name(name: str, what: str = "program") -> str:
+    """``name`` when it is a valid name of a ``what`` (program, output file); StoreError
+    otherwise."""
     if not name:
-        raise StoreError(StoreFault.BAD_NAME, "a program name must not be empty")
+        raise StoreError(StoreFault.BAD_NAME, f"a {what} name must not be empty")
     if len(name) > PROGRAM_NAME_MAX_CHARS:
         raise StoreError(
             StoreFault.BAD_NAME,
-            f"program name {name[:20]!r}... has {len(name)} characters; "
+            f"{what} name {name[:20]!r}... has {len(name)} characters; "
             f"at most {PROGRAM_NAME_MAX_CHARS}",
         )
     if "/" in name or "\\" in name or ".." in name or not _NAME.fullmatch(name):
         raise StoreError(
             StoreFault.BAD_NAME,
-            f"program name {name!r} is not a plain file name (letters, digits, _ - . ; "
+            f"{what} name {name!r} is not a plain file name (letters, digits, _ - . ; "
             "no path separators, no '..', no leading dot)",
         )
     return name
@@ -102,20 +104,6 @@ class ProgramStore:
                     StoreFault.FULL, f"the store holds {self.max_files} files; delete some first"
                 )
             self._replace(name, data)
-
-    def append(self, name: str, data: bytes) -> None:
-        """Add ``data`` at the end of ``name`` (created when absent), atomically; when the
-        file would exceed the size bound its oldest bytes are dropped (whole lines)."""
-        with self._lock:
-            try:
-                old = self._path(name).read_bytes()
-            except FileNotFoundError:
-                old = b""
-            content = old + data
-            if len(content) > self.max_bytes:
-                content = content[-self.max_bytes :]
-                content = content[content.find(b"\n") + 1 :]
-            self._replace(name, content)
 
     def _replace(self, name: str, data: bytes) -> None:
         path = self._path(name)

@@ -1,9 +1,9 @@
 """The program selection dialog: type a name, or pick one of the program store's NC programs.
 
-The store also holds the files the kernel writes (``errors-ch<c>.log``, ``dec0<c>.sc``,
-``prodtime0<c>.csv``, ``msg_save.txt``, cycle results) and user cycles (``*.ecy``, called
-by a program, never selected). The list shows what a channel can run: names ending in
-``.nc`` (any case) and names without a suffix. A name typed into the input is selected
+The store also holds user cycles (``*.ecy``, called by a program, never selected) and
+whatever else an admin uploaded (the files the kernel writes are in the output area, not
+here). The list shows what a channel can run: names ending in ``.nc`` (any case) and
+names without a suffix. A name typed into the input is selected
 as typed, listed or not.
 """
 

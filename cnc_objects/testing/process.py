@@ -41,6 +41,7 @@ from pathlib import Path
 
 _LISTENING = re.compile(r"listening on (tcp://\S+)")
 _ADS_LISTENING = re.compile(r"ADS on \[?([^\s\]]+?)\]?:(\d+), AMS Net ID (\S+)")
+_OUTPUT_AREA = re.compile(r"output area: (.+) \(")
 _ADS_BUSY = "cannot listen for ADS"
 START_TIMEOUT_S = 20.0  # a cold start imports numpy and pydantic: seconds on a busy CI
 STOP_TIMEOUT_S = 10.0
@@ -102,6 +103,7 @@ class ServiceProcess:
                  owned_dir: tempfile.TemporaryDirectory[str] | None = None) -> None:
         self.process = process
         self.program_dir = program_dir  # the service's program store
+        self.output_dir: Path | None = None  # its output area (the files the kernel writes)
         self.endpoint = ""  # set once the service has logged it
         self.ads_address: tuple[str, int] | None = None  # (host, port) when ADS is on
         self.ams_net_id: str | None = None  # the service's AMS Net ID when ADS is on
@@ -264,7 +266,7 @@ def _start(args: tuple[str, ...], program_dir: str | os.PathLike[str] | None,
         args = (*args, "--program-dir", str(store))
     else:
         owned = tempfile.TemporaryDirectory(prefix="cnc-programs-")
-        store = Path(owned.name)
+        store = Path(owned.name) / "programs"  # the output area goes beside it, removed too
         args = (*args, "--program-dir", str(store))
     process = subprocess.Popen(
         service_command(*args), cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
@@ -283,6 +285,9 @@ def _start(args: tuple[str, ...], program_dir: str | os.PathLike[str] | None,
         raise
     service.endpoint = _LISTENING.search(line).group(1)  # type: ignore[union-attr]
     for logged in service.log:  # the ADS line comes before the ZeroMQ one
+        found_output = _OUTPUT_AREA.search(logged)
+        if found_output:
+            service.output_dir = Path(found_output.group(1))
         found = _ADS_LISTENING.search(logged)
         if found:
             service.ads_address = (found.group(1), int(found.group(2)))

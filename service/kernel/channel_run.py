@@ -85,17 +85,19 @@ class ChannelRunner:
         *,
         params: dict[int, AxisParameters],
         switchover: Switchover,
+        save: Callable[[str, bytes, bool], None] = lambda name, data, replace: None,
     ) -> None:
         """``params`` are the kernel's effective axis parameters (read at each program
         start, so a parameter update applies from the next run); ``switchover`` links
-        the channel's axes to the drives."""
+        the channel's axes to the drives; ``files`` writes the channel's own files (logs,
+        reports), ``save`` those its NC programs write, both into the output area."""
         self.channel = channel
         self.config = config
         self._loader = loader
         self._exists = exists
         self._cycle_s = cycle_s
         self._deterministic = deterministic  # virtual clock: wait for the decoder
-        self._files = files  # appends to a file of the program store, off this thread
+        self._files = files  # the output area's writer: queues, never blocks this thread
         self.error_log_name = f"errors-ch{channel.channel_id}.log"
         self._axes = tuple(a.name for a in config.axes)
         self._axis_numbers = tuple(a.logical_number for a in config.axes)
@@ -115,7 +117,7 @@ class ChannelRunner:
         # #MSG texts from the decoder thread (deque appends are thread-safe)
         self._messages: deque[str] = deque(maxlen=MESSAGES_KEPT)
         self._surroundings = Surroundings(
-            write_file=lambda name, text, replace: files(name, text.encode(), replace=replace),
+            write_file=lambda name, text, replace: save(name, text.encode(), replace),
             show_message=self._messages.append,
             hscs={mode.upper(): HscProgram(c.prog, c.tolerance * 1e-4)  # 0.1 um -> mm
                   for mode, c in config.hscs},
@@ -555,7 +557,7 @@ class ChannelRunner:
 
     def _ended(self, run: ChannelRun | None, how: str) -> None:
         """The program time of the run that ended; a traced PROD_TIME run's rows go to
-        the program store (``how``: its last row)."""
+        the output area (``how``: its last row)."""
         if run is None:
             return
         self.channel.program_time_s = self.time_s - run.started_at_s

@@ -86,11 +86,15 @@ class Kernel:
         loader: Loader = _no_programs,
         exists: Callable[[str], bool] = lambda name: False,
         files: Callable[..., None] = lambda name, data, replace=False: None,
+        save: Callable[[str, bytes, bool], None] = lambda name, data, replace: None,
     ) -> None:
         """``loader(name)`` returns a program's text (KeyError when absent) and
-        ``exists(name)`` says whether it is there: the program store, seen by the kernel.
-        ``files(name, data, replace=False)`` appends to a file of the store (logs), or
-        replaces its content (a result file); it must not block."""
+        ``exists(name)`` says whether it is there: the program store, seen by the kernel,
+        which never writes there. The files it writes go to the output area:
+        ``files(name, data, replace=False)`` for its own (a log line at the end, or a
+        report as the whole content), ``save(name, data, replace)`` for those an NC
+        program writes (``#MSG SAVE``, a cycle's result), which may raise
+        ``nc.technology.OutputLimitReached``; neither blocks."""
         self.config = config
         self.cycle_s = config.cycle_ms / 1000.0
         self.cycle_ns = round(config.cycle_ms * 1e6)
@@ -98,6 +102,7 @@ class Kernel:
         self._loader = loader
         self._exists = exists
         self._files = files
+        self._save = save
         self._busy = False
         self._changed: list[bool] | None = None  # channels the cycle touched; None = all
         self.state = self._initial_state()
@@ -124,7 +129,8 @@ class Kernel:
         deterministic = isinstance(self._clock, VirtualClock)
         state.runners = [
             ChannelRunner(channel, cfg, self.config, self._loader, self._exists, self.cycle_s,
-                          deterministic, self._files, params=params, switchover=self.switchover)
+                          deterministic, self._files, params=params, switchover=self.switchover,
+                          save=self._save)
             for channel, cfg in zip(state.channels, self.config.channels, strict=True)
         ]
         for message in messages:

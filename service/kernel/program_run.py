@@ -422,10 +422,10 @@ class ProdTimeRun(ProgramRun):
                               shown_line)
 
     def write_trace(self, ended: str, files: Callable[..., None]) -> None:
-        """The end of a traced run: its rows go to the program store."""
+        """The end of a traced run: its rows go to the output area."""
         trace, self.trace = self.trace, None
         if trace is not None:
-            # formatted by the store writer's thread, not in this cycle
+            # formatted by the output writer's thread, not in this cycle
             files(trace_file_name(self.channel.channel_id),
                   partial(trace.csv_bytes, ended), replace=True)
 

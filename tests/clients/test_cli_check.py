@@ -157,7 +157,7 @@ def test_software_limit_violation_aborts(service: RunningService, tmp_path: Path
     assert again.returncode == 2
     assert "ADS 0x707 NOTREADY: channel 1 is in ERROR (error 50101: far.nc:1:1:" in again.stderr
     assert "a syntax check needs a RESET first" in again.stderr
-    log = cnc("download", "dec01.sc", endpoint=ep).stdout
+    log = cnc("output", "dec01.sc", endpoint=ep).stdout
     assert log.splitlines()[-2:] == [
         "error 50101 (abort) at far.nc:1:1: " + abort["message"],
         "; end: 1 lines, 0 blocks, 0 errors, aborted",
@@ -215,7 +215,7 @@ def test_client_syntax_check(service: RunningService) -> None:
             "example.nc", 17, 9, 20121, "combination", "G0 and G1 in one block")
         assert (result.lines, result.blocks) == (17, 3)
         assert result.aborted is None and not result.stopped_early
-        assert result.log == c.download("dec01.sc").decode()
+        assert result.log == c.download_output("dec01.sc").decode()
         assert c.syntax_check("clean.nc").clean
         far = c.syntax_check("far.nc")  # an aborted check is a result, not an exception
         assert not far.clean and far.errors == ()

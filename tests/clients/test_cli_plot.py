@@ -63,11 +63,11 @@ def test_trace_time_is_the_time_of_a_real_run(service: RunningService) -> None:
     assert end == {"ch1.ax1.command_position_acs": 0, "ch1.ax2.command_position_acs": 200_000}
 
 
-def test_a_long_run_is_thinned_to_fit_the_store(service: RunningService) -> None:
+def test_a_long_run_is_thinned_to_fit_one_download(service: RunningService) -> None:
     with Client(service.endpoint) as c:
         c.upload("slow.nc", b"G01 X150 F60\nM30\n")  # 150 s: 150,000 cycles
         trace = c.trace_run("slow.nc")
-        size = next(p.size_bytes for p in c.programs() if p.name == "prodtime01.csv")
+        size = next(p.size_bytes for p in c.outputs() if p.name == "prodtime01.csv")
     assert trace.stride > 1 and len(trace.t_s) < 20_001
     assert size <= 1_000_000
     assert trace.axis("X")[-1] == 150.0 and trace.program_time_s == pytest.approx(150.001)

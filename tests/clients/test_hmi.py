@@ -157,8 +157,10 @@ async def test_program_dialog_lists_the_nc_programs_only(service: RunningService
         app = await started(pilot)
         await wait_until(pilot, lambda: app.channels.cell("ch1", "state") == "ERROR")
         stored = [p.name for p in await c.programs()]
-        assert stored == ["Part.NC", "SUB", "bad.nc", "dec01.sc", "drill.ecy",
-                          "errors-ch1.log", "msg_save.txt", "prodtime01.csv"]
+        assert stored == ["Part.NC", "SUB", "bad.nc", "drill.ecy"]
+        # the kernel's files are in the output area, never among the programs
+        assert [p.name for p in await c.outputs()] == [
+            "dec01.sc", "errors-ch1.log", "msg_save.txt", "prodtime01.csv"]
 
         await pilot.press("p")
         await wait_until(pilot, lambda: isinstance(app.screen, ProgramPicker), what="dialog")
@@ -169,7 +171,7 @@ async def test_program_dialog_lists_the_nc_programs_only(service: RunningService
                     for k in range(options.option_count)]
 
         assert listed() == ["Part.NC", "SUB", "bad.nc"]
-        await pilot.press("s")  # typing narrows the NC programs only (not msg_save.txt)
+        await pilot.press("s")  # typing narrows the NC programs only (not drill.ecy)
         await wait_until(pilot, lambda: listed() == ["SUB"], what="filtered to SUB")
         await pilot.press("escape")
         await wait_until(pilot, lambda: app.message.text == "ch1: no program selected")

@@ -27,13 +27,13 @@ def test_calculation_rotation_and_pattern_examples_run_on_the_service(cnc_client
     cycles = EXAMPLES / "cycles"
     _upload(api, *sorted(cycles.iterdir()))
     _run(api, "calc-circle.nc")
-    assert api.download("SysCalcCircleResult.txt").decode() == (
+    assert api.download_output("SysCalcCircleResult.txt").decode() == (
         "Center X = 0.000000\nCenter Y = 0.000000\nRadius = 1.000000\n"
         "Variance = 0.000000\n")
     _run(api, "calc-circle.nc")  # EXCLUSIVE: the second run replaces the file again
-    assert api.download("SysCalcCircleResult.txt").decode().count("Radius") == 1
+    assert api.download_output("SysCalcCircleResult.txt").decode().count("Radius") == 1
     _run(api, "rotate-to-plane.nc")
-    result = api.download("SysPosRotationToPlaneResult.txt").decode().splitlines()
+    result = api.download_output("SysPosRotationToPlaneResult.txt").decode().splitlines()
     assert result[2:6] == ["Origin = 140.000000, 0.000000, -80.000000",
                            "X axis = 0.000000, 1.000000, 0.000000",
                            "Y axis = -0.514496, 0.000000, 0.857493",

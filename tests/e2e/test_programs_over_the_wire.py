@@ -102,10 +102,12 @@ def test_error_is_readable_through_objects(c):
     assert values["ch1.mc_error_1_line_r"] == 2
     assert values["ch1.mc_error_1_column_r"] == 8  # the Q of "G1 Y10 Q7"
     assert "Q" in values["ch1.mc_error_1_text_r"]
-    # The kernel logs every error into the store, where it can be downloaded.
-    log = c.download("errors-ch1.log").decode()
+    # The kernel logs every error into its output area, where it can be downloaded at
+    # once: the download answers after the writer has written the line (no flush).
+    log = c.download_output("errors-ch1.log").decode()
     assert "bad.nc:2:8:" in log.splitlines()[-1]
-    assert "errors-ch1.log" in [p.name for p in c.programs()]
+    assert "errors-ch1.log" in [p.name for p in c.outputs()]
+    assert "errors-ch1.log" not in [p.name for p in c.programs()]
 
 
 def test_start_without_program_is_refused_with_a_reason(c):
@@ -170,3 +172,17 @@ def test_cli_mdi_and_bad_upload(machine, tmp_path):
     assert bad.returncode == 1 and "0x706" in bad.stderr
     missing = cnc("upload", str(tmp_path / "nope.nc"), endpoint=machine.endpoint)
     assert missing.returncode == 2 and "cannot read" in missing.stderr
+
+
+def test_cli_lists_downloads_and_deletes_output_files(machine, c):
+    c.wait_mdi(c.mdi('#FILE NAME [MSG="cli-out.txt"]\n#MSG SAVE ["hello %d", 7]'), timeout_s=30)
+    ep = machine.endpoint
+    listed = cnc("outputs", endpoint=ep)
+    assert listed.returncode == 0 and "cli-out.txt" in listed.stdout, listed.stderr
+    assert "cli-out.txt" not in cnc("programs", endpoint=ep).stdout
+    assert cnc("output", "cli-out.txt", endpoint=ep).stdout == "hello 7\n"
+    deleted = cnc("delete-output", "cli-out.txt", endpoint=ep)
+    assert deleted.returncode == 0 and "deleted output cli-out.txt" in deleted.stdout
+    missing = cnc("output", "cli-out.txt", endpoint=ep)
+    assert missing.returncode == 1 and "0x70c NOTFOUND" in missing.stderr, missing.stderr
+    assert "no output file 'cli-out.txt'" in missing.stderr

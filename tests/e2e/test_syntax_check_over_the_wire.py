@@ -47,7 +47,7 @@ def test_mode_objects_plc_unit_flags_and_log_over_the_wire(cnc_client: Client) -
     api.wait_program(timeout_s=30)
     assert api.read("pMC[0].StateDecoder_Data.X_SyntaxCheck") is False
     assert [api.read(f"ch1.mc_error_{k}_id_r") for k in (1, 2, 3)] == [21309, 21220, 20121]
-    log = api.download("dec01.sc").decode()
+    log = api.download_output("dec01.sc").decode()
     assert "error 21220 (term) at prog.nc:2:8: " in log
     assert "error 20121 (combination) at prog.nc:3:9: " in log
     assert log.rstrip().endswith("; end: 4 lines, 4 blocks, 2 errors, complete")

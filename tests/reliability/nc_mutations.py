@@ -1,5 +1,7 @@
 """Mutated NC programs: the example programs and test data, changed the ways a careless
-editor, a broken transfer or a hostile user change them.
+editor, a broken transfer or a hostile user change them; a hostile one also makes the
+program write files named like the programs of the store (``file_writes``), which must
+land in the output area and leave the store as it was.
 
 Each mutation is a pure function of (text, random generator); ``mutate`` applies one to
 three of them and names what it did, so that a failure names its program. Endless loops
@@ -36,6 +38,13 @@ TOKENS = [
     "G41 D99", "F0", "F-1", "M30", "M17", "V.L.X = 1/0", "V.P.Y = SQRT[-1]",
     "#CONTOUR LOOKAHEAD LOG ON", "#MSG SAVE [\"%f\", 1]", "(", ")", "[", "]", "\x1a", "\x7f",
 ]
+#: The store file every fuzz run keeps (``keep.nc``): the file writes aim at it.
+KEEP = ("keep.nc", b"N10 G01 X1 F600\nN20 M30\n")
+#: Names a mutant's ``#MSG SAVE`` writes to: store files, escapes, the kernel's own logs.
+FILE_TARGETS = [KEEP[0], "drill.ecy", "mutant-00000.nc", "../keep.nc", "/tmp/x.nc",
+                "errors-ch1.log", "dec01.sc", ".hidden", "msg.txt", "x" * 90]
+FILE_SAVES = ['#MSG SAVE ["G01 X%d F9999", 777]', '#MSG SAVE EXCLUSIVE ["M30"]',
+              '#MSG SAVE EXCLUSIVE ["%f", 2.5]', '#MSG SAVE ["' + "w" * 200 + '"]']
 MOTION = ["G1 X10 F6000", "G1 X0 F6000", "G0 Y5", "G2 X0 Y0 I5 J0 F3000"]
 
 
@@ -163,10 +172,22 @@ def long_line(text: str, rnd: random.Random) -> tuple[str, str]:
     return "\n".join(lines), f"a line of {len(line)} characters"
 
 
+def file_writes(text: str, rnd: random.Random) -> tuple[str, str]:
+    """Insert ``#FILE NAME [MSG=...]`` naming a store file (or an escape, or a log) and
+    1..200 ``#MSG SAVE [EXCLUSIVE]`` lines at a random place."""
+    lines = _lines(text)
+    target = rnd.choice(FILE_TARGETS)
+    count = rnd.choice([1, 2, rnd.randint(3, 200)])
+    saves = [rnd.choice(FILE_SAVES) for _ in range(count)]
+    lines[rnd.randrange(len(lines) + 1):0] = [f'#FILE NAME [MSG="{target}"]', *saves]
+    return "\n".join(lines), f"{count} #MSG SAVE to {target[:20]}"
+
+
 MUTATIONS: list[Callable[[str, random.Random], tuple[str, str]]] = [
     flip_characters, flip_characters, delete_lines, duplicate_lines, swap_lines,
     huge_numbers, huge_numbers, deep_nesting, truncate, insert_tokens, insert_tokens, long_line,
 ]
+FILE_WRITE_SHARE = 0.25  # of the mutants also write files (drawn apart: see ``mutate``)
 ENDLESS_SHARE = 0.08  # of the mutants get an endless loop (each costs the run timeout)
 BINARY_SHARE = 0.05  # of the mutants get bytes that are not text
 
@@ -188,6 +209,11 @@ def mutate(index: int, path: Path, rnd: random.Random) -> Mutant:
     changes = []
     for _ in range(rnd.randint(1, 3)):
         text, change = rnd.choice(MUTATIONS)(text, rnd)
+        changes.append(change)
+    # drawn from a generator of their own, so the other mutations stay what they were
+    writes = random.Random(f"{index} {path.name} {rnd.getstate()[1][0]}")
+    if writes.random() < FILE_WRITE_SHARE:
+        text, change = file_writes(text, writes)
         changes.append(change)
     endless = rnd.random() < ENDLESS_SHARE
     if endless:

@@ -1,6 +1,8 @@
 """Fuzz NC programs: mutants of every example program go through the syntax check and a
 run; the channel reports an error or finishes (or, for an endless loop, is RESET after a
-bounded time); no kernel thread dies and the service answers afterwards.
+bounded time); no kernel thread dies and the service answers afterwards. Mutants that
+write files (``#FILE NAME`` naming a stored program, ``#MSG SAVE [EXCLUSIVE]``) leave the
+program store as it was: every byte of every stored file is the same afterwards.
 
 The mutants are the same every ``make test`` run (a fixed seed); ``make soak`` draws
 a new seed and prints it, so that a failure can be reproduced (``CNC_NC_SEED=<seed>``).
@@ -31,14 +33,17 @@ from tests.reliability.health import (
     vitals,
     wait_for_tick_after,
 )
-from tests.reliability.nc_mutations import Mutant, mutate, sources, support_files
+from tests.reliability.nc_mutations import KEEP, Mutant, mutate, sources, support_files
 from tests.reliability.scale import Scale
 
 QUICK_SEED = 20_211  # the mutants of `make test`
 CHECK_TIMEOUT_S = 3.0  # a syntax check that has not ended is RESET (endless loops)
 RUN_TIMEOUT_S = 3.0  # a run that has not ended is RESET (endless loops with motion)
 STOP_TIMEOUT_S = 10.0  # after RESET the channel must stop working within this
-CLIENT_TIMEOUT_S = 20.0  # one request (a busy machine; the decoder may be busy too)
+# one request (a busy machine; the decoder may be busy too). With the virtual clock a
+# START is acknowledged only when the decoder hands GEO its first block: an idle endless
+# loop ($WHILE 1 V.L.X = ..) holds it until ENDLESS_LOOP, 14-21 s on a loaded 2-core box
+CLIENT_TIMEOUT_S = 40.0
 #: What the service may answer when it refuses to start a mutant (ADS codes).
 START_REFUSALS = {
     AdsReturnCode.DEVICE_NOTFOUND,  # the program is not stored (never, here)
@@ -56,7 +61,13 @@ def service() -> ServiceProcess:
         with Client(running.endpoint, timeout_s=CLIENT_TIMEOUT_S) as client:
             for path in support_files():
                 client.upload(path.name, path.read_bytes())
+            client.upload(*KEEP)
         yield running
+
+
+def stored(client: Client) -> dict[str, bytes]:
+    """Every file of the program store with its content."""
+    return {p.name: client.download(p.name) for p in client.programs()}
 
 
 def seed() -> int:
@@ -132,10 +143,12 @@ def test_mutated_programs_end_in_a_defined_state(service: ServiceProcess, run_sc
     rnd = random.Random(used_seed)
     before = vitals(service.endpoint)
     outcomes: Counter[str] = Counter()
-    endless = 0
+    endless = writes = 0
     started = time.monotonic()
     print(f"\nNC fuzz: seed {used_seed} (CNC_NC_SEED={used_seed} makes the same mutants)")
     with Client(service.endpoint, timeout_s=CLIENT_TIMEOUT_S) as client:
+        store_before = stored(client)
+        assert KEEP[0] in store_before
         for mutant in mutants(run_scale.nc_mutations, rnd):
             client.upload(mutant.name, mutant.data)
             try:
@@ -145,15 +158,18 @@ def test_mutated_programs_end_in_a_defined_state(service: ServiceProcess, run_sc
                 raise AssertionError(f"seed {used_seed}: {mutant.name} from {mutant.source} "
                                      f"({'; '.join(mutant.changes)}): {exc!r}") from None
             endless += mutant.endless
+            writes += any("#MSG SAVE" in change for change in mutant.changes)
             client.delete_program(mutant.name)
             assert client.read("cnc_tick_counter_r") is not None  # it answers
+        assert stored(client) == store_before, "an NC program changed the program store"
     elapsed_s = time.monotonic() - started
     assert_well(service, before.tick, before)
     summary = ", ".join(f"{k} {v}" for k, v in sorted(outcomes.items()))
     print(f"\nNC fuzz (seed {used_seed}): {run_scale.nc_mutations} mutants ({endless} with an "
-          f"endless loop) in {elapsed_s:.1f} s: {summary}")
+          f"endless loop, {writes} writing files) in {elapsed_s:.1f} s: {summary}")
     figures.record("NC mutants checked and run (seed)",
-                   f"{run_scale.nc_mutations} ({used_seed}), {endless} with endless loops", NODE)
+                   f"{run_scale.nc_mutations} ({used_seed}), {endless} with endless loops, "
+                   f"{writes} writing files (the store unchanged)", NODE)
     figures.record("NC outcomes", summary, NODE)
 
 

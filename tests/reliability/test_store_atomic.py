@@ -144,6 +144,7 @@ def test_a_signal_during_a_run_leaves_the_store_whole(
     tmp_path: Path, run_scale: Scale, sig: signal.Signals
 ) -> None:
     store = tmp_path / "store"
+    outputs = tmp_path / "store-output"  # the output area beside a --program-dir store
     passes = []
     for _ in range(run_scale.store_kills):
         # --speed 1: kernel time at wall pace, so the program is running at the signal
@@ -162,14 +163,15 @@ def test_a_signal_during_a_run_leaves_the_store_whole(
                 service.stop()
         assert code == (0 if sig == signal.SIGTERM else -signal.SIGKILL), service.log_text
         assert (store / "loop.nc").read_bytes() == LOOP_PROGRAM
-        lines = (store / RUN_LOG).read_bytes().split(b"\n")
+        assert sorted(p.name for p in store.iterdir()) == ["loop.nc"]  # the log is not here
+        lines = (outputs / RUN_LOG).read_bytes().split(b"\n")
         assert lines[-1] == b"", "the message file ends inside a line"
         matches = [LOG_LINE.fullmatch(line) for line in lines[:-1]]
         assert all(matches), "a line of the message file is not whole"
         numbers = [int(m.group(1)) for m in matches]  # type: ignore[union-attr]
         assert numbers == list(range(1, len(numbers) + 1)), "lines lost or doubled"
         passes.append(len(numbers))
-        (store / RUN_LOG).unlink()
+        (outputs / RUN_LOG).unlink()
     # started again on the same store, the program runs
     service = start_service(program_dir=store)
     try:
@@ -186,7 +188,7 @@ def test_a_signal_during_a_run_leaves_the_store_whole(
 
 def _log_lines(client: Client) -> int:
     """Lines of RUN_LOG so far (0 before it exists)."""
-    files = {p.name: p.size_bytes for p in client.programs()}
+    files = {p.name: p.size_bytes for p in client.outputs()}
     if RUN_LOG not in files:
         return 0
-    return client.download(RUN_LOG).count(b"\n")
+    return client.download_output(RUN_LOG).count(b"\n")

@@ -1,4 +1,5 @@
-"""Where a service's program store is: options over configuration, store over data dir."""
+"""Where a service's program store is: options over configuration, store over data dir;
+and its output area, never the store."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from cnc_objects.service.data_location import program_store_location
+from cnc_objects.service.data_location import output_area_location, program_store_location
 
 
 @pytest.mark.parametrize(
@@ -41,3 +42,32 @@ def test_paths_are_absolute_with_home_expanded(tmp_path: Path) -> None:
         tmp_path / "abs" / "programs").resolve()
     assert program_store_location(None, None, None, "a/../b", tmp_path).path == (
         tmp_path.resolve() / "b" / "programs")
+
+
+@pytest.mark.parametrize(
+    ("program_dir", "data_dir", "output_dir", "key_output_dir", "output", "source"),
+    [
+        (None, None, None, None, "cnc-data/output", "output/ in the data directory"),
+        (None, "d", None, None, "d/output", "output/ in the data directory"),
+        ("data/progs", None, None, None, "data/progs-output", "beside the program store"),
+        ("p", None, None, "outs", "outs", "output_dir of the configuration"),
+        ("p", None, "o", "outs", "o", "--output-dir"),
+    ],
+)
+def test_the_output_area_is_a_directory_of_its_own(
+    tmp_path: Path, program_dir: str | None, data_dir: str | None, output_dir: str | None,
+    key_output_dir: str | None, output: str, source: str,
+) -> None:
+    store = program_store_location(Path(program_dir) if program_dir else None,
+                                   Path(data_dir) if data_dir else None, None, None, tmp_path)
+    location = output_area_location(Path(output_dir) if output_dir else None,
+                                    key_output_dir, store, cwd=tmp_path)
+    assert location.path == (tmp_path / output).resolve()
+    assert location.source == source
+
+
+@pytest.mark.parametrize("output_dir", ["p", "p/sub", "."])
+def test_an_output_area_in_or_around_the_store_is_refused(tmp_path: Path, output_dir: str) -> None:
+    store = program_store_location(Path("p"), None, None, None, tmp_path)
+    with pytest.raises(ValueError, match="must not be the program store"):
+        output_area_location(Path(output_dir), None, store, cwd=tmp_path)

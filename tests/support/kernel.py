@@ -55,11 +55,12 @@ class KernelHarness:
     def __init__(self, programs: dict[str, str] | None = None,
                  config: MachineConfig | None = None) -> None:
         self.programs = dict(programs or {})
-        self.files: dict[str, bytes] = {}  # files the kernel wrote (logs, dec0<c>.sc)
+        self.files: dict[str, bytes] = {}  # files the kernel wrote (its output area)
         self.config = config or build_config()
         self.kernel = Kernel(
             self.config, VirtualClock(self.config.cycle_ms / 1000.0),
             self._load, lambda name: name in self.programs, self._write,
+            lambda name, data, replace: self._write(name, data, replace),
         )
         self._recording: list[Sample] | None = None
         self._finished = threading.Event()

@@ -35,6 +35,7 @@ from .program import Program
 from .running_decoder import CallingDecoder
 from .source import LogicalLine
 from .statements import Call, CycleArgs, NcBlock
+from .technology import OutputLimitReached
 from .variables import Scope, Value, VariableFault
 
 PATTERN_WRAPPER = "SysPosPatternWrapper.ecy"
@@ -85,9 +86,16 @@ class CycleContext:
                                  f"{fault.message}") from None
 
     def write_file(self, name: str, text: str) -> None:
-        """Replace file ``name`` of the store (nothing in a syntax check)."""
+        """Replace file ``name`` of the output area (nothing in a syntax check)."""
         if self.decoder.check is None:
-            self.decoder.surroundings.write_file(name, text, True)
+            try:
+                self.decoder.surroundings.write_file(name, text, True)
+            except OutputLimitReached as exc:
+                raise self.error(NcErrorId.OUTPUT_LIMIT_REACHED,
+                                 f"result file {name}: {exc}") from None
+            except (OSError, ValueError) as exc:  # e.g. the service is stopping
+                raise self.error(NcErrorId.FILE_WRITE_FAILED,
+                                 f"cannot write result file {name}: {exc}") from None
 
 
 def _param_pos(cycle_call: CycleCall, param: int | None) -> int:

@@ -139,7 +139,8 @@ class NcErrorId(IntEnum):
     PATTERN_ROTATION_NOT_SUPPORTED = 20526  # #AT with a rotation about X or Y
     INSTRUCTION_SYNTAX = 20530  # malformed #CS, #FILE, #MSG, #TRAFO, #HSC, #SLOPE, #FILTER
     MESSAGE_FORMAT = 20531  # #MSG: format and arguments do not match
-    FILE_WRITE_FAILED = 20532  # #MSG SAVE: the file store refused the write
+    FILE_WRITE_FAILED = 20532  # #MSG SAVE: the output area refused the write
+    OUTPUT_LIMIT_REACHED = 20533  # #MSG SAVE, a cycle's result file: an output_* limit
 
 
 class NcError(Exception):

@@ -17,6 +17,7 @@ from .messages import format_message
 from .patterns import OpenPattern, PatternPosition
 from .running_decoder import CallingDecoder
 from .source import LogicalLine
+from .technology import OutputLimitReached
 from .variables import VariableFault
 
 DEFAULT_MSG_FILE = "msg_save.txt"  # #MSG SAVE before any #FILE NAME
@@ -206,6 +207,9 @@ def _msg_save(stmt: Instruction, decoder: CallingDecoder) -> None:
     decoder.files_written.add(name)
     try:
         decoder.surroundings.write_file(name, text + "\n", replace)
+    except OutputLimitReached as exc:
+        raise stmt.line.error(NcErrorId.OUTPUT_LIMIT_REACHED,
+                              f"#MSG SAVE to {name}: {exc}", stmt.pos) from None
     except (OSError, ValueError) as exc:
         raise stmt.line.error(NcErrorId.FILE_WRITE_FAILED,
                               f"#MSG SAVE cannot write {name}: {exc}", stmt.pos) from None

@@ -47,15 +47,26 @@ def _ignore(*_args: object) -> None:
     return None
 
 
+class OutputLimitReached(ValueError):
+    """A file an NC program writes would pass a limit of the output area; ``limit`` is
+    the ``[limits]`` key (``output_max_file_bytes``, ...), the message says by how much.
+    The program stops with ``OUTPUT_LIMIT_REACHED`` at the statement that wrote."""
+
+    def __init__(self, limit: str, message: str) -> None:
+        super().__init__(message)
+        self.limit = limit
+
+
 @dataclass(frozen=True, slots=True)
 class Surroundings:
     """What the decoder may reach outside the program text.
 
-    ``write_file(name, text, replace)`` writes a result file into the file store
-    (``#MSG SAVE``); ``show_message(text)`` puts a ``#MSG`` into the channel's message
-    list; ``hscs`` maps a mode of ``HSCS_MODES`` to its program and tolerance;
-    ``kinematics``: the channel has a kinematic transformation configured (needed to
-    rotate the tool). The defaults drop files and messages.
+    ``write_file(name, text, replace)`` writes a file of the output area (``#MSG SAVE``,
+    a cycle's result; never the program store): it queues the text and returns at once,
+    or raises ``OutputLimitReached``; ``show_message(text)`` puts a ``#MSG`` into the
+    channel's message list; ``hscs`` maps a mode of ``HSCS_MODES`` to its program and
+    tolerance; ``kinematics``: the channel has a kinematic transformation configured
+    (needed to rotate the tool). The defaults drop files and messages.
     """
 
     write_file: Callable[[str, str, bool], None] = _ignore
