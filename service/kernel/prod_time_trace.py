@@ -4,13 +4,14 @@ With ``ch<c>.prod_time_trace`` TRUE, a PROD_TIME run records after every simulat
 the command position of each channel axis, the path distance, the path speed and the
 feed limit (F of the block in the interpolator; the axis limit for G0). At the end of
 the run (READY or ERROR) the channel writes the rows to ``prodtime0<c>.csv`` in the
-program store, where ``cnc plot`` and ``Client.trace_run`` read them.
+output area (the files the kernel writes), where ``cnc plot`` and ``Client.trace_run``
+read them.
 
 A run of any length stays bounded: when ``rows_max`` rows are kept, every second one is
 dropped and from then on only every second cycle is recorded (the stride doubles each
-time), so a long program is thinned evenly, never cut off. The file must also fit into
-the program store (``PROGRAM_MAX_BYTES``): the rows are thinned the same way until it
-does. The last cycle is always in the file, so the trace ends at the program's end point.
+time), so a long program is thinned evenly, never cut off. The file must also fit one
+download (``PROGRAM_MAX_BYTES``, 1 MB, the default of ``[limits] output_max_file_bytes``):
+the rows are thinned the same way until it does. The last cycle is always in the file, so the trace ends at the program's end point.
 """
 
 from __future__ import annotations
