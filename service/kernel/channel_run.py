@@ -127,6 +127,8 @@ class ChannelRunner:
         self._started_at_s = 0.0
         self._time_s = 0.0
         self._check: CheckRun | None = None  # syntax check or dry run of the program
+        self._check_max_errors = machine.limits.check_max_errors  # errors kept per check
+        self._check_left_out = 0  # errors of the check counted but not kept, shown so far
         self._released: Pause = Pause.NONE  # START ended this pause (flag for one cycle)
         self._prod_time = False  # PROD_TIME: the run is simulated, no axis moves
         self._sim_steps = 0  # PROD_TIME: cycles simulated so far
@@ -493,7 +495,9 @@ class ChannelRunner:
             deterministic=self._deterministic, files=self._files,
             surroundings=self._surroundings,
             modal=self.new_modal(tuple(a.position_mm for a in ch.axes)),
+            max_errors=self._check_max_errors,
         )
+        self._check_left_out = 0
         self._released = Pause.NONE
         self._executor = None
         self._pending_error = None
@@ -517,6 +521,9 @@ class ChannelRunner:
             err = found.error
             self._raise(ChannelError(int(err.id), err.message, found.file, found.line,
                                      found.column, warning=True), to_log=False, keep_last=True)
+        # errors over limits.check_max_errors are counted, not listed
+        ch.error_count += p.left_out - self._check_left_out
+        self._check_left_out = p.left_out
         flags = ch.decoder_flags & DecoderFlag.SYNTAX_CHECK
         if p.pause == Pause.AFTER_ERROR:
             flags |= DecoderFlag.WAIT_AFTER_ERROR

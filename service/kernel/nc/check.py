@@ -149,11 +149,21 @@ _INCOMPLETE = frozenset({
     NcErrorId.UNDECLARED_VARIABLE, NcErrorId.UNKNOWN_VARIABLE, NcErrorId.LABEL_NOT_FOUND,
 })
 
+# the category of an error id found in no command and no assignment target
+_CATEGORY_OF_ID = {
+    **dict.fromkeys(_COMBINATION, ErrorCategory.COMBINATION),
+    **dict.fromkeys(_LIMIT, ErrorCategory.LIMIT),
+    **dict.fromkeys(_VALUE, ErrorCategory.VALUE),
+    **dict.fromkeys(_INCOMPLETE, ErrorCategory.INCOMPLETE),
+}
+
 # the $ or # that starts the command of a line (after an N number and a label). Every
 # run is possessive: blanks next to blanks ("N  :  ") must not be split up in all ways
 # when there is no command, which made a line of thousands of blanks take minutes.
 _COMMAND_START = re.compile(
     r"[ \t]*+(?:N[ \t]*+[0-9]*+[ \t]*+:?[ \t]*+)?(?:\[[^\]]*+\][ \t]*+)?([$#])")
+# a run of characters that opens neither brackets nor a string, up to a blank
+_PLAIN_RUN = re.compile(r'[^ \t\["]*')
 # "V.x.name[...] =" (not "==") at a position: the target of an assignment
 _ASSIGN_TARGET = re.compile(r"V\.[A-Z]+\.[A-Z_][A-Z0-9_]*(?:\[[^\]=]*\])*[ \t]*=(?!=)")
 
@@ -166,8 +176,10 @@ def command_position(line: LogicalLine) -> int:
     return m.start(1)
 
 
-def categorize(error: NcError, line: LogicalLine | None) -> ErrorCategory:
-    """The category of ``error`` found in ``line`` (None: not in one line)."""
+def categorize(error: NcError, line: LogicalLine | None,
+               command_at: int | None = None) -> ErrorCategory:
+    """The category of ``error`` found in ``line`` (None: not in one line);
+    ``command_at``: ``command_position(line)`` when the caller knows it already."""
     err_id = error.id
     if err_id in _RESOURCE:
         return ErrorCategory.RESOURCE
@@ -176,17 +188,9 @@ def categorize(error: NcError, line: LogicalLine | None) -> ErrorCategory:
     if line is not None and error.pos >= 0:
         if _ASSIGN_TARGET.match(line.upper, error.pos):
             return ErrorCategory.ASSIGNMENT
-        if command_position(line) >= 0:
+        if (command_position(line) if command_at is None else command_at) >= 0:
             return ErrorCategory.COMMAND
-    if err_id in _COMBINATION:
-        return ErrorCategory.COMBINATION
-    if err_id in _LIMIT:
-        return ErrorCategory.LIMIT
-    if err_id in _VALUE:
-        return ErrorCategory.VALUE
-    if err_id in _INCOMPLETE:
-        return ErrorCategory.INCOMPLETE
-    return ErrorCategory.TERM
+    return _CATEGORY_OF_ID.get(err_id, ErrorCategory.TERM)
 
 
 # ---------------------------------------------------------------- repositioning
@@ -201,6 +205,18 @@ class RepositionedLine(LogicalLine):
         super().__init__(line.file, text, line.segments, line.offset)
         self.errors = errors
 
+    @classmethod
+    def counted(cls, line: LogicalLine, errors: int) -> RepositionedLine:
+        """``line`` itself (its text not copied, not upper-cased again) with ``errors``."""
+        if type(line) is cls:
+            line.errors = errors
+            return line
+        new = cls.__new__(cls)
+        for name in LogicalLine.__slots__:
+            setattr(new, name, getattr(line, name))
+        new.errors = errors
+        return new
+
 
 def blanked(line: LogicalLine, start: int, stop: int) -> LogicalLine:
     """``line`` with ``[start, stop)`` replaced by blanks (columns stay as they were)."""
@@ -208,14 +224,18 @@ def blanked(line: LogicalLine, start: int, stop: int) -> LogicalLine:
     return RepositionedLine(line, text, getattr(line, "errors", 0))
 
 
-def term_start(text: str, pos: int) -> int:
+def term_start(text: str, pos: int, origin: int = 0) -> int:
     """Start of the term that holds ``pos``: ``pos`` itself, or when ``pos`` is inside
     brackets or a string, the start of the word whose ``[`` or ``"`` opened them (an
-    error inside ``X[...]`` drops all of ``X[...]``, not the part after the error)."""
+    error inside ``X[...]`` drops all of ``X[...]``, not the part after the error).
+    ``origin``: a position outside any brackets or string at or before ``pos`` (the
+    start of the item being parsed), where the scan begins."""
+    if _PLAIN_RUN.match(text, origin, pos).end() >= pos:  # no bracket or string before
+        return pos
     depth = 0
     quoted = False
     opened = pos
-    for k in range(min(pos, len(text))):
+    for k in range(origin, min(pos, len(text))):
         c = text[k]
         if c == '"':
             if not quoted and depth == 0:
@@ -237,6 +257,11 @@ def term_start(text: str, pos: int) -> int:
 
 def term_end(text: str, pos: int) -> int:
     """End of the term at ``pos``: the next blank outside brackets and strings."""
+    n = len(text)
+    k = pos + 1 if pos < n and text[pos] in " \t" else pos
+    k = _PLAIN_RUN.match(text, k).end()
+    if k >= n or text[k] in " \t":  # no bracket, no string: the next blank
+        return k
     depth = 0
     quoted = False
     k = pos
@@ -360,16 +385,89 @@ def dropped_control(line: LogicalLine, errors: int):
                    step=_DROPPED, values=(_DROPPED,))
 
 
+EXACT_REPOSITIONS = 16  # per line: errors inside a term repositioned by a blanked copy
+
+
+class _LineDropped(Exception):
+    """Raised by ``_ItemErrors`` to drop the rest of the line."""
+
+
+class _ItemErrors:
+    """The parser's handler of an error in an item of an NC block (``ItemErrorHandler``):
+    reports it and says where parsing goes on, in the same pass over the line.
+
+    The result is the one of blanking the term and parsing the line again (the
+    reference): after an error at the item's start the parser goes on after the term;
+    after one inside the item (``V.P.A = 1 +* 2``) it parses the item again on a copy
+    of the line with the term blanked. Such copies cost the line's length, so after
+    ``EXACT_REPOSITIONS`` of them in one line the whole item is dropped instead: the
+    check of a line stays linear in its length whatever it holds."""
+
+    __slots__ = ("line", "check", "count", "copies", "_command_at")
+
+    def __init__(self, line: LogicalLine, check: SyntaxCheck, count: int) -> None:
+        self.line = line
+        self.check = check
+        self.count = count
+        self.copies = 0
+        self._command_at: int | None = None
+
+    def __call__(self, error: NcError, item: int) -> int | LogicalLine:
+        line = self.line
+        command_at = self._command_at
+        if command_at is None:
+            command_at = self._command_at = command_position(line)
+        if command_at >= 0:  # not an NC block after all: the general way
+            raise error
+        category = categorize(error, line, command_at)
+        check = self.check
+        check.report(error, category)
+        self.count += 1
+        limit = check.errors_per_block
+        text = line.text
+        pos = error.pos
+        if (limit and self.count >= limit) or pos < 0 or pos > len(text) or category in (
+                ErrorCategory.RESOURCE, ErrorCategory.COMMAND):
+            raise _LineDropped
+        if category == ErrorCategory.ASSIGNMENT and pos < len(text):
+            start, stop = pos, assignment_end(line, pos)
+        else:
+            start = pos if pos == item else term_start(text, pos, item)
+            if start >= len(text):
+                raise _LineDropped
+            stop = term_end(text, start)
+        if stop <= item:  # no progress: nothing left to drop
+            raise _LineDropped
+        if start > item and self.copies < EXACT_REPOSITIONS:
+            self.copies += 1
+            self.line = blanked(line, start, stop)
+            return self.line
+        return stop
+
+
 def parse_checked(parse, line: LogicalLine, check: SyntaxCheck):
     """Parse ``line``, reporting each error and repositioning after it; the statement
     of what was understood, or None when the line is dropped (a control statement
-    with an expression stays as ``dropped_control``)."""
+    with an expression stays as ``dropped_control``).
+
+    Errors in the items of an NC block are handled during the one pass of the parser
+    (``_ItemErrors``); an error elsewhere (block number, label, a ``$``/``#`` command)
+    blanks the term and parses the line again, which happens a bounded number of
+    times per line."""
     original = line
     count = 0
     while True:
+        handler = _ItemErrors(line, check, count)
         try:
-            return parse(line)
+            stmt = parse(line, handler)
+            if handler.count > count:  # errors in its items: the block counts them
+                stmt.line = RepositionedLine.counted(stmt.line, handler.count)
+            return stmt
+        except _LineDropped:
+            return dropped_control(original, handler.count)
         except NcError as error:
+            count = handler.count
+            line = handler.line
             command = after_command(line, error, parse)
             category = ErrorCategory.AFTER_COMMAND if command is not None else \
                 categorize(error, line)

@@ -21,6 +21,10 @@ SIGNED_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)")
 IDENT = re.compile(r"[A-Z_][A-Z0-9_]*")
 VARIABLE = re.compile(r"V\.([A-Z]+)\.([A-Z_][A-Z0-9_]*)")
 _NAME = re.compile(r"[^ \t\f\v]+")  # a file or subprogram name: anything up to a blank
+# the start of a word shown in a message: never more than 25 characters are looked at,
+# so an error in a word of a megabyte costs no more than one in ``X1``
+_SHOWN = re.compile(r"[^ \t\f\v]{1,25}")
+_SHOWN_MAX = 24
 
 
 class Cursor:
@@ -71,9 +75,9 @@ class Cursor:
 
     def word_text(self, pos: int | None = None) -> str:
         """The blank-delimited text at ``pos`` (for messages), shortened when long."""
-        m = _NAME.match(self.text, self.pos if pos is None else pos)
+        m = _SHOWN.match(self.text, self.pos if pos is None else pos)
         text = m.group() if m else ""
-        return text if len(text) <= 24 else text[:21] + "..."
+        return text if len(text) <= _SHOWN_MAX else text[:_SHOWN_MAX - 3] + "..."
 
     def error(self, err_id: NcErrorId, message: str, pos: int | None = None) -> NcError:
         """An NcError at ``pos`` (default: the current position)."""
