@@ -330,6 +330,17 @@ def item_at(line: LogicalLine, items: list, pos: int) -> int | None:
     return found if pos < end else None
 
 
+def holds_error(line: LogicalLine, items: list, k: int, pos: int) -> bool:
+    """True when ``item_at(line, items, pos)`` is ``k``, found without scanning the
+    other items (the items of a block stand in the order of their text)."""
+    item = items[k]
+    if item.pos > pos or (k + 1 < len(items) and items[k + 1].pos <= pos):
+        return False
+    if type(item) is Assign:
+        return pos < assignment_end(line, item.pos)
+    return pos < term_end(line.text, item.pos)
+
+
 def after_command(line: LogicalLine, error: NcError, parse) -> object | None:
     """For an error in a command line: the command as understood before ``error``
     (``parse`` of the line cut there) when that is a command, else None."""
@@ -486,7 +497,7 @@ def parse_checked(parse, line: LogicalLine, check: SyntaxCheck):
 
 __all__ = [
     "BATCH_LINES", "CHECK_FEED_MM_MIN", "CheckAborted", "ErrorCategory", "ErrorReported",
-    "PointBatch", "SyntaxCheck", "categorize", "command_position", "item_at",
+    "PointBatch", "SyntaxCheck", "categorize", "command_position", "holds_error", "item_at",
     "parse_checked",
 ]
 

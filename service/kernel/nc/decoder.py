@@ -26,7 +26,7 @@ from .blockexec import BlockExecutor, Flow
 from .blocks import Block, LogArea
 from .check import (
     CHECK_FEED_MM_MIN, CheckAborted, ErrorCategory, ErrorReported, SyntaxCheck, categorize,
-    item_at,
+    holds_error, item_at,
 )
 from .contour_run import execute_contour
 from .control import ControlFlow
@@ -387,9 +387,27 @@ class Decoder:
         check = self.check
         executor = self.executor
         count = getattr(stmt.line, "errors", 0)  # errors reported when it was parsed
+        skipped: set[int] = set()  # items left out in the pass (their errors reported)
+
+        def item_failed(error: NcError, k: int) -> None:
+            """An item's own error: reported, the item left out, the pass goes on."""
+            nonlocal count
+            items = stmt.items
+            if not holds_error(stmt.line, items, k, error.pos):
+                raise error  # not this item's: the general way below
+            check.report(error, categorize(error, stmt.line))
+            count += 1
+            if check.errors_per_block and count >= check.errors_per_block:
+                raise ErrorReported  # the line is dropped, its call and $GOTO too
+            item = items[k]
+            if type(item) is Word and item.kind == WordKind.FEED:  # F unknown now
+                self._modal.feed_mm_min = self._modal.feed_mm_min or CHECK_FEED_MM_MIN
+            skipped.add(k)
+
         while True:
+            skipped.clear()
             try:
-                block, flow, flow_pos = executor.execute(stmt, self)
+                block, flow, flow_pos = executor.execute(stmt, self, item_failed)
                 if flow == Flow.SUBPROGRAM_END and self.frames[-1].kind == FrameKind.MAIN:
                     # M17/M29 in the main program: dropped, the rest of the block used
                     check.report(stmt.line.error(
@@ -419,8 +437,8 @@ class Decoder:
                     item = items[drop]
                     if type(item) is Word and item.kind == WordKind.FEED:  # F unknown now
                         self._modal.feed_mm_min = self._modal.feed_mm_min or CHECK_FEED_MM_MIN
-                kept = [item for k, item in enumerate(items)
-                        if k != drop and not (k < done and type(item) is Assign)]
+                kept = [item for k, item in enumerate(items) if k != drop and k not in skipped
+                        and not (k < done and type(item) is Assign)]
                 stmt = replace(stmt, items=kept)
 
     # ------------------------------------------------------------ subprograms
