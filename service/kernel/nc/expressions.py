@@ -68,6 +68,9 @@ class ExpressionParser:
         """The keyword operator at the cursor (whole identifier only), consumed."""
         cur = self.cur
         cur.skip_ws()
+        c = cur.peek()
+        if not ("A" <= c <= "Z"):  # no identifier here: spare the match (hot in long lines)
+            return None
         m = IDENT.match(cur.up, cur.pos)
         if m is not None and m.group() in words:
             cur.pos = m.end()

@@ -15,6 +15,7 @@ from .errors import NcError, NcErrorId
 from .source import LogicalLine
 
 _WS = re.compile(r"[ \t\f\v]*")
+_BLANKS = " \t\f\v"
 # unsigned: in an expression a sign is an operator
 NUMBER = re.compile(r"(?:[0-9]+\.?[0-9]*|\.[0-9]+)")
 SIGNED_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)")
@@ -41,7 +42,10 @@ class Cursor:
 
     def skip_ws(self) -> None:
         """Move over blanks."""
-        self.pos = _WS.match(self.up, self.pos).end()
+        pos = self.pos
+        if pos < self.end and self.up[pos] not in _BLANKS:  # most often: no blank here
+            return
+        self.pos = _WS.match(self.up, pos).end()
 
     def at_end(self) -> bool:
         """True when only blanks are left."""
