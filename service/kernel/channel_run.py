@@ -15,6 +15,7 @@ limit is refused before it moves.
 from __future__ import annotations
 
 import logging
+import threading
 import time
 from collections import deque
 from collections.abc import Callable
@@ -127,6 +128,9 @@ class ChannelRunner:
         self._started_at_s = 0.0
         self._time_s = 0.0
         self._check: CheckRun | None = None  # syntax check or dry run of the program
+        # set by the kernel when a RESET of this channel is queued: a cycle waiting for
+        # the decoder or the check (virtual clock) stops waiting; cleared by ``reset``
+        self.reset_pending = threading.Event()
         self._check_max_errors = machine.limits.check_max_errors  # errors kept per check
         self._check_left_out = 0  # errors of the check counted but not kept, shown so far
         self._released: Pause = Pause.NONE  # START ended this pause (flag for one cycle)
@@ -238,6 +242,7 @@ class ChannelRunner:
     def reset(self) -> Refusal | None:
         """RESET from any state: stop at once, clear errors, back to READY or SELECTED."""
         ch = self.channel
+        self.reset_pending.clear()
         self._stop_run()
         if self._check is not None:
             self._check.cancel()
@@ -405,6 +410,7 @@ class ChannelRunner:
             contour_lookahead=self.config.contour_lookahead, surroundings=self._surroundings,
             section_planner=partial(plan_section, dynamics=dynamics,
                                     buffer_blocks=self._buffer_blocks, cycle_s=self._cycle_s),
+            interrupted=self.reset_pending.is_set,
         )
         self._last_pushed = None
         self._buffer_warned = False
@@ -495,7 +501,7 @@ class ChannelRunner:
             deterministic=self._deterministic, files=self._files,
             surroundings=self._surroundings,
             modal=self.new_modal(tuple(a.position_mm for a in ch.axes)),
-            max_errors=self._check_max_errors,
+            max_errors=self._check_max_errors, interrupted=self.reset_pending.is_set,
         )
         self._check_left_out = 0
         self._released = Pause.NONE

@@ -21,7 +21,7 @@ from ..config import MachineConfig
 from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
-from .commands import Command, Refusal, RefusalReason
+from .commands import Command, Refusal, RefusalReason, ResetChannel
 from .state import ChannelError, CycleStats, KernelState, Snapshot
 from .switchover import Switchover
 
@@ -138,6 +138,10 @@ class Kernel:
         if self._closed:
             done(Refusal(RefusalReason.NOT_READY, "the kernel is shut down"))
             return
+        if type(command) is ResetChannel and command.value:
+            # a cycle that waits for the channel's decoder or syntax check (virtual
+            # clock) stops waiting, so that the RESET is applied at the next cycle
+            self.state.runners[command.channel_index].reset_pending.set()
         self._queue.put((command, done))
 
     def start(self) -> None:

@@ -51,6 +51,7 @@ log = logging.getLogger(__name__)
 SYNCHK_WITHOUT_MACHINE_LOCK = 21309  # ISG P-ERR-21309 (warning): MACHINE_LOCK set implicitly
 CHECK_STOPPED_WARNING = 21310  # the check ended early: syn_chk.errors_total reached
 LINES_PER_CYCLE = 20_000  # virtual clock: lines decoded per GEO cycle
+_ADVANCE_POLL_S = 0.02  # how often a cycle waiting for the check looks for a RESET
 # errors kept per check (listed, logged); the default of [limits] check_max_errors
 CHECK_MAX_ERRORS = 1000
 _N_WORD = re.compile(r"[ \t]*N[ \t]*([0-9]+)", re.IGNORECASE)
@@ -123,9 +124,12 @@ class CheckRun:
         surroundings: Surroundings | None = None,
         modal: ModalState | None = None,
         max_errors: int = CHECK_MAX_ERRORS,
+        interrupted: Callable[[], bool] = lambda: False,
     ) -> None:
         """``max_errors``: errors kept (listed and logged) per check, the limit
-        ``check_max_errors``; the rest are counted only."""
+        ``check_max_errors``; the rest are counted only. ``interrupted``: True once a
+        RESET is queued: ``advance`` stops waiting for the check then."""
+        self._interrupted = interrupted
         self.channel_id = channel_id
         self.max_errors = max(1, max_errors)
         self.name = name
@@ -179,8 +183,11 @@ class CheckRun:
         with self._cond:
             self._budget += lines
             self._cond.notify_all()
-            self._cond.wait_for(lambda: self._budget <= 0 or self._progress.pause
-                                or self._progress.done)
+            # a long line may take seconds: a queued RESET must not wait for its end
+            while not self._cond.wait_for(lambda: self._budget <= 0 or self._progress.pause
+                                          or self._progress.done, _ADVANCE_POLL_S):
+                if self._interrupted():
+                    return
 
     def resume(self) -> bool:
         """START / RESUME: go on after a pause; False when the check was not paused."""

@@ -135,6 +135,8 @@ class Decoder:
         self._started = False
         self.emitted = 0  # grows whenever blocks were yielded (the loop guard watches it)
         self.own_variables: set[int] = set()  # ids of the variables this decoder declared
+        # the run's owner sets this to learn of a RESET (``DecodingCancelled``)
+        self.cancelled: Callable[[], bool] = _never
         self._executed: Block | None = None  # check mode: the Block of the line's words
 
     @property
@@ -525,6 +527,10 @@ class Decoder:
             return
         raise NcError(NcErrorId.MISSING_PROGRAM_END, name, line, 1,
                       f"program {name} ends without M30 (or M2)")
+
+
+def _never() -> bool:
+    return False
 
 
 def _first_pos(line) -> int:

@@ -162,3 +162,9 @@ class NcError(Exception):
 
     def __reduce__(self):  # noqa: D105 - keep the five fields when pickled
         return (type(self), (self.id, self.file, self.line, self.column, self.message))
+
+
+class DecodingCancelled(BaseException):
+    """Raised inside the decoder when its run was cancelled (RESET) while it works
+    without yielding blocks (a loop without motion). A ``BaseException``, so that no
+    handler of program errors or decoder faults takes it for one."""
