@@ -33,6 +33,7 @@ CHECK_TIMEOUT_S = 120.0
 SYNCHK_MACHINE_LOCK = 0x48
 RESET_MAX_CYCLES = 100  # 100 ms of kernel time at the 1 ms cycle
 RSS_GROWTH_MAX_KIB = 100 << 10  # after RESET: the check's memory is given back, not grown
+RATE_WINDOW_S = 0.3  # cycles/s are measured over this much wall time
 WATCH_AFTER_RESET_S = 3.0  # RSS is watched this long after RESET (it once grew 230 MiB/s)
 CHECK_MAX_ERRORS = 1000  # the default of limits.check_max_errors
 ONE_MB_CPU_MAX_S = 5.0
@@ -67,6 +68,14 @@ async def _tick(c: AsyncClient) -> int:
     return await c.read("cnc_tick_counter_r")
 
 
+async def _cycles_per_s(c: AsyncClient, window_s: float) -> float:
+    """Cycles per second of wall time over about ``window_s`` (paced by tick samples)."""
+    start, start_s = await _tick(c), time.monotonic()
+    while time.monotonic() - start_s < window_s:
+        await wait_for_async(c, "cnc_tick_counter_r", lambda _: True)
+    return (await _tick(c) - start) / (time.monotonic() - start_s)
+
+
 @pytest.mark.parametrize("clock", [("--clock", "realtime"), ("--clock", "virtual", "--speed", "1")],
                          ids=["realtime", "virtual"])
 async def test_reset_during_the_check_of_a_long_line_ends_it_at_once(clock, run_scale) -> None:
@@ -85,11 +94,13 @@ async def test_reset_during_the_check_of_a_long_line_ends_it_at_once(clock, run_
             await c.upload("long.nc", program.encode())
             await c.write("ch1.mc_command_execution_mode_w", SYNCHK_MACHINE_LOCK)
             threads_idle = thread_count(pid)
+            idle_rate = await _cycles_per_s(c, RATE_WINDOW_S) if realtime else 0.0
             for _ in range(run_scale.long_line_resets):
                 await c.run_program("long.nc")
                 if realtime:  # errors shown: the check is in the long lines (~0.5 s each)
                     await wait_for_async(c, "ch1.mc_error_count_r", lambda n: n > 0,
                                          timeout_s=CHECK_TIMEOUT_S)
+                    rate = await _cycles_per_s(c, RATE_WINDOW_S)  # a figure, not a bound
                     assert await c.read("ch1.mc_active_state_r") == ChannelState.ACTIVE
                 rss_before_kib = rss_kib(pid)
                 before = await _tick(c)
@@ -112,6 +123,9 @@ async def test_reset_during_the_check_of_a_long_line_ends_it_at_once(clock, run_
                 assert thread_count(pid) == threads_idle, "the check's thread is still running"
         figures.record(f"RESET during a 100k-word check ({clock[1]} clock): cycles to idle",
                        f"{after - before}", NODE)
+        if realtime:
+            figures.record("cycles/s (realtime clock) while that check runs",
+                           f"{rate:.0f} (idle {idle_rate:.0f})", NODE)
         figures.record(f"RSS growth within {WATCH_AFTER_RESET_S:g} s after that RESET "
                        f"({clock[1]})", f"{(peak_kib - rss_before_kib) / 1024:.1f} MiB", NODE)
         assert_well(service, after)
