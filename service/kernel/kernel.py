@@ -232,6 +232,8 @@ class Kernel:
                 self._publish()
                 done(result)
             else:
+                if type(command) is ResetChannel:  # refused: no cycle may stop waiting for it
+                    self.state.runners[command.channel_index].reset_pending.clear()
                 done(Refusal(RefusalReason.NOT_READY, "the kernel is stopped (ADS state STOP)"))
         return True
 

@@ -14,6 +14,7 @@ machine does not inflate; the wall time is recorded beside it.
 
 from __future__ import annotations
 
+import asyncio
 import time
 
 import pytest
@@ -32,6 +33,7 @@ CLIENT_TIMEOUT_S = 30.0
 CHECK_TIMEOUT_S = 120.0
 SYNCHK_MACHINE_LOCK = 0x48
 RESET_MAX_CYCLES = 100  # 100 ms of kernel time at the 1 ms cycle
+RESET_REPLY_TIMEOUT_S = 5.0  # a RESET is answered within this (the loop guard takes 10 s+)
 RSS_GROWTH_MAX_KIB = 100 << 10  # after RESET: the check's memory is given back, not grown
 RATE_WINDOW_S = 0.3  # cycles/s are measured over this much wall time
 WATCH_AFTER_RESET_S = 3.0  # RSS is watched this long after RESET (it once grew 230 MiB/s)
@@ -131,6 +133,20 @@ async def test_reset_during_the_check_of_a_long_line_ends_it_at_once(clock, run_
         assert_well(service, after)
 
 
+async def _until_the_cycle_stands(c: AsyncClient, timeout_s: float = 10.0) -> None:
+    """Wait until ``cnc_tick_counter_r`` has not moved for 50 ms of wall time (at
+    ``--speed 1`` an idle kernel counts a cycle per ms): a cycle waits for something."""
+    deadline = time.monotonic() + timeout_s
+    last, since = await _tick(c), time.monotonic()
+    while time.monotonic() < deadline:
+        now = await _tick(c)
+        if now != last:
+            last, since = now, time.monotonic()
+        elif time.monotonic() - since >= 0.05:
+            return
+    raise AssertionError(f"the cycle never stood still within {timeout_s:g} s")
+
+
 async def _timed_check(c: AsyncClient, pid: int, name: str) -> tuple[object, float, float]:
     """(result, service CPU s, wall s) of ``cnc check`` of the stored ``name``."""
     cpu0, wall0 = cpu_s(pid), time.monotonic()
@@ -202,3 +218,39 @@ async def test_check_time_grows_linearly_with_the_words_of_a_line() -> None:
     assert ratio < 8, f"{small} words {cost[small]:.2f} s, {large} words {cost[large]:.2f} s"
     figures.record(f"check of {small} / {large} words in one line",
                    f"{cost[small]:.2f} s / {cost[large]:.2f} s CPU (x{ratio:.1f})", NODE)
+
+
+async def test_reset_ends_a_run_whose_decoder_loops_without_blocks() -> None:
+    """A run whose decoder, after a first move, loops without producing blocks: with the
+    virtual clock the cycle that starts it waits for the decoder to fill the look-ahead
+    buffer, once until the loop guard (a million passes, 10-30 s) and every RESET sent
+    meanwhile with it. Now a queued RESET ends that wait: START and RESET are answered
+    at once, and the decoder's thread stops at the RESET.
+
+    (**Open**: the START alone is still answered only after the loop guard.)"""
+    program = ("#VAR\nV.L.N = 0\n#ENDVAR\nN10 G01 X1 F6000\n"
+               "$WHILE 1\nV.L.N = V.L.N + 1\n$ENDWHILE\nM30\n")
+    with serving("--speed", "1") as service:  # kernel time runs as wall time when idle
+        pid = service.process.pid
+        async with AsyncClient(service.endpoint, timeout_s=CLIENT_TIMEOUT_S) as c, \
+                AsyncClient(service.endpoint, timeout_s=RESET_REPLY_TIMEOUT_S) as quick:
+            await c.upload("idle.nc", program.encode())
+            threads_idle = thread_count(pid)
+            before = await _tick(c)
+            start = asyncio.create_task(c.run_program("idle.nc"))
+            # the cycle that took the START waits for the decoder: the counter stands
+            await _until_the_cycle_stands(quick)
+            wall_s = time.monotonic()
+            await quick.reset()
+            wall_s = time.monotonic() - wall_s
+            await start
+            state, after = (await c.read_many(["ch1.mc_active_state_r",
+                                               "cnc_tick_counter_r"])).values()
+            assert state == ChannelState.READY
+            assert after - before <= RESET_MAX_CYCLES, (before, after)
+            deadline = time.monotonic() + 10.0
+            while thread_count(pid) > threads_idle and time.monotonic() < deadline:
+                await wait_for_async(c, "cnc_tick_counter_r", lambda _: True)
+            assert thread_count(pid) == threads_idle, "the decoder's thread is still running"
+    figures.record("RESET of a run whose decoder loops without blocks (virtual clock)",
+                   f"{after - before} cycles, reply after {wall_s * 1000:.0f} ms", NODE)
