@@ -12,9 +12,12 @@ radius compensation go through the path preparation, so its errors are found too
   With ``interactive`` the check waits after each error (``Pause.AFTER_ERROR``) until
   ``resume`` (START) or ``cancel`` (RESET). With ``record_result`` every checked line
   and every error go to ``dec0<channel>.sc``, written in one piece when the check ends.
+  Only the first ``max_errors`` errors (``[limits] check_max_errors``) are kept, listed
+  and logged; the others are counted (``Progress.left_out``, a line of the log).
 * **Dry run** (``settings`` None): the first error ends the run, as in a real run.
 
-A software limit violation ends both with that error. Single step at decoder level
+A software limit violation ends both with that error. RESET (``cancel``) ends the
+decoding at the next line or the next error, even inside a long line. Single step at decoder level
 (``single_step``) stops after every NC line (``Pause.SINGLE_STEP``); ``stop`` (STOP)
 pauses decoding at the next line or batch (``Pause.STOPPED``); ``resume`` goes on.
 
