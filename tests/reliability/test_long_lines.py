@@ -236,10 +236,10 @@ async def test_reset_ends_a_run_whose_decoder_loops_without_blocks() -> None:
                 AsyncClient(service.endpoint, timeout_s=RESET_REPLY_TIMEOUT_S) as quick:
             await c.upload("idle.nc", program.encode())
             threads_idle = thread_count(pid)
-            before = await _tick(c)
             start = asyncio.create_task(c.run_program("idle.nc"))
             # the cycle that took the START waits for the decoder: the counter stands
             await _until_the_cycle_stands(quick)
+            before = await _tick(quick)
             wall_s = time.monotonic()
             await quick.reset()
             wall_s = time.monotonic() - wall_s
