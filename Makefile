@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 ENDPOINT ?= tcp://127.0.0.1:5555
 
-.PHONY: run test bench soak clean
+.PHONY: run test bench soak clean generate
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -32,6 +32,10 @@ bench: $(VENV)/.installed-test
 # requests, 20 restarts of each kind): bounded, about 16 minutes on a 2-core machine.
 soak: $(VENV)/.installed-test
 	$(BIN)/python -m pytest tests/reliability -q --soak $(PYTEST_ARGS)
+
+# Code made from other code: the blocking Client from AsyncClient's methods.
+generate: | $(BIN)/python
+	$(BIN)/python tools/gen_blocking_client.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

@@ -12,7 +12,9 @@ spiral's speed plot to ``lookahead-spiral.png``.
 
 ADS part (``--part ads``): pyads sequential reads against a minimal asyncio AMS/TCP
 echo server and against the service, and ``read_list_by_name`` of 100 symbols
-(``bench/ads_bench.py``).
+(``bench/ads_bench.py``); then by-name reads on a fresh connection with each ADS client
+the tests run, against pyads', and the time to upload and read every symbol
+(``bench/ads_clients_bench.py``).
 
 Jitter part (``--part jitter``): the realtime cycle's lateness (p50, p99, max) and
 overruns while the service answers 5 000 reads/s and feeds 20 on-change subscriptions
@@ -20,6 +22,9 @@ during a run (``bench/jitter_bench.py``).
 Virtual part (``--part virtual``): simulated seconds per wall second of the whole service
 on the virtual clock for the pocket, a 10 000-block spiral and a one-hour part, with no
 and with 20 on-change subscriptions (``bench/virtual_bench.py``).
+Fairness part (``--part fairness``): another client's read latency while one client
+holds every notification the service takes (20 000 cyclic, 1 ms), idle and loaded
+(``bench/fairness_bench.py``; target p99 < 10 ms).
 Dispatch part (``--part dispatch``):
 
 Baseline: a raw pyzmq ROUTER in a second process that answers each msgpack frame with a
@@ -197,21 +202,23 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
     parser.add_argument("--part", choices=("all", "dispatch", "ads", "kernel", "jitter",
-                                           "virtual", "lookahead"),
+                                           "virtual", "lookahead", "fairness"),
                         default="all",
                         help="dispatch: request dispatch (ZeroMQ); ads: pyads over AMS/TCP; "
                         "kernel: decoder, interpolator, planner; jitter: the realtime cycle "
                         "under load; virtual: whole-service virtual time speed; lookahead: "
-                        "machining time against the optimum")
+                        "machining time against the optimum; fairness: reads while the "
+                        "notification limit is used up")
     parser.add_argument("--jitter-s", type=float, default=20.0,
                         help="seconds of load per jitter run (issue 22 asks 60)")
     args = parser.parse_args(argv)
     if args.part in ("all", "dispatch"):
         dispatch(args)
     if args.part in ("all", "ads"):
-        from . import ads_bench
+        from . import ads_bench, ads_clients_bench
 
         ads_bench.main(args.runs, args.count // 4)
+        ads_clients_bench.main()
     if args.part in ("all", "kernel"):
         kernel(args.runs)
     if args.part in ("all", "jitter"):
@@ -222,6 +229,10 @@ def main(argv: list[str] | None = None) -> int:
         from . import virtual_bench
 
         virtual_bench.main(min(args.runs, 3))
+    if args.part in ("all", "fairness"):
+        from . import fairness_bench
+
+        fairness_bench.main(min(args.runs, 3), 2000)
     if args.part in ("all", "lookahead"):
         from . import lookahead_bench
 

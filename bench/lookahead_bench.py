@@ -32,7 +32,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cnc_objects.service.config import MachineConfig, build_config
+from cnc_objects.service.config import build_config
+from cnc_objects.service.machine_config import MachineConfig
 from tests.support.kernel import KernelHarness, Run
 
 from .lookahead_programs import BenchProgram, all_programs, spiral, with_la_on

@@ -37,7 +37,8 @@ from dataclasses import KW_ONLY, dataclass
 
 import numpy as np
 
-from cnc_objects.service.config import MachineConfig, build_config
+from cnc_objects.service.config import build_config
+from cnc_objects.service.machine_config import MachineConfig
 
 SQRT2 = math.sqrt(2.0)
 FULL_CIRCLE_TOLERANCE_MM = 1e-9  # an arc whose end is this close to its start is a full circle

@@ -10,7 +10,9 @@ Imports protocol and objects, never service.
 
 from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.values import ExecutionMode
 
+from .blocking import Client
 from .channel_ops import ContourBlock, ContourReply
 from .client import (
     DEFAULT_ENDPOINT,
@@ -18,7 +20,6 @@ from .client import (
     ChannelStatus,
     CheckError,
     CheckResult,
-    Client,
     DeviceInfo,
     ObjectInfo,
     ProgramEntry,
@@ -28,13 +29,13 @@ from .client import (
 from .errors import (
     AdsConnectionError,
     AdsError,
-    AuthenticationError,
     AdsTimeoutError,
+    AuthenticationError,
     ChannelError,
     ClientValueError,
     NoReplyError,
 )
-from .execution_mode import ExecutionMode, describe_execution_mode
+from .execution_mode import describe_execution_mode
 from .path_trace import PathTrace
 
 __all__ = [

@@ -20,14 +20,26 @@ import time
 from dataclasses import dataclass, fields
 from typing import Any
 
-from cnc_objects.protocol.constants import MAX_DATA_BYTES, PROGRAM_MAX_BYTES, PROGRAM_STORE_GROUP, CncPort
+from cnc_objects.protocol.constants import (
+    MAX_DATA_BYTES,
+    PROGRAM_MAX_BYTES,
+    PROGRAM_STORE_GROUP,
+    CncPort,
+)
 from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
-from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockType, value_names
+from cnc_objects.protocol.values import (
+    ChannelMode,
+    ChannelState,
+    ContourBlockType,
+    ExecutionMode,
+    value_names,
+)
 
+from .client_core import MixinBase
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError
-from .execution_mode import ExecutionMode, describe_execution_mode
+from .execution_mode import describe_execution_mode
 
 POLL_S = 0.01  # how often waiting re-reads the channel state (wall time)
 
@@ -48,7 +60,7 @@ class ProgramEntry:
 
 
 CONTOUR_RESPONSE_BLOCKS = 32  # gpCh[i].contour_lookahead.response.block[0..31]
-CONTOUR_BLOCK_TYPES = {  # as the HMI and `cnc lookahead` show them
+CONTOUR_BLOCK_TYPES: dict[int, str] = {  # as the HMI and `cnc lookahead` show them
     ContourBlockType.LINEAR: "linear", ContourBlockType.CIRCULAR: "circular",
     ContourBlockType.LOG_ON: "LOG ON", ContourBlockType.LOG_PARAM: "LOG PARAM",
     ContourBlockType.LOG_OFF: "LOG OFF", ContourBlockType.POLYNOMIAL: "polynomial",
@@ -213,7 +225,7 @@ def _name_bytes(name: str) -> bytes:
     return name.encode(STRING_ENCODING) + b"\x00"
 
 
-class ProgramOps:
+class ProgramOps(MixinBase):
     """Upload, list, download and delete programs of the service's store."""
 
     async def upload(self, name: str, data: bytes) -> None:
@@ -245,7 +257,7 @@ class ProgramOps:
         await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.DELETE, _name_bytes(name))
 
 
-class ChannelOps:
+class ChannelOps(ProgramOps):
     """Select, start, hold, resume, reset, manual blocks, status, waiting."""
 
     async def run_program(self, name: str, channel: int = 1) -> None:
@@ -306,7 +318,7 @@ class ChannelOps:
         before = await self.read(f"ch{channel}.mc_manual_blocks_done_r")
         await self._command(channel, "a manual block", f"ch{channel}.mc_command_manual_block_w",
                             blocks)
-        return before
+        return int(before)
 
     async def channel_errors(self, channel: int = 1) -> list[str]:
         """The channel's error list as readable lines."""

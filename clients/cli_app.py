@@ -22,7 +22,8 @@ from typing import Any, NoReturn, TypeVar
 import typer
 from rich.console import Console
 
-from .client import AsyncClient, Client
+from .blocking import Client
+from .client import AsyncClient
 from .errors import AdsError, AdsTimeoutError, AuthenticationError, ClientValueError, NoReplyError
 
 T = TypeVar("T")

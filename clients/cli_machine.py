@@ -30,9 +30,9 @@ from typing import Any
 
 import typer
 
+from .blocking import Client
 from .channel_ops import CONTOUR_BLOCK_TYPES, ChannelStatus, CheckError, CheckResult
 from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
-from .client import Client
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
 
 EXIT_CHANNEL_ERROR = 4
@@ -210,7 +210,7 @@ def mdi(
           f"channel {channel}: manual block {'finished' if wait else 'started'}")
 
 
-def _channel_command(method: str, done: str, request: str):
+def _channel_command(method: str, done: str, request: str) -> Callable[..., None]:
     def command(ctx: typer.Context, channel: int = ChannelOption) -> None:
         settings: Settings = ctx.obj
         settings.call(lambda c: getattr(c, method)(channel), f"{request} of channel {channel}")
@@ -322,10 +322,11 @@ def lookahead(
     first = int(start) if length == 0.0 else 0  # mode 1 numbers the entries by log index
     for k, b in enumerate(reply.blocks, start=first):
         motion = b.block_type in (1, 2, 6)
+        kind = CONTOUR_BLOCK_TYPES.get(b.block_type, str(b.block_type))
         size = f"{b.length / 10_000:.4f}" if motion else f"PARAM {b.length:g}"
         number = str(b.block_number) if b.block_number >= 0 else "-"
         out.print(
-            f"{k:>3} {CONTOUR_BLOCK_TYPES.get(b.block_type, str(b.block_type)):<10} "
+            f"{k:>3} {kind:<10} "
             f"{number:>5} {b.block_count_r:>5} {b.start_position / 10_000:>10.4f} {size:>10} "
             f"{b.programmed_radius / 10_000:>9.4f} {b.compensated_radius / 10_000:>9.4f} "
             f"{math.degrees(b.circle_angle):>9.3f} {math.degrees(b.tangent_variation):>8.3f}"
@@ -336,7 +337,7 @@ EXIT_CHECK_ERRORS = 1  # cnc check: the program has errors, or the check was abo
 EXIT_CHECK_TROUBLE = 2  # cnc check: no result (usage, connection, ADS error, timeout)
 
 
-def _check_record(e: CheckError) -> dict:
+def _check_record(e: CheckError) -> dict[str, object]:
     return {"file": e.file, "line": e.line, "column": e.column, "id": e.id,
             "category": e.category, "message": e.message}
 

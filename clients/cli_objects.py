@@ -24,7 +24,8 @@ import typer
 from cnc_objects.protocol.datatypes import DataType, parse_type, parse_value
 
 from .cli_app import EXIT_USAGE, Settings, command, emit, fail, out, say_error
-from .client import AsyncClient, ObjectInfo
+from .client import AsyncClient
+from .object_info import ObjectInfo
 from .errors import AdsError, ClientValueError, NoReplyError
 
 EXIT_WATCH_TIMEOUT = 5  # watch --count N --timeout S: a name got fewer than N samples
@@ -75,7 +76,9 @@ def _number(text: str, what: str) -> int:
         raise typer.Exit(EXIT_USAGE) from None
 
 
-def _address(port: str | None, group: str | None, offset: str | None, dtype: str | None):
+def _address(
+    port: str | None, group: str | None, offset: str | None, dtype: str | None
+) -> tuple[int, int, int, DataType] | None:
     given = [x is not None for x in (port, group, offset, dtype)]
     if not any(given):
         return None
@@ -160,7 +163,7 @@ def read(
     offset: OffsetOption = None,
     dtype: TypeOption = None,
 ) -> None:
-    """Read objects by name, or one value by address.
+    """Read objects by name (globs: ch1.mc_*_w), or one value by address.
 
     A value is shown with its unit or its name in parentheses: 500 (0.1 %), 3 (READY).
     With --json the value stays raw; "unit" and, for a named value, "value_name" are
@@ -179,12 +182,26 @@ def read(
                 emit(settings, {"port": p, "group": g, "offset": o, "type": t.name, "value": value},
                      f"{p}:0x{g:x}:0x{o:x} = {value}")
                 return
+            names = _expanded(c, names)
             values = c.read_many(names) if len(names) > 1 else {names[0]: c.read(names[0])}
             infos = {n: c.describe(n) for n in values}
     except (AdsError, ClientValueError) as exc:
         fail(exc)
     for name, value in values.items():
         emit(settings, value_record(infos[name], value), f"{name} = {show_value(infos[name], value)}")
+
+
+def _expanded(client: Any, names: list[str]) -> list[str]:
+    """``names`` with each glob (``ch1.mc_*_w``; a bracketed number is an index, not a
+    class) replaced by the names it matches, in catalog order; a glob that matches
+    nothing stays, so that its read says the name is unknown."""
+    out: list[str] = []
+    for name in names:
+        if "*" in name or "?" in name:
+            out += [info.name for info in client.browse(name)] or [name]
+        else:
+            out.append(name)
+    return out
 
 
 # A negative value ("-1") is a value, not an unknown option.

@@ -29,19 +29,18 @@ from __future__ import annotations
 
 import contextlib
 import difflib
-import functools
-import inspect
 import os
-from collections.abc import AsyncIterator, Iterable, Iterator
-from dataclasses import dataclass, field
-from datetime import UTC, datetime, timedelta
-from typing import Any
+from collections.abc import AsyncGenerator, AsyncIterator, Coroutine, Iterable, Iterator
+from dataclasses import dataclass
+from datetime import datetime
+from typing import Any, Self, TypeVar, cast
 
 from cnc_objects.protocol import sum as sums
 from cnc_objects.protocol.constants import AdsState, CncPort, TransmissionMode
 from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
 from cnc_objects.protocol.datatypes import STRING_ENCODING, DataType, parse_type
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.filetime import filetime_to_datetime
 from cnc_objects.protocol.frames import (
     AddNotificationRequest,
     BrowseRequest,
@@ -57,61 +56,23 @@ from cnc_objects.protocol.frames import (
 )
 
 from .channel_ops import (
-    ChannelOps, ChannelStatus, CheckError, CheckResult, ProgramEntry, ProgramOps,
+    ChannelStatus,
+    CheckError,
+    CheckResult,
+    ProgramEntry,
 )
 from .curve import client_curve
 from .errors import AdsConnectionError, AdsError, ClientValueError, NoReplyError
-from .path_trace import PathTrace, TraceOps
+from .object_info import ObjectInfo
+from .path_trace import TraceOps
 from .sync_transport import SyncTransport, drive
 from .transport import AsyncTransport
 
 DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
 DEFAULT_TIMEOUT_S = 5.0
-_FILETIME_EPOCH = datetime(1601, 1, 1, tzinfo=UTC)
 _HANDLE_PORT = CncPort.COM  # handles are global in the service; any CNC port serves them
 SUGGESTIONS = 3  # nearest names offered for an unknown one
-_BROWSE_FIELDS = 9  # name .. description: what every service sends
-
-
-@dataclass(frozen=True, slots=True)
-class ObjectInfo:
-    """What the service says about one object (a browse row).
-
-    ``enum`` names the values of an enumeration object (``{3: "READY", ...}`` for
-    ``ch1.mc_active_state_r``); it is empty for every other object, bit sets included.
-    """
-
-    name: str
-    port: int
-    group: int
-    offset: int
-    type: str
-    length: int
-    access: str
-    unit: str
-    description: str
-    # Not hashed: a dict is not hashable, and the name identifies the object anyway.
-    enum: dict[int, str] = field(default_factory=dict, hash=False)
-
-    @property
-    def dtype(self) -> DataType:
-        """The object's data type."""
-        return parse_type(self.type)
-
-    @classmethod
-    def from_row(cls, row: Any) -> ObjectInfo:
-        """The info of one browse descriptor (protocol/frames.py). A row of a service
-        without value names (nine fields) has an empty ``enum``; fields after the ones
-        known here are ignored, so a later service may add more."""
-        try:
-            if len(row) < _BROWSE_FIELDS:
-                raise ValueError(f"{len(row)} fields, at least {_BROWSE_FIELDS} expected")
-            names = row[_BROWSE_FIELDS] if len(row) > _BROWSE_FIELDS else []
-            return cls(*row[:_BROWSE_FIELDS], {int(v): str(n) for v, n in names})
-        except (TypeError, ValueError) as exc:
-            raise AdsError(
-                AdsReturnCode.CLIENT_SYNCRESINVALID, f"malformed browse row {row!r:.80}: {exc}"
-            ) from None
+T = TypeVar("T")
 
 
 @dataclass(frozen=True, slots=True)
@@ -194,15 +155,10 @@ def _decode(dtype: DataType, data: bytes, what: str) -> Any:
         raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, f"{what}: {exc}") from None
 
 
-def filetime_to_datetime(filetime: int) -> datetime:
-    """A FILETIME (100 ns since 1601) as an aware UTC datetime."""
-    return _FILETIME_EPOCH + timedelta(microseconds=filetime // 10)
-
-
 PathText = str | os.PathLike[str]
 
 
-class AsyncClient(ProgramOps, ChannelOps, TraceOps):
+class AsyncClient(TraceOps):
     """Asyncio client of a cnc-objects service. Use with ``async with``.
 
     ``key_file``: this client's CURVE secret key file (``NAME.key_secret``, or ``NAME.key``
@@ -249,6 +205,14 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
             return reply.fields[index]
         except IndexError:
             raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, "reply lacks its data") from None
+
+    def _data(self, reply: Response) -> bytes:
+        """The data bytes of a reply (a Read's or a ReadWrite's)."""
+        data = self._payload(reply)
+        if type(data) is not bytes:
+            raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID,
+                           f"reply data is {type(data).__name__}, not bytes")
+        return data
 
     async def describe(self, name: str) -> ObjectInfo:
         """What the service says about the object ``name`` (cached per connection)."""
@@ -303,7 +267,7 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
 
     async def read_raw(self, port: int, group: int, offset: int, length: int) -> bytes:
         """Read ``length`` raw bytes at an ADS address."""
-        return self._payload(await self._call(ReadRequest, port, group, offset, length))
+        return self._data(await self._call(ReadRequest, port, group, offset, length))
 
     async def read(self, name: str) -> Any:
         """Read the object ``name``."""
@@ -327,7 +291,7 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
     ) -> bytes:
         """ADS ReadWrite at an address: ``data`` in, up to ``read_length`` bytes out."""
         reply = await self._call(ReadWriteRequest, port, group, offset, read_length, data)
-        return self._payload(reply)
+        return self._data(reply)
 
     async def write_raw(self, port: int, group: int, offset: int, data: bytes) -> None:
         """Write raw bytes at an ADS address."""
@@ -390,7 +354,7 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
 
     async def subscribe(
         self, name: str, on_change: bool = True, cycle_ms: int | None = None
-    ) -> AsyncIterator[Sample]:
+    ) -> AsyncGenerator[Sample, None]:
         """Samples of ``name`` as the service sends them (server-side notification).
 
         ``on_change``: a sample when the value changed, checked every ``cycle_ms`` (default:
@@ -425,33 +389,30 @@ class AsyncClient(ProgramOps, ChannelOps, TraceOps):
                 await self._call(DeleteNotificationRequest, info.port, handle)
 
 
-def _blocking(method: Any) -> Any:
-    """Wrap an AsyncClient method so that it runs to completion on a SyncTransport."""
-    if inspect.isasyncgenfunction(method):
+def run_blocking(coro: Coroutine[Any, Any, T]) -> T:
+    """Run one ``AsyncClient`` coroutine to completion on the blocking transport."""
+    return drive(coro)
 
-        @functools.wraps(method)
-        def generator(self: Client, *args: Any, **kwargs: Any) -> Iterator[Any]:
-            agen = method(self._core, *args, **kwargs)
+
+def iterate_blocking(agen: AsyncIterator[T]) -> Iterator[T]:
+    """An ``AsyncClient`` async generator as a blocking iterator; leaving the loop closes
+    the generator (a subscription is deleted)."""
+    try:
+        while True:
             try:
-                while True:
-                    try:
-                        yield drive(agen.__anext__())
-                    except StopAsyncIteration:
-                        return
-            finally:
-                drive(agen.aclose())
-
-        return generator
-
-    @functools.wraps(method)
-    def call(self: Client, *args: Any, **kwargs: Any) -> Any:
-        return drive(method(self._core, *args, **kwargs))
-
-    return call
+                # an async generator's step object has send() and throw(): a coroutine
+                yield drive(cast("Coroutine[Any, Any, T]", agen.__anext__()))
+            except StopAsyncIteration:
+                return
+    finally:
+        aclose = getattr(agen, "aclose", None)
+        if aclose is not None:
+            drive(aclose())
 
 
-class Client:
-    """Blocking client: the same methods as ``AsyncClient``. Use with ``with``."""
+class BlockingClientBase:
+    """Connection handling of the blocking ``Client`` (``clients/blocking.py``, generated
+    from ``AsyncClient``'s methods)."""
 
     def __init__(
         self,
@@ -468,7 +429,7 @@ class Client:
             endpoint, _transport=SyncTransport(endpoint, timeout_s, curve=curve)
         )
 
-    def __enter__(self) -> Client:
+    def __enter__(self) -> Self:
         drive(self._core._t.open())
         return self
 
@@ -476,11 +437,7 @@ class Client:
         drive(self._core._t.close())
 
 
-for _name, _method in inspect.getmembers(AsyncClient, inspect.isfunction):
-    if not _name.startswith("_"):
-        setattr(Client, _name, _blocking(_method))
-
 __all__ = [
-    "AsyncClient", "ChannelStatus", "CheckError", "CheckResult", "Client", "DeviceInfo",
+    "AsyncClient", "BlockingClientBase", "ChannelStatus", "CheckError", "CheckResult", "DeviceInfo",
     "ObjectInfo", "ProgramEntry", "Sample", "filetime_to_datetime",
 ]

@@ -52,7 +52,7 @@ class ClientCurve:
     key_file: Path
     server_key_file: Path
 
-    def secure(self, sock: zmq.Socket) -> None:
+    def secure(self, sock: zmq.Socket[bytes]) -> None:
         """Make ``sock`` a CURVE client of the service (call before connect)."""
         sock.curve_publickey = self.public_key
         sock.curve_secretkey = self.secret_key
@@ -112,7 +112,7 @@ class HandshakeWatch:
     """The handshake events of one socket (its ZeroMQ monitor). Create it before the
     socket connects; ``check`` reads what happened without blocking, ``wait`` blocks."""
 
-    def __init__(self, sock: zmq.Socket, endpoint: str, curve: ClientCurve | None) -> None:
+    def __init__(self, sock: zmq.Socket[bytes], endpoint: str, curve: ClientCurve | None) -> None:
         self._sock = sock
         self._monitor = sock.get_monitor_socket(_EVENTS)
         self._endpoint = endpoint

@@ -72,7 +72,7 @@ def _draw_path(fig: Figure, ax: Axes, trace: PathTrace, x_mm: np.ndarray, y_mm: 
     segments = np.stack([points[:-1], points[1:]], axis=1)  # (n - 1, 2 ends, xy)
     # each piece of path takes the mean speed of its two samples
     v_mm_s = 0.5 * (trace.v_mm_s[:-1] + trace.v_mm_s[1:])
-    path = LineCollection(segments, cmap=SPEED_COLORMAP,
+    path = LineCollection(segments, cmap=SPEED_COLORMAP,  # type: ignore[arg-type]  # an (n, 2, 2) array is what it takes; its stubs say Sequence
                           norm=Normalize(0.0, _speed_scale_mm_s(trace)),
                           linewidths=PATH_WIDTH_PT, capstyle="round", joinstyle="round")
     path.set_array(v_mm_s)

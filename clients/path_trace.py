@@ -22,6 +22,7 @@ import numpy as np
 
 from cnc_objects.protocol.errors import AdsReturnCode
 
+from .channel_ops import ChannelOps
 from .errors import AdsError, AdsTimeoutError, ChannelError
 
 PROD_TIME = 0x10  # execution mode bit: machining time calculation (FCT-C9)
@@ -94,11 +95,11 @@ def parse_trace(text: str) -> PathTrace:
     )
 
 
-class TraceOps:
+class TraceOps(ChannelOps):
     """``trace_run``: the traced dry run (mixed into ``AsyncClient``)."""
 
     async def trace_run(
-        self: Any, program: str, channel: int = 1, timeout_s: float | None = None
+        self, program: str, channel: int = 1, timeout_s: float | None = None
     ) -> PathTrace:
         """Run the stored ``program`` in ``channel`` as a machining time calculation
         (PROD_TIME, no axis moves) with ``prod_time_trace`` TRUE and return its path.

@@ -10,7 +10,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Coroutine, Generator
-from typing import Any
+from typing import Any, TypeVar
 
 import zmq
 
@@ -22,6 +22,7 @@ from .errors import AdsConnectionError
 from .transport import _NOBLOCK, _new_socket, _Transport
 
 log = logging.getLogger(__name__)
+T = TypeVar("T")
 
 
 class _Pending:
@@ -69,11 +70,11 @@ class _Pause:
 class SyncTransport(_Transport):
     """DEALER socket used by blocking calls; no event loop, no thread."""
 
-    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context | None = None,
+    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context[zmq.Socket[bytes]] | None = None,
                  curve: ClientCurve | None = None) -> None:
         super().__init__(endpoint, timeout_s, curve)
         self._context = context or zmq.Context.instance()
-        self._sock: zmq.Socket | None = None
+        self._sock: zmq.Socket[bytes] | None = None
         self._watch: HandshakeWatch | None = None
         self._shaken = False  # a handshake succeeded: requests go straight out
 
@@ -86,7 +87,7 @@ class SyncTransport(_Transport):
         self._shaken = self.endpoint.startswith("inproc://")  # inproc has no handshake
         self._timeout_ms = max(1, int(self.timeout_s * 1000))
         sock.setsockopt(zmq.RCVTIMEO, self._timeout_ms)
-        raw = zmq.Socket.__mro__[1]  # the Cython methods, without pyzmq's Python wrappers
+        raw: Any = zmq.Socket.__mro__[1]  # the Cython methods, without pyzmq's Python wrappers
         self._raw_send = raw.send.__get__(sock)
         self._raw_recv = raw.recv.__get__(sock)
 
@@ -172,7 +173,7 @@ class SyncTransport(_Transport):
             self._shaken = False
             raise self._watch.failure  # type: ignore[misc]
 
-    def _receive(self, sock: zmq.Socket) -> Response | None:
+    def _receive(self, sock: zmq.Socket[bytes]) -> Response | None:
         raw = self._raw_recv(0)
         try:
             message = decode_incoming(raw)
@@ -185,7 +186,7 @@ class SyncTransport(_Transport):
         return None
 
 
-def drive(coro: Coroutine[Any, Any, Any]) -> Any:
+def drive(coro: Coroutine[Any, Any, T]) -> T:
     """Run a client coroutine to completion on a ``SyncTransport``, blocking."""
     send: Any = None
     error: BaseException | None = None
@@ -193,7 +194,8 @@ def drive(coro: Coroutine[Any, Any, Any]) -> Any:
         try:
             pending = coro.throw(error) if error is not None else coro.send(send)
         except StopIteration as stop:
-            return stop.value
+            result: T = stop.value
+            return result
         try:
             send, error = pending.transport.perform(pending), None
         except BaseException as exc:

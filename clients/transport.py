@@ -46,8 +46,8 @@ EARLY_HANDLES = 4096
 
 
 def _new_socket(
-    context: zmq.Context, endpoint: str, curve: ClientCurve | None = None
-) -> tuple[zmq.Socket, HandshakeWatch]:
+    context: zmq.Context[zmq.Socket[bytes]], endpoint: str, curve: ClientCurve | None = None
+) -> tuple[zmq.Socket[bytes], HandshakeWatch]:
     """A connected DEALER socket and the watch on its handshakes."""
     sock = context.socket(zmq.DEALER)
     sock.setsockopt(zmq.LINGER, 0)
@@ -86,7 +86,8 @@ class _Transport:
 
     def open_samples(self, handle: int) -> None:
         """Start buffering samples of ``handle`` (claims any that arrived early)."""
-        self._samples[handle] = self._early.pop(handle, None) or deque(maxlen=SAMPLE_BUFFER)
+        early = self._early.pop(handle, None)
+        self._samples[handle] = early if early else deque(maxlen=SAMPLE_BUFFER)
 
     def close_samples(self, handle: int) -> None:
         """Stop buffering samples of ``handle``."""
@@ -122,11 +123,11 @@ class AsyncTransport(_Transport):
     sent, with ``NoReplyError`` (an ``AdsTimeoutError``).
     """
 
-    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context | None = None,
+    def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context[zmq.Socket[bytes]] | None = None,
                  curve: ClientCurve | None = None) -> None:
         super().__init__(endpoint, timeout_s, curve)
         self._context = context or zmq.Context.instance()
-        self._sock: zmq.Socket | None = None
+        self._sock: zmq.Socket[bytes] | None = None
         self._watch: HandshakeWatch | None = None
         # what a request on a closed transport raises: not connected, or refused
         self._closed: AdsConnectionError = AdsConnectionError(
@@ -145,7 +146,7 @@ class AsyncTransport(_Transport):
         self._loop = asyncio.get_running_loop()
         sock, watch = _new_socket(self._context, self.endpoint, self.curve)
         self._sock, self._watch = sock, watch
-        raw = zmq.Socket.__mro__[1]  # the Cython methods, without pyzmq's Python wrappers
+        raw: Any = zmq.Socket.__mro__[1]  # the Cython methods, without pyzmq's Python wrappers
         self._raw_send = raw.send.__get__(sock)
         self._raw_recv = raw.recv.__get__(sock)
         self._raw_get = raw.get.__get__(sock)
@@ -183,9 +184,9 @@ class AsyncTransport(_Transport):
         for fut, _, _ in self._pending.values():
             if not fut.done():
                 fut.set_exception(closed)
-        for fut in self._sample_waiters.values():
-            if not fut.done():
-                fut.set_exception(closed)
+        for waiter in self._sample_waiters.values():
+            if not waiter.done():
+                waiter.set_exception(closed)
         self._pending.clear()
 
     async def pause(self, seconds: float) -> None:

@@ -35,6 +35,8 @@ class Entry:
     handle: int
     read: Getter | None
     write: Setter | None
+    #: Told each value once the write is applied (a command object keeps it to read back).
+    written: Callable[[Any], None] | None = None
 
 
 class GroupHandler(Protocol):
@@ -46,6 +48,14 @@ class GroupHandler(Protocol):
 
 
 _INDEX = re.compile(r"\[\d+\]")
+
+
+def name_key(name: str) -> str:
+    """The key a name is looked up by: case-insensitive, as TwinCAT's symbol names, and
+    without the ``^`` of pointer dereferences, since ISG's HLI documentation writes
+    paths through the pointers (``gpCh[0]^.bahn_mc_control``) and the symbols are named
+    without them (``gpCh[0].bahn_mc_control``)."""
+    return name.lower().replace("^", "")
 
 
 def _glob(pattern: str) -> re.Pattern[str]:
@@ -79,8 +89,10 @@ class AddressSpace:
         read: Getter | None = None,
         write: Setter | None = None,
         aliases: Iterable[int] = (),
+        written: Callable[[Any], None] | None = None,
     ) -> Entry:
-        """Register ``obj``; ``aliases`` are other groups that address it (index-based)."""
+        """Register ``obj``; ``aliases`` are other groups that address it (index-based);
+        ``written`` is told each value written once the write has been applied."""
         key = obj.name.lower()
         if key in self._by_name:
             raise ValueError(f"object {obj.name} is registered twice")
@@ -93,7 +105,7 @@ class AddressSpace:
             if address in self._by_address:
                 other = self._by_address[address].obj.name
                 raise ValueError(f"{obj.name} and {other} share address {address}")
-        entry = Entry(obj, len(self._entries) + 1, read, write)
+        entry = Entry(obj, len(self._entries) + 1, read, write, written)
         for address in addresses:
             self._by_address[address] = entry
             self._groups.add(address[:2])
@@ -123,8 +135,8 @@ class AddressSpace:
         return [e.obj for e in self._entries]
 
     def by_name(self, name: str) -> Entry | None:
-        """The entry named ``name`` (case-insensitive), or None."""
-        return self._by_name.get(name.lower())
+        """The entry named ``name`` (case-insensitive, ``^`` ignored), or None."""
+        return self._by_name.get(name_key(name))
 
     def by_handle(self, handle: int) -> Entry | None:
         """The entry whose handle is ``handle``, or None."""
@@ -188,6 +200,20 @@ class AddressSpace:
             _E.DEVICE_INVALIDSIZE,
             f"{entry.obj.name} is {dtype.name}, {dtype.size} bytes; read asked {length}",
         )
+
+    @classmethod
+    def read_entry_buffer(cls, entry: Entry, length: int) -> tuple[int, bytes | str]:
+        """Read ``entry`` into a buffer of ``length`` bytes, as TwinCAT answers a read by
+        handle or by name: a buffer at least the value's size gets the value (its own
+        size, however large the buffer: clients that do not know the size send
+        0xFFFFFFFF), a smaller one 0x705, except a STRING, whose buffer is cut to it."""
+        size = entry.obj.dtype.size
+        if length >= size:
+            return cls.read_entry(entry, size)
+        if entry.obj.dtype.kind == "str":
+            code, data = cls.read_entry(entry, size)
+            return (code, data) if code else (0, data[:length])
+        return cls.read_entry(entry, length)  # the 0x705 that names the size
 
     def decode_write(
         self, port: int, group: int, offset: int, data: bytes

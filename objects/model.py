@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import Enum, IntEnum
+from typing import Any
 
 from cnc_objects.protocol.datatypes import DataType
 from cnc_objects.protocol.values import value_names
@@ -13,12 +14,13 @@ class Access(str, Enum):
     """Who may do what with an object, in the ISG tables' spelling."""
 
     READ = "r"  # read-only: writes get ADS 0x704
-    WRITE = "w"  # write-only: reads get ADS 0x704
+    WRITE = "w"  # write-only, a command: the service reads back the value last written
     READ_WRITE = "rw"  # both
 
     @property
     def readable(self) -> bool:
-        """True when the object can be read."""
+        """True when the object shows a state of its own; a write-only command has none
+        (the service binds it to the value last written, as a PLC command variable)."""
         return self is not Access.WRITE
 
     @property
@@ -62,7 +64,7 @@ class CncObject:
         """``{3: "READY", ...}`` for an enumeration object; empty for any other."""
         return value_names(self.values) if self.values is not None else {}
 
-    def describe(self) -> list:
+    def describe(self) -> list[Any]:
         """The browse descriptor: [name, port, group, offset, type, length, access, unit,
         description, value names]. The value names are ``[[value, name], ...]`` (empty
         for an object that is not an enumeration): pairs, because msgpack maps with

@@ -403,6 +403,29 @@ def decode_upload_info(data: bytes) -> UploadInfo:
     return UploadInfo(*words[:9])
 
 
+_HANDLE_INFO = struct.Struct("<IIIH")
+
+
+def encode_handle_info(handle: int, size: int, type_name: str, decoration: int = 0) -> bytes:
+    """TwinCAT 3's extended answer to handle by name (0xF003) for a read length over 4::
+
+        u32 handle, u32 size, u32 type decoration, u16 type name length, type name NUL
+
+    (the layout jisotalo's ads-client reads; the decoration's meaning is undocumented
+    and no client uses it)."""
+    name = _text(type_name, "type")
+    return _HANDLE_INFO.pack(handle, size, decoration, len(name)) + name + b"\x00"
+
+
+def decode_handle_info(data: bytes) -> tuple[int, int, int, str]:
+    """(handle, size, decoration, type name) of an extended handle answer."""
+    if len(data) < _HANDLE_INFO.size + 1:
+        raise ValueError(f"an extended handle answer has at least {_HANDLE_INFO.size + 1} bytes")
+    handle, size, decoration, length = _HANDLE_INFO.unpack_from(data)
+    (type_name,), _ = _strings(data, _HANDLE_INFO.size, len(data), (length,))
+    return handle, size, decoration, type_name
+
+
 def encode_symbol_version(version: int) -> bytes:
     """The symbol version (0xF008): one byte."""
     return bytes((version,))

@@ -32,7 +32,7 @@ as in ADS: the wall-clock time at which the kernel cycle that produced the value
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any, ClassVar, NamedTuple, cast
 
 import msgpack
 
@@ -43,77 +43,109 @@ U32_MAX = 0xFFFFFFFF
 _packb = msgpack.Packer(use_bin_type=True, autoreset=True).pack
 
 
+def _pack(obj: list[Any]) -> bytes:
+    """``obj`` as msgpack bytes (msgpack has no type hints: its ``pack`` returns bytes)."""
+    packed: bytes = _packb(obj)
+    return packed
+
+
 # --------------------------------------------------------------------------- requests
 # Requests are NamedTuples: immutable, and built from a decoded frame in one call (the
 # dispatch hot path). Fields are (invoke_id, port, *command fields); ``FIELDS`` names the
 # command fields with their kind, ``COMMAND`` is the ADS command id.
 
 
-class ReadDeviceInfoRequest(NamedTuple):
-    """Ask for the device name and version."""
+class _RequestFrame:
+    """What every request class adds to its fields: its ADS command id, the kinds of its
+    command fields, and its encoding. A request class is a NamedTuple of the fields
+    (``_<Name>Fields``) with this mixed in: the constants are class variables, not
+    fields."""
 
-    invoke_id: int
-    port: int
-    COMMAND = AdsCommand.READ_DEVICE_INFO
-    FIELDS = ()
+    __slots__ = ()
+    COMMAND: ClassVar[AdsCommand]
+    FIELDS: ClassVar[tuple[tuple[str, str], ...]]
 
     def encode(self) -> bytes:
         """The frame as msgpack bytes."""
-        return _packb([self[0], self.COMMAND, *self[1:]])
+        fields = cast("tuple[Any, ...]", self)
+        return _pack([fields[0], self.COMMAND, *fields[1:]])
 
 
-class ReadRequest(NamedTuple):
-    """Read ``length`` bytes at ``group``/``offset``."""
+class _ReadDeviceInfoFields(NamedTuple):
+    invoke_id: int
+    port: int
 
+
+class ReadDeviceInfoRequest(_ReadDeviceInfoFields, _RequestFrame):
+    """Ask for the device name and version."""
+
+    __slots__ = ()
+    COMMAND = AdsCommand.READ_DEVICE_INFO
+    FIELDS = ()
+
+
+class _ReadFields(NamedTuple):
     invoke_id: int
     port: int
     group: int
     offset: int
     length: int
+
+
+class ReadRequest(_ReadFields, _RequestFrame):
+    """Read ``length`` bytes at ``group``/``offset``."""
+
+    __slots__ = ()
     COMMAND = AdsCommand.READ
     FIELDS = (("group", "u32"), ("offset", "u32"), ("length", "u32"))
-    encode = ReadDeviceInfoRequest.encode
 
 
-class WriteRequest(NamedTuple):
-    """Write ``data`` at ``group``/``offset``."""
-
+class _WriteFields(NamedTuple):
     invoke_id: int
     port: int
     group: int
     offset: int
     data: bytes
+
+
+class WriteRequest(_WriteFields, _RequestFrame):
+    """Write ``data`` at ``group``/``offset``."""
+
+    __slots__ = ()
     COMMAND = AdsCommand.WRITE
     FIELDS = (("group", "u32"), ("offset", "u32"), ("data", "bytes"))
-    encode = ReadDeviceInfoRequest.encode
 
 
-class ReadStateRequest(NamedTuple):
-    """Ask for the ADS state and the device state."""
-
+class _ReadStateFields(NamedTuple):
     invoke_id: int
     port: int
+
+
+class ReadStateRequest(_ReadStateFields, _RequestFrame):
+    """Ask for the ADS state and the device state."""
+
+    __slots__ = ()
     COMMAND = AdsCommand.READ_STATE
     FIELDS = ()
-    encode = ReadDeviceInfoRequest.encode
 
 
-class WriteControlRequest(NamedTuple):
-    """Change the ADS state (RUN, STOP, RESET) and device state."""
-
+class _WriteControlFields(NamedTuple):
     invoke_id: int
     port: int
     ads_state: int
     device_state: int
     data: bytes
+
+
+class WriteControlRequest(_WriteControlFields, _RequestFrame):
+    """Change the ADS state (RUN, STOP, RESET) and device state."""
+
+    __slots__ = ()
     COMMAND = AdsCommand.WRITE_CONTROL
     FIELDS = (("ads_state", "u32"), ("device_state", "u32"), ("data", "bytes"))
-    encode = ReadDeviceInfoRequest.encode
 
 
-class AddNotificationRequest(NamedTuple):
-    """Subscribe to ``length`` bytes at ``group``/``offset``."""
-
+class _AddNotificationFields(NamedTuple):
     invoke_id: int
     port: int
     group: int
@@ -122,6 +154,12 @@ class AddNotificationRequest(NamedTuple):
     transmission_mode: int
     max_delay_ms: int
     cycle_time_ms: int
+
+
+class AddNotificationRequest(_AddNotificationFields, _RequestFrame):
+    """Subscribe to ``length`` bytes at ``group``/``offset``."""
+
+    __slots__ = ()
     COMMAND = AdsCommand.ADD_DEVICE_NOTIFICATION
     FIELDS = (
         ("group", "u32"),
@@ -131,43 +169,51 @@ class AddNotificationRequest(NamedTuple):
         ("max_delay_ms", "u32"),
         ("cycle_time_ms", "u32"),
     )
-    encode = ReadDeviceInfoRequest.encode
 
 
-class DeleteNotificationRequest(NamedTuple):
-    """End the subscription ``handle``."""
-
+class _DeleteNotificationFields(NamedTuple):
     invoke_id: int
     port: int
     handle: int
+
+
+class DeleteNotificationRequest(_DeleteNotificationFields, _RequestFrame):
+    """End the subscription ``handle``."""
+
+    __slots__ = ()
     COMMAND = AdsCommand.DELETE_DEVICE_NOTIFICATION
     FIELDS = (("handle", "u32"),)
-    encode = ReadDeviceInfoRequest.encode
 
 
-class ReadWriteRequest(NamedTuple):
-    """Write ``data``, then read ``read_length`` bytes, at ``group``/``offset``."""
-
+class _ReadWriteFields(NamedTuple):
     invoke_id: int
     port: int
     group: int
     offset: int
     read_length: int
     data: bytes
+
+
+class ReadWriteRequest(_ReadWriteFields, _RequestFrame):
+    """Write ``data``, then read ``read_length`` bytes, at ``group``/``offset``."""
+
+    __slots__ = ()
     COMMAND = AdsCommand.READ_WRITE
     FIELDS = (("group", "u32"), ("offset", "u32"), ("read_length", "u32"), ("data", "bytes"))
-    encode = ReadDeviceInfoRequest.encode
 
 
-class BrowseRequest(NamedTuple):
-    """Project extension: describe every object whose name matches ``pattern`` (glob)."""
-
+class _BrowseFields(NamedTuple):
     invoke_id: int
     port: int
     pattern: str
+
+
+class BrowseRequest(_BrowseFields, _RequestFrame):
+    """Project extension: describe every object whose name matches ``pattern`` (glob)."""
+
+    __slots__ = ()
     COMMAND = AdsCommand.BROWSE
     FIELDS = (("pattern", "str"),)
-    encode = ReadDeviceInfoRequest.encode
 
 
 Request = (
@@ -182,7 +228,7 @@ Request = (
     | BrowseRequest
 )
 
-REQUEST_TYPES: dict[int, Any] = {
+REQUEST_TYPES: dict[int, type[Request]] = {
     int(cls.COMMAND): cls
     for cls in (
         ReadDeviceInfoRequest,
@@ -198,7 +244,7 @@ REQUEST_TYPES: dict[int, Any] = {
 }
 _KIND_TYPES = {"u32": int, "bytes": bytes, "str": str, "list": list}
 #: Per command: (frame length, ((python type, is u32), ...)) for the fast shape check.
-_SHAPES: dict[int, tuple[int, tuple[tuple[type, bool], ...]]] = {
+_SHAPES: dict[int, tuple[int, tuple[tuple[type[Any], bool], ...]]] = {
     command: (3 + len(cls.FIELDS), tuple((_KIND_TYPES[k], k == "u32") for _, k in cls.FIELDS))
     for command, cls in REQUEST_TYPES.items()
 }
@@ -229,7 +275,8 @@ def decode_request(raw: bytes) -> Request:
                 if type(value) is not kind or (is_u32 and not 0 <= value <= U32_MAX):
                     break
             else:
-                return REQUEST_TYPES[command](invoke_id, *obj[2:])
+                request: Request = REQUEST_TYPES[command](invoke_id, *obj[2:])
+                return request
     raise _explain_bad_request(obj)
 
 
@@ -307,17 +354,17 @@ class Response(NamedTuple):
 def encode_request(invoke_id: int, command: int, port: int, fields: tuple[Any, ...]) -> bytes:
     """Encode a request without building its NamedTuple (the client's hot path); the
     bytes are those of ``<Request type>(invoke_id, port, *fields).encode()``."""
-    return _packb([invoke_id, command, port, *fields])
+    return _pack([invoke_id, command, port, *fields])
 
 
 def encode_response(invoke_id: int, command: int, *fields: Any) -> bytes:
     """Encode a successful reply without building a ``Response`` (the hot path)."""
-    return _packb([invoke_id, command, 0, *fields])
+    return _pack([invoke_id, command, 0, *fields])
 
 
 def encode_error(invoke_id: int, command: int, code: int, message: str) -> bytes:
     """Encode an error reply carrying the ADS code and a sentence that says why."""
-    return _packb([invoke_id, command, int(code), message])
+    return _pack([invoke_id, command, int(code), message])
 
 
 @dataclass(frozen=True, slots=True)
@@ -332,7 +379,7 @@ class Sample:
 
 def encode_notification(port: int, samples: list[list[Any]]) -> bytes:
     """Encode samples ``[[handle, sequence, timestamp, data], ...]`` as one frame."""
-    return _packb([0, AdsCommand.DEVICE_NOTIFICATION, port, samples])
+    return _pack([0, AdsCommand.DEVICE_NOTIFICATION, port, samples])
 
 
 @dataclass(frozen=True, slots=True)

@@ -26,6 +26,12 @@ frames wait (at most those of one read from the socket), nothing is refused, and
 slows the client down as a busy router would.
 A peer that does not read what it is sent is not read either, until it catches up; its
 notifications are dropped meanwhile, so a slow client cannot grow the service's memory.
+
+What connections hold is bounded (``connection_limits``, ``[limits]``): a connection
+beyond ``connections_per_front_end`` is closed as soon as it connects; a frame still
+incomplete ``frame_timeout_s`` after its first byte closes its connection; a read that
+takes the incomplete frames of all connections over ``receive_buffer_bytes_total``
+closes the connection it came from. Each is logged (throttled); the others are served.
 """
 
 from __future__ import annotations
@@ -51,6 +57,7 @@ from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
 from cnc_objects.protocol.roles import Role
 
 from .ads_routes import Admission, RouteTable
+from .connection_limits import ConnectionLimits
 from .dispatch import Dispatcher
 from .log_throttle import ThrottledWarning
 from .notifications import NotificationHub
@@ -76,6 +83,7 @@ class Listener(Protocol):
     hub: NotificationHub
     connections: set[AmsConnection]  # the open connections, for closing them all
     rate: RateLimiter | None  # requests per connection; None: no limit
+    limits: ConnectionLimits  # open connections and bytes of incomplete frames
 
 
 class AmsConnection(asyncio.Protocol):
@@ -97,6 +105,11 @@ class AmsConnection(asyncio.Protocol):
         self._rate = server.rate
         self._held: deque[AmsFrame | FrameError] | None = None  # waiting for the rate
         self._held_timer: asyncio.TimerHandle | None = None
+        self._limits = server.limits
+        self._admitted = False  # counted by the limits (released when lost)
+        self._buffered = 0  # bytes of the incomplete frame, as the limits account them
+        self._frame_started_s: float | None = None  # first byte of the incomplete frame
+        self._frame_timer: asyncio.TimerHandle | None = None
 
     # ------------------------------------------------------------ asyncio.Protocol
 
@@ -111,16 +124,56 @@ class AmsConnection(asyncio.Protocol):
             log.warning("ADS connection from %s refused: no route for this address", self.peer)
             transport.close()
             return
+        if not self._limits.admit(self.peer):
+            transport.close()
+            return
+        self._admitted = True
         self._server.connections.add(self)
         log.debug("ADS connection from %s", self.peer)
 
     def data_received(self, data: bytes) -> None:
         """Answer every frame ``data`` completes, in order."""
-        items = self._parser.feed(data)
+        parser = self._parser
+        items = parser.feed(data)
+        if (parser.buffered or self._buffered) and not self._account(items):
+            return
         if self._held is not None:  # earlier frames wait for the rate: these behind them
             self._held.extend(items)
             return
         self._answer(items)
+
+    def _account(self, items: list[AmsFrame | FrameError]) -> bool:
+        """Tell the limits what the incomplete frame now holds and time it; False when
+        that closed the connection (over the receive budget)."""
+        buffered = self._parser.buffered
+        if not self._limits.buffer(self.peer, self._buffered, buffered):
+            self._buffered = 0
+            self._parser = AmsStreamParser(self._parser.max_frame_bytes)  # free it now
+            self.close()
+            return False
+        self._buffered = buffered
+        if not buffered:
+            self._frame_started_s = None
+        elif self._frame_started_s is None or items:  # a new frame began
+            self._frame_started_s = perf_counter()
+            if self._frame_timer is None:
+                self._frame_timer = asyncio.get_running_loop().call_later(
+                    self._limits.frame_timeout_s, self._frame_deadline)
+        return True
+
+    def _frame_deadline(self) -> None:
+        """The timer of the incomplete frame: close when it is still the same frame."""
+        self._frame_timer = None
+        started_s = self._frame_started_s
+        if started_s is None or self._transport is None:
+            return
+        left_s = started_s + self._limits.frame_timeout_s - perf_counter()
+        if left_s > 0:  # another frame began since: time that one
+            self._frame_timer = asyncio.get_running_loop().call_later(
+                left_s, self._frame_deadline)
+            return
+        self._limits.timed_out.note(f"{self.peer} ({self._buffered} bytes)")
+        self.close()
 
     def _answer(self, items: list[AmsFrame | FrameError]) -> None:
         """Answer ``items`` in order while the rate allows; hold the rest."""
@@ -157,9 +210,14 @@ class AmsConnection(asyncio.Protocol):
 
     def connection_lost(self, exc: Exception | None) -> None:
         """Forget the connection and delete its notifications."""
-        if self._held_timer is not None:
-            self._held_timer.cancel()
-            self._held_timer = None
+        for timer in (self._held_timer, self._frame_timer):
+            if timer is not None:
+                timer.cancel()
+        self._held_timer = self._frame_timer = None
+        if self._admitted:
+            self._admitted = False
+            self._limits.release(self._buffered)
+            self._buffered = 0
         self._held = None
         if self._rate is not None:
             self._rate.forget(self)

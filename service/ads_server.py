@@ -42,7 +42,9 @@ from cnc_objects.protocol.errors import AdsReturnCode, describe_code
 from .ads_connection import AmsConnection
 from .ads_routes import RouteTable
 from .backend import Backend
+from .connection_limits import ConnectionLimits
 from .dispatch import Dispatcher
+from .limits import LimitsConfig
 from .rate_limit import RateLimiter
 
 log = logging.getLogger(__name__)
@@ -90,6 +92,7 @@ class AdsTcpServer:
         routes: RouteTable | None = None,
         max_frame_bytes: int = AMS_MAX_FRAME_BYTES,
         rate: RateLimiter | None = None,
+        limits: LimitsConfig | None = None,
     ) -> None:
         self.backend = backend
         self.hub = backend.hub
@@ -97,6 +100,8 @@ class AdsTcpServer:
         self.routes = routes if routes is not None else RouteTable()  # empty is falsy
         self.max_frame_bytes = max_frame_bytes
         self.rate = rate  # requests per connection ([limits]); None: no limit
+        # open connections and bytes of incomplete frames ([limits])
+        self.limits = ConnectionLimits("ADS", limits or LimitsConfig())
         self.ports = SERVED_PORTS
         self.dispatcher = Dispatcher(backend, self)
         self.connections: set[AmsConnection] = set()
@@ -134,15 +139,17 @@ class AdsTcpServer:
     def ok(self, envelope: tuple[Any, ...], req: Any, *fields: Any) -> bytes:
         """The response frame of ``req`` with its fields."""
         command = req.COMMAND
+        payload: bytes
         if command == _READ or command == _READ_WRITE:  # the hot path: data only
             data = fields[0]
             payload = _pack_ok_data(0, len(data)) + data
         else:
             payload = _encode_response(command, *fields)
-        return _pack_frame(
+        frame: bytes = _pack_frame(
             0, _AMS_HEADER_BYTES + len(payload), envelope[1], envelope[2], self.net_id,
             req.port, command, RESPONSE_FLAGS, len(payload), 0, req.invoke_id,
-        ) + payload
+        )
+        return frame + payload
 
     def error(self, envelope: tuple[Any, ...], req: Any, code: int, message: str) -> bytes:
         """The error response frame of ``req``: the command's length, result ``code``."""
@@ -161,7 +168,8 @@ class AdsTcpServer:
     @staticmethod
     def send(envelope: tuple[Any, ...], payload: bytes) -> bool:
         """Send on the client's connection; False when it is gone."""
-        return envelope[0].write(payload)
+        delivered: bool = envelope[0].write(payload)
+        return delivered
 
     def notify(self, envelope: tuple[Any, ...], port: int, samples: list[list[Any]]) -> bool:
         """A DeviceNotification to the client's Net ID and port, from ``port`` of ours
@@ -177,9 +185,11 @@ class AdsTcpServer:
             0, _AMS_HEADER_BYTES + len(payload), envelope[1], envelope[2], self.net_id, port,
             _NOTIFICATION, REQUEST_FLAGS, len(payload), 0, next(self._invoke_ids) & 0xFFFFFFFF,
         ) + payload
-        return connection.write(frame)
+        delivered: bool = connection.write(frame)
+        return delivered
 
     @staticmethod
     def cycle_ns(req: Any) -> int:
         """ADS gives the cycle time in 100 ns."""
-        return req.cycle_time_100ns * 100
+        cycle_100ns: int = req.cycle_time_100ns
+        return cycle_100ns * 100

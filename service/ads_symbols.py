@@ -46,8 +46,12 @@ import zlib
 from collections.abc import Callable
 
 from cnc_objects.objects import AddressSpace
-from cnc_objects.objects.address_space import Entry
+from cnc_objects.objects.address_space import Entry, name_key
+from cnc_objects.objects.catalog import PLC_GROUP
+from cnc_objects.objects.plc_structs import Node, PlcStructs
 from cnc_objects.protocol.ads_symbols import (
+    AdsDataType,
+    AdsDataTypeFlag,
     AdsSymbolFlag,
     TwinCatType,
     DataTypeEntry,
@@ -72,8 +76,6 @@ log = logging.getLogger(__name__)
 _E = AdsReturnCode
 Result = tuple[int, bytes | str]
 
-#: The symbol version: changes when the symbols change, which they never do here.
-SYMBOL_VERSION = 1
 #: CP1252, the code page of every name, type and comment (64-byte upload info).
 CODE_PAGE = 1252
 _OFFSET_HIGH_BIT = 0x8000_0000  # set by TwinCAT.Ads in the offset of its upload reads
@@ -98,10 +100,52 @@ def symbol_entry(entry: Entry) -> SymbolEntry:
     return SymbolEntry(group, offset, tc.size, tc.data_type, flags, obj.name, tc.name, obj.description)
 
 
+def struct_symbol_entry(node: Node) -> SymbolEntry:
+    """The AdsSymbolEntry of a struct or array: its address in the PLC memory area (0x4020,
+    its first member's offset), read-only when no member below may be written."""
+    flags = AdsSymbolFlag(0) if node.writable else AdsSymbolFlag.READONLY
+    return SymbolEntry(PLC_GROUP, node.start, node.size, AdsDataType.BIGTYPE,
+                       flags, node.name, node.type_name, "")
+
+
+def _member(name: str, node: Node, parent: Node) -> DataTypeEntry:
+    """A sub item of ``parent``'s type: ``node`` at its offset in ``parent``."""
+    offset = node.start - parent.start
+    if node.entry is not None:
+        tc = twincat_type(node.entry.obj.dtype)
+        return DataTypeEntry(name, tc.size, tc.data_type, AdsDataTypeFlag.DATAITEM, tc.name,
+                             node.entry.obj.description, offset)
+    return DataTypeEntry(name, node.size, AdsDataType.BIGTYPE, AdsDataTypeFlag.DATAITEM,
+                         node.type_name, "", offset)
+
+
+def struct_datatype_entry(node: Node) -> DataTypeEntry:
+    """The AdsDatatypeEntry of a struct's type (its members as sub items, at their
+    offsets) or of an array's (its element type, bounds and count)."""
+    hash_value = zlib.crc32(node.type_name.encode())
+    if node.is_array:
+        (first, element), *_ = node.children()
+        lower, count = min(node.elements), len(node.elements)
+        element_type = (twincat_type(element.entry.obj.dtype).name if element.entry is not None
+                        else element.type_name)
+        return DataTypeEntry(node.type_name, node.size, AdsDataType.BIGTYPE,
+                             AdsDataTypeFlag.DATATYPE, element_type, hash_value=hash_value,
+                             array=((lower, count),))
+    members = tuple(_member(name, child, node) for name, child in node.children())
+    return DataTypeEntry(node.type_name, node.size, AdsDataType.BIGTYPE, AdsDataTypeFlag.DATATYPE,
+                         hash_value=hash_value, sub_items=members)
+
+
 def datatype_entry(tc: TwinCatType) -> DataTypeEntry:
     """The AdsDatatypeEntry of a base type: TwinCAT name, size, ADST id; the hash is the
     CRC-32 of the name, so that clients comparing types by hash tell them apart."""
     return DataTypeEntry(tc.name, tc.size, tc.data_type, hash_value=zlib.crc32(tc.name.encode()))
+
+
+def _type_key(name: str) -> str:
+    """A type name as it is looked up: any case, without blanks (``ARRAY[0..1] OF X`` is
+    ``ARRAY [0..1] OF X``)."""
+    return "".join(name.split()).upper()
 
 
 def _name(data: bytes) -> str | None:
@@ -121,23 +165,35 @@ def _fits(answer: bytes, length: int, what: str) -> Result:
 class SymbolService:
     """Symbol version, symbol and data type uploads and lookups over an address space."""
 
-    def __init__(self, space: AddressSpace, version: int = SYMBOL_VERSION) -> None:
+    def __init__(
+        self, space: AddressSpace, structs: PlcStructs | None = None, version: int | None = None,
+    ) -> None:
+        """``structs``: the HLI's struct and array symbols, listed after the objects;
+        ``version``: the symbol version (default: from the table's bytes, so that it
+        changes when the table does)."""
         started_ns = time.perf_counter_ns()
-        self._version = encode_symbol_version(version)
+        nodes = structs.symbols if structs is not None else []
         entries = [e for obj in space.objects() if (e := space.by_name(obj.name)) is not None]
-        symbols = [symbol_entry(e) for e in entries]
+        symbols = [symbol_entry(e) for e in entries] + [struct_symbol_entry(n) for n in nodes]
         encoded = [encode_symbol_entry(s) for s in symbols]
-        self._by_name = {s.name.lower(): blob for s, blob in zip(symbols, encoded)}
+        self._by_name = {name_key(s.name): blob for s, blob in zip(symbols, encoded)}
         self._info_by_name = {
-            s.name.lower(): _INFO_BY_NAME.pack(s.group, s.offset, s.size) for s in symbols
+            name_key(s.name): _INFO_BY_NAME.pack(s.group, s.offset, s.size) for s in symbols
         }
         self._upload = b"".join(encoded)
+        if version is None:  # 1..255, from the table: another table, another version
+            version = zlib.crc32(self._upload) % 255 + 1
+        self.version = version
+        self._version = encode_symbol_version(version)
         types = {twincat_type(e.obj.dtype) for e in entries}
         type_blobs = {
             tc.name: encode_datatype_entry(datatype_entry(tc))
             for tc in sorted(types, key=lambda tc: (tc.data_type, tc.size))
         }
-        self._types_by_name = {name.upper(): blob for name, blob in type_blobs.items()}
+        for node in nodes:  # struct and array types, each once (instances share them)
+            if node.type_name not in type_blobs:
+                type_blobs[node.type_name] = encode_datatype_entry(struct_datatype_entry(node))
+        self._types_by_name = {_type_key(name): blob for name, blob in type_blobs.items()}
         self._datatype_upload = b"".join(type_blobs.values())
         info = UploadInfo(
             symbol_count=len(symbols),
@@ -211,19 +267,19 @@ class SymbolService:
     # ------------------------------------------------------------------ services
 
     def _symbol_by_name(self, name: str, length: int) -> Result:
-        blob = self._by_name.get(name.lower())
+        blob = self._by_name.get(name_key(name))
         if blob is None:
             return _E.DEVICE_SYMBOLNOTFOUND, f"no symbol is named {name!r}"
         return _fits(blob, length, f"the symbol entry of {name}")
 
     def _info_by_name_answer(self, name: str, length: int) -> Result:
-        blob = self._info_by_name.get(name.lower())
+        blob = self._info_by_name.get(name_key(name))
         if blob is None:
             return _E.DEVICE_SYMBOLNOTFOUND, f"no symbol is named {name!r}"
         return _fits(blob, length, f"the symbol info of {name}")
 
     def _type_by_name(self, name: str, length: int) -> Result:
-        blob = self._types_by_name.get(name.strip().upper())
+        blob = self._types_by_name.get(_type_key(name))
         if blob is None:  # an elementary type no symbol uses, or another STRING(n)
             try:
                 blob = encode_datatype_entry(datatype_entry(parse_twincat_type(name)))

@@ -22,13 +22,16 @@ from __future__ import annotations
 import asyncio
 import struct
 from collections.abc import Callable
+from functools import partial
 from typing import Any, Protocol
 
 from cnc_objects.objects import AddressSpace, Entry
+from cnc_objects.objects.catalog import PLC_GROUP
+from cnc_objects.objects.plc_structs import PlcStructs
+from cnc_objects.protocol.ads_symbols import encode_handle_info, twincat_type
 from cnc_objects.protocol.constants import (
     DEVICE_DATA_ADS_STATE,
     DEVICE_DATA_DEVICE_STATE,
-    MAX_DATA_BYTES,
     AdsState,
     AmsPort,
     CncPort,
@@ -83,11 +86,14 @@ class Backend:
         symbols: SymbolServices | None = None,
         notification_limits: tuple[int, int] = (MAX_PER_CLIENT, MAX_TOTAL),
         notification_counts: NotificationCounts | None = None,
+        structs: PlcStructs | None = None,
     ) -> None:
         """``notification_limits``: (per client, in total), ``[limits]``
         notifications_per_client and notifications_total; ``notification_counts``: where
-        the hub keeps its counts (the address space serves them)."""
+        the hub keeps its counts (the address space serves them); ``structs``: the HLI's
+        struct and array symbols, by name and by handle (none without)."""
         self.space = space
+        self.structs = structs if structs is not None else PlcStructs(AddressSpace())
         self.kernel = kernel
         self.loop = loop
         self.programs = programs
@@ -101,25 +107,34 @@ class Backend:
 
     def read_value(self, port: int, group: int, offset: int, length: int) -> ValueResult:
         """Read at an address, reserved groups included: (0, data) or (code, message)."""
-        if length > MAX_DATA_BYTES:
-            return _E.DEVICE_INVALIDSIZE, f"read length {length} exceeds {MAX_DATA_BYTES} bytes"
         if group == RIG.SYM_VALUE_BY_HANDLE:
             entry = self.space.by_handle(offset)
-            if entry is None:
+            if entry is not None:
+                return self.space.read_entry_buffer(entry, length)
+            node = self.structs.by_handle(offset)
+            if node is None:
                 return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown"
-            return self.space.read_entry(entry, length)
+            return self.structs.read(node, length)
         if group == RIG.DEVICE_DATA and port == CncPort.PLC:
             return self._device_data(offset, length)
         symbols = self.symbols
         if symbols is not None and symbols.handles(group):
             return symbols.read(group, offset, length)
-        return self.space.read(port, group, offset, length)
+        code, data = self.space.read(port, group, offset, length)
+        if code == _E.DEVICE_INVALIDSIZE:
+            return self.read_other_length(port, group, offset, length) or (code, data)
+        return code, data
 
-    def read_string(self, port: int, group: int, offset: int, length: int) -> ValueResult | None:
-        """A STRING object read with another length than its buffer: the buffer cut to
-        ``length`` (or whole, when ``length`` is longer), as a TwinCAT PLC answers; None
-        for any other object. ADS clients read strings with a buffer of their own size
-        (pyads: 1024 characters, or the type name's length without the NUL)."""
+    def read_other_length(
+        self, port: int, group: int, offset: int, length: int,
+    ) -> ValueResult | None:
+        """A read at an address with another length than the object's, as a TwinCAT PLC
+        answers it: a STRING object gets its buffer cut to ``length`` (whole when longer;
+        ADS clients read strings with a buffer of their own size, pyads 1024 characters);
+        at a PLC symbol's address (port 851, 0x4020), ``length`` bytes of the PLC memory
+        area (a struct, or the symbols that follow); None for any other object."""
+        if port == CncPort.PLC and group == PLC_GROUP:
+            return self.structs.read_memory(offset, length)
         if group == RIG.SYM_VALUE_BY_HANDLE:
             entry = self.space.by_handle(offset)
         else:
@@ -138,16 +153,17 @@ class Backend:
         return AdsState.STOP
 
     def _device_data(self, offset: int, length: int) -> ValueResult:
+        """ADS state and device state (UINT each) from ``offset`` on, as much of them as
+        the read length holds: the length is a buffer size, as in TwinCAT."""
         state = self.ads_state(CncPort.PLC)
-        if offset == DEVICE_DATA_ADS_STATE and length == 4:
-            return 0, _U16.pack(state) + _U16.pack(0)
         if offset not in (DEVICE_DATA_ADS_STATE, DEVICE_DATA_DEVICE_STATE):
             return (_E.DEVICE_INVALIDOFFSET,
                     f"device data has offset 0 (ADS state) and 2 (device state), not {offset}")
-        if length != 2:
+        fields = (_U16.pack(state) + _U16.pack(0))[offset:]
+        if length < 2:
             return (_E.DEVICE_INVALIDSIZE,
                     f"device data fields are UINT, 2 bytes; read asked {length}")
-        return 0, _U16.pack(state if offset == DEVICE_DATA_ADS_STATE else 0)
+        return 0, fields[: 2 * min(length // 2, len(fields) // 2)]
 
     def read_write_value(
         self, port: int, group: int, offset: int, read_length: int, data: bytes
@@ -161,44 +177,65 @@ class Backend:
                 return _E.DEVICE_INVALIDDATA, "a symbol name must be CP1252 text"
             entry = self.space.by_name(name)
             if entry is None:
-                return _E.DEVICE_SYMBOLNOTFOUND, f"no object is named {name!r}"
+                return self._struct_by_name(group, name, read_length)
             if group == RIG.SYM_VALUE_BY_NAME:
-                return self.space.read_entry(entry, read_length)
-            if read_length != 4:
-                return _E.DEVICE_INVALIDSIZE, "a handle is 4 bytes: read length must be 4"
-            return 0, _U32.pack(entry.handle)
+                return self.space.read_entry_buffer(entry, read_length)
+            tc = twincat_type(entry.obj.dtype)
+            return _handle_answer(entry.handle, tc.size, tc.name, read_length)
         symbols = self.symbols
         if symbols is not None and symbols.handles(group):
             return symbols.read_write(group, offset, data, read_length)
         found = self.space.find(port, group, offset)
         if isinstance(found, tuple):
             return found
-        return _E.DEVICE_SRVNOTSUPP, f"{found.obj.name} does not take ReadWrite; use Read or Write"
+        if not data:  # a ReadWrite that writes nothing reads, the length a buffer size
+            return self.space.read_entry_buffer(found, read_length)
+        return (_E.DEVICE_SRVNOTSUPP,
+                f"{found.obj.name} takes ReadWrite without data (a read); write with Write")
+
+    def _struct_by_name(self, group: int, name: str, read_length: int) -> ValueResult:
+        """Handle or value of a struct or array symbol (``gpCh[0].contour_lookahead``)."""
+        node = self.structs.by_name(name)
+        if node is None:
+            return _E.DEVICE_SYMBOLNOTFOUND, f"no object is named {name!r}"
+        if group == RIG.SYM_VALUE_BY_NAME:
+            return self.structs.read(node, read_length)
+        return _handle_answer(node.handle, node.size, node.type_name, read_length)
 
     # ------------------------------------------------------------ writes
 
-    def decode_write(self, port: int, group: int, offset: int, data: bytes) -> tuple:
-        """(0, entry, value), (0, None, None) for a handle release, or (code, message, None)."""
+    def decode_writes(
+        self, port: int, group: int, offset: int, data: bytes
+    ) -> tuple[int, str, list[tuple[Entry, Any]]]:
+        """(0, "", [(entry, value), ...]): the object writes a Write makes (none for a
+        handle release or a struct written with what it holds, one per changed member
+        of a struct), or (code, message, [])."""
         if group == RIG.SYM_VALUE_BY_HANDLE:
             entry = self.space.by_handle(offset)
-            if entry is None:
-                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown", None
-            return self.space.decode_entry_write(entry, data)
+            if entry is not None:
+                return _one(self.space.decode_entry_write(entry, data))
+            node = self.structs.by_handle(offset)
+            if node is None:
+                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {offset} is unknown", []
+            return self.structs.decode_write(node, data)
         if group == RIG.SYM_RELEASE_HANDLE:
             if len(data) != 4:
-                return _E.DEVICE_INVALIDSIZE, "release a handle by writing its 4 bytes", None
+                return _E.DEVICE_INVALIDSIZE, "release a handle by writing its 4 bytes", []
             handle = _U32.unpack(data)[0]
-            if self.space.by_handle(handle) is None:
-                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {handle} is unknown", None
-            return 0, None, None  # handles are stable per object: nothing to free
+            if self.space.by_handle(handle) is None and self.structs.by_handle(handle) is None:
+                return _E.DEVICE_SYMBOLNOTFOUND, f"handle {handle} is unknown", []
+            return 0, "", []  # handles are stable per object: nothing to free
         if group == RIG.DEVICE_DATA and port == CncPort.PLC:
             return (_E.DEVICE_INVALIDACCESS,
-                    "device data is read-only; change the state with WriteControl", None)
+                    "device data is read-only; change the state with WriteControl", [])
         symbols = self.symbols
         if symbols is not None and symbols.handles(group):
             code, message = symbols.write(group, offset, data)
-            return (code, message, None) if code else (0, None, None)
-        return self.space.decode_write(port, group, offset, data)
+            return (code, str(message), []) if code else (0, "", [])
+        decoded = self.space.decode_write(port, group, offset, data)
+        if decoded[0] == _E.DEVICE_INVALIDSIZE and port == CncPort.PLC and group == PLC_GROUP:
+            return self.structs.decode_memory_write(offset, data)  # a struct at its address
+        return _one(decoded)
 
     def apply_writes(
         self, items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None]
@@ -211,6 +248,8 @@ class Backend:
             finish(results)
             return
         loop = self.loop
+        if any(entry.written is not None for entry, _ in items):
+            finish = _telling_written(items, finish)
 
         def applied(k: int, refusal: Refusal | None) -> None:  # runs on the cycle thread
             if refusal is not None:
@@ -220,4 +259,38 @@ class Backend:
                 loop.call_soon_threadsafe(finish, results)
 
         for k, (entry, value) in enumerate(items):
-            self.kernel.submit(entry.write(value), lambda r, k=k: applied(k, r))
+            assert entry.write is not None  # decode_writes gives writable entries only
+            self.kernel.submit(entry.write(value), partial(applied, k))
+
+
+def _telling_written(
+    items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None]
+) -> Callable[[list[tuple[int, str]]], None]:
+    """``finish`` that first tells each entry that keeps its writes (a command object
+    reading back its last value) the value the kernel applied; refused ones are not."""
+
+    def told(results: list[tuple[int, str]]) -> None:
+        for (entry, value), (code, _) in zip(items, results):
+            if code == 0 and entry.written is not None:
+                entry.written(value)
+        finish(results)
+
+    return told
+
+
+def _one(decoded: tuple[int, Any, Any]) -> tuple[int, str, list[tuple[Entry, Any]]]:
+    """An address-space write decoding as ``decode_writes`` answers it."""
+    code, target, value = decoded
+    return (code, target, []) if code else (0, "", [(target, value)])
+
+
+def _handle_answer(handle: int, size: int, type_name: str, read_length: int) -> ValueResult:
+    """Handle by name: the handle alone for a 4-byte buffer (pyads, AdsLib), TwinCAT 3's
+    extended answer (handle, size, type name) when the buffer holds it (ads-client asks
+    with 0xFFFFFFFF, 0xFFFF per sum item)."""
+    extended = encode_handle_info(handle, size, type_name)
+    if read_length >= len(extended):
+        return 0, extended
+    if read_length >= 4:
+        return 0, _U32.pack(handle)
+    return _E.DEVICE_INVALIDSIZE, f"a handle is 4 bytes; read length is {read_length}"

@@ -8,6 +8,7 @@ become kernel commands, applied by the cycle thread before the reply is sent.
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 from cnc_objects.objects import AddressSpace, ChannelLayout, CncObject, MachineLayout, build_objects
@@ -18,7 +19,7 @@ from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from . import __version__
-from .config import MachineConfig
+from .machine_config import MachineConfig
 from .kernel.commands import (
     Command,
     Feedhold,
@@ -42,13 +43,13 @@ from .kernel.commands import (
     StartProgram,
     UpdateAxisParameters,
 )
-from .kernel.kernel import Kernel, ResetCycleStats
+from .kernel.kernel import Kernel, KernelCommand, ResetCycleStats
 from .kernel.state import DecoderFlag
 from .notifications import NotificationCounts
 from .param_list import ParamListError, parse_axis_list
 
 Getter = Callable[[], Any]
-CommandFactory = Callable[[Any], Command]
+CommandFactory = Callable[[Any], KernelCommand]
 
 REFUSAL_CODES: dict[RefusalReason, AdsReturnCode] = {
     RefusalReason.INVALID_VALUE: AdsReturnCode.DEVICE_INVALIDDATA,
@@ -382,6 +383,10 @@ SERVICE_READERS: dict[str, Callable[[NotificationCounts], Getter]] = {
 }
 
 
+def _syntax_check_parameter(name: str, ci: int, value: Any) -> Command:
+    return SetSyntaxCheckParameter(ci, name, value)
+
+
 def _channel_command(
     make: Callable[[int, Any], Command],
 ) -> Callable[[Kernel, CncObject], CommandFactory]:
@@ -397,8 +402,7 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
     "mc_command_execution_mode_w": _channel_command(SetExecutionMode),
     "decoder_mc_control.execution_mode.command_w": _channel_command(SetExecutionModePlc),
     "decoder_mc_control.execution_mode.enable_w": _channel_command(SetExecutionModeEnable),
-    **{f"syn_chk.{name}": _channel_command(
-        lambda ci, value, name=name: SetSyntaxCheckParameter(ci, name, value))
+    **{f"syn_chk.{name}": _channel_command(partial(_syntax_check_parameter, name))
        for name in ("errors_total", "errors_per_block", "interactive", "record_result")},
     "mc_command_single_block_w": _channel_command(SetSingleBlock),
     "prod_time_trace": _channel_command(SetProdTimeTrace),
@@ -428,6 +432,28 @@ def _axis_parameter_update(text: str) -> Command:
         return UpdateAxisParameters(parse_axis_list(text, "axis_parameter_update_w"))
     except ParamListError as exc:
         return UpdateAxisParameters(None, str(exc))
+
+
+class LastWritten:
+    """What a write-only command object (``mc_command_start_w``) reads: the value last
+    written to it, its type's zero before any write, as a command variable of a TwinCAT
+    PLC reads back. Every symbol of the upload is then readable, as in a PLC, and a read
+    of a glob that takes in a command object does not fail as a whole.
+
+    The value is kept once the kernel has applied the write: a write refused (0x706,
+    0x707, ...) leaves the value before it, as a PLC variable that an error reply did
+    not change. Kept and read on the event loop."""
+
+    def __init__(self, obj: CncObject) -> None:
+        self.value: Any = obj.dtype.decode(bytes(obj.dtype.size))
+
+    def read(self) -> Any:
+        """The value last written."""
+        return self.value
+
+    def keep(self, value: Any) -> None:
+        """A write of ``value`` was applied."""
+        self.value = value
 
 
 def machine_layout(kernel: Kernel) -> MachineLayout:
@@ -471,12 +497,17 @@ def build_address_space(
     counts = notifications if notifications is not None else NotificationCounts()
     for obj in objects:
         service = SERVICE_READERS.get(obj.element)
+        read: Getter | None
         if service is not None:
             read = service(counts)
         else:
             read = READERS[obj.element](kernel, obj) if obj.access.readable else None
         write = WRITERS[obj.element](kernel, obj) if obj.access.writable else None
-        space.add(obj, read, write, _aliases(kernel, obj))
+        written: Callable[[Any], None] | None = None
+        if read is None and write is not None:  # a command: reads give what was written
+            echo = LastWritten(obj)
+            read, written = echo.read, echo.keep
+        space.add(obj, read, write, _aliases(kernel, obj), written)
     # Platform-axis objects (ac_*) are left out: their element names repeat per axis.
     com = [
         o for o in objects if o.port == CncPort.COM and o.group != GroupBase.COM_PLATFORM_AXIS

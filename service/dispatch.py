@@ -203,30 +203,31 @@ class Dispatcher:
         else:
             code, payload = self._read_value(req.port, req.group, req.offset, req.length)
         if code:
-            if code == _E.DEVICE_INVALIDSIZE:  # a string may be read with any length
-                cut = self.backend.read_string(req.port, req.group, req.offset, req.length)
-                if cut is not None:
-                    return self._reply(envelope, req, cut)
+            if code == _E.DEVICE_INVALIDSIZE:  # a string, or PLC memory (a struct)
+                other = self.backend.read_other_length(req.port, req.group, req.offset, req.length)
+                if other is not None:
+                    return self._reply(envelope, req, other)
             return self._error(envelope, req, code, payload)
         return self._ok(envelope, req, payload)
 
     def _write(self, envelope: Envelope, req: WriteRequest) -> Reply:
         if self._is_store(req.port, req.group):
             return self._reply(envelope, req, self.programs.write(req.offset, req.data))
-        code, target, value = self.backend.decode_write(req.port, req.group, req.offset, req.data)
+        code, message, writes = self.backend.decode_writes(
+            req.port, req.group, req.offset, req.data)
         if code:
-            return self._error(envelope, req, code, target)
-        if target is None:
+            return self._error(envelope, req, code, message)
+        if not writes:
             return self._ok(envelope, req)
 
         def finish(results: list[tuple[int, str]]) -> None:
-            code, message = results[0]
+            code, message = next((r for r in results if r[0]), (0, ""))
             if code:
                 self._send(envelope, self._error(envelope, req, code, message))
             else:
                 self._send(envelope, self._ok(envelope, req))
 
-        self.backend.apply_writes([(target, value)], finish)
+        self.backend.apply_writes(writes, finish)
         return None
 
     def _read_state(self, envelope: Envelope, req: Any) -> Reply:
@@ -271,11 +272,8 @@ class Dispatcher:
     # ------------------------------------------------------------ read-write
 
     def _read_write(self, envelope: Envelope, req: ReadWriteRequest, role: Role = _ADMIN) -> Reply:
-        if req.read_length > MAX_DATA_BYTES:
-            return self._error(
-                envelope, req, _E.DEVICE_INVALIDSIZE,
-                f"read length {req.read_length} exceeds {MAX_DATA_BYTES} bytes",
-            )
+        # The read length is a buffer size (TwinCAT: 0xFFFFFFFF when the client does not
+        # know the size); each service answers with its data's real length.
         handler = self._read_write_groups.get(req.group)
         if handler is not None:  # a sum command
             if req.group == RIG.SUM_WRITE and role is not _ADMIN:
@@ -324,22 +322,21 @@ class Dispatcher:
             return self._error(envelope, req, code, items)
         codes: list[int] = [0] * len(items)
         writes: list[tuple[Entry, Any]] = []
-        slots: list[int] = []
+        slots: list[int] = []  # the item of each write (a struct item makes several)
         for k, item in enumerate(items):
             if role < _ADMIN and role < role_to_write(req.port, item.group):  # admin: no call
                 codes[k] = _E.DEVICE_INVALIDACCESS  # beyond the peer's role: this slot only
                 continue
-            code, target, value = self.backend.decode_write(
+            code, _, item_writes = self.backend.decode_writes(
                 req.port, item.group, item.offset, item.data)
             if code:
                 codes[k] = code
-            elif target is not None:
-                writes.append((target, value))
-                slots.append(k)
+            writes += item_writes
+            slots += [k] * len(item_writes)
 
         def finish(results: list[tuple[int, str]]) -> None:
             for k, (code, _) in zip(slots, results):
-                codes[k] = code
+                codes[k] = codes[k] or code
             self._send(envelope, self._ok(envelope, req, sums.encode_codes(codes)))
 
         self.backend.apply_writes(writes, finish)
@@ -354,4 +351,11 @@ class Dispatcher:
             code, data = self.backend.read_write_value(
                 req.port, item.group, item.offset, item.read_length, item.data)
             results.append((code, b"") if code else (0, data))
-        return self._ok(envelope, req, sums.encode_sum_read_write_reply(results))
+        reply = sums.encode_sum_read_write_reply(results)
+        if len(reply) > min(req.read_length, MAX_DATA_BYTES):
+            return self._error(
+                envelope, req, _E.DEVICE_INVALIDSIZE,
+                f"sum read-write of these items returns {len(reply)} bytes; read length is "
+                f"{req.read_length} (at most {MAX_DATA_BYTES})",
+            )
+        return self._ok(envelope, req, reply)

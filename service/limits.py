@@ -21,6 +21,13 @@ limit and the figures measured):
   mailbox, a full mailbox is answered ADS 0x502. The ADS front end stops reading a
   connection over the rate instead (TCP holds the rest).
 - ``program_max_bytes`` and ``program_max_files``: the program store.
+- ``connections_per_front_end``, ``frame_timeout_s`` and ``receive_buffer_bytes_total``:
+  what open connections and frames that never complete may hold. A connection beyond
+  the cap, a frame still incomplete after the timeout, and (ADS) a connection whose
+  incomplete frame would take the receive buffers of all connections over the budget
+  are closed and logged (throttled). ZeroMQ buffers incomplete frames inside libzmq,
+  where no budget can be kept: there the bound is the cap times the frame hard cap
+  (``zmq_receive_bound_bytes``), held at most ``frame_timeout_s``.
 
 Handles (0xF003 handle by name) are not a per-client resource: a handle is the stable
 number of an object, the same for every client, and releasing one frees nothing, so
@@ -110,6 +117,22 @@ class LimitsConfig(BaseModel):
         description="files the program store holds; an upload of one more: 0x70A",
     )
 
+    connections_per_front_end: int = Field(
+        64, ge=1, le=100_000,
+        description="open connections each front end (ZeroMQ, ADS) serves at once; one "
+        "more is closed at once (logged)",
+    )
+    frame_timeout_s: float = Field(
+        10.0, gt=0, le=3600,
+        description="seconds a frame may take from its first byte to its last; a "
+        "connection with a frame incomplete for longer is closed (logged)",
+    )
+    receive_buffer_bytes_total: int = Field(
+        32 << 20, ge=1 << 20, le=16 << 30,
+        description="bytes of incomplete frames all ADS connections may hold together; "
+        "the connection that would take it over is closed (logged)",
+    )
+
     @model_validator(mode="after")
     def _upload_fits_a_frame(self) -> LimitsConfig:
         needed = self.program_max_bytes + _UPLOAD_OVERHEAD_BYTES
@@ -124,6 +147,13 @@ class LimitsConfig(BaseModel):
     def frame_hard_cap_bytes(self) -> int:
         """ZeroMQ's MAXMSGSIZE: frames over it are never buffered (the peer is cut off)."""
         return frame_hard_cap_bytes(self.max_frame_bytes)
+
+    @property
+    def zmq_receive_bound_bytes(self) -> int:
+        """What incomplete ZeroMQ frames can hold at most (inside libzmq, which allocates
+        a frame's announced size): every connection of the cap with one frame just
+        under the hard cap."""
+        return self.connections_per_front_end * self.frame_hard_cap_bytes
 
     @property
     def mailbox_bytes(self) -> int:

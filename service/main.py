@@ -37,6 +37,7 @@ from typing import NoReturn, Optional
 import typer
 import zmq
 
+from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.protocol.ams import parse_net_id
 from cnc_objects.protocol.roles import Role
 
@@ -45,7 +46,8 @@ from .ads_server import AdsTcpServer
 from .ads_symbols import SymbolService
 from .backend import Backend
 from .binding import build_address_space
-from .config import ConfigError, MachineConfig, load_config, parse_ads_endpoint
+from .config import ConfigError, ServiceConfig, load_config
+from .frontend_config import parse_ads_endpoint
 from .data_location import StoreLocation, program_store_location
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
@@ -120,7 +122,7 @@ class AdsListen:
 
 
 async def serve(
-    config: MachineConfig, endpoint: str, clock_kind: ClockKind, speed: float | None,
+    config: ServiceConfig, endpoint: str, clock_kind: ClockKind, speed: float | None,
     store: ProgramStore, ads: AdsListen | None = None, curve: ServerCurve | None = None,
 ) -> int:
     """Run kernel and both front ends until SIGINT or SIGTERM (ADS when ``ads`` is given;
@@ -131,15 +133,17 @@ async def serve(
     load, exists = _kernel_loader(store)
     writer = StoreWriter(store)
     kernel = Kernel(
-        config, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists,
-        writer.append,
+        config.machine, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists,
+        writer.append, check_max_errors=config.limits.check_max_errors,
     )
     limits = config.limits
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows
     space = build_address_space(kernel, counts)
+    structs = PlcStructs(space)  # the HLI's structs and arrays over the PLC symbols
     backend = Backend(space, kernel, loop, ProgramStoreService(store, writer.flush),
-                      SymbolService(space),
-                      (limits.notifications_per_client, limits.notifications_total), counts)
+                      SymbolService(space, structs),
+                      (limits.notifications_per_client, limits.notifications_total), counts,
+                      structs)
     kernel.on_cycle_end = backend.hub.kernel_cycle_end  # one hub serves both front ends
     try:
         server = ZmqServer(backend, endpoint, curve=curve, limits=limits)
@@ -193,7 +197,7 @@ async def serve(
 
 
 async def _start_ads(
-    backend: Backend, config: MachineConfig, ads: AdsListen
+    backend: Backend, config: ServiceConfig, ads: AdsListen
 ) -> AdsTcpServer | None:
     """The listening ADS front end, or None after saying in one line why it cannot be."""
     routes = RouteTable(
@@ -201,7 +205,7 @@ async def _start_ads(
         ads.loopback_role, ads.open_to_all,
     )
     ads_server = AdsTcpServer(backend, routes, config.ads.max_frame_bytes,
-                              rate_limiter(config.limits))
+                              rate_limiter(config.limits), config.limits)
     try:
         await ads_server.start(ads.host, ads.port, ads.net_id)
     except OSError as exc:
@@ -288,7 +292,7 @@ def run(
     raise typer.Exit(asyncio.run(serve(config, endpoint, clock, speed, store, listen, curve)))
 
 
-def _server_curve(config: MachineConfig, keys: Path | None) -> ServerCurve | None:
+def _server_curve(config: ServiceConfig, keys: Path | None) -> ServerCurve | None:
     """The CURVE keys of ``--keys`` or ``[security]``, None when neither turns CURVE on."""
     security = config.security
     if keys is None and not security.curve:
@@ -309,7 +313,7 @@ def _path(text: str | None) -> Path | None:
 
 
 def _ads_listen(
-    config: MachineConfig, ads: str | None, net_id: str | None, keys: bool = False,
+    config: ServiceConfig, ads: str | None, net_id: str | None, keys: bool = False,
     insecure: bool = False,
 ) -> AdsListen | None:
     """Where ADS listens: ``--ads``/``--ams-net-id`` over the configuration's [ads]; and
@@ -340,12 +344,12 @@ def _ads_listen(
                      open_to_all=insecure and not local and not config.ads.routes)
 
 
-def _machine_config(path: Path | None, cycle_ms: float | None) -> MachineConfig:
+def _machine_config(path: Path | None, cycle_ms: float | None) -> ServiceConfig:
     """The configuration file over the default machine, ``--cycle-ms`` over both."""
     try:
         config = load_config(path)
         if cycle_ms is not None:
-            config = MachineConfig.model_validate({**config.model_dump(), "cycle_ms": cycle_ms})
+            config = ServiceConfig.model_validate({**config.model_dump(), "cycle_ms": cycle_ms})
     except ConfigError as exc:
         _usage(f"bad configuration:\n{exc}")
     except ValueError as exc:  # --cycle-ms out of range
@@ -353,7 +357,7 @@ def _machine_config(path: Path | None, cycle_ms: float | None) -> MachineConfig:
     return config
 
 
-def _open_store(location: StoreLocation, config: MachineConfig) -> ProgramStore:
+def _open_store(location: StoreLocation, config: ServiceConfig) -> ProgramStore:
     """The program store at ``location`` (created when absent), announced in the log."""
     try:
         store = ProgramStore(location.path, config.limits.program_max_bytes,

@@ -13,7 +13,10 @@ share it, and it never runs ahead of the wall clock, also not under the virtual 
 (where kernel time does): kernel time stays readable as ``cnc_kernel_time_r``.
 
 The kernel thread only looks at one number per cycle (when the next sample is due) and
-wakes the event loop when it is; all sampling and sending happens on the loop.
+wakes the event loop when it is; all sampling and sending happens on the loop, in
+slices of at most ``SAMPLE_SLICE_S`` of loop time (``SamplingPass``): with the
+notification limit used up by one client, another client's request waits one slice, not
+a pass over every subscription. Subscriptions of one object read it once per snapshot.
 
 One hub serves every front end: a subscription remembers the front end's ``notify``
 function, which turns samples into that front end's frames (msgpack for ZeroMQ, a
@@ -28,12 +31,14 @@ from __future__ import annotations
 
 import asyncio
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from time import perf_counter
 from typing import Any
 
 from cnc_objects.protocol.constants import TransmissionMode
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.filetime import filetime_from_unix_ns
 
 from .kernel.state import Snapshot
 
@@ -51,14 +56,11 @@ CYCLIC_MODES = {TransmissionMode.SERVER_CYCLE, TransmissionMode.SERVER_CYCLE2}
 ON_CHANGE_MODES = {TransmissionMode.SERVER_ON_CHANGE, TransmissionMode.SERVER_ON_CHANGE2}
 MAX_PER_CLIENT = 1000  # default of [limits] notifications_per_client
 MAX_TOTAL = 20000  # default of [limits] notifications_total
-
-#: FILETIME (100 ns since 1601-01-01) of the Unix epoch.
-_FILETIME_UNIX_EPOCH = 116444736000000000
-
-
-def filetime(wall_ns: int) -> int:
-    """A wall-clock time (ns since the Unix epoch) as a FILETIME (100 ns since 1601)."""
-    return _FILETIME_UNIX_EPOCH + wall_ns // 100
+#: Loop time one slice of a sampling pass may take before requests go first. Another
+#: client's read waits at most about this long behind the notifications of all clients.
+SAMPLE_SLICE_S = 0.0005
+SLICE_CHECK_EVERY = 32  # subscriptions sampled between two looks at the clock
+_NEVER = 1 << 64  # a due time no kernel time reaches
 
 
 @dataclass(slots=True)
@@ -88,6 +90,16 @@ class Subscription:
     sequence: int = 0
 
 
+@dataclass(slots=True)
+class SamplingPass:
+    """One pass over the subscriptions, done in slices of loop time: the kernel time it
+    samples for, the subscriptions still to look at, the soonest next due time seen."""
+
+    now_ns: int
+    todo: Iterator[Subscription]
+    soonest_ns: int = 1 << 64  # _NEVER
+
+
 #: Due time of a subscription whose first sample has not gone out yet: the cycle's sampling
 #: leaves it alone (else an unchanged value would go out twice, from both).
 FIRST_SAMPLE_PENDING = 1 << 63
@@ -115,6 +127,9 @@ class NotificationHub:
         # routing id or the ADS connection), so that the parts a client adds to its
         # envelope do not make it several clients.
         self._per_client: dict[Any, int] = {}
+        # Subscriptions by envelope, with the front end's notify: ``clients`` without a
+        # look at every subscription (the ZeroMQ probe asks every 2 s).
+        self._envelopes: dict[Envelope, tuple[NotifyFn, int]] = {}
         self.max_per_client = max_per_client
         self.max_total = max_total
         self.counts = counts if counts is not None else NotificationCounts()
@@ -122,6 +137,11 @@ class NotificationHub:
         self._next_due_ns: int | None = None
         self._scheduled = False
         self._last_snapshot: Snapshot | None = None
+        self._pass: SamplingPass | None = None  # the sampling pass in progress
+        self._read_cache: dict[tuple[int, int, int, int], tuple[int, bytes | str]] = {}
+        self._cached_snapshot: Snapshot | None = None  # the snapshot the cache holds
+        self._stamp = 0  # FILETIME of the cached snapshot
+        self._caching = False  # reads are shared: only inside one slice of a pass
         self.dropped = 0
 
     def __len__(self) -> int:
@@ -164,6 +184,8 @@ class NotificationHub:
         )
         self._subs[handle] = sub
         self._per_client[envelope[0]] = mine + 1
+        held = self._envelopes.get(envelope)
+        self._envelopes[envelope] = (notify, 1 if held is None else held[1] + 1)
         self._count()
         if first_delay_s > 0:
             self._loop.call_later(first_delay_s, self._first_sample, sub)
@@ -198,12 +220,14 @@ class NotificationHub:
 
     def clients(self) -> list[tuple[Envelope, NotifyFn]]:
         """Every client that holds notifications, with the ``notify`` of its front end."""
-        seen: dict[Envelope, NotifyFn] = {}
-        for sub in self._subs.values():
-            seen.setdefault(sub.envelope, sub.notify)
-        return list(seen.items())
+        return [(envelope, notify) for envelope, (notify, _) in self._envelopes.items()]
 
     def _forget_one(self, envelope: Envelope) -> None:
+        notify, count = self._envelopes[envelope]
+        if count > 1:
+            self._envelopes[envelope] = (notify, count - 1)
+        else:
+            del self._envelopes[envelope]
         key = envelope[0]
         left = self._per_client[key] - 1
         if left:
@@ -228,40 +252,66 @@ class NotificationHub:
     def _first_sample(self, sub: Subscription) -> None:
         if sub.handle not in self._subs:
             return
-        self._emit({(sub.envelope, sub.port): (sub.notify, [self._take(sub, force=True)])})
+        sample = self._take(sub, force=True)
+        assert sample is not None  # forced: a sample whether or not the value changed
+        self._emit({(sub.envelope, sub.port): (sub.notify, [sample])})
         # Only this subscription's due time changed: no need to look at all of them (with
         # thousands opened back to back that made opening them quadratic).
         due = self._next_due_ns
         if due is None or sub.next_due_ns < due:
             self._next_due_ns = sub.next_due_ns
+        if self._pass is not None:  # the pass in progress sets the due time when done
+            self._pass.soonest_ns = min(self._pass.soonest_ns, sub.next_due_ns)
 
     def _sample(self) -> None:
-        self._scheduled = False
+        """Begin a sampling pass over every subscription (the kernel said one is due)."""
         snapshot = self._last_snapshot
         if snapshot is None:
+            self._scheduled = False
             return
-        now_ns = snapshot.time_ns
-        batches: dict[tuple[Envelope, int], tuple[NotifyFn, list]] = {}
-        for sub in list(self._subs.values()):
-            if sub.next_due_ns > now_ns:
-                continue
-            sample = self._take(sub, force=False)
-            if sample is not None:
-                batches.setdefault((sub.envelope, sub.port), (sub.notify, []))[1].append(sample)
-        self._emit(batches)
-        self._update_due()
+        self._pass = SamplingPass(snapshot.time_ns, iter(list(self._subs.values())))
+        self._continue_pass()
 
-    def _take(self, sub: Subscription, force: bool) -> list | None:
-        """Read one subscription; a sample list or None when on-change saw no change."""
-        # The read serves whatever snapshot is newest. The stamp must be that snapshot's,
-        # so read again in the rare case the kernel published one meanwhile (the cycle
-        # thread may take the GIL between any two lines here).
-        current = self._current
-        while True:
-            snapshot = current()
-            code, data = self._read(sub.port, sub.group, sub.offset, sub.length)
-            if current() is snapshot:
+    def _continue_pass(self) -> None:
+        """Sample for at most ``SAMPLE_SLICE_S`` of loop time, send what was taken, and
+        come back after the loop has served what waits (requests of other clients go
+        between two slices, however many subscriptions there are)."""
+        run = self._pass
+        assert run is not None
+        subs, take, now_ns = self._subs, self._take, run.now_ns
+        batches: dict[tuple[Envelope, int], tuple[NotifyFn, list[list[Any]]]] = {}
+        soonest_ns = run.soonest_ns
+        deadline_s = perf_counter() + SAMPLE_SLICE_S
+        finished = True
+        self._read_cache.clear()  # values served by the loop may have changed meanwhile
+        self._caching = True
+        for k, sub in enumerate(run.todo, 1):
+            if subs.get(sub.handle) is not sub:
+                continue  # deleted since the pass began
+            if sub.next_due_ns <= now_ns:
+                sample = take(sub, force=False)
+                if sample is not None:
+                    batches.setdefault((sub.envelope, sub.port), (sub.notify, []))[1].append(
+                        sample)
+            if sub.next_due_ns < soonest_ns:
+                soonest_ns = sub.next_due_ns
+            if not k % SLICE_CHECK_EVERY and perf_counter() > deadline_s:
+                finished = False
                 break
+        self._caching = False
+        self._read_cache.clear()
+        run.soonest_ns = soonest_ns
+        self._emit(batches)
+        if not finished:
+            self._loop.call_soon(self._continue_pass)
+            return
+        self._pass = None
+        self._next_due_ns = None if soonest_ns == _NEVER else soonest_ns
+        self._scheduled = False  # the next kernel cycle that is due starts the next pass
+
+    def _take(self, sub: Subscription, force: bool) -> list[Any] | None:
+        """Read one subscription; a sample list or None when on-change saw no change."""
+        snapshot, code, data = self._read_current(sub.port, sub.group, sub.offset, sub.length)
         now_ns = snapshot.time_ns
         # Next due time on the subscription's own grid, never in the past.
         sub.next_due_ns = now_ns - now_ns % sub.cycle_ns + sub.cycle_ns
@@ -271,9 +321,43 @@ class NotificationHub:
             return None
         sub.last = data  # type: ignore[assignment]
         sub.sequence += 1
-        return [sub.handle, sub.sequence, filetime(snapshot.wall_ns), data]
+        return [sub.handle, sub.sequence, self._stamp, data]
 
-    def _emit(self, batches: dict[tuple[Envelope, int], tuple[NotifyFn, list]]) -> None:
+    def _read_current(self, port: int, group: int, offset: int,
+                      length: int) -> tuple[Snapshot, int, bytes | str]:
+        """(snapshot, code, data) of an address in the newest snapshot. Within one slice
+        of a sampling pass (nothing else runs on the loop meanwhile) the subscriptions of
+        one object share one read per snapshot: a client may open thousands on the same
+        object. The snapshot's FILETIME is computed once (``_stamp``)."""
+        current = self._current
+        snapshot = current()
+        cache = self._read_cache
+        if snapshot is not self._cached_snapshot:
+            cache.clear()
+            self._cached_snapshot = snapshot
+            self._stamp = filetime_from_unix_ns(snapshot.wall_ns)
+        key = (port, group, offset, length)
+        if self._caching:
+            hit = cache.get(key)
+            if hit is not None:
+                return snapshot, hit[0], hit[1]
+        # The read serves whatever snapshot is newest. The stamp must be that snapshot's,
+        # so read again in the rare case the kernel published one meanwhile (the cycle
+        # thread may take the GIL between any two lines here).
+        while True:
+            code, data = self._read(port, group, offset, length)
+            now = current()
+            if now is snapshot:
+                break
+            snapshot = now
+            cache.clear()
+            self._cached_snapshot = snapshot
+            self._stamp = filetime_from_unix_ns(snapshot.wall_ns)
+        if self._caching:
+            cache[key] = (code, data)
+        return snapshot, code, data
+
+    def _emit(self, batches: dict[tuple[Envelope, int], tuple[NotifyFn, list[list[Any]]]]) -> None:
         """One frame per client and port with all its samples of this cycle."""
         for (envelope, port), (notify, samples) in batches.items():
             samples = [s for s in samples if s is not None]

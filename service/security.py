@@ -100,11 +100,11 @@ class ServerCurve:
     secret_key: bytes  # Z85
     allow_list: AllowList
 
-    def authenticator(self, context: zmq.Context) -> ZapAuthenticator:
+    def authenticator(self, context: zmq.Context[zmq.Socket[bytes]]) -> ZapAuthenticator:
         """The ZAP handler for ``context``'s sockets (not started)."""
         return ZapAuthenticator(context, self.allow_list)
 
-    def secure(self, sock: zmq.Socket) -> None:
+    def secure(self, sock: zmq.Socket[bytes]) -> None:
         """Make ``sock`` a CURVE server of this key pair, authenticated by ZAP (call before
         bind)."""
         sock.curve_secretkey = self.secret_key
@@ -117,7 +117,7 @@ class ServerCurve:
 class ZapAuthenticator(ThreadAuthenticator):
     """pyzmq's ZAP thread with our allow-list as the CURVE credentials callback."""
 
-    def __init__(self, context: zmq.Context, allow_list: AllowList) -> None:
+    def __init__(self, context: zmq.Context[zmq.Socket[bytes]], allow_list: AllowList) -> None:
         super().__init__(context, log=logging.getLogger(f"{__name__}.zap"))
         self._allow = allow_list
         self._peer = "?"  # the address of the ZAP request being handled
@@ -185,6 +185,7 @@ def load_server_curve(
         log.warning("CURVE is on but the allow-list is empty: every client is refused "
                     "(put public keys into %s/<role>/, see docs/security.md)",
                     clients_dir or (keys_dir / CLIENTS_DIR if keys_dir else "clients"))
+    assert secret is not None  # _load_key_file(secret=True) refuses a file without one
     return ServerCurve(public, secret, allow_list)
 
 

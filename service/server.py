@@ -11,10 +11,13 @@ its mailbox (``rate_limit``), a full mailbox is answered 0x502; frames that do n
 decode get an error reply (or are dropped, logged, when not even the invoke id can be
 read), everything else gets an answer from the dispatcher. Replies to a client that
 does not read wait up to the send high-water mark, then are dropped (counted, logged
-now and then). A vanished client's notifications are dropped: ZeroMQ says a client is
-gone when a send to it fails, so clients with notifications get an empty notification
-frame every ``PROBE_S`` (a client that only subscribed on change to a value that never
-changes would otherwise never be sent anything).
+now and then). Connections beyond ``connections_per_front_end`` are shut down as they
+come, and a frame (or greeting) incomplete after ``frame_timeout_s`` ends its
+connection through libzmq's heartbeat (``zmq_connections``). A vanished client's
+notifications are dropped: ZeroMQ says a client is gone when a send to it fails, so
+clients with notifications get an empty notification frame every ``PROBE_S`` (a client
+that only subscribed on change to a value that never changes would otherwise never be
+sent anything).
 
 The envelope of a client is its ROUTER identity frames (a tuple of bytes): the routing
 id ZeroMQ gives the connection, then whatever parts the client put before its frame,
@@ -45,12 +48,14 @@ from cnc_objects.protocol.frames import decode_request, encode_error, encode_not
 from cnc_objects.protocol.roles import Role
 
 from .backend import Backend
+from .connection_limits import ConnectionLimits
 from .dispatch import Dispatcher
 from .limits import LimitsConfig, oversized_reply, rate_limiter, request_head
 from .rate_limit import BYTES_PER_TOKEN as _BYTES_PER_TOKEN
 from .log_throttle import ThrottledWarning
 from .rate_limit import RateLimiter, extra_tokens
 from .security import ServerCurve
+from .zmq_connections import ZmqConnectionWatch
 
 log = logging.getLogger(__name__)
 
@@ -81,7 +86,7 @@ class ZmqServer:
         self,
         backend: Backend,
         endpoint: str,
-        context: zmq.Context | None = None,
+        context: zmq.Context[zmq.Socket[bytes]] | None = None,
         curve: ServerCurve | None = None,
         limits: LimitsConfig | None = None,
     ) -> None:
@@ -96,6 +101,13 @@ class ZmqServer:
         sock.setsockopt(zmq.MAXMSGSIZE, limits.frame_hard_cap_bytes)
         sock.setsockopt(zmq.SNDHWM, limits.send_hwm_messages)
         sock.setsockopt(zmq.RCVHWM, limits.receive_hwm_messages)
+        # A frame that never completes: libzmq's heartbeat timeout is cancelled only by a
+        # whole message, which a peer in the middle of a frame cannot send
+        # (zmq_connections); a greeting that never completes: the handshake interval.
+        timeout_ms = max(1, round(limits.frame_timeout_s * 1000))
+        sock.setsockopt(zmq.HEARTBEAT_IVL, timeout_ms)
+        sock.setsockopt(zmq.HEARTBEAT_TIMEOUT, timeout_ms)
+        sock.setsockopt(zmq.HANDSHAKE_IVL, timeout_ms)
         self._max_frame_bytes = limits.max_frame_bytes
         self.rate = rate_limiter(limits)
         self._release_timer: asyncio.TimerHandle | None = None
@@ -126,11 +138,17 @@ class ZmqServer:
             raise
         self._sock = sock
         # The Cython socket methods: pyzmq's Python wrappers cost more than the send itself.
-        raw = zmq.Socket.__mro__[1]
+        raw: Any = zmq.Socket.__mro__[1]
         self._raw_send = raw.send.__get__(sock)
         self._raw_recv = raw.recv.__get__(sock)
         self._raw_get = raw.get.__get__(sock)
         self.endpoint = sock.getsockopt_string(zmq.LAST_ENDPOINT)
+        # Open connections, capped ([limits] connections_per_front_end); TCP only.
+        self.connections: ZmqConnectionWatch | None = None
+        if self.endpoint.startswith("tcp://"):
+            self.connections = ZmqConnectionWatch(
+                sock, int(self.endpoint.rsplit(":", 1)[1]),
+                ConnectionLimits("ZeroMQ", limits), self._loop)
         self.hub = backend.hub
         self.dispatcher = Dispatcher(backend, self)
         self._dispatch = self.dispatcher.dispatch
@@ -143,10 +161,14 @@ class ZmqServer:
         self._loop.add_reader(self._sock.FD, self._drain)
         self._schedule_drain()  # frames may already wait; the edge-triggered fd won't say
         self._probe_timer = self._loop.call_later(PROBE_S, self._probe)
+        if self.connections is not None:
+            self.connections.start()
 
     def close(self) -> None:
         """Stop serving and close the socket."""
         self._loop.remove_reader(self._sock.FD)
+        if self.connections is not None:
+            self.connections.close()
         for timer in (self._release_timer, self._probe_timer):
             if timer is not None:
                 timer.cancel()
@@ -322,7 +344,8 @@ class ZmqServer:
     def ok(envelope: Envelope, req: Any, *fields: Any) -> bytes:
         """``[invoke_id, command, 0, *fields]``: ``frames.encode_response``, packed here
         without its own call (the dispatch hot path)."""
-        return _packb([req.invoke_id, req.COMMAND, 0, *fields])
+        frame: bytes = _packb([req.invoke_id, req.COMMAND, 0, *fields])
+        return frame
 
     @staticmethod
     def error(envelope: Envelope, req: Any, code: int, message: str) -> bytes:
@@ -342,4 +365,5 @@ class ZmqServer:
     @staticmethod
     def cycle_ns(req: Any) -> int:
         """Frames carry the cycle time in ms."""
-        return req.cycle_time_ms * 1_000_000
+        cycle_ms: int = req.cycle_time_ms
+        return cycle_ms * 1_000_000

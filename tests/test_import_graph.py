@@ -42,9 +42,10 @@ OBJECTS = f"{ROOT_PACKAGE}.objects"
 SERVICE = f"{ROOT_PACKAGE}.service"
 CLIENTS = f"{ROOT_PACKAGE}.clients"
 KERNEL = f"{SERVICE}.kernel"
-# The one module outside the kernel that the kernel may read: its configuration. The
+# The one module outside the kernel that the kernel may read: the machine's
+# configuration (not the front ends', the keys' or the limits', nor the loading). The
 # server, dispatcher, bindings, notifications and entry point are above the kernel.
-KERNEL_MAY_IMPORT_FROM_SERVICE = (KERNEL, f"{SERVICE}.config")
+KERNEL_MAY_IMPORT_FROM_SERVICE = (KERNEL, f"{SERVICE}.machine_config")
 # Wire libraries the kernel must not know (DESIGN.md: "knows nothing of sockets, msgpack").
 KERNEL_FORBIDDEN_LIBRARIES = ("zmq", "msgpack")
 

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+from rich.text import Text
 from textual.widgets import DataTable
 
 
-class FixedColumnsTable(DataTable):
+class FixedColumnsTable(DataTable[str | Text]):
     """``COLUMNS`` (key, header, width) are added at mount with fixed widths, so that the
     widths do not jump while values change; a new row shows "…" until its values come."""
 

@@ -87,7 +87,7 @@ class LookaheadPanel(Vertical):
         super().__init__(**kwargs)
         self.view: LookaheadView | None = None  # the last answer shown
         self.summary = Static("", markup=False)
-        self.table = DataTable(cursor_type="none")
+        self.table: DataTable[str | Text] = DataTable(cursor_type="none")
         self.table.can_focus = False
 
     def compose(self) -> Any:
@@ -116,18 +116,17 @@ class LookaheadPanel(Vertical):
         )
         self.table.clear()
         for b in reply.blocks:
-            right = {"justify": "right"}
             self.table.add_row(
                 text.block_type(b.block_type),
-                Text(str(b.block_number) if b.block_number >= 0 else "-", **right),
-                Text(str(b.block_count_r), **right),
-                Text(text.mm(b.start_position), **right),
+                Text(str(b.block_number) if b.block_number >= 0 else "-", justify="right"),
+                Text(str(b.block_count_r), justify="right"),
+                Text(text.mm(b.start_position), justify="right"),
                 # LOG entries carry the PARAM value as programmed in `length`
-                Text(text.mm(b.length) if b.block_type in (1, 2, 6) else f"{b.length:g}", **right),
-                Text(text.mm(b.programmed_radius), **right),
-                Text(text.mm(b.compensated_radius), **right),
-                Text(_deg(b.circle_angle), **right),
-                Text(_deg(b.tangent_variation), **right),
+                Text(text.mm(b.length) if b.block_type in (1, 2, 6) else f"{b.length:g}", justify="right"),
+                Text(text.mm(b.programmed_radius), justify="right"),
+                Text(text.mm(b.compensated_radius), justify="right"),
+                Text(_deg(b.circle_angle), justify="right"),
+                Text(_deg(b.tangent_variation), justify="right"),
             )
 
     def show_error(self, channel: ChannelView, message: str) -> None:

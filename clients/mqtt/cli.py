@@ -58,7 +58,7 @@ def _read_password(path: Path) -> str:
 
 def _check_endpoint(endpoint: str) -> None:
     """ZeroMQ refuses a malformed endpoint at connect; better now than in every retry."""
-    sock = zmq.Context.instance().socket(zmq.DEALER)
+    sock: zmq.Socket[bytes] = zmq.Context.instance().socket(zmq.DEALER)
     try:
         sock.connect(endpoint)
     except zmq.ZMQError as exc:

@@ -11,7 +11,8 @@ from __future__ import annotations
 import asyncio
 from dataclasses import dataclass
 
-from ..client import ObjectInfo, Sample
+from ..client import Sample
+from ..object_info import ObjectInfo
 
 ONLINE = "online"
 OFFLINE = "offline"

@@ -157,6 +157,7 @@ def coerce(dtype: DataType, value: Any, what: str) -> Any:
     """The JSON ``value`` as the Python value of ``dtype``: a bool (or 0/1) for BOOLEAN,
     an integer for the integer types, a number for REAL, a string for STRING. Range and
     string length are checked as the client would; ``RequestError`` (0x706) otherwise."""
+    converted: bool | int | float | str | None
     match dtype.kind:
         case "bool":
             number = _integral(value)

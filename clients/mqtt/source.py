@@ -20,7 +20,8 @@ import logging
 import math
 from collections.abc import Callable
 
-from ..client import AsyncClient, ObjectInfo
+from ..client import AsyncClient
+from ..object_info import ObjectInfo
 from ..errors import AdsConnectionError, AdsError, AdsTimeoutError
 from .retry import Backoff, session
 from .config import BridgeConfig

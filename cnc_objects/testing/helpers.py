@@ -115,11 +115,12 @@ def wait_for(client: Client, name: str, expected: Expected,
         raise RuntimeError("wait_for blocks; in async code, await wait_for_async(...)")
     timeout = client._core._t.timeout_s  # the same request timeout as the test's client
     curve = client._core._t.curve  # and the same CURVE keys, for a service with --keys
-    keys = {} if curve is None else {"key_file": curve.key_file,
-                                     "server_key": curve.server_key_file}
+    key_file = None if curve is None else curve.key_file
+    server_key = None if curve is None else curve.server_key_file
 
     async def wait() -> Any:
-        async with AsyncClient(client.endpoint, timeout_s=timeout, **keys) as own:
+        async with AsyncClient(client.endpoint, timeout_s=timeout, key_file=key_file,
+                               server_key=server_key) as own:
             return await wait_for_async(own, name, expected, timeout_s)
 
     return asyncio.run(wait())

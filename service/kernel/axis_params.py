@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 from enum import IntEnum
 from typing import Any
 
-from ..config import AxisConfig, AxisLimits, MachineConfig
+from ..machine_config import AxisConfig, AxisLimits, MachineConfig
 
 
 class AxisErrorId(IntEnum):
@@ -116,7 +116,8 @@ def initialise_axes(
             params = _cloned(axis, master)
         else:
             params = _own(axis, config.link_of(axis.logical_number))
-        if params.sw_limit_min_mm >= params.sw_limit_max_mm:
+        # an axis's own limits are ordered (AxisLimits checks them); a clone's may not be
+        if master is not None and params.sw_limit_min_mm >= params.sw_limit_max_mm:
             messages.append(AxisMessage(
                 AxisErrorId.CLONE_LIMITS_INCONSISTENT,
                 f"axis {axis.name} ({axis.logical_number}): software limits "
@@ -139,7 +140,7 @@ def update_axis(
     list: ``logical_number`` plus what it writes), or (None, why not). Clones of the
     axis keep the copy they took at initialisation."""
     number = changes.get("logical_number")
-    current = axes.get(number)
+    current = axes.get(number) if number is not None else None
     if current is None:
         return None, f"there is no axis with kopf.achs_nr {number}"
     if "clone_of" in changes and changes["clone_of"] != current.clone_of:

@@ -1,7 +1,8 @@
 """The channel's operation mode and state (HLI ``channel_mc_control.mode_and_state``).
 
-Modes and states carry the documented HLI values. The rules, as this kernel implements
-them (docs/kernel.md has the diagram):
+Modes and states carry the documented HLI values. Which event takes a channel from
+which state to which is one table, ``channel_transitions.TRANSITIONS``, shown in
+docs/kernel.md ("Channel mode and state"); in short:
 
 * A mode is chosen only while the channel is not working (DESELECTED, SELECTED, READY);
   choosing a mode puts the channel in SELECTED (STANDBY: DESELECTED).
@@ -12,7 +13,8 @@ them (docs/kernel.md has the diagram):
   program: the channel stays ACTIVE and further manual blocks continue the same program
   (same modal state, path distance and program time) until M30 or RESET.
 * ACTIVE --feedhold--> HOLD --START--> ACTIVE.
-* Any error -> ERROR; RESET from any state -> READY (a program is selected) or SELECTED.
+* Any error -> ERROR; RESET from any state -> READY (AUTOMATIC with a program selected),
+  DESELECTED (STANDBY) or SELECTED.
 """
 
 from __future__ import annotations

@@ -9,30 +9,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from enum import IntEnum
-from typing import Any, NamedTuple, Protocol
+from typing import Any, ClassVar, Protocol
 
 from .axis_params import update_axis
 from .channel_mode import ChannelState
 from .contour_lookahead import RequestError, check_request
+from .refusal import Refusal as Refusal  # the commands' answer, imported from here too
+from .refusal import RefusalReason as RefusalReason
 from .state import ExecutionMode, KernelState
-
-
-class RefusalReason(IntEnum):
-    """Why the kernel did not apply a command."""
-
-    INVALID_VALUE = 1  # the value is outside what the object accepts
-    NOT_READY = 2  # the kernel or channel is not in a state that allows it
-    BUSY = 3  # try again in a later cycle
-    NOT_FOUND = 4  # the named thing (a program) does not exist
-    NOT_SUPPORTED = 5  # the function is not configured (e.g. not in P-CHAN-00650)
-
-
-class Refusal(NamedTuple):
-    """A command the kernel did not apply, with a sentence for the user."""
-
-    reason: RefusalReason
-    message: str
 
 
 class Command(Protocol):
@@ -61,7 +45,7 @@ def execution_mode_refused(value: int) -> Refusal | None:
         )
     missing = value & ~IMPLEMENTED_EXECUTION_MODES
     if missing:
-        names = "|".join(m.name for m in ExecutionMode if m and m & missing)
+        names = "|".join(m.name for m in ExecutionMode if m and m & missing and m.name)
         return Refusal(
             RefusalReason.INVALID_VALUE,
             f"execution mode {names} (0x{missing:x}) is not implemented by this kernel; "
@@ -87,7 +71,8 @@ class SetFeedOverride:
         if not 0 <= self.value <= channel.feed_override_max:
             return Refusal(
                 RefusalReason.INVALID_VALUE,
-                f"feed override {self.value / 10:g} % is outside 0..{channel.feed_override_max / 10:g} %",
+                f"feed override {self.value / 10:g} % is outside "
+                f"0..{channel.feed_override_max / 10:g} %",
             )
         channel.feed_override_command = self.value
         channel.feed_override_active = self.value
@@ -202,22 +187,28 @@ class SelectProgram:
         return state.runners[self.channel_index].select_program(self.value)
 
 
-def _pulse(name: str, method: str) -> type:
-    """A command object written with TRUE to trigger ``method`` of the channel runner."""
+@dataclass(frozen=True, slots=True)
+class ChannelPulse:
+    """A command object written with TRUE to trigger ``method`` of the channel runner
+    (the subclasses made by ``_pulse`` name the method)."""
 
-    @dataclass(frozen=True, slots=True)
-    class Pulse:
-        channel_index: int
-        value: bool
+    channel_index: int
+    value: bool
+    method: ClassVar[str] = ""
 
-        def apply(self, state: KernelState) -> Refusal | None:
-            if not self.value:
-                return None  # writing FALSE is accepted and does nothing, as a PLC edge
-            return getattr(state.runners[self.channel_index], method)()
+    def apply(self, state: KernelState) -> Refusal | None:
+        if not self.value:
+            return None  # writing FALSE is accepted and does nothing, as a PLC edge
+        answer: Refusal | None = getattr(state.runners[self.channel_index], self.method)()
+        return answer
 
-    Pulse.__name__ = Pulse.__qualname__ = name
-    Pulse.__doc__ = f"Write TRUE: ``ChannelRunner.{method}``."
-    return Pulse
+
+def _pulse(name: str, method: str) -> type[ChannelPulse]:
+    """The ``ChannelPulse`` that triggers ``method`` of the channel runner."""
+    return type(name, (ChannelPulse,), {
+        "__slots__": (), "method": method, "__qualname__": name,
+        "__doc__": f"Write TRUE: ``ChannelRunner.{method}``.",
+    })
 
 
 StartProgram = _pulse("StartProgram", "start")
@@ -318,7 +309,13 @@ class SetContourRequest:
             return Refusal(RefusalReason.INVALID_VALUE,
                            f"request.{self.field} must be a finite number, not {self.value}")
         channel = state.channels[self.channel_index]
-        channel.contour = replace(channel.contour, **{f"request_{self.field}": self.value})
+        match self.field:
+            case "start_position":
+                channel.contour = replace(channel.contour, request_start_position=self.value)
+            case "length":
+                channel.contour = replace(channel.contour, request_length=self.value)
+            case _:
+                raise ValueError(f"no contour request field {self.field!r}")
         return None
 
 

@@ -20,8 +20,8 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 from .nc import Decoder, ModalState, NcError, NcErrorId
-from .nc.errors import DecodingCancelled
 from .nc.blocks import Block, Compensation, SourceRef, StopKind
+from .nc.errors import DecodingCancelled
 from .nc.technology import Surroundings
 from .path.errors import PathError
 from .path.section_plan import SectionPlan
@@ -30,13 +30,6 @@ log = logging.getLogger(__name__)
 
 _PUT_POLL_S = 0.05  # how often a decoder waiting on a full queue checks for cancel
 _TAKE_POLL_S = 0.02  # how often a cycle waiting for the decoder checks for a RESET
-
-
-@dataclass(frozen=True, slots=True)
-class TextDone:
-    """Marker after the blocks of one text (a manual block): carried as a block."""
-
-    block: Block
 
 
 @dataclass(frozen=True, slots=True)

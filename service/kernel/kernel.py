@@ -17,13 +17,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from enum import Enum
 
-from ..config import MachineConfig
+from ..machine_config import MachineConfig
 from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
 from .commands import Command, Refusal, RefusalReason, ResetChannel
 from .state import ChannelError, CycleStats, KernelState, Snapshot
 from .switchover import Switchover
+from .syntax_check import CHECK_MAX_ERRORS
 
 log = logging.getLogger(__name__)
 
@@ -59,7 +60,21 @@ class ResetCycleStats:
     value: bool
 
 
-_SHUTDOWN = object()
+class _Shutdown:
+    """The queue entry that stops the cycle thread (``Kernel.close``)."""
+
+
+_SHUTDOWN = _Shutdown()
+
+
+def _no_answer(_result: Refusal | None) -> None:
+    """The ``done`` of the shutdown entry: nobody waits for it."""
+
+
+#: what the kernel's queue takes from the service
+KernelCommand = Command | ControlCommand | ResetCycleStats
+#: a queued command and the callback that gets its answer
+Queued = tuple[KernelCommand | _Shutdown, Done]
 
 
 class Kernel:
@@ -72,11 +87,14 @@ class Kernel:
         loader: Loader = _no_programs,
         exists: Callable[[str], bool] = lambda name: False,
         files: Callable[..., None] = lambda name, data, replace=False: None,
+        check_max_errors: int = CHECK_MAX_ERRORS,
     ) -> None:
         """``loader(name)`` returns a program's text (KeyError when absent) and
         ``exists(name)`` says whether it is there: the program store, seen by the kernel.
         ``files(name, data, replace=False)`` appends to a file of the store (logs), or
-        replaces its content (a result file); it must not block."""
+        replaces its content (a result file); it must not block. ``check_max_errors``:
+        errors one syntax check keeps ([limits] check_max_errors)."""
+        self._check_max_errors = check_max_errors
         self.config = config
         self.cycle_s = config.cycle_ms / 1000.0
         self.cycle_ns = round(config.cycle_ms * 1e6)
@@ -92,8 +110,8 @@ class Kernel:
         self.lateness: LatenessHistogram | None = clock.lateness
         self.snapshot: Snapshot = self.state.snapshot(0, 0, time.time_ns(), self.stats)
         self.on_cycle_end: Callable[[Snapshot], None] | None = None
-        self._queue: queue.SimpleQueue = queue.SimpleQueue()
-        self._waiting: deque = deque()
+        self._queue: queue.SimpleQueue[Queued] = queue.SimpleQueue()
+        self._waiting: deque[Queued] = deque()
         self._channel_index = {c.channel_id: k for k, c in enumerate(self.state.channels)}
         self._thread: threading.Thread | None = None
         self._closed = False
@@ -110,7 +128,8 @@ class Kernel:
         deterministic = isinstance(self._clock, VirtualClock)
         state.runners = [
             ChannelRunner(channel, cfg, self.config, self._loader, self._exists, self.cycle_s,
-                          deterministic, self._files, params=params, switchover=self.switchover)
+                          deterministic, self._files, params=params, switchover=self.switchover,
+                          check_max_errors=self._check_max_errors)
             for channel, cfg in zip(state.channels, self.config.channels, strict=True)
         ]
         for message in messages:
@@ -132,13 +151,13 @@ class Kernel:
         """Position of the channel with logical id ``channel_id`` in the state."""
         return self._channel_index[channel_id]
 
-    def submit(self, command: Command | ControlCommand, done: Done) -> None:
+    def submit(self, command: KernelCommand, done: Done) -> None:
         """Queue ``command``; ``done`` is called from the cycle thread once applied
         (at once, with a refusal, when the kernel is closed)."""
         if self._closed:
             done(Refusal(RefusalReason.NOT_READY, "the kernel is shut down"))
             return
-        if type(command) is ResetChannel and command.value:
+        if isinstance(command, ResetChannel) and command.value:
             # a cycle that waits for the channel's decoder or syntax check (virtual
             # clock) stops waiting, so that the RESET is applied at the next cycle
             self.state.runners[command.channel_index].reset_pending.set()
@@ -154,7 +173,7 @@ class Kernel:
         self._closed = True
         if self._thread is None:
             return
-        self._queue.put((_SHUTDOWN, None))
+        self._queue.put((_SHUTDOWN, _no_answer))
         self._thread.join(timeout_s)
         if self._thread.is_alive():
             log.error("cycle thread did not stop within %.1f s", timeout_s)
@@ -187,7 +206,7 @@ class Kernel:
             self.stats.running = False
             self._publish()
 
-    def _next_command(self, block: bool) -> tuple:
+    def _next_command(self, block: bool) -> Queued:
         if self._waiting:
             return self._waiting.popleft()
         return self._queue.get() if block else self._queue.get_nowait()
@@ -205,7 +224,7 @@ class Kernel:
                 command, done = self._next_command(block=False)
             except queue.Empty:
                 break
-            if command is _SHUTDOWN:
+            if isinstance(command, _Shutdown):
                 shutting_down = True
                 break
             applied.append((done, self._apply(command)))
@@ -224,7 +243,7 @@ class Kernel:
         """Wait in STOP until RUN or RESET; False on shutdown."""
         while not self.stats.running:
             command, done = self._next_command(block=True)
-            if command is _SHUTDOWN:
+            if isinstance(command, _Shutdown):
                 self._refuse_queued()
                 return False
             if isinstance(command, ControlCommand):
@@ -232,17 +251,20 @@ class Kernel:
                 self._publish()
                 done(result)
             else:
-                if type(command) is ResetChannel:  # refused: no cycle may stop waiting for it
+                if isinstance(command, ResetChannel):  # refused: no cycle may stop waiting for it
                     self.state.runners[command.channel_index].reset_pending.clear()
                 done(Refusal(RefusalReason.NOT_READY, "the kernel is stopped (ADS state STOP)"))
         return True
 
-    def _apply(self, command: Command | ControlCommand) -> Refusal | None:
+    def _apply(self, command: KernelCommand) -> Refusal | None:
         try:
             if isinstance(command, ControlCommand):
-                return self._control(command.control)
+                self._control(command.control)
+                return None
             if isinstance(command, ResetCycleStats):
-                return self._reset_cycle_stats() if command.value else None
+                if command.value:
+                    self._reset_cycle_stats()
+                return None
             return command.apply(self.state)
         except Exception:
             log.exception("command %r failed", command)
@@ -273,8 +295,7 @@ class Kernel:
                 command, done = self._next_command(block=False)
             except queue.Empty:
                 return
-            if done is not None:
-                done(Refusal(RefusalReason.NOT_READY, "the kernel is shutting down"))
+            done(Refusal(RefusalReason.NOT_READY, "the kernel is shutting down"))
 
     def _publish(self) -> None:
         cycle = self.stats.cycles

@@ -17,6 +17,9 @@ from __future__ import annotations
 
 from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES
 
+#: one cycle: (time s, position mm per axis..., distance mm, path velocity mm/s, feed
+#: limit mm/s, line); its length depends on the channel's axes
+Row = tuple[float | int, ...]
 TRACE_ROWS_MAX = 20_000  # rows kept at most while the run goes (a plot is ~1,200 px wide)
 
 
@@ -40,9 +43,9 @@ class ProdTimeTrace:
         self.cycle_s = cycle_s
         self.rows_max = rows_max
         self.stride = 1  # every stride-th cycle is recorded
-        self._rows: list[tuple] = []
+        self._rows: list[Row] = []
         self._cycles = 0  # cycles offered so far
-        self._last: tuple | None = None  # the newest cycle, recorded or not
+        self._last: Row | None = None  # the newest cycle, recorded or not
 
     def record(
         self, time_s: float, position_mm: tuple[float, ...], distance_mm: float,
@@ -59,7 +62,7 @@ class ProdTimeTrace:
         self._cycles += 1
 
     @property
-    def rows(self) -> list[tuple]:
+    def rows(self) -> list[Row]:
         """The recorded rows, the newest cycle included."""
         if self._last is not None and (not self._rows or self._rows[-1] is not self._last):
             return [*self._rows, self._last]

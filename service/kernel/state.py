@@ -7,15 +7,19 @@ consistent within one cycle and never waits for the kernel.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 from enum import IntFlag
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, Protocol
 
 # Defined with the wire's value sets; the kernel's modules import them from here.
-from cnc_objects.protocol.values import ExecutionMode, LinkState
+from cnc_objects.protocol.values import ExecutionMode as ExecutionMode
+from cnc_objects.protocol.values import LinkState as LinkState
 
-from ..config import ChannelConfig, MachineConfig
+from ..machine_config import ChannelConfig, MachineConfig
+from .axis_params import AxisParameters
 from .nc.technology import MachiningSettings
+from .refusal import Refusal
 
 MESSAGES_KEPT = 8  # #MSG texts a channel shows (ch<c>.mc_message_<k>_text_r)
 
@@ -259,14 +263,65 @@ class Snapshot:
     physical_axes: tuple[PhysicalAxis, ...]
 
 
+class ChannelRunnerView(Protocol):
+    """What the kernel, its commands and the switchover use of a channel's runner
+    (``channel_run.ChannelRunner``, which imports this module)."""
+
+    config: ChannelConfig  # the channel's configuration
+    touched: bool  # the last cycle changed the channel's state
+    # set when a RESET of the channel is queued: a cycle waiting for its decoder stops
+    reset_pending: threading.Event
+
+    @property
+    def moving(self) -> bool:
+        """The path is not at standstill."""
+
+    def select_mode(self, mode: int) -> Refusal | None:
+        """Choose the operation mode."""
+
+    def select_program(self, name: str) -> Refusal | None:
+        """Select a program of the store."""
+
+    def start(self) -> Refusal | None:
+        """START."""
+
+    def hold(self) -> Refusal | None:
+        """Feedhold."""
+
+    def reset(self) -> Refusal | None:
+        """RESET."""
+
+    def manual_block(self, text: str) -> Refusal | None:
+        """Run ``text`` as manual blocks (MDI)."""
+
+    def answer_contour_request(self) -> None:
+        """Fill the contour look-ahead's response (the PLC set the semaphore)."""
+
+    def internal_hold(self) -> bool:
+        """Brake the path for a suspend request; True when this started it."""
+
+    def release_internal_hold(self) -> bool:
+        """End the internal feedhold; True when one was active."""
+
+    def initialise_channel(self) -> None:
+        """Channel init (start-up, RESET)."""
+
+    def report(self, error: ChannelError) -> None:
+        """List ``error``."""
+
+    def cycle(self, time_s: float) -> bool:
+        """One GEO cycle; True while the channel has motion or decoding to do."""
+
+
 @dataclass(slots=True)
 class KernelState:
     """The live state the cycle thread works on."""
 
     channels: list[Channel] = field(default_factory=list)
     physical_axes: list[PhysicalAxis] = field(default_factory=list)
-    runners: list = field(default_factory=list)  # ChannelRunner per channel (kernel sets)
-    axis_params: dict = field(default_factory=dict)  # AxisParameters by logical number
+    runners: list[ChannelRunnerView] = field(default_factory=list)  # per channel (kernel sets)
+    # by logical axis number
+    axis_params: dict[int, AxisParameters] = field(default_factory=dict)
 
     @classmethod
     def from_config(cls, config: MachineConfig) -> KernelState:

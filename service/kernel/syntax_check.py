@@ -32,13 +32,13 @@ from __future__ import annotations
 import logging
 import re
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
 from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES
 
-from ..config import SyntaxCheckConfig
+from ..machine_config import SyntaxCheckConfig
 from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, Compensation, StopKind
 from .nc.check import CheckAborted, ErrorCategory, PointBatch
@@ -271,7 +271,7 @@ class CheckRun:
 
     def _stop_at_total(self, p: Progress) -> bool:
         """``errors_total`` reached: the check ends after this line (True)."""
-        total = self.settings.errors_total
+        total = self.settings.errors_total if self.settings is not None else 0
         if total and p.error_count >= total:
             p.stopped_early = self._limit_reached = True
             return True
@@ -300,10 +300,11 @@ class CheckRun:
             self._decoder = decoder
             if self._record:
                 self._log.append(f"; syntax check of {self.name} in channel {self.channel_id}")
-            for item in decoder.blocks():
+            items: Iterator[Block | PointBatch] = decoder.blocks()  # batches in a check
+            for item in items:
                 if self._checkpoint():
                     return
-                if type(item) is PointBatch:
+                if isinstance(item, PointBatch):
                     if self._batch(item):
                         break
                 elif self._block(item):
@@ -479,8 +480,8 @@ class CheckRun:
             # the store's file limit: the first errors are kept, the checked lines go
             errors = [entry for entry in entries if entry.startswith("error ")]
             left_out = p.left_out
-            entries = [entries[0], "; the checked lines are left out: the log would exceed "
-                       f"the store's file limit of {PROGRAM_MAX_BYTES} bytes"]
+            entries = [entries[0], ("; the checked lines are left out: the log would exceed "
+                                    f"the store's file limit of {PROGRAM_MAX_BYTES} bytes")]
             room = PROGRAM_MAX_BYTES - 400 - sum(len(e) + 1 for e in entries)
             kept = 0
             for entry in errors:

@@ -97,9 +97,24 @@ def test_write_then_read_back(service: RunningService) -> None:
     ] == 500
 
 
+def test_a_glob_over_command_objects_reads_what_was_last_written(service: RunningService) -> None:
+    """Write-only commands (``_w``) read back their last value, so a glob taking them in
+    reads as a whole."""
+    ep = service.endpoint
+    assert cnc("write", "ch2.mc_command_feed_override_w", "640", endpoint=ep).returncode == 0
+    result = cnc("--json", "read", "ch2.mc_*_feed_override_*", endpoint=ep)
+    assert result.returncode == 0, result.stderr
+    values = {row["name"]: row["value"] for row in json_lines(result)}
+    assert values == {
+        "ch2.mc_command_feed_override_w": 640,
+        "ch2.mc_command_feed_override_r": 640,
+        "ch2.mc_active_feed_override_r": 640,
+    }
+    assert cnc("write", "ch2.mc_command_feed_override_w", "1000", endpoint=ep).returncode == 0
+
+
 def test_errors_exit_nonzero_with_one_line_naming_the_code(endpoint: str) -> None:
     cases = [
-        (("read", "ch1.mc_command_execution_mode_w"), 1, "ADS 0x704 INVALIDACCESS"),
         (("write", "ch1.ax1.link_state", "1"), 1, "ADS 0x704 INVALIDACCESS"),
         (("write", "ch1.mc_command_feed_override_w", "2000"), 1, "ADS 0x706 INVALIDDATA"),
         (("write", "ch1.mc_command_feed_override_w", "fast"), 2,

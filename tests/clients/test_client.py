@@ -99,11 +99,9 @@ async def test_execution_mode_implemented_bits_are_accepted_others_refused(api: 
 
 async def test_error_names_code_and_reason(api: Any) -> None:
     with pytest.raises(AdsError) as caught:
-        await api.read("ch1.mc_command_execution_mode_w")
+        await api.write("ch1.ax1.link_state", 1)
     assert caught.value.code == 0x704
-    assert str(caught.value) == (
-        "ADS 0x704 INVALIDACCESS: ch1.mc_command_execution_mode_w is write-only"
-    )
+    assert str(caught.value) == "ADS 0x704 INVALIDACCESS: ch1.ax1.link_state is read-only"
     with pytest.raises(AdsError) as caught:
         await api.write("ch1.mc_command_feed_override_w", 1001)
     assert caught.value.code == 0x706
@@ -160,9 +158,12 @@ async def test_read_many_in_one_sum_read(api: Any) -> None:
         "cnc_version_r": "cnc-objects 0.1.0",
     }
     assert await api.read_many(names) == values  # second call: handles are cached
+    # A command object reads back its last written value: a list that holds one reads.
+    both = await api.read_many(["ch1.ax1.link_state", "ch1.mc_command_feed_override_w"])
+    assert set(both) == {"ch1.ax1.link_state", "ch1.mc_command_feed_override_w"}
     with pytest.raises(AdsError) as caught:
-        await api.read_many(["ch1.ax1.link_state", "ch1.mc_command_feed_override_w"])
-    assert caught.value.code == 0x704
+        await api.read_many(["ch1.ax1.link_state", "ch1.no_such_object"])
+    assert caught.value.code == 0x710
 
 
 async def test_browse_describes_objects(api: Any) -> None:

@@ -146,7 +146,9 @@ def test_sum_commands(ads: Ads) -> None:
 def test_get_all_symbols(ads: Ads) -> None:
     symbols = {s.name: s for s in ads.plc.get_all_symbols()}
     with Client(ads.service.endpoint) as client:
-        assert len(symbols) == len(client.browse())
+        objects = client.browse()
+    assert {info.name for info in objects} <= set(symbols)  # and the HLI's structs
+    assert symbols["gpCh[0].contour_lookahead.request"].symbol_type == "HLI_CONTOUR_LOOKAHEAD_REQUEST"
     length = symbols[LENGTH]
     assert (length.symbol_type, length.index_group) == ("LREAL", 0x4020)
     assert symbols[LINK].symbol_type == "UINT"

@@ -39,6 +39,21 @@ TWINCAT = {
 }
 
 
+BIGTYPE = 65  # ADST_BIGTYPE: structs and arrays
+
+
+def struct_names(catalog: list[ObjectInfo]) -> set[str]:
+    """The struct and array symbols above the PLC symbols: every prefix of a PLC path
+    that ends before a ``.`` or a ``[`` (``gpCh``, ``gpCh[0]``, ``gpCh[0].bahn_state``)."""
+    names = set()
+    for info in catalog:
+        if info.port == PLC:
+            for k, char in enumerate(info.name):
+                if char in ".[":
+                    names.add(info.name[:k])
+    return names
+
+
 def twincat(info: ObjectInfo) -> tuple[str, int]:
     """TwinCAT name and ADST id of an object's ISG type; STRING(n) is STRING(n-1)."""
     if info.type.startswith("STRING("):
@@ -176,10 +191,13 @@ def test_upload_info_64_bytes_field_by_field(ads: RawAds, catalog: list[ObjectIn
     assert len(data) == 64
     (symbols, symbol_bytes, types, type_bytes, max_dynamic, used_dynamic, invalid_dynamic,
      code_page, flags) = struct.unpack_from("<9I", data)
-    assert symbols == len(catalog) == 1004
+    assert len(catalog) == 1004
+    assert symbols == len(catalog) + len(struct_names(catalog))
     assert symbol_bytes == len(read_ok(ads, SYM_UPLOAD, symbol_bytes))
     assert type_bytes == len(read_ok(ads, SYM_DT_UPLOAD, type_bytes))
-    assert types == len({twincat(info)[0] for info in catalog})
+    struct_types = {s.type_name for s in parse_symbols(read_ok(ads, SYM_UPLOAD, symbol_bytes))
+                    if s.data_type == BIGTYPE}
+    assert types == len({twincat(info)[0] for info in catalog}) + len(struct_types)
     assert (max_dynamic, used_dynamic, invalid_dynamic) == (0, 0, 0)
     assert code_page == 1252
     assert flags & 0x2  # includes base types
@@ -192,7 +210,7 @@ def test_upload_info_forms_by_read_length(ads: RawAds) -> None:
     assert read_ok(ads, SYM_UPLOAD_INFO2, 24) == full[:24]  # AdsSymbolUploadInfo2
     assert read_ok(ads, SYM_UPLOAD_INFO, 8) == full[:8]  # AdsSymbolUploadInfo
     assert read_ok(ads, SYM_UPLOAD_INFO2, 64, port=GEO) == full  # every port serves it
-    assert read_ok(ads, SYM_VERSION, 1) == b"\x01"
+    assert read_ok(ads, SYM_VERSION, 1) != b"\x00"  # one byte, from the table's contents
 
 
 def test_upload_info_read_too_short_is_0x705_and_the_connection_goes_on(ads: RawAds) -> None:
@@ -207,7 +225,12 @@ def test_upload_info_read_too_short_is_0x705_and_the_connection_goes_on(ads: Raw
 def test_symbol_upload_field_by_field(ads: RawAds, catalog: list[ObjectInfo]) -> None:
     size = struct.unpack_from("<I", read_ok(ads, SYM_UPLOAD_INFO, 8), 4)[0]
     symbols = parse_symbols(read_ok(ads, SYM_UPLOAD, size))
-    assert [s.name for s in symbols] == [info.name for info in catalog]
+    assert [s.name for s in symbols[: len(catalog)]] == [info.name for info in catalog]
+    structs = symbols[len(catalog):]  # the structs and arrays of the HLI follow
+    assert {s.name for s in structs} == struct_names(catalog)
+    for symbol in structs:
+        assert (symbol.group, symbol.data_type) == (PLC_MEMORY, BIGTYPE), symbol.name
+        assert symbol.entry_length % 8 == 0
     for symbol, info in zip(symbols, catalog):
         assert (symbol.type_name, symbol.data_type) == twincat(info), info.name
         assert symbol.size == info.length, info.name
@@ -220,15 +243,17 @@ def test_symbol_upload_field_by_field(ads: RawAds, catalog: list[ObjectInfo]) ->
             assert symbol.group == VALUE_BY_HANDLE, info.name
 
 
-def test_every_readable_symbol_reads_at_its_address_on_port_851(
+def test_every_symbol_reads_at_its_address_on_port_851(
     ads: RawAds, catalog: list[ObjectInfo]
 ) -> None:
+    """Write-only command objects too: they read back the value last written."""
     size = struct.unpack_from("<I", read_ok(ads, SYM_UPLOAD_INFO, 8), 4)[0]
     symbols = parse_symbols(read_ok(ads, SYM_UPLOAD, size))
-    for symbol, info in zip(symbols, catalog):
-        if info.access != "w":
-            value = read_ok(ads, symbol.group, symbol.size, offset=symbol.offset)
-            assert len(value) == symbol.size, info.name
+    assert any(info.access == "w" for info in catalog)
+    assert len(symbols) > len(catalog)  # the structs and arrays too
+    for symbol in symbols:
+        value = read_ok(ads, symbol.group, symbol.size, offset=symbol.offset)
+        assert len(value) == symbol.size, symbol.name
 
 
 def test_a_geo_symbol_by_handle_reads_what_its_own_address_reads(
@@ -257,8 +282,9 @@ def test_data_type_upload_field_by_field(ads: RawAds, catalog: list[ObjectInfo])
         at += entry.entry_length
     assert at == len(data) and len(types) == count
     expected = {twincat(i)[0]: (twincat(i)[1], i.length) for i in catalog}
-    assert {t.name: (t.data_type, t.size) for t in types} == expected
-    for t in types:
+    base = [t for t in types if t.data_type != BIGTYPE]
+    assert {t.name: (t.data_type, t.size) for t in base} == expected
+    for t in base:
         assert (t.version, t.offset, t.flags) == (1, 0, ADSDATATYPEFLAG_DATATYPE)
         assert (t.array_dims, t.sub_items, t.type_name, t.comment) == (0, 0, "", "")
 
@@ -313,7 +339,8 @@ def test_symbol_info_by_name_and_its_errors(ads: RawAds, catalog: list[ObjectInf
 
 def test_pyads_get_all_symbols_lists_every_object(plc, catalog: list[ObjectInfo]) -> None:
     symbols = plc.get_all_symbols()
-    assert [s.name for s in symbols] == [info.name for info in catalog]
+    assert [s.name for s in symbols[: len(catalog)]] == [info.name for info in catalog]
+    assert {s.name for s in symbols[len(catalog):]} == struct_names(catalog)
     for symbol, info in zip(symbols, catalog):
         assert symbol.symbol_type == twincat(info)[0], info.name
         assert symbol.comment == info.description, info.name

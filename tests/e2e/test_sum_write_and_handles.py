@@ -70,7 +70,10 @@ def test_value_by_name(sock: zmq.Socket) -> None:
     name = b"ch1.ax2.actual_link_to_physical_axis\x00"
     reply = call(sock, ReadWriteRequest(next(_ids), GEO, RIG.SYM_VALUE_BY_NAME, 0, 2, name))
     assert reply.result == 0 and reply.fields[0] == struct.pack("<H", 2)
+    # The read length is a buffer size (TwinCAT): a larger one gets the value's 2 bytes.
     reply = call(sock, ReadWriteRequest(next(_ids), GEO, RIG.SYM_VALUE_BY_NAME, 0, 4, name))
+    assert reply.result == 0 and reply.fields[0] == struct.pack("<H", 2)
+    reply = call(sock, ReadWriteRequest(next(_ids), GEO, RIG.SYM_VALUE_BY_NAME, 0, 1, name))
     assert reply.result == 0x705
 
 
@@ -82,11 +85,15 @@ def test_write_and_read_by_handle(sock: zmq.Socket) -> None:
     reply = call(sock, WriteRequest(next(_ids), COM, RIG.SYM_VALUE_BY_HANDLE, handle, b"\x2c\x01"))
     assert reply.result == 0
     assert read_u16(sock, CH1_COM, 0x0C) == 300
-    # The handle names a write-only object: reading by it is refused like reading it.
+    # The handle names a write-only command: it reads back the value last written.
     reply = call(sock, ReadRequest(next(_ids), COM, RIG.SYM_VALUE_BY_HANDLE, handle, 2))
-    assert reply.result == 0x704
+    assert reply.result == 0 and reply.fields[0] == b"\x2c\x01"
 
 
-def test_readwrite_on_an_ordinary_object_is_not_supported(sock: zmq.Socket) -> None:
+def test_readwrite_on_an_ordinary_object_reads_without_data_and_refuses_data(
+    sock: zmq.Socket,
+) -> None:
     reply = call(sock, ReadWriteRequest(next(_ids), COM, CH1_COM, 0x0A, 2, b""))
+    assert reply.result == 0 and reply.fields[0] == struct.pack("<H", 1000)
+    reply = call(sock, ReadWriteRequest(next(_ids), COM, CH1_COM, 0x0A, 2, b"\x01\x00"))
     assert reply.result == 0x701 and "ReadWrite" in reply.message

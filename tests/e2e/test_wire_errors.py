@@ -315,8 +315,14 @@ def test_write_to_read_only_object_is_0x704(client: zmq.Socket) -> None:
     assert read(client, AX1_LINK_STATE) == before
 
 
-def test_read_of_write_only_object_is_0x704(client: zmq.Socket) -> None:
-    read_error(client, EXEC_MODE_W, INVALIDACCESS)
+def test_a_write_only_command_reads_back_the_value_last_applied(client: zmq.Socket) -> None:
+    """As a PLC's command variable; a refused write leaves the value before it."""
+    assert write(client, FEED_OVERRIDE_W, struct.pack("<H", 500))[2] == 0
+    assert read(client, FEED_OVERRIDE_W) == struct.pack("<H", 500)
+    assert write(client, FEED_OVERRIDE_W, struct.pack("<H", 2000))[2] == INVALIDDATA
+    assert read(client, FEED_OVERRIDE_W) == struct.pack("<H", 500)
+    assert write(client, FEED_OVERRIDE_W, struct.pack("<H", 1000))[2] == 0
+    assert read(client, FEED_OVERRIDE_W) == struct.pack("<H", 1000)
 
 
 # --------------------------------------------------------------------------- sizes
@@ -344,14 +350,17 @@ def test_write_with_wrong_data_length_is_0x705(cnc_service: ServiceProcess) -> N
         sock.close(linger=0)
 
 
-def test_huge_read_length_is_0x705(client: zmq.Socket) -> None:
+def test_huge_read_length_at_an_address_is_0x705_by_name_a_buffer_size(client: zmq.Socket) -> None:
+    """An object at its address is read with its size; a read by name takes the read
+    length as a buffer size (TwinCAT: 0xFFFFFFFF when the client does not know it)."""
     port, group, offset, _ = NUMBER_OF_AXES
     read_error(client, (port, group, offset, 0xFFFFFFFF), INVALIDSIZE)
     invoke_id = next_id()
     reply = request(
-        client, read_write_frame(invoke_id, COM, 0xF003, 0, 0xFFFFFFFF, b"cnc_tick_counter_r\0")
+        client, read_write_frame(invoke_id, COM, 0xF004, 0, 0xFFFFFFFF, b"cnc_tick_counter_r\0")
     )
-    assert_error(reply, invoke_id, READ_WRITE, INVALIDSIZE)
+    (data,) = assert_ok(reply, invoke_id, READ_WRITE)
+    assert len(data) == 4  # UNS32
     assert_serves(client)
 
 
@@ -595,7 +604,7 @@ def test_sum_read_mixes_good_and_bad_items(client: zmq.Socket) -> None:
         (PLATFORM, 0x1002, 2),  # cnc_number_of_channel_r: 2
         (PLATFORM, 0x7777, 4),  # unknown offset: 0x703
         (PLATFORM, 0x1003, 4),  # cnc_number_of_axis_r: 3
-        (CH1_COM, 0x3F, 4),  # mc_command_execution_mode_w is write-only: 0x704
+        (CH1_COM, 0x3F, 2),  # mc_command_execution_mode_w is SGN32: 0x705
         (PLATFORM, 0x1010, 4),  # cnc_cycle_time_r: 1000 us
         (0x7E0000, 0x1, 2),  # unknown group: 0x702
         (PLATFORM, 0x1003, 2),  # wrong length: 0x705
@@ -604,7 +613,7 @@ def test_sum_read_mixes_good_and_bad_items(client: zmq.Socket) -> None:
         (0, struct.pack("<H", 2)),
         (INVALIDOFFSET, bytes(4)),
         (0, struct.pack("<I", 3)),
-        (INVALIDACCESS, bytes(4)),
+        (INVALIDSIZE, bytes(2)),
         (0, struct.pack("<I", 1000)),
         (INVALIDGRP, bytes(2)),
         (INVALIDSIZE, bytes(2)),
@@ -783,7 +792,7 @@ def test_service_survives_everything_and_exits_cleanly(cnc_service: ServiceProce
         read_error(sock, (GEO, 0x7E0000, 0x1, 4), INVALIDGRP)
         read_error(sock, (GEO, CH1_GEO, 0x7777, 4), INVALIDOFFSET)
         read_error(sock, (999, CH1_GEO, 0x10018, 4), TARGETPORTNOTFOUND)
-        read_error(sock, EXEC_MODE_W, INVALIDACCESS)
+        read(sock, EXEC_MODE_W)  # a command reads back its last value
         read_error(sock, (COM, PLATFORM, 0x1003, 0xFFFFFFFF), INVALIDSIZE)
         assert write(sock, AX1_LINK_STATE, bytes(4))[2] == INVALIDACCESS
         assert write(sock, FEED_OVERRIDE_W, struct.pack("<H", 2000))[2] == INVALIDDATA

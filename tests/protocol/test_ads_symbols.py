@@ -15,6 +15,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from cnc_objects.protocol.ads_symbols import (
+    decode_handle_info,
+    encode_handle_info,
     ENTRY_ALIGNMENT,
     AdsDataType,
     AdsDataTypeFlag,
@@ -388,3 +390,11 @@ def test_symbol_version_is_one_byte() -> None:
     assert encode_symbol_version(255) == b"\xff"
     with pytest.raises(ValueError):
         encode_symbol_version(256)
+
+
+def test_extended_handle_answer_round_trip() -> None:
+    data = encode_handle_info(7, 84, "STRING(83)")
+    assert data[:14] == struct.pack("<IIIH", 7, 84, 0, 10) and data[14:] == b"STRING(83)\x00"
+    assert decode_handle_info(data) == (7, 84, 0, "STRING(83)")
+    with pytest.raises(ValueError):
+        decode_handle_info(data[:-1])

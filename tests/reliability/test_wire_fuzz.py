@@ -1,4 +1,6 @@
 """Fuzz the ZeroMQ front end: malformed frames get a defined answer, the service survives.
+Half-sent frames and connection floods on both front ends (raw TCP) are closed as the
+limits say, while clients connected before are served.
 
 10 000 frames in ``make test`` (the same ones every run: hypothesis derandomized), 100 000
 in ``make soak`` (random). After every batch of 500, a fresh client reads the device info
@@ -11,6 +13,7 @@ from __future__ import annotations
 import math
 import time
 from collections import Counter
+from pathlib import Path
 
 import msgpack
 import pytest
@@ -42,13 +45,17 @@ from tests.reliability.health import (
     wait_for_tick_after,
 )
 from tests.reliability.scale import Scale
+from tests.limits.wire import limited_service
+from tests.reliability.floods import AdsProbe, Flood
 from tests.reliability.wire_fuzz import (
     Expected,
+    HalfSent,
     Writable,
+    batches,
     changes_the_machine,
     check_replies,
     expected_reply,
-    batches,
+    half_sent_floods,
 )
 from tests.support.resources import rss_kib
 
@@ -296,3 +303,53 @@ def test_extra_frame_parts_do_not_multiply_a_clients_allowance(service: ServiceP
                     break
             accepted += reply[2] == 0
     assert accepted <= PER_CLIENT_NOTIFICATIONS
+
+
+#: Limits of the half-sent fuzz: small, so that each example reaches them.
+HALF_SENT_LIMITS = {"frame_timeout_s": 1.0, "connections_per_front_end": 16,
+                    "receive_buffer_bytes_total": 4 << 20}
+HALF_SENT_CLOSE_S = 30.0  # twice the timeout, on a loaded 2-core machine, with room
+#: RSS while a flood holds its sockets: ZeroMQ's cap times its hard cap (16 x 2 MiB) and
+#: the ADS budget (4 MiB), with room for the allocator.
+HALF_SENT_RSS_BOUND_KIB = (16 * 2 + 4) * 1024 + 24 * 1024
+
+
+def test_half_sent_frames_and_connection_floods_are_closed_as_the_limits_say(
+    tmp_path: Path, run_scale: Scale
+) -> None:
+    """Each example floods one front end with connections that each send part of a frame
+    (or nothing): every connection holding an incomplete frame, and every raw ZeroMQ
+    connection (it never answers the heartbeat), is closed; RSS stays within the bound;
+    clients of both front ends connected before are answered throughout."""
+    with limited_service(tmp_path, ads=True, **HALF_SENT_LIMITS) as service:
+        assert service.ads_address is not None and service.ams_net_id is not None
+        zmq_address = service.endpoint.removeprefix("tcp://").rsplit(":", 1)
+        rss_start_kib = rss_max_kib = rss_kib(service.process.pid)
+        with RawConnection(service.endpoint) as zmq_probe:
+            ads_probe = AdsProbe(service.ads_address, service.ams_net_id)
+            zmq_probe.call(ReadRequest, *TICK_ADDRESS, 4)  # both probes hold a slot now
+            assert ads_probe.read_device_info() == 0
+
+            @settings(max_examples=run_scale.half_sent_examples,
+                      derandomize=run_scale.name == "make test", database=None,
+                      deadline=None, print_blob=True, suppress_health_check=list(HealthCheck))
+            @given(half_sent_floods(24))
+            def fuzz(flood: HalfSent) -> None:
+                nonlocal rss_max_kib
+                address = (service.ads_address if flood.front_end == "ads"
+                           else (zmq_address[0], int(zmq_address[1])))
+                with Flood(address, flood.connections, flood.payload()) as sockets:
+                    rss_max_kib = max(rss_max_kib, rss_kib(service.process.pid))
+                    assert zmq_probe.call(ReadRequest, *TICK_ADDRESS, 4)[2] == 0
+                    assert ads_probe.read_device_info() == 0
+                    if flood.must_close:
+                        closed = sockets.wait_closed(flood.connections, HALF_SENT_CLOSE_S)
+                        assert closed == flood.connections, (flood, closed)
+                    rss_max_kib = max(rss_max_kib, rss_kib(service.process.pid))
+
+            fuzz()
+            ads_probe.close()
+    growth_kib = rss_max_kib - rss_start_kib
+    figures.record("half-sent frames / connection floods: RSS growth (max)",
+                   f"{growth_kib >> 10} MiB over {run_scale.half_sent_examples} floods", NODE)
+    assert growth_kib < HALF_SENT_RSS_BOUND_KIB, f"RSS grew by {growth_kib >> 10} MiB"

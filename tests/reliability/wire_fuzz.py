@@ -12,7 +12,10 @@ in front of the reply. The strategies make the kinds of bad input a network can 
 - msgpack headers that claim huge lengths (arrays, maps, bin, str of 4 GiB), deep nesting;
 - frames of the right shape with hostile content: sum commands with garbage item lists,
   names that are no names, notifications in client modes, the program store's offsets;
-- extra frame parts before the frame.
+- extra frame parts before the frame;
+- on raw TCP, half-sent frames and connection floods on both front ends
+  (``half_sent_floods``): what the service must do with them is ``HalfSent.must_close``
+  and the limits' bounds (test_wire_fuzz.py).
 
 ``expected_reply`` is the rule the service must follow, stated once: a frame whose
 msgpack is an array whose first element is an invoke id (1 .. 2**32-1) gets exactly one
@@ -47,6 +50,7 @@ from cnc_objects.protocol.frames import (
     WriteRequest,
     decode_request,
 )
+from tests.reliability.floods import ads_half_frame, zmtp_greeting, zmtp_half_frame
 
 U32_MAX = 0xFFFFFFFF
 
@@ -342,3 +346,49 @@ def check_replies(expected: list[Expected], received: list[tuple[tuple[bytes, ..
             assert bucket[code] > 0, (
                 f"frame with invoke id {e.invoke_id} refused with {dict(bucket)}, not {e.code:#x}")
             bucket[code] -= 1
+
+
+# --------------------------------------------------------------------------- half-sent
+
+
+@dataclass(frozen=True)
+class HalfSent:
+    """A flood of ``connections`` raw TCP connections to one front end (``"ads"`` or
+    ``"zmq"``), each sending the first ``sent`` bytes of a frame that announces
+    ``announced`` bytes (after a ZeroMQ greeting; ``sent == 0``: the connection only)."""
+
+    front_end: str
+    connections: int
+    announced: int
+    sent: int
+
+    def payload(self) -> bytes:
+        """What each connection sends."""
+        if self.front_end == "ads":
+            return ads_half_frame(self.announced, self.announced - self.sent) if self.sent else b""
+        if not self.sent:
+            return zmtp_greeting()
+        return zmtp_half_frame(self.announced, self.announced - self.sent)
+
+    @property
+    def must_close(self) -> bool:
+        """Every connection of the flood must end without the client closing it: one
+        holding an incomplete frame (closed by frame_timeout_s), and every raw ZeroMQ
+        connection (it never answers the heartbeat's PING). An idle ADS connection
+        within the cap may stay open."""
+        return self.front_end == "zmq" or self.sent > 0
+
+
+#: Frame sizes a flood announces: small, the ADS maximum, just under ZeroMQ's hard cap.
+ANNOUNCED = [64, 4096, 65536, 1 << 20, 2_000_000]
+
+
+@st.composite
+def half_sent_floods(draw: st.DrawFn, max_connections: int) -> HalfSent:
+    """Half-sent frames and connection floods, on either front end."""
+    front_end = draw(st.sampled_from(["ads", "zmq"]))
+    announced = draw(st.sampled_from(ANNOUNCED if front_end == "zmq" else ANNOUNCED[:4]))
+    # announced >= 64: the AMS header (32 bytes) fits, the frame is incomplete
+    sent = draw(st.one_of(st.just(0), st.integers(40, announced - 1),
+                          st.just(announced - 1)))
+    return HalfSent(front_end, draw(st.integers(1, max_connections)), announced, sent)

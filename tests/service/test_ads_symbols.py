@@ -32,6 +32,7 @@ from cnc_objects.protocol.ads_symbols import (
 )
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.service.ads_symbols import SymbolService
 from cnc_objects.service.binding import build_address_space
 from cnc_objects.service.config import build_config
@@ -339,9 +340,19 @@ def test_data_type_read_length_must_hold_the_entry(service: SymbolService) -> No
 
 
 def test_symbol_version_is_one_byte(service: SymbolService) -> None:
-    assert ok(service.read(SymbolGroup.VERSION, 0, 1)) == b"\x01"
-    assert ok(service.read(SymbolGroup.VERSION, 0, 4)) == b"\x01"
+    version = bytes((service.version,))
+    assert ok(service.read(SymbolGroup.VERSION, 0, 1)) == version != b"\x00"
+    assert ok(service.read(SymbolGroup.VERSION, 0, 4)) == version
     refused(service.read(SymbolGroup.VERSION, 0, 0), E.DEVICE_INVALIDSIZE)
+
+
+def test_symbol_version_changes_with_the_table(space: AddressSpace) -> None:
+    """Another table (here: the same objects without the HLI structs) gives another
+    version, so that clients watching 0xF008 reload their symbols."""
+    with_structs = SymbolService(space, PlcStructs(space))
+    without = SymbolService(space)
+    assert with_structs.version != without.version
+    assert SymbolService(space, PlcStructs(space)).version == with_structs.version
 
 
 def test_handles_exactly_the_symbol_groups(service: SymbolService) -> None:

@@ -11,7 +11,8 @@ import threading
 from dataclasses import dataclass, field
 from typing import Any
 
-from cnc_objects.service.config import MachineConfig, build_config
+from cnc_objects.service.config import build_config
+from cnc_objects.service.machine_config import MachineConfig
 from cnc_objects.service.kernel.channel_mode import ChannelState
 from cnc_objects.service.kernel.clock import VirtualClock
 from cnc_objects.service.kernel.commands import ManualBlock, Refusal, SelectProgram, StartProgram

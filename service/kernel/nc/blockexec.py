@@ -19,14 +19,24 @@ from __future__ import annotations
 
 import math
 import operator
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from enum import IntEnum
-from typing import Any
 
-from .blocks import AxisExchange, AxisExchangeKind, Block, Compensation, MotionKind, StopKind
+from .blocks import (
+    AxisExchange,
+    AxisExchangeKind,
+    Block,
+    Compensation,
+    Motion,
+    MotionKind,
+    StopKind,
+)
 from .construct import make_block, make_motion, make_source
-from .errors import NcError, NcErrorId
+from .coordinates import Placement
+from .cycles.rotation import Vector
+from .errors import ErrorAt, NcError, NcErrorId
+from .evaluation import Env
 from .exchange import moved_axes
 from .expressions import evaluate_number
 from .geometry import centre_from_offsets, centre_from_radius
@@ -44,7 +54,7 @@ class Flow(IntEnum):
 
 
 # flow-control M functions -> (stop of the block, flow)
-_M_FLOW = {
+_M_FLOW: dict[int, tuple[StopKind, Flow]] = {
     MCode.STOP: (StopKind.PROGRAMMED, Flow.NONE),
     MCode.OPTIONAL_STOP: (StopKind.OPTIONAL, Flow.NONE),
     MCode.PROGRAM_END: (StopKind.PROGRAM_END, Flow.PROGRAM_END),
@@ -79,6 +89,18 @@ _MODAL_FIELD = {
 }
 
 
+Groups = dict[GGroup, tuple[int, int]]  # G group -> (G number, pos)
+AxisWords = list[tuple[int, float, int, str]]  # (channel axis, value, pos, letter)
+Offsets = dict[int, tuple[float, int]]  # channel axis of I/J/K -> (offset, pos)
+Words = dict[WordKind, tuple[float, int]]  # F S T D R ... -> (value, pos)
+#: (plane axes or None, plane of line motions, roles of I/J/K (0 = p, 1 = q, -1 =
+#: outside), getter of the axes outside the plane (one value or a tuple) or None)
+ArcSetup = tuple[
+    tuple[int, int] | None, tuple[int, int], tuple[int, ...],
+    Callable[[Sequence[float]], object] | None,
+]
+
+
 def _integer(value: float) -> int | None:
     """``value`` as a non-negative int, or None when it is not one."""
     if value < 0 or value != int(value) or value > 0xFFFFFFFF:
@@ -105,7 +127,7 @@ class BlockExecutor:
         self.xyz = tuple(index.get(name, -1) for name in "XYZ")
         # plane -> (p, q) channel axis indices, or None when the channel lacks an axis
         self.plane_axes: dict[Plane, tuple[int, int] | None] = {}
-        self._arc_setup: dict[Plane, tuple] = {}
+        self._arc_setup: dict[Plane, ArcSetup] = {}
         offset_axes = tuple(index.get(name, -1) for name in "XYZ")  # axes of I, J, K
         for plane, (p, q) in PLANE_AXES.items():
             both = p in index and q in index
@@ -117,7 +139,7 @@ class BlockExecutor:
             getter = operator.itemgetter(*outside) if outside else None
             self._arc_setup[plane] = (pq, pq or (0, 1), roles, getter)
 
-    def arc_setup(self, plane: Plane) -> tuple:
+    def arc_setup(self, plane: Plane) -> ArcSetup:
         """For the hot path: (plane axes or None, plane of line motions, roles of I/J/K
         (0 = p, 1 = q, -1 = outside), getter of the axes outside the plane or None)."""
         return self._arc_setup[plane]
@@ -129,7 +151,7 @@ class BlockExecutor:
         radius = self.tools.get(d)
         return None if radius is None else float(radius)
 
-    def execute(self, stmt: NcBlock, env: Any, on_error: ItemFailed | None = None
+    def execute(self, stmt: NcBlock, env: Env, on_error: ItemFailed | None = None
                 ) -> tuple[Block | None, Flow, int]:
         """Run one block: (block or None, flow, position of the flow M word).
 
@@ -146,18 +168,18 @@ class BlockExecutor:
         try:
             return self._execute(stmt, env, on_error)
         except Exception:  # an NcError, or ``on_error`` ending the block
-            for name, value in zip(_MODAL_FIELDS, saved):
+            for name, value in zip(_MODAL_FIELDS, saved, strict=True):
                 setattr(modal, name, value)
             raise
 
-    def _execute(self, stmt: NcBlock, env: Any, on_error: ItemFailed | None = None
+    def _execute(self, stmt: NcBlock, env: Env, on_error: ItemFailed | None = None
                  ) -> tuple[Block | None, Flow, int]:
         line = stmt.line
         err = line.error
-        groups: dict[GGroup, tuple[int, int]] = {}  # group -> (G number, pos)
-        axis_words: list[tuple[int, float, int, str]] = []  # (axis, value, pos, letter)
-        offsets: dict[int, tuple[float, int]] = {}  # axis -> (offset, pos)
-        words: dict[WordKind, tuple[float, int]] = {}  # F S T D R -> (value, pos)
+        groups: Groups = {}
+        axis_words: AxisWords = []
+        offsets: Offsets = {}
+        words: Words = {}
         m_codes: list[tuple[int, int, int]] = []  # (M number, pos, item index)
         self.items_done = 0
         for k, item in enumerate(stmt.items):
@@ -185,18 +207,18 @@ class BlockExecutor:
         stop = StopKind.NONE
         flow = Flow.NONE
         flow_pos = -1
-        m_functions = []
+        m_functions: list[int] = []
         for number, pos, k in m_codes:
             action = _M_FLOW.get(number)
             if action is None:
                 m_functions.append(number)
                 continue
             if flow_pos >= 0:
-                error = err(NcErrorId.CONFLICTING_M_CODES,
-                            f"M{number} with another program-flow M", pos)
+                conflict = err(NcErrorId.CONFLICTING_M_CODES,
+                               f"M{number} with another program-flow M", pos)
                 if on_error is None:
-                    raise error
-                on_error(error, k)  # this M is left out
+                    raise conflict
+                on_error(conflict, k)  # this M is left out
                 continue
             stop, flow = action
             flow_pos = pos
@@ -214,8 +236,9 @@ class BlockExecutor:
         )
         return block, flow, flow_pos
 
-    def _word(self, item: Word, value: float, err, groups: dict, axis_words: list,
-              offsets: dict, words: dict, m_codes: list, index: int) -> None:
+    def _word(self, item: Word, value: float, err: ErrorAt, groups: Groups,
+              axis_words: AxisWords, offsets: Offsets, words: Words,
+              m_codes: list[tuple[int, int, int]], index: int) -> None:
         """Collect one word of a block (its value evaluated) for the parts that follow."""
         match item.kind:
             case WordKind.AXIS:
@@ -245,7 +268,7 @@ class BlockExecutor:
             case _:  # F S T D R
                 words[item.kind] = (value, item.pos)
 
-    def exchange(self, stmt: AxisCommand, env: Any) -> Block | None:
+    def exchange(self, stmt: AxisCommand, env: Env) -> Block | None:
         """Run ``#AX RELEASE`` / ``#AX REQUEST``: the block that hands the axes over, or
         None when no axis changes hands."""
         modal = self.modal
@@ -266,7 +289,7 @@ class BlockExecutor:
 
     # ------------------------------------------------------------ parts
 
-    def _g_word(self, value: float, pos: int, groups: dict, err) -> None:
+    def _g_word(self, value: float, pos: int, groups: Groups, err: ErrorAt) -> None:
         number = _integer(value)
         if number is None or number not in G_CODES:
             raise err(NcErrorId.UNSUPPORTED_G_CODE, f"G{value:g} is not supported", pos)
@@ -276,7 +299,7 @@ class BlockExecutor:
                       f"G{groups[group][0]} and G{number} in one block", pos)
         groups[group] = (number, pos)
 
-    def _weighting(self, letter: str, value: float, pos: int, err) -> None:
+    def _weighting(self, letter: str, value: float, pos: int, err: ErrorAt) -> None:
         """G133 = <%> (acceleration) / G134 = <%> (ramp time): shown, see technology."""
         if not WEIGHTING_MIN_PCT <= value <= WEIGHTING_MAX_PCT:
             raise err(NcErrorId.VALUE_OUT_OF_RANGE,
@@ -293,7 +316,7 @@ class BlockExecutor:
         modal = self.modal
         modal.look_ahead_mark = modal.look_ahead_params if on else None
 
-    def _look_ahead_param(self, name: str, value: float, pos: int, err) -> None:
+    def _look_ahead_param(self, name: str, value: float, pos: int, err: ErrorAt) -> None:
         """METB = <s> (> the cycle time), VFBT = <factor> (0 < f <= 1), BBTRC = <blocks>
         (an integer 1..BBTRC_MAX); they apply to the blocks that follow."""
         modal = self.modal
@@ -321,13 +344,13 @@ class BlockExecutor:
         if modal.look_ahead_mark is not None:
             modal.look_ahead_mark = params
 
-    def _modal_groups(self, groups: dict[GGroup, tuple[int, int]]) -> None:
+    def _modal_groups(self, groups: Groups) -> None:
         for group, (number, _pos) in groups.items():
             field = _MODAL_FIELD.get(group)
             if field is not None:  # G4 (DWELL) changes nothing modal
                 setattr(self.modal, field, G_CODES[number][1])
 
-    def _technology(self, words: dict, err) -> None:
+    def _technology(self, words: Words, err: ErrorAt) -> None:
         modal = self.modal
         if WordKind.TOOL_OFFSET in words:
             value, pos = words[WordKind.TOOL_OFFSET]
@@ -350,7 +373,7 @@ class BlockExecutor:
                           f"T{value:g} is not a valid tool number", pos)
             modal.tool = t
 
-    def _feed(self, word: tuple[float, int], err) -> None:
+    def _feed(self, word: tuple[float, int], err: ErrorAt) -> None:
         value, pos = word
         if value <= 0:
             raise err(NcErrorId.INVALID_FEED, f"feed F{value:g} must be greater than 0", pos)
@@ -359,7 +382,10 @@ class BlockExecutor:
                       f"feed F{value:.17g} overflows: at most {FEED_MAX_MM_MIN:,.2f} mm/min", pos)
         self.modal.feed_mm_min = value
 
-    def _dwell(self, groups, axis_words, offsets, words, err) -> float:
+    def _dwell(
+        self, groups: Groups, axis_words: AxisWords, offsets: Offsets, words: Words,
+        err: ErrorAt,
+    ) -> float:
         g_pos = groups[GGroup.DWELL][1]
         times = [(v, pos) for axis, v, pos, letter in axis_words if letter == "X"]
         others = [pos for axis, v, pos, letter in axis_words if letter != "X"]
@@ -380,7 +406,10 @@ class BlockExecutor:
             raise err(NcErrorId.INVALID_DWELL, f"dwell time {value:g} s is negative", pos)
         return value
 
-    def _motion(self, groups, axis_words, offsets, words, err):
+    def _motion(
+        self, groups: Groups, axis_words: AxisWords, offsets: Offsets, words: Words,
+        err: ErrorAt,
+    ) -> Motion | None:
         modal = self.modal
         radius_word = words.get(WordKind.RADIUS)
         if not axis_words and not offsets and radius_word is None:
@@ -407,7 +436,7 @@ class BlockExecutor:
                 end[axis] = start[axis] + value if incremental else value
         if placement is not None:  # X, Y, Z are programmed in the machining coordinates
             cs_start, cs_end = self._cs_targets(placement, start, end, axis_words, incremental)
-        for axis, value, pos, letter in axis_words:
+        for axis, _value, pos, letter in axis_words:
             if not math.isfinite(end[axis]):
                 raise err(NcErrorId.VALUE_OUT_OF_RANGE, f"{letter} position is out of range", pos)
         end_t = tuple(end)
@@ -436,21 +465,21 @@ class BlockExecutor:
                                    radius_word, motion_pos, feed, comp, radius, err)
         plane = self.plane_axes[modal.plane]
         if plane is None:
-            p, q = PLANE_AXES[modal.plane]
+            p_name, q_name = PLANE_AXES[modal.plane]
             raise err(NcErrorId.PLANE_AXIS_MISSING,
-                      f"G{int(modal.plane)} needs the axes {p} and {q}", motion_pos)
+                      f"G{int(modal.plane)} needs the axes {p_name} and {q_name}", motion_pos)
         p, q = plane
         if p in released or q in released:
             raise err(NcErrorId.AXIS_RELEASED,
                       f"axis {self.axes[p if p in released else q]} is not in the channel "
                       f"(released by #AX RELEASE): G{int(kind)} in G{int(modal.plane)} needs it",
                       motion_pos)
-        for axis, value, pos, letter in axis_words:
+        for axis, _value, pos, letter in axis_words:
             if axis != p and axis != q and end[axis] != start[axis]:
                 raise err(NcErrorId.HELIX_NOT_SUPPORTED,
                           f"{letter} is outside the G{int(modal.plane)} plane: "
                           "helical arcs are not supported", pos)
-        for axis, (value, pos) in offsets.items():
+        for axis, (_value, pos) in offsets.items():
             if axis != p and axis != q:
                 letter = _OFFSET_LETTER["XYZ".index(self.axes[axis])]
                 raise err(NcErrorId.ARC_OFFSET_OUT_OF_PLANE,
@@ -477,24 +506,31 @@ class BlockExecutor:
 
     # ------------------------------------------------------------ machining coordinates
 
-    def _cs_targets(self, placement, start, end, axis_words, incremental):
+    def _cs_targets(
+        self, placement: Placement, start: tuple[float, ...], end: list[float],
+        axis_words: AxisWords, incremental: bool,
+    ) -> tuple[Vector, Vector]:
         """Set X, Y, Z of ``end`` from words in machining coordinates: (start, end) in
         machining coordinates. Unprogrammed coordinates keep their machining value; when
         none changes, the machine position stays exactly (no rounding motion)."""
         ix, iy, iz = self.xyz
         cs_start = placement.from_machine((start[ix], start[iy], start[iz]))
-        cs_end = list(cs_start)
+        programmed = list(cs_start)
         for axis, value, _pos, _letter in axis_words:
             if axis in self.xyz:
                 k = self.xyz.index(axis)
-                cs_end[k] = cs_start[k] + value if incremental else value
-        cs_end = tuple(cs_end)
+                programmed[k] = cs_start[k] + value if incremental else value
+        cs_end = (programmed[0], programmed[1], programmed[2])
         if cs_end != cs_start:
             end[ix], end[iy], end[iz] = placement.to_machine(cs_end)
         return cs_start, cs_end
 
-    def _arc_in_cs(self, kind, placement, cs_start, cs_end, start, end_t, offsets,
-                   radius_word, motion_pos, feed, comp, radius, err):
+    def _arc_in_cs(
+        self, kind: MotionKind, placement: Placement, cs_start: Vector, cs_end: Vector,
+        start: tuple[float, ...], end_t: tuple[float, ...], offsets: Offsets,
+        radius_word: tuple[float, int] | None, motion_pos: int, feed: float,
+        comp: Compensation, radius: float, err: ErrorAt,
+    ) -> Motion:
         """G2/G3 in a machining coordinate system: the centre is found in machining
         coordinates, then the arc is placed in the machine plane its plane maps to."""
         modal = self.modal
@@ -536,15 +572,22 @@ class BlockExecutor:
         centre = list(cs_start)
         centre[p] = cp
         centre[q] = cq
-        machine_centre = placement.to_machine(tuple(centre))
+        machine_centre = placement.to_machine((centre[0], centre[1], centre[2]))
         machine_plane = _PLANE_OF_NORMAL[m]
+        machine_axes = self.plane_axes[machine_plane]
+        # a placement exists only when the channel has X, Y and Z (#CS checks it), so
+        # every machine plane has its two axes
+        assert machine_axes is not None
         mp, mq, _ = _CS_PLANE[machine_plane]
         if column[m] < 0.0:  # the normal turned over: clockwise seen from the machine
             kind = MotionKind.ARC_CCW if kind == MotionKind.ARC_CW else MotionKind.ARC_CW
-        return make_motion(kind, start, end_t, feed, self.plane_axes[machine_plane],
+        return make_motion(kind, start, end_t, feed, machine_axes,
                            (machine_centre[mp], machine_centre[mq]), comp, radius)
 
-    def _no_released_axis(self, released, axis_words, offsets, err) -> None:
+    def _no_released_axis(
+        self, released: frozenset[int], axis_words: AxisWords, offsets: Offsets,
+        err: ErrorAt,
+    ) -> None:
         """An error at the leftmost word (axis or I/J/K) of a released axis, if any."""
         hits = [(pos, axis) for axis, _, pos, _ in axis_words if axis in released]
         hits += [(pos, axis) for axis, (_, pos) in offsets.items() if axis in released]

@@ -77,7 +77,8 @@ class Motion:
 
 @dataclass(frozen=True, slots=True)
 class AxisExchange:
-    """#AX RELEASE / #AX REQUEST: channel axis indices (0-based) leaving or (re)joining the channel."""
+    """#AX RELEASE / #AX REQUEST: channel axis indices (0-based) leaving or (re)joining the
+    channel."""
 
     kind: AxisExchangeKind
     axes: tuple[int, ...]  # channel axis indices, in programmed order, without duplicates

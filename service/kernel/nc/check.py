@@ -41,13 +41,27 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import Protocol
+from typing import NoReturn, Protocol, cast
 
+from .blocks import MotionKind
 from .errors import NcError, NcErrorId
-from .expressions import ExpressionParser
+from .expressions import ExpressionParser, VarRef
+from .instructions import Instruction
 from .lexer import Cursor
+from .parser import ItemErrorHandler
 from .source import LogicalLine, SourceText
-from .statements import Assign, Control, NcBlock, StmtKind
+from .statements import (
+    Assign,
+    AxisCommand,
+    ContourStatement,
+    Control,
+    NcBlock,
+    StmtKind,
+    Word,
+)
+
+#: what a line parses to (``program.Statement``; that module imports this one)
+Statement = NcBlock | Control | AxisCommand | ContourStatement | Instruction
 
 BATCH_LINES = 2048  # plain lines per PointBatch (bounds the memory of one batch)
 CHECK_FEED_MM_MIN = 1000.0  # the feed the check assumes after a missing or bad F
@@ -96,6 +110,10 @@ class SyntaxCheck(Protocol):
         block (single step)."""
 
 
+#: one moving line of a ``PointBatch``: (line index, motion, end point, arc centre or None)
+BatchRecord = tuple[int, MotionKind, tuple[float, ...], tuple[float, float] | None]
+
+
 @dataclass(slots=True)
 class PointBatch:
     """Plain motion lines decoded by the hot path in check mode.
@@ -111,7 +129,7 @@ class PointBatch:
     stop: int
     start_mm: tuple[float, ...]
     plane: tuple[int, int] | None
-    records: list = field(default_factory=list)
+    records: list[BatchRecord] = field(default_factory=list)
 
 
 # ---------------------------------------------------------------- categories
@@ -150,11 +168,12 @@ _INCOMPLETE = frozenset({
 })
 
 # the category of an error id found in no command and no assignment target
-_CATEGORY_OF_ID = {
-    **dict.fromkeys(_COMBINATION, ErrorCategory.COMBINATION),
-    **dict.fromkeys(_LIMIT, ErrorCategory.LIMIT),
-    **dict.fromkeys(_VALUE, ErrorCategory.VALUE),
-    **dict.fromkeys(_INCOMPLETE, ErrorCategory.INCOMPLETE),
+_CATEGORY_OF_ID: dict[int, ErrorCategory] = {
+    int(err_id): category
+    for ids, category in ((_COMBINATION, ErrorCategory.COMBINATION),
+                          (_LIMIT, ErrorCategory.LIMIT), (_VALUE, ErrorCategory.VALUE),
+                          (_INCOMPLETE, ErrorCategory.INCOMPLETE))
+    for err_id in ids
 }
 
 # the $ or # that starts the command of a line (after an N number and a label). Every
@@ -218,7 +237,7 @@ class RepositionedLine(LogicalLine):
         return new
 
 
-def blanked(line: LogicalLine, start: int, stop: int) -> LogicalLine:
+def blanked(line: LogicalLine, start: int, stop: int) -> RepositionedLine:
     """``line`` with ``[start, stop)`` replaced by blanks (columns stay as they were)."""
     text = line.text[:start] + " " * (stop - start) + line.text[stop:]
     return RepositionedLine(line, text, getattr(line, "errors", 0))
@@ -230,7 +249,9 @@ def term_start(text: str, pos: int, origin: int = 0) -> int:
     error inside ``X[...]`` drops all of ``X[...]``, not the part after the error).
     ``origin``: a position outside any brackets or string at or before ``pos`` (the
     start of the item being parsed), where the scan begins."""
-    if _PLAIN_RUN.match(text, origin, pos).end() >= pos:  # no bracket or string before
+    run = _PLAIN_RUN.match(text, origin, pos)
+    assert run is not None  # the pattern matches the empty string too
+    if run.end() >= pos:  # no bracket or string before
         return pos
     depth = 0
     quoted = False
@@ -259,7 +280,9 @@ def term_end(text: str, pos: int) -> int:
     """End of the term at ``pos``: the next blank outside brackets and strings."""
     n = len(text)
     k = pos + 1 if pos < n and text[pos] in " \t" else pos
-    k = _PLAIN_RUN.match(text, k).end()
+    run = _PLAIN_RUN.match(text, k)
+    assert run is not None  # the pattern matches the empty string too
+    k = run.end()
     if k >= n or text[k] in " \t":  # no bracket, no string: the next blank
         return k
     depth = 0
@@ -296,7 +319,7 @@ def assignment_end(line: LogicalLine, pos: int) -> int:
 
 
 def without_error(line: LogicalLine, error: NcError, category: ErrorCategory
-                  ) -> LogicalLine | None:
+                  ) -> RepositionedLine | None:
     """The line to parse again after ``error``, or None to drop the line."""
     pos = error.pos
     if pos < 0 or pos > len(line.text) or category in (ErrorCategory.RESOURCE,
@@ -313,7 +336,7 @@ def without_error(line: LogicalLine, error: NcError, category: ErrorCategory
     return blanked(line, start, term_end(line.text, start))
 
 
-def item_at(line: LogicalLine, items: list, pos: int) -> int | None:
+def item_at(line: LogicalLine, items: list[Word | Assign], pos: int) -> int | None:
     """Index of the item (word or assignment) of an NC block whose text holds ``pos``
     (an error in ``X[1/0]`` or ``V.L.A = 1/0`` is that item's), or None."""
     found = None
@@ -330,7 +353,7 @@ def item_at(line: LogicalLine, items: list, pos: int) -> int | None:
     return found if pos < end else None
 
 
-def holds_error(line: LogicalLine, items: list, k: int, pos: int) -> bool:
+def holds_error(line: LogicalLine, items: list[Word | Assign], k: int, pos: int) -> bool:
     """True when ``item_at(line, items, pos)`` is ``k``, found without scanning the
     other items (the items of a block stand in the order of their text)."""
     item = items[k]
@@ -341,7 +364,15 @@ def holds_error(line: LogicalLine, items: list, k: int, pos: int) -> bool:
     return pos < term_end(line.text, item.pos)
 
 
-def after_command(line: LogicalLine, error: NcError, parse) -> object | None:
+class LineParse(Protocol):
+    """``LineParser.parse``: the statement of a line; ``on_error`` handles the errors
+    in the items of an NC block (the check's one pass)."""
+
+    def __call__(self, line: LogicalLine, on_error: ItemErrorHandler | None = None, /
+                 ) -> Statement: ...
+
+
+def after_command(line: LogicalLine, error: NcError, parse: LineParse) -> Statement | None:
     """For an error in a command line: the command as understood before ``error``
     (``parse`` of the line cut there) when that is a command, else None."""
     start = command_position(line)
@@ -360,10 +391,10 @@ class _Dropped:
 
     __slots__ = ()
 
-    def __call__(self, env):
+    def __call__(self, env: object) -> NoReturn:
         raise ErrorReported
 
-    def assign(self, env, value) -> None:
+    def assign(self, env: object, value: object) -> NoReturn:
         raise ErrorReported
 
 
@@ -373,7 +404,7 @@ _CONTROL_WITH_EXPRESSION = re.compile(
     r"\$(IF|ELSEIF|WHILE|FOR|SWITCH|CASE|UNTIL)\b|#[ \t]*RT[ \t]+WHILE\b")
 
 
-def dropped_control(line: LogicalLine, errors: int):
+def dropped_control(line: LogicalLine, errors: int) -> Control | None:
     """For a dropped line of a control statement with an expression ($IF, $ELSEIF,
     $WHILE, $FOR, $SWITCH, $CASE, $UNTIL, #RT WHILE): a statement of that kind whose
     expressions raise ``ErrorReported``, so the control flow keeps its structure (a
@@ -392,7 +423,9 @@ def dropped_control(line: LogicalLine, errors: int):
     else:
         kind = StmtKind[m.group(1)]
     line = RepositionedLine(line, line.text, errors)
-    return Control(kind, line, start, expr=_DROPPED, target=_DROPPED, end=_DROPPED,
+    # the $FOR variable: only its ``assign`` is used, which _Dropped has
+    target = cast(VarRef, _DROPPED)
+    return Control(kind, line, start, expr=_DROPPED, target=target, end=_DROPPED,
                    step=_DROPPED, values=(_DROPPED,))
 
 
@@ -456,7 +489,8 @@ class _ItemErrors:
         return stop
 
 
-def parse_checked(parse, line: LogicalLine, check: SyntaxCheck):
+def parse_checked(parse: LineParse, line: LogicalLine, check: SyntaxCheck
+                  ) -> Statement | None:
     """Parse ``line``, reporting each error and repositioning after it; the statement
     of what was understood, or None when the line is dropped (a control statement
     with an expression stays as ``dropped_control``).

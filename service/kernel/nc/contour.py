@@ -92,7 +92,7 @@ def _contour(cur: Cursor, hash_pos: int, number: int | None) -> ContourStatement
     sub = m.group() if m is not None else ""
     stmt = ContourStatement(ContourKind.LOG_PARAM, cur.line, hash_pos, number=number)
     if sub in _LOG_WORDS:
-        cur.pos = m.end()
+        cur.pos += len(sub)
         stmt.kind = _LOG_WORDS[sub]
     elif sub != "PARAM" and cur.peek() != "[":
         raise _syntax(cur, "ON, OFF, CLEAR or [PARAM=..] expected after #CONTOUR LOOKAHEAD "

@@ -22,17 +22,24 @@ otherwise hang the SDA task).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from .blocks import Block
-from .errors import DecodingCancelled, NcErrorId
+from .errors import DecodingCancelled, NcError, NcErrorId
 from .expressions import number, truth
 from .frames import ControlEntry, Frame
+from .program import Statement, Structure
 from .rt_loop_markers import RtLoopMarkers
 from .running_decoder import RunningDecoder
+from .source import LogicalLine
 from .statements import LOOPS, SPELLING, Control, Goto, StmtKind
 from .variables import Value
 
 MAX_IDLE_LOOP_PASSES = 1_000_000  # loop passes without a block before ENDLESS_LOOP
 CANCEL_CHECK_PASSES = 1024  # idle loop passes between two looks at ``decoder.cancelled``
+
+#: a control statement's handler: (frame, statement, index after it) -> marker Block or None
+Handler = Callable[[Frame, Control, int], Block | None]
 
 
 class ControlFlow:
@@ -44,7 +51,7 @@ class ControlFlow:
         self.blocks_at_last_pass = -1
         self.markers = RtLoopMarkers(decoder)
         k = StmtKind
-        self.handlers = {
+        self.handlers: dict[StmtKind, Handler] = {
             k.IF: self._if, k.IF_GOTO: self._if_goto, k.ELSEIF: self._else,
             k.ELSE: self._else, k.ENDIF: self._endif, k.WHILE: self._while,
             k.RT_WHILE: self._rt_while, k.ENDWHILE: self._endwhile,
@@ -62,7 +69,7 @@ class ControlFlow:
 
     # ------------------------------------------------------------ helpers
 
-    def loop_pass(self, stmt_line, pos: int) -> None:
+    def loop_pass(self, stmt_line: LogicalLine, pos: int) -> None:
         """Count one pass of a decode-time loop; too many without a block is an error."""
         emitted = self.decoder.emitted
         if emitted != self.blocks_at_last_pass:
@@ -83,7 +90,7 @@ class ControlFlow:
             return True
         return truth(stmt.expr(self.decoder), stmt.line, stmt.pos)
 
-    def _structure(self, frame: Frame, stmt: Control, index: int):
+    def _structure(self, frame: Frame, stmt: Control, index: int) -> Structure:
         return frame.program.structure(stmt, index, frame.section.end)
 
     def _top(self, frame: Frame, *kinds: StmtKind) -> ControlEntry | None:
@@ -91,7 +98,9 @@ class ControlFlow:
             return frame.control[-1]
         return None
 
-    def _mismatch(self, frame: Frame, stmt: Control, err: NcErrorId, opener: StmtKind):
+    def _mismatch(
+        self, frame: Frame, stmt: Control, err: NcErrorId, opener: StmtKind,
+    ) -> NcError:
         if frame.control:
             open_kind = frame.control[-1].kind
             return stmt.line.error(
@@ -113,7 +122,7 @@ class ControlFlow:
         structure = self._structure(frame, stmt, index)
         for kind, k in structure.parts:
             part, part_after = program.statement(k, end)
-            if kind == StmtKind.ELSE or self._cond(part):
+            if kind == StmtKind.ELSE or self._cond(_control(part)):
                 frame.control.append(ControlEntry(StmtKind.IF, index, stmt, part_after))
                 frame.index = part_after
                 return
@@ -121,6 +130,7 @@ class ControlFlow:
 
     def _if_goto(self, frame: Frame, stmt: Control, after: int) -> None:
         if self._cond(stmt):
+            assert stmt.goto is not None  # the parser gives every IF_GOTO its $GOTO
             self.goto(frame, stmt.goto, stmt.line, frame.index)
         else:
             frame.index = after
@@ -178,6 +188,8 @@ class ControlFlow:
     def _for(self, frame: Frame, stmt: Control, after: int) -> None:
         env = self.decoder
         line = stmt.line
+        # the parser gives every $FOR its variable, start and end
+        assert stmt.target is not None and stmt.expr is not None and stmt.end is not None
         stmt.target.assign(env, stmt.expr(env))
         end = number(stmt.end(env), line, stmt.pos, "a number as $FOR end")
         step = 1.0 if stmt.step is None else number(stmt.step(env), line, stmt.pos, "a step")
@@ -189,7 +201,8 @@ class ControlFlow:
         else:
             frame.index = self._structure(frame, stmt, frame.index).after
 
-    def _in_range(self, stmt: Control, end: Value, step: Value) -> bool:
+    def _in_range(self, stmt: Control, end: float, step: float) -> bool:
+        assert stmt.target is not None  # a $FOR (see _for)
         value = number(stmt.target(self.decoder), stmt.line, stmt.pos, "a number in $FOR")
         return value <= end if step > 0 else value >= end
 
@@ -198,6 +211,7 @@ class ControlFlow:
         if top is None:
             raise self._mismatch(frame, stmt, NcErrorId.LOOP_END_WITHOUT_BEGIN, StmtKind.FOR)
         opener = top.stmt
+        assert opener.target is not None  # a $FOR (see _for)
         value = number(opener.target(self.decoder), opener.line, opener.pos, "a number in $FOR")
         opener.target.assign(self.decoder, value + top.step)
         if self._in_range(opener, top.end, top.step):
@@ -226,16 +240,17 @@ class ControlFlow:
 
     def _switch(self, frame: Frame, stmt: Control, after: int) -> None:
         env = self.decoder
+        assert stmt.expr is not None  # the parser gives every $SWITCH its value
         value = stmt.expr(env)
         program = frame.program
         structure = self._structure(frame, stmt, frame.index)
-        target = None
+        target: int | None = None
         for kind, k in structure.parts:
             part, part_after = program.statement(k, frame.section.end)
             if kind == StmtKind.DEFAULT:
                 target = part_after if target is None else target
                 continue
-            if any(_same(value, v(env)) for v in part.values):
+            if any(_same(value, v(env)) for v in _control(part).values):
                 target = part_after
                 break
         if target is None:
@@ -294,7 +309,7 @@ class ControlFlow:
 
     # ------------------------------------------------------------ $GOTO
 
-    def goto(self, frame: Frame, goto: Goto, line, here: int) -> None:
+    def goto(self, frame: Frame, goto: Goto, line: LogicalLine, here: int) -> None:
         """Jump from line ``here`` to a label of the frame's section, leaving the
         control blocks the label is not in."""
         program = frame.program
@@ -311,6 +326,14 @@ class ControlFlow:
             frame.control.pop()
         frame.index = target
         frame.jumped = True
+
+
+def _control(part: Statement | None) -> Control:
+    """The $ELSEIF / $CASE statement of a part that ``Program.structure`` found."""
+    # the scan found the keyword of a control statement with an expression there, so the
+    # line parses to a Control (the syntax check keeps a failed one as dropped_control)
+    assert type(part) is Control
+    return part
 
 
 def _same(a: Value, b: Value) -> bool:

@@ -17,7 +17,7 @@ from __future__ import annotations
 import re
 
 from .errors import NcErrorId
-from .expressions import ExpressionParser
+from .expressions import ExpressionParser, Node
 from .lexer import Cursor
 from .statements import Call, CycleArgs, CycleParam
 
@@ -35,7 +35,7 @@ def parse_cycle_call(cur: Cursor, local: bool, call_pos: int) -> Call:
     name: str | None = None
     name_pos = -1
     params: dict[int, CycleParam] = {}
-    extra: dict[str, tuple] = {}
+    extra: dict[str, tuple[Node, int]] = {}  # PATTERN_ID=.. -> (value, position)
     seen: dict[str, int] = {}
     expr = ExpressionParser(cur)
     while True:

@@ -24,15 +24,17 @@ this module writes for the call, as ISG's cycle package does.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 from .check import ErrorReported, categorize
 from .errors import NcError, NcErrorId
 from .evaluation import number
 from .frames import Frame, FrameKind
 from .literals import nc_number
+from .patterns import PatternPosition
 from .program import Program
-from .statements import Call, NcBlock
+from .running_decoder import CallingDecoder
+from .source import LogicalLine
+from .statements import Call, CycleArgs, NcBlock
 from .variables import Scope, Value, VariableFault
 
 PATTERN_WRAPPER = "SysPosPatternWrapper.ecy"
@@ -44,15 +46,24 @@ class CycleCall:
 
     call: Call
     params: dict[int, Value]
-    line: Any  # the LogicalLine of the call
+    line: LogicalLine  # the line of the call
     program: Program  # the calling file (LL CYCLE looks for its %L section there)
+
+    @property
+    def args(self) -> CycleArgs:
+        """What the call passes (NAME, @P, PATTERN_ID, ...)."""
+        args = self.call.cycle
+        assert args is not None  # call_cycle makes a CycleCall only of a cycle call
+        return args
 
 
 class CycleContext:
     """What a built-in cycle sees: its parameters (defaults filled in), the decoder's
     state, outputs into the caller's ``V.CYC.`` variables, the file store."""
 
-    def __init__(self, decoder: Any, cycle_call: CycleCall, params: dict[int, Value]) -> None:
+    def __init__(
+        self, decoder: CallingDecoder, cycle_call: CycleCall, params: dict[int, Value],
+    ) -> None:
         self.decoder = decoder
         self.modal = decoder.modal
         self.params = params
@@ -80,15 +91,17 @@ class CycleContext:
 
 
 def _param_pos(cycle_call: CycleCall, param: int | None) -> int:
-    for p in cycle_call.call.cycle.params:
+    for p in cycle_call.args.params:
         if p.number == param:
             return p.pos
     return cycle_call.call.pos
 
 
-def call_cycle(decoder: Any, frame: Frame, stmt: NcBlock) -> None:
+def call_cycle(decoder: CallingDecoder, frame: Frame, stmt: NcBlock) -> None:
     """Run the cycle call of ``stmt`` (the block's words ran already)."""
     call = stmt.call
+    # Decoder._call calls it only for a block whose call is a cycle call
+    assert call is not None and call.cycle is not None
     args = call.cycle
     params = {p.number: p.value(decoder) for p in args.params}
     cycle_call = CycleCall(call, params, stmt.line, frame.program)
@@ -101,13 +114,13 @@ def call_cycle(decoder: Any, frame: Frame, stmt: NcBlock) -> None:
     _run_pattern(decoder, cycle_call)
 
 
-def run_cycle(decoder: Any, cycle_call: CycleCall) -> None:
+def run_cycle(decoder: CallingDecoder, cycle_call: CycleCall) -> None:
     """Start the cycle of ``cycle_call``: a built-in one runs (and may push its motion
     body), a user cycle's frame is pushed."""
-    # Deferred, and no circle (cycles/ imports nothing above it): the built-in cycles
+    # Deferred, and no circle (nothing cycles/ imports imports this module): the built-in cycles
     # load numpy (~150 ms), which a service that never calls a cycle need not pay at
     # its start. tests/test_import_graph.py counts this import as an edge all the same.
-    from .cycles.registry import BUILTIN_CYCLES, builtin_problems  # noqa: PLC0415
+    from .cycles.registry import BUILTIN_CYCLES, builtin_problems
 
     call = cycle_call.call
     line = cycle_call.line
@@ -145,7 +158,7 @@ def run_cycle(decoder: Any, cycle_call: CycleCall) -> None:
                        cycle_call.params)
 
 
-def _raise_all(decoder: Any, errors: list[NcError], line: Any) -> None:
+def _raise_all(decoder: CallingDecoder, errors: list[NcError], line: LogicalLine) -> None:
     """The first error; a syntax check reports every one of them."""
     check = decoder.check
     if check is None or len(errors) == 1:
@@ -157,9 +170,10 @@ def _raise_all(decoder: Any, errors: list[NcError], line: Any) -> None:
 
 # ---------------------------------------------------------------- call patterns
 
-def _run_pattern(decoder: Any, cycle_call: CycleCall) -> None:
-    args = cycle_call.call.cycle
+def _run_pattern(decoder: CallingDecoder, cycle_call: CycleCall) -> None:
+    args = cycle_call.args
     line = cycle_call.line
+    assert args.pattern_id is not None  # call_cycle runs a pattern only with PATTERN_ID
     pattern_value = number(args.pattern_id(decoder), line, args.pattern_id_pos, "a pattern ID")
     if args.pattern_retract is None:
         raise line.error(NcErrorId.CYCLE_PARAMETER_MISSING,
@@ -185,7 +199,7 @@ def _run_pattern(decoder: Any, cycle_call: CycleCall) -> None:
     decoder.push_cycle(frame, None)
 
 
-def pattern_wrapper(positions, retract_mm: float) -> str:
+def pattern_wrapper(positions: tuple[PatternPosition, ...], retract_mm: float) -> str:
     """The NC text that runs a cycle at every position (``#PATTERN CALL`` runs it)."""
     r = nc_number(retract_mm)
     lines = [f"; call pattern: {len(positions)} positions, retraction plane Z{r}"]

@@ -25,7 +25,7 @@ from .frames import Frame, FrameKind
 from .lexer import IDENT, VARIABLE, Cursor
 from .running_decoder import RunningDecoder
 from .source import LogicalLine, join_lines
-from .statements import Control, Declaration
+from .statements import Control, Declaration, InitList
 from .variables import (
     Scope, Value, Variable, VariableFault, VarType, convert, default_value,
 )
@@ -37,7 +37,7 @@ _DECL_SCOPES = {"L": Scope.L, "P": Scope.P, "G": Scope.G, "CYC": Scope.CYC}
 
 
 def read_block(decoder: RunningDecoder, frame: Frame, stmt: Control,
-               after: int) -> tuple[list, int]:
+               after: int) -> tuple[list[Declaration], int]:
     """The declarations of the ``#VAR`` block at ``frame.index`` and the index after it."""
     program = frame.program
     cached = program.var_blocks.get(frame.index)
@@ -85,7 +85,7 @@ def parse_declaration(line: LogicalLine) -> Declaration:
             NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED,
             f"V.{m.group(1)}. variables cannot be declared in #VAR", pos,
         )
-    dims = []
+    dims: list[int] = []
     while cur.peek() == "[":
         cur.pos += 1
         cur.skip_ws()
@@ -112,7 +112,7 @@ def parse_declaration(line: LogicalLine) -> Declaration:
         if vtype == VarType.STRING and cur.peek() == "[":
             if cur.match(_STRING_LENGTH) is None:
                 raise cur.error(NcErrorId.INVALID_DECLARATION, "STRING[n] needs a length")
-    init: Node | list | None = None
+    init: Node | InitList | None = None
     cur.skip_ws()
     if cur.peek() == "=":
         cur.pos += 1
@@ -122,9 +122,9 @@ def parse_declaration(line: LogicalLine) -> Declaration:
         raise cur.unexpected(f"in the declaration of V.{m.group(1)}.{m.group(2)}")
     return Declaration(scope, m.group(2), vtype, tuple(dims), init, line, pos)
 
-def _initializer(cur: Cursor) -> Node | list:
+def _initializer(cur: Cursor) -> Node | InitList:
     """``[a, b, [c, d]]`` (nested lists of expressions) or one bracketed expression."""
-    items: list = []
+    items: InitList = []
     cur.pos += 1  # '['
     parser = ExpressionParser(cur)
     while True:
@@ -177,11 +177,13 @@ def declare(decoder: RunningDecoder, frame: Frame, decl: Declaration) -> None:
     decoder.own_variables.add(id(variable))
 
 
-def _create(decoder: RunningDecoder, decl: Declaration, full: str, site) -> Variable:
+def _create(
+    decoder: RunningDecoder, decl: Declaration, full: str, site: tuple[str, int],
+) -> Variable:
     line = decl.line
     init = decl.init
     dims = decl.dims
-    values: list
+    values: list[Value]
     if isinstance(init, list) and not dims:
         if len(init) == 1 and not isinstance(init[0], list):
             init = init[0]  # "= [expr]" is a bracketed expression
@@ -202,6 +204,8 @@ def _create(decoder: RunningDecoder, decl: Declaration, full: str, site) -> Vari
                     if node is not _DEFAULT_NODE:
                         values[n] = convert(decl.vtype, node(decoder), full)
         else:
+            # a list without dims became the dims above, or was one bracketed expression
+            assert not isinstance(init, list)
             value: Value = default_value(decl.vtype) if init is None else init(decoder)
             values = [convert(decl.vtype, value, full)]
     except VariableFault as f:
@@ -209,25 +213,26 @@ def _create(decoder: RunningDecoder, decl: Declaration, full: str, site) -> Vari
     return Variable(full, decl.vtype, tuple(dims), values, site)
 
 
-def _shape(items: list) -> tuple[int, ...]:
+def _shape(items: InitList) -> tuple[int, ...]:
     """Dimensions of a (possibly nested) initializer list."""
     if items and isinstance(items[0], list):
         return (len(items), *_shape(items[0]))
     return (len(items),)
 
 
-def _flatten(items: list, dims: tuple[int, ...], full: str) -> list:
+def _flatten(items: InitList, dims: tuple[int, ...], full: str) -> list[Node]:
     """Row-major list of nodes; each level may be shorter than its dimension."""
     if len(items) > dims[0]:
         raise VariableFault(
             NcErrorId.INVALID_DECLARATION, f"{full}: {len(items)} values for {dims[0]} elements"
         )
     if len(dims) == 1:
-        if any(isinstance(x, list) for x in items):
+        nodes = [x for x in items if not isinstance(x, list)]
+        if len(nodes) != len(items):
             raise VariableFault(NcErrorId.INVALID_DECLARATION, f"{full}: too many [ levels")
-        return list(items)
+        return nodes
     inner = math.prod(dims[1:])
-    flat: list = []
+    flat: list[Node] = []
     for row in items:
         if not isinstance(row, list):
             raise VariableFault(NcErrorId.INVALID_DECLARATION, f"{full}: a row must be a [list]")
@@ -240,7 +245,7 @@ def _flatten(items: list, dims: tuple[int, ...], full: str) -> list:
 class _Default:
     """Placeholder for an element without initial value (keeps the type default)."""
 
-    def __call__(self, env) -> Value:
+    def __call__(self, env: object) -> Value:
         raise AssertionError("never evaluated")
 
 

@@ -25,28 +25,42 @@ from dataclasses import replace
 from .blockexec import BlockExecutor, Flow
 from .blocks import Block, LogArea
 from .check import (
-    CHECK_FEED_MM_MIN, CheckAborted, ErrorCategory, ErrorReported, SyntaxCheck, categorize,
-    holds_error, item_at,
+    CHECK_FEED_MM_MIN,
+    CheckAborted,
+    ErrorCategory,
+    ErrorReported,
+    SyntaxCheck,
+    categorize,
+    holds_error,
+    item_at,
 )
 from .contour_run import execute_contour
 from .control import ControlFlow
+from .cycle_run import call_cycle
 from .declarations import declare, read_block
 from .errors import NcError, NcErrorId
 from .fastpath import decoding_loop
 from .frames import MAX_CALL_DEPTH, Frame, FrameKind
-from .modal import ModalState
-from .parser import RESERVED_LETTERS, LineParser, word_table
-from .program import Program, Section
-from .source import strip_comments
-from .statements import (
-    CLOSER_OF, OPENERS, SPELLING, Assign, AxisCommand, ContourStatement, Control, NcBlock, Word,
-    WordKind,
-)
-from .cycle_run import call_cycle
 from .instruction_run import pattern_error, run_instruction
 from .instructions import Instruction
+from .modal import ModalState
+from .parser import RESERVED_LETTERS, LineParser, word_table
+from .program import Program, Section, Statement
+from .source import LogicalLine, SourceText, strip_comments
+from .statements import (
+    CLOSER_OF,
+    OPENERS,
+    SPELLING,
+    Assign,
+    AxisCommand,
+    ContourStatement,
+    Control,
+    NcBlock,
+    Word,
+    WordKind,
+)
 from .technology import HSCS_MODES, Surroundings
-from .variables import Scope, Variable, VarType
+from .variables import Scope, Value, Variable, VarType
 
 log = logging.getLogger(__name__)
 
@@ -140,11 +154,11 @@ class Decoder:
         self._executed: Block | None = None  # check mode: the Block of the line's words
 
     @property
-    def source(self):
+    def source(self) -> SourceText:
         """The text of the program being decoded (``SourceText``: lines, offsets)."""
         return self._main.src
 
-    def source_of(self, name: str):
+    def source_of(self, name: str) -> SourceText | None:
         """The text of file ``name`` if this decoder has loaded it (main or subprogram)."""
         if name == self._main.name:
             return self._main.src
@@ -196,7 +210,7 @@ class Decoder:
             value = setting.tolerance_mm if setting is not None else 0.0
         return Variable(f"V.G.{name}", VarType.REAL64, (), [float(value)])
 
-    def cycle_parameter(self, number: int, line, pos: int):
+    def cycle_parameter(self, number: int, line: LogicalLine, pos: int) -> Value:
         """``@P<number>`` in the innermost running cycle."""
         for frame in reversed(self.frames):
             params = frame.cycle_params
@@ -210,7 +224,7 @@ class Decoder:
                          f"@P{number} outside a cycle: cycle parameters exist only in a cycle "
                          "called with L CYCLE [...]", pos)
 
-    def push_cycle(self, frame: Frame, params: dict | None) -> None:
+    def push_cycle(self, frame: Frame, params: dict[int, Value] | None) -> None:
         """Run ``frame`` as a cycle: with its parameters, returning the caller's modal
         G functions (G0..G3, G90/G91, G17..G19) when it ends."""
         if len(self.frames) > MAX_CALL_DEPTH:
@@ -332,6 +346,7 @@ class Decoder:
         When the call or ``$GOTO`` of an NC block fails after its words ran, the Block
         of the words is still yielded (the modal state has moved to its end)."""
         check = self.check
+        assert check is not None  # slow_step calls it only when a syntax check runs
         program = frame.program
         index = frame.index
         end = frame.section.end
@@ -354,7 +369,7 @@ class Decoder:
                             "program too deeply nested to decode")
             check.report(error, ErrorCategory.RESOURCE)
             frame.index = program.statement(index, end)[1]
-        except Exception as exc:  # noqa: BLE001 - every error is the program's, reported
+        except Exception as exc:  # every error is the program's, reported
             block = self._executed
             error = self.fault(exc, frame, index)
             stmt, after = program.statement(index, end)
@@ -367,7 +382,9 @@ class Decoder:
         check.line(program.src, index, program.statement(index, end)[1])
         return block
 
-    def _skip_failed(self, frame: Frame, stmt, index: int, after: int, depth: int) -> int:
+    def _skip_failed(
+        self, frame: Frame, stmt: Statement | None, index: int, after: int, depth: int,
+    ) -> int:
         """Where to go on after the statement at ``index`` failed: an opening control
         statement skips its block (so its end is no follow-up error), others the line.
         A failing ``$UNTIL`` or ``$ENDFOR`` (``depth``: the open blocks before it) ends
@@ -382,11 +399,12 @@ class Decoder:
             frame.control.pop()
         return after
 
-    def _execute_checked(self, stmt: NcBlock):
+    def _execute_checked(self, stmt: NcBlock) -> tuple[Block | None, Flow, int]:
         """``executor.execute`` for the syntax check: after an error the offending word
         is dropped and the block executed again (assignments that ran stay done). When
         the whole line is dropped it raises ``ErrorReported`` (no call, no $GOTO)."""
         check = self.check
+        assert check is not None  # _step calls it only in a syntax check
         executor = self.executor
         count = getattr(stmt.line, "errors", 0)  # errors reported when it was parsed
         skipped: set[int] = set()  # items left out in the pass (their errors reported)
@@ -426,12 +444,12 @@ class Decoder:
                 check.report(error, categorize(error, stmt.line))
                 count += 1
                 if check.errors_per_block and count >= check.errors_per_block:
-                    raise ErrorReported  # the line is dropped, its call and $GOTO too
+                    raise ErrorReported from None  # the line is dropped, its call and $GOTO too
                 done = executor.items_done
                 items = stmt.items
                 if error.id == NcErrorId.NO_FEED:  # go on as if F were programmed
                     self._modal.feed_mm_min = CHECK_FEED_MM_MIN
-                    drop = -1
+                    drop: int | None = -1
                 else:
                     drop = item_at(stmt.line, items, error.pos)
                     if drop is None:  # no single word at fault: the line is dropped
@@ -447,6 +465,7 @@ class Decoder:
 
     def _call(self, frame: Frame, stmt: NcBlock) -> None:
         call = stmt.call
+        assert call is not None  # _step calls it only for a block with a call
         line = stmt.line
         if call.cycle is not None:
             call_cycle(self, frame, stmt)
@@ -533,7 +552,7 @@ def _never() -> bool:
     return False
 
 
-def _first_pos(line) -> int:
+def _first_pos(line: LogicalLine) -> int:
     """Position of the first non-blank character of ``line``."""
     text = line.text
     return len(text) - len(text.lstrip())

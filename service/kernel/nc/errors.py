@@ -8,12 +8,13 @@ Ids marked "ISG" are the documented ids of the ISG kernel for the same problem; 
 others are this kernel's own and stay stable.
 
 21309 (warning: SYNCHK without MACHINE_LOCK) is ISG's id and raised by the kernel when a
-syntax check starts (``cnc_objects.service.kernel.syntax_check``). 22073 (``#CONTOUR LOOKAHEAD LOG CLEAR`` inside ``#RT WHILE``) is ISG's id
-and used for that.
+syntax check starts (``cnc_objects.service.kernel.syntax_check``). 22073 (``#CONTOUR
+LOOKAHEAD LOG CLEAR`` inside ``#RT WHILE``) is ISG's id and used for that.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from enum import IntEnum
 
 
@@ -150,7 +151,7 @@ class NcError(Exception):
 
     pos = -1
 
-    def __init__(  # noqa: A002 - "id" is the field name the callers use
+    def __init__(  # "id" (a builtin's name) is the field name the callers use
         self, id: int, file: str, line: int, column: int, message: str
     ) -> None:
         self.id = id
@@ -160,7 +161,9 @@ class NcError(Exception):
         self.message = message
         super().__init__(f"error {int(id)}: {file}:{line}:{column}: {message}")
 
-    def __reduce__(self):  # noqa: D105 - keep the five fields when pickled
+    def __reduce__(  # keep the five fields when pickled
+        self,
+    ) -> tuple[type[NcError], tuple[int, str, int, int, str]]:
         return (type(self), (self.id, self.file, self.line, self.column, self.message))
 
 
@@ -168,3 +171,7 @@ class DecodingCancelled(BaseException):
     """Raised inside the decoder when its run was cancelled (RESET) while it works
     without yielding blocks (a loop without motion). A ``BaseException``, so that no
     handler of program errors or decoder faults takes it for one."""
+
+
+#: ``LogicalLine.error`` of the line being run: (id, message, position) -> the NcError
+ErrorAt = Callable[[NcErrorId, str, int], NcError]

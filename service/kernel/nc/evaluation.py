@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 import operator
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
 from .errors import NcErrorId
@@ -33,6 +33,9 @@ class Env(Protocol):
 
     def find_variable(self, scope: Scope, name: str) -> Variable | None:
         """The visible variable ``V.<scope>.<name>`` or None."""
+
+    def cycle_parameter(self, number: int, line: LogicalLine, pos: int) -> Value:
+        """``@P<number>`` of the innermost running cycle (NcError at ``pos`` if none)."""
 
 
 class Const:
@@ -62,7 +65,7 @@ class VarRef:
         self.line = line
         self.pos = pos
 
-    def _resolve(self, env: Any) -> tuple[Variable, tuple[int, ...]]:
+    def _resolve(self, env: Env) -> tuple[Variable, tuple[int, ...]]:
         var = env.find_variable(self.scope, self.name)
         if var is None:
             raise self.line.error(
@@ -72,14 +75,14 @@ class VarRef:
             return var, ()
         return var, tuple(_index(node(env), self.line, self.pos) for node in self.indices)
 
-    def __call__(self, env: Any) -> Value:
+    def __call__(self, env: Env) -> Value:
         var, indices = self._resolve(env)
         try:
             return var.get(indices)
         except Fault as f:
             raise self.line.error(f.err_id, f.message, self.pos) from None
 
-    def assign(self, env: Any, value: Value) -> None:
+    def assign(self, env: Env, value: Value) -> None:
         """Store ``value`` (converted to the variable's type)."""
         var, indices = self._resolve(env)
         try:
@@ -98,7 +101,7 @@ class ParamRef:
         self.line = line
         self.pos = pos
 
-    def __call__(self, env: Any) -> Value:
+    def __call__(self, env: Env) -> Value:
         return env.cycle_parameter(self.number, self.line, self.pos)
 
 
@@ -127,35 +130,36 @@ def truth(value: Value, line: LogicalLine, pos: int) -> bool:
 # ------------------------------------------------------------------ operators
 
 
-def _numbers(a: Value, b: Value, op: str) -> None:
+def _numbers(a: Value, b: Value, op: str) -> tuple[float, float]:
+    """``a`` and ``b`` unchanged (int, bool or float); a Fault when one is a string."""
     if isinstance(a, str) or isinstance(b, str):
         raise Fault(NcErrorId.TYPE_MISMATCH, f"operator {op} needs numbers")
+    return a, b
 
 
 def _add(a: Value, b: Value) -> Value:
     if isinstance(a, str) and isinstance(b, str):
         return a + b
-    _numbers(a, b, "+")
-    return a + b
+    x, y = _numbers(a, b, "+")
+    return x + y
 
 
 def _arith(op: str, fn: Callable[[Any, Any], Value]) -> Callable[[Value, Value], Value]:
     def apply(a: Value, b: Value) -> Value:
-        _numbers(a, b, op)
-        return fn(a, b)
+        return fn(*_numbers(a, b, op))
 
     return apply
 
 
 def _div(a: Value, b: Value) -> Value:
-    _numbers(a, b, "/")
-    if b == 0:
+    x, y = _numbers(a, b, "/")
+    if y == 0:
         raise Fault(NcErrorId.DIVISION_BY_ZERO, "division by zero")
-    return a / b
+    return x / y
 
 
 def _mod(a: Value, b: Value) -> Value:
-    _numbers(a, b, "MOD")
+    a, b = _numbers(a, b, "MOD")
     if b == 0:
         raise Fault(NcErrorId.DIVISION_BY_ZERO, "division by zero (MOD 0)")
     try:
@@ -166,7 +170,7 @@ def _mod(a: Value, b: Value) -> Value:
 
 def pow_op(a: Value, b: Value) -> Value:
     """a ** b (and a ^ b) as a float; Fault when undefined or too large."""
-    _numbers(a, b, "**")
+    a, b = _numbers(a, b, "**")
     try:
         return math.pow(a, b)
     except (ValueError, OverflowError):
@@ -226,12 +230,16 @@ FUNCTIONS: dict[str, tuple[int, Callable[..., float]]] = {
 # ------------------------------------------------------------------ closures
 
 
-def fold(first: Node, rest: list[tuple[Callable, Node, int]], line: LogicalLine) -> Node:
+def fold(
+    first: Node, rest: Sequence[tuple[Callable[[Value, Value], Value], Node, int]],
+    line: LogicalLine,
+) -> Node:
     """One closure for ``first op1 x1 op2 x2 ...`` evaluated left to right."""
     if isinstance(first, Const) and all(isinstance(x, Const) for _, x, _ in rest):
         try:
             value = first.value
-            for op, x, pos in rest:
+            for op, x, _pos in rest:
+                assert isinstance(x, Const)  # checked by the condition above
                 value = op(value, x.value)
             return Const(value)
         except Fault:
@@ -272,7 +280,7 @@ def xor_op(a: Value, b: Value) -> Value:
     return (a != 0) != (b != 0)
 
 
-def evaluate_number(node: Node | float, env: Any, line: LogicalLine, pos: int) -> float:
+def evaluate_number(node: Node | float, env: Env, line: LogicalLine, pos: int) -> float:
     """A word value: a parsed constant or an evaluated node, as a finite float."""
     value = node if isinstance(node, float) else number(node(env), line, pos)
     if not math.isfinite(value):

@@ -20,11 +20,11 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from typing import Any
+from typing import TypeVar
 
 from .blocks import AxisExchangeKind
 from .errors import NcErrorId
-from .evaluation import evaluate_number
+from .evaluation import Env, evaluate_number
 from .expressions import ExpressionParser, Node
 from .lexer import IDENT, Cursor
 from .statements import AxisCommand, AxisRef
@@ -65,10 +65,10 @@ def _release_axes(cur: Cursor) -> tuple[AxisRef, ...] | None:
     m = IDENT.match(cur.up, cur.pos)
     word = m.group() if m is not None else ""
     if word == "ALL":
-        cur.pos = m.end()
+        cur.pos += len(word)
         return None
     if word == "NBR":
-        cur.pos = m.end()
+        cur.pos += len(word)
         return tuple(AxisRef(pos, number=node, number_pos=pos)
                      for node, pos in _list(cur, _expression, "#AX RELEASE NBR"))
     return tuple(AxisRef(pos, name=name) for name, pos in _list(cur, _name, "#AX RELEASE"))
@@ -101,7 +101,10 @@ def _open(cur: Cursor, after: str) -> int:
     return cur.pos - 1
 
 
-def _list(cur: Cursor, part: Callable[[Cursor], tuple], after: str) -> list:
+Part = TypeVar("Part")  # what one part of a bracket list is
+
+
+def _list(cur: Cursor, part: Callable[[Cursor], Part], after: str) -> list[Part]:
     """``[ part {, part} ]``."""
     open_pos = _open(cur, after)
     parts = [part(cur)]
@@ -133,7 +136,7 @@ def _expression(cur: Cursor) -> tuple[Node, int]:
 # ------------------------------------------------------------------ execution
 
 
-def moved_axes(stmt: AxisCommand, env: Any, axes: tuple[str, ...],
+def moved_axes(stmt: AxisCommand, env: Env, axes: tuple[str, ...],
                numbers: tuple[int, ...], released: frozenset[int]) -> tuple[int, ...]:
     """Channel axis indices that ``stmt`` takes out of the channel (RELEASE: those still
     in it) or brings back (REQUEST: those released), in programmed order, no duplicates.
@@ -141,6 +144,7 @@ def moved_axes(stmt: AxisCommand, env: Any, axes: tuple[str, ...],
     Every axis of the command is checked before anything changes (an error leaves the
     channel's axes as they were).
     """
+    wanted: list[int | None]
     if stmt.axes is None:  # RELEASE ALL
         wanted = list(range(len(axes)))
     elif stmt.kind == AxisExchangeKind.RELEASE:
@@ -155,19 +159,22 @@ def moved_axes(stmt: AxisCommand, env: Any, axes: tuple[str, ...],
     return tuple(moved)
 
 
-def _released(ref: AxisRef, stmt: AxisCommand, env: Any, axes: tuple[str, ...],
+def _released(ref: AxisRef, stmt: AxisCommand, env: Env, axes: tuple[str, ...],
               numbers: tuple[int, ...]) -> int | None:
     """Channel index of a RELEASE axis; None for an axis the channel does not have."""
     if ref.name is not None:
         return axes.index(ref.name) if ref.name in axes else None
+    assert ref.number is not None  # RELEASE NBR: the parser gives each axis its number
     number = _integer(ref.number, 1, "axis number", stmt, env, ref.number_pos)
     return numbers.index(number) if number in numbers else None
 
 
-def _requested(ref: AxisRef, stmt: AxisCommand, env: Any, axes: tuple[str, ...],
+def _requested(ref: AxisRef, stmt: AxisCommand, env: Env, axes: tuple[str, ...],
                numbers: tuple[int, ...]) -> int:
     """Channel index of a REQUEST axis; it must be the channel's own axis, unchanged."""
     err = stmt.line.error
+    # REQUEST: the parser gives each axis its name, number and index
+    assert ref.number is not None and ref.index is not None
     number = _integer(ref.number, 1, "axis number", stmt, env, ref.number_pos)
     index = _integer(ref.index, 0, "axis index", stmt, env, ref.index_pos)
     unsupported = NcErrorId.AXIS_EXCHANGE_NOT_SUPPORTED
@@ -189,7 +196,7 @@ def _requested(ref: AxisRef, stmt: AxisCommand, env: Any, axes: tuple[str, ...],
     return k
 
 
-def _integer(node: Node, lowest: int, what: str, stmt: AxisCommand, env: Any, pos: int) -> int:
+def _integer(node: Node, lowest: int, what: str, stmt: AxisCommand, env: Env, pos: int) -> int:
     value = evaluate_number(node, env, stmt.line, pos)
     if value != int(value) or not lowest <= value <= 0xFFFFFFFF:
         raise stmt.line.error(NcErrorId.INVALID_AXIS_NUMBER,

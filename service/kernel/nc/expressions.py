@@ -23,15 +23,29 @@ line of 10,000 ``[`` is an error and never exhausts Python's stack.
 from __future__ import annotations
 
 import re
+from typing import Any
 
 from .errors import NcError, NcErrorId
 from .evaluation import (
-    ADD_OPS, CMP_OPS, CMP_SYMBOLS, FUNCTIONS, MUL_OPS, Const, Node, ParamRef, VarRef,
+    ADD_OPS,
+    CMP_OPS,
+    CMP_SYMBOLS,
+    FUNCTIONS,
+    MUL_OPS,
+    Const,
+    Node,
+    ParamRef,
+    VarRef,
     evaluate_number,
-    fold, logic, number, pow_op, truth, xor_op,
+    fold,
+    logic,
+    number,
+    pow_op,
+    truth,
+    xor_op,
 )
 from .lexer import IDENT, NUMBER, VARIABLE, Cursor
-from .variables import Scope
+from .variables import Scope, Value
 
 _PARAM_REF = re.compile(r"@P([0-9]+)")
 # V.G. variables with members that the decoder provides (they are not declared)

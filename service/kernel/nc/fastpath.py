@@ -30,6 +30,7 @@ import math
 import re
 from collections.abc import Callable, Iterator
 from functools import lru_cache
+from typing import cast
 
 from .blockexec import FEED_MAX_MM_MIN
 from .blocks import Block, Compensation, Motion, MotionKind, SourceRef, StopKind
@@ -339,5 +340,6 @@ def decoding_loop(axes: tuple[str, ...], check: bool = False) -> Callable[..., I
     }
     code = compile(loop_source(axes, check),
                    f"<decoding loop {''.join(axes)}{' check' if check else ''}>", "exec")
-    exec(code, namespace)  # noqa: S102 - our own template, no outside input
-    return namespace["run"]
+    exec(code, namespace)  # our own template, no outside input
+    # the template defines run(decoder), a generator of Blocks (see loop_source)
+    return cast(Callable[..., Iterator[Block]], namespace["run"])

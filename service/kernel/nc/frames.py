@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import Any
 
+from .blocks import MotionKind
+from .modal import DistanceMode, Plane
 from .program import Program, Section
 from .statements import Control, StmtKind
 from .variables import Value, Variable
@@ -29,8 +31,8 @@ class ControlEntry:
     index: int  # line index of the opening statement
     stmt: Control
     body: int  # line index of the first line of the body
-    end: Value = 0.0  # $FOR: end value
-    step: Value = 1.0  # $FOR: step
+    end: float = 0.0  # $FOR: end value
+    step: float = 1.0  # $FOR: step
 
 
 @dataclass(slots=True)
@@ -48,5 +50,7 @@ class Frame:
     # a cycle: its @P parameters (None: no cycle), the caller's modal G functions to
     # restore when it returns, and for the pattern wrapper the call it repeats
     cycle_params: dict[int, Value] | None = None
-    restore: tuple | None = None
+    restore: tuple[MotionKind, DistanceMode, Plane] | None = None
+    # the pattern wrapper: the cycle call it repeats (a cycle_run.CycleCall; cycle_run
+    # imports this module, so the type is not named here)
     pattern_call: Any = None

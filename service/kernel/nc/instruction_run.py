@@ -8,22 +8,22 @@ format is reported) but writes nothing.
 
 from __future__ import annotations
 
-from typing import Any
-
 from .coordinates import CoordinateSystem, placement_of
 from .cycle_run import run_cycle
-from .errors import NcErrorId
+from .errors import NcError, NcErrorId
 from .evaluation import evaluate_number
 from .instructions import Instruction, InstructionKind
 from .messages import format_message
 from .patterns import OpenPattern, PatternPosition
+from .running_decoder import CallingDecoder
+from .source import LogicalLine
 from .variables import VariableFault
 
 DEFAULT_MSG_FILE = "msg_save.txt"  # #MSG SAVE before any #FILE NAME
 MAX_PATTERN_POSITIONS = 1000
 
 
-def run_instruction(stmt: Instruction, decoder: Any) -> None:
+def run_instruction(stmt: Instruction, decoder: CallingDecoder) -> None:
     """Execute ``stmt`` (raises NcError on a bad value)."""
     modal = decoder.modal
     kind = stmt.kind
@@ -37,17 +37,18 @@ def run_instruction(stmt: Instruction, decoder: Any) -> None:
     _RUN[kind](stmt, decoder)
 
 
-def pattern_error(line, pos: int):
+def pattern_error(line: LogicalLine, pos: int) -> NcError:
     """The error for an ordinary command inside ``#PATTERN BEGIN ... END``."""
     return line.error(NcErrorId.PATTERN_COMMAND_INSIDE,
                       "only #AT may stand between #PATTERN BEGIN and #PATTERN END", pos)
 
 
-def _numbers(stmt: Instruction, decoder: Any) -> list[float]:
-    return [evaluate_number(v, decoder, stmt.line, p) for v, p in zip(stmt.values, stmt.value_pos)]
+def _numbers(stmt: Instruction, decoder: CallingDecoder) -> list[float]:
+    return [evaluate_number(v, decoder, stmt.line, p)
+            for v, p in zip(stmt.values, stmt.value_pos, strict=True)]
 
 
-def _integer_id(stmt: Instruction, decoder: Any) -> int:
+def _integer_id(stmt: Instruction, decoder: CallingDecoder) -> int:
     value = evaluate_number(stmt.values[0], decoder, stmt.line, stmt.value_pos[0])
     if value != int(value) or not 0 <= value <= 0xFFFFFFFF:
         raise stmt.line.error(NcErrorId.PATTERN_SYNTAX,
@@ -58,7 +59,7 @@ def _integer_id(stmt: Instruction, decoder: Any) -> int:
 
 # ---------------------------------------------------------------- coordinate systems
 
-def _xyz_present(stmt: Instruction, decoder: Any) -> None:
+def _xyz_present(stmt: Instruction, decoder: CallingDecoder) -> None:
     missing = [n for n in "XYZ" if n not in decoder.axes]
     if missing:
         raise stmt.line.error(NcErrorId.INSTRUCTION_SYNTAX,
@@ -66,19 +67,20 @@ def _xyz_present(stmt: Instruction, decoder: Any) -> None:
                               f"{', '.join(missing)}", stmt.pos)
 
 
-def _cs_from_values(stmt: Instruction, decoder: Any) -> CoordinateSystem:
-    values = _numbers(stmt, decoder)
-    angles = tuple(values[3:]) if len(values) == 6 else (0.0, 0.0, 0.0)
-    return CoordinateSystem.from_values(tuple(values[:3]), angles, stmt.name)
+def _cs_from_values(stmt: Instruction, decoder: CallingDecoder) -> CoordinateSystem:
+    values = _numbers(stmt, decoder)  # 3 or 6 of them (the parser checks the count)
+    offset = (values[0], values[1], values[2])
+    angles = (values[3], values[4], values[5]) if len(values) == 6 else (0.0, 0.0, 0.0)
+    return CoordinateSystem.from_values(offset, angles, stmt.name)
 
 
-def _select(decoder: Any, cs: CoordinateSystem) -> None:
+def _select(decoder: CallingDecoder, cs: CoordinateSystem) -> None:
     modal = decoder.modal
     modal.cs = modal.cs + (cs,)
     modal.cs_placement = placement_of(modal.cs)
 
 
-def _cs_on(stmt: Instruction, decoder: Any) -> None:
+def _cs_on(stmt: Instruction, decoder: CallingDecoder) -> None:
     _xyz_present(stmt, decoder)
     modal = decoder.modal
     if stmt.values:
@@ -86,20 +88,21 @@ def _cs_on(stmt: Instruction, decoder: Any) -> None:
         if stmt.name:
             modal.cs_defined[stmt.name] = cs
     else:
-        cs = modal.cs_defined.get(stmt.name)
-        if cs is None:
+        defined = modal.cs_defined.get(stmt.name)
+        if defined is None:
             raise stmt.line.error(NcErrorId.INSTRUCTION_SYNTAX,
                                   f"no coordinate system named {stmt.name}: define it with "
                                   f"#CS DEF [{stmt.name}] [x, y, z, a, b, c]", stmt.pos)
+        cs = defined
     _select(decoder, cs)
 
 
-def _cs_def(stmt: Instruction, decoder: Any) -> None:
+def _cs_def(stmt: Instruction, decoder: CallingDecoder) -> None:
     _xyz_present(stmt, decoder)
     decoder.modal.cs_defined[stmt.name] = _cs_from_values(stmt, decoder)
 
 
-def _cs_off(stmt: Instruction, decoder: Any) -> None:
+def _cs_off(stmt: Instruction, decoder: CallingDecoder) -> None:
     modal = decoder.modal
     modal.cs = () if stmt.all else modal.cs[:-1]
     modal.cs_placement = placement_of(modal.cs)
@@ -107,11 +110,11 @@ def _cs_off(stmt: Instruction, decoder: Any) -> None:
 
 # ---------------------------------------------------------------- patterns
 
-def _pattern_begin(stmt: Instruction, decoder: Any) -> None:
+def _pattern_begin(stmt: Instruction, decoder: CallingDecoder) -> None:
     decoder.modal.pattern = OpenPattern(_integer_id(stmt, decoder), stmt.line, stmt.pos)
 
 
-def _pattern_end(stmt: Instruction, decoder: Any) -> None:
+def _pattern_end(stmt: Instruction, decoder: CallingDecoder) -> None:
     modal = decoder.modal
     pattern = modal.pattern
     if pattern is None:
@@ -125,7 +128,7 @@ def _pattern_end(stmt: Instruction, decoder: Any) -> None:
     modal.patterns[pattern.id] = tuple(pattern.positions)
 
 
-def _pattern_delete(stmt: Instruction, decoder: Any) -> None:
+def _pattern_delete(stmt: Instruction, decoder: CallingDecoder) -> None:
     modal = decoder.modal
     if stmt.all:
         modal.patterns.clear()
@@ -137,7 +140,7 @@ def _pattern_delete(stmt: Instruction, decoder: Any) -> None:
                               "be deleted", stmt.value_pos[0])
 
 
-def _at(stmt: Instruction, decoder: Any) -> None:
+def _at(stmt: Instruction, decoder: CallingDecoder) -> None:
     pattern = decoder.modal.pattern
     if pattern is None:
         raise stmt.line.error(NcErrorId.PATTERN_SYNTAX,
@@ -158,7 +161,7 @@ def _at(stmt: Instruction, decoder: Any) -> None:
     pattern.positions.append(PatternPosition(values[0], values[1], values[2], c))
 
 
-def _pattern_call(stmt: Instruction, decoder: Any) -> None:
+def _pattern_call(stmt: Instruction, decoder: CallingDecoder) -> None:
     cycle_call = decoder.frames[-1].pattern_call
     if cycle_call is None:
         raise stmt.line.error(NcErrorId.PATTERN_SYNTAX,
@@ -170,7 +173,8 @@ def _pattern_call(stmt: Instruction, decoder: Any) -> None:
 
 # ---------------------------------------------------------------- messages
 
-def _message_text(stmt: Instruction, decoder: Any) -> str:
+def _message_text(stmt: Instruction, decoder: CallingDecoder) -> str:
+    assert stmt.text is not None  # #MSG and #MSG SAVE: the parser sets the text
     fmt = stmt.text(decoder)
     args = tuple(v(decoder) for v in stmt.values)
     if not isinstance(fmt, str):
@@ -182,17 +186,17 @@ def _message_text(stmt: Instruction, decoder: Any) -> str:
         raise stmt.line.error(fault.err_id, fault.message, stmt.text_pos) from None
 
 
-def _file_name(stmt: Instruction, decoder: Any) -> None:
+def _file_name(stmt: Instruction, decoder: CallingDecoder) -> None:
     decoder.modal.msg_file = stmt.name
 
 
-def _msg(stmt: Instruction, decoder: Any) -> None:
+def _msg(stmt: Instruction, decoder: CallingDecoder) -> None:
     text = _message_text(stmt, decoder)
     if decoder.check is None:
         decoder.surroundings.show_message(text)
 
 
-def _msg_save(stmt: Instruction, decoder: Any) -> None:
+def _msg_save(stmt: Instruction, decoder: CallingDecoder) -> None:
     text = _message_text(stmt, decoder)
     if decoder.check is not None:
         return
@@ -209,19 +213,20 @@ def _msg_save(stmt: Instruction, decoder: Any) -> None:
 
 # ---------------------------------------------------------------- technology
 
-def _tolerance(stmt: Instruction, decoder: Any, key: str) -> float:
+def _tolerance(stmt: Instruction, decoder: CallingDecoder, key: str) -> float:
     node, pos = stmt.options[key]
+    assert node is not None  # PATH_DEV, TRACK_DEV, AX_DEV: _options requires their '= value'
     value = evaluate_number(node, decoder, stmt.line, pos)
     if value < 0:
         raise stmt.line.error(NcErrorId.VALUE_OUT_OF_RANGE, f"{key} {value:g} is negative", pos)
     return value
 
 
-def _trafo(stmt: Instruction, decoder: Any) -> None:
+def _trafo(stmt: Instruction, decoder: CallingDecoder) -> None:
     decoder.modal.settings.trafo = stmt.on
 
 
-def _hsc(stmt: Instruction, decoder: Any) -> None:
+def _hsc(stmt: Instruction, decoder: CallingDecoder) -> None:
     settings = decoder.modal.settings
     settings.hsc = stmt.on
     if not stmt.on:
@@ -233,11 +238,11 @@ def _hsc(stmt: Instruction, decoder: Any) -> None:
                                  if "TRACK_DEV" in stmt.options else 0.0)
 
 
-def _slope(stmt: Instruction, decoder: Any) -> None:
+def _slope(stmt: Instruction, decoder: CallingDecoder) -> None:
     decoder.modal.settings.slope = stmt.name
 
 
-def _filter(stmt: Instruction, decoder: Any) -> None:
+def _filter(stmt: Instruction, decoder: CallingDecoder) -> None:
     settings = decoder.modal.settings
     settings.filter = stmt.on
     if stmt.on:
@@ -249,7 +254,8 @@ _RUN = {
     InstructionKind.CS_ON: _cs_on, InstructionKind.CS_DEF: _cs_def,
     InstructionKind.CS_OFF: _cs_off, InstructionKind.PATTERN_BEGIN: _pattern_begin,
     InstructionKind.PATTERN_END: _pattern_end, InstructionKind.PATTERN_DELETE: _pattern_delete,
-    InstructionKind.AT: _at, InstructionKind.PATTERN_CALL: _pattern_call, InstructionKind.FILE_NAME: _file_name, InstructionKind.MSG: _msg,
+    InstructionKind.AT: _at, InstructionKind.PATTERN_CALL: _pattern_call,
+    InstructionKind.FILE_NAME: _file_name, InstructionKind.MSG: _msg,
     InstructionKind.MSG_SAVE: _msg_save, InstructionKind.TRAFO: _trafo,
     InstructionKind.HSC: _hsc, InstructionKind.SLOPE: _slope, InstructionKind.FILTER: _filter,
 }

@@ -21,8 +21,10 @@ Values are expressions, evaluated when the instruction runs (``instruction_run``
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import IntEnum
+from typing import final
 
 from .errors import NcErrorId
 from .expressions import ExpressionParser, Node
@@ -57,6 +59,7 @@ class InstructionKind(IntEnum):
     FILTER = 33  # #FILTER ON [..] / OFF
 
 
+@final  # the decoder dispatches on type(stmt) is Instruction: no subclasses
 @dataclass(slots=True)
 class Instruction:
     """One parsed ``#`` instruction of this module."""
@@ -260,7 +263,8 @@ def _file(cur: Cursor, stmt: Instruction) -> None:
     cur.skip_ws()
     open_pos = cur.pos
     if cur.peek() != "[":
-        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX, "'[MSG=\"<file>\"]' expected after #FILE NAME")
+        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX,
+                        "'[MSG=\"<file>\"]' expected after #FILE NAME")
     cur.pos += 1
     cur.skip_ws()
     if not cur.startswith("MSG"):
@@ -316,7 +320,9 @@ def _msg(cur: Cursor, stmt: Instruction) -> None:
     stmt.values, stmt.value_pos = tuple(values), tuple(positions)
 
 
-def _on_off(word: str, kind: InstructionKind, options: dict[str, bool] | None):
+def _on_off(
+    word: str, kind: InstructionKind, options: dict[str, bool] | None,
+) -> Callable[[Cursor, Instruction], None]:
     def parse(cur: Cursor, stmt: Instruction) -> None:
         stmt.kind = kind
         stmt.on = _sub(cur, word, ("ON", "OFF")) == "ON"

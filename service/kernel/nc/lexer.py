@@ -45,7 +45,9 @@ class Cursor:
         pos = self.pos
         if pos < self.end and self.up[pos] not in _BLANKS:  # most often: no blank here
             return
-        self.pos = _WS.match(self.up, pos).end()
+        m = _WS.match(self.up, pos)
+        assert m is not None  # the pattern matches the empty string too
+        self.pos = m.end()
 
     def at_end(self) -> bool:
         """True when only blanks are left."""

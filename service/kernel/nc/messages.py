@@ -11,14 +11,14 @@ import math
 import re
 
 from .errors import NcErrorId
-from .variables import VariableFault
+from .variables import Value, VariableFault
 
 _SPEC = re.compile(r"%([-+ #0]*)([0-9]*)(?:\.([0-9]*))?([a-zA-Z%])")
 _CONVERSIONS = frozenset("fFeEgGdixXs%")
 MAX_WIDTH = 99
 
 
-def format_message(fmt: str, args: tuple) -> str:
+def format_message(fmt: str, args: tuple[Value, ...]) -> str:
     """``fmt`` with ``args`` filled in; VariableFault (MESSAGE_FORMAT) when they do not fit."""
     out: list[str] = []
     k = 0
@@ -48,7 +48,7 @@ def format_message(fmt: str, args: tuple) -> str:
     return "".join(out)
 
 
-def _convert(spec: str, conv: str, value) -> str:
+def _convert(spec: str, conv: str, value: Value) -> str:
     if conv == "s":
         text = value if isinstance(value, str) else f"{value:g}" if isinstance(value, float) \
             else str(value)

@@ -4,9 +4,10 @@
 G90/G91, the plane, the motion mode, F, tool radius compensation and D, S, T, the
 program-global (V.P.) and global (V.G.) variables, the axes released by
 ``#AX RELEASE``, the machining coordinate systems (``#CS``), call patterns
-(``#PATTERN``) and high-speed settings (``#HSC``, ``G133``, ...). It is mutable and outlives a ``Decoder``: in the extended manual (MDI)
-mode every new manual block is decoded with the modal state the previous one left. A
-program start (a ``Decoder`` that is not manual) gives all axes back to the channel.
+(``#PATTERN``) and high-speed settings (``#HSC``, ``G133``, ...). It is mutable and
+outlives a ``Decoder``: in the extended manual (MDI) mode every new manual block is
+decoded with the modal state the previous one left. A program start (a ``Decoder`` that
+is not manual) gives all axes back to the channel.
 
 Defaults after a reset: G90, G17, G01 (a motion block without F is an error until an F
 is programmed, never an accidental rapid), G40, D0, no F, S or T.

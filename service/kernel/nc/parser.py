@@ -19,16 +19,25 @@ from .contour import CONTOUR_WORD, parse_contour_command
 from .cycle_call import CYCLE_WORD, parse_cycle_call
 from .errors import NcError, NcErrorId
 from .exchange import AX_WORD, parse_axis_command
+from .expressions import Const, ExpressionParser, Node, VarRef
 from .instructions import WORDS as INSTRUCTION_WORDS
 from .instructions import Instruction, parse_instruction
-from .expressions import Const, ExpressionParser, Node, VarRef
 from .lexer import IDENT, SIGNED_NUMBER, Cursor
 from .modal import G_CODES, GGroup
 from .source import LogicalLine
 from .statements import (
-    Assign, AxisCommand, Call, ContourStatement, Control, Goto, NcBlock, StmtKind, Word,
+    Assign,
+    AxisCommand,
+    Call,
+    ContourStatement,
+    Control,
+    Goto,
+    NcBlock,
+    StmtKind,
+    Word,
     WordKind,
 )
+from .variables import Value
 
 _N_WORD = re.compile(r"N[ \t]*([-+]?[0-9.]*)([ \t]*:)?")
 _LABEL = re.compile(r"\[[ \t]*([A-Z0-9_]+)[ \t]*\]")
@@ -123,6 +132,7 @@ class LineParser:
             return current
         pos = cur.pos
         m = cur.match(_N_WORD)
+        assert m is not None  # at an 'N' (checked above): the rest of the pattern is optional
         digits = m.group(1)
         if current is not None:
             raise cur.error(NcErrorId.BLOCK_NUMBER_TWICE, "block number N programmed twice", pos)
@@ -138,6 +148,7 @@ class LineParser:
     def _control(self, cur: Cursor, number: int | None) -> Control:
         pos = cur.pos
         m = cur.match(_KEYWORD)
+        assert m is not None  # called at a '$': the rest of the pattern is optional
         word = m.group(1)
         kind = _CONTROL.get(word)
         if kind is None:
@@ -182,6 +193,7 @@ class LineParser:
     ) -> Control | AxisCommand | ContourStatement | Instruction:
         pos = cur.pos
         m = cur.match(_DIRECTIVE)
+        assert m is not None  # called at a '#': the rest of the pattern is optional
         word = m.group(1)
         if word == "AX":
             return parse_axis_command(cur, pos, number)
@@ -256,7 +268,7 @@ class LineParser:
                 if on_error is None:
                     raise
                 where = on_error(error, pos)  # the term is dropped, parsing goes on
-                if type(where) is int:
+                if isinstance(where, int):
                     cur.pos = where
                 else:  # the line with the term blanked, parsed again from this item on
                     cur = Cursor(where, pos)
@@ -271,7 +283,9 @@ class LineParser:
         c = cur.peek()
         if c == "$":
             if not cur.up.startswith("$GOTO", pos):
-                word = cur.match(_KEYWORD).group(1)
+                keyword = cur.match(_KEYWORD)
+                assert keyword is not None  # at a '$': the rest is optional
+                word = keyword.group(1)
                 raise cur.error(
                     NcErrorId.UNKNOWN_CONTROL_KEYWORD,
                     f"${word} must stand at the start of its line", pos,
@@ -319,7 +333,9 @@ class LineParser:
             raise cur.error(NcErrorId.AXIS_COMMAND_NOT_ALONE,
                             "#AX must stand alone in its NC line")
         elif c == "#" and CONTOUR_WORD.match(cur.up, pos):
-            word = _DIRECTIVE.match(cur.up, pos).group(1)
+            directive = _DIRECTIVE.match(cur.up, pos)
+            assert directive is not None  # at a '#': the rest is optional
+            word = directive.group(1)
             raise cur.error(NcErrorId.CONTOUR_COMMAND_SYNTAX,
                             f"#{word} must stand alone in its NC line")
         else:
@@ -366,14 +382,14 @@ class LineParser:
         c = cur.peek()
         parser = ExpressionParser(cur)
         if c == "[":
-            node = parser._primary()  # noqa: SLF001 - only the bracket, not what follows
+            node = parser._primary()  # only the bracket, not what follows
         elif c == "V" and cur.peek(1) == ".":
             node = parser.variable()
         else:
             raise cur.error(NcErrorId.MISSING_VALUE, f"value expected after '{letter}'", letter_pos)
         if negative:
             inner = node
-            node = lambda env: _negate(inner(env))  # noqa: E731
+            node = lambda env: _negate(inner(env))
         if isinstance(node, Const):
             value = node.value
             if isinstance(value, str):
@@ -423,7 +439,7 @@ def _skip(cur: Cursor) -> int:
     return cur.pos
 
 
-def _negate(value):
+def _negate(value: Value) -> Value:
     """-value; a string stays a string so that the word's evaluation reports it."""
     return value if isinstance(value, str) else -value
 

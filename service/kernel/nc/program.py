@@ -26,13 +26,16 @@ from enum import IntEnum
 
 from .check import SyntaxCheck, categorize, parse_checked
 from .errors import NcError, NcErrorId
+from .instructions import Instruction
 from .parser import LineParser
 from .source import LogicalLine, SourceText, comment_directive, read_logical, strip_comments
 from .statements import (
-    CLOSER_OF, OPENERS, SPELLING, AxisCommand, ContourStatement, Control, NcBlock, StmtKind,
+    CLOSER_OF, OPENERS, SPELLING, AxisCommand, ContourStatement, Control, Declaration, NcBlock,
+    StmtKind,
 )
 
-Statement = NcBlock | Control | AxisCommand | ContourStatement  # what a parsed line is
+# what a parsed line is
+Statement = NcBlock | Control | AxisCommand | ContourStatement | Instruction
 
 # parsed lines kept for loops and repeated calls; a long straight program does not
 # keep all of its lines parsed in memory (the cache starts over when full)
@@ -111,7 +114,8 @@ class Program:
         self._logical: dict[int, tuple[LogicalLine | None, int]] = {}
         self._structures: dict[int, Structure] = {}
         self._labels: dict[int, dict[str, list[int]]] = {}
-        self.var_blocks: dict[int, tuple[list, int]] = {}  # #VAR line -> (declarations, after)
+        # #VAR line -> (declarations, after)
+        self.var_blocks: dict[int, tuple[list[Declaration], int]] = {}
 
     # ------------------------------------------------------------ lines
 
@@ -163,8 +167,8 @@ class Program:
         if m is None:
             return None, line, after
         if m.group(2) is not None:
-            kind = StmtKind.RT_WHILE if m.group(2) == "WHILE" else StmtKind.RT_ENDWHILE
-            return kind, line, after
+            rt_kind = StmtKind.RT_WHILE if m.group(2) == "WHILE" else StmtKind.RT_ENDWHILE
+            return rt_kind, line, after
         kind = _KEYWORDS.get(m.group(1))
         if kind == StmtKind.IF and "$GOTO" in line.upper[m.end():]:
             kind = StmtKind.IF_GOTO
@@ -186,6 +190,9 @@ class Program:
         k = self.logical(index, end)[1]
         while k < end:
             found, line, after = self.keyword(k, end)
+            if found is None or line is None:  # no control keyword (or no code) here
+                k = after
+                continue
             if found in OPENERS:
                 stack.append((found, line))
             elif found in CLOSER_OF:
@@ -235,6 +242,7 @@ class Program:
                 continue
             if line is not None:
                 m = _LABEL_SCAN.match(line.upper)
+                assert m is not None  # every part of the pattern is optional: it always matches
                 if m.group(2):
                     labels.setdefault(f"N{int(m.group(1))}", []).append(k)
                 if m.group(3):
@@ -297,7 +305,11 @@ def _sections(text: str, src: SourceText) -> tuple[Section, dict[str, list[Secti
         if local is not None:
             headers.append((line_no, SectionKind.LOCAL, local.group(1).upper()))
         else:
-            headers.append((line_no, SectionKind.MAIN, _MAIN_HEADER.match(code).group(1).upper()))
+            main_header = _MAIN_HEADER.match(code)
+            # _header_lines gives lines whose first non-blank is '%' (not '#', see above),
+            # and comments start with '(' or ';': the '%' is still there
+            assert main_header is not None
+            headers.append((line_no, SectionKind.MAIN, main_header.group(1).upper()))
     bounds = [h[0] for h in headers] + [count]
     locals_: dict[str, list[Section]] = {}
     main: Section | None = None

@@ -13,12 +13,12 @@ events; the markers do not count for its endless-loop guard (``contour.LOOP_MARK
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 from .blocks import Block, ContourCommand, ContourKind, LogArea
 from .contour_run import contour_block
 from .frames import ControlEntry, Frame
 from .running_decoder import RunningDecoder
+from .statements import Control
 
 
 @dataclass(slots=True)
@@ -53,14 +53,14 @@ class RtLoopMarkers:
         """``#RT ENDWHILE`` closed ``entry``: its loop tests its condition next."""
         self._closed = (frame, entry)
 
-    def tested(self, frame: Frame, stmt: Any, index: int,
+    def tested(self, frame: Frame, stmt: Control, index: int,
                entry: ControlEntry | None) -> Block | None:
         """The ``#RT WHILE`` ``stmt`` at line ``index`` was tested: ``entry`` is its new
         control entry (None: the condition was false). The marker, if any."""
         closed, self._closed = self._closed, None
         retest = closed is not None and closed[0] is frame and closed[1].index == index
         tracked = self.tracked
-        if retest:
+        if closed is not None and retest:
             if tracked is None or tracked.entry is not closed[1]:
                 return None  # an untracked loop (or one nested in the tracked one)
             if entry is None:
@@ -100,9 +100,9 @@ class RtLoopMarkers:
             self.tracked = None
         return alive
 
-    def _pass(self, stmt: Any, tracked: _Tracked) -> Block:
+    def _pass(self, stmt: Control, tracked: _Tracked) -> Block:
         return self._marker(stmt, ContourCommand(ContourKind.RT_PASS, loop=tracked.serial,
                                                  rt_pass=tracked.rt_pass))
 
-    def _marker(self, stmt: Any, command: ContourCommand) -> Block:
+    def _marker(self, stmt: Control, command: ContourCommand) -> Block:
         return contour_block(stmt.line, stmt.pos, stmt.number, self.decoder.manual, command)

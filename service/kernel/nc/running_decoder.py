@@ -12,10 +12,16 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Protocol
 
+from .blockexec import BlockExecutor
+from .check import SyntaxCheck
 from .evaluation import Env
 from .frames import Frame
 from .modal import ModalState
+from .parser import LineParser
+from .program import Program
 from .statements import Control
+from .technology import Surroundings
+from .variables import Value
 
 
 class RunningDecoder(Env, Protocol):
@@ -37,3 +43,25 @@ class RunningDecoder(Env, Protocol):
 
     def declare_block(self, frame: Frame, stmt: Control, after: int) -> None:
         """Run the ``#VAR`` block at ``frame.index``."""
+
+
+class CallingDecoder(RunningDecoder, Protocol):
+    """What the instruction runners (``instruction_run``) and the cycle calls
+    (``cycle_run``, the built-in cycles) use besides: the channel's axes, the syntax
+    check, the surroundings and the (sub)programs they load and push."""
+
+    axes: tuple[str, ...]  # the channel's axis names
+    check: SyntaxCheck | None  # the running syntax check, None when the program runs
+    surroundings: Surroundings  # the file store and settings outside the program
+    files_written: set[str]  # #MSG SAVE files written in this run
+    parser: LineParser  # parses the lines of the programs it loads
+    executor: BlockExecutor  # the modal state's block executor (tool radius, ...)
+
+    def load(self, name: str) -> Program:
+        """File ``name`` of the program store, parsed lazily (KeyError if absent)."""
+
+    def has_file(self, name: str) -> bool:
+        """Whether the program store holds file ``name``."""
+
+    def push_cycle(self, frame: Frame, params: dict[int, Value] | None) -> None:
+        """Run ``frame`` as a cycle with its ``@P`` parameters."""

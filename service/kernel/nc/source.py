@@ -21,6 +21,7 @@ came from, so an error in the third continuation line points at that line.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from itertools import accumulate
 
 from .errors import NcError, NcErrorId
@@ -44,7 +45,7 @@ class SourceText:
             base = 3
         raw = text.split("\n")
         if text.isascii():
-            lengths = map(len, raw)
+            lengths: Iterable[int] = map(len, raw)
         else:  # offsets are byte offsets of the UTF-8 file, as the HMI counts them
             lengths = (len(line.encode("utf-8")) for line in raw)
         # byte offset of line i = starts[i] + i (the i newlines before it)
@@ -93,12 +94,6 @@ class LogicalLine:
         error = NcError(err_id, self.file, line, column, message)
         error.pos = pos
         return error
-
-    def first_column(self) -> int:
-        """1-based column of the first non-blank character (1 for an empty line)."""
-        stripped = self.text.lstrip()
-        pos = len(self.text) - len(stripped) if stripped else 0
-        return self.locate(pos)[1]
 
 
 def _upper(text: str) -> str:

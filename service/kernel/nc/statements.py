@@ -9,11 +9,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import IntEnum
+from typing import TypeAlias, final
 
 from .blocks import AxisExchangeKind, ContourKind
 from .expressions import Node, VarRef
 from .source import LogicalLine
 from .variables import Scope, VarType
+
+#: an initializer list of ``#VAR``: expressions, nested lists for the rows of an array
+InitList: TypeAlias = list["Node | InitList"]
 
 
 class StmtKind(IntEnum):
@@ -85,6 +89,7 @@ class WordKind(IntEnum):
     LOOK_AHEAD_PARAM = 11  # METB = <s> / VFBT = <factor> / BBTRC = <blocks>
 
 
+@final  # the decoder dispatches on type(stmt) is ...: no subclasses
 @dataclass(slots=True)
 class Word:
     """An address letter with its value (float constant or expression node)."""
@@ -96,6 +101,7 @@ class Word:
     axis: int = -1  # AXIS: channel axis index (-1: X without such an axis); OFFSET: too
 
 
+@final
 @dataclass(slots=True)
 class Assign:
     """``V.x.y = expr`` inside an NC block."""
@@ -145,6 +151,7 @@ class Goto:
     pos: int
 
 
+@final
 @dataclass(slots=True)
 class NcBlock:
     """An NC block: its items in program order, evaluated left to right."""
@@ -158,6 +165,7 @@ class NcBlock:
     has_g4: bool = False  # a constant G4 (dwell) is in the block
 
 
+@final
 @dataclass(slots=True)
 class Control:
     """A control statement ($IF ... $ENDSWITCH, #VAR, #RT WHILE, ...)."""
@@ -187,6 +195,7 @@ class AxisRef:
     index_pos: int = -1
 
 
+@final
 @dataclass(slots=True)
 class AxisCommand:
     """``#AX RELEASE`` / ``#AX REQUEST``: alone in its NC line (besides N and a label)."""
@@ -198,6 +207,7 @@ class AxisCommand:
     number: int | None = None  # N number of the line, if any
 
 
+@final
 @dataclass(slots=True)
 class ContourStatement:
     """``#CONTOUR LOOKAHEAD LOG ...`` or ``#DISTANCE PROG START CLEAR``: alone in its NC
@@ -219,6 +229,6 @@ class Declaration:
     name: str
     vtype: VarType
     dims: tuple[int, ...]
-    init: Node | list | None  # expression, or nested lists of expressions for arrays
+    init: Node | InitList | None  # expression, or nested lists of expressions for arrays
     line: LogicalLine
     pos: int

@@ -43,7 +43,7 @@ class HscProgram:
     tolerance_mm: float = 0.0
 
 
-def _ignore(*_args) -> None:
+def _ignore(*_args: object) -> None:
     return None
 
 

@@ -62,7 +62,9 @@ _INT_RANGE = {
     VarType.SGN32: (-0x80000000, 0x7FFFFFFF),
 }
 
-_DEFAULT = {VarType.BOOLEAN: False, VarType.REAL32: 0.0, VarType.REAL64: 0.0, VarType.STRING: ""}
+_DEFAULT: dict[VarType, Value] = {
+    VarType.BOOLEAN: False, VarType.REAL32: 0.0, VarType.REAL64: 0.0, VarType.STRING: "",
+}
 
 Value = float | int | bool | str
 
@@ -129,7 +131,7 @@ class Variable:
                 f"{self.name} needs {len(self.dims)} index(es), got {len(indices)}",
             )
         flat = 0
-        for index, size in zip(indices, self.dims):
+        for index, size in zip(indices, self.dims, strict=True):
             if not 0 <= index < size:
                 raise VariableFault(
                     NcErrorId.ARRAY_INDEX_OUT_OF_RANGE,

@@ -17,13 +17,16 @@ from collections.abc import Sequence
 
 from ..nc.blocks import MotionKind
 from .errors import PathError
-from .geometry import ARC_RADIUS_TOLERANCE_MM, Arc, Line
+from .geometry import ARC_RADIUS_TOLERANCE_MM, Arc, Element, Line
 from .limits import SW_LIMIT_TOLERANCE_MM, check_software_limits
 
 Limits = Sequence[tuple[float, float]]
+#: (line index, MotionKind, end point, arc centre (p, q) or None): nc.check.PointBatch
+Record = tuple[int, MotionKind, tuple[float, ...], tuple[float, float] | None]
 
 
-def first_violation(start_mm: Sequence[float], records: list, plane: tuple[int, int] | None,
+def first_violation(start_mm: Sequence[float], records: Sequence[Record],
+                    plane: tuple[int, int] | None,
                     sw_limits_mm: Limits) -> tuple[int, PathError] | None:
     """The first record of ``records`` (``(line, kind, end, centre)`` as in ``PointBatch``,
     the first starting at ``start_mm``) that leaves the limits, with the error; None
@@ -41,14 +44,16 @@ def first_violation(start_mm: Sequence[float], records: list, plane: tuple[int, 
     return None
 
 
-def _inside(start_mm, records: list, plane, sw_limits_mm: Limits) -> bool:
+def _inside(start_mm: Sequence[float], records: Sequence[Record], plane: tuple[int, int] | None,
+            sw_limits_mm: Limits) -> bool:
     """True when every end point and every arc's full circle is inside the limits."""
     tol = SW_LIMIT_TOLERANCE_MM
     ends = [r[2] for r in records]
     for column, (lo, hi) in zip(zip(*ends), sw_limits_mm):
         if min(column) < lo - tol or max(column) > hi + tol:
             return False
-    arcs = [k for k, r in enumerate(records) if type(r[3]) is tuple]
+    arcs = [(k, centre) for k, (_, _, _, centre) in enumerate(records)
+            if type(centre) is tuple]
     if not arcs or plane is None:
         return True
     p, q = plane
@@ -56,9 +61,8 @@ def _inside(start_mm, records: list, plane, sw_limits_mm: Limits) -> bool:
     lo_q, hi_q = sw_limits_mm[q]
     lo_p, hi_p, lo_q, hi_q = lo_p - tol, hi_p + tol, lo_q - tol, hi_q + tol
     sqrt = math.sqrt
-    for k in arcs:
+    for k, (cp, cq) in arcs:
         start = records[k - 1][2] if k else start_mm
-        cp, cq = records[k][3]
         dp, dq = start[p] - cp, start[q] - cq
         # the end lies within the arc tolerance of the circle through the start
         r = sqrt(dp * dp + dq * dq) + ARC_RADIUS_TOLERANCE_MM
@@ -67,10 +71,11 @@ def _inside(start_mm, records: list, plane, sw_limits_mm: Limits) -> bool:
     return True
 
 
-def _exact(start: Sequence[float], record: tuple, plane: tuple[int, int] | None,
+def _exact(start: Sequence[float], record: Record, plane: tuple[int, int] | None,
            sw_limits_mm: Limits) -> PathError | None:
     """The limit error of one record, checked as the path preparation checks it."""
     _, kind, end, centre = record
+    element: Element
     try:
         if type(centre) is tuple and plane is not None:
             element = Arc.from_points(start, end, centre, plane, kind == MotionKind.ARC_CCW)

@@ -66,5 +66,7 @@ class PathError(Exception):
             where = f" ({number}{src.file}:{src.line})"
         return f"path error {int(self.id)} {self.id.name}: {self.message}{where}"
 
-    def __reduce__(self):  # picklable despite the custom __init__
+    def __reduce__(  # picklable despite the custom __init__
+        self,
+    ) -> tuple[type[PathError], tuple[PathErrorId, str, Block | None]]:
         return (PathError, (self.id, self.message, self.block))

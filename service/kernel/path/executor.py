@@ -104,6 +104,8 @@ class PathExecutor:
                 or self._closed):
             return False
         tail = self._planner.tail
+        # the interpolator's segment is the planner's head (pop_head), so there is a tail
+        assert tail is not None
         if (tail.junction_mm_s > 0.0 or tail.stop or tail.single_stop
                 or tail.block.look_ahead is not None):  # a section's end is planned
             return False

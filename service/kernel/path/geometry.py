@@ -125,7 +125,8 @@ class Arc:
                             f"arc end radius {r1:.4f} mm differs from start radius {r0:.4f} mm "
                             f"by more than {ARC_RADIUS_TOLERANCE_MM} mm")
         a0, a1 = math.atan2(sq, sp), math.atan2(eq, ep)
-        full = math.hypot(end_mm[p] - start_mm[p], end_mm[q] - start_mm[q]) <= FULL_CIRCLE_TOLERANCE_MM
+        full = (math.hypot(end_mm[p] - start_mm[p], end_mm[q] - start_mm[q])
+                <= FULL_CIRCLE_TOLERANCE_MM)
         if full:
             sweep = TWO_PI
         else:

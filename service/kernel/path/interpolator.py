@@ -211,6 +211,7 @@ class Interpolator:
                 self.dwell_left_s = 0.0
                 self.waiting = Waiting.NONE
                 block, self.wait_block = self.wait_block, None
+                assert block is not None  # DWELL is entered with its block (below)
                 if self._finish(block, self.dwell_single, finished):
                     return 0.0
                 continue

@@ -9,6 +9,7 @@ axes at its programmed ends, so consecutive elements stay connected).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 from .errors import PathError, PathErrorId
 from .geometry import Arc, Element, Line, with_plane
@@ -17,13 +18,14 @@ MIN_LENGTH_MM = 1e-9  # elements shorter than this are dropped (their block end 
 ON_ELEMENT_TOLERANCE_MM = 1e-7  # an intersection may lie this far outside an element
 
 
-def plane_point(point, plane) -> tuple[float, float]:
+def plane_point(point: Sequence[float], plane: tuple[int, int]) -> tuple[float, float]:
     """The in-plane coordinates (p, q) of a point."""
     return point[plane[0]], point[plane[1]]
 
 
-def plane_tangent(tangent, plane) -> tuple[float, float]:
-    """The in-plane direction of a tangent, normalised; PathError without motion in the plane."""
+def plane_tangent(tangent: Sequence[float], plane: tuple[int, int]) -> tuple[float, float]:
+    """The in-plane direction of a tangent, normalised; PathError without motion in the
+    plane."""
     tp, tq = tangent[plane[0]], tangent[plane[1]]
     norm = math.hypot(tp, tq)
     if norm <= 1e-12:
@@ -55,7 +57,10 @@ def offset_element(element: Element, plane: tuple[int, int], side: float,
                element.start_mm, r1)
 
 
-def line_circle(p0, d, center, radius) -> list[tuple[float, float]]:
+def line_circle(
+    p0: tuple[float, float], d: tuple[float, float], center: tuple[float, float],
+    radius: float,
+) -> list[tuple[float, float]]:
     """Points where the line through ``p0`` with unit direction ``d`` meets the circle."""
     fx, fy = p0[0] - center[0], p0[1] - center[1]
     b = fx * d[0] + fy * d[1]
@@ -69,7 +74,9 @@ def line_circle(p0, d, center, radius) -> list[tuple[float, float]]:
     return [(p0[0] + t * d[0], p0[1] + t * d[1]) for t in (-b - root, -b + root)]
 
 
-def circle_circle(c1, r1, c2, r2) -> list[tuple[float, float]]:
+def circle_circle(
+    c1: tuple[float, float], r1: float, c2: tuple[float, float], r2: float,
+) -> list[tuple[float, float]]:
     """Points where two circles meet (none for concentric circles)."""
     dx, dy = c2[0] - c1[0], c2[1] - c1[1]
     dist = math.hypot(dx, dy)
@@ -86,9 +93,19 @@ def circle_circle(c1, r1, c2, r2) -> list[tuple[float, float]]:
     return [(mx + h * dy / dist, my - h * dx / dist), (mx - h * dy / dist, my + h * dx / dist)]
 
 
+def line_and_arc(first: Element, second: Element) -> tuple[Line, Arc]:
+    """The two elements as (line, arc); ValueError unless one is a line, one an arc."""
+    if isinstance(first, Line) and isinstance(second, Arc):
+        return first, second
+    if isinstance(first, Arc) and isinstance(second, Line):
+        return second, first
+    raise ValueError(f"a line and an arc expected, got {first!r} and {second!r}")
+
+
 def intersect(first: Element, second: Element, plane: tuple[int, int],
               near: tuple[float, float]) -> tuple[float, float] | None:
-    """Intersection of the two elements' carrier lines/circles in the plane nearest to ``near``."""
+    """Intersection of the two elements' carrier lines/circles in the plane nearest to
+    ``near``."""
     if isinstance(first, Line) and isinstance(second, Line):
         p1, p2 = plane_point(first.start_mm, plane), plane_point(second.start_mm, plane)
         d1, d2 = plane_tangent(first.direction, plane), plane_tangent(second.direction, plane)
@@ -97,14 +114,14 @@ def intersect(first: Element, second: Element, plane: tuple[int, int],
             return None
         t = ((p2[0] - p1[0]) * d2[1] - (p2[1] - p1[1]) * d2[0]) / cross
         return p1[0] + t * d1[0], p1[1] + t * d1[1]
-    if isinstance(first, Line) or isinstance(second, Line):
-        line, arc = (first, second) if isinstance(first, Line) else (second, first)
-        candidates = line_circle(plane_point(line.start_mm, plane),
-                                  plane_tangent(line.direction, plane), arc.center,
-                                  arc.radius_mm)
-    else:
+    if isinstance(first, Arc) and isinstance(second, Arc):
         candidates = circle_circle(first.center, first.radius_mm, second.center,
-                                    second.radius_mm)
+                                   second.radius_mm)
+    else:
+        line, arc = line_and_arc(first, second)
+        candidates = line_circle(plane_point(line.start_mm, plane),
+                                 plane_tangent(line.direction, plane), arc.center,
+                                 arc.radius_mm)
     if not candidates:
         return None
     return min(candidates, key=lambda x: math.hypot(x[0] - near[0], x[1] - near[1]))
@@ -121,14 +138,16 @@ def trim_end(element: Element, point: tuple[float, float], plane: tuple[int, int
         tp, tq = plane_tangent(element.direction, plane)
         s = element.start_mm
         along = (point[0] - s[plane[0]]) * tp + (point[1] - s[plane[1]]) * tq
-        full = (element.end_mm[plane[0]] - s[plane[0]]) * tp + (element.end_mm[plane[1]] - s[plane[1]]) * tq
+        full = ((element.end_mm[plane[0]] - s[plane[0]]) * tp
+                + (element.end_mm[plane[1]] - s[plane[1]]) * tq)
         if along <= MIN_LENGTH_MM or along > full + ON_ELEMENT_TOLERANCE_MM:
             raise _violation("end of the previous element")
         return Line(s, with_plane(element.end_mm, plane, *point))
     angle = math.atan2(point[1] - element.center[1], point[0] - element.center[0])
     off = element.angle_offset(angle, at_end=True)
     span = abs(element.sweep_rad)
-    if off * element.radius_mm <= MIN_LENGTH_MM or (off - span) * element.radius_mm > ON_ELEMENT_TOLERANCE_MM:
+    if (off * element.radius_mm <= MIN_LENGTH_MM
+            or (off - span) * element.radius_mm > ON_ELEMENT_TOLERANCE_MM):
         raise _violation("end of the previous arc")
     off = min(off, span)
     frac = off / span
@@ -144,7 +163,8 @@ def trim_start(element: Element, point: tuple[float, float], plane: tuple[int, i
         tp, tq = plane_tangent(element.direction, plane)
         e = element.end_mm
         left = (e[plane[0]] - point[0]) * tp + (e[plane[1]] - point[1]) * tq
-        full = (e[plane[0]] - element.start_mm[plane[0]]) * tp + (e[plane[1]] - element.start_mm[plane[1]]) * tq
+        full = ((e[plane[0]] - element.start_mm[plane[0]]) * tp
+                + (e[plane[1]] - element.start_mm[plane[1]]) * tq)
         if left <= MIN_LENGTH_MM or left > full + ON_ELEMENT_TOLERANCE_MM:
             raise _violation("start of the next element")
         return Line(with_plane(element.start_mm, plane, *point), e)

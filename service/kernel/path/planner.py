@@ -186,15 +186,16 @@ class LookAhead:
         if self.tail is not None:
             self.backward(self.tail)
 
-    def backward(self, seg: Segment) -> None:
-        """Backward pass from ``seg`` towards the head.
+    def backward(self, last: Segment) -> None:
+        """Backward pass from ``last`` towards the head.
 
         exit = min(junction, entry of the next), entry = min(cap, sqrt(exit^2 + 2 a L)).
         Stops at the first planned segment whose exit speed stays the same.
         """
         sqrt = math.sqrt
         # the last segment's junction is its exit limit (0, or an LA_ON section's plan)
-        nxt_entry = seg.next.entry_mm_s if seg.next is not None else math.inf
+        nxt_entry = last.next.entry_mm_s if last.next is not None else math.inf
+        seg: Segment | None = last
         while seg is not None:
             exit_ = seg.junction_mm_s
             if nxt_entry < exit_:

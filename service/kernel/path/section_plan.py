@@ -52,7 +52,7 @@ from ..nc.blocks import Block, Compensation, LookAheadMark, Motion, MotionKind
 from .errors import PathError, PathErrorId
 from .geometry import Arc, Element, Line
 from .limits import AxisDynamics, corner_limit_mm_s
-from .offsets import circle_circle, line_circle, plane_point, plane_tangent
+from .offsets import circle_circle, line_and_arc, line_circle, plane_point, plane_tangent
 from .planner import trapezoid
 from .segments import PathPreparation, Segment
 
@@ -107,6 +107,20 @@ def plan_section(blocks: Sequence[Block], dynamics: Sequence[AxisDynamics], *,
     return SectionPlan(out, error)
 
 
+def _mark(block: Block) -> LookAheadMark:
+    """The look-ahead mark of a block of the section (``plan_section``: all have one)."""
+    if block.look_ahead is None:
+        raise ValueError(f"a block of an LA_ON section without its mark: {block.source}")
+    return block.look_ahead
+
+
+def _motion(block: Block) -> Motion:
+    """The motion of a block that has elements (a block without motion has none)."""
+    if block.motion is None:
+        raise ValueError(f"a planned element of a block without motion: {block.source}")
+    return block.motion
+
+
 def _prepare(blocks: list[Block], dynamics: Sequence[AxisDynamics],
              start: Sequence[float]) -> tuple[list[_Element], int]:
     """Segments of the section, and how many leading blocks are complete (their end
@@ -143,17 +157,17 @@ def _limits(elements: list[_Element], blocks: list[Block], buffer_blocks: int,
         block_mm[e.index] += e.seg.length_mm
     slots, stops, per_cycle = _slots(blocks, block_mm, buffer_blocks)
     rate = per_cycle / cycle_s  # blocks per second the buffer can pass
-    rate_caps = [length * rate / n for length, n in zip(block_mm, slots)]
+    rate_caps = [length * rate / n for length, n in zip(block_mm, slots, strict=True)]
     last = {e.index: e for e in elements}
     for k in stops:  # bare blocks alone fill the buffer behind block k: it must stop
         last[k].stop = True
-    for e, nxt in zip(elements, elements[1:] + [None]):
+    for e, nxt in zip(elements, [*elements[1:], None], strict=True):
         e.cap = min(e.cap, rate_caps[e.index])
         if nxt is None:
             continue
         corner = corner_limit_mm_s(e.seg.tangent_end, nxt.seg.tangent_start, jumps)
         if corner != math.inf:
-            corner *= blocks[nxt.index].look_ahead.vfbt
+            corner *= _mark(blocks[nxt.index]).vfbt
         e.corner = corner
     return rate_caps
 
@@ -242,10 +256,10 @@ def _rewrite(blocks: list[Block], elements: list[_Element],
     split = {k for k, es in own.items() if len(es) == 1 and _splittable(blocks[k])}
     pieces: list[_Piece] = []
     for e in elements:
-        rapid = blocks[e.index].motion.kind == MotionKind.RAPID
+        rapid = _motion(blocks[e.index]).kind == MotionKind.RAPID
         if e.index in split:
             begin = 0.0
-            for end, f in _pieces(e, blocks[e.index].look_ahead.metb_s):
+            for end, f in _pieces(e, _mark(blocks[e.index]).metb_s):
                 pieces.append(_Piece(e, begin, end, min(f, e.cap)))
                 begin = end
         else:
@@ -294,7 +308,7 @@ def _exits(pieces: list[_Piece]) -> None:
 
 def _splittable(block: Block) -> bool:
     """Only a plain feed move is split: nothing else happens at its start or end."""
-    m = block.motion
+    m = _motion(block)
     return (m.kind != MotionKind.RAPID and m.compensation == Compensation.OFF
             and block.dwell_s == 0.0 and not block.stop and not block.m_functions
             and block.spindle_speed_rpm is None and block.tool is None
@@ -310,7 +324,7 @@ def _feed(motion: Motion, speed_mm_s: float) -> Motion:
 
 def _with_plan(block: Block, motion: Motion, exit_mm_s: float, max_mm_s: float) -> Block:
     return replace(block, motion=motion, look_ahead=replace(
-        block.look_ahead, exit_mm_s=exit_mm_s, max_mm_s=max_mm_s))
+        _mark(block), exit_mm_s=exit_mm_s, max_mm_s=max_mm_s))
 
 
 def _pieces(e: _Element, metb_s: float) -> list[tuple[float, float]]:
@@ -347,7 +361,7 @@ def _split(block: Block, pieces: list[_Piece], exit_mm_s: float,
            max_mm_s: float) -> list[Block]:
     """``block`` as one sub-block per piece of its element; the last one ends where
     the block ends and carries the block's exit speed."""
-    motion = block.motion
+    motion = _motion(block)
     if len(pieces) == 1:
         return [_with_plan(block, _feed(motion, pieces[0].cap), exit_mm_s, max_mm_s)]
     element = pieces[0].element.seg.element
@@ -383,10 +397,10 @@ def _bottleneck(elements: list[_Element], blocks: list[Block],
     earlier block. Moves without compensation (G40, or a tool radius of 0) are not
     part of the compensated path: a rapid that crosses it higher up is no bottleneck."""
     for i, e in enumerate(elements):
-        motion = e.seg.block.motion
+        motion = _motion(e.seg.block)
         if not _compensated(e.seg.block) or e.index >= planned:
             continue
-        reach = e.index + blocks[e.index].look_ahead.bbtrc
+        reach = e.index + _mark(blocks[e.index]).bbtrc
         for other in elements[i + 2:]:
             if other.index > reach or other.index >= planned:
                 break
@@ -404,7 +418,7 @@ def _bottleneck(elements: list[_Element], blocks: list[Block],
                     f"bottleneck: the compensated path crosses itself at ({point[0]:.4f}, "
                     f"{point[1]:.4f}) with {where}; the tool radius "
                     f"{motion.tool_radius_mm:g} mm does not fit between them "
-                    f"(BBTRC={blocks[e.index].look_ahead.bbtrc})", blocks[e.index],
+                    f"(BBTRC={_mark(blocks[e.index]).bbtrc})", blocks[e.index],
                 ), e.index
     return None, planned
 
@@ -432,11 +446,11 @@ def _carrier_points(first: Element, second: Element,
             return []
         t = ((p2[0] - p1[0]) * w[1] - (p2[1] - p1[1]) * w[0]) / cross
         return [(p1[0] + t * u[0], p1[1] + t * u[1])]
-    if isinstance(first, Line) or isinstance(second, Line):
-        line, arc = (first, second) if isinstance(first, Line) else (second, first)
-        return line_circle(plane_point(line.start_mm, plane), plane_tangent(line.direction, plane),
-                           arc.center, arc.radius_mm)
-    return circle_circle(first.center, first.radius_mm, second.center, second.radius_mm)
+    if isinstance(first, Arc) and isinstance(second, Arc):
+        return circle_circle(first.center, first.radius_mm, second.center, second.radius_mm)
+    line, arc = line_and_arc(first, second)
+    return line_circle(plane_point(line.start_mm, plane), plane_tangent(line.direction, plane),
+                       arc.center, arc.radius_mm)
 
 
 _INSIDE_MM = 1e-6  # a crossing this close to an element's end is a touching end point

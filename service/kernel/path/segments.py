@@ -11,7 +11,7 @@ acceleration, speed limits, tangents). Blocks without motion come out as bare
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 from ..nc.blocks import Block, Compensation, MotionKind
 from .compensation import Piece, RadiusCompensator
@@ -83,7 +83,7 @@ class Segment:
                 f"exit={self.exit_mm_s:.6g})")
 
 
-def _finite(values) -> bool:
+def _finite(values: Iterable[float]) -> bool:
     return all(map(math.isfinite, values))
 
 

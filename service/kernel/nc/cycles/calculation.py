@@ -12,14 +12,17 @@ set to 0, so exact input prints exact output (no ``-0.000000``).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
+from typing import TypeVar
 
 from ..errors import NcErrorId
 from ..variables import Value
 from .fitting import (
     Degeneracy, FitError, fit_circle_2d, fit_circle_3d, fit_line, fit_plane, fit_sphere,
 )
-from .spec import BuiltinCycle, ParamProblem, ParamSpec
+from .spec import BuiltinCycle, CycleContext, ParamProblem, ParamSpec
+
+Fit = TypeVar("Fit")  # the result of one of the fits
 
 MAX_POINTS = 10
 _NOISE = 1e-13  # result components this small (relative to the points) are rounding noise
@@ -36,9 +39,11 @@ def _point_params(dims: int) -> dict[int, ParamSpec]:
             for d in range(dims) for k in range(MAX_POINTS)}
 
 
-def _points_check(name: str, dims: int, minimum: int):
+def _points_check(
+    name: str, dims: int, minimum: int,
+) -> Callable[[Mapping[int, Value]], list[ParamProblem]]:
     def check(values: Mapping[int, Value]) -> list[ParamProblem]:
-        problems = []
+        problems: list[ParamProblem] = []
         count = sum(1 for k in range(MAX_POINTS) if 50 + k in values)
         for k in range(MAX_POINTS):
             given = [50 + 10 * d + k in values for d in range(dims)]
@@ -62,7 +67,7 @@ def _points_check(name: str, dims: int, minimum: int):
 
 
 def _points(values: Mapping[int, Value], dims: int) -> list[tuple[float, ...]]:
-    points = []
+    points: list[tuple[float, ...]] = []
     for k in range(MAX_POINTS):
         if 50 + k not in values:
             break
@@ -70,20 +75,23 @@ def _points(values: Mapping[int, Value], dims: int) -> list[tuple[float, ...]]:
     return points
 
 
-def _fitted(context, fit: Callable, points):
+def _fitted(
+    context: CycleContext, name: str, fit: Callable[[Sequence[Sequence[float]]], Fit],
+    points: list[tuple[float, ...]],
+) -> tuple[Fit, float]:
+    """The fit of ``points`` and their scale (1 + the largest coordinate's size)."""
     try:
         result = fit(points)
     except FitError as fault:
         err_id = _ERROR_OF.get(fault.degeneracy, NcErrorId.CYCLE_PARAMETER_RANGE)
-        raise context.error(err_id, f"{context.name}: {fault.message}") from None
-    context.scale = 1.0 + max(abs(c) for point in points for c in point)
-    return result
+        raise context.error(err_id, f"{name}: {fault.message}") from None
+    return result, 1.0 + max(abs(c) for point in points for c in point)
 
 
-def _position(context, value: float) -> float:
-    """A coordinate of a result point: rounding noise (relative to the points) is 0, so
-    that the unit circle's centre prints as 0.000000, not -0.000000."""
-    return 0.0 if abs(value) <= _NOISE * context.scale else value
+def _position(scale: float, value: float) -> float:
+    """A coordinate of a result point: rounding noise (relative to the points' ``scale``)
+    is 0, so that the unit circle's centre prints as 0.000000, not -0.000000."""
+    return 0.0 if abs(value) <= _NOISE * scale else value
 
 
 def _unit(value: float) -> float:
@@ -91,50 +99,51 @@ def _unit(value: float) -> float:
     return 0.0 if abs(value) <= _NOISE else value
 
 
-def _circle(context) -> None:
-    result = _fitted(context, fit_circle_2d, _points(context.params, 2))
-    context.set_output("SysRetCenterX", _position(context, result.center_x))
-    context.set_output("SysRetCenterY", _position(context, result.center_y))
+def _circle(context: CycleContext, name: str) -> None:
+    result, scale = _fitted(context, name, fit_circle_2d, _points(context.params, 2))
+    context.set_output("SysRetCenterX", _position(scale, result.center_x))
+    context.set_output("SysRetCenterY", _position(scale, result.center_y))
     context.set_output("SysRetRadius", result.radius)
     context.set_output("SysRetVariance", result.variance)
 
 
-def _plane(context) -> None:
-    result = _fitted(context, fit_plane, _points(context.params, 3))
-    for axis, n, s in zip(_AXES, result.normal, result.support):
+def _plane(context: CycleContext, name: str) -> None:
+    result, scale = _fitted(context, name, fit_plane, _points(context.params, 3))
+    for axis, n, s in zip(_AXES, result.normal, result.support, strict=True):
         context.set_output(f"SysRetNormal{axis}", _unit(n))
-        context.set_output(f"SysRetSupVector{axis}", _position(context, s))
+        context.set_output(f"SysRetSupVector{axis}", _position(scale, s))
 
 
-def _line(context) -> None:
-    result = _fitted(context, fit_line, _points(context.params, 3))
-    for axis, d, s in zip(_AXES, result.direction, result.support):
+def _line(context: CycleContext, name: str) -> None:
+    result, scale = _fitted(context, name, fit_line, _points(context.params, 3))
+    for axis, d, s in zip(_AXES, result.direction, result.support, strict=True):
         context.set_output(f"SysRetDirVector{axis}", _unit(d))
-        context.set_output(f"SysRetSupVector{axis}", _position(context, s))
+        context.set_output(f"SysRetSupVector{axis}", _position(scale, s))
     context.set_output("SysRetVariance", result.variance)
 
 
-def _sphere(context) -> None:
-    result = _fitted(context, fit_sphere, _points(context.params, 3))
-    for axis, c in zip(_AXES, result.center):
-        context.set_output(f"SysRetCenter{axis}", _position(context, c))
+def _sphere(context: CycleContext, name: str) -> None:
+    result, scale = _fitted(context, name, fit_sphere, _points(context.params, 3))
+    for axis, c in zip(_AXES, result.center, strict=True):
+        context.set_output(f"SysRetCenter{axis}", _position(scale, c))
     context.set_output("SysRetRadius", result.radius)
     context.set_output("SysRetVariance", result.variance)
 
 
-def _plane_circle(context) -> None:
-    result = _fitted(context, fit_circle_3d, _points(context.params, 3))
-    for axis, c, n in zip(_AXES, result.center, result.normal):
-        context.set_output(f"SysRetCenter{axis}", _position(context, c))
+def _plane_circle(context: CycleContext, name: str) -> None:
+    result, scale = _fitted(context, name, fit_circle_3d, _points(context.params, 3))
+    for axis, c, n in zip(_AXES, result.center, result.normal, strict=True):
+        context.set_output(f"SysRetCenter{axis}", _position(scale, c))
         context.set_output(f"SysRetNormal{axis}", _unit(n))
     context.set_output("SysRetRadius", result.radius)
     context.set_output("SysRetRadVariance", result.radius_variance)
 
 
-def _cycle(name: str, dims: int, minimum: int, run) -> BuiltinCycle:
-    def body(context) -> None:
-        context.name = name
-        run(context)
+def _cycle(
+    name: str, dims: int, minimum: int, run: Callable[[CycleContext, str], None],
+) -> BuiltinCycle:
+    def body(context: CycleContext) -> None:
+        run(context, name)  # a calculation has no motion part: the body returns None
 
     return BuiltinCycle(name, _point_params(dims), body, _points_check(name, dims, minimum))
 

@@ -149,7 +149,7 @@ class Circle3dFit:
 # --- public fits -------------------------------------------------------------------------
 
 
-def fit_circle_2d(points: Sequence[tuple[float, float]]) -> CircleFit:
+def fit_circle_2d(points: Sequence[Sequence[float]]) -> CircleFit:
     """Geometric least-squares circle through 3..10 points in the XY plane.
 
     Raises ``FitError`` for a wrong count, NaN/inf, identical or collinear points.
@@ -163,7 +163,7 @@ def fit_circle_2d(points: Sequence[tuple[float, float]]) -> CircleFit:
     return CircleFit(float(centre[0]) + 0.0, float(centre[1]) + 0.0, radius, variance)
 
 
-def fit_plane(points: Sequence[tuple[float, float, float]]) -> PlaneFit:
+def fit_plane(points: Sequence[Sequence[float]]) -> PlaneFit:
     """Total least-squares plane through 3..10 points (normal +Z, else +Y, else +X).
 
     Raises ``FitError`` for a wrong count, NaN/inf, identical or collinear points.
@@ -173,7 +173,7 @@ def fit_plane(points: Sequence[tuple[float, float, float]]) -> PlaneFit:
     return PlaneFit(normal=_vector(_oriented(basis[2])), support=_vector(centroid))
 
 
-def fit_line(points: Sequence[tuple[float, float, float]]) -> LineFit:
+def fit_line(points: Sequence[Sequence[float]]) -> LineFit:
     """Total least-squares line through 2..10 points, directed from first toward last.
 
     Raises ``FitError`` for a wrong count, NaN/inf or identical points.
@@ -196,7 +196,7 @@ def fit_line(points: Sequence[tuple[float, float, float]]) -> LineFit:
     return LineFit(direction=_vector(direction), support=_vector(centroid), variance=variance)
 
 
-def fit_sphere(points: Sequence[tuple[float, float, float]]) -> SphereFit:
+def fit_sphere(points: Sequence[Sequence[float]]) -> SphereFit:
     """Geometric least-squares sphere through 4..10 points.
 
     Raises ``FitError`` for a wrong count, NaN/inf, identical, collinear or coplanar
@@ -217,7 +217,7 @@ def fit_sphere(points: Sequence[tuple[float, float, float]]) -> SphereFit:
     return SphereFit(center=_vector(centre), radius=radius, variance=variance)
 
 
-def fit_circle_3d(points: Sequence[tuple[float, float, float]]) -> Circle3dFit:
+def fit_circle_3d(points: Sequence[Sequence[float]]) -> Circle3dFit:
     """Circle in space through 3..10 points: plane fit, then 2D circle fit in that plane.
 
     The normal is the one ``fit_plane`` returns for the same points. Raises ``FitError``
@@ -387,7 +387,8 @@ def _kasa_centre(q: np.ndarray) -> np.ndarray:
     n, dim = q.shape
     design = np.column_stack([2.0 * q, np.ones(n)])
     solution, *_ = np.linalg.lstsq(design, np.einsum("ij,ij->i", q, q), rcond=None)
-    return solution[:dim]
+    centre: np.ndarray = solution[:dim]  # numpy's stubs type the slice as Any
+    return centre
 
 
 def _residuals(q: np.ndarray, centre: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 from ..errors import NcErrorId
 from ..technology import HSCS_MODES
-from .spec import BuiltinCycle, ParamSpec
+from .spec import BuiltinCycle, CycleContext, ParamSpec
 
 
-def _run(context) -> str | None:
+def _run(context: CycleContext) -> str | None:
     mode = HSCS_MODES[int(context.params[1]) - 1]
     setting = context.decoder.surroundings.hscs.get(mode)
     prog = setting.prog if setting is not None else ""

@@ -40,9 +40,10 @@ from ..errors import NcErrorId
 from ..literals import nc_number
 from ..variables import Value
 from .rotation import (
-    RotationError, RotationOrder, angles_from_rotation, rotation_from_angles, rotation_from_points,
+    Matrix, RotationError, RotationOrder, Vector, angles_from_rotation, rotation_from_angles,
+    rotation_from_points,
 )
-from .spec import BuiltinCycle, ParamProblem, ParamSpec
+from .spec import BuiltinCycle, CycleContext, ParamProblem, ParamSpec
 
 RESULT_FILE = "SysPosRotationToPlaneResult.txt"
 _POINTS = tuple(range(6, 15))
@@ -82,13 +83,17 @@ def _check(values: Mapping[int, Value]) -> list[ParamProblem]:
             for n in _POINTS if points and n not in values]
 
 
-def _rotation(context):
+def _point(params: Mapping[int, Value], first: int) -> Vector:
+    """The reference point in @P<first>..@P<first + 2> (numbers: check_parameters)."""
+    x, y, z = (float(params[n]) for n in (first, first + 1, first + 2))
+    return (x, y, z)
+
+
+def _rotation(context: CycleContext) -> Matrix:
     p = context.params
     if 6 in context.given:
         try:
-            return rotation_from_points(tuple(p[n] for n in (6, 7, 8)),
-                                        tuple(p[n] for n in (9, 10, 11)),
-                                        tuple(p[n] for n in (12, 13, 14)))
+            return rotation_from_points(_point(p, 6), _point(p, 9), _point(p, 12))
         except RotationError as fault:
             err_id = (NcErrorId.CYCLE_POINTS_IDENTICAL if "coincide" in fault.message
                       else NcErrorId.CYCLE_POINTS_COLLINEAR)
@@ -98,7 +103,7 @@ def _rotation(context):
     return rotation_from_angles(a, b, c, RotationOrder(int(p[19])), int(p[18]) == 1)
 
 
-def _run(context) -> str | None:
+def _run(context: CycleContext) -> str | None:
     p = context.params
     mode = int(p[1])
     if mode in (1, 2) and not context.decoder.surroundings.kinematics:
@@ -116,7 +121,7 @@ def _run(context) -> str | None:
         lines = ["SysPosRotationToPlane result", f"Mode = {mode}",
                  "Origin = " + ", ".join(f"{v:f}" for v in origin)]
         lines += [f"{axis} axis = " + ", ".join(f"{v + 0.0:f}" for v in column)
-                  for axis, column in zip(_COORD, columns)]
+                  for axis, column in zip(_COORD, columns, strict=True)]
         lines.append("#CS ON [" + ", ".join(f"{v + 0.0:f}" for v in (*origin, a, b, c)) + "]")
         context.write_file(RESULT_FILE, "\n".join(lines) + "\n")
     if mode == 4:
@@ -131,7 +136,7 @@ def _run(context) -> str | None:
     return "\n".join(body) + "\n"
 
 
-def _retraction(context, distance_mm: float) -> str:
+def _retraction(context: CycleContext, distance_mm: float) -> str:
     """G0 by ``distance_mm`` along machine +Z, written in the active coordinates."""
     decoder = context.decoder
     ix, iy, iz = decoder.executor.xyz

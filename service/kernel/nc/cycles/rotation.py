@@ -155,13 +155,17 @@ def is_rotation(m: Matrix, tol: float = 1e-9) -> bool:
     return abs(det - 1.0) <= tol
 
 
+def _axis_indices(order: RotationOrder, intrinsic: bool) -> tuple[int, int, int]:
+    first, second, third = (_AXIS_INDEX[name] for name in order.name)
+    return (first, second, third) if intrinsic else (third, second, first)
+
+
 # Axis indices of the factors of R from left to right, per (order, intrinsic): intrinsic
 # rotations multiply in the order's sequence, extrinsic ones in reverse. A table because
 # this is looked up for every rotation built.
 _FACTOR_AXES: dict[tuple[int, bool], tuple[int, int, int]] = {
-    (order, intrinsic): axes if intrinsic else axes[::-1]
+    (order, intrinsic): _axis_indices(order, intrinsic)
     for order in RotationOrder
-    for axes in [tuple(_AXIS_INDEX[name] for name in order.name)]
     for intrinsic in (True, False)
 }
 

@@ -11,9 +11,30 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import Protocol
 
-from ..errors import NcErrorId
+from ..errors import NcError, NcErrorId
+from ..modal import ModalState
+from ..running_decoder import CallingDecoder
 from ..variables import Value
+
+
+class CycleContext(Protocol):
+    """What a built-in cycle sees when it runs (``cycle_run.CycleContext``)."""
+
+    decoder: CallingDecoder  # the decoder running the call
+    modal: ModalState  # its modal state
+    params: dict[int, Value]  # the call's parameters, defaults filled in
+    given: dict[int, Value]  # the parameters the call gave
+
+    def error(self, err_id: NcErrorId, message: str, param: int | None = None) -> NcError:
+        """An error at the parameter's ``@P`` in the call (else at its NAME)."""
+
+    def set_output(self, name: str, value: Value) -> None:
+        """``V.CYC.<name>`` of the caller, when it declared one."""
+
+    def write_file(self, name: str, text: str) -> None:
+        """Replace file ``name`` of the store (nothing in a syntax check)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,7 +68,7 @@ class BuiltinCycle:
 
     name: str
     params: Mapping[int, ParamSpec]
-    run: Callable[..., str | None]
+    run: Callable[[CycleContext], str | None]
     check: Callable[[Mapping[int, Value]], list[ParamProblem]] = lambda values: []
 
 
@@ -89,6 +110,8 @@ def _range(spec: ParamSpec) -> str:
 
 def with_defaults(cycle: BuiltinCycle, values: Mapping[int, Value]) -> dict[int, Value]:
     """``values`` completed with the defaults of the parameters not given."""
-    done = {n: spec.default for n, spec in cycle.params.items() if spec.default is not None}
+    done: dict[int, Value] = {
+        n: spec.default for n, spec in cycle.params.items() if spec.default is not None
+    }
     done.update(values)
     return done

@@ -1,0 +1,468 @@
+"""One run of a program (or of manual blocks) in a channel: what it owns and its cycle.
+
+A ``ProgramRun`` is created when the run begins (START, a manual block, once the axes
+are linked) and dropped when it ends, fails or is RESET; everything that belongs to one
+run lives here, so nothing has to be reset by hand. Its decoder runs in the run's SDA
+thread (``DecoderFeed``); blocks enter the look-ahead buffer of the ``PathExecutor`` as
+slots free up, and each GEO cycle steps the path once (``cycle``).
+
+``ProdTimeRun`` is the production-time simulation (PROD_TIME): the same run, but the
+axes stay where they are and each GEO cycle simulates as many cycles of the path as the
+CPU allows. The syntax check and dry run are the third kind (``channel_check``).
+
+A run never changes the channel's state: ``cycle`` answers a ``Step`` and the
+``ChannelRunner`` makes the transition (end of program, error, pause).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import replace
+from enum import IntEnum
+from functools import partial
+from typing import Protocol
+
+from .channel_mode import ChannelMode, ChannelState
+from .contour_lookahead import LOG_FULL_WARNING, ContourLog
+from .decoder_feed import DecodeEnd, DecoderFeed, Item, Job
+from .nc import ModalState, NcError
+from .nc.blocks import AxisExchange, AxisExchangeKind, Block, ContourKind, SourceRef, StopKind
+from .nc.contour import LOOP_MARKERS
+from .path.errors import PathErrorId
+from .path.executor import PathError, PathExecutor
+from .path.interpolator import StepResult, Waiting
+from .path.segments import Segment
+from .prod_time_trace import ProdTimeTrace, trace_file_name
+from .state import Channel, ChannelError
+
+_INCR_PER_MM = 10_000  # 0.1 um increments per mm
+PROD_TIME_STEPS_PER_CYCLE = 5_000  # virtual clock: simulated cycles per GEO cycle (PROD_TIME)
+_PROD_TIME_SHARE = 0.4  # realtime clock: share of a GEO cycle the calculation may use
+
+
+class Step(IntEnum):
+    """What one GEO cycle of a run came to."""
+
+    BUSY = 1  # motion or decoding to do
+    WAITING = 2  # nothing to do this cycle (a link, the next manual block, HOLD)
+    ENDED = 3  # the end of the program: the channel becomes READY
+    FAILED = 4  # an error stopped the run (``failure``): the channel goes to ERROR
+    PAUSED = 5  # the syntax check waits for START: the channel goes to HOLD
+
+
+class RunHost(Protocol):
+    """What a run needs of its channel runner."""
+
+    time_s: float  # kernel time of the cycle (PROD_TIME: the simulated time)
+
+    @property
+    def axes_ready(self) -> bool:
+        """The channel's output is not suspended and every axis in it is linked."""
+
+    def list_error(self, error: ChannelError, to_log: bool = True,
+                   keep_last: bool = False) -> None:
+        """Put ``error`` (a warning here) in the channel's error list."""
+
+    def show_decoder_state(self) -> None:
+        """Show the #MSG texts and machining settings the decoder reached."""
+
+    def jog_of_path_error(self) -> ChannelError | None:
+        """The error that keeps a jog-of-path channel from working (None: it may)."""
+
+
+class ChannelRun(Protocol):
+    """What every kind of run offers the channel runner."""
+
+    started_at_s: float  # kernel time the run began (program time counts from it)
+    failure: ChannelError | None  # the error of a FAILED step
+
+    @property
+    def ignores_feedhold(self) -> bool:
+        """A dry run goes on through feedhold."""
+
+    def cycle(self, time_s: float) -> Step:
+        """One GEO cycle of the run."""
+
+    def hold(self) -> None:
+        """Feedhold (the channel is HOLD from now on)."""
+
+    def resume(self) -> None:
+        """START in HOLD, or after a programmed or single-block stop."""
+
+    def cancel(self) -> ModalState | None:
+        """End the run at once (RESET, end, error); the modal state it reached."""
+
+
+class ProgramRun:
+    """A real run: blocks from the decoder move the channel's axes along the path."""
+
+    _waits_for_decoder = False  # PROD_TIME: every take waits for the decoder
+
+    def __init__(self, host: RunHost, channel: Channel, feed: DecoderFeed,
+                 executor: PathExecutor, contour: ContourLog | None, *,
+                 started_at_s: float, buffer_blocks: int, deterministic: bool) -> None:
+        """``contour``: the contour look-ahead log of this run (None: not configured)."""
+        self._host = host
+        self.channel = channel
+        self.feed = feed
+        self.executor = executor
+        self.contour = contour
+        self.started_at_s = started_at_s
+        self._buffer_blocks = buffer_blocks
+        self._deterministic = deterministic  # virtual clock: wait for the decoder
+        # a block that waits for standstill (axis exchange, LOG CLEAR: flush and wait)
+        self._sync: Block | None = None
+        self._backlog: list[Item] = []  # decoded items that came after it
+        self._contour_changed = False  # blocks were prepared: show the unit's new state
+        self._last_pushed: Block | None = None  # the block that entered the buffer last
+        self._buffer_warned = False  # BUFFER_LIMITS_SPEED shown in this run
+        self._pending_error: ChannelError | None = None  # takes effect where the path stops
+        self._fed_all = False
+        self.failure: ChannelError | None = None
+        if contour is not None:
+            executor.on_prepared = self._prepared
+
+    # ------------------------------------------------------------ commands
+
+    @property
+    def ignores_feedhold(self) -> bool:
+        """Feedhold stops the path."""
+        return False
+
+    def add(self, job: Job) -> None:
+        """Extended MDI: a further manual block continues the same program."""
+        self.feed.add(job)
+
+    def hold(self) -> None:
+        """Feedhold: decelerate on the path."""
+        self.executor.hold()
+
+    def resume(self) -> None:
+        """Go on from HOLD or a stop at a block end."""
+        self.executor.resume()
+
+    def cancel(self) -> ModalState | None:
+        """Stop decoding and the path at once; the modal state the decoder reached."""
+        self.feed.cancel()
+        self.executor.stop_now()
+        return self.feed.modal
+
+    # ------------------------------------------------------------ cycle
+
+    def cycle(self, time_s: float) -> Step:
+        """One interpolation cycle of the path, output to the channel's axes."""
+        return self._motion_cycle(time_s, self.channel.feed_override_active / 1000.0,
+                                  output=True)
+
+    def _motion_cycle(self, time_s: float, override: float, output: bool) -> Step:
+        """One interpolation cycle of the path; ``output`` False: the axes stay where
+        they are (PROD_TIME)."""
+        ch = self.channel
+        executor = self.executor
+        if output and executor.single_block != ch.single_block:
+            executor.single_block = ch.single_block
+        if self._sync is not None and executor.idle:
+            failure = self._apply_sync()
+            if failure is not None:
+                return self._fail(failure)
+            if not self._host.axes_ready:  # a requested axis links first
+                return Step.WAITING
+        if self._sync is None:
+            self._feed_blocks()
+            if self._contour_changed:  # once per cycle, not per block
+                self._contour_changed = False
+                self._show_contour_state()
+        # the buffer is full and more blocks wait: does its end hold the speed down?
+        full = not (self._buffer_warned or self._fed_all) and executor.free_slots() == 0
+        step = executor.step(override)
+        if full and executor.buffer_limits_speed():
+            self._warn_buffer_limits()
+        if output:
+            for axis, pos in zip(ch.axes, step.position_mm, strict=True):
+                axis.position_mm = pos
+                axis.command_position_incr = round(pos * _INCR_PER_MM)
+            ch.path_velocity_mm_s = step.path_velocity_mm_s
+            ch.programmed_velocity_mm_s = step.programmed_velocity_mm_s
+            ch.remaining_in_block_mm = step.remaining_in_block_mm
+            ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
+        ch.program_time_s = time_s - self.started_at_s
+        self._stepped(step)
+        for block in step.finished:
+            ch.block_count += 1
+            if self.contour is not None and block.contour is not None and (
+                    block.contour.kind == ContourKind.DISTANCE_CLEAR):
+                self.contour.distance_cleared()  # mode 2 answers in the new distances
+            if self.feed.is_marker(block):
+                ch.manual_blocks_done += 1
+        shown = step.current or (step.finished[-1] if step.finished else None)
+        if shown is not None and not self.feed.is_marker(shown):
+            src = shown.source
+            ch.file_name, ch.line, ch.file_offset = src.file, src.line, src.offset
+            ch.block_number = shown.number if shown.number is not None else -1
+        stopped = step.stopped_at
+        if stopped is not None and stopped.stop == StopKind.PROGRAM_END:
+            return Step.ENDED
+        # M0/M1 or a single-block stop: the path stands at a block end until START.
+        ch.waiting_for_start = ch.state == ChannelState.ACTIVE and executor.waiting in (
+            Waiting.PROGRAMMED_STOP, Waiting.SINGLE_BLOCK,
+        )
+        if executor.idle:
+            if self._pending_error is not None:
+                return self._fail(self._pending_error)
+            if self._fed_all:
+                return Step.ENDED
+            if ch.mode == ChannelMode.MDI and self.feed.keep_open:
+                return Step.WAITING  # extended MDI: waiting for the next manual block
+        return Step.BUSY
+
+    def _stepped(self, step: StepResult) -> None:
+        """After each interpolation cycle (a traced PROD_TIME run records it)."""
+
+    def _fail(self, error: ChannelError) -> Step:
+        self.failure = error
+        return Step.FAILED
+
+    def _apply_sync(self) -> ChannelError | None:
+        """Carry out the block the path stands at (axis exchange, LOG CLEAR); the error
+        when the channel cannot work after it (jog of path)."""
+        block, self._sync = self._sync, None
+        assert block is not None
+        ch = self.channel
+        ch.block_count += 1
+        src = block.source
+        ch.file_name, ch.line, ch.file_offset = src.file, src.line, src.offset
+        ch.block_number = block.number if block.number is not None else -1
+        if self.contour is not None:
+            self.contour.count_block()
+        exchange: AxisExchange | None = block.axis_exchange
+        if exchange is None:  # #CONTOUR LOOKAHEAD LOG CLEAR
+            if self.contour is not None:
+                self.contour.clear()
+                self._show_contour_state()
+            return None
+        release = exchange.kind == AxisExchangeKind.RELEASE
+        for index in exchange.axes:
+            ch.axes[index].released = release
+        return self._host.jog_of_path_error()  # P-CHAN-00306: checked at axis exchange too
+
+    # ------------------------------------------------------------ feeding the path
+
+    def _feed_blocks(self) -> None:
+        executor, feed = self.executor, self.feed
+        if self._fed_all or self._pending_error is not None:
+            return
+        free = executor.free_slots()
+        if free <= 0:
+            return
+        # PROD_TIME waits for the decoder as the virtual clock does: a simulated cycle
+        # must never pass starved (``ProdTimeRun.cycle`` only steps when the feed is ready)
+        wait = self._deterministic or self._waits_for_decoder
+        pending = self._section_pending()
+        if pending and not wait:  # planned already: waiting only takes the SDA's put
+            free, wait = min(free, pending), True
+        items, self._backlog = self._backlog or feed.take(free, wait=wait), []
+        if items:
+            self._host.show_decoder_state()
+        contour = self.contour
+        for k, item in enumerate(items):
+            if isinstance(item, Block) and item.contour is not None and (
+                    item.contour.kind in LOOP_MARKERS):
+                # a real-time loop pass: for the contour log only, never a block of the path
+                if contour is not None:
+                    contour.mark(item.contour)
+                continue
+            if isinstance(item, Block) and _waits_for_standstill(item):
+                # axes change hands, or the log is cleared, at standstill: flush, feed
+                # the rest after it
+                self._backlog = items[k + 1:]
+                if self._close(item):
+                    self._sync = item
+                return
+            if isinstance(item, Block):
+                if contour is not None:
+                    contour.expect(item)
+                try:
+                    executor.push(item)
+                except PathError as exc:
+                    self._stop_feeding(_path_error(exc, item))
+                    return
+                self._last_pushed = item
+            elif isinstance(item, PathError):  # LA_ON section planning (bottleneck)
+                self._stop_feeding(_path_error(item, item.block))
+                return
+            elif isinstance(item, NcError):
+                self._stop_feeding(ChannelError(
+                    int(item.id), item.message, item.file, item.line, item.column
+                ))
+                return
+            elif isinstance(item, DecodeEnd):
+                self._fed_all = True
+                if self._close(None) and contour is not None:
+                    if contour.end_of_data():
+                        self._warn_log_full()
+                    self._show_contour_state()
+
+    def _section_pending(self) -> int:
+        """Blocks of the planned LA_ON section still to come after the last one pushed:
+        the path runs towards them at the section's planned speed, so they must enter
+        the buffer in time (they are planned, the wait is short and bounded)."""
+        last = self._last_pushed
+        if last is None or last.look_ahead is None or last.look_ahead.exit_mm_s <= 0.0:
+            return 0
+        return last.look_ahead.blocks_after
+
+    def _stop_feeding(self, error: ChannelError) -> None:
+        """Nothing after this error enters the path; what radius compensation holds
+        back is released, so the blocks before the error run to their end."""
+        self._pending_error = error
+        self._close(None)  # an error of a held block replaces it: it comes first
+
+    def _close(self, block: Block | None) -> bool:
+        """End of the data so far (end of program, or ``block`` waits for standstill):
+        what radius compensation holds back is released. False when that fails (the
+        error takes effect where the path stops)."""
+        if self.contour is not None:
+            self.contour.expect(None)
+        try:
+            self.executor.close()
+        except PathError as exc:
+            self._pending_error = _path_error(exc, block)
+            return False
+        return True
+
+    def _feed_ready(self) -> bool:
+        """The next cycle's feed would not wait for the decoder."""
+        if (self._fed_all or self._backlog or self._sync is not None
+                or self._pending_error is not None):
+            return True
+        return self.feed.ready(self.executor.free_slots())
+
+    # ------------------------------------------------------------ contour look-ahead
+
+    def _prepared(self, items: list[Segment | Block]) -> None:
+        """Blocks entering the look-ahead buffer: the contour log sees them."""
+        assert self.contour is not None
+        if self.contour.take(items):
+            self._warn_log_full()
+        self._contour_changed = True
+
+    def _warn_buffer_limits(self) -> None:
+        """Warn (once per run) that the look-ahead buffer's size limits the path speed,
+        at the block the path is in."""
+        self._buffer_warned = True
+        ch = self.channel
+        self._host.list_error(ChannelError(
+            int(PathErrorId.BUFFER_LIMITS_SPEED),
+            f"the look-ahead buffer of {self._buffer_blocks} blocks limits the path speed "
+            f"to {ch.path_velocity_mm_s:.1f} mm/s (the path must be able to stop after the "
+            "last buffered block): choose a larger buffer (interpolator_function, "
+            "P-CHAN-00650) or program LA_ON", ch.file_name, ch.line, warning=True))
+
+    def _warn_log_full(self) -> None:
+        assert self.contour is not None
+        self._host.list_error(log_full_warning(self.contour, self.channel.file_name))
+
+    def _show_contour_state(self) -> None:
+        assert self.contour is not None
+        show_contour_state(self.channel, self.contour)
+
+
+class ProdTimeRun(ProgramRun):
+    """PROD_TIME: the run is simulated in kernel time as fast as the CPU allows (a share
+    of each GEO cycle); no axis moves, ``program_time`` is the simulated time. With
+    ``trace`` every simulated cycle is recorded (``ch<c>.prod_time_trace``)."""
+
+    _waits_for_decoder = True
+
+    def __init__(self, host: RunHost, channel: Channel, feed: DecoderFeed,
+                 executor: PathExecutor, contour: ContourLog | None, *,
+                 started_at_s: float, buffer_blocks: int, deterministic: bool,
+                 cycle_s: float, trace: ProdTimeTrace | None) -> None:
+        super().__init__(host, channel, feed, executor, contour, started_at_s=started_at_s,
+                         buffer_blocks=buffer_blocks, deterministic=deterministic)
+        self._cycle_s = cycle_s
+        self.sim_steps = 0  # cycles simulated so far
+        self.trace = trace
+
+    def hold(self) -> None:
+        """Feedhold pauses the calculation (``cycle`` does nothing in HOLD)."""
+
+    def wait_for_link(self) -> None:
+        """A GEO cycle passed while a link waits: a real run's time runs on."""
+        self.sim_steps += 1
+
+    def cycle(self, time_s: float) -> Step:
+        """Simulate cycles of the run until the share of this GEO cycle is used."""
+        if self.channel.state == ChannelState.HOLD:
+            return Step.WAITING
+        deadline = time.perf_counter() + _PROD_TIME_SHARE * self._cycle_s
+        for n in range(PROD_TIME_STEPS_PER_CYCLE):
+            if not self._deterministic:
+                if n % 4 == 0 and time.perf_counter() > deadline:
+                    break
+                if not self._feed_ready():  # the decoder is behind: go on next cycle
+                    break
+            self.sim_steps += 1
+            self._host.time_s = self.started_at_s + self.sim_steps * self._cycle_s
+            step = self._motion_cycle(self._host.time_s, 1.0, output=False)
+            if step != Step.BUSY:
+                return step
+            if self.executor.waiting in (Waiting.PROGRAMMED_STOP, Waiting.SINGLE_BLOCK):
+                self.executor.resume()  # M0/M1: the calculation does not wait
+                self.channel.waiting_for_start = False
+        return Step.BUSY
+
+    def _stepped(self, step: StepResult) -> None:
+        if self.trace is not None:
+            ch = self.channel
+            shown_line = step.current.source.line if step.current is not None else 0
+            self.trace.record(ch.program_time_s, step.position_mm, step.distance_mm,
+                              step.path_velocity_mm_s, step.programmed_velocity_mm_s,
+                              shown_line)
+
+    def write_trace(self, ended: str, files: Callable[..., None]) -> None:
+        """The end of a traced run: its rows go to the program store."""
+        trace, self.trace = self.trace, None
+        if trace is not None:
+            # formatted by the store writer's thread, not in this cycle
+            files(trace_file_name(self.channel.channel_id),
+                  partial(trace.csv_bytes, ended), replace=True)
+
+
+def show_contour_state(channel: Channel, contour: ContourLog) -> None:
+    """The contour look-ahead unit's state after blocks were prepared, the log cleared
+    or ended."""
+    channel.contour = replace(
+        channel.contour, max_dist_prog_start_incr=contour.max_dist_prog_start_incr,
+        count_logged_blocks=len(contour.log), log_active=contour.active,
+    )
+
+
+def log_full_warning(contour: ContourLog, file_name: str) -> ChannelError:
+    """The warning (once per marked area) that the log dropped elements, at the block
+    that did not fit (else in ``file_name``)."""
+    block = contour.dropped_at
+    src = block.source if block is not None else SourceRef(file_name, 0)
+    return ChannelError(
+        LOG_FULL_WARNING,
+        f"the contour look-ahead log is full ({contour.log_max} entries, "
+        "contour_lookahead_log_max P-CHAN-00658): later elements of the marked area "
+        "are not logged", src.file, src.line, src.column, warning=True,
+    )
+
+
+def _path_error(exc: PathError, block: Block | None) -> ChannelError:
+    """The channel error of a path error, at the block it names (else ``block``)."""
+    named = exc.block if exc.block is not None else block
+    if named is None:
+        return ChannelError(int(exc.id), exc.message)
+    src = named.source
+    return ChannelError(int(exc.id), exc.message, src.file, src.line, src.column)
+
+
+def _waits_for_standstill(block: Block) -> bool:
+    """An axis exchange or a LOG CLEAR: the path stops, the block runs at standstill."""
+    if block.axis_exchange is not None:
+        return True
+    return block.contour is not None and block.contour.kind == ContourKind.LOG_CLEAR

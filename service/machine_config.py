@@ -1,0 +1,372 @@
+"""The machine as the kernel sees it: axes, channels, tools, look-ahead, cycle time.
+
+Pydantic models, validated once at start (``config.load_config``); the kernel imports
+this module and nothing else of the service (tests/test_import_graph.py), so it cannot
+depend on front ends, keys or limits. The embedded default machine is ``DEFAULT_MACHINE``.
+"""
+
+from __future__ import annotations
+
+from enum import StrEnum
+from typing import Any, Literal
+
+from pydantic import AliasChoices, BaseModel, ConfigDict, Field, field_validator, model_validator
+
+
+class Strict(BaseModel):
+    """A configuration table: unknown keys refused, values frozen."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class AxisLimits(Strict):
+    """Limits the planner and the position controller respect for one axis."""
+
+    vel_max_mm_s: float = Field(500.0, gt=0, description="maximum axis velocity (mm/s)")
+    acc_max_mm_s2: float = Field(5000.0, gt=0, description="maximum acceleration (mm/s^2)")
+    sw_limit_min_mm: float = Field(-1000.0, description="negative software limit (mm)")
+    sw_limit_max_mm: float = Field(1000.0, description="positive software limit (mm)")
+    vel_jump_mm_s: float = Field(
+        20.0, ge=0, description="permitted velocity jump of the axis at a block junction (mm/s)"
+    )
+
+    @model_validator(mode="after")
+    def _limits_ordered(self) -> AxisLimits:
+        if self.sw_limit_min_mm >= self.sw_limit_max_mm:
+            raise ValueError("sw_limit_min_mm must be below sw_limit_max_mm")
+        return self
+
+
+class PhysicalAxisConfig(Strict):
+    """A drive of the platform."""
+
+    number: int = Field(ge=1, le=0xFFFF, description="physical axis number (link target)")
+    name: str = Field(min_length=1, max_length=15)
+
+
+class AxisConfig(Strict):
+    """A logical axis of a channel: its name there and its axis parameter list.
+
+    A clone (``clone_of``) takes every parameter of its master when the kernel
+    initialises the axes and overrides only what is written here: which fields were
+    written is kept by pydantic (``model_fields_set``), so leave out what the clone
+    should inherit. ``link_to`` left out means the drive with the axis's own number
+    (or, for a clone, the master's drive).
+    """
+
+    name: str = Field(min_length=1, max_length=15, description="axis name in the channel")
+    logical_number: int = Field(ge=1, le=0xFFFF, description="kopf.achs_nr (P-AXIS-00016)")
+    link_to: int | None = Field(None, ge=1, le=0xFFFF, description="kopf.link_to (P-AXIS-00101)")
+    clone_of: int | None = Field(
+        None, ge=1, le=0xFFFE, description="kopf.clone_of (P-AXIS-00040)"
+    )
+    axis_type: Literal["linear"] = Field("linear", description="kenngr.achs_typ (P-AXIS-00018)")
+    auto_release_of_axis_link: bool = Field(
+        False, description="kenngr.auto_release_of_axis_link (P-AXIS-00483)"
+    )
+    limits: AxisLimits = AxisLimits()
+
+
+class InterpolatorFunction(StrEnum):
+    """Identifiers of the interpolator functions (P-CHAN-00650) this kernel implements."""
+
+    IPO_DEFAULT = "FCT_IPO_DEFAULT"  # = FCT_LOOK_AHEAD_STANDARD
+    LOOK_AHEAD_LOW = "FCT_LOOK_AHEAD_LOW"  # 30 blocks
+    LOOK_AHEAD_STANDARD = "FCT_LOOK_AHEAD_STANDARD"  # 120 blocks
+    LOOK_AHEAD_HIGH = "FCT_LOOK_AHEAD_HIGH"  # 190 blocks
+    LOOK_AHEAD_CUSTOM = "FCT_LOOK_AHEAD_CUSTOM"  # look_ahead_custom_blocks (P-CHAN-00653)
+    CONTOUR_LAH = "FCT_CONTOUR_LAH"  # contour look-ahead (FCT-C40)
+
+
+LOOK_AHEAD_BLOCKS = {
+    InterpolatorFunction.IPO_DEFAULT: 120,
+    InterpolatorFunction.LOOK_AHEAD_LOW: 30,
+    InterpolatorFunction.LOOK_AHEAD_STANDARD: 120,
+    InterpolatorFunction.LOOK_AHEAD_HIGH: 190,
+}
+_LOOK_AHEAD_SIZES = frozenset(LOOK_AHEAD_BLOCKS) | {InterpolatorFunction.LOOK_AHEAD_CUSTOM}
+# ISG identifiers of functions this kernel does not have: named as such when configured
+_NOT_SUPPORTED_FUNCTIONS = frozenset({
+    "FCT_SYNC", "FCT_LOOK_AHEAD_OPT", "FCT_LIFT_UP_TIME", "FCT_SHIFT_NCBL",
+    "FCT_CALC_STATE_AT_T", "FCT_CALC_TIME", "FCT_DYN_POS_LIMIT", "FCT_EXTENSION_EQUIDIST",
+})
+
+
+def parse_interpolator_functions(text: str) -> frozenset[InterpolatorFunction]:
+    """The functions of a P-CHAN-00650 value such as ``FCT_IPO_DEFAULT | FCT_CONTOUR_LAH``
+    (identifiers separated by ``|``, commas or blanks); ValueError names what is wrong.
+    At most one look-ahead size; none means FCT_IPO_DEFAULT."""
+    words = [w for w in text.replace("|", " ").replace(",", " ").split() if w]
+    found: set[InterpolatorFunction] = set()
+    for word in words:
+        upper = word.upper()
+        if upper in _NOT_SUPPORTED_FUNCTIONS:
+            raise ValueError(f"{upper} is not supported by this kernel")
+        try:
+            found.add(InterpolatorFunction(upper))
+        except ValueError:
+            known = ", ".join(f.value for f in InterpolatorFunction)
+            raise ValueError(f"unknown interpolator function {word!r} (known: {known})") from None
+    sizes = sorted(f.value for f in found & _LOOK_AHEAD_SIZES)
+    if len(sizes) > 1:
+        raise ValueError(f"choose one look-ahead size, not {' and '.join(sizes)}")
+    if not sizes:
+        found.add(InterpolatorFunction.IPO_DEFAULT)
+    return frozenset(found)
+
+
+class ToolConfig(Strict):
+    """One entry of the tool table: D number and radius."""
+
+    d: int = Field(ge=1, le=9999, description="tool offset number (D word)")
+    radius_mm: float = Field(ge=0, description="tool radius (mm)")
+
+
+class SyntaxCheckConfig(Strict):
+    """Channel parameters of the syntax check (FCT-C9), ``syn_chk.*``; ISG's spellings
+    before V2.11.2012.07 (``fehler_gesamt``, ``fehler_pro_zeile``) are accepted too."""
+
+    errors_total: int = Field(
+        0, ge=0, le=0xFFFF, validation_alias=AliasChoices("errors_total", "fehler_gesamt"),
+        description="P-CHAN-00019: the check ends after this many errors (0: no limit)",
+    )
+    errors_per_block: int = Field(
+        0, ge=0, le=0xFFFF,
+        validation_alias=AliasChoices("errors_per_block", "fehler_pro_zeile"),
+        description="P-CHAN-00020: after this many errors in one NC line the check goes on "
+        "with the next line (0: no limit)",
+    )
+    interactive: bool = Field(
+        False, description="P-CHAN-00028: stop after each error and wait for START or RESET"
+    )
+    record_result: bool = Field(
+        False, description="P-CHAN-00416: write every checked line and error to dec0<c>.sc"
+    )
+
+
+class HscsModeConfig(Strict):
+    """One mode of the high-speed settings (SysHscSettings): ``hscs.<mode>.*``."""
+
+    prog: str = Field("", max_length=83, description="program the cycle calls (L <prog>)")
+    tolerance: int = Field(
+        0, ge=0, le=0x7FFFFFFF,
+        description="machining tolerance in 0.1 um; NC programs read it in mm as "
+        "V.G.HSCS.<MODE>.TOLERANCE",
+    )
+
+
+def _hscs_default(mode: str, tolerance: int) -> HscsModeConfig:
+    return HscsModeConfig(prog=f"manufacturerHsc{mode}Settings.nc", tolerance=tolerance)
+
+
+class HscsConfig(Strict):
+    """Channel parameters of the SysHscSettings cycle (``hscs.<mode>.prog/.tolerance``).
+    The defaults name the example programs of the cycle documentation (docs/examples/hsc)."""
+
+    deselect: HscsModeConfig = Field(default_factory=lambda: _hscs_default("Deselect", 0))
+    rough: HscsModeConfig = Field(default_factory=lambda: _hscs_default("Rough", 1000))
+    prefinish: HscsModeConfig = Field(default_factory=lambda: _hscs_default("Prefinish", 500))
+    finish: HscsModeConfig = Field(default_factory=lambda: _hscs_default("Finish", 100))
+
+
+class EnhancedLookAheadConfig(Strict):
+    """Defaults of the enhanced look-ahead parameters (MTC200 names), ``la.*``; a
+    program changes them with ``METB=``, ``VFBT=``, ``BBTRC=`` (docs/lookahead.md)."""
+
+    metb_s: float = Field(
+        0.010, gt=0, le=10.0,
+        description="METB: shortest execution time of a sub-block the section planner "
+        "creates (s); must exceed the cycle time",
+    )
+    vfbt: float = Field(
+        1.0, gt=0, le=1.0,
+        description="VFBT: factor on the permitted speed at non-tangential block transitions",
+    )
+    bbtrc: int = Field(
+        8, ge=1, le=1000,
+        description="BBTRC: blocks the bottleneck check of the tool radius compensation "
+        "compares each compensated block with",
+    )
+
+
+class ChannelConfig(Strict):
+    """A channel and its axes."""
+
+    id: int = Field(ge=1, le=0xFF, description="logical channel id (CID)")
+    name: str = Field(min_length=1, max_length=31)
+    axes: tuple[AxisConfig, ...] = Field(min_length=1, max_length=32)
+    jog_of_path_only: bool = Field(False, description="P-CHAN-00306")
+    suspend_output_at_start: bool = Field(
+        False, description="start with axis output suspended (the channel holds no axes)"
+    )
+    feed_override_max: int = Field(
+        1000, ge=0, le=0xFFFF, description="largest accepted feed override (0.1 %)"
+    )
+    interpolator_function: str = Field(
+        "FCT_IPO_DEFAULT",
+        description="P-CHAN-00650: interpolator functions, e.g. 'FCT_IPO_DEFAULT | "
+        "FCT_CONTOUR_LAH' (look-ahead size and functions such as contour look-ahead)",
+    )
+    look_ahead_custom_blocks: int = Field(
+        120, ge=2, le=10_000, description="P-CHAN-00653: buffer size with FCT_LOOK_AHEAD_CUSTOM"
+    )
+    contour_lookahead_log_max: int = Field(
+        128, ge=0, le=0xFFFFFFFE,
+        description="P-CHAN-00658: contour elements the contour look-ahead log keeps",
+    )
+    syn_chk: SyntaxCheckConfig = Field(
+        default_factory=SyntaxCheckConfig, description="syntax check (P-CHAN-00019/20/28/416)"
+    )
+    hscs: HscsConfig = Field(
+        default_factory=HscsConfig, description="high-speed settings cycle (hscs.*)"
+    )
+    la: EnhancedLookAheadConfig = Field(
+        default_factory=EnhancedLookAheadConfig,
+        description="enhanced look-ahead defaults (LA_ON/LA_OFF; METB, VFBT, BBTRC)",
+    )
+
+    @field_validator("interpolator_function")
+    @classmethod
+    def _known_functions(cls, value: str) -> str:
+        parse_interpolator_functions(value)
+        return value
+
+    @property
+    def interpolator_functions(self) -> frozenset[InterpolatorFunction]:
+        """The functions of ``interpolator_function``."""
+        return parse_interpolator_functions(self.interpolator_function)
+
+    @property
+    def look_ahead_blocks(self) -> int:
+        """Blocks the look-ahead buffer holds."""
+        functions = self.interpolator_functions
+        for function, blocks in LOOK_AHEAD_BLOCKS.items():
+            if function in functions:
+                return blocks
+        return self.look_ahead_custom_blocks
+
+    @property
+    def contour_lookahead(self) -> bool:
+        """FCT_CONTOUR_LAH is enabled: #CONTOUR LOOKAHEAD and the control unit work."""
+        return InterpolatorFunction.CONTOUR_LAH in self.interpolator_functions
+
+    @model_validator(mode="after")
+    def _unique_axis_names(self) -> ChannelConfig:
+        names = [a.name for a in self.axes]
+        if len(set(names)) != len(names):
+            raise ValueError(f"axis names repeat in channel {self.id}: {names}")
+        return self
+
+
+class MachineConfig(Strict):
+    """The machine the kernel runs: platform axes, channels, tools, cycle time."""
+
+    name: str = Field("cnc-objects", min_length=1, max_length=31)
+    cycle_ms: float = Field(1.0, gt=0.05, le=100.0, description="GEO cycle time (ms)")
+    physical_axes: tuple[PhysicalAxisConfig, ...] = Field(min_length=1)
+    channels: tuple[ChannelConfig, ...] = Field(min_length=1, max_length=12)
+    tools: tuple[ToolConfig, ...] = Field((), description="tool table (D number -> radius)")
+
+    @model_validator(mode="after")
+    def _references_resolve(self) -> MachineConfig:
+        physical = [a.number for a in self.physical_axes]
+        if len(set(physical)) != len(physical):
+            raise ValueError(f"physical axis numbers repeat: {physical}")
+        ids = [c.id for c in self.channels]
+        if len(set(ids)) != len(ids):
+            raise ValueError(f"channel ids repeat: {ids}")
+        d_numbers = [t.d for t in self.tools]
+        if len(set(d_numbers)) != len(d_numbers):
+            raise ValueError(f"tool D numbers repeat: {d_numbers}")
+        logical = [a.logical_number for c in self.channels for a in c.axes]
+        if len(set(logical)) != len(logical):
+            raise ValueError(f"logical axis numbers (kopf.achs_nr) repeat: {logical}")
+        for ci, channel in enumerate(self.channels):
+            if channel.la.metb_s <= self.cycle_ms / 1000.0:
+                raise ValueError(
+                    f"channels.{ci}.la.metb_s: METB {channel.la.metb_s:g} s must be greater "
+                    f"than the cycle time {self.cycle_ms / 1000.0:g} s"
+                )
+            for ai, axis in enumerate(channel.axes):
+                where = f"channels.{ci}.axes.{ai}"
+                if axis.link_to is not None and axis.link_to not in physical:
+                    raise ValueError(
+                        f"{where}.link_to: physical axis {axis.link_to} does not exist "
+                        f"(configured: {physical})"
+                    )
+                link = self.link_of(axis.logical_number)
+                if link not in physical:
+                    raise ValueError(
+                        f"{where}.link_to: missing, and there is no physical axis {link} "
+                        "to link to (the axis's own number, or its master's drive)"
+                    )
+        return self
+
+    def axis(self, logical_number: int) -> AxisConfig | None:
+        """The configured axis with ``logical_number``, or None."""
+        for channel in self.channels:
+            for axis in channel.axes:
+                if axis.logical_number == logical_number:
+                    return axis
+        return None
+
+    def link_of(self, logical_number: int) -> int:
+        """The physical axis a logical axis is linked to (``kopf.link_to``): written, or
+        inherited from the master of a clone, or else the axis's own number."""
+        seen: set[int] = set()
+        axis = self.axis(logical_number)
+        while axis is not None and axis.link_to is None and axis.clone_of is not None:
+            master = self.axis(axis.clone_of)
+            if master is None or axis.logical_number in seen:  # no master, or a ring
+                break
+            seen.add(axis.logical_number)
+            axis = master
+        if axis is None:
+            return logical_number
+        return axis.link_to if axis.link_to is not None else axis.logical_number
+
+    def startup_axes(self) -> list[tuple[int, AxisConfig]]:
+        """Every logical axis in start-up order (channel by channel, axis by axis),
+        with the index of its channel: the order the kernel initialises them in."""
+        return [(ci, axis) for ci, c in enumerate(self.channels) for axis in c.axes]
+
+
+DEFAULT_MACHINE: dict[str, Any] = {
+    "name": "cnc-objects",
+    "cycle_ms": 1.0,
+    "tools": [
+        {"d": 1, "radius_mm": 1.0},
+        {"d": 2, "radius_mm": 2.5},
+        {"d": 3, "radius_mm": 5.0},
+        {"d": 8, "radius_mm": 4.0},  # the tools of the cycle documentation's examples
+        {"d": 9, "radius_mm": 3.0},
+    ],
+    "physical_axes": [
+        {"number": 1, "name": "X"},
+        {"number": 2, "name": "Y"},
+        {"number": 3, "name": "Z"},
+    ],
+    "channels": [
+        {
+            "id": 1,
+            "name": "main",
+            "interpolator_function": "FCT_IPO_DEFAULT | FCT_CONTOUR_LAH",
+            "axes": [
+                {"name": "X", "logical_number": 1, "link_to": 1},
+                {"name": "Y", "logical_number": 2, "link_to": 2},
+                {"name": "Z", "logical_number": 3, "link_to": 3},
+            ],
+        },
+        {
+            "id": 2,
+            "name": "jog-of-path",
+            "jog_of_path_only": True,
+            "suspend_output_at_start": True,
+            "axes": [
+                {"name": "X", "logical_number": 11, "link_to": 1, "clone_of": 1},
+                {"name": "Y", "logical_number": 12, "link_to": 2, "clone_of": 2},
+                {"name": "Z", "logical_number": 13, "link_to": 3, "clone_of": 3},
+            ],
+        },
+    ],
+}

@@ -1,0 +1,244 @@
+"""The HLI's structs and arrays as a PLC's symbols, over real ADS (issue 26, item 4).
+
+Every level of the HLI hierarchy is a symbol (``gpCh``, ``gpCh[0]``,
+``gpCh[0].contour_lookahead``, ...) whose data type (0xF011) lists its members with
+offsets and sizes that match the bytes a read of the struct returns. Structs are read,
+written (their writable members), subscribed and used in sum commands like any symbol.
+Frames are built and parsed by hand here (``test_ads_raw``, ``test_ads_symbols_raw``).
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import pytest
+
+from cnc_objects.testing import ServiceProcess, start_service
+
+from .test_ads_raw import (
+    ADD_NOTIFICATION,
+    DELETE_NOTIFICATION,
+    READ,
+    READ_WRITE,
+    WRITE,
+    RawAds,
+    add_notification,
+    read,
+    read_write,
+    write,
+)
+from .test_ads_read_length import ANY, INVALIDSIZE, OK, answer
+from .test_ads_symbols_raw import BIGTYPE, cstrings, parse_symbol, parse_symbols
+
+REQUEST = "gpCh[0].contour_lookahead.request"  # start_position, length: LREAL, writable
+STATE = "gpCh[0].contour_lookahead.state"  # read-only members
+INVALIDACCESS = 0x704
+
+
+@dataclass(frozen=True)
+class Item:
+    """An AdsDatatypeEntry with its array bounds and sub items, parsed by hand."""
+
+    name: str
+    type_name: str
+    size: int
+    offset: int
+    data_type: int
+    flags: int
+    array: tuple[tuple[int, int], ...]
+    members: tuple[Item, ...]
+    length: int
+
+
+def parse_type(data: bytes, at: int = 0) -> Item:
+    """8 x u32, 5 x u16, the strings, array infos (2 x u32 each), sub items."""
+    length, _, _, _, size, offset, data_type, flags = struct.unpack_from("<8I", data, at)
+    name_length, type_length, comment_length, dims, items = struct.unpack_from("<5H", data, at + 32)
+    name, type_name, _ = cstrings(data, at + 42, name_length, type_length, comment_length)
+    pos = at + 42 + name_length + type_length + comment_length + 3
+    array = tuple(struct.unpack_from("<II", data, pos + 8 * k) for k in range(dims))
+    pos += 8 * dims
+    members = []
+    for _ in range(items):
+        member = parse_type(data, pos)
+        members.append(member)
+        pos += member.length
+    assert pos <= at + length
+    return Item(name, type_name, size, offset, data_type, flags, array, tuple(members), length)
+
+
+def symbol(ads: RawAds, name: str):
+    result, data = answer(ads, READ_WRITE, read_write(0xF009, 0, ANY, name.encode() + b"\0"))
+    assert result == OK, (name, hex(result))
+    return parse_symbol(data, 0)
+
+
+def data_type(ads: RawAds, name: str) -> Item:
+    result, data = answer(ads, READ_WRITE, read_write(0xF011, 0, ANY, name.encode() + b"\0"))
+    assert result == OK, (name, hex(result))
+    return parse_type(data)
+
+
+def value(ads: RawAds, name: str) -> bytes:
+    result, data = answer(ads, READ_WRITE, read_write(0xF004, 0, ANY, name.encode() + b"\0"))
+    assert result == OK, (name, hex(result))
+    return data
+
+
+@pytest.fixture(scope="module")
+def service(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceProcess]:
+    running = start_service(program_dir=tmp_path_factory.mktemp("ads-structs"), ads="127.0.0.1:0")
+    yield running
+    assert running.stop() == 0, running.log_text
+
+
+@pytest.fixture
+def ads(service: ServiceProcess) -> Iterator[RawAds]:
+    connection = RawAds(service)
+    yield connection
+    connection.close()
+
+
+def test_a_struct_symbol_and_its_type(ads: RawAds) -> None:
+    entry = symbol(ads, REQUEST)
+    assert (entry.size, entry.data_type, entry.type_name) == (
+        16, BIGTYPE, "HLI_CONTOUR_LOOKAHEAD_REQUEST")
+    assert entry.flags & 0x20 == 0  # writable members
+    assert symbol(ads, STATE).flags & 0x20  # read-only
+    request = data_type(ads, entry.type_name)
+    assert request.size == 16 and request.flags & 0x1
+    assert [(m.name, m.type_name, m.offset, m.size) for m in request.members] == [
+        ("start_position", "LREAL", 0, 8), ("length", "LREAL", 8, 8)]
+    assert all(m.flags & 0x2 for m in request.members)  # ADSDATATYPEFLAG_DATAITEM
+    assert symbol(ads, "gpCh[0]^.contour_lookahead.request") == entry
+
+
+def test_every_struct_type_places_its_members_where_a_read_finds_them(ads: RawAds) -> None:
+    """For every struct and array of the upload: each member of its type, at its offset
+    in the struct's bytes, is what a read of the member by name returns."""
+    info = answer(ads, READ, read(0xF00F, 0, 64))[1]
+    upload = parse_symbols(answer(ads, READ, read(0xF00B, 0, struct.unpack_from("<I", info, 4)[0]))[1])
+    structs = [s for s in upload if s.data_type == BIGTYPE]
+    assert {s.name for s in structs} >= {"gpCh", "gpCh[0]", "gpCh[1]", "gpAx", "gpAx[0].lr_state",
+                                         "gpCh[0].contour_lookahead.response.block"}
+    for entry in structs:
+        whole = value(ads, entry.name)
+        assert len(whole) == entry.size, entry.name
+        item = data_type(ads, entry.type_name)
+        assert item.size == entry.size
+        if item.array:  # the elements: contiguous, each the element type's size
+            ((lower, count),) = item.array
+            stride = entry.size // count
+            assert data_type(ads, item.type_name).size == stride
+            for k in range(lower, lower + count):
+                assert whole[k * stride : (k + 1) * stride] == value(
+                    ads, f"{entry.name}[{k}]"), (entry.name, k)
+            continue
+        for member in item.members:
+            assert member.offset + member.size <= item.size, (entry.name, member.name)
+            assert whole[member.offset : member.offset + member.size] == value(
+                ads, f"{entry.name}.{member.name}"), (entry.name, member.name)
+
+
+def test_an_array_symbol(ads: RawAds) -> None:
+    gpch = symbol(ads, "gpCh")
+    assert gpch.type_name.startswith("ARRAY [0..1] OF ")
+    array = data_type(ads, gpch.type_name)
+    assert array.array == ((0, 2),) and array.type_name == gpch.type_name.split(" OF ")[1]
+    element = data_type(ads, array.type_name)
+    assert gpch.size == 2 * element.size
+    assert data_type(ads, gpch.type_name.replace(" ", "")).size == gpch.size  # any spacing
+
+
+def test_write_a_whole_struct_then_read_its_members(ads: RawAds) -> None:
+    entry = symbol(ads, REQUEST)
+    data = struct.pack("<dd", 12.5, 40.0)
+    assert ads.call(WRITE, write(entry.group, entry.offset, data)).result == OK
+    assert value(ads, REQUEST + ".start_position") == struct.pack("<d", 12.5)
+    assert value(ads, REQUEST + ".length") == struct.pack("<d", 40.0)
+    assert answer(ads, READ, read(entry.group, entry.offset, entry.size)) == (OK, data)
+    # At the address, 8 bytes are the first member (same offset); a write must cover one
+    # symbol exactly.
+    assert ads.call(WRITE, write(entry.group, entry.offset, struct.pack("<d", 1.0))).result == OK
+    assert value(ads, REQUEST + ".start_position") == struct.pack("<d", 1.0)
+    assert ads.call(WRITE, write(entry.group, entry.offset, data[:12])).result == INVALIDSIZE
+    state = symbol(ads, STATE)
+    assert ads.call(WRITE, write(state.group, state.offset, bytes(state.size))).result == (
+        INVALIDACCESS)
+
+
+def test_a_struct_handle_reads_and_a_buffer_too_small_is_0x705(ads: RawAds) -> None:
+    result, data = answer(ads, READ_WRITE, read_write(0xF003, 0, ANY, REQUEST.encode() + b"\0"))
+    handle, size, _, type_length = struct.unpack_from("<IIIH", data)
+    assert result == OK and size == 16
+    assert data[14 : 14 + type_length] == b"HLI_CONTOUR_LOOKAHEAD_REQUEST"
+    assert answer(ads, READ, read(0xF005, handle, 16))[0] == OK
+    assert answer(ads, READ, read(0xF005, handle, 15)) == (INVALIDSIZE, b"")
+    assert ads.call(WRITE, write(0xF005, handle, bytes(8))).result == INVALIDSIZE
+
+
+def test_a_notification_on_a_struct_sends_its_bytes_when_a_member_changes(ads: RawAds) -> None:
+    entry = symbol(ads, REQUEST)
+    got = ads.call(ADD_NOTIFICATION, add_notification(entry.group, entry.offset, entry.size, 4,
+                                                      10_000))
+    assert got.result == OK
+    handle = struct.unpack_from("<I", got.data, 4)[0]
+    try:
+        first = _sample(ads, handle)
+        assert first == value(ads, REQUEST)
+        changed = struct.pack("<d", struct.unpack_from("<d", first, 8)[0] + 1.0)
+        member = symbol(ads, REQUEST + ".length")
+        assert ads.call(WRITE, write(member.group, member.offset, changed)).result == OK
+        assert _sample(ads, handle) == first[:8] + changed
+    finally:
+        ads.call(DELETE_NOTIFICATION, struct.pack("<I", handle))
+
+
+def _sample(ads: RawAds, handle: int) -> bytes:
+    """The data of the next sample of notification ``handle``."""
+    while True:
+        body = ads.notification().data
+        _, stamps = struct.unpack_from("<II", body)
+        at = 8
+        for _ in range(stamps):
+            _, samples = struct.unpack_from("<QI", body, at)
+            at += 12
+            for _ in range(samples):
+                got, size = struct.unpack_from("<II", body, at)
+                if got == handle:
+                    return body[at + 8 : at + 8 + size]
+                at += 8 + size
+
+
+def test_sum_read_and_sum_write_of_structs(ads: RawAds) -> None:
+    request, state = symbol(ads, REQUEST), symbol(ads, STATE)
+    items = [(request.group, request.offset, request.size), (state.group, state.offset, state.size)]
+    head = b"".join(struct.pack("<III", *item) for item in items)
+    result, body = answer(ads, READ_WRITE, read_write(0xF080, 2, ANY, head))
+    assert result == OK and struct.unpack_from("<II", body) == (OK, OK)
+    assert body[8 : 8 + request.size] == value(ads, REQUEST)
+    assert body[8 + request.size :] == value(ads, STATE)
+    data = struct.pack("<dd", 2.0, 3.0)
+    writes = (struct.pack("<III", request.group, request.offset, 16)
+              + struct.pack("<III", state.group, state.offset, state.size) + data + bytes(state.size))
+    result, codes = answer(ads, READ_WRITE, read_write(0xF081, 2, 8, writes))
+    assert result == OK and struct.unpack("<II", codes) == (OK, INVALIDACCESS)
+    assert value(ads, REQUEST) == data
+
+
+def test_the_plc_memory_area_reads_as_a_plc_reads_it(ads: RawAds) -> None:
+    """At a PLC address the read length says how many bytes of memory: a struct's
+    members share its first member's offset, and a longer read takes the symbols that
+    follow; a range past the end of the memory area is 0x705, an offset where no symbol
+    starts 0x703."""
+    request, first = symbol(ads, REQUEST), symbol(ads, REQUEST + ".start_position")
+    assert (first.group, first.offset) == (request.group, request.offset) == (0x4020, first.offset)
+    whole = answer(ads, READ, read(0x4020, first.offset, 16))
+    assert whole == (OK, value(ads, REQUEST))
+    assert answer(ads, READ, read(0x4020, first.offset, 8)) == (OK, whole[1][:8])
+    assert answer(ads, READ, read(0x4020, first.offset, ANY)) == (INVALIDSIZE, b"")
+    assert answer(ads, READ, read(0x4020, first.offset + 1, 4))[0] == 0x703
+    gpch = symbol(ads, "gpCh")
+    assert answer(ads, READ, read(0x4020, gpch.offset, gpch.size)) == (OK, value(ads, "gpCh"))

@@ -1,0 +1,103 @@
+"""Struct and array symbols derived from the PLC leaves' names and offsets."""
+
+from __future__ import annotations
+
+import struct
+from typing import Any
+
+import pytest
+
+from cnc_objects.objects.address_space import AddressSpace
+from cnc_objects.objects.model import Access, CncObject
+from cnc_objects.objects.plc_structs import HANDLE_BASE, PlcStructs
+from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, UNS16, DataType
+from cnc_objects.protocol.errors import AdsReturnCode
+
+PLC = 851
+LEAVES = [  # name, offset, type, access
+    ("gpX[0].a.flag", 0x100, BOOLEAN, Access.READ_WRITE),
+    ("gpX[0].a.count", 0x102, UNS16, Access.READ),
+    ("gpX[0].b[0].v", 0x110, REAL64, Access.READ),
+    ("gpX[0].b[1].v", 0x120, REAL64, Access.READ),
+    ("gpX[1].a.flag", 0x200, BOOLEAN, Access.READ_WRITE),
+    ("gpX[1].a.count", 0x202, UNS16, Access.READ),
+    ("gpX[1].b[0].v", 0x210, REAL64, Access.READ),
+    ("gpX[1].b[1].v", 0x220, REAL64, Access.READ),
+]
+
+
+def leaf(name: str, offset: int, dtype: DataType, access: Access) -> CncObject:
+    return CncObject(name, name, PLC, 0x4020, offset, dtype, access, "-", name)
+
+
+@pytest.fixture
+def built() -> tuple[PlcStructs, dict[str, Any]]:
+    values: dict[str, Any] = {name: 0 for name, *_ in LEAVES}
+    values["gpX[1].a.count"] = 7
+    space = AddressSpace()
+    for name, offset, dtype, access in LEAVES:
+        space.add(leaf(name, offset, dtype, access), lambda n=name: values[n],
+                  (lambda v: None) if access.writable else None)
+    return PlcStructs(space), values
+
+
+def test_every_prefix_is_a_symbol_with_a_handle_of_its_own(built) -> None:
+    structs, _ = built
+    names = [node.name for node in structs.symbols]
+    assert names == ["gpX", "gpX[0]", "gpX[0].a", "gpX[0].b", "gpX[0].b[0]", "gpX[0].b[1]",
+                     "gpX[1]", "gpX[1].a", "gpX[1].b", "gpX[1].b[0]", "gpX[1].b[1]"]
+    assert [node.handle for node in structs.symbols] == [HANDLE_BASE + k for k in range(11)]
+    assert structs.by_handle(HANDLE_BASE + 1) is structs.by_name("GPX[0]")
+    assert structs.by_name("gpX[0]^.a") is structs.symbols[2]
+    assert structs.by_handle(1) is None and structs.by_name("gpX[0].a.flag") is None
+
+
+def test_layout_strides_and_padding(built) -> None:
+    structs, _ = built
+    gpx, element, b = (structs.by_name(n) for n in ("gpX", "gpX[1]", "gpX[1].b"))
+    assert (element.start, element.size) == (0x200, 0x100)  # the stride between elements
+    assert (gpx.start, gpx.size, gpx.type_name) == (0x100, 0x200, "ARRAY [0..1] OF ST_gpX")
+    assert (b.start, b.size, b.type_name) == (0x210, 0x20, "ARRAY [0..1] OF ST_gpX_b")
+    assert structs.by_name("gpX[0].a").size == 4
+    assert not structs.by_name("gpX[0].b").writable and structs.by_name("gpX[0]").writable
+
+
+def test_read_places_members_at_their_offsets(built) -> None:
+    structs, values = built
+    values["gpX[1].b[1].v"] = 2.5
+    code, data = structs.read(structs.by_name("gpX[1]"), 0xFFFF_FFFF)
+    assert code == 0 and len(data) == 0x100
+    assert data[:4] == b"\x00\x00\x07\x00" and data[0x20:0x28] == struct.pack("<d", 2.5)
+    assert structs.read(structs.by_name("gpX[1]"), 0xFF)[0] == AdsReturnCode.DEVICE_INVALIDSIZE
+
+
+def test_a_write_touches_only_changed_writable_members(built) -> None:
+    structs, _ = built
+    node = structs.by_name("gpX[0].a")
+    assert structs.decode_write(node, b"\x00\x00\x09\x00") == (0, "", [])  # count: read-only
+    code, _, writes = structs.decode_write(node, b"\x01\x00\x00\x00")
+    assert code == 0 and [(e.obj.name, v) for e, v in writes] == [("gpX[0].a.flag", True)]
+    assert structs.decode_write(node, b"\x02\x00\x00\x00")[0] == AdsReturnCode.DEVICE_INVALIDDATA
+    assert structs.decode_write(node, b"\x01")[0] == AdsReturnCode.DEVICE_INVALIDSIZE
+    assert structs.decode_write(structs.by_name("gpX[0].b"), bytes(32))[0] == (
+        AdsReturnCode.DEVICE_INVALIDACCESS)
+
+
+def test_elements_laid_out_unevenly_are_refused() -> None:
+    space = AddressSpace()
+    for name, offset in (("p[0].v", 0), ("p[1].v", 8), ("p[2].v", 20)):
+        space.add(leaf(name, offset, UNS16, Access.READ), lambda: 0)
+    with pytest.raises(ValueError, match="not evenly laid out"):
+        PlcStructs(space)
+
+
+def test_the_memory_area_reads_any_range_from_a_symbol_and_writes_whole_symbols(built) -> None:
+    structs, values = built
+    values["gpX[0].a.count"] = 0x0102
+    assert structs.read_memory(0x100, 4) == (0, b"\x00\x00\x02\x01")  # flag, padding, count
+    assert structs.read_memory(0x102, 1) == (0, b"\x02")  # the first byte of count
+    assert structs.read_memory(0x101, 1)[0] == AdsReturnCode.DEVICE_INVALIDOFFSET
+    assert structs.read_memory(0x100, 0x1000)[0] == AdsReturnCode.DEVICE_INVALIDSIZE
+    code, _, writes = structs.decode_memory_write(0x100, b"\x01\x00\x02\x01")  # gpX[0].a
+    assert code == 0 and [e.obj.name for e, _ in writes] == ["gpX[0].a.flag"]
+    assert structs.decode_memory_write(0x100, b"\x01\x00")[0] == AdsReturnCode.DEVICE_INVALIDSIZE
