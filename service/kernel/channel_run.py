@@ -87,11 +87,15 @@ class ChannelRunner:
         params: dict[int, AxisParameters],
         switchover: Switchover,
         check_max_errors: int = CHECK_MAX_ERRORS,
+        on_wait: Callable[[], None] = lambda: None,
     ) -> None:
         """``params`` are the kernel's effective axis parameters (read at each program
         start, so a parameter update applies from the next run); ``switchover`` links
         the channel's axes to the drives; ``check_max_errors``: errors a syntax check
-        keeps ([limits] check_max_errors), the rest are counted only."""
+        keeps ([limits] check_max_errors), the rest are counted only; ``on_wait``: called
+        while a cycle waits for the decoder or the check (virtual clock), so that the
+        kernel answers the cycle's commands meanwhile."""
+        self._on_wait = on_wait
         self.channel = channel
         self.config = config
         self._loader = loader
@@ -223,6 +227,13 @@ class ChannelRunner:
             Job(_MDI_NAME, text, manual=True), keep_open=extended, fresh_modal=False
         )
         return None
+
+    def _waiting(self) -> bool:
+        """Called at each poll of a cycle that waits for the decoder or the check
+        (virtual clock): the kernel answers the commands of the cycle; True once a RESET
+        is queued (the wait ends, the RESET is applied at the next cycle)."""
+        self._on_wait()
+        return self.reset_pending.is_set()
 
     def reset(self) -> Refusal | None:
         """RESET from any state: stop at once, clear errors, back to READY or SELECTED."""
@@ -389,7 +400,7 @@ class ChannelRunner:
             contour_lookahead=self.config.contour_lookahead, surroundings=self._surroundings,
             section_planner=partial(plan_section, dynamics=dynamics,
                                     buffer_blocks=self._buffer_blocks, cycle_s=self._cycle_s),
-            interrupted=self.reset_pending.is_set,
+            interrupted=self._waiting,
         )
         feed.add(job)
         for more in self._queued_jobs:
@@ -483,7 +494,7 @@ class ChannelRunner:
             deterministic=self._deterministic, files=self._files,
             surroundings=self._surroundings,
             modal=self.new_modal(tuple(a.position_mm for a in ch.axes)),
-            max_errors=self._check_max_errors, interrupted=self.reset_pending.is_set,
+            max_errors=self._check_max_errors, interrupted=self._waiting,
         )
         self._run = ChannelCheck(self, ch, check, started_at_s=self.time_s,
                                  deterministic=self._deterministic)

@@ -129,8 +129,10 @@ class DecoderFeed:
         decoder accepts ``#CONTOUR LOOKAHEAD``; ``surroundings``: the file store, message
         list and cycle parameters the decoder reaches (``nc.technology``);
         ``section_planner``: plans the LA_ON sections (None: they pass unplanned);
-        ``interrupted``: True once a RESET is queued, so that ``take`` stops waiting
-        (a decoder in a loop without blocks would hold the cycle until its loop guard)."""
+        ``interrupted``: called at each poll while ``take`` waits (the kernel answers
+        the cycle's commands then); True once a RESET is queued, so that ``take`` stops
+        waiting (a decoder in a loop without blocks would hold the cycle until its loop
+        guard)."""
         self._interrupted = interrupted
         self._surroundings = surroundings
         self._sections = SectionCollector(section_planner) if section_planner else None

@@ -130,8 +130,9 @@ class CheckRun:
         interrupted: Callable[[], bool] = lambda: False,
     ) -> None:
         """``max_errors``: errors kept (listed and logged) per check, the limit
-        ``check_max_errors``; the rest are counted only. ``interrupted``: True once a
-        RESET is queued: ``advance`` stops waiting for the check then."""
+        ``check_max_errors``; the rest are counted only. ``interrupted``: called at each
+        poll while ``advance`` waits (the kernel answers the cycle's commands then); True
+        once a RESET is queued: ``advance`` stops waiting for the check then."""
         self._interrupted = interrupted
         self.channel_id = channel_id
         self.max_errors = max(1, max_errors)

@@ -225,9 +225,8 @@ async def test_reset_ends_a_run_whose_decoder_loops_without_blocks() -> None:
     virtual clock the cycle that starts it waits for the decoder to fill the look-ahead
     buffer, once until the loop guard (a million passes, 10-30 s) and every RESET sent
     meanwhile with it. Now a queued RESET ends that wait: START and RESET are answered
-    at once, and the decoder's thread stops at the RESET.
-
-    (**Open**: the START alone is still answered only after the loop guard.)"""
+    at once, and the decoder's thread stops at the RESET. (The START alone is answered
+    at once too: ``test_start_reply.py``.)"""
     program = ("#VAR\nV.L.N = 0\n#ENDVAR\nN10 G01 X1 F6000\n"
                "$WHILE 1\nV.L.N = V.L.N + 1\n$ENDWHILE\nM30\n")
     with serving("--speed", "1") as service:  # kernel time runs as wall time when idle
