@@ -143,7 +143,8 @@ class CheckResult:
     and ``blocks``: how many NC lines and blocks were checked; ``stopped_early``: the
     check stopped at ``syn_chk.errors_total``; ``log``: the whole log file;
     ``error_count``: all errors the check found (more than ``errors`` when the log had to
-    leave some out at the output area's file limit).
+    leave some out: over the service's ``limits.check_max_errors`` or at the output
+    area's file limit); ``left_out``: how many of them the log says it does not list.
     """
 
     errors: tuple[CheckError, ...]
@@ -153,6 +154,7 @@ class CheckResult:
     log: str
     stopped_early: bool
     error_count: int = 0
+    left_out: int = 0
 
     @property
     def clean(self) -> bool:
@@ -169,6 +171,7 @@ def check_log_name(channel: int) -> str:
 _LOG_HEADER = re.compile(r"; syntax check of (.*) in channel (\d+)")
 _LOG_END = re.compile(r"; end: (\d+) lines, (\d+) blocks, (\d+) errors, (.*)")
 _LOG_ERROR = re.compile(r"error (\d+) \((\w+)\) at (.*)")
+_LOG_LEFT_OUT = re.compile(r"; (\d+) more errors are not listed \(.*\)")
 _LOG_POSITION = re.compile(r":(\d+):(\d+): ")  # after the file name of an error
 _LOG_LINE = re.compile(r":(\d+): ")  # after the file name of a checked line
 
@@ -192,9 +195,14 @@ def parse_check_log(text: str, program: str = "") -> CheckResult:
     errors: list[CheckError] = []
     aborted: CheckError | None = None
     end = None
+    left_out = 0
     for entry in entries:
         if entry.startswith("; end: "):
             end = _LOG_END.fullmatch(entry) or end
+            continue
+        more = _LOG_LEFT_OUT.fullmatch(entry)
+        if more:
+            left_out += int(more.group(1))
             continue
         found = _LOG_ERROR.fullmatch(entry)
         if not found:
@@ -213,7 +221,7 @@ def parse_check_log(text: str, program: str = "") -> CheckResult:
     if end is None:
         raise ValueError("the log has no '; end: ...' line: it is not a complete syntax check log")
     return CheckResult(tuple(errors), aborted, int(end.group(1)), int(end.group(2)), text,
-                       end.group(4).startswith("stopped"), int(end.group(3)))
+                       end.group(4).startswith("stopped"), int(end.group(3)), left_out)
 
 
 def _name_bytes(name: str) -> bytes:

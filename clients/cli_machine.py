@@ -398,6 +398,8 @@ def _check_summary(result: CheckResult, channel: int) -> str:
     if result.clean:
         return f"clean: {lines}"
     text = f"{_plural(max(result.error_count, len(result.errors)), 'error')} in {lines}"
+    if result.left_out:
+        text += f" ({result.left_out} not listed)"
     if result.stopped_early:
         text += ", stopped early: syn_chk.errors_total reached"
     if result.aborted is not None:

@@ -105,6 +105,11 @@ class LimitsConfig(BaseModel):
         description="requests of a client over its rate that wait for their turn (at most "
         "16 MiB of them); more are answered ADS 0x502 (mailbox full)",
     )
+    check_max_errors: int = Field(
+        1000, ge=1, le=1_000_000,
+        description="errors one syntax check keeps (listed in the channel, written to "
+        "dec0<c>.sc); more are counted only, and the log says how many were left out",
+    )
     program_max_bytes: int = Field(
         PROGRAM_MAX_BYTES, ge=1, le=MAX_DATA_BYTES - _UPLOAD_OVERHEAD_BYTES,
         description="largest program the store takes in one upload (bytes; one frame "

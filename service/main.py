@@ -150,7 +150,7 @@ async def serve(
         limits.output_queue_max_bytes))
     kernel = Kernel(
         config.machine, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists,
-        writer.kernel_file, writer.save,
+        writer.kernel_file, writer.save, check_max_errors=config.limits.check_max_errors,
     )
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows
     space = build_address_space(kernel, counts)

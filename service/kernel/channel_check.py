@@ -26,6 +26,7 @@ class ChannelCheck:
         self.started_at_s = started_at_s
         self._deterministic = deterministic  # virtual clock: the cycle lets the check go on
         self._released = Pause.NONE  # START ended this pause (flag for one cycle)
+        self._left_out = 0  # errors counted but not kept (check_max_errors), shown so far
         self.failure: ChannelError | None = None
 
     @property
@@ -64,6 +65,9 @@ class ChannelCheck:
             self._host.list_error(ChannelError(int(err.id), err.message, found.file,
                                                found.line, found.column, warning=True),
                                   to_log=False, keep_last=True)
+        # errors over limits.check_max_errors are counted, not listed
+        ch.error_count += p.left_out - self._left_out
+        self._left_out = p.left_out
         flags = ch.decoder_flags & DecoderFlag.SYNTAX_CHECK
         if p.pause == Pause.AFTER_ERROR:
             flags |= DecoderFlag.WAIT_AFTER_ERROR

@@ -20,6 +20,7 @@ limit is refused before it moves.
 from __future__ import annotations
 
 import logging
+import threading
 from collections import deque
 from collections.abc import Callable
 from dataclasses import replace
@@ -51,7 +52,7 @@ from .program_run import (
 )
 from .state import MESSAGES_KEPT, Channel, ChannelError, DecoderFlag
 from .switchover import Switchover
-from .syntax_check import SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
+from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
 
 log = logging.getLogger(__name__)
 
@@ -86,11 +87,18 @@ class ChannelRunner:
         params: dict[int, AxisParameters],
         switchover: Switchover,
         save: Callable[[str, bytes, bool], None] = lambda name, data, replace: None,
+        check_max_errors: int = CHECK_MAX_ERRORS,
+        on_wait: Callable[[], None] = lambda: None,
     ) -> None:
         """``params`` are the kernel's effective axis parameters (read at each program
         start, so a parameter update applies from the next run); ``switchover`` links
         the channel's axes to the drives; ``files`` writes the channel's own files (logs,
-        reports), ``save`` those its NC programs write, both into the output area."""
+        reports), ``save`` those its NC programs write, both into the output area;
+        ``check_max_errors``: errors a syntax check keeps ([limits] check_max_errors), the
+        rest are counted only; ``on_wait``: called while a cycle waits for the decoder or
+        the check (virtual clock), so that the kernel answers the cycle's commands
+        meanwhile."""
+        self._on_wait = on_wait
         self.channel = channel
         self.config = config
         self._loader = loader
@@ -113,6 +121,10 @@ class ChannelRunner:
         self._internal_hold = False  # feedhold of a suspend_axis_output request
         self._modal: ModalState | None = None  # MDI: modal state carried between blocks
         self.time_s = 0.0  # kernel time of the cycle (PROD_TIME: the simulated time)
+        # set by the kernel when a RESET of this channel is queued: a cycle waiting for
+        # the decoder or the check (virtual clock) stops waiting; cleared by ``reset``
+        self.reset_pending = threading.Event()
+        self._check_max_errors = check_max_errors  # errors kept per check
         self.touched = False  # the last cycle changed the channel's state
         # #MSG texts from the decoder thread (deque appends are thread-safe)
         self._messages: deque[str] = deque(maxlen=MESSAGES_KEPT)
@@ -219,9 +231,17 @@ class ChannelRunner:
         )
         return None
 
+    def _waiting(self) -> bool:
+        """Called at each poll of a cycle that waits for the decoder or the check
+        (virtual clock): the kernel answers the commands of the cycle; True once a RESET
+        is queued (the wait ends, the RESET is applied at the next cycle)."""
+        self._on_wait()
+        return self.reset_pending.is_set()
+
     def reset(self) -> Refusal | None:
         """RESET from any state: stop at once, clear errors, back to READY or SELECTED."""
         ch = self.channel
+        self.reset_pending.clear()
         self._drop_run()
         ch.decoder_flags = 0
         self._pending_start = None
@@ -383,6 +403,7 @@ class ChannelRunner:
             contour_lookahead=self.config.contour_lookahead, surroundings=self._surroundings,
             section_planner=partial(plan_section, dynamics=dynamics,
                                     buffer_blocks=self._buffer_blocks, cycle_s=self._cycle_s),
+            interrupted=self._waiting,
         )
         feed.add(job)
         for more in self._queued_jobs:
@@ -476,6 +497,7 @@ class ChannelRunner:
             deterministic=self._deterministic, files=self._files,
             surroundings=self._surroundings,
             modal=self.new_modal(tuple(a.position_mm for a in ch.axes)),
+            max_errors=self._check_max_errors, interrupted=self._waiting,
         )
         self._run = ChannelCheck(self, ch, check, started_at_s=self.time_s,
                                  deterministic=self._deterministic)

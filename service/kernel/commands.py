@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Any, Protocol
+from typing import Any, ClassVar, Protocol
 
 from .axis_params import update_axis
 from .channel_mode import ChannelState
@@ -187,23 +187,28 @@ class SelectProgram:
         return state.runners[self.channel_index].select_program(self.value)
 
 
-def _pulse(name: str, method: str) -> type:
-    """A command object written with TRUE to trigger ``method`` of the channel runner."""
+@dataclass(frozen=True, slots=True)
+class ChannelPulse:
+    """A command object written with TRUE to trigger ``method`` of the channel runner
+    (the subclasses made by ``_pulse`` name the method)."""
 
-    @dataclass(frozen=True, slots=True)
-    class Pulse:
-        channel_index: int
-        value: bool
+    channel_index: int
+    value: bool
+    method: ClassVar[str] = ""
 
-        def apply(self, state: KernelState) -> Refusal | None:
-            if not self.value:
-                return None  # writing FALSE is accepted and does nothing, as a PLC edge
-            answer: Refusal | None = getattr(state.runners[self.channel_index], method)()
-            return answer
+    def apply(self, state: KernelState) -> Refusal | None:
+        if not self.value:
+            return None  # writing FALSE is accepted and does nothing, as a PLC edge
+        answer: Refusal | None = getattr(state.runners[self.channel_index], self.method)()
+        return answer
 
-    Pulse.__name__ = Pulse.__qualname__ = name
-    Pulse.__doc__ = f"Write TRUE: ``ChannelRunner.{method}``."
-    return Pulse
+
+def _pulse(name: str, method: str) -> type[ChannelPulse]:
+    """The ``ChannelPulse`` that triggers ``method`` of the channel runner."""
+    return type(name, (ChannelPulse,), {
+        "__slots__": (), "method": method, "__qualname__": name,
+        "__doc__": f"Write TRUE: ``ChannelRunner.{method}``.",
+    })
 
 
 StartProgram = _pulse("StartProgram", "start")

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, Compensation, SourceRef, StopKind
+from .nc.errors import DecodingCancelled
 from .nc.technology import Surroundings
 from .path.errors import PathError
 from .path.section_plan import SectionPlan
@@ -28,6 +29,7 @@ from .path.section_plan import SectionPlan
 log = logging.getLogger(__name__)
 
 _PUT_POLL_S = 0.05  # how often a decoder waiting on a full queue checks for cancel
+_TAKE_POLL_S = 0.02  # how often a cycle waiting for the decoder checks for a RESET
 
 
 @dataclass(frozen=True, slots=True)
@@ -121,11 +123,17 @@ class DecoderFeed:
         contour_lookahead: bool = False,
         surroundings: Surroundings | None = None,
         section_planner: SectionPlanner | None = None,
+        interrupted: Callable[[], bool] = lambda: False,
     ) -> None:
         """``contour_lookahead``: FCT_CONTOUR_LAH is enabled (P-CHAN-00650), so the
         decoder accepts ``#CONTOUR LOOKAHEAD``; ``surroundings``: the file store, message
         list and cycle parameters the decoder reaches (``nc.technology``);
-        ``section_planner``: plans the LA_ON sections (None: they pass unplanned)."""
+        ``section_planner``: plans the LA_ON sections (None: they pass unplanned);
+        ``interrupted``: called at each poll while ``take`` waits (the kernel answers
+        the cycle's commands then); True once a RESET is queued, so that ``take`` stops
+        waiting (a decoder in a loop without blocks would hold the cycle until its loop
+        guard)."""
+        self._interrupted = interrupted
         self._surroundings = surroundings
         self._sections = SectionCollector(section_planner) if section_planner else None
         self._axes = axes
@@ -172,7 +180,12 @@ class DecoderFeed:
             except queue.Empty:
                 if not wait or self._outstanding <= 0:
                     break
-                item = self._out.get()
+                try:
+                    item = self._out.get(timeout=_TAKE_POLL_S)
+                except queue.Empty:
+                    if self._interrupted():  # RESET is queued: it discards all this
+                        break
+                    continue
             items.append(item)
             if isinstance(item, DecodeEnd | NcError):
                 self._ended = True
@@ -218,6 +231,7 @@ class DecoderFeed:
             modal=self.modal, manual=job.manual, axis_numbers=self._axis_numbers,
             contour_lookahead=self._contour_lookahead, surroundings=self._surroundings,
         )
+        decoder.cancelled = self._cancel.is_set
         yield from decoder.blocks()
         self.modal = decoder.modal
 
@@ -257,6 +271,8 @@ class DecoderFeed:
                 if not self.keep_open:
                     break
             self._put(DecodeEnd())
+        except DecodingCancelled:  # RESET while the decoder looped without blocks
+            return
         except NcError as exc:
             if self._flush_section():  # the blocks before the error run to their end
                 self._put(exc)

@@ -21,9 +21,10 @@ from ..machine_config import MachineConfig
 from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
-from .commands import Command, Refusal, RefusalReason
+from .commands import Command, Refusal, RefusalReason, ResetChannel
 from .state import ChannelError, CycleStats, KernelState, Snapshot
 from .switchover import Switchover
+from .syntax_check import CHECK_MAX_ERRORS
 
 log = logging.getLogger(__name__)
 
@@ -87,6 +88,7 @@ class Kernel:
         exists: Callable[[str], bool] = lambda name: False,
         files: Callable[..., None] = lambda name, data, replace=False: None,
         save: Callable[[str, bytes, bool], None] = lambda name, data, replace: None,
+        check_max_errors: int = CHECK_MAX_ERRORS,
     ) -> None:
         """``loader(name)`` returns a program's text (KeyError when absent) and
         ``exists(name)`` says whether it is there: the program store, seen by the kernel,
@@ -94,7 +96,9 @@ class Kernel:
         ``files(name, data, replace=False)`` for its own (a log line at the end, or a
         report as the whole content), ``save(name, data, replace)`` for those an NC
         program writes (``#MSG SAVE``, a cycle's result), which may raise
-        ``nc.technology.OutputLimitReached``; neither blocks."""
+        ``nc.technology.OutputLimitReached``; neither blocks. ``check_max_errors``:
+        errors one syntax check keeps ([limits] check_max_errors)."""
+        self._check_max_errors = check_max_errors
         self.config = config
         self.cycle_s = config.cycle_ms / 1000.0
         self.cycle_ns = round(config.cycle_ms * 1e6)
@@ -116,6 +120,10 @@ class Kernel:
         self._channel_index = {c.channel_id: k for k, c in enumerate(self.state.channels)}
         self._thread: threading.Thread | None = None
         self._closed = False
+        # the replies of this cycle's commands while its work may still wait (virtual
+        # clock), and the snapshot that shows the commands applied, published with them
+        self._held: list[tuple[Done, Refusal | None]] = []
+        self._applied_snapshot: Snapshot | None = None
 
     def _initial_state(self) -> KernelState:
         """State, axis parameters (clones resolved), switchover and channel runners as
@@ -126,11 +134,13 @@ class Kernel:
         state.axis_params = params  # shared: an update reaches runners and switchover
         self.switchover = Switchover(state, params)
         # Virtual time must give the same result cycle by cycle: GEO waits for the decoder.
-        deterministic = isinstance(self._clock, VirtualClock)
+        self._deterministic = deterministic = isinstance(self._clock, VirtualClock)
         state.runners = [
             ChannelRunner(channel, cfg, self.config, self._loader, self._exists, self.cycle_s,
                           deterministic, self._files, params=params, switchover=self.switchover,
-                          save=self._save)
+                          save=self._save,
+                          check_max_errors=self._check_max_errors,
+                          on_wait=self._reply_while_waiting)
             for channel, cfg in zip(state.channels, self.config.channels, strict=True)
         ]
         for message in messages:
@@ -158,6 +168,10 @@ class Kernel:
         if self._closed:
             done(Refusal(RefusalReason.NOT_READY, "the kernel is shut down"))
             return
+        if isinstance(command, ResetChannel) and command.value:
+            # a cycle that waits for the channel's decoder or syntax check (virtual
+            # clock) stops waiting, so that the RESET is applied at the next cycle
+            self.state.runners[command.channel_index].reset_pending.set()
         self._queue.put((command, done))
 
     def start(self) -> None:
@@ -212,7 +226,10 @@ class Kernel:
         """One cycle; False when the kernel is shutting down.
 
         Commands are acknowledged only after the snapshot that shows their effect is
-        published, so a read sent after a write's reply always sees the write.
+        published, so a read sent after a write's reply always sees the write. With the
+        virtual clock the cycle's work may wait for a decoder (a run's first blocks):
+        then the replies go out with a snapshot of the state as the commands left it
+        (``_reply_while_waiting``), not after the wait.
         """
         applied: list[tuple[Done, Refusal | None]] = []
         shutting_down = False
@@ -226,10 +243,16 @@ class Kernel:
                 break
             applied.append((done, self._apply(command)))
         self.stats.cycles += 1
+        had_commands = bool(applied)
+        if had_commands and self._deterministic and self.stats.running:
+            self._held = applied  # answered at once should the work wait
+            self._applied_snapshot = self._snapshot()
+            applied = []
         if self.stats.running:
-            self._work(bool(applied))
+            self._work(had_commands)
         self._publish()
-        for done, result in applied:
+        held, self._held, self._applied_snapshot = self._held, [], None
+        for done, result in applied + held:
             done(result)
         if shutting_down:
             self._refuse_queued()
@@ -248,6 +271,8 @@ class Kernel:
                 self._publish()
                 done(result)
             else:
+                if isinstance(command, ResetChannel):  # refused: no cycle may stop waiting for it
+                    self.state.runners[command.channel_index].reset_pending.clear()
                 done(Refusal(RefusalReason.NOT_READY, "the kernel is stopped (ADS state STOP)"))
         return True
 
@@ -292,15 +317,33 @@ class Kernel:
                 return
             done(Refusal(RefusalReason.NOT_READY, "the kernel is shutting down"))
 
-    def _publish(self) -> None:
+    def _reply_while_waiting(self) -> None:
+        """A channel's cycle waits for its decoder or check (virtual clock): the
+        replies of the commands this cycle applied go out now, with the snapshot taken
+        after they were applied (no client request waits on the kernel's backlog). Reads
+        see that snapshot until the cycle ends; the cycle's own publication (and its
+        notifications) are as without the wait, so runs stay the same cycle by cycle."""
+        if self._applied_snapshot is None:
+            return
+        self.snapshot, self._applied_snapshot = self._applied_snapshot, None
+        held, self._held = self._held, []
+        for done, result in held:
+            done(result)
+
+    def _snapshot(self) -> Snapshot:
+        """The state as it is now, as readers see it (every channel copied unless
+        ``_work`` noted which changed)."""
         cycle = self.stats.cycles
         # One wall-clock reading per cycle: the time the cycle's values were produced,
         # which notifications carry as their timestamp (kernel time is not wall time
         # under the virtual clock, nor under load).
-        self.snapshot = self.state.snapshot(
+        return self.state.snapshot(
             cycle, cycle * self.cycle_ns, time.time_ns(), self.stats, self.snapshot,
             self._changed,
         )
+
+    def _publish(self) -> None:
+        self.snapshot = self._snapshot()
         self._changed = None
         hook = self.on_cycle_end
         if hook is not None:

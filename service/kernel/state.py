@@ -7,6 +7,7 @@ consistent within one cycle and never waits for the kernel.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 from enum import IntFlag
 from typing import Any, NamedTuple, Protocol
@@ -268,6 +269,8 @@ class ChannelRunnerView(Protocol):
 
     config: ChannelConfig  # the channel's configuration
     touched: bool  # the last cycle changed the channel's state
+    # set when a RESET of the channel is queued: a cycle waiting for its decoder stops
+    reset_pending: threading.Event
 
     @property
     def moving(self) -> bool:

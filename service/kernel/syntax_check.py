@@ -12,9 +12,12 @@ radius compensation go through the path preparation, so its errors are found too
   With ``interactive`` the check waits after each error (``Pause.AFTER_ERROR``) until
   ``resume`` (START) or ``cancel`` (RESET). With ``record_result`` every checked line
   and every error go to ``dec0<channel>.sc``, written in one piece when the check ends.
+  Only the first ``max_errors`` errors (``[limits] check_max_errors``) are kept, listed
+  and logged; the others are counted (``Progress.left_out``, a line of the log).
 * **Dry run** (``settings`` None): the first error ends the run, as in a real run.
 
-A software limit violation ends both with that error. Single step at decoder level
+A software limit violation ends both with that error. RESET (``cancel``) ends the
+decoding at the next line or the next error, even inside a long line. Single step at decoder level
 (``single_step``) stops after every NC line (``Pause.SINGLE_STEP``); ``stop`` (STOP)
 pauses decoding at the next line or batch (``Pause.STOPPED``); ``resume`` goes on.
 
@@ -29,7 +32,7 @@ from __future__ import annotations
 import logging
 import re
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
@@ -51,6 +54,9 @@ log = logging.getLogger(__name__)
 SYNCHK_WITHOUT_MACHINE_LOCK = 21309  # ISG P-ERR-21309 (warning): MACHINE_LOCK set implicitly
 CHECK_STOPPED_WARNING = 21310  # the check ended early: syn_chk.errors_total reached
 LINES_PER_CYCLE = 20_000  # virtual clock: lines decoded per GEO cycle
+_ADVANCE_POLL_S = 0.02  # how often a cycle waiting for the check looks for a RESET
+# errors kept per check (listed, logged); the default of [limits] check_max_errors
+CHECK_MAX_ERRORS = 1000
 _N_WORD = re.compile(r"[ \t]*N[ \t]*([0-9]+)", re.IGNORECASE)
 
 
@@ -90,7 +96,8 @@ class Progress:
     lines: int = 0  # NC lines decoded
     blocks: int = 0  # blocks checked (motion lines and other blocks)
     errors: list[CheckedError] = field(default_factory=list)  # not yet taken by GEO
-    error_count: int = 0
+    error_count: int = 0  # all errors found
+    left_out: int = 0  # errors counted but not kept (over ``max_errors``)
     pause: Pause = Pause.NONE
     done: bool = False
     failure: CheckedError | None = None  # the error that ended the run
@@ -119,8 +126,16 @@ class CheckRun:
         files: Callable[..., None],
         surroundings: Surroundings | None = None,
         modal: ModalState | None = None,
+        max_errors: int = CHECK_MAX_ERRORS,
+        interrupted: Callable[[], bool] = lambda: False,
     ) -> None:
+        """``max_errors``: errors kept (listed and logged) per check, the limit
+        ``check_max_errors``; the rest are counted only. ``interrupted``: called at each
+        poll while ``advance`` waits (the kernel answers the cycle's commands then); True
+        once a RESET is queued: ``advance`` stops waiting for the check then."""
+        self._interrupted = interrupted
         self.channel_id = channel_id
+        self.max_errors = max(1, max_errors)
         self.name = name
         self.settings = settings
         self.errors_per_block = settings.errors_per_block if settings else 0
@@ -172,8 +187,11 @@ class CheckRun:
         with self._cond:
             self._budget += lines
             self._cond.notify_all()
-            self._cond.wait_for(lambda: self._budget <= 0 or self._progress.pause
-                                or self._progress.done)
+            # a long line may take seconds: a queued RESET must not wait for its end
+            while not self._cond.wait_for(lambda: self._budget <= 0 or self._progress.pause
+                                          or self._progress.done, _ADVANCE_POLL_S):
+                if self._interrupted():
+                    return
 
     def resume(self) -> bool:
         """START / RESUME: go on after a pause; False when the check was not paused."""
@@ -209,13 +227,29 @@ class CheckRun:
     # ------------------------------------------------------------ decoder callbacks
 
     def report(self, error: NcError, category: ErrorCategory) -> None:
-        """The decoder found ``error`` and goes on after it (syntax check) or stops."""
-        checked = CheckedError(error, category, error.file, error.line, error.column)
+        """The decoder found ``error`` and goes on after it (syntax check) or stops.
+
+        Only the first ``max_errors`` errors are kept (listed, logged); the others are
+        counted (``Progress.left_out``), so a line of 100,000 bad words costs no more
+        memory than one of 1,000. After RESET (``cancel``) the next error ends the
+        decoding at once."""
+        if self._cancelled:
+            raise CheckAborted
         if self.settings is None:  # dry run: the first error ends it
-            self._end_with(checked)
+            self._end_with(CheckedError(error, category, error.file, error.line, error.column))
             raise CheckAborted
         if self._limit_reached:  # the rest of the line the check ends at
             return
+        p = self._progress
+        if p.error_count >= self.max_errors:  # counted, not kept: memory stays bounded
+            p.error_count += 1  # only this thread writes them; GEO reads a copy
+            p.left_out += 1
+            if not self._stop_at_total(p) and self.settings.interactive:
+                self._wait(Pause.AFTER_ERROR)
+            return
+        # the traceback holds the parser's frames (and through them the line): not kept
+        error.__traceback__ = error.__context__ = None
+        checked = CheckedError(error, category, error.file, error.line, error.column)
         if self._record:  # written after the line it belongs to
             if self._log_bytes < PROGRAM_MAX_BYTES:
                 entry = _error_line(error, category)
@@ -224,7 +258,6 @@ class CheckRun:
             else:  # the log is full: counted, not kept (memory stays bounded)
                 self._errors_not_logged += 1
         with self._cond:
-            p = self._progress
             p.errors.append(checked)
             p.error_count += 1
             src = self._sources.get(error.file)
@@ -232,12 +265,18 @@ class CheckRun:
                 src = self._decoder.source_of(error.file)
             if src is not None and 0 < error.line <= len(src.lines):  # the decoder is here
                 p.file, p.line, p.offset = error.file, error.line, src.offset(error.line - 1)
-            total = self.settings.errors_total
-            if total and p.error_count >= total:  # the check ends after this line
-                p.stopped_early = self._limit_reached = True
+            if self._stop_at_total(p):
                 return
         if self.settings.interactive:
             self._wait(Pause.AFTER_ERROR)
+
+    def _stop_at_total(self, p: Progress) -> bool:
+        """``errors_total`` reached: the check ends after this line (True)."""
+        total = self.settings.errors_total if self.settings is not None else 0
+        if total and p.error_count >= total:
+            p.stopped_early = self._limit_reached = True
+            return True
+        return False
 
     def line(self, src: SourceText, index: int, after: int) -> None:
         """Lines ``index``..``after``-1 were decoded by the general path."""
@@ -262,10 +301,11 @@ class CheckRun:
             self._decoder = decoder
             if self._record:
                 self._log.append(f"; syntax check of {self.name} in channel {self.channel_id}")
-            for item in decoder.blocks():
+            items: Iterator[Block | PointBatch] = decoder.blocks()  # batches in a check
+            for item in items:
                 if self._checkpoint():
                     return
-                if type(item) is PointBatch:
+                if isinstance(item, PointBatch):
                     if self._batch(item):
                         break
                 elif self._block(item):
@@ -434,11 +474,15 @@ class CheckRun:
                else "aborted" if p.failure is not None else "complete")
         end = (f"; end: {p.lines} lines, {p.blocks} blocks, {p.error_count} errors, {how}")
         entries = self._log
+        if p.left_out:
+            entries.append(f"; {p.left_out} more errors are not listed (limits."
+                           f"check_max_errors: the first {self.max_errors} are kept)")
         if self._errors_not_logged or self._log_bytes >= PROGRAM_MAX_BYTES:
             # the store's file limit: the first errors are kept, the checked lines go
             errors = [entry for entry in entries if entry.startswith("error ")]
-            entries = [entries[0], "; the checked lines are left out: the log would exceed "
-                       f"the store's file limit of {PROGRAM_MAX_BYTES} bytes"]
+            left_out = p.left_out
+            entries = [entries[0], ("; the checked lines are left out: the log would exceed "
+                                    f"the store's file limit of {PROGRAM_MAX_BYTES} bytes")]
             room = PROGRAM_MAX_BYTES - 400 - sum(len(e) + 1 for e in entries)
             kept = 0
             for entry in errors:
@@ -447,7 +491,7 @@ class CheckRun:
                     break
                 kept += 1
             entries += errors[:kept]
-            left = len(errors) - kept + self._errors_not_logged
+            left = len(errors) - kept + self._errors_not_logged + left_out
             if left:
                 entries.append(f"; {left} more errors are not listed (the store's file limit)")
         data = ("\n".join(entries) + "\n" + end + "\n").encode()

@@ -240,3 +240,15 @@ def test_parse_check_log_handles_colons_in_names_and_messages() -> None:
         CheckError("a:b.nc", 1, 9, 21220, "term", "unknown word 'Q:1:2: '"),
     )
     assert (result.lines, result.blocks, result.stopped_early) == (2, 2, False)
+
+
+def test_parse_check_log_reads_the_count_of_errors_not_listed() -> None:
+    log = (
+        "; syntax check of big.nc in channel 1\n"
+        "error 20111 (combination) at big.nc:1:19: X programmed twice in one block\n"
+        "; 41 more errors are not listed (limits.check_max_errors: the first 1 are kept)\n"
+        "; end: 2 lines, 2 blocks, 42 errors, complete\n"
+    )
+    result = parse_check_log(log, "big.nc")
+    assert (len(result.errors), result.error_count, result.left_out) == (1, 42, 41)
+    assert not result.clean

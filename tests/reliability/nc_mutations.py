@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES
+from tests.reliability import scale
 
 ROOT = Path(__file__).resolve().parents[2]
 #: Programs the mutations start from: every example of the docs and the syntax showcase.
@@ -183,11 +184,45 @@ def file_writes(text: str, rnd: random.Random) -> tuple[str, str]:
     return "\n".join(lines), f"{count} #MSG SAVE to {target[:20]}"
 
 
+#: Words a line of many words is made of: each one bad in its own way (a word twice, an
+#: unknown letter, an error inside brackets or in an expression, a G of a group given
+#: before, a second program-flow M, a division by zero), or valid and distinct.
+MANY_WORDS = [
+    lambda k: "X1", lambda k: "Q5", lambda k: "M[1+*2]", lambda k: "G0 G1", lambda k: "M30",
+    lambda k: "M[1/0]", lambda k: "V.L.X = 1/0", lambda k: "V.P.A = 1 +* 2",
+    lambda k: f"M{100 + k}", lambda k: f"M[{k}+1-1]",
+]
+
+
+def many_words(text: str, rnd: random.Random) -> tuple[str, str]:
+    """A line of thousands of words (up to ``Scale.long_line_words``), mostly of one
+    kind, or one long expression, or a long comment after the words: the syntax check
+    once took time quadratic in them and kept every error (issue 25)."""
+    words = rnd.randint(1_000, max(1_000, scale.current().long_line_words))
+    kind = rnd.randrange(len(MANY_WORDS) + 2)
+    if kind == len(MANY_WORDS):  # one word whose value is a long expression
+        line = "N1 G01 F100 X[1" + "+1-1" * (words // 2) + "]"
+    elif kind == len(MANY_WORDS) + 1:  # a long comment behind the words
+        line = "N1 G01 X1 F100 (" + "c" * (4 * words) + ")"
+    else:
+        make = MANY_WORDS[kind]
+        mixed = rnd.random() < 0.3  # now and then other kinds in between
+        line = "N1 G01 X1 F100 " + " ".join(
+            (rnd.choice(MANY_WORDS) if mixed and rnd.random() < 0.2 else make)(k)
+            for k in range(words))
+    lines = _lines(text)
+    lines.insert(rnd.randrange(len(lines) + 1), line)
+    return "\n".join(lines), f"a line of {words} words ({len(line)} characters)"
+
+
 MUTATIONS: list[Callable[[str, random.Random], tuple[str, str]]] = [
     flip_characters, flip_characters, delete_lines, duplicate_lines, swap_lines,
     huge_numbers, huge_numbers, deep_nesting, truncate, insert_tokens, insert_tokens, long_line,
 ]
 FILE_WRITE_SHARE = 0.25  # of the mutants also write files (drawn apart: see ``mutate``)
+#: Every MANY_WORDS_EVERY-th mutant also gets a line of many words, drawn from a generator
+#: of its own (so the other mutants of a seed stay what they were).
+MANY_WORDS_EVERY = 4
 ENDLESS_SHARE = 0.08  # of the mutants get an endless loop (each costs the run timeout)
 BINARY_SHARE = 0.05  # of the mutants get bytes that are not text
 
@@ -214,6 +249,9 @@ def mutate(index: int, path: Path, rnd: random.Random) -> Mutant:
     writes = random.Random(f"{index} {path.name} {rnd.getstate()[1][0]}")
     if writes.random() < FILE_WRITE_SHARE:
         text, change = file_writes(text, writes)
+        changes.append(change)
+    if index % MANY_WORDS_EVERY == MANY_WORDS_EVERY - 1:
+        text, change = many_words(text, random.Random(f"many words {index}"))
         changes.append(change)
     endless = rnd.random() < ENDLESS_SHARE
     if endless:

@@ -28,6 +28,8 @@ class Scale:
     restarts: int  # stop-and-start-again cycles on one endpoint
     broker_restarts: int  # MQTT broker stop/start cycles under the bridge
     output_write_loops: int  # MDI #MSG SAVE loops run to the output limit, clients reading
+    long_line_resets: int  # RESETs during the syntax check of a 100 000-word line
+    long_line_words: int  # the most words of a long line the NC fuzz generates
     flood_ads: int  # ADS connections of a partial-frame flood (each 1 MiB - 100 bytes)
     flood_zmq: int  # ZeroMQ connections of a partial-frame flood (each 2 MB - 100 bytes)
     half_sent_examples: int  # wire fuzz: floods of half-sent frames (hypothesis examples)
@@ -37,13 +39,15 @@ class Scale:
 QUICK = Scale(
     "make test", wire_frames=10_000, wire_batch=500, nc_mutations=64, nc_cli_programs=3,
     load_clients=50, load_rounds=1_000, killed_clients=1, store_kills=3, restarts=3,
-    broker_restarts=2, output_write_loops=2, flood_ads=200, flood_zmq=150,
+    broker_restarts=2, output_write_loops=2, long_line_resets=1, long_line_words=4_000,
+    flood_ads=200, flood_zmq=150,
     half_sent_examples=8, fairness_reads=2_000,
 )
 SOAK = Scale(
     "make soak", wire_frames=100_000, wire_batch=500, nc_mutations=640, nc_cli_programs=12,
     load_clients=50, load_rounds=10_000, killed_clients=5, store_kills=20, restarts=20,
-    broker_restarts=10, output_write_loops=10, flood_ads=600, flood_zmq=400,
+    broker_restarts=10, output_write_loops=10, long_line_resets=5, long_line_words=60_000,
+    flood_ads=600, flood_zmq=400,
     half_sent_examples=60, fairness_reads=20_000,
 )
 

@@ -24,7 +24,13 @@ from dataclasses import replace
 from enum import IntEnum
 
 from .blocks import (
-    AxisExchange, AxisExchangeKind, Block, Compensation, Motion, MotionKind, StopKind,
+    AxisExchange,
+    AxisExchangeKind,
+    Block,
+    Compensation,
+    Motion,
+    MotionKind,
+    StopKind,
 )
 from .construct import make_block, make_motion, make_source
 from .coordinates import Placement
@@ -35,7 +41,7 @@ from .exchange import moved_axes
 from .expressions import evaluate_number
 from .geometry import centre_from_offsets, centre_from_radius
 from .modal import G_CODES, PLANE_AXES, DistanceMode, GGroup, MCode, ModalState, Plane
-from .statements import Assign, AxisCommand, NcBlock, WordKind
+from .statements import Assign, AxisCommand, NcBlock, Word, WordKind
 from .variables import VariableFault
 
 
@@ -56,6 +62,10 @@ _M_FLOW: dict[int, tuple[StopKind, Flow]] = {
     MCode.SUBPROGRAM_END: (StopKind.NONE, Flow.SUBPROGRAM_END),
     MCode.SUBPROGRAM_END_FAST: (StopKind.NONE, Flow.SUBPROGRAM_END),
 }
+
+# the syntax check's handler of an error of item <index> of a block: returns to leave
+# the item out and go on, raises to end the block
+ItemFailed = Callable[[NcError, int], None]
 
 # The largest feed: the path velocity is carried in 0.1 um/s as SGN32 (as the ISG
 # interface objects carry it), 2**31 - 1 increments = 12,884,901.88 mm/min.
@@ -141,63 +151,48 @@ class BlockExecutor:
         radius = self.tools.get(d)
         return None if radius is None else float(radius)
 
-    def execute(self, stmt: NcBlock, env: Env) -> tuple[Block | None, Flow, int]:
+    def execute(self, stmt: NcBlock, env: Env, on_error: ItemFailed | None = None
+                ) -> tuple[Block | None, Flow, int]:
         """Run one block: (block or None, flow, position of the flow M word).
 
         A block with an error leaves the modal state as it was (a manual block after
         it continues from the last good one); its assignments are not undone.
+
+        ``on_error`` (the syntax check): an error of one item (its value, a G of a
+        group already given, a second program-flow M, ...) is handed to it with the
+        item's index; when it returns, the item is left out and the block goes on,
+        in the same pass (executing the block again after each error was quadratic).
         """
         modal = self.modal
         saved = tuple(getattr(modal, name) for name in _MODAL_FIELDS)
         try:
-            return self._execute(stmt, env)
-        except NcError:
+            return self._execute(stmt, env, on_error)
+        except Exception:  # an NcError, or ``on_error`` ending the block
             for name, value in zip(_MODAL_FIELDS, saved, strict=True):
                 setattr(modal, name, value)
             raise
 
-    def _execute(self, stmt: NcBlock, env: Env) -> tuple[Block | None, Flow, int]:
+    def _execute(self, stmt: NcBlock, env: Env, on_error: ItemFailed | None = None
+                 ) -> tuple[Block | None, Flow, int]:
         line = stmt.line
         err = line.error
         groups: Groups = {}
         axis_words: AxisWords = []
         offsets: Offsets = {}
         words: Words = {}
-        m_codes: list[tuple[int, int]] = []
+        m_codes: list[tuple[int, int, int]] = []  # (M number, pos, item index)
         self.items_done = 0
-        for item in stmt.items:
-            if type(item) is Assign:
-                item.target.assign(env, item.value(env))
-                self.items_done += 1
-                continue
-            value = evaluate_number(item.value, env, line, item.pos)
-            match item.kind:
-                case WordKind.AXIS:
-                    axis_words.append((item.axis, value, item.pos, item.letter))
-                case WordKind.OFFSET:
-                    if item.axis < 0:
-                        raise err(
-                            NcErrorId.ARC_OFFSET_OUT_OF_PLANE,
-                            f"{item.letter}: the channel has no axis "
-                            f"{'XYZ'[_OFFSET_LETTER.index(item.letter)]}", item.pos,
-                        )
-                    offsets[item.axis] = (value, item.pos)
-                case WordKind.G:
-                    self._g_word(value, item.pos, groups, err)
-                case WordKind.M:
-                    number = _integer(value)
-                    if number is None:
-                        raise err(NcErrorId.INVALID_M_CODE,
-                                  f"M{value:g} is not a valid M function", item.pos)
-                    m_codes.append((number, item.pos))
-                case WordKind.WEIGHTING:
-                    self._weighting(item.letter, value, item.pos, err)
-                case WordKind.LOOK_AHEAD:
-                    self._look_ahead_switch(value != 0.0)
-                case WordKind.LOOK_AHEAD_PARAM:
-                    self._look_ahead_param(item.letter, value, item.pos, err)
-                case _:  # F S T D R
-                    words[item.kind] = (value, item.pos)
+        for k, item in enumerate(stmt.items):
+            try:
+                if type(item) is Assign:
+                    item.target.assign(env, item.value(env))
+                else:
+                    self._word(item, evaluate_number(item.value, env, line, item.pos), err,
+                               groups, axis_words, offsets, words, m_codes, k)
+            except NcError as error:
+                if on_error is None:
+                    raise
+                on_error(error, k)  # the item is left out, the block goes on
             self.items_done += 1
         self._modal_groups(groups)
         self._technology(words, err)
@@ -213,14 +208,18 @@ class BlockExecutor:
         flow = Flow.NONE
         flow_pos = -1
         m_functions: list[int] = []
-        for number, pos in m_codes:
+        for number, pos, k in m_codes:
             action = _M_FLOW.get(number)
             if action is None:
                 m_functions.append(number)
                 continue
             if flow_pos >= 0:
-                raise err(NcErrorId.CONFLICTING_M_CODES,
-                          f"M{number} with another program-flow M", pos)
+                conflict = err(NcErrorId.CONFLICTING_M_CODES,
+                               f"M{number} with another program-flow M", pos)
+                if on_error is None:
+                    raise conflict
+                on_error(conflict, k)  # this M is left out
+                continue
             stop, flow = action
             flow_pos = pos
         spindle = words.get(WordKind.SPINDLE)
@@ -236,6 +235,38 @@ class BlockExecutor:
             self.modal.look_ahead_mark,
         )
         return block, flow, flow_pos
+
+    def _word(self, item: Word, value: float, err: ErrorAt, groups: Groups,
+              axis_words: AxisWords, offsets: Offsets, words: Words,
+              m_codes: list[tuple[int, int, int]], index: int) -> None:
+        """Collect one word of a block (its value evaluated) for the parts that follow."""
+        match item.kind:
+            case WordKind.AXIS:
+                axis_words.append((item.axis, value, item.pos, item.letter))
+            case WordKind.OFFSET:
+                if item.axis < 0:
+                    raise err(
+                        NcErrorId.ARC_OFFSET_OUT_OF_PLANE,
+                        f"{item.letter}: the channel has no axis "
+                        f"{'XYZ'[_OFFSET_LETTER.index(item.letter)]}", item.pos,
+                    )
+                offsets[item.axis] = (value, item.pos)
+            case WordKind.G:
+                self._g_word(value, item.pos, groups, err)
+            case WordKind.M:
+                number = _integer(value)
+                if number is None:
+                    raise err(NcErrorId.INVALID_M_CODE,
+                              f"M{value:g} is not a valid M function", item.pos)
+                m_codes.append((number, item.pos, index))
+            case WordKind.WEIGHTING:
+                self._weighting(item.letter, value, item.pos, err)
+            case WordKind.LOOK_AHEAD:
+                self._look_ahead_switch(value != 0.0)
+            case WordKind.LOOK_AHEAD_PARAM:
+                self._look_ahead_param(item.letter, value, item.pos, err)
+            case _:  # F S T D R
+                words[item.kind] = (value, item.pos)
 
     def exchange(self, stmt: AxisCommand, env: Env) -> Block | None:
         """Run ``#AX RELEASE`` / ``#AX REQUEST``: the block that hands the axes over, or

@@ -41,13 +41,27 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import Protocol
+from typing import NoReturn, Protocol, cast
 
+from .blocks import MotionKind
 from .errors import NcError, NcErrorId
-from .expressions import ExpressionParser
+from .expressions import ExpressionParser, VarRef
+from .instructions import Instruction
 from .lexer import Cursor
+from .parser import ItemErrorHandler
 from .source import LogicalLine, SourceText
-from .statements import Assign, Control, NcBlock, StmtKind
+from .statements import (
+    Assign,
+    AxisCommand,
+    ContourStatement,
+    Control,
+    NcBlock,
+    StmtKind,
+    Word,
+)
+
+#: what a line parses to (``program.Statement``; that module imports this one)
+Statement = NcBlock | Control | AxisCommand | ContourStatement | Instruction
 
 BATCH_LINES = 2048  # plain lines per PointBatch (bounds the memory of one batch)
 CHECK_FEED_MM_MIN = 1000.0  # the feed the check assumes after a missing or bad F
@@ -96,6 +110,10 @@ class SyntaxCheck(Protocol):
         block (single step)."""
 
 
+#: one moving line of a ``PointBatch``: (line index, motion, end point, arc centre or None)
+BatchRecord = tuple[int, MotionKind, tuple[float, ...], tuple[float, float] | None]
+
+
 @dataclass(slots=True)
 class PointBatch:
     """Plain motion lines decoded by the hot path in check mode.
@@ -111,7 +129,7 @@ class PointBatch:
     stop: int
     start_mm: tuple[float, ...]
     plane: tuple[int, int] | None
-    records: list = field(default_factory=list)
+    records: list[BatchRecord] = field(default_factory=list)
 
 
 # ---------------------------------------------------------------- categories
@@ -149,11 +167,22 @@ _INCOMPLETE = frozenset({
     NcErrorId.UNDECLARED_VARIABLE, NcErrorId.UNKNOWN_VARIABLE, NcErrorId.LABEL_NOT_FOUND,
 })
 
+# the category of an error id found in no command and no assignment target
+_CATEGORY_OF_ID: dict[int, ErrorCategory] = {
+    int(err_id): category
+    for ids, category in ((_COMBINATION, ErrorCategory.COMBINATION),
+                          (_LIMIT, ErrorCategory.LIMIT), (_VALUE, ErrorCategory.VALUE),
+                          (_INCOMPLETE, ErrorCategory.INCOMPLETE))
+    for err_id in ids
+}
+
 # the $ or # that starts the command of a line (after an N number and a label). Every
 # run is possessive: blanks next to blanks ("N  :  ") must not be split up in all ways
 # when there is no command, which made a line of thousands of blanks take minutes.
 _COMMAND_START = re.compile(
     r"[ \t]*+(?:N[ \t]*+[0-9]*+[ \t]*+:?[ \t]*+)?(?:\[[^\]]*+\][ \t]*+)?([$#])")
+# a run of characters that opens neither brackets nor a string, up to a blank
+_PLAIN_RUN = re.compile(r'[^ \t\["]*')
 # "V.x.name[...] =" (not "==") at a position: the target of an assignment
 _ASSIGN_TARGET = re.compile(r"V\.[A-Z]+\.[A-Z_][A-Z0-9_]*(?:\[[^\]=]*\])*[ \t]*=(?!=)")
 
@@ -166,8 +195,10 @@ def command_position(line: LogicalLine) -> int:
     return m.start(1)
 
 
-def categorize(error: NcError, line: LogicalLine | None) -> ErrorCategory:
-    """The category of ``error`` found in ``line`` (None: not in one line)."""
+def categorize(error: NcError, line: LogicalLine | None,
+               command_at: int | None = None) -> ErrorCategory:
+    """The category of ``error`` found in ``line`` (None: not in one line);
+    ``command_at``: ``command_position(line)`` when the caller knows it already."""
     err_id = error.id
     if err_id in _RESOURCE:
         return ErrorCategory.RESOURCE
@@ -176,17 +207,9 @@ def categorize(error: NcError, line: LogicalLine | None) -> ErrorCategory:
     if line is not None and error.pos >= 0:
         if _ASSIGN_TARGET.match(line.upper, error.pos):
             return ErrorCategory.ASSIGNMENT
-        if command_position(line) >= 0:
+        if (command_position(line) if command_at is None else command_at) >= 0:
             return ErrorCategory.COMMAND
-    if err_id in _COMBINATION:
-        return ErrorCategory.COMBINATION
-    if err_id in _LIMIT:
-        return ErrorCategory.LIMIT
-    if err_id in _VALUE:
-        return ErrorCategory.VALUE
-    if err_id in _INCOMPLETE:
-        return ErrorCategory.INCOMPLETE
-    return ErrorCategory.TERM
+    return _CATEGORY_OF_ID.get(err_id, ErrorCategory.TERM)
 
 
 # ---------------------------------------------------------------- repositioning
@@ -201,21 +224,39 @@ class RepositionedLine(LogicalLine):
         super().__init__(line.file, text, line.segments, line.offset)
         self.errors = errors
 
+    @classmethod
+    def counted(cls, line: LogicalLine, errors: int) -> RepositionedLine:
+        """``line`` itself (its text not copied, not upper-cased again) with ``errors``."""
+        if type(line) is cls:
+            line.errors = errors
+            return line
+        new = cls.__new__(cls)
+        for name in LogicalLine.__slots__:
+            setattr(new, name, getattr(line, name))
+        new.errors = errors
+        return new
 
-def blanked(line: LogicalLine, start: int, stop: int) -> LogicalLine:
+
+def blanked(line: LogicalLine, start: int, stop: int) -> RepositionedLine:
     """``line`` with ``[start, stop)`` replaced by blanks (columns stay as they were)."""
     text = line.text[:start] + " " * (stop - start) + line.text[stop:]
     return RepositionedLine(line, text, getattr(line, "errors", 0))
 
 
-def term_start(text: str, pos: int) -> int:
+def term_start(text: str, pos: int, origin: int = 0) -> int:
     """Start of the term that holds ``pos``: ``pos`` itself, or when ``pos`` is inside
     brackets or a string, the start of the word whose ``[`` or ``"`` opened them (an
-    error inside ``X[...]`` drops all of ``X[...]``, not the part after the error)."""
+    error inside ``X[...]`` drops all of ``X[...]``, not the part after the error).
+    ``origin``: a position outside any brackets or string at or before ``pos`` (the
+    start of the item being parsed), where the scan begins."""
+    run = _PLAIN_RUN.match(text, origin, pos)
+    assert run is not None  # the pattern matches the empty string too
+    if run.end() >= pos:  # no bracket or string before
+        return pos
     depth = 0
     quoted = False
     opened = pos
-    for k in range(min(pos, len(text))):
+    for k in range(origin, min(pos, len(text))):
         c = text[k]
         if c == '"':
             if not quoted and depth == 0:
@@ -237,6 +278,13 @@ def term_start(text: str, pos: int) -> int:
 
 def term_end(text: str, pos: int) -> int:
     """End of the term at ``pos``: the next blank outside brackets and strings."""
+    n = len(text)
+    k = pos + 1 if pos < n and text[pos] in " \t" else pos
+    run = _PLAIN_RUN.match(text, k)
+    assert run is not None  # the pattern matches the empty string too
+    k = run.end()
+    if k >= n or text[k] in " \t":  # no bracket, no string: the next blank
+        return k
     depth = 0
     quoted = False
     k = pos
@@ -271,7 +319,7 @@ def assignment_end(line: LogicalLine, pos: int) -> int:
 
 
 def without_error(line: LogicalLine, error: NcError, category: ErrorCategory
-                  ) -> LogicalLine | None:
+                  ) -> RepositionedLine | None:
     """The line to parse again after ``error``, or None to drop the line."""
     pos = error.pos
     if pos < 0 or pos > len(line.text) or category in (ErrorCategory.RESOURCE,
@@ -288,7 +336,7 @@ def without_error(line: LogicalLine, error: NcError, category: ErrorCategory
     return blanked(line, start, term_end(line.text, start))
 
 
-def item_at(line: LogicalLine, items: list, pos: int) -> int | None:
+def item_at(line: LogicalLine, items: list[Word | Assign], pos: int) -> int | None:
     """Index of the item (word or assignment) of an NC block whose text holds ``pos``
     (an error in ``X[1/0]`` or ``V.L.A = 1/0`` is that item's), or None."""
     found = None
@@ -305,7 +353,26 @@ def item_at(line: LogicalLine, items: list, pos: int) -> int | None:
     return found if pos < end else None
 
 
-def after_command(line: LogicalLine, error: NcError, parse) -> object | None:
+def holds_error(line: LogicalLine, items: list[Word | Assign], k: int, pos: int) -> bool:
+    """True when ``item_at(line, items, pos)`` is ``k``, found without scanning the
+    other items (the items of a block stand in the order of their text)."""
+    item = items[k]
+    if item.pos > pos or (k + 1 < len(items) and items[k + 1].pos <= pos):
+        return False
+    if type(item) is Assign:
+        return pos < assignment_end(line, item.pos)
+    return pos < term_end(line.text, item.pos)
+
+
+class LineParse(Protocol):
+    """``LineParser.parse``: the statement of a line; ``on_error`` handles the errors
+    in the items of an NC block (the check's one pass)."""
+
+    def __call__(self, line: LogicalLine, on_error: ItemErrorHandler | None = None, /
+                 ) -> Statement: ...
+
+
+def after_command(line: LogicalLine, error: NcError, parse: LineParse) -> Statement | None:
     """For an error in a command line: the command as understood before ``error``
     (``parse`` of the line cut there) when that is a command, else None."""
     start = command_position(line)
@@ -324,10 +391,10 @@ class _Dropped:
 
     __slots__ = ()
 
-    def __call__(self, env):
+    def __call__(self, env: object) -> NoReturn:
         raise ErrorReported
 
-    def assign(self, env, value) -> None:
+    def assign(self, env: object, value: object) -> NoReturn:
         raise ErrorReported
 
 
@@ -337,7 +404,7 @@ _CONTROL_WITH_EXPRESSION = re.compile(
     r"\$(IF|ELSEIF|WHILE|FOR|SWITCH|CASE|UNTIL)\b|#[ \t]*RT[ \t]+WHILE\b")
 
 
-def dropped_control(line: LogicalLine, errors: int):
+def dropped_control(line: LogicalLine, errors: int) -> Control | None:
     """For a dropped line of a control statement with an expression ($IF, $ELSEIF,
     $WHILE, $FOR, $SWITCH, $CASE, $UNTIL, #RT WHILE): a statement of that kind whose
     expressions raise ``ErrorReported``, so the control flow keeps its structure (a
@@ -356,20 +423,96 @@ def dropped_control(line: LogicalLine, errors: int):
     else:
         kind = StmtKind[m.group(1)]
     line = RepositionedLine(line, line.text, errors)
-    return Control(kind, line, start, expr=_DROPPED, target=_DROPPED, end=_DROPPED,
+    # the $FOR variable: only its ``assign`` is used, which _Dropped has
+    target = cast(VarRef, _DROPPED)
+    return Control(kind, line, start, expr=_DROPPED, target=target, end=_DROPPED,
                    step=_DROPPED, values=(_DROPPED,))
 
 
-def parse_checked(parse, line: LogicalLine, check: SyntaxCheck):
+EXACT_REPOSITIONS = 16  # per line: errors inside a term repositioned by a blanked copy
+
+
+class _LineDropped(Exception):
+    """Raised by ``_ItemErrors`` to drop the rest of the line."""
+
+
+class _ItemErrors:
+    """The parser's handler of an error in an item of an NC block (``ItemErrorHandler``):
+    reports it and says where parsing goes on, in the same pass over the line.
+
+    The result is the one of blanking the term and parsing the line again (the
+    reference): after an error at the item's start the parser goes on after the term;
+    after one inside the item (``V.P.A = 1 +* 2``) it parses the item again on a copy
+    of the line with the term blanked. Such copies cost the line's length, so after
+    ``EXACT_REPOSITIONS`` of them in one line the whole item is dropped instead: the
+    check of a line stays linear in its length whatever it holds."""
+
+    __slots__ = ("line", "check", "count", "copies", "_command_at")
+
+    def __init__(self, line: LogicalLine, check: SyntaxCheck, count: int) -> None:
+        self.line = line
+        self.check = check
+        self.count = count
+        self.copies = 0
+        self._command_at: int | None = None
+
+    def __call__(self, error: NcError, item: int) -> int | LogicalLine:
+        line = self.line
+        command_at = self._command_at
+        if command_at is None:
+            command_at = self._command_at = command_position(line)
+        if command_at >= 0:  # not an NC block after all: the general way
+            raise error
+        category = categorize(error, line, command_at)
+        check = self.check
+        check.report(error, category)
+        self.count += 1
+        limit = check.errors_per_block
+        text = line.text
+        pos = error.pos
+        if (limit and self.count >= limit) or pos < 0 or pos > len(text) or category in (
+                ErrorCategory.RESOURCE, ErrorCategory.COMMAND):
+            raise _LineDropped
+        if category == ErrorCategory.ASSIGNMENT and pos < len(text):
+            start, stop = pos, assignment_end(line, pos)
+        else:
+            start = pos if pos == item else term_start(text, pos, item)
+            if start >= len(text):
+                raise _LineDropped
+            stop = term_end(text, start)
+        if stop <= item:  # no progress: nothing left to drop
+            raise _LineDropped
+        if start > item and self.copies < EXACT_REPOSITIONS:
+            self.copies += 1
+            self.line = blanked(line, start, stop)
+            return self.line
+        return stop
+
+
+def parse_checked(parse: LineParse, line: LogicalLine, check: SyntaxCheck
+                  ) -> Statement | None:
     """Parse ``line``, reporting each error and repositioning after it; the statement
     of what was understood, or None when the line is dropped (a control statement
-    with an expression stays as ``dropped_control``)."""
+    with an expression stays as ``dropped_control``).
+
+    Errors in the items of an NC block are handled during the one pass of the parser
+    (``_ItemErrors``); an error elsewhere (block number, label, a ``$``/``#`` command)
+    blanks the term and parses the line again, which happens a bounded number of
+    times per line."""
     original = line
     count = 0
     while True:
+        handler = _ItemErrors(line, check, count)
         try:
-            return parse(line)
+            stmt = parse(line, handler)
+            if handler.count > count:  # errors in its items: the block counts them
+                stmt.line = RepositionedLine.counted(stmt.line, handler.count)
+            return stmt
+        except _LineDropped:
+            return dropped_control(original, handler.count)
         except NcError as error:
+            count = handler.count
+            line = handler.line
             command = after_command(line, error, parse)
             category = ErrorCategory.AFTER_COMMAND if command is not None else \
                 categorize(error, line)
@@ -388,7 +531,7 @@ def parse_checked(parse, line: LogicalLine, check: SyntaxCheck):
 
 __all__ = [
     "BATCH_LINES", "CHECK_FEED_MM_MIN", "CheckAborted", "ErrorCategory", "ErrorReported",
-    "PointBatch", "SyntaxCheck", "categorize", "command_position", "item_at",
+    "PointBatch", "SyntaxCheck", "categorize", "command_position", "holds_error", "item_at",
     "parse_checked",
 ]
 

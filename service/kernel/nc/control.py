@@ -25,7 +25,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from .blocks import Block
-from .errors import NcError, NcErrorId
+from .errors import DecodingCancelled, NcError, NcErrorId
 from .expressions import number, truth
 from .frames import ControlEntry, Frame
 from .program import Statement, Structure
@@ -36,6 +36,7 @@ from .statements import LOOPS, SPELLING, Control, Goto, StmtKind
 from .variables import Value
 
 MAX_IDLE_LOOP_PASSES = 1_000_000  # loop passes without a block before ENDLESS_LOOP
+CANCEL_CHECK_PASSES = 1024  # idle loop passes between two looks at ``decoder.cancelled``
 
 #: a control statement's handler: (frame, statement, index after it) -> marker Block or None
 Handler = Callable[[Frame, Control, int], Block | None]
@@ -75,6 +76,8 @@ class ControlFlow:
             self.blocks_at_last_pass = emitted
             self.idle_passes = 0
         self.idle_passes += 1
+        if not self.idle_passes % CANCEL_CHECK_PASSES and self.decoder.cancelled():
+            raise DecodingCancelled  # RESET: the SDA thread ends now, not at the guard
         if self.idle_passes > MAX_IDLE_LOOP_PASSES:
             raise stmt_line.error(
                 NcErrorId.ENDLESS_LOOP,

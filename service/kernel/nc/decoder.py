@@ -25,26 +25,40 @@ from dataclasses import replace
 from .blockexec import BlockExecutor, Flow
 from .blocks import Block, LogArea
 from .check import (
-    CHECK_FEED_MM_MIN, CheckAborted, ErrorCategory, ErrorReported, SyntaxCheck, categorize,
+    CHECK_FEED_MM_MIN,
+    CheckAborted,
+    ErrorCategory,
+    ErrorReported,
+    SyntaxCheck,
+    categorize,
+    holds_error,
     item_at,
 )
 from .contour_run import execute_contour
 from .control import ControlFlow
+from .cycle_run import call_cycle
 from .declarations import declare, read_block
 from .errors import NcError, NcErrorId
 from .fastpath import decoding_loop
 from .frames import MAX_CALL_DEPTH, Frame, FrameKind
+from .instruction_run import pattern_error, run_instruction
+from .instructions import Instruction
 from .modal import ModalState
 from .parser import RESERVED_LETTERS, LineParser, word_table
 from .program import Program, Section, Statement
 from .source import LogicalLine, SourceText, strip_comments
 from .statements import (
-    CLOSER_OF, OPENERS, SPELLING, Assign, AxisCommand, ContourStatement, Control, NcBlock, Word,
+    CLOSER_OF,
+    OPENERS,
+    SPELLING,
+    Assign,
+    AxisCommand,
+    ContourStatement,
+    Control,
+    NcBlock,
+    Word,
     WordKind,
 )
-from .cycle_run import call_cycle
-from .instruction_run import pattern_error, run_instruction
-from .instructions import Instruction
 from .technology import HSCS_MODES, Surroundings
 from .variables import Scope, Value, Variable, VarType
 
@@ -135,6 +149,8 @@ class Decoder:
         self._started = False
         self.emitted = 0  # grows whenever blocks were yielded (the loop guard watches it)
         self.own_variables: set[int] = set()  # ids of the variables this decoder declared
+        # the run's owner sets this to learn of a RESET (``DecodingCancelled``)
+        self.cancelled: Callable[[], bool] = _never
         self._executed: Block | None = None  # check mode: the Block of the line's words
 
     @property
@@ -391,9 +407,27 @@ class Decoder:
         assert check is not None  # _step calls it only in a syntax check
         executor = self.executor
         count = getattr(stmt.line, "errors", 0)  # errors reported when it was parsed
+        skipped: set[int] = set()  # items left out in the pass (their errors reported)
+
+        def item_failed(error: NcError, k: int) -> None:
+            """An item's own error: reported, the item left out, the pass goes on."""
+            nonlocal count
+            items = stmt.items
+            if not holds_error(stmt.line, items, k, error.pos):
+                raise error  # not this item's: the general way below
+            check.report(error, categorize(error, stmt.line))
+            count += 1
+            if check.errors_per_block and count >= check.errors_per_block:
+                raise ErrorReported  # the line is dropped, its call and $GOTO too
+            item = items[k]
+            if type(item) is Word and item.kind == WordKind.FEED:  # F unknown now
+                self._modal.feed_mm_min = self._modal.feed_mm_min or CHECK_FEED_MM_MIN
+            skipped.add(k)
+
         while True:
+            skipped.clear()
             try:
-                block, flow, flow_pos = executor.execute(stmt, self)
+                block, flow, flow_pos = executor.execute(stmt, self, item_failed)
                 if flow == Flow.SUBPROGRAM_END and self.frames[-1].kind == FrameKind.MAIN:
                     # M17/M29 in the main program: dropped, the rest of the block used
                     check.report(stmt.line.error(
@@ -423,8 +457,8 @@ class Decoder:
                     item = items[drop]
                     if type(item) is Word and item.kind == WordKind.FEED:  # F unknown now
                         self._modal.feed_mm_min = self._modal.feed_mm_min or CHECK_FEED_MM_MIN
-                kept = [item for k, item in enumerate(items)
-                        if k != drop and not (k < done and type(item) is Assign)]
+                kept = [item for k, item in enumerate(items) if k != drop and k not in skipped
+                        and not (k < done and type(item) is Assign)]
                 stmt = replace(stmt, items=kept)
 
     # ------------------------------------------------------------ subprograms
@@ -512,6 +546,10 @@ class Decoder:
             return
         raise NcError(NcErrorId.MISSING_PROGRAM_END, name, line, 1,
                       f"program {name} ends without M30 (or M2)")
+
+
+def _never() -> bool:
+    return False
 
 
 def _first_pos(line: LogicalLine) -> int:

@@ -168,5 +168,11 @@ class NcError(Exception):
         return (type(self), (self.id, self.file, self.line, self.column, self.message))
 
 
+class DecodingCancelled(BaseException):
+    """Raised inside the decoder when its run was cancelled (RESET) while it works
+    without yielding blocks (a loop without motion). A ``BaseException``, so that no
+    handler of program errors or decoder faults takes it for one."""
+
+
 #: ``LogicalLine.error`` of the line being run: (id, message, position) -> the NcError
 ErrorAt = Callable[[NcErrorId, str, int], NcError]

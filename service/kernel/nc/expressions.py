@@ -27,9 +27,22 @@ from typing import Any
 
 from .errors import NcError, NcErrorId
 from .evaluation import (
-    ADD_OPS, CMP_OPS, CMP_SYMBOLS, FUNCTIONS, MUL_OPS, Const, Node, ParamRef, VarRef,
+    ADD_OPS,
+    CMP_OPS,
+    CMP_SYMBOLS,
+    FUNCTIONS,
+    MUL_OPS,
+    Const,
+    Node,
+    ParamRef,
+    VarRef,
     evaluate_number,
-    fold, logic, number, pow_op, truth, xor_op,
+    fold,
+    logic,
+    number,
+    pow_op,
+    truth,
+    xor_op,
 )
 from .lexer import IDENT, NUMBER, VARIABLE, Cursor
 from .variables import Scope, Value
@@ -69,6 +82,9 @@ class ExpressionParser:
         """The keyword operator at the cursor (whole identifier only), consumed."""
         cur = self.cur
         cur.skip_ws()
+        c = cur.peek()
+        if not ("A" <= c <= "Z"):  # no identifier here: spare the match (hot in long lines)
+            return None
         m = IDENT.match(cur.up, cur.pos)
         if m is not None and m.group() in words:
             cur.pos = m.end()

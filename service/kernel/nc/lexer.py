@@ -15,12 +15,17 @@ from .errors import NcError, NcErrorId
 from .source import LogicalLine
 
 _WS = re.compile(r"[ \t\f\v]*")
+_BLANKS = " \t\f\v"
 # unsigned: in an expression a sign is an operator
 NUMBER = re.compile(r"(?:[0-9]+\.?[0-9]*|\.[0-9]+)")
 SIGNED_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)")
 IDENT = re.compile(r"[A-Z_][A-Z0-9_]*")
 VARIABLE = re.compile(r"V\.([A-Z]+)\.([A-Z_][A-Z0-9_]*)")
 _NAME = re.compile(r"[^ \t\f\v]+")  # a file or subprogram name: anything up to a blank
+# the start of a word shown in a message: never more than 25 characters are looked at,
+# so an error in a word of a megabyte costs no more than one in ``X1``
+_SHOWN = re.compile(r"[^ \t\f\v]{1,25}")
+_SHOWN_MAX = 24
 
 
 class Cursor:
@@ -37,7 +42,10 @@ class Cursor:
 
     def skip_ws(self) -> None:
         """Move over blanks."""
-        m = _WS.match(self.up, self.pos)
+        pos = self.pos
+        if pos < self.end and self.up[pos] not in _BLANKS:  # most often: no blank here
+            return
+        m = _WS.match(self.up, pos)
         assert m is not None  # the pattern matches the empty string too
         self.pos = m.end()
 
@@ -73,9 +81,9 @@ class Cursor:
 
     def word_text(self, pos: int | None = None) -> str:
         """The blank-delimited text at ``pos`` (for messages), shortened when long."""
-        m = _NAME.match(self.text, self.pos if pos is None else pos)
+        m = _SHOWN.match(self.text, self.pos if pos is None else pos)
         text = m.group() if m else ""
-        return text if len(text) <= 24 else text[:21] + "..."
+        return text if len(text) <= _SHOWN_MAX else text[:_SHOWN_MAX - 3] + "..."
 
     def error(self, err_id: NcErrorId, message: str, pos: int | None = None) -> NcError:
         """An NcError at ``pos`` (default: the current position)."""

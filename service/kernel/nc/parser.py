@@ -13,20 +13,28 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 from .contour import CONTOUR_WORD, parse_contour_command
 from .cycle_call import CYCLE_WORD, parse_cycle_call
-from .errors import NcErrorId
+from .errors import NcError, NcErrorId
 from .exchange import AX_WORD, parse_axis_command
+from .expressions import Const, ExpressionParser, Node, VarRef
 from .instructions import WORDS as INSTRUCTION_WORDS
 from .instructions import Instruction, parse_instruction
-from .expressions import Const, ExpressionParser, Node, VarRef
 from .lexer import IDENT, SIGNED_NUMBER, Cursor
 from .modal import G_CODES, GGroup
 from .source import LogicalLine
 from .statements import (
-    Assign, AxisCommand, Call, ContourStatement, Control, Goto, NcBlock, StmtKind, Word,
+    Assign,
+    AxisCommand,
+    Call,
+    ContourStatement,
+    Control,
+    Goto,
+    NcBlock,
+    StmtKind,
+    Word,
     WordKind,
 )
 from .variables import Value
@@ -58,6 +66,10 @@ LOOK_AHEAD_PARAMS = frozenset({"METB", "VFBT", "BBTRC"})
 _LOOK_AHEAD_INITIALS = frozenset("LMVB")
 
 WordTable = Mapping[str, tuple[WordKind, int]]
+# the syntax check's handler of an error in an item of an NC block: (error, start of the
+# item) -> where parsing goes on (a position, or the line with the bad term blanked, to
+# be parsed from the item's start); raises to end the line
+ItemErrorHandler = Callable[[NcError, int], "int | LogicalLine"]
 
 
 def word_table(axes: tuple[str, ...]) -> dict[str, tuple[WordKind, int]]:
@@ -89,9 +101,14 @@ class LineParser:
     # ------------------------------------------------------------ entry
 
     def parse(
-        self, line: LogicalLine
+        self, line: LogicalLine, on_error: ItemErrorHandler | None = None
     ) -> NcBlock | Control | AxisCommand | ContourStatement | Instruction:
-        """The statement of one logical line (raises NcError on a syntax error)."""
+        """The statement of one logical line (raises NcError on a syntax error).
+
+        ``on_error`` (the syntax check): an error in an item of an NC block is handed
+        to it with the item's start; it returns where parsing goes on (after the
+        dropped term) or raises. Parsing thus goes on in one pass, whatever the number
+        of errors in a line (re-parsing the line after each error was quadratic)."""
         cur = Cursor(line)
         cur.skip_ws()
         number = self._block_number(cur, None)
@@ -106,7 +123,7 @@ class LineParser:
             return self._control(cur, number)
         if c == "#":
             return self._directive(cur, number)
-        return self._block(cur, number)
+        return self._block(cur, number, on_error)
 
     # ------------------------------------------------------------ pieces
 
@@ -238,73 +255,91 @@ class LineParser:
             f"$GOTO needs Nnn or [LABEL], found '{cur.word_text()}'",
         )
 
-    def _block(self, cur: Cursor, number: int | None) -> NcBlock:
+    def _block(self, cur: Cursor, number: int | None,
+               on_error: ItemErrorHandler | None = None) -> NcBlock:
         block = NcBlock(cur.line, number)
         letters: set[str] = set()
         table = self.table
         while not cur.at_end():
             pos = cur.pos
-            c = cur.peek()
-            if c == "$":
-                if not cur.up.startswith("$GOTO", pos):
-                    keyword = cur.match(_KEYWORD)
-                    assert keyword is not None  # at a '$': the rest is optional
-                    word = keyword.group(1)
-                    raise cur.error(
-                        NcErrorId.UNKNOWN_CONTROL_KEYWORD,
-                        f"${word} must stand at the start of its line", pos,
-                    )
-                if block.goto is not None:
-                    raise cur.error(NcErrorId.WORD_REPEATED, "$GOTO programmed twice", pos)
-                block.goto = self._goto(cur)
-            elif c == "V" and cur.peek(1) == ".":
-                block.items.append(self._assign(cur))
-            elif c in _LOOK_AHEAD_INITIALS and self._look_ahead_word(cur, block):
-                continue
-            elif c == "L":
-                self._call(cur, block)
-            elif c == "N":
-                block.number = self._block_number(cur, block.number)
-            elif "A" <= c <= "Z" or c == "_":
-                spec = table.get(c)
-                if spec is None:
-                    raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
-                kind, axis = spec
-                if kind != WordKind.G and kind != WordKind.M:
-                    if c in letters:
-                        raise cur.error(
-                            NcErrorId.WORD_REPEATED, f"{c} programmed twice in one block"
-                        )
-                    letters.add(c)
-                cur.pos += 1
-                value = self._value(cur, c, pos)
-                if kind == WordKind.G and value in _WEIGHTINGS and _skip(cur) < cur.end \
-                        and cur.peek() == "=" and cur.peek(1) != "=":
-                    cur.pos += 1  # G133 = <percent> / G134 = <percent>
-                    block.items.append(Word(WordKind.WEIGHTING, f"G{int(value)}",
-                                            ExpressionParser(cur).parse(), pos))
-                    continue
-                if kind == WordKind.G and isinstance(value, float):
-                    if not value.is_integer() or int(value) not in G_CODES:
-                        raise cur.error(
-                            NcErrorId.UNSUPPORTED_G_CODE, f"G{value:g} is not supported", pos
-                        )
-                    if G_CODES[int(value)][0] == GGroup.DWELL:
-                        block.has_g4 = True
-                block.items.append(Word(kind, c, value, pos, axis))
-            elif c == "#" and AX_WORD.match(cur.up, pos):
-                raise cur.error(NcErrorId.AXIS_COMMAND_NOT_ALONE,
-                                "#AX must stand alone in its NC line")
-            elif c == "#" and CONTOUR_WORD.match(cur.up, pos):
-                directive = _DIRECTIVE.match(cur.up, pos)
-                assert directive is not None  # at a '#': the rest is optional
-                word = directive.group(1)
-                raise cur.error(NcErrorId.CONTOUR_COMMAND_SYNTAX,
-                                f"#{word} must stand alone in its NC line")
-            else:
-                raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
+            try:
+                self._item(cur, block, letters, table, pos)
+            except NcError as error:
+                if on_error is None:
+                    raise
+                where = on_error(error, pos)  # the term is dropped, parsing goes on
+                if isinstance(where, int):
+                    cur.pos = where
+                else:  # the line with the term blanked, parsed again from this item on
+                    cur = Cursor(where, pos)
+                    block.line = where
         block.letters = frozenset(letters)
         return block
+
+    def _item(self, cur: Cursor, block: NcBlock, letters: set[str], table: WordTable,
+              pos: int) -> None:
+        """Parse the item at ``pos`` into ``block`` (a letter counts in ``letters``
+        only once its word is complete, so a dropped word leaves no trace)."""
+        c = cur.peek()
+        if c == "$":
+            if not cur.up.startswith("$GOTO", pos):
+                keyword = cur.match(_KEYWORD)
+                assert keyword is not None  # at a '$': the rest is optional
+                word = keyword.group(1)
+                raise cur.error(
+                    NcErrorId.UNKNOWN_CONTROL_KEYWORD,
+                    f"${word} must stand at the start of its line", pos,
+                )
+            if block.goto is not None:
+                raise cur.error(NcErrorId.WORD_REPEATED, "$GOTO programmed twice", pos)
+            block.goto = self._goto(cur)
+        elif c == "V" and cur.peek(1) == ".":
+            block.items.append(self._assign(cur))
+        elif c in _LOOK_AHEAD_INITIALS and self._look_ahead_word(cur, block):
+            return
+        elif c == "L":
+            self._call(cur, block)
+        elif c == "N":
+            block.number = self._block_number(cur, block.number)
+        elif "A" <= c <= "Z" or c == "_":
+            spec = table.get(c)
+            if spec is None:
+                raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
+            kind, axis = spec
+            if kind != WordKind.G and kind != WordKind.M:
+                if c in letters:
+                    raise cur.error(
+                        NcErrorId.WORD_REPEATED, f"{c} programmed twice in one block"
+                    )
+            cur.pos += 1
+            value = self._value(cur, c, pos)
+            if kind == WordKind.G and value in _WEIGHTINGS and _skip(cur) < cur.end \
+                    and cur.peek() == "=" and cur.peek(1) != "=":
+                cur.pos += 1  # G133 = <percent> / G134 = <percent>
+                block.items.append(Word(WordKind.WEIGHTING, f"G{int(value)}",
+                                        ExpressionParser(cur).parse(), pos))
+                return
+            if kind == WordKind.G and isinstance(value, float):
+                if not value.is_integer() or int(value) not in G_CODES:
+                    raise cur.error(
+                        NcErrorId.UNSUPPORTED_G_CODE, f"G{value:g} is not supported", pos
+                    )
+                if G_CODES[int(value)][0] == GGroup.DWELL:
+                    block.has_g4 = True
+            if kind != WordKind.G and kind != WordKind.M:
+                letters.add(c)
+            block.items.append(Word(kind, c, value, pos, axis))
+        elif c == "#" and AX_WORD.match(cur.up, pos):
+            raise cur.error(NcErrorId.AXIS_COMMAND_NOT_ALONE,
+                            "#AX must stand alone in its NC line")
+        elif c == "#" and CONTOUR_WORD.match(cur.up, pos):
+            directive = _DIRECTIVE.match(cur.up, pos)
+            assert directive is not None  # at a '#': the rest is optional
+            word = directive.group(1)
+            raise cur.error(NcErrorId.CONTOUR_COMMAND_SYNTAX,
+                            f"#{word} must stand alone in its NC line")
+        else:
+            raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
 
     def _look_ahead_word(self, cur: Cursor, block: NcBlock) -> bool:
         """``LA_ON`` / ``LA_OFF`` or ``METB|VFBT|BBTRC = <expr>`` at the cursor: parsed
@@ -409,4 +444,6 @@ def _negate(value: Value) -> Value:
     return value if isinstance(value, str) else -value
 
 
-__all__ = ["LineParser", "RESERVED_LETTERS", "VarRef", "WordTable", "word_table"]
+__all__ = [
+    "ItemErrorHandler", "LineParser", "RESERVED_LETTERS", "VarRef", "WordTable", "word_table",
+]

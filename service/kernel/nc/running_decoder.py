@@ -9,6 +9,7 @@ so they name the decoder by this protocol instead of importing the ``Decoder`` c
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol
 
 from .blockexec import BlockExecutor
@@ -34,6 +35,7 @@ class RunningDecoder(Env, Protocol):
     contour_lookahead: bool  # the channel has FCT_CONTOUR_LAH (P-CHAN-00650)
     emitted: int  # grows whenever blocks were yielded (the endless-loop guard watches it)
     own_variables: set[int]  # ids of the variables this decoder declared
+    cancelled: Callable[[], bool]  # True once the run is cancelled (RESET)
 
     @property
     def modal(self) -> ModalState:
