@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from typing import Any, Protocol
+from typing import Any, Protocol, cast
 
 from cnc_objects.objects import Entry
 from cnc_objects.protocol import sum as sums
@@ -55,6 +55,7 @@ from .kernel.commands import Refusal
 from .kernel.kernel import Control, ControlCommand
 from .notifications import Envelope
 from .output_service import OutputService
+from .program_service import ProgramStoreService
 
 log = logging.getLogger(__name__)
 
@@ -150,7 +151,9 @@ class Dispatcher:
                 return self._read_write(envelope, request, role)  # type: ignore[arg-type]
             needed = COMMAND_ROLES.get(command)
             if needed is None:  # a Write: by its address
-                needed = role_to_write(request.port, request.group)  # type: ignore[attr-defined]
+                # every command but Write has its role in COMMAND_ROLES
+                write = cast("WriteRequest", request)
+                needed = role_to_write(write.port, write.group)
             if role >= needed:
                 return self._handlers[command](envelope, request)
             return self._error(envelope, request, _E.DEVICE_INVALIDACCESS,
@@ -196,8 +199,9 @@ class Dispatcher:
         major, minor, build = (int(p) for p in __version__.split("."))
         return self._ok(envelope, req, major, minor, build, DEVICE_NAME)
 
-    def _is_store(self, port: int, group: int) -> bool:
-        return group == PROGRAM_STORE_GROUP and port == CncPort.COM and self.programs is not None
+    def _store(self, port: int, group: int) -> ProgramStoreService | None:
+        """The program store's service when ``port`` and ``group`` address it, else None."""
+        return self.programs if group == PROGRAM_STORE_GROUP and port == CncPort.COM else None
 
     def _output_area(self, port: int, group: int) -> OutputService | None:
         """The output area's service when ``port`` and ``group`` address it, else None."""
@@ -205,8 +209,9 @@ class Dispatcher:
 
     def _read(self, envelope: Envelope, req: ReadRequest) -> Reply:
         # The hot path: an object address goes straight to the address space.
-        if req.group == PROGRAM_STORE_GROUP and self._is_store(req.port, req.group):
-            return self._reply(envelope, req, self.programs.read(req.offset, req.length))
+        if req.group == PROGRAM_STORE_GROUP and (
+                programs := self._store(req.port, req.group)) is not None:
+            return self._reply(envelope, req, programs.read(req.offset, req.length))
         if req.group == OUTPUT_AREA_GROUP and (
                 outputs := self._output_area(req.port, req.group)) is not None:
             return self._reply(envelope, req, outputs.read(req.offset, req.length))
@@ -219,12 +224,12 @@ class Dispatcher:
                 other = self.backend.read_other_length(req.port, req.group, req.offset, req.length)
                 if other is not None:
                     return self._reply(envelope, req, other)
-            return self._error(envelope, req, code, payload)
+            return self._error(envelope, req, code, str(payload))
         return self._ok(envelope, req, payload)
 
     def _write(self, envelope: Envelope, req: WriteRequest) -> Reply:
-        if self._is_store(req.port, req.group):
-            return self._reply(envelope, req, self.programs.write(req.offset, req.data))
+        if (programs := self._store(req.port, req.group)) is not None:
+            return self._reply(envelope, req, programs.write(req.offset, req.data))
         if (outputs := self._output_area(req.port, req.group)) is not None:
             return self._reply(envelope, req, outputs.write(req.offset, req.data))
         code, message, writes = self.backend.decode_writes(
@@ -293,9 +298,9 @@ class Dispatcher:
             if req.group == RIG.SUM_WRITE and role is not _ADMIN:
                 return self._sum_write(envelope, req, role)
             return handler(envelope, req)
-        if self._is_store(req.port, req.group):
+        if (programs := self._store(req.port, req.group)) is not None:
             return self._reply(
-                envelope, req, self.programs.read_write(req.offset, req.data, req.read_length)
+                envelope, req, programs.read_write(req.offset, req.data, req.read_length)
             )
         if (outputs := self._output_area(req.port, req.group)) is not None:
             return self._output_download(outputs, envelope, req)
@@ -319,7 +324,9 @@ class Dispatcher:
         result = outputs.read_write(req.offset, req.data, req.read_length, answer)
         return None if result is None else self._reply(envelope, req, result)
 
-    def _sum_items(self, req: ReadWriteRequest, decode: Callable) -> tuple[int, Any]:
+    def _sum_items(
+        self, req: ReadWriteRequest, decode: Callable[..., Any]
+    ) -> tuple[int, Any]:
         if not 0 < req.offset <= SUM_COMMAND_MAX_ITEMS:
             return _E.DEVICE_INVALIDPARM, f"a sum command carries 1..{SUM_COMMAND_MAX_ITEMS} items"
         try:

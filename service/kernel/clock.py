@@ -21,7 +21,9 @@ class Clock(Protocol):
     """Decides when the next cycle starts; ``lateness`` of the cycle starts against their
     deadlines, where there are deadlines (None: virtual time has none)."""
 
-    lateness: LatenessHistogram | None
+    @property
+    def lateness(self) -> LatenessHistogram | None:
+        """The lateness of the cycle starts, or None where there are no deadlines."""
 
     def start(self) -> None:
         """Called once before the first cycle."""

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import os
 import random
-import re
 import subprocess
 import sys
 import time
@@ -40,10 +39,10 @@ QUICK_SEED = 20_211  # the mutants of `make test`
 CHECK_TIMEOUT_S = 3.0  # a syntax check that has not ended is RESET (endless loops)
 RUN_TIMEOUT_S = 3.0  # a run that has not ended is RESET (endless loops with motion)
 STOP_TIMEOUT_S = 10.0  # after RESET the channel must stop working within this
-# one request (a busy machine; the decoder may be busy too). With the virtual clock a
-# START is acknowledged only when the decoder hands GEO its first block: an idle endless
-# loop ($WHILE 1 V.L.X = ..) holds it until ENDLESS_LOOP, 14-21 s on a loaded 2-core box
-CLIENT_TIMEOUT_S = 40.0
+# one request (a busy machine; the decoder may be busy too). A START is answered when the
+# kernel has applied it, also while the run's first cycle waits for the decoder (an idle
+# endless loop, $WHILE 1 V.L.X = .., once held the reply until ENDLESS_LOOP: 14-21 s)
+CLIENT_TIMEOUT_S = 20.0
 #: What the service may answer when it refuses to start a mutant (ADS codes).
 START_REFUSALS = {
     AdsReturnCode.DEVICE_NOTFOUND,  # the program is not stored (never, here)
