@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 import zmq
 
 from cnc_objects.protocol.errors import ProtocolError
-from cnc_objects.protocol.frames import Response, Sample, decode_incoming
+from cnc_objects.protocol.frames import Response, RawSample, decode_incoming
 
 from .curve import ClientCurve, HandshakeWatch
 from .errors import AdsConnectionError
@@ -113,7 +113,7 @@ class SyncTransport(_Transport):
         """Awaitable next sample of ``handle`` (performed by ``drive``)."""
         return _Pending(self, handle=handle)
 
-    def perform(self, pending: _Pending) -> Response | Sample:
+    def perform(self, pending: _Pending) -> Response | RawSample:
         """Do the blocking I/O a ``_Pending`` stands for."""
         sock = self._sock
         if sock is None:

@@ -27,7 +27,7 @@ from cnc_objects.protocol.errors import ProtocolError
 from cnc_objects.protocol.frames import (
     Notification,
     Response,
-    Sample,
+    RawSample,
     decode_incoming,
     encode_request,
 )
@@ -73,8 +73,8 @@ class _Transport:
         self.timeout_s = timeout_s
         self.curve = curve
         self._ids = itertools.count(1)
-        self._samples: dict[int, deque[Sample]] = {}
-        self._early: dict[int, deque[Sample]] = {}
+        self._samples: dict[int, deque[RawSample]] = {}
+        self._early: dict[int, deque[RawSample]] = {}
 
     def _frame(self, command: int, port: int, fields: tuple[Any, ...]) -> tuple[int, bytes]:
         """A fresh invoke id (1..2**32-1) and the request frame that carries it."""
@@ -209,7 +209,7 @@ class AsyncTransport(_Transport):
             self._loop.call_soon(self._drain)  # type: ignore[union-attr]
         return fut
 
-    async def next_sample(self, handle: int) -> Sample:
+    async def next_sample(self, handle: int) -> RawSample:
         """The next buffered sample of ``handle``, waiting for one if needed."""
         while True:
             buffer = self._samples[handle]

@@ -41,7 +41,7 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any, ClassVar, NamedTuple
 
 from .constants import AdsCommand
 from .datatypes import STRING_ENCODING
@@ -70,10 +70,7 @@ DEVICE_NAME_BYTES = 16
 _C = AdsCommand
 
 
-class AddNotificationRequest(NamedTuple):
-    """AddDeviceNotification as ADS carries it: ``max_delay_100ns`` and
-    ``cycle_time_100ns`` in units of 100 ns."""
-
+class _AmsAddNotificationFields(NamedTuple):
     invoke_id: int
     port: int
     group: int
@@ -82,7 +79,15 @@ class AddNotificationRequest(NamedTuple):
     transmission_mode: int
     max_delay_100ns: int
     cycle_time_100ns: int
-    COMMAND = AdsCommand.ADD_DEVICE_NOTIFICATION
+
+
+class AmsAddNotificationRequest(_AmsAddNotificationFields):
+    """AddDeviceNotification as ADS carries it: ``max_delay_100ns`` and
+    ``cycle_time_100ns`` in units of 100 ns (the ZeroMQ frame's ``AddNotificationRequest``
+    carries milliseconds)."""
+
+    __slots__ = ()
+    COMMAND: ClassVar[AdsCommand] = AdsCommand.ADD_DEVICE_NOTIFICATION
 
 
 # --------------------------------------------------------------------------- requests
@@ -141,7 +146,7 @@ def _write_control(invoke_id: int, port: int, data: bytes) -> Any:
 
 def _add_notification(invoke_id: int, port: int, data: bytes) -> Any:
     _size(_C.ADD_DEVICE_NOTIFICATION, data, _ADD.size, invoke_id)
-    return AddNotificationRequest(invoke_id, port, *_ADD.unpack(data)[:6])
+    return AmsAddNotificationRequest(invoke_id, port, *_ADD.unpack(data)[:6])
 
 
 def _delete_notification(invoke_id: int, port: int, data: bytes) -> Any:

@@ -19,7 +19,7 @@ Every ADS message on TCP is one AMS/TCP frame; all integers are little-endian::
 
 ``AmsStreamParser`` cuts frames out of a byte stream however TCP segments it (a frame
 split over several segments, several frames in one segment). It never raises on bad
-input: each frame it cannot use becomes a ``FrameError`` that says why, so that the
+input: each frame it cannot use becomes a ``SkippedFrame`` that says why, so that the
 server can answer (when the header could be read) and keep the connection; only a frame
 longer than the configured maximum ends the stream, because what follows it cannot be
 trusted to be read in time.
@@ -142,7 +142,7 @@ class FrameProblem(IntEnum):
 
 
 @dataclass(frozen=True, slots=True)
-class FrameError:
+class SkippedFrame:
     """A frame that was skipped, with the reason; ``header`` when it could be read (so
     the sender can be answered), ``length`` the AMS/TCP length it announced."""
 
@@ -166,7 +166,7 @@ class AmsStreamParser:
     """Cuts AMS/TCP frames out of a byte stream: ``feed`` bytes, get complete frames.
 
     ``max_frame_bytes`` bounds the AMS/TCP length of one frame; the first frame over it
-    yields ``FrameError(TOO_LONG)`` and the parser takes no more input (``closed``).
+    yields ``SkippedFrame(TOO_LONG)`` and the parser takes no more input (``closed``).
     """
 
     def __init__(self, max_frame_bytes: int = AMS_MAX_FRAME_BYTES) -> None:
@@ -180,9 +180,9 @@ class AmsStreamParser:
         """Bytes received that do not make a whole frame yet."""
         return len(self._pending)
 
-    def feed(self, data: bytes) -> list[AmsFrame | FrameError]:
+    def feed(self, data: bytes) -> list[AmsFrame | SkippedFrame]:
         """Take ``data`` (any amount); return the frames it completes, in order."""
-        out: list[AmsFrame | FrameError] = []
+        out: list[AmsFrame | SkippedFrame] = []
         if self.closed:
             return out
         if self._pending:
@@ -197,7 +197,7 @@ class AmsStreamParser:
             reserved, length = unpack_tcp(data, pos)
             if length > self.max_frame_bytes:
                 self.closed = True
-                out.append(FrameError(FrameProblem.TOO_LONG, length))
+                out.append(SkippedFrame(FrameProblem.TOO_LONG, length))
                 return out
             stop = pos + AMS_TCP_HEADER_BYTES + length
             if stop > end:
@@ -212,13 +212,13 @@ class AmsStreamParser:
         return out
 
 
-def _frame(data: bytes, start: int, length: int, reserved: int) -> AmsFrame | FrameError:
+def _frame(data: bytes, start: int, length: int, reserved: int) -> AmsFrame | SkippedFrame:
     """The frame of ``length`` bytes at ``start`` (after its AMS/TCP header)."""
     if reserved != 0:
-        return FrameError(FrameProblem.NOT_AMS_COMMAND, length)
+        return SkippedFrame(FrameProblem.NOT_AMS_COMMAND, length)
     if length < AMS_HEADER_BYTES:
-        return FrameError(FrameProblem.TRUNCATED_HEADER, length)
+        return SkippedFrame(FrameProblem.TRUNCATED_HEADER, length)
     header = AmsHeader(*AMS_HEADER.unpack_from(data, start))
     if header.data_length != length - AMS_HEADER_BYTES:
-        return FrameError(FrameProblem.LENGTH_MISMATCH, length, header)
+        return SkippedFrame(FrameProblem.LENGTH_MISMATCH, length, header)
     return AmsFrame(header, data[start + AMS_HEADER_BYTES:start + length])

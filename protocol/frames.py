@@ -368,7 +368,7 @@ def encode_error(invoke_id: int, command: int, code: int, message: str) -> bytes
 
 
 @dataclass(frozen=True, slots=True)
-class Sample:
+class RawSample:
     """One notification sample: handle, sequence number, FILETIME timestamp, raw data."""
 
     handle: int
@@ -387,7 +387,7 @@ class Notification:
     """An unsolicited server frame with one or more samples."""
 
     port: int
-    samples: tuple[Sample, ...]
+    samples: tuple[RawSample, ...]
 
 
 def decode_incoming(raw: bytes) -> Response | Notification:
@@ -413,7 +413,7 @@ def decode_incoming(raw: bytes) -> Response | Notification:
                 or type(s[3]) is not bytes
             ):
                 raise ProtocolError("a sample is [handle, sequence, timestamp, data]")
-            samples.append(Sample(*s))
+            samples.append(RawSample(*s))
         return Notification(obj[2], tuple(samples))
     if type(invoke_id) is not int or type(command) is not int or type(obj[2]) is not int:
         raise ProtocolError("invoke id, command and result must be integers")

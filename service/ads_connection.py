@@ -47,7 +47,7 @@ from cnc_objects.protocol.ams import (
     AmsFrame,
     AmsHeader,
     AmsStreamParser,
-    FrameError,
+    SkippedFrame,
     FrameProblem,
     encode_reply_frame,
     format_net_id,
@@ -103,7 +103,7 @@ class AmsConnection(asyncio.Protocol):
         self._skipped = ThrottledWarning(log, "ADS frame skipped")
         self.paused = False  # the peer does not read: notifications are dropped
         self._rate = server.rate
-        self._held: deque[AmsFrame | FrameError] | None = None  # waiting for the rate
+        self._held: deque[AmsFrame | SkippedFrame] | None = None  # waiting for the rate
         self._held_timer: asyncio.TimerHandle | None = None
         self._limits = server.limits
         self._admitted = False  # counted by the limits (released when lost)
@@ -142,7 +142,7 @@ class AmsConnection(asyncio.Protocol):
             return
         self._answer(items)
 
-    def _account(self, items: list[AmsFrame | FrameError]) -> bool:
+    def _account(self, items: list[AmsFrame | SkippedFrame]) -> bool:
         """Tell the limits what the incomplete frame now holds and time it; False when
         that closed the connection (over the receive budget)."""
         buffered = self._parser.buffered
@@ -175,7 +175,7 @@ class AmsConnection(asyncio.Protocol):
         self._limits.timed_out.note(f"{self.peer} ({self._buffered} bytes)")
         self.close()
 
-    def _answer(self, items: list[AmsFrame | FrameError]) -> None:
+    def _answer(self, items: list[AmsFrame | SkippedFrame]) -> None:
         """Answer ``items`` in order while the rate allows; hold the rest."""
         rate = self._rate
         now_s = perf_counter() if rate is not None else 0.0
@@ -190,7 +190,7 @@ class AmsConnection(asyncio.Protocol):
             else:
                 self._bad_frame(item)  # type: ignore[arg-type]
 
-    def _hold(self, items: list[AmsFrame | FrameError], wait_s: float) -> None:
+    def _hold(self, items: list[AmsFrame | SkippedFrame], wait_s: float) -> None:
         """Over the rate: keep ``items`` and stop reading until a token is due."""
         self._held = deque(items)
         if self._transport is not None:
@@ -310,7 +310,7 @@ class AmsConnection(asyncio.Protocol):
                   format_net_id(header.target_net_id), header.target_port)
         self.write(encode_reply_frame(header, b"", code))
 
-    def _bad_frame(self, error: FrameError) -> None:
+    def _bad_frame(self, error: SkippedFrame) -> None:
         if error.problem is FrameProblem.TOO_LONG:
             log.warning("ADS connection from %s closed: %s (%d bytes)", self.peer, error,
                         self._parser.max_frame_bytes)

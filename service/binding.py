@@ -285,7 +285,7 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "link_state": _channel_axis("link_state"),
     "dist_prog_start": _channel("dist_prog_start_incr"),
     "mc_command_feed_override_r": _channel("feed_override_command"),
-    "mc_active_feed_override_r": _channel("feed_override_active"),
+    "mc_active_feed_override_r": _channel("feed_override_per_mille"),
     "mc_command_execution_mode_r": _channel("execution_mode_command"),
     "decoder_mc_control.execution_mode.command_w": _channel("execution_mode_plc_command"),
     "decoder_mc_control.execution_mode.enable_w": _channel("execution_mode_plc_enable"),

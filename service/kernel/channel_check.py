@@ -11,7 +11,7 @@ from __future__ import annotations
 from .channel_mode import ChannelState
 from .nc import ModalState
 from .program_run import RunHost, Step
-from .state import Channel, ChannelError, DecoderFlag
+from .state import Channel, ErrorEntry, DecoderFlag
 from .syntax_check import CHECK_STOPPED_WARNING, CheckRun, Pause
 
 
@@ -27,7 +27,7 @@ class ChannelCheck:
         self._deterministic = deterministic  # virtual clock: the cycle lets the check go on
         self._released = Pause.NONE  # START ended this pause (flag for one cycle)
         self._left_out = 0  # errors counted but not kept (check_max_errors), shown so far
-        self.failure: ChannelError | None = None
+        self.failure: ErrorEntry | None = None
 
     @property
     def ignores_feedhold(self) -> bool:
@@ -62,7 +62,7 @@ class ChannelCheck:
         ch.program_time_s = time_s - self.started_at_s
         for found in p.errors:
             err = found.error
-            self._host.list_error(ChannelError(int(err.id), err.message, found.file,
+            self._host.list_error(ErrorEntry(int(err.id), err.message, found.file,
                                                found.line, found.column, warning=True),
                                   to_log=False, keep_last=True)
         # errors over limits.check_max_errors are counted, not listed
@@ -83,11 +83,11 @@ class ChannelCheck:
             ch.decoder_flags = 0
             if p.failure is not None:
                 err = p.failure.error
-                self.failure = ChannelError(int(err.id), err.message, p.failure.file,
+                self.failure = ErrorEntry(int(err.id), err.message, p.failure.file,
                                             p.failure.line, p.failure.column)
                 return Step.FAILED
             if p.stopped_early:
-                self._host.list_error(ChannelError(
+                self._host.list_error(ErrorEntry(
                     CHECK_STOPPED_WARNING, f"syntax check stopped after {p.error_count} errors "
                     "(syn_chk.errors_total, P-CHAN-00019)", p.file, p.line, warning=True))
             return Step.ENDED

@@ -50,7 +50,7 @@ from .program_run import (
     log_full_warning,
     show_contour_state,
 )
-from .state import MESSAGES_KEPT, Channel, ChannelError, DecoderFlag
+from .state import MESSAGES_KEPT, Channel, ErrorEntry, DecoderFlag
 from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
 
@@ -268,14 +268,14 @@ class ChannelRunner:
         self._switchover.adjust_to_drives(self.channel)
         self._check_jog_of_path()
 
-    def jog_of_path_error(self) -> ChannelError | None:
+    def jog_of_path_error(self) -> ErrorEntry | None:
         """None when the channel may work: not a jog-of-path channel, or all its axes
         in the channel are clones; otherwise the error naming the axis."""
         if not self.config.jog_of_path_only:
             return None
         for axis in self.channel.axes:
             if not axis.released and not self._params[axis.logical_number].cloned:
-                return ChannelError(
+                return ErrorEntry(
                     AxisErrorId.JOG_OF_PATH_AXIS_NOT_CLONE,
                     f"axis {axis.name} (kopf.achs_nr {axis.logical_number}) of jog-of-path "
                     f"channel {self.channel.channel_id} is not a clone (jog_of_path_only, "
@@ -290,7 +290,7 @@ class ChannelRunner:
             self._fail(error)
         return error is None
 
-    def report(self, error: ChannelError) -> None:
+    def report(self, error: ErrorEntry) -> None:
         """List ``error`` (a warning leaves the channel's state alone)."""
         if error.warning:
             self.list_error(error)
@@ -372,7 +372,7 @@ class ChannelRunner:
         mode = self.channel.execution_mode_commanded
         if mode & ExecutionMode.SYNCHK:
             if not mode & ExecutionMode.MACHINE_LOCK:
-                self.list_error(ChannelError(
+                self.list_error(ErrorEntry(
                     SYNCHK_WITHOUT_MACHINE_LOCK, "syntax check (SYNCHK) without MACHINE_LOCK: "
                     "MACHINE_LOCK is set implicitly, the axes do not move", warning=True))
             mode |= ExecutionMode.MACHINE_LOCK | ExecutionMode.SUPPRESS_TECHNO_OUTPUT
@@ -566,7 +566,7 @@ class ChannelRunner:
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
         self._ended(run, "READY")
 
-    def _fail(self, error: ChannelError) -> None:
+    def _fail(self, error: ErrorEntry) -> None:
         ch = self.channel
         self.list_error(error)
         run = self._drop_run()
@@ -586,7 +586,7 @@ class ChannelRunner:
         if isinstance(run, ProdTimeRun):
             run.write_trace(how, self._files)
 
-    def list_error(self, error: ChannelError, to_log: bool = True,
+    def list_error(self, error: ErrorEntry, to_log: bool = True,
                    keep_last: bool = False) -> None:
         """List ``error``; ``to_log``: also in the channel's error log file (not the
         findings of a syntax check, which may be thousands: they go to dec0<c>.sc);

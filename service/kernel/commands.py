@@ -75,7 +75,7 @@ class SetFeedOverride:
                 f"0..{channel.feed_override_max / 10:g} %",
             )
         channel.feed_override_command = self.value
-        channel.feed_override_active = self.value
+        channel.feed_override_per_mille = self.value
         return None
 
 

@@ -22,7 +22,7 @@ from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
 from .commands import Command, Refusal, RefusalReason, ResetChannel
-from .state import ChannelError, CycleStats, KernelState, Snapshot
+from .state import ErrorEntry, CycleStats, KernelState, Snapshot
 from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS
 
@@ -145,7 +145,7 @@ class Kernel:
         ]
         for message in messages:
             state.runners[message.channel_index].report(
-                ChannelError(int(message.id), message.text, warning=message.warning)
+                ErrorEntry(int(message.id), message.text, warning=message.warning)
             )
         for runner in state.runners:
             runner.initialise_channel()

@@ -34,7 +34,7 @@ from .path.executor import PathError, PathExecutor
 from .path.interpolator import StepResult, Waiting
 from .path.segments import Segment
 from .prod_time_trace import ProdTimeTrace, trace_file_name
-from .state import Channel, ChannelError
+from .state import Channel, ErrorEntry
 
 _INCR_PER_MM = 10_000  # 0.1 um increments per mm
 PROD_TIME_STEPS_PER_CYCLE = 5_000  # virtual clock: simulated cycles per GEO cycle (PROD_TIME)
@@ -60,14 +60,14 @@ class RunHost(Protocol):
     def axes_ready(self) -> bool:
         """The channel's output is not suspended and every axis in it is linked."""
 
-    def list_error(self, error: ChannelError, to_log: bool = True,
+    def list_error(self, error: ErrorEntry, to_log: bool = True,
                    keep_last: bool = False) -> None:
         """Put ``error`` (a warning here) in the channel's error list."""
 
     def show_decoder_state(self) -> None:
         """Show the #MSG texts and machining settings the decoder reached."""
 
-    def jog_of_path_error(self) -> ChannelError | None:
+    def jog_of_path_error(self) -> ErrorEntry | None:
         """The error that keeps a jog-of-path channel from working (None: it may)."""
 
 
@@ -75,7 +75,7 @@ class ChannelRun(Protocol):
     """What every kind of run offers the channel runner."""
 
     started_at_s: float  # kernel time the run began (program time counts from it)
-    failure: ChannelError | None  # the error of a FAILED step
+    failure: ErrorEntry | None  # the error of a FAILED step
 
     @property
     def ignores_feedhold(self) -> bool:
@@ -117,9 +117,9 @@ class ProgramRun:
         self._contour_changed = False  # blocks were prepared: show the unit's new state
         self._last_pushed: Block | None = None  # the block that entered the buffer last
         self._buffer_warned = False  # BUFFER_LIMITS_SPEED shown in this run
-        self._pending_error: ChannelError | None = None  # takes effect where the path stops
+        self._pending_error: ErrorEntry | None = None  # takes effect where the path stops
         self._fed_all = False
-        self.failure: ChannelError | None = None
+        self.failure: ErrorEntry | None = None
         if contour is not None:
             executor.on_prepared = self._prepared
 
@@ -152,7 +152,7 @@ class ProgramRun:
 
     def cycle(self, time_s: float) -> Step:
         """One interpolation cycle of the path, output to the channel's axes."""
-        return self._motion_cycle(time_s, self.channel.feed_override_active / 1000.0,
+        return self._motion_cycle(time_s, self.channel.feed_override_per_mille / 1000.0,
                                   output=True)
 
     def _motion_cycle(self, time_s: float, override: float, output: bool) -> Step:
@@ -219,11 +219,11 @@ class ProgramRun:
     def _stepped(self, step: StepResult) -> None:
         """After each interpolation cycle (a traced PROD_TIME run records it)."""
 
-    def _fail(self, error: ChannelError) -> Step:
+    def _fail(self, error: ErrorEntry) -> Step:
         self.failure = error
         return Step.FAILED
 
-    def _apply_sync(self) -> ChannelError | None:
+    def _apply_sync(self) -> ErrorEntry | None:
         """Carry out the block the path stands at (axis exchange, LOG CLEAR); the error
         when the channel cannot work after it (jog of path)."""
         block, self._sync = self._sync, None
@@ -292,7 +292,7 @@ class ProgramRun:
                 self._stop_feeding(_path_error(item, item.block))
                 return
             elif isinstance(item, NcError):
-                self._stop_feeding(ChannelError(
+                self._stop_feeding(ErrorEntry(
                     int(item.id), item.message, item.file, item.line, item.column
                 ))
                 return
@@ -312,7 +312,7 @@ class ProgramRun:
             return 0
         return last.look_ahead.blocks_after
 
-    def _stop_feeding(self, error: ChannelError) -> None:
+    def _stop_feeding(self, error: ErrorEntry) -> None:
         """Nothing after this error enters the path; what radius compensation holds
         back is released, so the blocks before the error run to their end."""
         self._pending_error = error
@@ -352,7 +352,7 @@ class ProgramRun:
         at the block the path is in."""
         self._buffer_warned = True
         ch = self.channel
-        self._host.list_error(ChannelError(
+        self._host.list_error(ErrorEntry(
             int(PathErrorId.BUFFER_LIMITS_SPEED),
             f"the look-ahead buffer of {self._buffer_blocks} blocks limits the path speed "
             f"to {ch.path_velocity_mm_s:.1f} mm/s (the path must be able to stop after the "
@@ -439,12 +439,12 @@ def show_contour_state(channel: Channel, contour: ContourLog) -> None:
     )
 
 
-def log_full_warning(contour: ContourLog, file_name: str) -> ChannelError:
+def log_full_warning(contour: ContourLog, file_name: str) -> ErrorEntry:
     """The warning (once per marked area) that the log dropped elements, at the block
     that did not fit (else in ``file_name``)."""
     block = contour.dropped_at
     src = block.source if block is not None else SourceRef(file_name, 0)
-    return ChannelError(
+    return ErrorEntry(
         LOG_FULL_WARNING,
         f"the contour look-ahead log is full ({contour.log_max} entries, "
         "contour_lookahead_log_max P-CHAN-00658): later elements of the marked area "
@@ -452,13 +452,13 @@ def log_full_warning(contour: ContourLog, file_name: str) -> ChannelError:
     )
 
 
-def _path_error(exc: PathError, block: Block | None) -> ChannelError:
+def _path_error(exc: PathError, block: Block | None) -> ErrorEntry:
     """The channel error of a path error, at the block it names (else ``block``)."""
     named = exc.block if exc.block is not None else block
     if named is None:
-        return ChannelError(int(exc.id), exc.message)
+        return ErrorEntry(int(exc.id), exc.message)
     src = named.source
-    return ChannelError(int(exc.id), exc.message, src.file, src.line, src.column)
+    return ErrorEntry(int(exc.id), exc.message, src.file, src.line, src.column)
 
 
 def _waits_for_standstill(block: Block) -> bool:

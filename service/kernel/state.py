@@ -91,7 +91,7 @@ class LogicalAxis:
 
 
 @dataclass(frozen=True, slots=True)
-class ChannelError:
+class ErrorEntry:
     """An error of a channel: ISG-style id, text, and where in which NC file it arose."""
 
     id: int
@@ -151,7 +151,7 @@ class Channel:
     axes: list[LogicalAxis]
     feed_override_max: int
     feed_override_command: int = 1000  # 0.1 %
-    feed_override_active: int = 1000  # 0.1 %
+    feed_override_per_mille: int = 1000  # 0.1 %
     execution_mode_command: int = 0
     execution_mode_active: int = 0
     dist_prog_start_incr: float = 0.0  # 0.1 um
@@ -171,7 +171,7 @@ class Channel:
     programmed_velocity_mm_s: float = 0.0
     remaining_in_block_mm: float = 0.0
     program_time_s: float = 0.0
-    errors: tuple[ChannelError, ...] = ()
+    errors: tuple[ErrorEntry, ...] = ()
     error_count: int = 0
     # gpCh[i].bahn_mc_control.suspend_axis_output (ISG control unit, see docs/jog-of-path.md)
     suspend_command_w: bool = False
@@ -209,7 +209,7 @@ class Channel:
         """A copy for the snapshot, with copies of its axes."""
         return Channel(
             self.channel_id, self.name, [a.frozen() for a in self.axes],
-            self.feed_override_max, self.feed_override_command, self.feed_override_active,
+            self.feed_override_max, self.feed_override_command, self.feed_override_per_mille,
             self.execution_mode_command, self.execution_mode_active,
             self.dist_prog_start_incr, self.output_suspended, self.mode, self.state,
             self.program_name, self.single_block, self.waiting_for_start, self.block_number,
@@ -306,7 +306,7 @@ class ChannelRunnerView(Protocol):
     def initialise_channel(self) -> None:
         """Channel init (start-up, RESET)."""
 
-    def report(self, error: ChannelError) -> None:
+    def report(self, error: ErrorEntry) -> None:
         """List ``error``."""
 
     def cycle(self, time_s: float) -> bool:
@@ -412,7 +412,7 @@ def _channel_from_config(config: ChannelConfig, machine: MachineConfig) -> Chann
         axes,
         config.feed_override_max,
         feed_override_command=min(1000, config.feed_override_max),
-        feed_override_active=min(1000, config.feed_override_max),
+        feed_override_per_mille=min(1000, config.feed_override_max),
         output_suspended=suspended,
         suspend_command_w=suspended,
         suspend_request_r=suspended,

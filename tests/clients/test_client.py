@@ -22,7 +22,7 @@ from cnc_objects.clients import (
 from cnc_objects.clients.transport import EARLY_HANDLES, _Transport
 from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.frames import Notification
-from cnc_objects.protocol.frames import Sample as FrameSample
+from cnc_objects.protocol.frames import RawSample as FrameSample
 from tests.support.service import RunningService
 
 GEO, COM = 551, 553

@@ -19,7 +19,7 @@ from cnc_objects.protocol.ams import (
     AmsFrame,
     AmsHeader,
     AmsStreamParser,
-    FrameError,
+    SkippedFrame,
     FrameProblem,
     encode_frame,
     encode_reply_frame,
@@ -112,8 +112,8 @@ def test_reply_frame_swaps_addresses_and_keeps_the_invoke_id() -> None:
 # --------------------------------------------------------------------------- stream
 
 
-def frames_of(items: list[AmsFrame | FrameError]) -> list[tuple[int, bytes]]:
-    """(invoke id, data) of the frames; fails on a FrameError."""
+def frames_of(items: list[AmsFrame | SkippedFrame]) -> list[tuple[int, bytes]]:
+    """(invoke id, data) of the frames; fails on a SkippedFrame."""
     assert all(isinstance(i, AmsFrame) for i in items), items
     return [(i.header.invoke_id, i.data) for i in items]  # type: ignore[union-attr]
 
@@ -166,7 +166,7 @@ def test_a_frame_over_the_maximum_ends_the_stream() -> None:
     # Only the 6-byte AMS/TCP header of the long frame has arrived: that is enough.
     items = parser.feed(ok + struct.pack("<HI", 0, 101))
     assert isinstance(items[0], AmsFrame)
-    assert isinstance(items[1], FrameError) and items[1].problem is FrameProblem.TOO_LONG
+    assert isinstance(items[1], SkippedFrame) and items[1].problem is FrameProblem.TOO_LONG
     assert items[1].length == 101 and "exceeds" in str(items[1])
     assert parser.closed
     assert parser.feed(ok) == []
@@ -177,14 +177,14 @@ def test_the_default_maximum_is_one_mebibyte() -> None:
     assert parser.feed(struct.pack("<HI", 0, 1 << 20))[:1] == []  # allowed, incomplete
     parser = AmsStreamParser()
     (error,) = parser.feed(struct.pack("<HI", 0, (1 << 20) + 1))
-    assert isinstance(error, FrameError) and error.problem is FrameProblem.TOO_LONG
+    assert isinstance(error, SkippedFrame) and error.problem is FrameProblem.TOO_LONG
 
 
 def test_a_truncated_header_is_reported_and_the_stream_goes_on() -> None:
     short = struct.pack("<HI", 0, 20) + bytes(20)  # no room for the 32-byte AMS header
     after = request_frame(4, b"", invoke_id=5)
     items = AmsStreamParser().feed(short + after)
-    assert isinstance(items[0], FrameError)
+    assert isinstance(items[0], SkippedFrame)
     assert items[0].problem is FrameProblem.TRUNCATED_HEADER and items[0].header is None
     assert frames_of(items[1:]) == [(5, b"")]
 
@@ -195,7 +195,7 @@ def test_a_data_length_that_does_not_match_is_reported_with_the_header() -> None
     after = request_frame(4, b"", invoke_id=10)
     items = AmsStreamParser().feed(bytes(raw) + after)
     error = items[0]
-    assert isinstance(error, FrameError) and error.problem is FrameProblem.LENGTH_MISMATCH
+    assert isinstance(error, SkippedFrame) and error.problem is FrameProblem.LENGTH_MISMATCH
     assert error.header is not None and error.header.invoke_id == 9
     assert frames_of(items[1:]) == [(10, b"")]
 
@@ -203,7 +203,7 @@ def test_a_data_length_that_does_not_match_is_reported_with_the_header() -> None
 def test_a_frame_that_is_not_an_ams_command_is_skipped() -> None:
     router_frame = struct.pack("<HI", 0x1000, 2) + b"\x01\x02"  # AMS/TCP port connect
     items = AmsStreamParser().feed(router_frame + request_frame(4, b"", invoke_id=3))
-    assert isinstance(items[0], FrameError)
+    assert isinstance(items[0], SkippedFrame)
     assert items[0].problem is FrameProblem.NOT_AMS_COMMAND
     assert frames_of(items[1:]) == [(3, b"")]
 
@@ -246,7 +246,7 @@ def test_add_notification_request(fields: tuple[int, ...]) -> None:
     data = cmd.encode_add_notification_request(*fields)
     assert len(data) == 40 and data == struct.pack("<6I", *fields) + bytes(16)
     request = cmd.decode_request(6, 5, 851, data)
-    assert request == cmd.AddNotificationRequest(5, 851, *fields)
+    assert request == cmd.AmsAddNotificationRequest(5, 851, *fields)
     assert request.cycle_time_100ns == fields[5] and request.max_delay_100ns == fields[4]
 
 

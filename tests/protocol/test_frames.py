@@ -26,7 +26,7 @@ from cnc_objects.protocol.frames import (
     ReadStateRequest,
     ReadWriteRequest,
     Response,
-    Sample,
+    RawSample,
     WriteControlRequest,
     WriteRequest,
     decode_incoming,
@@ -318,8 +318,8 @@ def test_notification_round_trips_its_samples() -> None:
     assert note == Notification(
         551,
         (
-            Sample(1, 10, 133_000_000_000_000_000, b"\x01\x00"),
-            Sample(2, 11, 133_000_000_000_000_001, b""),
+            RawSample(1, 10, 133_000_000_000_000_000, b"\x01\x00"),
+            RawSample(2, 11, 133_000_000_000_000_001, b""),
         ),
     )
 

@@ -62,14 +62,14 @@ def test_initial_links_follow_the_configuration() -> None:
 def test_command_is_visible_in_the_snapshot_once_applied(kernel: Kernel) -> None:
     assert submit(kernel, SetFeedOverride(0, 420)) is None
     snapshot = kernel.snapshot
-    assert snapshot.channels[0].feed_override_active == 420
-    assert snapshot.channels[1].feed_override_active == 1000
+    assert snapshot.channels[0].feed_override_per_mille == 420
+    assert snapshot.channels[1].feed_override_per_mille == 1000
 
 
 def test_snapshot_is_a_copy_the_kernel_does_not_change(kernel: Kernel) -> None:
     before = kernel.snapshot
     assert submit(kernel, SetFeedOverride(0, 10)) is None
-    assert before.channels[0].feed_override_active == 1000
+    assert before.channels[0].feed_override_per_mille == 1000
     assert kernel.snapshot.cycle > before.cycle
 
 

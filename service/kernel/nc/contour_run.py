@@ -13,7 +13,7 @@ from .blocks import Block, Compensation, ContourCommand, ContourKind, StopKind, 
 from .construct import make_block, make_source
 from .errors import NcErrorId
 from .evaluation import evaluate_number
-from .frames import Frame
+from .call_stack import CallFrame
 from .running_decoder import RunningDecoder
 from .source import LogicalLine
 from .statements import ContourStatement, StmtKind
@@ -50,7 +50,7 @@ def execute_contour(stmt: ContourStatement, decoder: RunningDecoder) -> Block:
                          ContourCommand(kind, param))
 
 
-def inside_rt_loop(frames: list[Frame]) -> bool:
+def inside_rt_loop(frames: list[CallFrame]) -> bool:
     """True when a ``#RT WHILE`` is open in any frame (a subprogram called from inside
     a real-time loop runs inside it too)."""
     return any(entry.kind == StmtKind.RT_WHILE for frame in frames for entry in frame.control)

@@ -27,7 +27,7 @@ from collections.abc import Callable
 from .blocks import Block
 from .errors import DecodingCancelled, NcError, NcErrorId
 from .expressions import number, truth
-from .frames import ControlEntry, Frame
+from .call_stack import ControlEntry, CallFrame
 from .program import Statement, Structure
 from .rt_loop_markers import RtLoopMarkers
 from .running_decoder import RunningDecoder
@@ -39,7 +39,7 @@ MAX_IDLE_LOOP_PASSES = 1_000_000  # loop passes without a block before ENDLESS_L
 CANCEL_CHECK_PASSES = 1024  # idle loop passes between two looks at ``decoder.cancelled``
 
 #: a control statement's handler: (frame, statement, index after it) -> marker Block or None
-Handler = Callable[[Frame, Control, int], Block | None]
+Handler = Callable[[CallFrame, Control, int], Block | None]
 
 
 class ControlFlow:
@@ -62,7 +62,7 @@ class ControlFlow:
             k.ENDVAR: self._endvar,
         }
 
-    def run(self, frame: Frame, stmt: Control, after: int) -> Block | None:
+    def run(self, frame: CallFrame, stmt: Control, after: int) -> Block | None:
         """Execute ``stmt`` (the line at ``frame.index``); sets the next ``frame.index``.
         Returns a real-time loop marker Block or None (the handlers return nothing else)."""
         return self.handlers[stmt.kind](frame, stmt, after)
@@ -90,16 +90,16 @@ class ControlFlow:
             return True
         return truth(stmt.expr(self.decoder), stmt.line, stmt.pos)
 
-    def _structure(self, frame: Frame, stmt: Control, index: int) -> Structure:
+    def _structure(self, frame: CallFrame, stmt: Control, index: int) -> Structure:
         return frame.program.structure(stmt, index, frame.section.end)
 
-    def _top(self, frame: Frame, *kinds: StmtKind) -> ControlEntry | None:
+    def _top(self, frame: CallFrame, *kinds: StmtKind) -> ControlEntry | None:
         if frame.control and frame.control[-1].kind in kinds:
             return frame.control[-1]
         return None
 
     def _mismatch(
-        self, frame: Frame, stmt: Control, err: NcErrorId, opener: StmtKind,
+        self, frame: CallFrame, stmt: Control, err: NcErrorId, opener: StmtKind,
     ) -> NcError:
         if frame.control:
             open_kind = frame.control[-1].kind
@@ -111,7 +111,7 @@ class ControlFlow:
 
     # ------------------------------------------------------------ $IF
 
-    def _if(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _if(self, frame: CallFrame, stmt: Control, after: int) -> None:
         index = frame.index
         if self._cond(stmt):
             frame.control.append(ControlEntry(StmtKind.IF, index, stmt, after))
@@ -128,14 +128,14 @@ class ControlFlow:
                 return
         frame.index = structure.after
 
-    def _if_goto(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _if_goto(self, frame: CallFrame, stmt: Control, after: int) -> None:
         if self._cond(stmt):
             assert stmt.goto is not None  # the parser gives every IF_GOTO its $GOTO
             self.goto(frame, stmt.goto, stmt.line, frame.index)
         else:
             frame.index = after
 
-    def _else(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _else(self, frame: CallFrame, stmt: Control, after: int) -> None:
         # reached from a branch that ran: the rest of the $IF block is skipped
         top = self._top(frame, StmtKind.IF)
         if top is not None:
@@ -146,7 +146,7 @@ class ControlFlow:
         else:
             raise self._mismatch(frame, stmt, NcErrorId.ELSE_WITHOUT_IF, StmtKind.IF)
 
-    def _endif(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _endif(self, frame: CallFrame, stmt: Control, after: int) -> None:
         if self._top(frame, StmtKind.IF) is not None:
             frame.control.pop()
         elif not frame.jumped:
@@ -155,14 +155,14 @@ class ControlFlow:
 
     # ------------------------------------------------------------ loops
 
-    def _while(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _while(self, frame: CallFrame, stmt: Control, after: int) -> None:
         if self._cond(stmt):
             frame.control.append(ControlEntry(stmt.kind, frame.index, stmt, after))
             frame.index = after
         else:
             frame.index = self._structure(frame, stmt, frame.index).after
 
-    def _rt_while(self, frame: Frame, stmt: Control, after: int) -> Block | None:
+    def _rt_while(self, frame: CallFrame, stmt: Control, after: int) -> Block | None:
         """``$WHILE`` semantics; tells the markers about the test (first or re-test)."""
         index = frame.index
         entry = None
@@ -174,7 +174,7 @@ class ControlFlow:
             frame.index = self._structure(frame, stmt, index).after
         return self.markers.tested(frame, stmt, index, entry)
 
-    def _endwhile(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _endwhile(self, frame: CallFrame, stmt: Control, after: int) -> None:
         opener = StmtKind.WHILE if stmt.kind == StmtKind.ENDWHILE else StmtKind.RT_WHILE
         top = self._top(frame, opener)
         if top is None:
@@ -185,7 +185,7 @@ class ControlFlow:
             self.markers.closed(frame, top)
         frame.index = top.index  # the loop statement tests its condition again
 
-    def _for(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _for(self, frame: CallFrame, stmt: Control, after: int) -> None:
         env = self.decoder
         line = stmt.line
         # the parser gives every $FOR its variable, start and end
@@ -206,7 +206,7 @@ class ControlFlow:
         value = number(stmt.target(self.decoder), stmt.line, stmt.pos, "a number in $FOR")
         return value <= end if step > 0 else value >= end
 
-    def _endfor(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _endfor(self, frame: CallFrame, stmt: Control, after: int) -> None:
         top = self._top(frame, StmtKind.FOR)
         if top is None:
             raise self._mismatch(frame, stmt, NcErrorId.LOOP_END_WITHOUT_BEGIN, StmtKind.FOR)
@@ -221,11 +221,11 @@ class ControlFlow:
             frame.control.pop()
             frame.index = after
 
-    def _repeat(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _repeat(self, frame: CallFrame, stmt: Control, after: int) -> None:
         frame.control.append(ControlEntry(StmtKind.REPEAT, frame.index, stmt, after))
         frame.index = after
 
-    def _until(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _until(self, frame: CallFrame, stmt: Control, after: int) -> None:
         top = self._top(frame, StmtKind.REPEAT)
         if top is None:
             raise self._mismatch(frame, stmt, NcErrorId.LOOP_END_WITHOUT_BEGIN, StmtKind.REPEAT)
@@ -238,7 +238,7 @@ class ControlFlow:
 
     # ------------------------------------------------------------ $SWITCH
 
-    def _switch(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _switch(self, frame: CallFrame, stmt: Control, after: int) -> None:
         env = self.decoder
         assert stmt.expr is not None  # the parser gives every $SWITCH its value
         value = stmt.expr(env)
@@ -259,7 +259,7 @@ class ControlFlow:
         frame.control.append(ControlEntry(StmtKind.SWITCH, frame.index, stmt, target))
         frame.index = target
 
-    def _case(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _case(self, frame: CallFrame, stmt: Control, after: int) -> None:
         # reached by falling through from the case before: nothing to do
         if self._top(frame, StmtKind.SWITCH) is None:
             raise self._mismatch(
@@ -267,7 +267,7 @@ class ControlFlow:
             )
         frame.index = after
 
-    def _endswitch(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _endswitch(self, frame: CallFrame, stmt: Control, after: int) -> None:
         if self._top(frame, StmtKind.SWITCH) is None:
             raise self._mismatch(
                 frame, stmt, NcErrorId.SWITCH_PART_WITHOUT_SWITCH, StmtKind.SWITCH
@@ -277,7 +277,7 @@ class ControlFlow:
 
     # ------------------------------------------------------------ $BREAK, $CONTINUE
 
-    def _break(self, frame: Frame, stmt: Control, after: int) -> Block | None:
+    def _break(self, frame: CallFrame, stmt: Control, after: int) -> Block | None:
         for n in range(len(frame.control) - 1, -1, -1):
             entry = frame.control[n]
             if entry.kind == StmtKind.SWITCH or entry.kind in LOOPS:
@@ -289,7 +289,7 @@ class ControlFlow:
             NcErrorId.BREAK_OUTSIDE_LOOP, "$BREAK outside a loop or $SWITCH", stmt.pos
         )
 
-    def _continue(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _continue(self, frame: CallFrame, stmt: Control, after: int) -> None:
         for n in range(len(frame.control) - 1, -1, -1):
             entry = frame.control[n]
             if entry.kind in LOOPS:
@@ -301,15 +301,15 @@ class ControlFlow:
 
     # ------------------------------------------------------------ #VAR
 
-    def _var(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _var(self, frame: CallFrame, stmt: Control, after: int) -> None:
         self.decoder.declare_block(frame, stmt, after)
 
-    def _endvar(self, frame: Frame, stmt: Control, after: int) -> None:
+    def _endvar(self, frame: CallFrame, stmt: Control, after: int) -> None:
         raise stmt.line.error(NcErrorId.ENDVAR_WITHOUT_VAR, "#ENDVAR without #VAR", stmt.pos)
 
     # ------------------------------------------------------------ $GOTO
 
-    def goto(self, frame: Frame, goto: Goto, line: LogicalLine, here: int) -> None:
+    def goto(self, frame: CallFrame, goto: Goto, line: LogicalLine, here: int) -> None:
         """Jump from line ``here`` to a label of the frame's section, leaving the
         control blocks the label is not in."""
         program = frame.program

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from .check import ErrorReported, categorize
 from .errors import NcError, NcErrorId
 from .evaluation import number
-from .frames import Frame, FrameKind
+from .call_stack import CallFrame, CallFrameKind
 from .literals import nc_number
 from .patterns import PatternPosition
 from .program import Program
@@ -105,7 +105,7 @@ def _param_pos(cycle_call: CycleCall, param: int | None) -> int:
     return cycle_call.call.pos
 
 
-def call_cycle(decoder: CallingDecoder, frame: Frame, stmt: NcBlock) -> None:
+def call_cycle(decoder: CallingDecoder, frame: CallFrame, stmt: NcBlock) -> None:
     """Run the cycle call of ``stmt`` (the block's words ran already)."""
     call = stmt.call
     # Decoder._call calls it only for a block whose call is a cycle call
@@ -142,8 +142,8 @@ def run_cycle(decoder: CallingDecoder, cycle_call: CycleCall) -> None:
         text = builtin.run(CycleContext(decoder, cycle_call, params))
         if text:
             program = Program(text, builtin.name, decoder.parser, 1, decoder.check)
-            decoder.push_cycle(Frame(program, program.main, program.main.start,
-                                     FrameKind.FILE), cycle_call.params)
+            decoder.push_cycle(CallFrame(program, program.main, program.main.start,
+                                     CallFrameKind.FILE), cycle_call.params)
         return
     if call.local:
         sections = cycle_call.program.local(call.name)
@@ -153,7 +153,7 @@ def run_cycle(decoder: CallingDecoder, cycle_call: CycleCall) -> None:
                              f"cycle {call.name}: {'no' if not sections else 'more than one'} "
                              f"%L {call.name} in {cycle_call.program.name}", call.pos)
         section = sections[0]
-        decoder.push_cycle(Frame(cycle_call.program, section, section.start, FrameKind.LOCAL),
+        decoder.push_cycle(CallFrame(cycle_call.program, section, section.start, CallFrameKind.LOCAL),
                            cycle_call.params)
         return
     try:
@@ -162,7 +162,7 @@ def run_cycle(decoder: CallingDecoder, cycle_call: CycleCall) -> None:
         raise line.error(NcErrorId.CYCLE_NOT_FOUND,
                          f"cycle {call.name} not found: it is no built-in cycle and no file "
                          "of the program store", call.pos) from None
-    decoder.push_cycle(Frame(program, program.main, program.main.start, FrameKind.FILE),
+    decoder.push_cycle(CallFrame(program, program.main, program.main.start, CallFrameKind.FILE),
                        cycle_call.params)
 
 
@@ -202,7 +202,7 @@ def _run_pattern(decoder: CallingDecoder, cycle_call: CycleCall) -> None:
                          args.pattern_id_pos)
     text = pattern_wrapper(positions, retract)
     program = Program(text, PATTERN_WRAPPER, decoder.parser, 1, decoder.check)
-    frame = Frame(program, program.main, program.main.start, FrameKind.FILE)
+    frame = CallFrame(program, program.main, program.main.start, CallFrameKind.FILE)
     frame.pattern_call = cycle_call
     decoder.push_cycle(frame, None)
 

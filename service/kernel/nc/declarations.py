@@ -21,7 +21,7 @@ import re
 
 from .errors import NcErrorId
 from .expressions import ExpressionParser, Node
-from .frames import Frame, FrameKind
+from .call_stack import CallFrame, CallFrameKind
 from .lexer import IDENT, VARIABLE, Cursor
 from .running_decoder import RunningDecoder
 from .source import LogicalLine, join_lines
@@ -36,7 +36,7 @@ _STRING_LENGTH = re.compile(r"\[[ \t]*[0-9]+[ \t]*\]")
 _DECL_SCOPES = {"L": Scope.L, "P": Scope.P, "G": Scope.G, "CYC": Scope.CYC}
 
 
-def read_block(decoder: RunningDecoder, frame: Frame, stmt: Control,
+def read_block(decoder: RunningDecoder, frame: CallFrame, stmt: Control,
                after: int) -> tuple[list[Declaration], int]:
     """The declarations of the ``#VAR`` block at ``frame.index`` and the index after it."""
     program = frame.program
@@ -143,7 +143,7 @@ def _open_brackets(text: str) -> int:
     return text.count("[") - text.count("]")
 
 
-def declare(decoder: RunningDecoder, frame: Frame, decl: Declaration) -> None:
+def declare(decoder: RunningDecoder, frame: CallFrame, decl: Declaration) -> None:
     """Create (or re-initialise) the variable of one declaration."""
     modal = decoder.modal
     line = decl.line
@@ -153,7 +153,7 @@ def declare(decoder: RunningDecoder, frame: Frame, decl: Declaration) -> None:
     elif decl.scope == Scope.CYC:
         table = frame.cycle_vars
     elif decl.scope == Scope.P:
-        if frame.kind != FrameKind.MAIN:
+        if frame.kind != CallFrameKind.MAIN:
             raise line.error(
                 NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED,
                 f"{full}: V.P. variables can only be declared in the main program", decl.pos,

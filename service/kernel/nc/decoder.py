@@ -40,7 +40,7 @@ from .cycle_run import call_cycle
 from .declarations import declare, read_block
 from .errors import NcError, NcErrorId
 from .fastpath import decoding_loop
-from .frames import MAX_CALL_DEPTH, Frame, FrameKind
+from .call_stack import MAX_CALL_DEPTH, CallFrame, CallFrameKind
 from .instruction_run import pattern_error, run_instruction
 from .instructions import Instruction
 from .modal import ModalState
@@ -143,7 +143,7 @@ class Decoder:
         self.executor = BlockExecutor(axes, tools, modal, manual, axis_numbers)
         self._main = Program(text, file, self.parser, skip_levels, check)
         self._files: dict[str, Program] = {}
-        self.frames: list[Frame] = []
+        self.frames: list[CallFrame] = []
         self._control = ControlFlow(self)
         self.finished = False
         self._started = False
@@ -176,7 +176,7 @@ class Decoder:
             raise RuntimeError("Decoder.blocks() can run only once")
         self._started = True
         main = self._main
-        self.frames.append(Frame(main, main.main, main.main.start, FrameKind.MAIN))
+        self.frames.append(CallFrame(main, main.main, main.main.start, CallFrameKind.MAIN))
         return decoding_loop(self.axes, self.check is not None)(self)
 
     # ------------------------------------------------------------ variables (Env)
@@ -224,7 +224,7 @@ class Decoder:
                          f"@P{number} outside a cycle: cycle parameters exist only in a cycle "
                          "called with L CYCLE [...]", pos)
 
-    def push_cycle(self, frame: Frame, params: dict[int, Value] | None) -> None:
+    def push_cycle(self, frame: CallFrame, params: dict[int, Value] | None) -> None:
         """Run ``frame`` as a cycle: with its parameters, returning the caller's modal
         G functions (G0..G3, G90/G91, G17..G19) when it ends."""
         if len(self.frames) > MAX_CALL_DEPTH:
@@ -259,7 +259,7 @@ class Decoder:
             return False
         return True
 
-    def declare_block(self, frame: Frame, stmt: Control, after: int) -> None:
+    def declare_block(self, frame: CallFrame, stmt: Control, after: int) -> None:
         """Run the ``#VAR`` block at ``frame.index``."""
         declarations, next_index = read_block(self, frame, stmt, after)
         for declaration in declarations:
@@ -268,7 +268,7 @@ class Decoder:
 
     # ------------------------------------------------------------ the general path
 
-    def slow_step(self, frame: Frame) -> Block | None:
+    def slow_step(self, frame: CallFrame) -> Block | None:
         """Decode the logical line at ``frame.index`` with the general parser (or end
         the frame's section); the Block it produces, if any."""
         if self.check is not None:
@@ -286,7 +286,7 @@ class Decoder:
         except Exception as exc:  # a decoder bug must still be the program's error
             raise self.fault(exc, frame, frame.index) from exc
 
-    def fault(self, exc: Exception, frame: Frame, index: int) -> NcError:
+    def fault(self, exc: Exception, frame: CallFrame, index: int) -> NcError:
         """An unexpected exception as the program's error (logged with its traceback)."""
         if isinstance(exc, NcError):
             return exc
@@ -294,7 +294,7 @@ class Decoder:
         return NcError(NcErrorId.INTERNAL_ERROR, frame.program.name, index + 1, 1,
                        f"decoder fault: {exc!r}")
 
-    def _step(self, frame: Frame) -> Block | None:
+    def _step(self, frame: CallFrame) -> Block | None:
         stmt, after = frame.program.statement(frame.index, frame.section.end)
         if stmt is None:
             frame.index = after
@@ -325,7 +325,7 @@ class Decoder:
             self.finished = True
             return block
         if flow == Flow.SUBPROGRAM_END:
-            if frame.kind == FrameKind.MAIN:
+            if frame.kind == CallFrameKind.MAIN:
                 raise stmt.line.error(
                     NcErrorId.SUBPROGRAM_END_IN_MAIN,
                     "M17/M29 ends a subprogram; the main program ends with M30", flow_pos,
@@ -340,7 +340,7 @@ class Decoder:
 
     # ------------------------------------------------------------ syntax check
 
-    def _checked_step(self, frame: Frame) -> Block | None:
+    def _checked_step(self, frame: CallFrame) -> Block | None:
         """``slow_step`` of the syntax check: an error is reported, decoding goes on.
 
         When the call or ``$GOTO`` of an NC block fails after its words ran, the Block
@@ -383,7 +383,7 @@ class Decoder:
         return block
 
     def _skip_failed(
-        self, frame: Frame, stmt: Statement | None, index: int, after: int, depth: int,
+        self, frame: CallFrame, stmt: Statement | None, index: int, after: int, depth: int,
     ) -> int:
         """Where to go on after the statement at ``index`` failed: an opening control
         statement skips its block (so its end is no follow-up error), others the line.
@@ -428,7 +428,7 @@ class Decoder:
             skipped.clear()
             try:
                 block, flow, flow_pos = executor.execute(stmt, self, item_failed)
-                if flow == Flow.SUBPROGRAM_END and self.frames[-1].kind == FrameKind.MAIN:
+                if flow == Flow.SUBPROGRAM_END and self.frames[-1].kind == CallFrameKind.MAIN:
                     # M17/M29 in the main program: dropped, the rest of the block used
                     check.report(stmt.line.error(
                         NcErrorId.SUBPROGRAM_END_IN_MAIN,
@@ -463,7 +463,7 @@ class Decoder:
 
     # ------------------------------------------------------------ subprograms
 
-    def _call(self, frame: Frame, stmt: NcBlock) -> None:
+    def _call(self, frame: CallFrame, stmt: NcBlock) -> None:
         call = stmt.call
         assert call is not None  # _step calls it only for a block with a call
         line = stmt.line
@@ -489,7 +489,7 @@ class Decoder:
                     f"%L {call.name} is defined {len(sections)} times", call.pos,
                 )
             section = sections[0]
-            self.frames.append(Frame(frame.program, section, section.start, FrameKind.LOCAL))
+            self.frames.append(CallFrame(frame.program, section, section.start, CallFrameKind.LOCAL))
             return
         try:
             program = self.load(call.name)
@@ -501,9 +501,9 @@ class Decoder:
             raise line.error(
                 NcErrorId.FILE_NOT_FOUND, f"file {call.name} cannot be read: {exc}", call.pos
             ) from None
-        self.frames.append(Frame(program, program.main, program.main.start, FrameKind.FILE))
+        self.frames.append(CallFrame(program, program.main, program.main.start, CallFrameKind.FILE))
 
-    def _end_of_section(self, frame: Frame) -> None:
+    def _end_of_section(self, frame: CallFrame) -> None:
         if self.check is None:
             self._end_section(frame)
             return
@@ -514,14 +514,14 @@ class Decoder:
             frame.control.clear()
             if error.id == NcErrorId.BLOCK_NOT_CLOSED:
                 self._end_of_section(frame)  # the end itself may be an error too
-            elif frame.kind == FrameKind.MAIN:
+            elif frame.kind == CallFrameKind.MAIN:
                 self.finished = True
             else:
                 self._return()
 
-    def _end_section(self, frame: Frame) -> None:
+    def _end_section(self, frame: CallFrame) -> None:
         pattern = self._modal.pattern
-        if pattern is not None and frame.kind == FrameKind.MAIN:
+        if pattern is not None and frame.kind == CallFrameKind.MAIN:
             self._modal.pattern = None
             raise pattern.line.error(NcErrorId.PATTERN_NOT_CLOSED,
                                      f"#PATTERN BEGIN [ID={pattern.id}] without #PATTERN END",
@@ -533,12 +533,12 @@ class Decoder:
                 NcErrorId.BLOCK_NOT_CLOSED,
                 f"{SPELLING[entry.kind]} without {SPELLING[closer]}", entry.stmt.pos,
             )
-        if frame.kind == FrameKind.LOCAL:  # %L ends at the next % line: implicit M17
+        if frame.kind == CallFrameKind.LOCAL:  # %L ends at the next % line: implicit M17
             self._return()
             return
         line = _last_code_line(frame.program, frame.section)
         name = frame.program.name
-        if frame.kind == FrameKind.FILE:
+        if frame.kind == CallFrameKind.FILE:
             raise NcError(NcErrorId.SUBPROGRAM_END_MISSING, name, line, 1,
                           f"subprogram {name} ends without M17 or M29")
         if self.manual:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 from .blocks import Block, ContourCommand, ContourKind, LogArea
 from .contour_run import contour_block
-from .frames import ControlEntry, Frame
+from .call_stack import ControlEntry, CallFrame
 from .running_decoder import RunningDecoder
 from .statements import Control
 
@@ -25,7 +25,7 @@ from .statements import Control
 class _Tracked:
     """The real-time loop that gets markers: where it runs and how far it is."""
 
-    frame: Frame
+    frame: CallFrame
     entry: ControlEntry  # its open control entry (a new one each pass)
     serial: int
     rt_pass: int
@@ -47,13 +47,13 @@ class RtLoopMarkers:
         self.decoder = decoder
         self.serial = 0  # serial number of the last tracked loop (per decoder)
         self.tracked: _Tracked | None = None
-        self._closed: tuple[Frame, ControlEntry] | None = None  # the last #RT ENDWHILE
+        self._closed: tuple[CallFrame, ControlEntry] | None = None  # the last #RT ENDWHILE
 
-    def closed(self, frame: Frame, entry: ControlEntry) -> None:
+    def closed(self, frame: CallFrame, entry: ControlEntry) -> None:
         """``#RT ENDWHILE`` closed ``entry``: its loop tests its condition next."""
         self._closed = (frame, entry)
 
-    def tested(self, frame: Frame, stmt: Control, index: int,
+    def tested(self, frame: CallFrame, stmt: Control, index: int,
                entry: ControlEntry | None) -> Block | None:
         """The ``#RT WHILE`` ``stmt`` at line ``index`` was tested: ``entry`` is its new
         control entry (None: the condition was false). The marker, if any."""
@@ -76,7 +76,7 @@ class RtLoopMarkers:
         self.tracked = _Tracked(frame, entry, self.serial, 1)
         return self._pass(stmt, self.tracked)
 
-    def broken(self, frame: Frame, left: list[ControlEntry]) -> Block | None:
+    def broken(self, frame: CallFrame, left: list[ControlEntry]) -> Block | None:
         """A ``$BREAK`` left the control entries ``left`` of ``frame``: RT_END when the
         tracked loop is among them."""
         tracked = self.tracked

@@ -15,7 +15,7 @@ from typing import Protocol
 from .blockexec import BlockExecutor
 from .check import SyntaxCheck
 from .evaluation import Env
-from .frames import Frame
+from .call_stack import CallFrame
 from .modal import ModalState
 from .parser import LineParser
 from .program import Program
@@ -30,7 +30,7 @@ class RunningDecoder(Env, Protocol):
     As an ``Env`` it also evaluates expressions (``find_variable``).
     """
 
-    frames: list[Frame]  # the call frames, the running one last
+    frames: list[CallFrame]  # the call frames, the running one last
     manual: bool  # decoding a manual block (MDI), not a program
     contour_lookahead: bool  # the channel has FCT_CONTOUR_LAH (P-CHAN-00650)
     emitted: int  # grows whenever blocks were yielded (the endless-loop guard watches it)
@@ -41,7 +41,7 @@ class RunningDecoder(Env, Protocol):
     def modal(self) -> ModalState:
         """The modal state, changed as decoding goes."""
 
-    def declare_block(self, frame: Frame, stmt: Control, after: int) -> None:
+    def declare_block(self, frame: CallFrame, stmt: Control, after: int) -> None:
         """Run the ``#VAR`` block at ``frame.index``."""
 
 
@@ -63,5 +63,5 @@ class CallingDecoder(RunningDecoder, Protocol):
     def has_file(self, name: str) -> bool:
         """Whether the program store holds file ``name``."""
 
-    def push_cycle(self, frame: Frame, params: dict[int, Value] | None) -> None:
+    def push_cycle(self, frame: CallFrame, params: dict[int, Value] | None) -> None:
         """Run ``frame`` as a cycle with its ``@P`` parameters."""

@@ -41,7 +41,7 @@ from cnc_objects.service.kernel.commands import (
     SetSingleBlock,
     StartProgram,
 )
-from cnc_objects.service.kernel.state import ChannelError, DecoderFlag, KernelState
+from cnc_objects.service.kernel.state import ErrorEntry, DecoderFlag, KernelState
 from tests.support.kernel import KernelHarness
 
 S, E = ChannelState, ChannelEvent
@@ -69,7 +69,7 @@ class Report:
     """A start-up message that is an error (``ChannelRunner.report``): FAIL in any state."""
 
     def apply(self, state: KernelState) -> Refusal | None:
-        state.runners[0].report(ChannelError(1, "a test error stops the channel"))
+        state.runners[0].report(ErrorEntry(1, "a test error stops the channel"))
         return None
 
 

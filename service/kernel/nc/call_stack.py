@@ -15,7 +15,7 @@ from .variables import Value, Variable
 MAX_CALL_DEPTH = 20  # subprogram nesting below the main program
 
 
-class FrameKind(IntEnum):
+class CallFrameKind(IntEnum):
     """What kind of program a frame runs."""
 
     MAIN = 0  # the main program (or the manual block)
@@ -36,13 +36,13 @@ class ControlEntry:
 
 
 @dataclass(slots=True)
-class Frame:
+class CallFrame:
     """A running (sub)program: where it is, its variables and open control blocks."""
 
     program: Program
     section: Section
     index: int  # next line to decode
-    kind: FrameKind
+    kind: CallFrameKind
     local_vars: dict[str, Variable] = field(default_factory=dict)  # V.L.
     cycle_vars: dict[str, Variable] = field(default_factory=dict)  # V.CYC. declared here
     control: list[ControlEntry] = field(default_factory=list)
