@@ -16,11 +16,12 @@ RESET clears them (a CNC does not start in ERROR).
 
 from __future__ import annotations
 
-import re
 import time
 from dataclasses import dataclass, fields
 from typing import Any
 
+from cnc_objects.protocol import check_log
+from cnc_objects.protocol.check_log import check_log_name
 from cnc_objects.protocol.constants import (
     MAX_DATA_BYTES,
     OUTPUT_AREA_GROUP,
@@ -32,6 +33,7 @@ from cnc_objects.protocol.constants import OutputAreaOffset as OutOp
 from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.file_listing import decode_listing
 from cnc_objects.protocol.values import (
     ChannelMode,
     ChannelState,
@@ -163,17 +165,9 @@ class CheckResult:
                 and not self.stopped_early)
 
 
-def check_log_name(channel: int) -> str:
-    """The output-area file a syntax check in ``channel`` writes (``dec01.sc``)."""
-    return f"dec0{channel}.sc"
-
-
-_LOG_HEADER = re.compile(r"; syntax check of (.*) in channel (\d+)")
-_LOG_END = re.compile(r"; end: (\d+) lines, (\d+) blocks, (\d+) errors, (.*)")
-_LOG_ERROR = re.compile(r"error (\d+) \((\w+)\) at (.*)")
-_LOG_LEFT_OUT = re.compile(r"; (\d+) more errors are not listed \(.*\)")
-_LOG_POSITION = re.compile(r":(\d+):(\d+): ")  # after the file name of an error
-_LOG_LINE = re.compile(r":(\d+): ")  # after the file name of a checked line
+_LOG_HEADER, _LOG_END, _LOG_ERROR = check_log.HEADER, check_log.END, check_log.ERROR
+_LOG_LEFT_OUT, _LOG_POSITION, _LOG_LINE = (
+    check_log.LEFT_OUT, check_log.POSITION, check_log.CHECKED_LINE)
 
 
 def parse_check_log(text: str, program: str = "") -> CheckResult:
@@ -221,7 +215,7 @@ def parse_check_log(text: str, program: str = "") -> CheckResult:
     if end is None:
         raise ValueError("the log has no '; end: ...' line: it is not a complete syntax check log")
     return CheckResult(tuple(errors), aborted, int(end.group(1)), int(end.group(2)), text,
-                       end.group(4).startswith("stopped"), int(end.group(3)), left_out)
+                       end.group(4).startswith(check_log.STOPPED), int(end.group(3)), left_out)
 
 
 def _name_bytes(name: str) -> bytes:
@@ -249,11 +243,7 @@ class ProgramOps(MixinBase):
     async def programs(self) -> list[ProgramEntry]:
         """Every file in the store, sorted by name."""
         raw = await self.read_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.LIST, MAX_DATA_BYTES)
-        entries = []
-        for line in raw.decode("utf-8").splitlines():
-            name, size, mtime = line.split("\t")
-            entries.append(ProgramEntry(name, int(size), float(mtime)))
-        return entries
+        return [ProgramEntry(*entry) for entry in decode_listing(raw)]
 
     async def delete_program(self, name: str) -> None:
         """Remove ``name`` from the store."""
@@ -264,9 +254,7 @@ class ProgramOps(MixinBase):
         ``errors-ch<c>.log``, ``dec0<c>.sc``, ``prodtime0<c>.csv``, cycle results), sorted
         by name; sizes as they will be once the kernel's queued writes are written."""
         raw = await self.read_raw(CncPort.COM, OUTPUT_AREA_GROUP, OutOp.LIST, MAX_DATA_BYTES)
-        return [ProgramEntry(name, int(size), float(mtime))
-                for name, size, mtime in (line.split("\t") for line in
-                                          raw.decode("utf-8").splitlines())]
+        return [ProgramEntry(*entry) for entry in decode_listing(raw)]
 
     async def download_output(self, name: str) -> bytes:
         """The content of output file ``name``, with every write the kernel queued for it

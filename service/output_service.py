@@ -15,6 +15,7 @@ from collections.abc import Callable
 
 from cnc_objects.protocol.constants import OutputAreaOffset as Op
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.file_listing import encode_listing
 
 from .output_area import WHAT
 from .output_writer import OutputWriter
@@ -40,9 +41,8 @@ class OutputService:
         """ADS Read: the file list."""
         if offset != Op.LIST:
             return _unknown(offset, "answer a read")
-        listing = "".join(
-            f"{p.name}\t{p.size_bytes}\t{p.mtime_s:.3f}\n" for p in self.writer.listing()
-        ).encode("utf-8")
+        listing = encode_listing(
+            (p.name, p.size_bytes, p.mtime_s) for p in self.writer.listing())
         if len(listing) > length:
             return _E.DEVICE_INVALIDSIZE, f"the list has {len(listing)} bytes; read asked {length}"
         return 0, listing

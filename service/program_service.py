@@ -9,9 +9,11 @@ an oversized upload or a short read buffer 0x705, a full store 0x70A.
 from __future__ import annotations
 
 import logging
+
 from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.file_listing import encode_listing
 
 from .program_store import ProgramStore, StoreError, StoreFault
 
@@ -52,9 +54,7 @@ class ProgramStoreService:
         """ADS Read: the program list."""
         if offset != Op.LIST:
             return _unknown(offset, "answer a read")
-        listing = "".join(
-            f"{p.name}\t{p.size_bytes}\t{p.mtime_s:.3f}\n" for p in self.store.list()
-        ).encode("utf-8")
+        listing = encode_listing((p.name, p.size_bytes, p.mtime_s) for p in self.store.list())
         if len(listing) > length:
             return _E.DEVICE_INVALIDSIZE, f"the list has {len(listing)} bytes; read asked {length}"
         return 0, listing

@@ -36,6 +36,8 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
+from cnc_objects.protocol import check_log
+from cnc_objects.protocol.check_log import check_log_name
 from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES
 
 from ..machine_config import SyntaxCheckConfig
@@ -60,9 +62,7 @@ CHECK_MAX_ERRORS = 1000
 _N_WORD = re.compile(r"[ \t]*N[ \t]*([0-9]+)", re.IGNORECASE)
 
 
-def log_name(channel_id: int) -> str:
-    """The result file of a syntax check in channel ``channel_id`` (``dec01.sc``)."""
-    return f"dec0{channel_id}.sc"
+log_name = check_log_name  # the result file of a check in a channel (``dec01.sc``)
 
 
 class Pause(IntEnum):
@@ -300,7 +300,7 @@ class CheckRun:
             self._sources[self.name] = decoder.source
             self._decoder = decoder
             if self._record:
-                self._log.append(f"; syntax check of {self.name} in channel {self.channel_id}")
+                self._log.append(check_log.header_line(self.name, self.channel_id))
             items: Iterator[Block | PointBatch] = decoder.blocks()  # batches in a check
             for item in items:
                 if self._checkpoint():
@@ -460,8 +460,8 @@ class CheckRun:
             self._log.extend(self._pending_log)
             self._pending_log.clear()
             err = checked.error
-            self._log.append(f"error {int(err.id)} (abort) at {checked.file}:{checked.line}:"
-                             f"{checked.column}: {err.message}")
+            self._log.append(check_log.error_line(int(err.id), "abort", checked.file,
+                                                  checked.line, checked.column, err.message))
         with self._cond:
             self._progress.failure = checked
 
@@ -470,19 +470,19 @@ class CheckRun:
             return
         self._log.extend(self._pending_log)
         p = self._progress
-        how = ("stopped: syn_chk.errors_total reached" if p.stopped_early
-               else "aborted" if p.failure is not None else "complete")
-        end = (f"; end: {p.lines} lines, {p.blocks} blocks, {p.error_count} errors, {how}")
+        how = (f"{check_log.STOPPED}: syn_chk.errors_total reached" if p.stopped_early
+               else check_log.ABORTED if p.failure is not None else check_log.COMPLETE)
+        end = check_log.end_line(p.lines, p.blocks, p.error_count, how)
         entries = self._log
         if p.left_out:
-            entries.append(f"; {p.left_out} more errors are not listed (limits."
-                           f"check_max_errors: the first {self.max_errors} are kept)")
+            entries.append(check_log.left_out_line(
+                p.left_out, f"limits.check_max_errors: the first {self.max_errors} are kept"))
         if self._errors_not_logged or self._log_bytes >= PROGRAM_MAX_BYTES:
-            # the store's file limit: the first errors are kept, the checked lines go
+            # the output area's file limit (one download): the first errors are kept, the checked lines go
             errors = [entry for entry in entries if entry.startswith("error ")]
             left_out = p.left_out
             entries = [entries[0], ("; the checked lines are left out: the log would exceed "
-                                    f"the store's file limit of {PROGRAM_MAX_BYTES} bytes")]
+                                    f"the output area's file limit of {PROGRAM_MAX_BYTES} bytes")]
             room = PROGRAM_MAX_BYTES - 400 - sum(len(e) + 1 for e in entries)
             kept = 0
             for entry in errors:
@@ -493,15 +493,15 @@ class CheckRun:
             entries += errors[:kept]
             left = len(errors) - kept + self._errors_not_logged + left_out
             if left:
-                entries.append(f"; {left} more errors are not listed (the store's file limit)")
+                entries.append(check_log.left_out_line(left, "the output area's file limit"))
         data = ("\n".join(entries) + "\n" + end + "\n").encode()
         self._files(log_name(self.channel_id), data, replace=True)
 
 
 def _error_line(error: NcError, category: ErrorCategory) -> str:
     """An error as the log writes it (``clients`` parse this form)."""
-    return (f"error {int(error.id)} ({category.label}) at {error.file}:{error.line}:"
-            f"{error.column}: {error.message}")
+    return check_log.error_line(int(error.id), category.label, error.file, error.line,
+                                error.column, error.message)
 
 
 def _limit_error(error: PathError, file: str, line: int, column: int = 1) -> CheckedError:

@@ -344,5 +344,5 @@ def test_a_log_over_the_store_limit_keeps_the_first_errors_and_the_count(harness
     log = data.decode().splitlines()
     assert log[0] == "; syntax check of many.nc in channel 1"
     assert log[2].startswith("error 21220 (term) at many.nc:1:")  # the first error is kept
-    assert log[-2].endswith("more errors are not listed (the store's file limit)")
+    assert log[-2].endswith("more errors are not listed (the output area's file limit)")
     assert log[-1] == "; end: 30001 lines, 30001 blocks, 30000 errors, complete"
