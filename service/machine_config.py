@@ -189,6 +189,16 @@ class EnhancedLookAheadConfig(Strict):
     )
 
 
+class ProgStartConfig(Strict):
+    """ISG's start-up defaults of a channel (channel list ``prog_start.*``)."""
+
+    feedrate: float = Field(
+        0.0, ge=0, le=1e7,
+        description="P-CHAN-00099 prog_start.feedrate: the feed (mm/min) of a G01/G02/G03 "
+        "block when no F was programmed; 0: none (the block is an error)",
+    )
+
+
 class ChannelConfig(Strict):
     """A channel and its axes."""
 
@@ -223,6 +233,9 @@ class ChannelConfig(Strict):
     la: EnhancedLookAheadConfig = Field(
         default_factory=EnhancedLookAheadConfig,
         description="enhanced look-ahead defaults (LA_ON/LA_OFF; METB, VFBT, BBTRC)",
+    )
+    prog_start: ProgStartConfig = Field(
+        default_factory=ProgStartConfig, description="start-up defaults (prog_start.*)"
     )
 
     @field_validator("interpolator_function")
@@ -362,6 +375,8 @@ DEFAULT_MACHINE: dict[str, Any] = {
             "name": "jog-of-path",
             "jog_of_path_only": True,
             "suspend_output_at_start": True,
+            # FCT-C15's example moves this channel with `G91 Y10` and no F (section 2.4)
+            "prog_start": {"feedrate": 1000.0},
             "axes": [
                 {"name": "X", "logical_number": 11, "link_to": 1, "clone_of": 1},
                 {"name": "Y", "logical_number": 12, "link_to": 2, "clone_of": 2},

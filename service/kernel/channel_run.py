@@ -422,8 +422,12 @@ class ChannelRunner:
         cycle time (METB must exceed it)."""
         la = self.config.la
         defaults = LookAheadMark(metb_s=la.metb_s, vfbt=la.vfbt, bbtrc=la.bbtrc)
-        return ModalState(position_mm=position_mm, look_ahead_defaults=defaults,
-                          look_ahead_params=defaults, cycle_s=self._cycle_s)
+        modal = ModalState(position_mm=position_mm, look_ahead_defaults=defaults,
+                           look_ahead_params=defaults, cycle_s=self._cycle_s)
+        feed_mm_min = self.config.prog_start.feedrate  # P-CHAN-00099: F of a block without F
+        if feed_mm_min > 0.0:
+            modal.feed_mm_min = feed_mm_min
+        return modal
 
     def _show_start(self, job: Job) -> None:
         """What a run or check shows at its start: counters at 0, the job's file; a
