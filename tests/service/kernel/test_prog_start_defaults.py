@@ -73,7 +73,8 @@ def test_without_the_start_feed_step_4_is_the_no_feed_error() -> None:
         s = _run_example(h)
         ch2 = s.channels[1]
         assert ch2.state == ChannelState.ERROR
-        assert [(e.id, e.line, e.column) for e in ch2.errors] == [(NcErrorId.NO_FEED, 1, 5)]  # at Y10
+        errors = [(e.id, e.line, e.column) for e in ch2.errors]
+        assert errors == [(NcErrorId.NO_FEED, 1, 5)]  # at Y10
 
 
 @pytest.mark.parametrize("feed", [-1.0, 1e8])
