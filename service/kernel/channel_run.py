@@ -36,6 +36,8 @@ from .commands import Refusal, RefusalReason
 from .contour_lookahead import ContourLog
 from .decoder_feed import DecoderFeed, Job
 from .nc import ModalState
+from .plc_functions import PlcFunctions, show_technology
+from .spindle import Spindle
 from .nc.blocks import LogArea, LookAheadMark
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
 from .path.executor import AxisDynamics, PathExecutor
@@ -111,6 +113,8 @@ class ChannelRunner:
         self._internal_hold = False  # feedhold of a suspend_axis_output request
         self._modal: ModalState | None = None  # MDI: modal state carried between blocks
         self.time_s = 0.0  # kernel time of the cycle (PROD_TIME: the simulated time)
+        self.plc = PlcFunctions(config.techno, Spindle(config.techno.spindel))
+        channel.spindle = self.plc.spindle.state
         self.touched = False  # the last cycle changed the channel's state
         # #MSG texts from the decoder thread (deque appends are thread-safe)
         self._messages: deque[str] = deque(maxlen=MESSAGES_KEPT)
@@ -228,6 +232,8 @@ class ChannelRunner:
             self._contour.stop()
             show_contour_state(ch, self._contour)
         self._internal_hold = False
+        self.plc.reset()
+        ch.plc_functions = self.plc.unit
         ch.errors, ch.error_count = (), 0
         ch.waiting_for_start = False
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
@@ -487,7 +493,15 @@ class ChannelRunner:
     # ------------------------------------------------------------ cycle
 
     def cycle(self, time_s: float) -> bool:
-        """One GEO cycle of the channel; True while it has motion or decoding to do."""
+        """One GEO cycle of the channel; True while it has motion, decoding or a
+        spindle ramp to do."""
+        busy = self._run_cycle(time_s)
+        if show_technology(self.channel, self.plc, time_s, self._cycle_s):
+            self.touched = True
+            busy = True
+        return busy
+
+    def _run_cycle(self, time_s: float) -> bool:
         self.time_s = time_s
         ch = self.channel
         if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
