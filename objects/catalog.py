@@ -577,6 +577,11 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
     ),
 )
 
+# technology output and spindle (catalog_technology builds on the names above)
+from .catalog_technology import TECHNOLOGY_TEMPLATES  # noqa: E402
+
+TEMPLATES = TEMPLATES + TECHNOLOGY_TEMPLATES
+
 
 def _instantiate(
     t: ObjectTemplate, channel: int = 0, axis: int = 0, index: int = 0

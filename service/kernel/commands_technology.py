@@ -10,12 +10,16 @@ from .state import KernelState
 
 @dataclass(frozen=True, slots=True)
 class AcknowledgeTechnoUnit:
-    """The PLC acknowledges ``techno_unit_std_sync[index]`` of a channel."""
+    """The PLC acknowledges ``techno_unit_std_sync[index]`` of a channel (``command_w``
+    TRUE; FALSE changes nothing: the PLC may clear its own flag)."""
 
     channel_index: int
     index: int
+    value: bool = True
 
     def apply(self, state: KernelState) -> Refusal | None:
+        if not self.value:
+            return None
         why = state.runners[self.channel_index].plc.acknowledge(self.index)
         if why is not None:
             return Refusal(RefusalReason.INVALID_VALUE, why)

@@ -123,6 +123,7 @@ class ProgramRun:
         self._buffer_warned = False  # BUFFER_LIMITS_SPEED shown in this run
         self._pending_error: ChannelError | None = None  # takes effect where the path stops
         self._fed_all = False
+        self._technology_part: Block | None = None  # the last pre/post block finished
         self.failure: ChannelError | None = None
         if contour is not None:
             executor.on_prepared = self._prepared
@@ -198,6 +199,7 @@ class ProgramRun:
         self._stepped(step)
         for block in step.finished:
             if plc is not None and plc.block_finished(block, time_s):
+                self._technology_part = block
                 continue  # a pre/post block of the technology output, not counted
             ch.block_count += 1
             if self.contour is not None and block.contour is not None and (
@@ -210,6 +212,9 @@ class ProgramRun:
             src = shown.source
             ch.file_name, ch.line, ch.file_offset = src.file, src.line, src.offset
             ch.block_number = shown.number if shown.number is not None else -1
+        if (executor.waiting == Waiting.SINGLE_BLOCK and step.current is not None
+                and step.current is self._technology_part):
+            executor.resume()  # not a block of the program: single block goes on
         stopped = step.stopped_at
         if stopped is not None and stopped.stop == StopKind.PROGRAM_END:
             return Step.ENDED

@@ -70,6 +70,7 @@ class Interpolator:
         self.wait_block: Block | None = None  # block dwelling or waited at
         self.dwell_left_s = 0.0
         self.dwell_single = False
+        self.techno_single = False  # a single-block stop follows the technology wait
         self.hold = False
         self.override = 1.0
         self.unfinished = 0  # blocks handed over and not yet finished
@@ -92,6 +93,9 @@ class Interpolator:
     def release_technology(self) -> None:
         """The technology functions the path waits for are acknowledged: go on."""
         if self.waiting == Waiting.TECHNOLOGY:
+            if self.techno_single:  # single block: the stop at the block end comes next
+                self.waiting = Waiting.SINGLE_BLOCK
+                return
             self.waiting = Waiting.NONE
             self.wait_block = None
 
@@ -242,6 +246,7 @@ class Interpolator:
             self.distance_base_mm = -self.s_mm  # the path distance restarts here
         if block.stop == StopKind.TECHNOLOGY:
             self.waiting = Waiting.TECHNOLOGY
+            self.techno_single = single
         elif block.stop != StopKind.NONE:
             self.waiting = Waiting.PROGRAMMED_STOP
         elif single:
