@@ -20,6 +20,7 @@ from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16
 from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockType, LinkState
 
 from .addressing import GroupBase, axis_offset, channel_group
+from .catalog_technology import TECHNOLOGY_ROWS
 from .model import Access, CncObject
 
 
@@ -577,10 +578,13 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
     ),
 )
 
-# technology output and spindle (catalog_technology builds on the names above)
-from .catalog_technology import TECHNOLOGY_TEMPLATES  # noqa: E402
-
-TEMPLATES = TEMPLATES + TECHNOLOGY_TEMPLATES
+# technology output and spindle: HLI symbols of gpCh[i] and COM objects of the channel
+TEMPLATES = TEMPLATES + tuple(
+    ObjectTemplate(r.element, Scope.PLC_CHANNEL if r.hli else Scope.CHANNEL,
+                   PLC if r.hli else COM, PLC_GROUP if r.hli else COM_CH, r.offset, r.dtype,
+                   r.access, r.unit, r.description)
+    for r in TECHNOLOGY_ROWS
+)
 
 
 def _instantiate(

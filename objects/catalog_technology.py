@@ -4,20 +4,18 @@ HLI symbols on port 851 under ``gpCh[i]`` (ISG: ``techno_unit_std_sync[..]``,
 ``used_units_std_sync_r``; the spindle's elements are ISG's ``gpAx[spindle]`` names,
 placed under the channel because the twin's spindle has no HLI axis slot) and the same
 values as COM objects of the channel (project offsets 0x3400..). Sources per object:
-docs/spindle-plc.md. Imported by ``catalog`` (its TEMPLATES end with these rows).
+docs/spindle-plc.md. ``catalog`` turns the rows into templates (its TEMPLATES end with them).
 """
 
 from __future__ import annotations
 
-from cnc_objects.protocol.constants import CncPort
-from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, UNS16, UNS32
+from typing import NamedTuple
 
-from .catalog import PLC_GROUP, ObjectTemplate, Scope
-from .addressing import GroupBase
+from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, UNS16, UNS32, DataType
+
 from .model import Access
 
 R, RW = Access.READ, Access.READ_WRITE
-PLC, COM, COM_CH = CncPort.PLC, CncPort.COM, GroupBase.COM_CHANNEL
 
 TECHNO_UNITS = 16  # techno_unit_std_sync[0..15]: the units the PLC side lists
 TECHNO_UNIT_OFFSET, TECHNO_UNIT_STRIDE = 0xD00, 0x10  # in the gpCh[i] block (project)
@@ -51,42 +49,55 @@ SPINDLE_FIELDS = (
     ("position_r", 0x18, REAL64, R, "deg", "Spindle position after M19 (S.POS, project)"),
 )
 
-TECHNOLOGY_TEMPLATES: tuple[ObjectTemplate, ...] = (
+class TechnologyRow(NamedTuple):
+    """One object: an HLI symbol under gpCh[i] (``hli``) or a COM object of the channel."""
+
+    element: str
+    hli: bool
+    offset: int
+    dtype: DataType
+    access: Access
+    unit: str
+    description: str
+
+
+def com_name(k: int, name: str) -> str:
+    """COM element of field ``name`` of unit ``k``: mc_techno_<k>_<short name>."""
+    short = name.replace("attribut_r.", "").removesuffix("_r").removesuffix("_w")
+    return f"mc_techno_{k}_{short}"
+
+
+TECHNOLOGY_ROWS: tuple[TechnologyRow, ...] = (
     *(
-        ObjectTemplate(
-            f"techno_unit_std_sync[{k}].{name}", Scope.PLC_CHANNEL, PLC, PLC_GROUP,
+        TechnologyRow(
+            f"techno_unit_std_sync[{k}].{name}", True,
             TECHNO_UNIT_OFFSET + k * TECHNO_UNIT_STRIDE + offset, dtype, access, unit,
             f"Technology unit {k}: {text}",
         )
         for k in range(TECHNO_UNITS)
         for name, offset, dtype, access, unit, text in TECHNO_UNIT_FIELDS
     ),
-    ObjectTemplate(
-        "used_units_std_sync_r", Scope.PLC_CHANNEL, PLC, PLC_GROUP, USED_UNITS_OFFSET, UNS16,
-        R, "-", "Technology units waiting for the PLC's acknowledge",
+    TechnologyRow(
+        "used_units_std_sync_r", True, USED_UNITS_OFFSET, UNS16, R, "-",
+        "Technology units waiting for the PLC's acknowledge",
     ),
     *(
-        ObjectTemplate(
-            f"spindle.{name}", Scope.PLC_CHANNEL, PLC, PLC_GROUP, SPINDLE_OFFSET + offset,
-            dtype, access, unit, text,
-        )
+        TechnologyRow(f"spindle.{name}", True, SPINDLE_OFFSET + offset, dtype, access, unit,
+                      text)
         for name, offset, dtype, access, unit, text in SPINDLE_FIELDS
     ),
-    # the same on the CNC ports (COM, per channel)
+    # the same values on the CNC ports (COM, per channel)
     *(
-        ObjectTemplate(
-            f"mc_techno_{k}_{name.replace('attribut_r.', '').removesuffix('_r').removesuffix('_w')}",
-            Scope.CHANNEL, COM, COM_CH, COM_TECHNO + k * 8 + n, dtype, access, unit,
+        TechnologyRow(
+            com_name(k, name), False, COM_TECHNO + k * 8 + n, dtype, access, unit,
             f"Technology unit {k} (gpCh[i].techno_unit_std_sync[{k}].{name}): {text}",
         )
         for k in range(TECHNO_UNITS)
         for n, (name, _offset, dtype, access, unit, text) in enumerate(TECHNO_UNIT_FIELDS)
     ),
     *(
-        ObjectTemplate(
-            f"mc_spindle_{name}", Scope.CHANNEL, COM, COM_CH, COM_SPINDLE + n, dtype, access,
-            unit, f"{text} (gpCh[i].spindle.{name})",
-        )
+        TechnologyRow(f"mc_spindle_{name}", False, COM_SPINDLE + n, dtype, access, unit,
+                      f"{text} (gpCh[i].spindle.{name})")
         for n, (name, _offset, dtype, access, unit, text) in enumerate(SPINDLE_FIELDS)
     ),
 )

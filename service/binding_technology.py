@@ -10,7 +10,12 @@ from collections.abc import Callable
 from typing import Any
 
 from cnc_objects.objects import CncObject
-from cnc_objects.objects.catalog_technology import SPINDLE_FIELDS, TECHNO_UNIT_FIELDS, TECHNO_UNITS
+from cnc_objects.objects.catalog_technology import (
+    SPINDLE_FIELDS,
+    TECHNO_UNIT_FIELDS,
+    TECHNO_UNITS,
+    com_name,
+)
 
 from .kernel.commands import Command
 from .kernel.commands_technology import AcknowledgeTechnoUnit, SetSpindleOverride
@@ -85,15 +90,10 @@ def _override(kernel: Kernel, obj: CncObject) -> Callable[[Any], Command]:
     return lambda value: SetSpindleOverride(ci, int(value))
 
 
-def _com_name(k: int, field: str) -> str:
-    short = field.replace("attribut_r.", "").removesuffix("_r").removesuffix("_w")
-    return f"mc_techno_{k}_{short}"
-
-
 TECHNOLOGY_READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     **{f"techno_unit_std_sync[{k}].{f[0]}": _unit(k, f[0])
        for k in range(TECHNO_UNITS) for f in TECHNO_UNIT_FIELDS},
-    **{_com_name(k, f[0]): _unit(k, f[0]) for k in range(TECHNO_UNITS) for f in TECHNO_UNIT_FIELDS},
+    **{com_name(k, f[0]): _unit(k, f[0]) for k in range(TECHNO_UNITS) for f in TECHNO_UNIT_FIELDS},
     "used_units_std_sync_r": _used_units,
     **{f"spindle.{f[0]}": _spindle(f[0]) for f in SPINDLE_FIELDS},
     **{f"mc_spindle_{f[0]}": _spindle(f[0]) for f in SPINDLE_FIELDS},
@@ -101,7 +101,7 @@ TECHNOLOGY_READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
 
 TECHNOLOGY_WRITERS: dict[str, Callable[[Kernel, CncObject], Callable[[Any], Command]]] = {
     **{f"techno_unit_std_sync[{k}].command_w": _acknowledge(k) for k in range(TECHNO_UNITS)},
-    **{_com_name(k, "command_w"): _acknowledge(k) for k in range(TECHNO_UNITS)},
+    **{com_name(k, "command_w"): _acknowledge(k) for k in range(TECHNO_UNITS)},
     "spindle.override_w": _override,
     "mc_spindle_override_w": _override,
 }

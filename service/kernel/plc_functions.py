@@ -23,14 +23,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from enum import IntEnum
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from ..machine_config import PlcFunctionsConfig, SyncKind
 from .nc.blocks import Block, StopKind
-from .spindle import SPINDLE_M_FUNCTIONS, Spindle
-
-if TYPE_CHECKING:
-    from .state import Channel
+from .spindle import SPINDLE_M_FUNCTIONS, Spindle, SpindleState
 
 
 class TechnoType(IntEnum):
@@ -212,7 +209,14 @@ class PlcFunctions:
         self._spindle_waits = False
 
 
-def show_technology(channel: Channel, plc: PlcFunctions, now_s: float, cycle_s: float) -> bool:
+class ShowsTechnology(Protocol):
+    """Where a channel shows its technology units and spindle (``state.Channel``)."""
+
+    plc_functions: PlcFunctionsUnit
+    spindle: SpindleState
+
+
+def show_technology(channel: ShowsTechnology, plc: PlcFunctions, now_s: float, cycle_s: float) -> bool:
     """One cycle of ``plc`` (acknowledges due, spindle ramp), shown in ``channel``; True
     when something changed or the spindle still ramps."""
     plc.tick(now_s, cycle_s)
