@@ -80,9 +80,9 @@ def spindle(
 
     s = settings.call(act, f"spindle of channel {channel}")
     lines = [
-        f"channel {channel} spindle: {s['mode']}  S{s['programmed_rpm']:g}  "
-        f"commanded {s['commanded_rpm']:g} rpm  actual {s['actual_rpm']:g} rpm  "
-        f"override {s['override_pct']:g} %  {'reached' if s['speed_reached'] else 'ramping'}",
+        (f"channel {channel} spindle: {s['mode']}  S{s['programmed_rpm']:g}  "
+         f"commanded {s['commanded_rpm']:g} rpm  actual {s['actual_rpm']:g} rpm  "
+         f"override {s['override_pct']:g} %  {'reached' if s['speed_reached'] else 'ramping'}"),
         *(f"  unit {k}: {u['type']}{u['number']} {u['sync']}"
           f"{' waits for the PLC' if u['pending'] else ''}" for k, u in enumerate(s["units"])),
     ]

@@ -113,8 +113,8 @@ class PlcFunctions:
             if block.needs_stop or not any(k in _WAIT_BEFORE | _WAIT_AFTER for k in kinds):
                 return [block]
             return [replace(block, stop=StopKind.TECHNOLOGY)]
-        before = [f for f, k in zip(functions, kinds) if k in _OUTPUT_BEFORE]
-        after = [f for f, k in zip(functions, kinds) if k == SyncKind.MNS_SNS]
+        before = [f for f, k in zip(functions, kinds, strict=True) if k in _OUTPUT_BEFORE]
+        after = [f for f, k in zip(functions, kinds, strict=True) if k == SyncKind.MNS_SNS]
         out: list[Block] = []
         if before:
             wait = any(k in _WAIT_BEFORE for k in kinds)
@@ -216,7 +216,9 @@ class ShowsTechnology(Protocol):
     spindle: SpindleState
 
 
-def show_technology(channel: ShowsTechnology, plc: PlcFunctions, now_s: float, cycle_s: float) -> bool:
+def show_technology(
+    channel: ShowsTechnology, plc: PlcFunctions, now_s: float, cycle_s: float
+) -> bool:
     """One cycle of ``plc`` (acknowledges due, spindle ramp), shown in ``channel``; True
     when something changed or the spindle still ramps."""
     plc.tick(now_s, cycle_s)

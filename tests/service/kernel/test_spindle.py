@@ -10,13 +10,13 @@ import pytest
 
 from cnc_objects.service.kernel.channel_mode import ChannelState
 from cnc_objects.service.kernel.commands_technology import SetSpindleOverride
-from cnc_objects.service.kernel.spindle import DEG_S2_PER_RPM_S, SpindleMode
+from cnc_objects.service.kernel.spindle import DEG_S2_PER_RPM_S, SpindleMode, SpindleState
 from cnc_objects.service.kernel.state import Snapshot
 from tests.service.kernel.test_plc_functions import Recorder
 from tests.support.kernel import KernelHarness
 
 
-def _spindle(s: Snapshot):  # noqa: ANN202
+def _spindle(s: Snapshot) -> SpindleState:
     return s.channels[0].spindle
 
 
