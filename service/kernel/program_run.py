@@ -411,6 +411,10 @@ class ProdTimeRun(ProgramRun):
     def hold(self) -> None:
         """Feedhold pauses the calculation (``cycle`` does nothing in HOLD)."""
 
+    def _technology(self) -> PlcFunctions | None:
+        """The calculation outputs no technology and waits for no acknowledge."""
+        return None
+
     def wait_for_link(self) -> None:
         """A GEO cycle passed while a link waits: a real run's time runs on."""
         self.sim_steps += 1

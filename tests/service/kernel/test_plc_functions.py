@@ -14,8 +14,10 @@ from typing import Any
 
 import pytest
 
+from cnc_objects.protocol.values import ExecutionMode
 from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.channel_mode import ChannelState
+from cnc_objects.service.kernel.commands import SetExecutionMode
 from cnc_objects.service.kernel.commands_technology import AcknowledgeTechnoUnit
 from cnc_objects.service.kernel.state import Snapshot
 from cnc_objects.service.machine_config import DEFAULT_MACHINE, SyncKind
@@ -160,3 +162,13 @@ def test_an_acknowledge_of_nothing_pending_is_refused() -> None:
     with KernelHarness(config=_config()) as h:
         refusal = h.command(AcknowledgeTechnoUnit(0, 0))
         assert refusal is not None and "does not exist" in refusal.message
+
+
+def test_prod_time_outputs_nothing_and_waits_for_no_plc() -> None:
+    """The machining time calculation runs through without a PLC acknowledge."""
+    with KernelHarness(config=_config()) as h:
+        assert h.command(SetExecutionMode(0, ExecutionMode.PROD_TIME)) is None
+        run = h.run(PROGRAM.format(m=11))
+        assert run.channel.state == ChannelState.READY
+        assert _units(run.final) == ()
+        assert run.channel.program_time_s > 0.0
