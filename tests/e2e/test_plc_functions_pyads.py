@@ -137,3 +137,21 @@ def test_an_acknowledge_without_a_pending_unit_is_refused(plc: Plc) -> None:
     with pytest.raises(pyads.ADSError) as refused:
         plc.plc.write_by_name(UNIT.format(k=15, field="command_w"), True)
     assert refused.value.err_code == 0x706  # ADS DEVICE_INVALIDDATA
+
+
+def test_the_spindle_over_ads(plc: Plc) -> None:
+    """S.. M3 waits for the speed (MVS_SVS); the PLC reads it and sets the override."""
+    plc.plc.write_by_name("gpCh[0].spindle.override_w", 500, pyads.PLCTYPE_UINT)
+    with Client(plc.service.endpoint) as client:
+        client.upload("spindle.nc", b"S2000 M3\nG01 X1 F6000\nM30\n")
+        client.run_program("spindle.nc")
+        client.wait_program(timeout_s=WAIT_S)
+    assert plc.read("gpCh[0].spindle.mode_r") == 2  # M03
+    assert plc.read("gpCh[0].spindle.cmd_rev_r") == 1000 * 6000  # 0.001 deg/s: 1000 rpm
+    assert plc.read("gpCh[0].spindle.active_rev_r") == 1000 * 6000
+    assert plc.read("gpCh[0].spindle.speed_reached_r") is True
+    with pytest.raises(pyads.ADSError) as refused:
+        plc.plc.write_by_name("gpCh[0].spindle.override_w", 1501, pyads.PLCTYPE_UINT)
+    assert refused.value.err_code == 0x706
+    plc.plc.write_by_name("gpCh[0].spindle.override_w", 1000, pyads.PLCTYPE_UINT)
+    plc.until(lambda: plc.read("gpCh[0].spindle.active_rev_r") == 2000 * 6000)
