@@ -43,6 +43,7 @@ class TechnoType(IntEnum):
 _OUTPUT_BEFORE = frozenset({SyncKind.MOS, SyncKind.MVS_SVS, SyncKind.MVS_SNS})
 _WAIT_BEFORE = frozenset({SyncKind.MVS_SVS})
 _WAIT_AFTER = frozenset({SyncKind.MVS_SNS, SyncKind.MNS_SNS})
+_NO_WAIT = frozenset({SyncKind.NO_SYNCH, SyncKind.MOS})
 
 
 @dataclass(frozen=True, slots=True)
@@ -150,9 +151,10 @@ class PlcFunctions:
         speed = next((n for t, n in functions if t == TechnoType.S), None)
         if spindle_m or speed is not None:
             self.spindle.command(spindle_m, speed)
-            self._spindle_waits = any(
-                self.kind(TechnoType.M, n) not in (SyncKind.NO_SYNCH, SyncKind.MOS)
-                for n in spindle_m)
+            kinds = [self.kind(TechnoType.M, n) for n in spindle_m]
+            if speed is not None:
+                kinds.append(self.kind(TechnoType.S, speed))
+            self._spindle_waits = any(k not in _NO_WAIT for k in kinds)
         units = list(self.unit.units)
         count = self.unit.output_count
         for type_, number in functions:
@@ -161,7 +163,8 @@ class PlcFunctions:
             sync = self.kind(type_, number)
             if sync == SyncKind.NO_SYNCH:
                 continue
-            acked = sync == SyncKind.MOS
+            # S is acknowledged by the spindle: listed for the PLC as information
+            acked = sync == SyncKind.MOS or type_ == TechnoType.S
             due = None
             if not acked and self.config.auto_acknowledge:
                 due = now_s + self.config.prozess_zeit_s(int(type_), number)

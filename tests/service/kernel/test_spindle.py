@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import pytest
 
+from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.channel_mode import ChannelState
 from cnc_objects.service.kernel.commands_technology import SetSpindleOverride
 from cnc_objects.service.kernel.spindle import DEG_S2_PER_RPM_S, SpindleMode, SpindleState
 from cnc_objects.service.kernel.state import Snapshot
+from cnc_objects.service.machine_config import DEFAULT_MACHINE
 from tests.service.kernel.test_plc_functions import Recorder
 from tests.support.kernel import KernelHarness
 
@@ -79,3 +81,19 @@ def test_m3_without_s_is_no_error_and_does_not_turn() -> None:
         assert run.channel.state == ChannelState.READY
         sp = _spindle(run.final)
         assert (sp.mode, sp.actual_rpm) == (SpindleMode.M03, 0.0)
+
+
+def test_s_with_s_synch_mvs_svs_waits_for_the_new_speed() -> None:
+    """spindel[0].s_synch = MVS_SVS: a changed S in a motion block holds the motion until
+    the spindle has the speed (IS/tf5200_spindle/287528075.html)."""
+    channels = [dict(c) for c in DEFAULT_MACHINE["channels"]]
+    channels[0]["techno"] = {"spindel": {"s_synch": "MVS_SVS"}}
+    with KernelHarness(config=build_config({"channels": channels})) as h:
+        h.run("S1000 M3\nM30\n")
+        rec = Recorder(h)
+        h.run("G01 X10 F6000 S3000\nM30\n")
+        reached = rec.first(lambda s: _spindle(s).actual_rpm == 3000.0)
+        moving = rec.first(lambda s: s.channels[0].axes[0].position_mm > 0.0)
+        assert moving.cycle > reached.cycle
+        units = h.kernel.snapshot.channels[0].plc_functions.units
+        assert [(u.number, u.acknowledged) for u in units] == [(1000, True), (3000, True)]
