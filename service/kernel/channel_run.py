@@ -114,7 +114,7 @@ class ChannelRunner:
         self._modal: ModalState | None = None  # MDI: modal state carried between blocks
         self.time_s = 0.0  # kernel time of the cycle (PROD_TIME: the simulated time)
         self.plc = PlcFunctions(config.techno, Spindle(config.techno.spindel))
-        channel.spindle = self.plc.spindle.state
+        channel.spindle, channel.plc_functions = self.plc.spindle.state, self.plc.unit
         self.touched = False  # the last cycle changed the channel's state
         # #MSG texts from the decoder thread (deque appends are thread-safe)
         self._messages: deque[str] = deque(maxlen=MESSAGES_KEPT)
