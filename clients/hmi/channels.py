@@ -35,7 +35,8 @@ MDEG_S_PER_RPM = 6000.0  # mc_spindle_active_rev_r is in 0.001 degrees/s
 
 class ChannelTable(FixedColumnsTable):
     """Mode, state, program, block, override, single block, axis output, error count and
-    spindle (mode, actual rpm) of every channel. The cursor row is the current channel, the one the keys act on."""
+    spindle (mode, actual rpm) of every channel. The cursor row is the current channel,
+    the one the keys act on."""
 
     DEFAULT_CSS = "ChannelTable { height: auto; max-height: 12; }"
     COLUMNS = COLUMNS

@@ -36,12 +36,11 @@ from .commands import Refusal, RefusalReason
 from .contour_lookahead import ContourLog
 from .decoder_feed import DecoderFeed, Job
 from .nc import ModalState
-from .plc_functions import PlcFunctions, show_technology
-from .spindle import Spindle
 from .nc.blocks import LogArea, LookAheadMark
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
 from .path.executor import AxisDynamics, PathExecutor
 from .path.section_plan import plan_section
+from .plc_functions import PlcFunctions, show_technology
 from .prod_time_trace import ProdTimeTrace
 from .program_run import (
     ChannelRun,
@@ -51,6 +50,7 @@ from .program_run import (
     log_full_warning,
     show_contour_state,
 )
+from .spindle import Spindle
 from .state import MESSAGES_KEPT, Channel, ChannelError, DecoderFlag
 from .switchover import Switchover
 from .syntax_check import SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
