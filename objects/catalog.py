@@ -20,6 +20,7 @@ from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16
 from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockType, LinkState
 
 from .addressing import GroupBase, axis_offset, channel_group
+from .catalog_technology import TECHNOLOGY_ROWS
 from .model import Access, CncObject
 
 
@@ -575,6 +576,14 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "ipo_state.link_to_lr", Scope.PLC_AXIS, PLC, PLC_GROUP, 0x40, UNS16, R, "-",
         "Physical axis this logical axis outputs to; 0 = not linked",
     ),
+)
+
+# technology output and spindle: HLI symbols of gpCh[i] and COM objects of the channel
+TEMPLATES = TEMPLATES + tuple(
+    ObjectTemplate(r.element, Scope.PLC_CHANNEL if r.hli else Scope.CHANNEL,
+                   PLC if r.hli else COM, PLC_GROUP if r.hli else COM_CH, r.offset, r.dtype,
+                   r.access, r.unit, r.description)
+    for r in TECHNOLOGY_ROWS
 )
 
 

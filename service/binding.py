@@ -19,6 +19,7 @@ from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from . import __version__
+from .binding_technology import TECHNOLOGY_READERS, TECHNOLOGY_WRITERS
 from .machine_config import MachineConfig
 from .kernel.commands import (
     Command,
@@ -424,6 +425,10 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
     ),
     "contour_lookahead.semaphor_rw": _channel_command(SetContourSemaphore),
 }
+
+
+READERS |= TECHNOLOGY_READERS  # techno units and spindle (binding_technology)
+WRITERS |= TECHNOLOGY_WRITERS
 
 
 def _axis_parameter_update(text: str) -> Command:

@@ -7,7 +7,7 @@ depend on front ends, keys or limits. The embedded default machine is ``DEFAULT_
 
 from __future__ import annotations
 
-from enum import StrEnum
+from enum import IntEnum, StrEnum
 from typing import Any, Literal
 
 from pydantic import AliasChoices, BaseModel, ConfigDict, Field, field_validator, model_validator
@@ -189,6 +189,108 @@ class EnhancedLookAheadConfig(Strict):
     )
 
 
+class ProgStartConfig(Strict):
+    """ISG's start-up defaults of a channel (channel list ``prog_start.*``)."""
+
+    feedrate: float = Field(
+        0.0, ge=0, le=1e7,
+        description="P-CHAN-00099 prog_start.feedrate: the feed (mm/min) of a G01/G02/G03 "
+        "block when no F was programmed; 0: none (the block is an error)",
+    )
+
+
+class SyncKind(IntEnum):
+    """ISG's synchronisation kinds of M/H/S/T functions (``m_synch[i]`` values)."""
+
+    NO_SYNCH = 0x0  # not output to the PLC
+    MOS = 0x1  # output, no synchronisation
+    MVS_SVS = 0x2  # output before the motion, motion starts after the acknowledge
+    MVS_SNS = 0x4  # output before the motion, waited for at the block end
+    MNS_SNS = 0x8  # output after the motion, waited for at the block end
+
+
+def _sync_kind(value: str) -> str:
+    if value not in SyncKind.__members__:
+        raise ValueError(f"{value!r} is not a synchronisation kind; use one of "
+                         + ", ".join(SyncKind.__members__))
+    return value
+
+
+class SpindleConfig(Strict):
+    """The channel's spindle (channel list ``spindel[0].*``, axis list of its S axis)."""
+
+    bezeichnung: str = Field("S", min_length=1, max_length=15,
+                             description="P-CHAN-00007 spindel[0].bezeichnung: its name")
+    a_max: float = Field(36000.0, gt=0, le=1e9,
+                         description="P-AXIS-00008 getriebe[0].dynamik.a_max: acceleration "
+                         "(degrees/s^2; 6 degrees/s^2 = 1 rpm/s)")
+    max_rpm: float = Field(24000.0, gt=0, le=1e6,
+                           description="P-AXIS-00212 vb_max as rpm: the largest speed")
+    s_synch: str = Field("MOS", description="P-CHAN-00081 spindel[0].s_synch")
+    m3_synch: str = Field("MVS_SVS", description="P-CHAN-00045 spindel[0].m3_synch")
+    m4_synch: str = Field("MVS_SVS", description="P-CHAN-00047 spindel[0].m4_synch")
+    m5_synch: str = Field("MVS_SVS", description="P-CHAN-00049 spindel[0].m5_synch")
+    m19_synch: str = Field("MNS_SNS", description="P-CHAN-00043 spindel[0].m19_synch")
+
+    @field_validator("s_synch", "m3_synch", "m4_synch", "m5_synch", "m19_synch")
+    @classmethod
+    def _kind(cls, value: str) -> str:
+        return _sync_kind(value)
+
+
+class PlcFunctionsConfig(Strict):
+    """M, S and T functions to the PLC: kinds per function, the embedded PLC's acknowledge.
+
+    Keys of ``m_synch`` / ``m_prozess_zeit`` are M numbers ("8" for M8)."""
+
+    m_synch: dict[str, str] = Field(
+        default_factory=dict, description="P-CHAN-00041 m_synch[i]: kind of M<i>")
+    m_synch_default: str = Field(
+        "MVS_SVS", description="kind of an M function m_synch does not list (ISG: NOT_VALID)")
+    t_synch: str = Field("MOS", description="kind of the T word (project)")
+    m_prozess_zeit: dict[str, int] = Field(
+        default_factory=dict, description="P-CHAN-00040 m_prozess_zeit[i]: time of M<i> (us)")
+    prozess_zeit_default: int = Field(
+        0, ge=0, le=3_600_000_000, description="time (us) of a function m_prozess_zeit "
+        "does not list; the embedded PLC acknowledges after it")
+    auto_acknowledge: bool = Field(
+        True, description="the embedded PLC acknowledges after the function's time "
+        "(kernelv's default); false: the PLC acknowledges over ADS")
+    spindel: SpindleConfig = Field(default_factory=SpindleConfig)
+
+    @field_validator("m_synch")
+    @classmethod
+    def _m_kinds(cls, value: dict[str, str]) -> dict[str, str]:
+        for key, kind in value.items():
+            if not key.isdigit():
+                raise ValueError(f"m_synch key {key!r} is not an M number")
+            _sync_kind(kind)
+        return value
+
+    @field_validator("m_synch_default", "t_synch")
+    @classmethod
+    def _kind(cls, value: str) -> str:
+        return _sync_kind(value)
+
+    def kind(self, type_: int, number: int) -> SyncKind:
+        """The kind of function ``number`` of type ``type_`` (1 M, 3 S, 4 T)."""
+        spindle = self.spindel
+        if type_ == 3:
+            return SyncKind[spindle.s_synch]
+        if type_ == 4:
+            return SyncKind[self.t_synch]
+        named = {3: spindle.m3_synch, 4: spindle.m4_synch, 5: spindle.m5_synch,
+                 19: spindle.m19_synch}.get(number)
+        if named is not None:
+            return SyncKind[named]
+        return SyncKind[self.m_synch.get(str(number), self.m_synch_default)]
+
+    def prozess_zeit_s(self, type_: int, number: int) -> float:
+        """The function's time in s (the embedded PLC acknowledges after it)."""
+        us = self.m_prozess_zeit.get(str(number)) if type_ == 1 else None
+        return (self.prozess_zeit_default if us is None else us) / 1e6
+
+
 class ChannelConfig(Strict):
     """A channel and its axes."""
 
@@ -223,6 +325,13 @@ class ChannelConfig(Strict):
     la: EnhancedLookAheadConfig = Field(
         default_factory=EnhancedLookAheadConfig,
         description="enhanced look-ahead defaults (LA_ON/LA_OFF; METB, VFBT, BBTRC)",
+    )
+    prog_start: ProgStartConfig = Field(
+        default_factory=ProgStartConfig, description="start-up defaults (prog_start.*)"
+    )
+    techno: PlcFunctionsConfig = Field(
+        default_factory=PlcFunctionsConfig,
+        description="M/S/T functions to the PLC and the spindle (docs/spindle-plc.md)",
     )
 
     @field_validator("interpolator_function")
@@ -362,6 +471,8 @@ DEFAULT_MACHINE: dict[str, Any] = {
             "name": "jog-of-path",
             "jog_of_path_only": True,
             "suspend_output_at_start": True,
+            # FCT-C15's example moves this channel with `G91 Y10` and no F (section 2.4)
+            "prog_start": {"feedrate": 1000.0},
             "axes": [
                 {"name": "X", "logical_number": 11, "link_to": 1, "clone_of": 1},
                 {"name": "Y", "logical_number": 12, "link_to": 2, "clone_of": 2},

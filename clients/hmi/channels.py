@@ -26,12 +26,17 @@ COLUMNS: tuple[tuple[str, str, int], ...] = (
     ("single", "single", 6),
     ("output", "output", 9),
     ("errors", "errors", 6),
+    ("spindle", "spindle", 4),
+    ("rpm", "rpm", 7),
 )
+SPINDLE_MODES = {1: "M5", 2: "M3", 4: "M4", 8: "M19"}  # mc_spindle_mode_r
+MDEG_S_PER_RPM = 6000.0  # mc_spindle_active_rev_r is in 0.001 degrees/s
 
 
 class ChannelTable(FixedColumnsTable):
-    """Mode, state, program, block, override, single block, axis output and error count of
-    every channel. The cursor row is the current channel, the one the keys act on."""
+    """Mode, state, program, block, override, single block, axis output, error count and
+    spindle (mode, actual rpm) of every channel. The cursor row is the current channel,
+    the one the keys act on."""
 
     DEFAULT_CSS = "ChannelTable { height: auto; max-height: 12; }"
     COLUMNS = COLUMNS
@@ -64,6 +69,10 @@ class ChannelTable(FixedColumnsTable):
                 Feed(ch.suspend("state_r"),
                      cell("output", lambda v: "suspended" if v else "active")),
                 Feed(ch.obj("mc_error_count_r"), cell("errors", str)),
+                Feed(ch.obj("mc_spindle_mode_r"),
+                     cell("spindle", lambda v: SPINDLE_MODES.get(v, "?"))),
+                Feed(ch.obj("mc_spindle_active_rev_r"),
+                     cell("rpm", lambda v: f"{v / MDEG_S_PER_RPM:.0f}")),
             ]
         return feeds
 

@@ -41,6 +41,7 @@ from .nc.blocks import LogArea, LookAheadMark
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
 from .path.executor import AxisDynamics, PathExecutor
 from .path.section_plan import plan_section
+from .plc_functions import PlcFunctions, show_technology
 from .prod_time_trace import ProdTimeTrace
 from .program_run import (
     ChannelRun,
@@ -50,6 +51,7 @@ from .program_run import (
     log_full_warning,
     show_contour_state,
 )
+from .spindle import Spindle
 from .state import MESSAGES_KEPT, Channel, ErrorEntry, DecoderFlag
 from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
@@ -125,6 +127,8 @@ class ChannelRunner:
         # the decoder or the check (virtual clock) stops waiting; cleared by ``reset``
         self.reset_pending = threading.Event()
         self._check_max_errors = check_max_errors  # errors kept per check
+        self.plc = PlcFunctions(config.techno, Spindle(config.techno.spindel))
+        channel.spindle, channel.plc_functions = self.plc.spindle.state, self.plc.unit
         self.touched = False  # the last cycle changed the channel's state
         # #MSG texts from the decoder thread (deque appends are thread-safe)
         self._messages: deque[str] = deque(maxlen=MESSAGES_KEPT)
@@ -250,6 +254,8 @@ class ChannelRunner:
             self._contour.stop()
             show_contour_state(ch, self._contour)
         self._internal_hold = False
+        self.plc.reset()
+        ch.plc_functions = self.plc.unit
         ch.errors, ch.error_count = (), 0
         ch.waiting_for_start = False
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
@@ -445,8 +451,12 @@ class ChannelRunner:
         cycle time (METB must exceed it)."""
         la = self.config.la
         defaults = LookAheadMark(metb_s=la.metb_s, vfbt=la.vfbt, bbtrc=la.bbtrc)
-        return ModalState(position_mm=position_mm, look_ahead_defaults=defaults,
-                          look_ahead_params=defaults, cycle_s=self._cycle_s)
+        modal = ModalState(position_mm=position_mm, look_ahead_defaults=defaults,
+                           look_ahead_params=defaults, cycle_s=self._cycle_s)
+        feed_mm_min = self.config.prog_start.feedrate  # P-CHAN-00099: F of a block without F
+        if feed_mm_min > 0.0:
+            modal.feed_mm_min = feed_mm_min
+        return modal
 
     def _show_start(self, job: Job) -> None:
         """What a run or check shows at its start: counters at 0, the job's file; a
@@ -507,7 +517,15 @@ class ChannelRunner:
     # ------------------------------------------------------------ cycle
 
     def cycle(self, time_s: float) -> bool:
-        """One GEO cycle of the channel; True while it has motion or decoding to do."""
+        """One GEO cycle of the channel; True while it has motion, decoding or a
+        spindle ramp to do."""
+        busy = self._run_cycle(time_s)
+        if show_technology(self.channel, self.plc, time_s, self._cycle_s):
+            self.touched = True
+            busy = True
+        return busy
+
+    def _run_cycle(self, time_s: float) -> bool:
         self.time_s = time_s
         ch = self.channel
         if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):

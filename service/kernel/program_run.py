@@ -23,6 +23,8 @@ from enum import IntEnum
 from functools import partial
 from typing import Protocol
 
+from cnc_objects.protocol.values import ExecutionMode
+
 from .channel_mode import ChannelMode, ChannelState
 from .contour_lookahead import LOG_FULL_WARNING, ContourLog
 from .decoder_feed import DecodeEnd, DecoderFeed, Item, Job
@@ -33,6 +35,7 @@ from .path.errors import PathErrorId
 from .path.executor import PathError, PathExecutor
 from .path.interpolator import StepResult, Waiting
 from .path.segments import Segment
+from .plc_functions import PlcFunctions
 from .prod_time_trace import ProdTimeTrace, trace_file_name
 from .state import Channel, ErrorEntry
 
@@ -55,6 +58,7 @@ class RunHost(Protocol):
     """What a run needs of its channel runner."""
 
     time_s: float  # kernel time of the cycle (PROD_TIME: the simulated time)
+    plc: PlcFunctions  # the channel's M/S/T output to the PLC and its spindle
 
     @property
     def axes_ready(self) -> bool:
@@ -119,6 +123,7 @@ class ProgramRun:
         self._buffer_warned = False  # BUFFER_LIMITS_SPEED shown in this run
         self._pending_error: ErrorEntry | None = None  # takes effect where the path stops
         self._fed_all = False
+        self._technology_part: Block | None = None  # the last pre/post block finished
         self.failure: ErrorEntry | None = None
         if contour is not None:
             executor.on_prepared = self._prepared
@@ -168,6 +173,10 @@ class ProgramRun:
                 return self._fail(failure)
             if not self._host.axes_ready:  # a requested axis links first
                 return Step.WAITING
+        plc = self._technology()
+        if (plc is not None and executor.waiting == Waiting.TECHNOLOGY
+                and plc.all_acknowledged()):
+            executor.release_technology()  # acknowledged in the last cycle: go on
         if self._sync is None:
             self._feed_blocks()
             if self._contour_changed:  # once per cycle, not per block
@@ -189,6 +198,9 @@ class ProgramRun:
         ch.program_time_s = time_s - self.started_at_s
         self._stepped(step)
         for block in step.finished:
+            if plc is not None and plc.block_finished(block, time_s):
+                self._technology_part = block
+                continue  # a pre/post block of the technology output, not counted
             ch.block_count += 1
             if self.contour is not None and block.contour is not None and (
                     block.contour.kind == ContourKind.DISTANCE_CLEAR):
@@ -200,6 +212,9 @@ class ProgramRun:
             src = shown.source
             ch.file_name, ch.line, ch.file_offset = src.file, src.line, src.offset
             ch.block_number = shown.number if shown.number is not None else -1
+        if (executor.waiting == Waiting.SINGLE_BLOCK and step.current is not None
+                and step.current is self._technology_part):
+            executor.resume()  # not a block of the program: single block goes on
         stopped = step.stopped_at
         if stopped is not None and stopped.stop == StopKind.PROGRAM_END:
             return Step.ENDED
@@ -215,6 +230,12 @@ class ProgramRun:
             if ch.mode == ChannelMode.MDI and self.feed.keep_open:
                 return Step.WAITING  # extended MDI: waiting for the next manual block
         return Step.BUSY
+
+    def _technology(self) -> PlcFunctions | None:
+        """The channel's technology output, None while it is suppressed (PROD_TIME)."""
+        if self.channel.execution_mode_active & ExecutionMode.SUPPRESS_TECHNO_OUTPUT:
+            return None
+        return self._host.plc
 
     def _stepped(self, step: StepResult) -> None:
         """After each interpolation cycle (a traced PROD_TIME run records it)."""
@@ -282,8 +303,10 @@ class ProgramRun:
             if isinstance(item, Block):
                 if contour is not None:
                     contour.expect(item)
+                plc = self._technology()
                 try:
-                    executor.push(item)
+                    for part in ([item] if plc is None else plc.split(item)):
+                        executor.push(part)
                 except PathError as exc:
                     self._stop_feeding(_path_error(exc, item))
                     return
@@ -387,6 +410,10 @@ class ProdTimeRun(ProgramRun):
 
     def hold(self) -> None:
         """Feedhold pauses the calculation (``cycle`` does nothing in HOLD)."""
+
+    def _technology(self) -> PlcFunctions | None:
+        """The calculation outputs no technology and waits for no acknowledge."""
+        return None
 
     def wait_for_link(self) -> None:
         """A GEO cycle passed while a link waits: a real run's time runs on."""

@@ -19,7 +19,9 @@ from cnc_objects.protocol.values import LinkState as LinkState
 from ..machine_config import ChannelConfig, MachineConfig
 from .axis_params import AxisParameters
 from .nc.technology import MachiningSettings
+from .plc_functions import PlcFunctions, PlcFunctionsUnit
 from .refusal import Refusal
+from .spindle import SpindleState
 
 MESSAGES_KEPT = 8  # #MSG texts a channel shows (ch<c>.mc_message_<k>_text_r)
 
@@ -190,6 +192,9 @@ class Channel:
     # #TRAFO/#HSC/#SLOPE/#FILTER/G133/G134 as decoded so far (nc.technology)
     machining: MachiningSettings = field(default_factory=MachiningSettings)
     prod_time_trace: bool = False  # PROD_TIME runs write their path (ch<c>.prod_time_trace)
+    # M/S/T functions output to the PLC and the spindle (kernel.plc_functions, .spindle)
+    plc_functions: PlcFunctionsUnit = field(default_factory=PlcFunctionsUnit)
+    spindle: SpindleState = field(default_factory=SpindleState)
 
     @property
     def execution_mode_commanded(self) -> int:
@@ -219,7 +224,7 @@ class Channel:
             self.suspend_command_w, self.suspend_enable_w, self.suspend_request_r,
             self.contour, self.execution_mode_plc_command, self.execution_mode_plc_enable,
             self.syn_chk, self.decoder_flags, self.messages, self.message_count,
-            self.machining, self.prod_time_trace,
+            self.machining, self.prod_time_trace, self.plc_functions, self.spindle,
         )
 
 
@@ -271,6 +276,7 @@ class ChannelRunnerView(Protocol):
     touched: bool  # the last cycle changed the channel's state
     # set when a RESET of the channel is queued: a cycle waiting for its decoder stops
     reset_pending: threading.Event
+    plc: PlcFunctions  # the channel's M/S/T functions to the PLC and its spindle
 
     @property
     def moving(self) -> bool:

@@ -95,6 +95,7 @@ async def test_shows_channels_and_axes_from_the_service(endpoint: str) -> None:
                 v[ch.obj("mc_active_feed_override_r")])
             assert app.channels.cell(ch, "output") == (
                 "suspended" if v[ch.suspend("state_r")] else "active")
+            assert (app.channels.cell(ch, "spindle"), app.channels.cell(ch, "rpm")) == ("M5", "0")
         # The default machine: channel 1 holds the drives, channel 2 (jog of path) waits.
         assert app.axes.cell("ch1.ax1", "axis") == "ch1.X"
         assert app.axes.cell("ch1.ax1", "link") == "0 linked → ax1"

@@ -37,6 +37,7 @@ class StopKind(IntEnum):
     PROGRAMMED = 1  # M0: stop, wait for START
     OPTIONAL = 2  # M1: optional stop; this kernel always stops (no optional-stop switch)
     PROGRAM_END = 3  # M2 / M30: end of the main program
+    TECHNOLOGY = 4  # M/S/T functions wait for their acknowledge (kernel.plc_functions)
 
 
 class AxisExchangeKind(IntEnum):

@@ -41,7 +41,7 @@ class NcErrorId(IntEnum):
     INVALID_M_CODE = 20122  # M not a non-negative integer
     CONFLICTING_M_CODES = 20123  # two program-flow M functions in a block (M0 M30)
     INVALID_FEED = 20130  # F <= 0
-    NO_FEED = 20131  # G1/G2/G3 before any F was programmed
+    NO_FEED = 20008  # ISG "Feed rate in motion block is 0.": G1/G2/G3 without F or prog_start
     INVALID_SPINDLE_SPEED = 20132  # S < 0
     INVALID_TOOL_NUMBER = 20133  # T not a non-negative integer
     TOOL_NOT_IN_TABLE = 20134  # D number without an entry in the tool table

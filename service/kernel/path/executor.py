@@ -160,6 +160,10 @@ class PathExecutor:
         """Continue after feedhold, M0/M1/M2/M30 and single-block stops."""
         self._ipo.resume()
 
+    def release_technology(self) -> None:
+        """Continue after a stop for technology acknowledges (StopKind.TECHNOLOGY)."""
+        self._ipo.release_technology()
+
     @property
     def single_block(self) -> bool:
         """Stop at the end of every block (from the first block end still reachable)."""

@@ -38,6 +38,7 @@ class Waiting(IntEnum):
     DWELL = 1  # dwell time of a block running
     PROGRAMMED_STOP = 2  # M0/M1/M2/M30 reached: waiting for resume()
     SINGLE_BLOCK = 3  # single block: waiting for resume() at a block end
+    TECHNOLOGY = 4  # M/S/T functions: waiting for release_technology()
 
 
 @dataclass(slots=True)
@@ -69,6 +70,7 @@ class Interpolator:
         self.wait_block: Block | None = None  # block dwelling or waited at
         self.dwell_left_s = 0.0
         self.dwell_single = False
+        self.techno_single = False  # a single-block stop follows the technology wait
         self.hold = False
         self.override = 1.0
         self.unfinished = 0  # blocks handed over and not yet finished
@@ -85,6 +87,15 @@ class Interpolator:
         """Release feedhold and continue after a programmed or single-block stop."""
         self.hold = False
         if self.waiting in (Waiting.PROGRAMMED_STOP, Waiting.SINGLE_BLOCK):
+            self.waiting = Waiting.NONE
+            self.wait_block = None
+
+    def release_technology(self) -> None:
+        """The technology functions the path waits for are acknowledged: go on."""
+        if self.waiting == Waiting.TECHNOLOGY:
+            if self.techno_single:  # single block: the stop at the block end comes next
+                self.waiting = Waiting.SINGLE_BLOCK
+                return
             self.waiting = Waiting.NONE
             self.wait_block = None
 
@@ -234,7 +245,10 @@ class Interpolator:
         contour = block.contour
         if contour is not None and contour.kind == ContourKind.DISTANCE_CLEAR:
             self.distance_base_mm = -self.s_mm  # the path distance restarts here
-        if block.stop != StopKind.NONE:
+        if block.stop == StopKind.TECHNOLOGY:
+            self.waiting = Waiting.TECHNOLOGY
+            self.techno_single = single
+        elif block.stop != StopKind.NONE:
             self.waiting = Waiting.PROGRAMMED_STOP
         elif single:
             self.waiting = Waiting.SINGLE_BLOCK
