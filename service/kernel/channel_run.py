@@ -35,6 +35,7 @@ from .channel_transitions import ChannelEvent, allowed, next_state
 from .commands import Refusal, RefusalReason
 from .contour_lookahead import ContourLog
 from .decoder_feed import DecoderFeed, Job
+from .manual_mode import ManualMode
 from .nc import ModalState
 from .nc.blocks import LogArea, LookAheadMark
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
@@ -121,6 +122,8 @@ class ChannelRunner:
                   for mode, c in config.hscs},
             kinematics=False,  # this kernel configures no kinematic transformation
         )
+        self._programs_need_referenced_axes = machine.programs_need_referenced_axes
+        self.manual = ManualMode(channel, machine, params, cycle_s, self._move, self.report)
 
     def _move(self, event: ChannelEvent) -> None:
         """The channel's state changes only here, as ``TRANSITIONS`` says (an event the
@@ -141,6 +144,7 @@ class ChannelRunner:
             return _not_ready(ch, "select a mode after the program ends or after RESET")
         ch.mode = mode
         self._move(ChannelEvent.SELECT_MODE)
+        self.manual.publish()  # hb_display_r.state follows the mode
         if mode != ChannelMode.AUTOMATIC:
             ch.program_name = ""
         self._modal = None
@@ -177,6 +181,11 @@ class ChannelRunner:
             return None
         if ch.state != ChannelState.READY or ch.mode != ChannelMode.AUTOMATIC:
             return _not_ready(ch, "START needs AUTOMATIC/READY (select a program first) or HOLD")
+        if self._programs_need_referenced_axes and self.manual.unreferenced_axes():
+            names = ", ".join(self.manual.unreferenced_axes())
+            return _not_ready(ch, f"axes {names} are not referenced and the machine parameter "
+                              "programs_need_referenced_axes is set: home them first (G74 in "
+                              "MDI, or homing_start_w in MANUAL)")
         self._start_when_linked(Job(ch.program_name), keep_open=False, fresh_modal=True)
         return None
 
@@ -188,6 +197,8 @@ class ChannelRunner:
         if self._run is not None and self._run.ignores_feedhold:
             return None  # a dry run (MACHINE_LOCK) ignores feedhold
         self._move(ChannelEvent.HOLD)
+        if self.manual.engaged:
+            self.manual.feedhold()
         if self._run is not None:
             self._run.hold()
         return None
@@ -221,6 +232,7 @@ class ChannelRunner:
         """RESET from any state: stop at once, clear errors, back to READY or SELECTED."""
         ch = self.channel
         self._drop_run()
+        self.manual.stop_at_once()
         ch.decoder_flags = 0
         self._pending_start = None
         self._queued_jobs.clear()
@@ -489,6 +501,9 @@ class ChannelRunner:
         if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
             self.touched = False
             return False
+        if self.manual.engaged and self._run is None:  # jog, handwheel, homing (MANUAL)
+            self.touched = True
+            return self.manual.cycle()
         run = self._run
         if not self.axes_ready and not isinstance(run, ChannelCheck):
             # suspended, or a link waits

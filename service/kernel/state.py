@@ -186,6 +186,7 @@ class Channel:
     # #TRAFO/#HSC/#SLOPE/#FILTER/G133/G134 as decoded so far (nc.technology)
     machining: MachiningSettings = field(default_factory=MachiningSettings)
     prod_time_trace: bool = False  # PROD_TIME runs write their path (ch<c>.prod_time_trace)
+    manual: tuple[Any, ...] = ()  # ManualAxisView per axis (manual_mode.ManualMode sets)
 
     @property
     def execution_mode_commanded(self) -> int:
@@ -215,7 +216,7 @@ class Channel:
             self.suspend_command_w, self.suspend_enable_w, self.suspend_request_r,
             self.contour, self.execution_mode_plc_command, self.execution_mode_plc_enable,
             self.syn_chk, self.decoder_flags, self.messages, self.message_count,
-            self.machining, self.prod_time_trace,
+            self.machining, self.prod_time_trace, self.manual,
         )
 
 
