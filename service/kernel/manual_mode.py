@@ -27,7 +27,7 @@ from enum import IntEnum
 
 from cnc_objects.protocol.values import ManualOperationMode
 
-from ..machine_config import ManualAxisConfig, MachineConfig
+from ..machine_config import MachineConfig, ManualAxisConfig
 from .axis_params import AxisParameters
 from .channel_mode import ChannelMode, ChannelState, describe
 from .channel_transitions import ChannelEvent, allowed
