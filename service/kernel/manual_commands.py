@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .commands import Refusal
+from .manual_mode import ManualMode
 from .state import KernelState
 
 
@@ -22,7 +23,7 @@ class ManualAxisCommand:
     value: int | bool
 
     def apply(self, state: KernelState) -> Refusal | None:
-        manual = state.runners[self.channel_index].manual
+        manual: ManualMode = state.runners[self.channel_index].manual
         k, value = self.axis_index, self.value
         match self.action:
             case "operation_mode":
