@@ -36,6 +36,7 @@ from . import cli_objects  # noqa: E402,F401,I001  (info, browse, read, write, w
 from . import cli_machine  # noqa: E402,F401,I001  (programs, channel commands, check)
 from . import cli_plot  # noqa: E402,F401,I001  (plot)
 from . import cli_keys  # noqa: E402,F401,I001  (keys new)
+from . import cli_manual  # noqa: E402,F401,I001  (jog, home)
 
 __all__ = ["app", "main"]
 

@@ -47,12 +47,15 @@ class AxisMotion:
     target_mm: float | None = None  # goal of an increment, the handwheel, homing
     direction: int = 0  # continuous jog: +1 / -1 toward that software limit; 0 = none
     hit_limit: bool = False  # the goal was cut at a software limit (or the jog reached it)
+    _dt_s: float = 0.001  # the cycle time of the last step
+    _arrived_last_cycle: bool = False  # the goal was reached in the last step
 
     @property
     def at_rest(self) -> bool:
         """No goal and no velocity: the motion is over."""
         return (self.target_mm is None and self.direction == 0
-                and abs(self.velocity_mm_s) < _STANDSTILL_MM_S)
+                and abs(self.velocity_mm_s) < _STANDSTILL_MM_S
+                and not self._arrived_last_cycle)
 
     def move_to(self, target_mm: float) -> None:
         """Go to ``target_mm`` (cut at the software limits; ``hit_limit`` when cut)."""
@@ -75,6 +78,12 @@ class AxisMotion:
 
     def step(self, dt_s: float) -> float:
         """Advance one cycle; returns the new position."""
+        self._dt_s = dt_s
+        if self._arrived_last_cycle:  # at the goal: this cycle the velocity is 0
+            self._arrived_last_cycle = False
+            self.velocity_mm_s = 0.0
+            if self._goal() is None:
+                return self.position_mm
         acc = self.limits.acc_mm_s2
         wanted = self._wanted_velocity()
         dv = max(-acc * dt_s, min(acc * dt_s, wanted - self.velocity_mm_s))
@@ -83,7 +92,10 @@ class AxisMotion:
         goal = self._goal()
         if goal is not None and (goal - position) * (goal - self.position_mm) <= 0.0 \
                 and abs(goal - self.position_mm) <= abs(velocity * dt_s) + _AT_GOAL_MM:
-            position, velocity = goal, 0.0  # reached (or would pass) the goal this cycle
+            # reached the goal this cycle at this velocity (at most acc * dt): the
+            # velocity shows for this cycle, the next one stands
+            position = goal
+            self._arrived_last_cycle = True
             self._arrived()
         clipped = self.limits.clip(position)
         if clipped != position:  # braking from a fast jog may not pass a limit either
@@ -112,7 +124,11 @@ class AxisMotion:
         distance = goal - self.position_mm
         if abs(distance) < _AT_GOAL_MM:
             return 0.0
-        reachable = math.sqrt(2.0 * self.limits.acc_mm_s2 * abs(distance))
+        # Braking cycle by cycle from v (v, v - a dt, ... 0, each for dt) covers
+        # v^2 / 2a + v dt / 2; the fastest v that still stops within the distance:
+        half_step = self.limits.acc_mm_s2 * self._dt_s / 2.0
+        reachable = math.sqrt(2.0 * self.limits.acc_mm_s2 * abs(distance)
+                              + half_step * half_step) - half_step
         return math.copysign(min(self.limits.vel_mm_s, reachable), distance)
 
     def _arrived(self) -> None:
