@@ -273,6 +273,11 @@ class ChannelRunner:
                 )
         return None
 
+    def referenced(self, axes: tuple[int, ...]) -> None:
+        """G74 homed the channel axes with these indices (a run reports it)."""
+        for axis_index in axes:
+            self.manual.mark_referenced(axis_index)
+
     def _check_jog_of_path(self) -> bool:
         """True when the channel may work; otherwise it goes to ERROR naming the axis."""
         error = self.jog_of_path_error()
@@ -435,7 +440,8 @@ class ChannelRunner:
         la = self.config.la
         defaults = LookAheadMark(metb_s=la.metb_s, vfbt=la.vfbt, bbtrc=la.bbtrc)
         return ModalState(position_mm=position_mm, look_ahead_defaults=defaults,
-                          look_ahead_params=defaults, cycle_s=self._cycle_s)
+                          look_ahead_params=defaults, cycle_s=self._cycle_s,
+                          homing=self.manual.homing_table())
 
     def _show_start(self, job: Job) -> None:
         """What a run or check shows at its start: counters at 0, the job's file; a

@@ -136,6 +136,11 @@ class ManualMode:
         homing = self._axes[axis_index].homing
         return homing is not None and homing.referenced
 
+    def homing_table(self) -> dict[int, tuple[float, float]]:
+        """For G74: axis index -> (reference position mm, homing speed mm/s)."""
+        return {k: (a.config.pos_refpkt_mm, a.config.homing_vel_mm_s)
+                for k, a in enumerate(self._axes)}
+
     def unreferenced_axes(self) -> list[str]:
         """Names of the channel's axes that are not referenced."""
         return [a.name for k, a in enumerate(self._channel.axes) if not self.referenced(k)]

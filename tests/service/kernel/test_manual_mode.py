@@ -276,3 +276,41 @@ def test_hb_display_state_follows_the_mode_and_operation_mode(k) -> None:
     assert (view(k).state, view(k).operation_mode, view(k).control_element) == (2, 1, 1)
     assert k.command(SelectMode(0, ChannelMode.MDI)) is None
     assert view(k).state == 0
+
+
+def test_g74_in_a_program_homes_the_axes_in_its_sequence(k) -> None:
+    k.mdi("G01 X-2 Y4 Z1 F600")
+    run = k.run("N10 G74 Z1\nN20 G74 X1 Y1\nN30 G01 X5 F600\nM30\n", record=True)
+    assert run.channel.state == ChannelState.READY, run.channel.errors
+    assert [m.referenced for m in run.channel.manual] == [True, True, True]
+    # Z homed alone first (to 0), then X (to its pos_refpkt 3 mm) and Y together
+    z_home = next(n for n, s in enumerate(run.samples) if s.positions_mm[2] == 0.0)
+    assert run.samples[z_home].positions_mm[:2] == pytest.approx((-2.0, 4.0))
+    assert any(s.positions_mm[:2] == pytest.approx((3.0, 0.0)) for s in run.samples)
+    assert run.positions_mm == pytest.approx((5.0, 0.0, 0.0))
+    # the path speed of the homing block of X and Y is the lower homing speed: Y's
+    # default 10 mm/s (X has 15)
+    home_block = [s for s in run.samples if s.block_count == 1]
+    assert max(s.path_velocity_mm_s for s in home_block) == pytest.approx(10.0)
+
+
+def test_g74_in_mdi_references_an_axis_already_at_its_reference_position(k) -> None:
+    run = k.mdi("G74 Y1")
+    assert run.channel.state == ChannelState.READY
+    assert [m.referenced for m in run.channel.manual] == [False, True, False]
+
+
+@pytest.mark.parametrize(("text", "column", "words"), [
+    ("G74", 1, "needs the axes"),
+    ("G74 X1 Y2", 5, "one G74 block per place"),
+    ("G74 X0.5", 5, "whole number"),
+])
+def test_bad_g74_blocks_stop_with_20136_naming_the_place(k, text, column, words) -> None:
+    k.command(ResetChannel(0, True))
+    run = k.run(f"N10 G01 X1 F600\n{text}\nM30\n", name="bad.nc")
+    assert run.channel.state == ChannelState.ERROR
+    [error] = run.channel.errors
+    assert (error.id, error.file, error.line, error.column) == (20136, "bad.nc", 2, column)
+    assert words in error.text
+    assert run.positions_mm[0] == pytest.approx(1.0)  # the blocks before it ran
+    k.command(ResetChannel(0, True))
