@@ -3,6 +3,8 @@ the HLI status symbols on port 851, the ADS errors of refused writes, and the CL
 
 from __future__ import annotations
 
+import time
+
 import pytest
 
 from cnc_objects.clients import AdsError, Client
@@ -22,8 +24,6 @@ def machine():
 def wait_standstill(c: Client, prefix: str, timeout_s: float = 30.0) -> None:
     """Poll the axis's manual_moving_r until FALSE (the service runs on the virtual
     clock, so the motion takes little wall time)."""
-    import time
-
     deadline = time.monotonic() + timeout_s
     while c.read(f"{prefix}.manual_moving_r"):
         assert time.monotonic() < deadline, f"{prefix} still moves"
