@@ -42,11 +42,13 @@ class ManualAxisConfig(Strict):
     resolution, homing speed and end position."""
 
     jog_vel_mm_s: float = Field(
-        20.0, gt=0, description="continuous and incremental jog speed (mm/s), "
-        "shown as hb_display_r.tipp_geschw; capped at vel_max_mm_s")
+        16.666, gt=0, description="continuous and incremental jog speed (mm/s), as ISG's "
+        "P-AXIS-00077 handbetrieb.tipp.geschw[0] (default 16666 um/s); shown as "
+        "hb_display_r.tipp_geschw; capped at vel_max_mm_s")
     jog_rapid_vel_mm_s: float = Field(
         100.0, gt=0, description="jog speed while the rapid key is pressed (rapid "
-        "override, mm/s); capped at vel_max_mm_s")
+        "override, mm/s), as ISG's P-AXIS-00530 handbetrieb.jog.rapid_velocity; capped "
+        "at vel_max_mm_s")
     handwheel_resolution_incr: int = Field(
         10, ge=1, le=100_000, description="path per handwheel pulse (0.1 um), "
         "hb_display_r.hr_aufloesung; the HMI/PLC may change it")

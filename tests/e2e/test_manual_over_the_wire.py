@@ -41,7 +41,7 @@ def test_the_hli_status_symbols_live_on_port_851(machine: ServiceProcess) -> Non
         c.write("ch1.ax3.manual_hr_aufloesung_w", 50)
         values = c.read_many([HB.format(2, f) for f in (
             "state", "operation_mode", "control_element", "hr_aufloesung", "tipp_geschw")])
-        assert list(values.values()) == [2, 1, 1, 50, 20_000]
+        assert list(values.values()) == [2, 1, 1, 50, 16_666]  # ISG's default jog speed
         with pytest.raises(AdsError) as info_error:
             c.write(HB.format(2, "state"), 1)
         assert info_error.value.code == 0x704
