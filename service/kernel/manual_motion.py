@@ -90,8 +90,8 @@ class AxisMotion:
         velocity = self.velocity_mm_s + dv
         position = self.position_mm + velocity * dt_s
         goal = self._goal()
-        if goal is not None and (goal - position) * (goal - self.position_mm) <= 0.0 \
-                and abs(goal - self.position_mm) <= abs(velocity * dt_s) + _AT_GOAL_MM:
+        if goal is not None and ((goal - position) * (goal - self.position_mm) <= 0.0
+                                 or abs(goal - position) <= _AT_GOAL_MM):
             # reached the goal this cycle at this velocity (at most acc * dt): the
             # velocity shows for this cycle, the next one stands
             position = goal
@@ -124,11 +124,14 @@ class AxisMotion:
         distance = goal - self.position_mm
         if abs(distance) < _AT_GOAL_MM:
             return 0.0
-        # Braking cycle by cycle from v (v, v - a dt, ... 0, each for dt) covers
-        # v^2 / 2a + v dt / 2; the fastest v that still stops within the distance:
-        half_step = self.limits.acc_mm_s2 * self._dt_s / 2.0
-        reachable = math.sqrt(2.0 * self.limits.acc_mm_s2 * abs(distance)
-                              + half_step * half_step) - half_step
+        # Braking cycle by cycle from v (v, v - a dt, ... down to 0, each for dt) covers
+        # at most v^2 / 2a + v dt / 2 + a dt^2 / 8 = (v + a dt / 2)^2 / 2a: the fastest v
+        # that still stops within the distance is sqrt(2 a d) - a dt / 2. The last bit
+        # (d <= a dt^2 / 2) is covered in one cycle at d / dt <= a dt / 2.
+        acc, dt = self.limits.acc_mm_s2, self._dt_s
+        half_step = acc * dt / 2.0
+        reachable = max(math.sqrt(2.0 * acc * abs(distance)) - half_step,
+                        min(abs(distance) / dt, half_step))
         return math.copysign(min(self.limits.vel_mm_s, reachable), distance)
 
     def _arrived(self) -> None:
