@@ -253,8 +253,12 @@ class ManualMode:
             motion = axis.motion
             if motion is None:
                 continue
+            logical = ch.axes[k]
+            if ch.output_suspended or not (logical.actual_link or logical.released):
+                axis.motion = None  # the drive was given up (jog of path): the axis stands
+                continue
             position = motion.step(self._cycle_s)
-            logical = ch.axes[k]  # the drive follows the step (KernelState.drive_axes)
+            # the drive follows the step (KernelState.drive_axes)
             logical.command_position_incr = round(position * _INCR_PER_MM)
             logical.position_mm = logical.command_position_incr / _INCR_PER_MM
             if motion.hit_limit and not axis.limit_warning:

@@ -20,6 +20,7 @@ from cnc_objects.service.kernel.commands import (
     ResetChannel,
     SelectMode,
     SelectProgram,
+    SetSuspendCommand,
     StartProgram,
 )
 from cnc_objects.service.kernel.manual_commands import ManualAxisCommand
@@ -314,3 +315,17 @@ def test_bad_g74_blocks_stop_with_20136_naming_the_place(k, text, column, words)
     assert words in error.text
     assert run.positions_mm[0] == pytest.approx(1.0)  # the blocks before it ran
     k.command(ResetChannel(0, True))
+
+
+def test_suspending_the_axis_output_stops_a_jog_and_refuses_the_next(k) -> None:
+    manual(k)
+    write(k, "operation_mode", ManualOperationMode.CONTINUOUS)
+    moving = (lambda v: v.velocity_um_s > 5_000, SetSuspendCommand(0, True))
+    samples = record_until_rest(k, ("jog_plus", True), then=moving)
+    stopped_mm = samples[-1][0]
+    assert 0.0 < stopped_mm < LIMIT_MAX_MM and not view(k).moving
+    assert k.kernel.snapshot.channels[0].output_suspended
+    refusal = write(k, "jog_plus", True)
+    assert refusal is not None and "not linked" in refusal.message
+    assert k.command(SetSuspendCommand(0, False)) is None
+    k.wait_for(lambda s: not s.channels[0].output_suspended)
