@@ -37,6 +37,7 @@ from . import cli_machine  # noqa: E402,F401,I001  (programs, channel commands, 
 from . import cli_plot  # noqa: E402,F401,I001  (plot)
 from . import cli_keys  # noqa: E402,F401,I001  (keys new)
 from . import cli_spindle  # noqa: E402,F401,I001  (spindle)
+from . import cli_manual  # noqa: E402,F401,I001  (jog, home)
 
 __all__ = ["app", "main"]
 

@@ -21,6 +21,7 @@ from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockT
 
 from .addressing import GroupBase, axis_offset, channel_group
 from .catalog_technology import TECHNOLOGY_ROWS
+from .catalog_manual import MANUAL_ROWS
 from .model import Access, CncObject
 
 
@@ -34,6 +35,8 @@ class Scope(Enum):
     PLC_CHANNEL = "plc_channel"  # HLI per channel: gpCh[i].element, i = channel index from 0
     PLC_MC = "plc_mc"  # older HLI per channel: pMC[i].element (same address block as gpCh[i])
     PLC_AXIS = "plc_axis"  # HLI per axis: gpAx[i].element, i = HLI axis slot from 0
+    PLC_CHANNEL_AXIS = "plc_channel_axis"  # HLI per axis of a channel:
+    # gpCh[i].bahn_state.coord_r[k].element, k = axis index in the channel from 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,6 +79,8 @@ class MachineLayout:
 PLC_GROUP = 0x4020
 PLC_CHANNEL_BASE, PLC_CHANNEL_STRIDE = 0x10000, 0x1000
 PLC_AXIS_BASE, PLC_AXIS_STRIDE = 0x80000, 0x100
+# gpCh[i].bahn_state.coord_r[k] (per axis of the channel, k from 0), after the contour reply
+PLC_COORD_BASE, PLC_COORD_STRIDE = 0xE00, 0x10
 
 # gpCh[i].contour_lookahead.response.block[0..N-1] (HLI_CONTOUR_LOOKAHEAD_BLOCK)
 CONTOUR_RESPONSE_BLOCKS = 32
@@ -587,6 +592,10 @@ TEMPLATES = TEMPLATES + tuple(
 )
 
 
+# manual mode and homing (objects/catalog_manual.py: rows of plain data, no import back)
+TEMPLATES += tuple(ObjectTemplate(r.element, Scope(r.scope), *r[2:]) for r in MANUAL_ROWS)
+
+
 def _instantiate(
     t: ObjectTemplate, channel: int = 0, axis: int = 0, index: int = 0
 ) -> CncObject:
@@ -598,6 +607,10 @@ def _instantiate(
         case Scope.PLC_AXIS:
             name, group = f"gpAx[{index}].{t.element}", t.group_base
             offset = PLC_AXIS_BASE + index * PLC_AXIS_STRIDE + t.offset
+        case Scope.PLC_CHANNEL_AXIS:
+            name, group = f"gpCh[{index}].bahn_state.coord_r[{axis - 1}].{t.element}", t.group_base
+            offset = (PLC_CHANNEL_BASE + index * PLC_CHANNEL_STRIDE + PLC_COORD_BASE
+                      + (axis - 1) * PLC_COORD_STRIDE + t.offset)
         case Scope.PLATFORM:
             name, group, offset = t.element, t.group_base, t.offset
         case Scope.PHYSICAL_AXIS:
@@ -642,6 +655,12 @@ def build_objects(
             case Scope.PLC_CHANNEL | Scope.PLC_MC:
                 objects.extend(
                     _instantiate(t, c.channel_id, index=i) for i, c in enumerate(layout.channels)
+                )
+            case Scope.PLC_CHANNEL_AXIS:
+                objects.extend(
+                    _instantiate(t, c.channel_id, a, index=i)
+                    for i, c in enumerate(layout.channels)
+                    for a in range(1, c.axis_count + 1)
                 )
             case Scope.PLC_AXIS:
                 objects.extend(

@@ -75,6 +75,16 @@ class ExecutionMode(IntFlag):
     SUPPRESS_TECHNO_OUTPUT = 0x2000  # no M/H/T output
 
 
+class ManualOperationMode(IntEnum):
+    """Operation mode of an axis in manual mode (HLI
+    ``bahn_state.coord_r[i].hb_display_r.operation_mode``)."""
+
+    NONE = 0  # no operation mode selected
+    HANDWHEEL = 1  # the axis follows the handwheel counter
+    CONTINUOUS = 2  # continuous jog: moves while the jog key is held
+    INCREMENTAL = 3  # jog mode: one increment per key press
+
+
 def value_names(values: type[IntEnum]) -> dict[int, str]:
     """``{3: "READY", ...}``: the names of an enumeration's values."""
     return {int(member): member.name for member in values}

@@ -44,6 +44,7 @@ from .kernel.commands import (
     StartProgram,
     UpdateAxisParameters,
 )
+from .binding_manual import MANUAL_READERS, MANUAL_WRITERS
 from .kernel.kernel import Kernel, KernelCommand, ResetCycleStats
 from .kernel.state import DecoderFlag
 from .notifications import NotificationCounts
@@ -374,6 +375,7 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "mc_message_count_r": _channel("message_count"),
     **{f"mc_message_{k}_text_r": _channel_message(k) for k in range(1, 9)},
     **{f"{name}_r": _machining(attr) for name, attr, *_ in MACHINING_FIELDS},
+    **MANUAL_READERS,
 }
 
 
@@ -424,6 +426,7 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
         lambda ci, value: SetContourRequest(ci, "length", value)
     ),
     "contour_lookahead.semaphor_rw": _channel_command(SetContourSemaphore),
+    **MANUAL_WRITERS,
 }
 
 

@@ -37,6 +37,28 @@ class AxisLimits(Strict):
         return self
 
 
+class ManualAxisConfig(Strict):
+    """Manual mode and homing of one axis (docs/manual.md): jog speeds, handwheel
+    resolution, homing speed and end position."""
+
+    jog_vel_mm_s: float = Field(
+        16.666, gt=0, description="continuous and incremental jog speed (mm/s), as ISG's "
+        "P-AXIS-00077 handbetrieb.tipp.geschw[0] (default 16666 um/s); shown as "
+        "hb_display_r.tipp_geschw; capped at vel_max_mm_s")
+    jog_rapid_vel_mm_s: float = Field(
+        100.0, gt=0, description="jog speed while the rapid key is pressed (rapid "
+        "override, mm/s), as ISG's P-AXIS-00530 handbetrieb.jog.rapid_velocity; capped "
+        "at vel_max_mm_s")
+    handwheel_resolution_incr: int = Field(
+        10, ge=1, le=100_000, description="path per handwheel pulse (0.1 um), "
+        "hb_display_r.hr_aufloesung; the HMI/PLC may change it")
+    homing_vel_mm_s: float = Field(
+        10.0, gt=0, description="speed of the homing run (G74 or homing_start_w, mm/s)")
+    pos_refpkt_mm: float = Field(
+        0.0, description="P-AXIS-00152 kenngr.pos_refpkt: the position the axis "
+        "takes at the end of homing (mm)")
+
+
 class PhysicalAxisConfig(Strict):
     """A drive of the platform."""
 
@@ -65,6 +87,7 @@ class AxisConfig(Strict):
         False, description="kenngr.auto_release_of_axis_link (P-AXIS-00483)"
     )
     limits: AxisLimits = AxisLimits()
+    manual: ManualAxisConfig = ManualAxisConfig()
 
 
 class InterpolatorFunction(StrEnum):
@@ -375,6 +398,10 @@ class MachineConfig(Strict):
     physical_axes: tuple[PhysicalAxisConfig, ...] = Field(min_length=1)
     channels: tuple[ChannelConfig, ...] = Field(min_length=1, max_length=12)
     tools: tuple[ToolConfig, ...] = Field((), description="tool table (D number -> radius)")
+    programs_need_referenced_axes: bool = Field(
+        False, description="START of a program (AUTOMATIC) is refused while an axis of "
+        "the channel is not referenced (homing, docs/manual.md); manual blocks (G74 in "
+        "MDI) still run")
 
     @model_validator(mode="after")
     def _references_resolve(self) -> MachineConfig:

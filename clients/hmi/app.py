@@ -31,7 +31,7 @@ from cnc_objects.clients.curve import client_curve
 from cnc_objects.clients.errors import AdsError, ClientValueError
 from cnc_objects.clients.key_options import key_option, server_key_option
 
-from . import control, text
+from . import control, manual_keys, text
 from .axes import AxesTable
 from .channels import ChannelTable, ErrorsPanel
 from .lookahead import MIN_GAP_S, REFRESH_S, LookaheadMode, LookaheadPanel, fetch
@@ -67,6 +67,10 @@ class HmiApp(App[None]):
         Binding("j", "suspend", "Jog path"),
         Binding("l", "lookahead", "Look-ahead"),
         Binding("m", "lookahead_mode", "LA mode"),
+        Binding("right_square_bracket", "jog(1)", "Jog+", key_display="]"),
+        Binding("left_square_bracket", "jog(-1)", "Jog-", key_display="["),
+        Binding("a", "jog_axis", "Jog axis"),
+        Binding("i", "jog_increment", "Incr"),
         Binding("q", "quit", "Quit"),
     ]
     _DIALOG_ACTIONS = {"quit"}  # what the keys may still do while the program dialog is open
@@ -87,6 +91,7 @@ class HmiApp(App[None]):
         self.errors = ErrorsPanel(id="errors")
         self.lookahead = LookaheadPanel(id="lookahead")
         self.message = MessageLine(id="message")
+        self.jog_choice = manual_keys.JogChoice()  # manual mode: jog axis and increment
 
     def compose(self) -> ComposeResult:
         """Header, the panels, the message line, the key bindings."""
@@ -219,6 +224,20 @@ class HmiApp(App[None]):
     def action_suspend(self) -> None:
         """Toggle the jog-of-path suspension of the current channel's axis output."""
         self._command("suspend axis output", control.toggle_suspend)
+
+    def action_jog(self, direction: int) -> None:
+        """Jog the chosen axis one increment (selects MANUAL; docs/manual.md)."""
+        self._command("jog", lambda client, ch: manual_keys.jog(client, ch, self.jog_choice,
+                                                                 direction))
+
+    def action_jog_axis(self) -> None:
+        """Choose the next axis of the current channel to jog."""
+        if self.current_channel is not None:
+            self.message.say(self.jog_choice.next_axis(self.current_channel))
+
+    def action_jog_increment(self) -> None:
+        """Choose the next jog increment (1 um .. 10 mm)."""
+        self.message.say(self.jog_choice.next_increment())
 
     def action_select_program(self) -> None:
         """Ask for a program (the store's NC programs) and select it in the current channel."""

@@ -12,6 +12,9 @@ docs/kernel.md ("Channel mode and state"); in short:
   execution mode bit ADD_MDI_BLOCK the end of a manual block is not the end of the
   program: the channel stays ACTIVE and further manual blocks continue the same program
   (same modal state, path distance and program time) until M30 or RESET.
+* MANUAL (docs/manual.md): a jog, handwheel or homing motion takes SELECTED/READY to
+  ACTIVE; when every manual motion is over the channel is READY. Feedhold brakes them
+  (HOLD); START ends the hold.
 * ACTIVE --feedhold--> HOLD --START--> ACTIVE.
 * Any error -> ERROR; RESET from any state -> READY (AUTOMATIC with a program selected),
   DESELECTED (STANDBY) or SELECTED.

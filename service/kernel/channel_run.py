@@ -36,6 +36,7 @@ from .channel_transitions import ChannelEvent, allowed, next_state
 from .commands import Refusal, RefusalReason
 from .contour_lookahead import ContourLog
 from .decoder_feed import DecoderFeed, Job
+from .manual_mode import ManualMode
 from .nc import ModalState
 from .nc.blocks import LogArea, LookAheadMark
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
@@ -139,6 +140,8 @@ class ChannelRunner:
                   for mode, c in config.hscs},
             kinematics=False,  # this kernel configures no kinematic transformation
         )
+        self._programs_need_referenced_axes = machine.programs_need_referenced_axes
+        self.manual = ManualMode(channel, machine, params, cycle_s, self._move, self.report)
 
     def _move(self, event: ChannelEvent) -> None:
         """The channel's state changes only here, as ``TRANSITIONS`` says (an event the
@@ -159,6 +162,7 @@ class ChannelRunner:
             return _not_ready(ch, "select a mode after the program ends or after RESET")
         ch.mode = mode
         self._move(ChannelEvent.SELECT_MODE)
+        self.manual.publish()  # hb_display_r.state follows the mode
         if mode != ChannelMode.AUTOMATIC:
             ch.program_name = ""
         self._modal = None
@@ -195,6 +199,11 @@ class ChannelRunner:
             return None
         if ch.state != ChannelState.READY or ch.mode != ChannelMode.AUTOMATIC:
             return _not_ready(ch, "START needs AUTOMATIC/READY (select a program first) or HOLD")
+        if self._programs_need_referenced_axes and self.manual.unreferenced_axes():
+            names = ", ".join(self.manual.unreferenced_axes())
+            return _not_ready(ch, f"axes {names} are not referenced and the machine parameter "
+                              "programs_need_referenced_axes is set: home them first (G74 in "
+                              "MDI, or homing_start_w in MANUAL)")
         self._start_when_linked(Job(ch.program_name), keep_open=False, fresh_modal=True)
         return None
 
@@ -206,6 +215,8 @@ class ChannelRunner:
         if self._run is not None and self._run.ignores_feedhold:
             return None  # a dry run (MACHINE_LOCK) ignores feedhold
         self._move(ChannelEvent.HOLD)
+        if self.manual.engaged:
+            self.manual.feedhold()
         if self._run is not None:
             self._run.hold()
         return None
@@ -247,6 +258,7 @@ class ChannelRunner:
         ch = self.channel
         self.reset_pending.clear()
         self._drop_run()
+        self.manual.stop_at_once()
         ch.decoder_flags = 0
         self._pending_start = None
         self._queued_jobs.clear()
@@ -288,6 +300,11 @@ class ChannelRunner:
                     "P-CHAN-00306): configure it with kopf.clone_of",
                 )
         return None
+
+    def referenced(self, axes: tuple[int, ...]) -> None:
+        """G74 homed the channel axes with these indices (a run reports it)."""
+        for axis_index in axes:
+            self.manual.mark_referenced(axis_index)
 
     def _check_jog_of_path(self) -> bool:
         """True when the channel may work; otherwise it goes to ERROR naming the axis."""
@@ -452,7 +469,8 @@ class ChannelRunner:
         la = self.config.la
         defaults = LookAheadMark(metb_s=la.metb_s, vfbt=la.vfbt, bbtrc=la.bbtrc)
         modal = ModalState(position_mm=position_mm, look_ahead_defaults=defaults,
-                           look_ahead_params=defaults, cycle_s=self._cycle_s)
+                           look_ahead_params=defaults, cycle_s=self._cycle_s,
+                           homing=self.manual.homing_table())
         feed_mm_min = self.config.prog_start.feedrate  # P-CHAN-00099: F of a block without F
         if feed_mm_min > 0.0:
             modal.feed_mm_min = feed_mm_min
@@ -531,6 +549,9 @@ class ChannelRunner:
         if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
             self.touched = False
             return False
+        if self.manual.engaged and self._run is None:  # jog, handwheel, homing (MANUAL)
+            self.touched = True
+            return self.manual.cycle()
         run = self._run
         if not self.axes_ready and not isinstance(run, ChannelCheck):
             # suspended, or a link waits

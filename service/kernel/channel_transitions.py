@@ -24,11 +24,13 @@ class ChannelEvent(IntEnum):
 
     SELECT_MODE = 1  # a client chose the operation mode (mc_command_mode_w)
     SELECT_PROGRAM = 2  # a client selected a program of the store (selects AUTOMATIC too)
-    START = 3  # START of the selected program, or a manual block: the run begins
+    START = 3  # START of the selected program, or a manual block: the run begins; in
+    # MANUAL the first jog, handwheel or homing motion (manual_mode)
     RESUME = 4  # START in HOLD: the path (or the check's decoding) goes on
     HOLD = 5  # feedhold: decelerate on the path and stop
     CHECK_PAUSE = 6  # internal: the syntax check waits for START (error, single step, STOP)
-    PROGRAM_END = 7  # internal: M30 or the end of the blocks (or of the check) was reached
+    PROGRAM_END = 7  # internal: M30 or the end of the blocks (or of the check) was reached;
+    # in MANUAL: every manual motion is over
     FAIL = 8  # internal: an error stopped the channel (or the channel cannot work)
     RESET = 9  # RESET: stop at once, clear the errors
 

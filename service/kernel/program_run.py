@@ -74,6 +74,9 @@ class RunHost(Protocol):
     def jog_of_path_error(self) -> ErrorEntry | None:
         """The error that keeps a jog-of-path channel from working (None: it may)."""
 
+    def referenced(self, axes: tuple[int, ...]) -> None:
+        """G74 homed the channel axes with these indices."""
+
 
 class ChannelRun(Protocol):
     """What every kind of run offers the channel runner."""
@@ -202,6 +205,8 @@ class ProgramRun:
                 self._technology_part = block
                 continue  # a pre/post block of the technology output, not counted
             ch.block_count += 1
+            if block.homing_axes and output:  # G74 done: the axes are referenced
+                self._host.referenced(block.homing_axes)
             if self.contour is not None and block.contour is not None and (
                     block.contour.kind == ContourKind.DISTANCE_CLEAR):
                 self.contour.distance_cleared()  # mode 2 answers in the new distances

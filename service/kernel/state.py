@@ -195,6 +195,7 @@ class Channel:
     # M/S/T functions output to the PLC and the spindle (kernel.plc_functions, .spindle)
     plc_functions: PlcFunctionsUnit = field(default_factory=PlcFunctionsUnit)
     spindle: SpindleState = field(default_factory=SpindleState)
+    manual: tuple[Any, ...] = ()  # ManualAxisView per axis (manual_mode.ManualMode sets)
 
     @property
     def execution_mode_commanded(self) -> int:
@@ -224,7 +225,7 @@ class Channel:
             self.suspend_command_w, self.suspend_enable_w, self.suspend_request_r,
             self.contour, self.execution_mode_plc_command, self.execution_mode_plc_enable,
             self.syn_chk, self.decoder_flags, self.messages, self.message_count,
-            self.machining, self.prod_time_trace, self.plc_functions, self.spindle,
+            self.machining, self.prod_time_trace, self.plc_functions, self.spindle, self.manual,
         )
 
 
@@ -277,6 +278,9 @@ class ChannelRunnerView(Protocol):
     # set when a RESET of the channel is queued: a cycle waiting for its decoder stops
     reset_pending: threading.Event
     plc: PlcFunctions  # the channel's M/S/T functions to the PLC and its spindle
+    # manual mode of the channel's axes: a manual_mode.ManualMode (that module imports
+    # this one, so it is named where it is used: manual_commands)
+    manual: Any
 
     @property
     def moving(self) -> bool:

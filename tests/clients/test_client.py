@@ -20,6 +20,7 @@ from cnc_objects.clients import (
     AdsError, AdsTimeoutError, AsyncClient, Client, ClientValueError, NoReplyError,
 )
 from cnc_objects.clients.transport import EARLY_HANDLES, _Transport
+from cnc_objects.objects.catalog_manual import MANUAL_ROWS
 from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.frames import Notification
 from cnc_objects.protocol.frames import RawSample as FrameSample
@@ -179,6 +180,7 @@ async def test_browse_describes_objects(api: Any) -> None:
         "ch1.ax1.vel_max",
         "ch1.ax1.acc_max",
         "ch1.ax1.vel_jump_max",
+        *(f"ch1.ax1.{row.element}" for row in MANUAL_ROWS if row.scope == "channel_axis"),
     }
     link = found["ch1.ax1.link_state"]
     assert (link.port, link.group, link.offset, link.type, link.length, link.access) == (

@@ -355,3 +355,36 @@ def test_latency_options_in_the_style_of_cnc() -> None:
         result = _cli(module, *args)
         assert result.returncode == 2, args
         assert message in result.stderr and "Traceback" not in result.stderr
+
+
+async def test_jog_keys_move_the_chosen_axis_in_manual_mode(endpoint: str) -> None:
+    """``]``/``[`` jog one increment in MANUAL (selected by the key); ``a`` and ``i``
+    choose axis and increment (docs/hmi.md, docs/manual.md)."""
+    async with HmiApp(endpoint).run_test(size=SIZE) as pilot, AsyncClient(endpoint) as c:
+        app = await started(pilot)
+        await c.reset(1)
+        y0 = await c.read("ch1.ax2.command_position_acs")
+        await pilot.press("a")  # Y
+        assert app.message.text == "ch1: jog axis Y"
+        await pilot.press("i", "i")  # 1 mm -> 10 mm -> 1 um
+        assert app.message.text == "jog increment 0.001 mm"
+        await pilot.press("right_square_bracket")
+        await wait_until(pilot, lambda: app.message.text == "ch1: jog Y+0.001 mm",
+                         what=lambda: app.message.text)
+
+        async def position() -> int:
+            return await c.read("ch1.ax2.command_position_acs")
+
+        deadline = time.monotonic() + WAIT_S
+        while await position() != y0 + 10:
+            assert time.monotonic() < deadline, "Y did not move one increment"
+            await pilot.pause()
+        assert await c.read("ch1.mc_active_mode_r") == 4  # MANUAL
+        await pilot.press("left_square_bracket", "left_square_bracket")
+        deadline = time.monotonic() + WAIT_S
+        while await position() != y0 - 10:
+            assert time.monotonic() < deadline, "Y did not move back two increments"
+            await pilot.pause()
+        shown = {(k.key_display or k.key) for k in app.query("FooterKey")}
+        assert {"]", "[", "a", "i"} <= shown
+        await c.reset(1)

@@ -11,6 +11,7 @@ one deletes the route the others use).
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
@@ -244,3 +245,29 @@ def test_strings_read_with_the_buffer_pyads_brings(ads: Ads) -> None:
     assert ads.plc.read_by_name(name, pyads.PLCTYPE_STRING) == expected
     assert ads.plc.read_by_name(name) == expected  # STRING(83) from the symbol information
     assert ads.com.read(CH1_COM, 0x3005, pyads.PLCTYPE_STRING) == expected
+
+
+def test_a_plc_jogs_by_handwheel_and_reads_hb_display_r(ads: Ads) -> None:
+    """Manual mode as a PLC plays it over ADS (docs/manual.md): the handwheel counter and
+    the operation mode by name, ISG's ``hb_display_r`` symbols on port 851."""
+    hb = "gpCh[0].bahn_state.coord_r[1].hb_display_r."
+    with Client(ads.service.endpoint) as client:
+        client.write("ch1.mc_command_reset_w", True)
+        client.write("ch1.mc_command_mode_w", 4)  # MANUAL
+    ads.plc.write_by_name("ch1.ax2.manual_operation_mode_w", 1, pyads.PLCTYPE_UINT)
+    assert ads.plc.read_by_name(hb + "operation_mode", pyads.PLCTYPE_UINT) == 1
+    assert ads.plc.read_by_name(hb + "state", pyads.PLCTYPE_UINT) == 2
+    assert ads.plc.read_by_name(hb + "hr_aufloesung", pyads.PLCTYPE_DINT) == 10
+    start = ads.plc.read_by_name("ch1.ax2.command_position_acs", pyads.PLCTYPE_DINT)
+    counter = ads.plc.read_by_name("ch1.ax2.manual_handwheel_counter_w", pyads.PLCTYPE_DINT)
+    ads.plc.write_by_name("ch1.ax2.manual_handwheel_counter_w", counter - 25,
+                          pyads.PLCTYPE_DINT)
+    deadline = time.monotonic() + WAIT_S
+    while ads.plc.read_by_name("ch1.ax2.manual_moving_r", pyads.PLCTYPE_BOOL):
+        assert time.monotonic() < deadline, "the handwheel motion did not end"
+        time.sleep(0.01)
+    assert ads.plc.read_by_name("ch1.ax2.command_position_acs",
+                                pyads.PLCTYPE_DINT) == start - 250
+    with pytest.raises(pyads.ADSError) as refused:  # 10 mm is the largest increment
+        ads.plc.write_by_name("ch1.ax2.manual_increment_w", 100_001, pyads.PLCTYPE_UDINT)
+    assert refused.value.err_code == 0x706

@@ -28,7 +28,13 @@ from cnc_objects.objects.catalog import (
 from cnc_objects.objects.model import Access, CncObject
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.datatypes import REAL64, SGN32, UNS16, UNS32, DataType
-from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockType, LinkState
+from cnc_objects.protocol.values import (
+    ChannelMode,
+    ChannelState,
+    ContourBlockType,
+    LinkState,
+    ManualOperationMode,
+)
 
 PLC = CncPort.PLC
 
@@ -116,6 +122,8 @@ def test_addresses_are_unique() -> None:
 
 def _scope(obj) -> Scope:
     """The scope an instance was made for, from its name, channel and axis."""
+    if obj.name.startswith("gpCh[") and ".bahn_state.coord_r[" in obj.name:
+        return Scope.PLC_CHANNEL_AXIS
     if obj.name.startswith("gpCh["):
         return Scope.PLC_CHANNEL
     if obj.name.startswith("pMC["):
@@ -137,6 +145,7 @@ def test_every_template_is_instantiated_once_per_scope_member() -> None:
         Scope.PLC_CHANNEL: len(LAYOUT.channels),
         Scope.PLC_MC: len(LAYOUT.channels),
         Scope.PLC_AXIS: len(LAYOUT.hli_axes),
+        Scope.PLC_CHANNEL_AXIS: sum(c.axis_count for c in LAYOUT.channels),
     }
     for template in TEMPLATES:
         count = sum(
@@ -270,6 +279,8 @@ ENUMERATIONS = {
     "mc_active_state_r": ChannelState,
     "link_state": LinkState,
     "block_type": ContourBlockType,
+    "operation_mode": ManualOperationMode,  # hb_display_r.operation_mode
+    "manual_operation_mode_w": ManualOperationMode,
 }
 
 

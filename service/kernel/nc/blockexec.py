@@ -39,6 +39,7 @@ from .errors import ErrorAt, NcError, NcErrorId
 from .evaluation import Env
 from .exchange import moved_axes
 from .expressions import evaluate_number
+from .homing_block import homing_motion, with_homing
 from .geometry import centre_from_offsets, centre_from_radius
 from .modal import G_CODES, PLANE_AXES, DistanceMode, GGroup, MCode, ModalState, Plane
 from .statements import Assign, AxisCommand, NcBlock, Word, WordKind
@@ -196,7 +197,13 @@ class BlockExecutor:
             self.items_done += 1
         self._modal_groups(groups)
         self._technology(words, err)
-        if GGroup.DWELL in groups:  # G4: X or F is the time, F stays as it was
+        homed: tuple[int, ...] = ()
+        if GGroup.HOMING in groups:  # G74: the axis words are places in the homing sequence
+            dwell_s = 0.0
+            motion, homed = homing_motion(self.modal, axis_words, groups[GGroup.HOMING][1],
+                                          self.plane_axes.get(self.modal.plane) or (0, 1), err)
+            axis_words = []
+        elif GGroup.DWELL in groups:  # G4: X or F is the time, F stays as it was
             dwell_s = self._dwell(groups, axis_words, offsets, words, err)
             motion = None
         else:
@@ -225,7 +232,8 @@ class BlockExecutor:
         spindle = words.get(WordKind.SPINDLE)
         tool = words.get(WordKind.TOOL)
         if (motion is None and dwell_s == 0.0 and stop == StopKind.NONE and not m_functions
-                and spindle is None and tool is None and not axis_words and not offsets):
+                and spindle is None and tool is None and not axis_words and not offsets
+                and not homed):
             return None, flow, flow_pos
         line_no, column = line.locate(_first(line.text))
         block = make_block(
@@ -234,6 +242,8 @@ class BlockExecutor:
             None if tool is None else int(tool[0]), self.manual, None, None,
             self.modal.look_ahead_mark,
         )
+        if homed:
+            block = with_homing(block, homed)
         return block, flow, flow_pos
 
     def _word(self, item: Word, value: float, err: ErrorAt, groups: Groups,

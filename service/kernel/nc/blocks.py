@@ -183,11 +183,12 @@ class Block:
     axis_exchange: AxisExchange | None = None  # #AX RELEASE / #AX REQUEST
     contour: ContourCommand | None = None  # #CONTOUR LOOKAHEAD, #DISTANCE, RT loop marker
     look_ahead: LookAheadMark | None = None  # decoded inside LA_ON .. LA_OFF
+    homing_axes: tuple[int, ...] = ()  # G74: channel axis indices referenced at its end
 
     @property
     def needs_stop(self) -> bool:
         """True when the path speed must be 0 at the end of this block (LOG CLEAR
         synchronises decoding and execution: flush and wait)."""
         return (self.dwell_s > 0.0 or self.stop != StopKind.NONE
-                or self.axis_exchange is not None
+                or self.axis_exchange is not None or bool(self.homing_axes)
                 or (self.contour is not None and self.contour.kind == ContourKind.LOG_CLEAR))

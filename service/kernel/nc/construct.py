@@ -85,6 +85,7 @@ def _fast_block(
     b.axis_exchange = axis_exchange
     b.contour = contour
     b.look_ahead = look_ahead
+    b.homing_axes = ()
     b.__class__ = Block
     return cast(Block, b)
 

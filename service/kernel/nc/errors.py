@@ -46,6 +46,8 @@ class NcErrorId(IntEnum):
     INVALID_TOOL_NUMBER = 20133  # T not a non-negative integer
     TOOL_NOT_IN_TABLE = 20134  # D number without an entry in the tool table
     INVALID_DWELL = 20135  # G4 without a time, negative time, or with axis motion
+    INVALID_HOMING = 20136  # G74 without axes, with a sequence number that is not
+    # a whole number >= 1, with motion words, or with several sequence numbers
     BLOCK_NUMBER_TWICE = 20841  # ISG: N programmed twice in one block (N10 N10:)
     UNKNOWN_WORD = 21220  # ISG: unknown or incomplete token (unknown address letter)
 

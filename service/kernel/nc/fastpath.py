@@ -229,6 +229,7 @@ _BLOCK_FAST = '''\
                 block.axis_exchange = None
                 block.contour = None
                 block.look_ahead = look_ahead
+                block.homing_axes = ()
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\

@@ -54,6 +54,7 @@ class GGroup(IntEnum):
     PLANE = 2  # G17 G18 G19 (modal)
     COMPENSATION = 3  # G40 G41 G42 (modal)
     DISTANCE = 4  # G90 G91 (modal)
+    HOMING = 5  # G74 (this block only): homing of the programmed axes
 
 
 # the G functions this decoder knows: number -> (group, value set in the modal state)
@@ -71,6 +72,7 @@ G_CODES: dict[int, tuple[GGroup, IntEnum | None]] = {
     42: (GGroup.COMPENSATION, Compensation.RIGHT),
     90: (GGroup.DISTANCE, DistanceMode.ABSOLUTE),
     91: (GGroup.DISTANCE, DistanceMode.INCREMENTAL),
+    74: (GGroup.HOMING, None),
 }
 
 
@@ -118,6 +120,9 @@ class ModalState:
     look_ahead_params: LookAheadMark = DEFAULT_LOOK_AHEAD
     look_ahead_mark: LookAheadMark | None = None
     cycle_s: float = 0.001  # GEO cycle time: METB must exceed it
+    # G74: channel axis index -> (reference position P-AXIS-00152 in mm, homing speed
+    # in mm/s); an axis missing here homes to 0 at HOMING_DEFAULT_MM_S
+    homing: dict[int, tuple[float, float]] = field(default_factory=dict)
 
     def start_program(self) -> None:
         """What a program start resets: no coordinate system, patterns or settings."""

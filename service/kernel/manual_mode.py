@@ -1,0 +1,383 @@
+"""Manual mode of one channel: continuous jog, incremental jog, handwheel, homing by object.
+
+ISG's manual mode (channel mode MANUAL, HLI ``hb_display_r``): each axis of the channel
+has an operation mode (``ManualOperationMode``: handwheel, continuous jog, jog by
+increments) and moves on its own, at the jog speed of its axis parameters (the rapid
+key selects the rapid jog speed), under its acceleration, and never past a software
+limit: a jog that reaches one stops there, sets the axis's limit warning and lists a
+warning in the channel's error list.
+
+The channel's state follows ISG's states of manual mode: SELECTED (nothing to do),
+ACTIVE while an axis moves, READY when the motions are over, HOLD after a feedhold (the
+axes brake; START ends the hold), ERROR only through RESET-able errors of other sources.
+Jogging is refused (``Refusal`` NOT_READY, ADS 0x707, with the reason) when the channel
+is not in MANUAL, is in HOLD or ERROR, or the axis is not linked to its drive.
+Out-of-range values are refused as INVALID_VALUE (ADS 0x706).
+
+``ManualMode.cycle`` runs in the GEO cycle (``ChannelRunner.cycle``), before the drives
+follow the axes. What HMI and PLC read is ``Channel.manual``: one immutable
+``ManualAxisView`` per axis, replaced when something changes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from enum import IntEnum
+
+from cnc_objects.protocol.values import ManualOperationMode
+
+from ..machine_config import MachineConfig, ManualAxisConfig
+from .axis_params import AxisParameters
+from .channel_mode import ChannelMode, ChannelState, describe
+from .channel_transitions import ChannelEvent, allowed
+from .commands import Refusal, RefusalReason
+from .homing import HomingState
+from .manual_motion import AxisDynamicsLimits, AxisMotion
+from .manual_view import DisplayState, ManualAxisView
+from .state import Channel, ErrorEntry
+
+INCREMENT_MIN_INCR = 1  # 0.1 um: the smallest jog increment
+INCREMENT_MAX_INCR = 100_000  # 10 mm: the largest jog increment
+RESOLUTION_MIN_INCR, RESOLUTION_MAX_INCR = 1, 100_000  # handwheel path per pulse, 0.1 um
+_INCR_PER_MM = 10_000
+
+
+class ManualErrorId(IntEnum):
+    """Ids of the warnings manual mode lists (project ids, as AxisErrorId's)."""
+
+    SW_LIMIT_REACHED = 70910  # a manual motion stopped at a software limit
+
+
+@dataclass(slots=True)
+class _Axis:
+    """Manual state of one axis of the channel (the view is made from it)."""
+
+    number: int  # logical axis number
+    config: ManualAxisConfig
+    operation_mode: int = ManualOperationMode.NONE
+    hr_aufloesung: int = 10
+    increment_incr: int = 10_000
+    rapid: bool = False
+    handwheel_counter: int = 0
+    jog_plus: bool = False
+    jog_minus: bool = False
+    limit_warning: bool = False
+    motion: AxisMotion | None = None
+    homing: HomingState | None = None
+
+
+def _s32_delta(new: int, old: int) -> int:
+    """new - old of a 32-bit counter that may wrap around."""
+    return ((new - old + 0x8000_0000) & 0xFFFF_FFFF) - 0x8000_0000
+
+
+class ManualMode:
+    """The manual motions of one channel's axes."""
+
+    def __init__(self, channel: Channel, machine: MachineConfig,
+                 params: dict[int, AxisParameters], cycle_s: float,
+                 move: Callable[[ChannelEvent], None],
+                 report: Callable[[ErrorEntry], None]) -> None:
+        """``move`` changes the channel's state (``ChannelRunner._move``); ``report``
+        lists a warning; ``params`` are the kernel's effective axis parameters."""
+        self._channel = channel
+        self._params = params
+        self._cycle_s = cycle_s
+        self._move = move
+        self._report = report
+        self._axes: list[_Axis] = []
+        for axis in channel.axes:
+            configured = machine.axis(axis.logical_number)
+            config = configured.manual if configured is not None else ManualAxisConfig()
+            self._axes.append(_Axis(axis.logical_number, config,
+                                    hr_aufloesung=config.handwheel_resolution_incr))
+        self.publish()
+
+    # ------------------------------------------------------------ queries
+
+    @property
+    def engaged(self) -> bool:
+        """Manual mode works the channel now (MANUAL, ACTIVE or HOLD)."""
+        ch = self._channel
+        return ch.mode == ChannelMode.MANUAL and ch.state in (ChannelState.ACTIVE,
+                                                               ChannelState.HOLD)
+
+    def referenced(self, axis_index: int) -> bool:
+        """The axis at ``axis_index`` of the channel has been homed."""
+        homing = self._axes[axis_index].homing
+        return homing is not None and homing.referenced
+
+    def homing_table(self) -> dict[int, tuple[float, float]]:
+        """For G74: axis index -> (reference position mm, homing speed mm/s)."""
+        return {k: (a.config.pos_refpkt_mm, a.config.homing_vel_mm_s)
+                for k, a in enumerate(self._axes)}
+
+    def unreferenced_axes(self) -> list[str]:
+        """Names of the channel's axes that are not referenced."""
+        return [a.name for k, a in enumerate(self._channel.axes) if not self.referenced(k)]
+
+    # ------------------------------------------------------------ commands (cycle thread)
+
+    def set_operation_mode(self, axis_index: int, value: int) -> Refusal | None:
+        """``manual_operation_mode_w``: 0 none, 1 handwheel, 2 continuous, 3 increments."""
+        if value not in ManualOperationMode._value2member_map_:
+            return _invalid(f"operation mode {value} is not one of "
+                            + ", ".join(f"{m.value} {m.name}" for m in ManualOperationMode))
+        axis = self._axes[axis_index]
+        if axis.motion is not None:
+            return self._not_ready(axis_index, "change the operation mode at standstill")
+        axis.operation_mode = value
+        self.publish()
+        return None
+
+    def set_increment(self, axis_index: int, value: int) -> Refusal | None:
+        """``manual_increment_w``: the jog increment in 0.1 um (0.1 um .. 10 mm)."""
+        if not INCREMENT_MIN_INCR <= value <= INCREMENT_MAX_INCR:
+            return _invalid(f"jog increment {value} (0.1 um) is outside {INCREMENT_MIN_INCR}.."
+                            f"{INCREMENT_MAX_INCR} (0.1 um .. 10 mm)")
+        self._axes[axis_index].increment_incr = value
+        self.publish()
+        return None
+
+    def set_resolution(self, axis_index: int, value: int) -> Refusal | None:
+        """``manual_hr_aufloesung_w``: handwheel path per pulse in 0.1 um."""
+        if not RESOLUTION_MIN_INCR <= value <= RESOLUTION_MAX_INCR:
+            return _invalid(f"handwheel resolution {value} (0.1 um per pulse) is outside "
+                            f"{RESOLUTION_MIN_INCR}..{RESOLUTION_MAX_INCR}")
+        self._axes[axis_index].hr_aufloesung = value
+        self.publish()
+        return None
+
+    def set_rapid(self, axis_index: int, value: bool) -> Refusal | None:
+        """``manual_rapid_w``: TRUE jogs at the rapid jog speed (from the next jog)."""
+        self._axes[axis_index].rapid = bool(value)
+        self.publish()
+        return None
+
+    def jog(self, axis_index: int, direction: int, pressed: bool) -> Refusal | None:
+        """``manual_jog_plus_w`` / ``manual_jog_minus_w``: the key pressed (TRUE) or
+        released (FALSE). Continuous: moves while pressed; increments: one increment per
+        press. Releasing is always accepted."""
+        axis = self._axes[axis_index]
+        if not pressed:
+            self._set_key(axis, direction, False)
+            if (axis.operation_mode == ManualOperationMode.CONTINUOUS
+                    and axis.motion is not None and axis.motion.direction == direction):
+                axis.motion.stop()
+            self.publish()
+            return None
+        mode = axis.operation_mode
+        if mode not in (ManualOperationMode.CONTINUOUS, ManualOperationMode.INCREMENTAL):
+            why = ("the axis moves by the handwheel counter in handwheel mode"
+                   if mode == ManualOperationMode.HANDWHEEL else
+                   "select continuous (2) or incremental (3) jog with manual_operation_mode_w")
+            return self._not_ready(axis_index, f"jog keys need a jog operation mode: {why}")
+        refused = self._may_move(axis_index)
+        if refused is not None:
+            return refused
+        self._set_key(axis, direction, True)
+        motion = self._motion(axis_index, self._jog_vel(axis))
+        if mode == ManualOperationMode.CONTINUOUS:
+            motion.run(direction)
+        else:
+            motion.move_by(direction * axis.increment_incr / _INCR_PER_MM)
+        self._started(axis_index)
+        return None
+
+    def handwheel(self, axis_index: int, counter: int) -> Refusal | None:
+        """``manual_handwheel_counter_w``: the PLC/HMI writes its counter; in handwheel
+        mode the axis moves by (new - old) pulses times the resolution. Outside it the
+        value is only taken (a PLC writes the counter every cycle)."""
+        axis = self._axes[axis_index]
+        pulses = _s32_delta(counter, axis.handwheel_counter)
+        axis.handwheel_counter = counter
+        if axis.operation_mode != ManualOperationMode.HANDWHEEL or pulses == 0:
+            self.publish()
+            return None
+        refused = self._may_move(axis_index)
+        if refused is not None:
+            self.publish()
+            return refused
+        motion = self._motion(axis_index, self._jog_vel(axis))
+        motion.move_by(pulses * axis.hr_aufloesung / _INCR_PER_MM)
+        self._started(axis_index)
+        return None
+
+    def start_homing(self, axis_index: int) -> Refusal | None:
+        """``homing_start_w``: the homing run of the axis (MANUAL mode)."""
+        refused = self._may_move(axis_index)
+        if refused is not None:
+            return refused
+        axis = self._axes[axis_index]
+        if axis.motion is not None:
+            return self._not_ready(axis_index, "start homing at standstill")
+        axis.homing = HomingState(referenced=False, active=True)
+        motion = self._motion(axis_index, axis.config.homing_vel_mm_s)
+        motion.move_to(axis.config.pos_refpkt_mm)
+        self._started(axis_index)
+        return None
+
+    def feedhold(self) -> None:
+        """HOLD: every manual motion brakes; the goals are dropped."""
+        for axis in self._axes:
+            if axis.motion is not None:
+                axis.motion.stop()
+            if axis.homing is not None and axis.homing.active:
+                axis.homing = HomingState(referenced=False, active=False)
+        self.publish()
+
+    def stop_at_once(self) -> None:
+        """RESET: the motions end where the axes are (the keys count as released)."""
+        for axis in self._axes:
+            axis.motion = None
+            axis.jog_plus = axis.jog_minus = False
+            axis.limit_warning = False
+            if axis.homing is not None and axis.homing.active:
+                axis.homing = HomingState(referenced=False, active=False)
+        self.publish()
+
+    def mark_referenced(self, axis_index: int) -> None:
+        """The axis was homed by G74 in a program."""
+        self._axes[axis_index].homing = HomingState(referenced=True, active=False)
+        self.publish()
+
+    # ------------------------------------------------------------ cycle
+
+    def cycle(self) -> bool:
+        """One GEO cycle of the manual motions; True while an axis moves. The channel
+        goes from ACTIVE to READY when all motions are over (HOLD stays HOLD)."""
+        ch = self._channel
+        moving = False
+        for k, axis in enumerate(self._axes):
+            motion = axis.motion
+            if motion is None:
+                continue
+            logical = ch.axes[k]
+            if ch.output_suspended or not (logical.actual_link or logical.released):
+                axis.motion = None  # the drive was given up (jog of path): the axis stands
+                continue
+            position = motion.step(self._cycle_s)
+            # the drive follows the step (KernelState.drive_axes)
+            logical.command_position_incr = round(position * _INCR_PER_MM)
+            logical.position_mm = logical.command_position_incr / _INCR_PER_MM
+            if motion.hit_limit and not axis.limit_warning:
+                axis.limit_warning = True
+                self._warn_limit(k, position)
+            if motion.at_rest:
+                axis.motion = None
+                if axis.homing is not None and axis.homing.active:
+                    axis.homing = HomingState(referenced=True, active=False)
+            else:
+                moving = True
+        if not moving and ch.state == ChannelState.ACTIVE:
+            self._move(ChannelEvent.PROGRAM_END)
+        self.publish()
+        return moving
+
+    def publish(self) -> None:
+        """Show the axes' manual state in ``Channel.manual``."""
+        self._channel.manual = tuple(self._view(axis) for axis in self._axes)
+
+    # ------------------------------------------------------------ helpers
+
+    def _view(self, axis: _Axis) -> ManualAxisView:
+        manual = self._channel.mode == ChannelMode.MANUAL
+        state = DisplayState.DEACTIVATED
+        if manual:
+            state = (DisplayState.ASSIGNED if axis.operation_mode != ManualOperationMode.NONE
+                     else DisplayState.ENABLED)
+        motion, homing = axis.motion, axis.homing
+        return ManualAxisView(
+            state=state, operation_mode=axis.operation_mode,
+            control_element=1 if state == DisplayState.ASSIGNED else 0,
+            hr_aufloesung=axis.hr_aufloesung,
+            tipp_geschw_um_s=round(self._jog_vel(axis) * 1000),
+            increment_incr=axis.increment_incr, rapid=axis.rapid,
+            handwheel_counter=axis.handwheel_counter,
+            jog_plus=axis.jog_plus, jog_minus=axis.jog_minus,
+            velocity_um_s=0.0 if motion is None else motion.velocity_mm_s * 1000,
+            moving=motion is not None, limit_warning=axis.limit_warning,
+            referenced=homing is not None and homing.referenced,
+            homing_active=homing is not None and homing.active,
+        )
+
+    def _jog_vel(self, axis: _Axis) -> float:
+        """The jog speed in effect (mm/s): jog or rapid jog speed, feed override
+        applied, capped at the axis's maximum velocity."""
+        config = axis.config
+        speed = config.jog_rapid_vel_mm_s if axis.rapid else config.jog_vel_mm_s
+        speed *= self._channel.feed_override_per_mille / 1000
+        return min(speed, self._params[axis.number].vel_max_mm_s)
+
+    def _motion(self, axis_index: int, vel_mm_s: float) -> AxisMotion:
+        """The axis's motion (a new one at its position), with the limits in force now."""
+        axis = self._axes[axis_index]
+        p = self._params[axis.number]
+        limits = AxisDynamicsLimits(max(vel_mm_s, 1e-6), p.acc_max_mm_s2,
+                                    p.sw_limit_min_mm, p.sw_limit_max_mm)
+        if axis.motion is None:
+            axis.motion = AxisMotion(self._channel.axes[axis_index].position_mm, limits)
+        else:
+            axis.motion.limits = limits
+        return axis.motion
+
+    def _started(self, axis_index: int) -> None:
+        """A motion began: the channel works (ACTIVE); a goal cut at a limit warns now."""
+        ch = self._channel
+        if ch.state != ChannelState.ACTIVE:
+            self._move(ChannelEvent.START)
+        axis = self._axes[axis_index]
+        motion = axis.motion
+        if motion is not None and motion.hit_limit:  # the goal was cut at a limit
+            if not axis.limit_warning:
+                self._warn_limit(axis_index, motion.target_mm)
+            axis.limit_warning = True
+        else:
+            axis.limit_warning = False
+        self.publish()
+
+    def _may_move(self, axis_index: int) -> Refusal | None:
+        """Why the axis cannot start a manual motion now, or None."""
+        ch = self._channel
+        if ch.mode != ChannelMode.MANUAL:
+            return self._not_ready(axis_index, "manual motion needs channel mode MANUAL (4); "
+                                   "select it with mc_command_mode_w")
+        if ch.state == ChannelState.HOLD:
+            return self._not_ready(axis_index, "manual mode is held (feedhold); START or "
+                                   "RESET first")
+        if ch.state != ChannelState.ACTIVE and not allowed(ch.state, ChannelEvent.START):
+            return self._not_ready(axis_index, "RESET clears the error first")
+        logical = ch.axes[axis_index]
+        if ch.output_suspended or (not logical.actual_link and not logical.released):
+            return self._not_ready(axis_index, "the axis is not linked to its drive")
+        homing = self._axes[axis_index].homing
+        if homing is not None and homing.active:
+            return self._not_ready(axis_index, "the axis is homing")
+        return None
+
+    def _not_ready(self, axis_index: int, what: str) -> Refusal:
+        ch = self._channel
+        return Refusal(RefusalReason.NOT_READY,
+                       f"channel {ch.channel_id} is {describe(ch.mode, ch.state)}, axis "
+                       f"{ch.axes[axis_index].name}: {what}")
+
+    @staticmethod
+    def _set_key(axis: _Axis, direction: int, pressed: bool) -> None:
+        if direction > 0:
+            axis.jog_plus = pressed
+        else:
+            axis.jog_minus = pressed
+
+    def _warn_limit(self, axis_index: int, position_mm: float | None) -> None:
+        name = self._channel.axes[axis_index].name
+        p = self._params[self._axes[axis_index].number]
+        where = "" if position_mm is None else f" at {position_mm:g} mm"
+        self._report(ErrorEntry(
+            ManualErrorId.SW_LIMIT_REACHED,
+            f"axis {name}: manual motion stopped at its software limit{where} "
+            f"(limits {p.sw_limit_min_mm:g}..{p.sw_limit_max_mm:g} mm)", warning=True))
+
+
+def _invalid(message: str) -> Refusal:
+    return Refusal(RefusalReason.INVALID_VALUE, message)
