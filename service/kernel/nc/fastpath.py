@@ -262,10 +262,13 @@ _FLUSH_RECORDS = '''\
         if i > start_i:
             yield POINT_BATCH(program.src, start_i, i, start_pos, plane, records)'''
 
-# a machining coordinate system (#CS) or a pattern definition open: the general path
-_FAST_END = "i if modal.released_axes or modal.cs or modal.pattern is not None else end"
+# a machining coordinate system (#CS), a zero offset or tool length (the program shift)
+# or a pattern definition open: the general path
+_FAST_END = ("i if modal.released_axes or modal.cs or modal.pattern is not None "
+             "or executor.program_shift() is not None else end")
 # check mode: compensation and single-stepping take the general path; batches are bounded
 _FAST_END_CHECK = ("i if modal.released_axes or modal.cs or modal.pattern is not None "
+                   "or executor.program_shift() is not None "
                    "or decoder.check.line_by_line or comp != COMP_OFF "
                    "else min(end, i + BATCH_LINES)")
 
