@@ -52,6 +52,8 @@ from .program_run import (
 from .state import MESSAGES_KEPT, Channel, ChannelError, DecoderFlag
 from .switchover import Switchover
 from .syntax_check import SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
+from .tooling import seed_modal, tables_from_config, tooling_of
+from .tooling_view import after_reset, initial_tooling
 
 log = logging.getLogger(__name__)
 
@@ -99,7 +101,10 @@ class ChannelRunner:
         self.error_log_name = f"errors-ch{channel.channel_id}.log"
         self._axes = tuple(a.name for a in config.axes)
         self._axis_numbers = tuple(a.logical_number for a in config.axes)
-        self._tools = {t.d: t.radius_mm for t in machine.tools}
+        # the tool list and zero offsets the decoders read and the objects write
+        self.tables = tables_from_config(machine)
+        channel.tooling = initial_tooling(self.tables, len(config.axes))
+        self._tools = self.tables.tools  # the radii, for decoders without modal tables
         self._params = params
         self._switchover = switchover
         self._buffer_blocks = config.look_ahead_blocks
@@ -233,6 +238,7 @@ class ChannelRunner:
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
         self._move(ChannelEvent.RESET)
         self._modal = None
+        ch.tooling = after_reset(ch.tooling)
         self.initialise_channel()
         return None
 
@@ -422,8 +428,10 @@ class ChannelRunner:
         cycle time (METB must exceed it)."""
         la = self.config.la
         defaults = LookAheadMark(metb_s=la.metb_s, vfbt=la.vfbt, bbtrc=la.bbtrc)
-        return ModalState(position_mm=position_mm, look_ahead_defaults=defaults,
-                          look_ahead_params=defaults, cycle_s=self._cycle_s)
+        modal = ModalState(position_mm=position_mm, look_ahead_defaults=defaults,
+                           look_ahead_params=defaults, cycle_s=self._cycle_s)
+        seed_modal(modal, self.tables, self.channel.tooling)
+        return modal
 
     def _show_start(self, job: Job) -> None:
         """What a run or check shows at its start: counters at 0, the job's file; a
@@ -449,6 +457,8 @@ class ChannelRunner:
             ch.message_count += len(new)
         if self._modal is not None and self._modal.settings != ch.machining:
             ch.machining = replace(self._modal.settings)
+        if self._modal is not None:
+            ch.tooling = tooling_of(self._modal, ch.tooling, self._axes)
 
     def _axis_limits(self) -> tuple[tuple[AxisDynamics, ...], tuple[tuple[float, float], ...]]:
         """Dynamics and software limits of the channel's axes from the effective axis

@@ -16,6 +16,7 @@ from cnc_objects.protocol.values import ExecutionMode, LinkState
 
 from ..machine_config import ChannelConfig, MachineConfig
 from .nc.technology import MachiningSettings
+from .tooling_view import ChannelTooling
 
 MESSAGES_KEPT = 8  # #MSG texts a channel shows (ch<c>.mc_message_<k>_text_r)
 
@@ -186,6 +187,7 @@ class Channel:
     # #TRAFO/#HSC/#SLOPE/#FILTER/G133/G134 as decoded so far (nc.technology)
     machining: MachiningSettings = field(default_factory=MachiningSettings)
     prod_time_trace: bool = False  # PROD_TIME runs write their path (ch<c>.prod_time_trace)
+    tooling: ChannelTooling = field(default_factory=ChannelTooling)  # T, D, zero offsets
 
     @property
     def execution_mode_commanded(self) -> int:
@@ -215,7 +217,7 @@ class Channel:
             self.suspend_command_w, self.suspend_enable_w, self.suspend_request_r,
             self.contour, self.execution_mode_plc_command, self.execution_mode_plc_enable,
             self.syn_chk, self.decoder_flags, self.messages, self.message_count,
-            self.machining, self.prod_time_trace,
+            self.machining, self.prod_time_trace, self.tooling,
         )
 
 
