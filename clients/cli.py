@@ -4,7 +4,8 @@
 
 The entry module: the global options and ``main``. The commands live in ``cli_objects``
 (info, browse, read, write, watch), ``cli_machine`` (program store, run, MDI, hold,
-resume, reset, status, lookahead, check), ``cli_plot`` (plot) and ``cli_keys`` (keys new);
+resume, reset, status, lookahead, check), ``cli_plot`` (plot), ``cli_keys`` (keys new) and
+``cli_tools`` (tool, offsets);
 what they share is in ``cli_app``. Importing them here registers them on the app, in this order.
 
 A service started with ``--keys`` needs this client's key (``--key FILE`` or
@@ -36,6 +37,7 @@ from . import cli_objects  # noqa: E402,F401,I001  (info, browse, read, write, w
 from . import cli_machine  # noqa: E402,F401,I001  (programs, channel commands, check)
 from . import cli_plot  # noqa: E402,F401,I001  (plot)
 from . import cli_keys  # noqa: E402,F401,I001  (keys new)
+from . import cli_tools  # noqa: E402,F401,I001  (tool, offsets)
 
 __all__ = ["app", "main"]
 
