@@ -33,6 +33,7 @@ offsets_app = typer.Typer(no_args_is_help=True,
 app.add_typer(tool_app, name="tool")
 app.add_typer(offsets_app, name="offsets")
 
+ValuesArgument = typer.Argument(..., help="AXIS=MM, e.g. X=10 Y=-5.5")
 _GROUP = re.compile(r"^(?:G(5[4-9])|(\d+))$", re.IGNORECASE)
 _ASSIGNMENT = re.compile(r"^([A-Za-z])=([-+]?[0-9.]+(?:[eE][-+]?\d+)?)$")
 
@@ -94,10 +95,10 @@ def tool_show(
     def read(c: Client) -> tuple[ActiveTool, list[dict[str, Any]]]:
         size = c.read(f"ch{channel}.mc_tool_list_size_r")
         names = [f"ch{channel}.wz[{i}].{f}" for i in range(1, size + 1)
-                 for f in ("valid", "r", "laenge")]
+                 for f in ("valid", "radius", "laenge")]
         v = c.read_many(names)
         rows = [{"channel": channel, "wz": i, "valid": v[f"ch{channel}.wz[{i}].valid"],
-                 "radius_mm": v[f"ch{channel}.wz[{i}].r"] / INCR_PER_MM,
+                 "radius_mm": v[f"ch{channel}.wz[{i}].radius"] / INCR_PER_MM,
                  "length_mm": v[f"ch{channel}.wz[{i}].laenge"] / INCR_PER_MM}
                 for i in range(1, size + 1)]
         return active_tool(c, channel), rows
@@ -112,7 +113,7 @@ def tool_show(
     for row in rows:
         if row["valid"] or show_all:
             emit(settings, row, f"wz[{row['wz']:>3}] {'valid' if row['valid'] else 'empty'}  "
-                                f"r {_mm(row['radius_mm']):>10} mm  "
+                                f"radius {_mm(row['radius_mm']):>10} mm  "
                                 f"laenge {_mm(row['length_mm']):>10} mm")
 
 
@@ -129,7 +130,7 @@ def tool_set(
     settings: Settings = ctx.obj
     writes: list[tuple[str, Any]] = []
     if radius_mm is not None:
-        writes.append((f"ch{channel}.wz[{d}].r", radius_mm * INCR_PER_MM))
+        writes.append((f"ch{channel}.wz[{d}].radius", radius_mm * INCR_PER_MM))
     if length_mm is not None:
         writes.append((f"ch{channel}.wz[{d}].laenge", length_mm * INCR_PER_MM))
     if invalid:
@@ -184,7 +185,7 @@ def offsets_show(ctx: typer.Context, channel: int = ChannelOption) -> None:
 def offsets_set(
     ctx: typer.Context,
     group: str = typer.Argument(..., help="G54..G59, or the np_grp index (G159 = i)."),
-    values: list[str] = typer.Argument(..., help="AXIS=MM, e.g. X=10 Y=-5.5"),
+    values: list[str] = ValuesArgument,
     channel: int = ChannelOption,
 ) -> None:
     """Write zero offsets of one group (mm per axis)."""

@@ -1,7 +1,7 @@
 """The catalog of tools and work offsets: active tool, D, zero offset, the tool list
 ``wz[i]``, the zero offset table ``np_grp[i]``, positions in workpiece coordinates.
 
-ISG documents the data (the tool list ``wz[i].r`` / ``wz[i].laenge`` of P-TOOL, the
+ISG documents the data (the tool list ``wz[i].radius`` / ``wz[i].laenge`` of P-TOOL, the
 zero offset groups ``np_grp[i]`` of P-ZERO, selected by D, T, G53..G59, G159) but not
 COM offsets for reading them; those offsets are this project's ("project" in the
 description) and found by name through the COM object directory. Two GEO objects have
@@ -30,9 +30,10 @@ ZERO_OFFSET_OFFSET = 0x4000  # ch<c>.ax<a>.np_grp[i].v at 0x<a>4000 + i
 #: the fields of one tool list row: (name, index in the row, type, unit, meaning)
 TOOL_ROW_FIELDS = (
     ("valid", 0, BOOLEAN, "-", "the row holds tool data (T<i> and D<i> may name it)"),
-    ("r", 1, REAL64, "0.1 um", "tool radius: G41/G42 compensate by it (>= 0)"),
-    ("laenge", 2, REAL64, "0.1 um", "tool length: compensated along the tool axis "
-     "(G17: Z, G18: Y, G19: X)"),
+    ("radius", 1, REAL64, "0.1 um",
+     "tool radius (P-TOOL-00004): G41/G42 compensate by it (>= 0)"),
+    ("laenge", 2, REAL64, "0.1 um",
+     "tool length (P-TOOL-00003), along the tool axis (G17: Z, G18: Y, G19: X)"),
 )
 
 TOOL_TEMPLATES: tuple[ObjectTemplate, ...] = (

@@ -12,7 +12,9 @@ from typing import Any
 
 from cnc_objects.objects import CncObject
 from cnc_objects.objects.catalog_tools import (
-    TOOL_ROW_FIELDS, tool_row_element, zero_offset_element,
+    TOOL_ROW_FIELDS,
+    tool_row_element,
+    zero_offset_element,
 )
 
 from .kernel.commands import Command
@@ -25,7 +27,7 @@ Getter = Callable[[], Any]
 Binder = Callable[[Kernel, CncObject], Getter]
 WriteBinder = Callable[[Kernel, CncObject], Callable[[Any], Command]]
 
-_FIELD_OF = {"valid": ToolField.VALID, "r": ToolField.RADIUS, "laenge": ToolField.LENGTH}
+_FIELD_OF = {"valid": ToolField.VALID, "radius": ToolField.RADIUS, "laenge": ToolField.LENGTH}
 
 
 def _tooling(value: Callable[[ChannelTooling], Any]) -> Binder:

@@ -89,7 +89,7 @@ def _value_refused(what: str, value_mm: float, low_mm: float) -> Refusal | None:
 
 @dataclass(frozen=True, slots=True)
 class SetToolData:
-    """Write one field of ``wz[index]`` of a channel's tool list (r and laenge in
+    """Write one field of ``wz[index]`` of a channel's tool list (radius and laenge in
     0.1 um, valid as a flag); in effect from the next block decoded with that D."""
 
     channel_index: int
@@ -108,7 +108,7 @@ class SetToolData:
         if self.which != ToolField.VALID:
             value_mm = float(self.value) / INCR_PER_MM
             low = 0.0 if self.which == ToolField.RADIUS else -TABLE_VALUE_MAX_MM
-            field = "r" if self.which == ToolField.RADIUS else "laenge"
+            field = "radius" if self.which == ToolField.RADIUS else "laenge"
             refused = _value_refused(f"{name}.{field}", value_mm, low)
             if refused is not None:
                 return refused

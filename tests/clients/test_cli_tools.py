@@ -13,7 +13,7 @@ def test_tool_set_and_show(service: ServiceProcess) -> None:
     assert done.returncode == 0, done.stderr
     assert "wz[7] written" in done.stdout
     with Client(service.endpoint, timeout_s=10) as c:
-        assert c.read("ch1.wz[7].r") == 45_000.0
+        assert c.read("ch1.wz[7].radius") == 45_000.0
         c.upload("t.nc", b"T7 M6\nD7\nM30\n")
         assert run_program(c, "t.nc").state == "READY"
     shown = cnc("--json", "tool", "show", endpoint=service.endpoint)
@@ -31,7 +31,7 @@ def test_tool_set_and_show(service: ServiceProcess) -> None:
 def test_tool_set_refused_values(service: ServiceProcess) -> None:
     bad = cnc("tool", "set", "3", "--radius", "-1", endpoint=service.endpoint)
     assert bad.returncode == 1
-    assert "0x706" in bad.stderr and "wz[3].r" in bad.stderr and "outside" in bad.stderr
+    assert "0x706" in bad.stderr and "wz[3].radius" in bad.stderr and "outside" in bad.stderr
     beyond = cnc("tool", "set", "33", "--radius", "1", endpoint=service.endpoint)
     assert beyond.returncode != 0 and "wz[33]" in beyond.stderr
     nothing = cnc("tool", "set", "3", endpoint=service.endpoint)

@@ -41,15 +41,15 @@ def errors(c: Client) -> list[str]:
 
 
 def test_the_configured_tool_list_is_readable_by_objects(c):
-    values = c.read_many(["ch1.mc_tool_list_size_r", "ch1.wz[2].valid", "ch1.wz[2].r",
+    values = c.read_many(["ch1.mc_tool_list_size_r", "ch1.wz[2].valid", "ch1.wz[2].radius",
                           "ch1.wz[2].laenge", "ch1.wz[4].valid"])
     assert values == {"ch1.mc_tool_list_size_r": 32, "ch1.wz[2].valid": True,
-                      "ch1.wz[2].r": 2.5 * INCR, "ch1.wz[2].laenge": 0.0,
+                      "ch1.wz[2].radius": 2.5 * INCR, "ch1.wz[2].laenge": 0.0,
                       "ch1.wz[4].valid": False}
 
 
 def test_tool_select_change_and_length_compensation(c):
-    c.write("ch1.wz[5].r", 3.0 * INCR)  # writing data makes the row valid
+    c.write("ch1.wz[5].radius", 3.0 * INCR)  # writing data makes the row valid
     c.write("ch1.wz[5].laenge", 100.0 * INCR)
     status = run(c, "G0 X0 Y0 Z0\nT5 M6\nD5\nG0 Z20\nM30\n")
     assert status.state == "READY", errors(c)
@@ -124,7 +124,7 @@ def test_incremental_moves_ignore_a_new_offset(c):
 
 
 def test_radius_compensation_keeps_taking_the_radius_from_d(c):
-    c.write("ch1.wz[6].r", 2.0 * INCR)
+    c.write("ch1.wz[6].radius", 2.0 * INCR)
     status = run(c, "G0 X0 Y-10 Z0\nD6\nG41 G1 X0 Y0 F1000\nG1 X20\nG40 G1 X20 Y-10\nM30\n")
     assert status.state == "READY", errors(c)
     assert c.read("ch1.mc_active_tool_radius_r") == 2.0 * INCR
@@ -168,7 +168,7 @@ def test_bad_nc_input_gives_isg_error_ids_with_place(c, program, error_id, line,
 @pytest.mark.parametrize(
     ("name", "value", "words"),
     [
-        ("ch1.wz[3].r", -1.0, "wz[3].r = -1"),
+        ("ch1.wz[3].radius", -1.0, "wz[3].radius = -1"),
         ("ch1.wz[3].laenge", float("inf"), "wz[3].laenge"),
         ("ch1.ax1.np_grp[1].v", 3e9, "np_grp[1] X"),
         ("ch1.ax1.np_grp[1].v", float("nan"), "np_grp[1] X"),
@@ -184,7 +184,7 @@ def test_writes_out_of_range_are_refused_with_0x706(c, name, value, words):
 
 
 def test_objects_beyond_the_tables_do_not_exist(c):
-    for name in ("ch1.wz[33].r", "ch1.ax1.np_grp[10].v", "ch1.ax1.np_grp[0].v"):
+    for name in ("ch1.wz[33].radius", "ch1.ax1.np_grp[10].v", "ch1.ax1.np_grp[0].v"):
         with pytest.raises(Exception) as info:
             c.read(name)
         assert name in str(info.value) or "unknown" in str(info.value).lower()

@@ -29,8 +29,8 @@ class ToolField(IntEnum):
     """The fields of one ``wz[i]`` row the objects write."""
 
     VALID = 0  # wz[i].valid: the row holds tool data
-    RADIUS = 1  # wz[i].r: tool radius (G41/G42)
-    LENGTH = 2  # wz[i].laenge: tool length along the tool axis
+    RADIUS = 1  # wz[i].radius: tool radius (G41/G42), P-TOOL-00004
+    LENGTH = 2  # wz[i].laenge: tool length along the tool axis, P-TOOL-00003
 
 
 @dataclass(frozen=True, slots=True)
