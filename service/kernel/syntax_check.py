@@ -29,7 +29,7 @@ from __future__ import annotations
 import logging
 import re
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
@@ -108,7 +108,7 @@ class CheckRun:
         text_of: Callable[[str], str],
         axes: tuple[str, ...],
         axis_numbers: tuple[int, ...],
-        tools: dict[int, float],
+        tools: Mapping[int, float],
         contour_lookahead: bool,
         start_mm: tuple[float, ...],
         dynamics: Sequence[AxisDynamics],

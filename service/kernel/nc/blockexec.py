@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 import operator
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 from enum import IntEnum
 from typing import Any
@@ -78,6 +78,10 @@ _MODAL_FIELD = {
 }
 G159 = 159  # G159 = <i>: zero offset group i (in the groups of a block)
 M_TOOL_CHANGE = 6  # M6: change to the tool T selected
+
+
+# how a block raises its errors: LogicalLine.error(id, message, position)
+ErrorAt = Callable[[NcErrorId, str, int], NcError]
 
 
 def _integer(value: float) -> int | None:
@@ -321,7 +325,8 @@ class BlockExecutor:
         if modal.look_ahead_mark is not None:
             modal.look_ahead_mark = params
 
-    def _zero_offset_index(self, value: float, pos: int, groups: dict, err) -> None:
+    def _zero_offset_index(self, value: float, pos: int,
+                           groups: dict[GGroup, tuple[int, int]], err: ErrorAt) -> None:
         """G159 = <i>: zero offset group i of the table (0 = G53, 1..6 = G54..G59)."""
         if GGroup.ZERO_OFFSET in groups:
             raise err(NcErrorId.ZERO_OFFSETS_TWICE,
@@ -338,7 +343,7 @@ class BlockExecutor:
         self._np_index = index
         groups[GGroup.ZERO_OFFSET] = (G159, pos)
 
-    def _tool_change(self, pos: int, err) -> float:
+    def _tool_change(self, pos: int, err: ErrorAt) -> float:
         """M6: the tool T selected goes into the spindle; the path waits the tool
         change time (returned, s)."""
         modal = self.modal
