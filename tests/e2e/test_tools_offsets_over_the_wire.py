@@ -185,6 +185,6 @@ def test_writes_out_of_range_are_refused_with_0x706(c, name, value, words):
 
 def test_objects_beyond_the_tables_do_not_exist(c):
     for name in ("ch1.wz[33].radius", "ch1.ax1.np_grp[10].v", "ch1.ax1.np_grp[0].v"):
-        with pytest.raises(Exception) as info:
+        with pytest.raises(AdsError) as info:
             c.read(name)
-        assert name in str(info.value) or "unknown" in str(info.value).lower()
+        assert info.value.code == 0x710 and name in str(info.value)
