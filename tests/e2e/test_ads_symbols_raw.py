@@ -176,7 +176,7 @@ def test_upload_info_64_bytes_field_by_field(ads: RawAds, catalog: list[ObjectIn
     assert len(data) == 64
     (symbols, symbol_bytes, types, type_bytes, max_dynamic, used_dynamic, invalid_dynamic,
      code_page, flags) = struct.unpack_from("<9I", data)
-    assert symbols == len(catalog) == 1004
+    assert symbols == len(catalog) == 1282  # 278 of them: tools and work offsets
     assert symbol_bytes == len(read_ok(ads, SYM_UPLOAD, symbol_bytes))
     assert type_bytes == len(read_ok(ads, SYM_DT_UPLOAD, type_bytes))
     assert types == len({twincat(info)[0] for info in catalog})
