@@ -126,17 +126,17 @@ def tool_set(
     invalid: bool = typer.Option(False, "--invalid", help="Empty the row (T/D refuse it)."),
     channel: int = ChannelOption,
 ) -> None:
-    """Write a row of the tool list; radius or length make the row valid."""
+    """Write a row of the tool list: radius and length, and the row valid (or empty it
+    with --invalid)."""
     settings: Settings = ctx.obj
     writes: list[tuple[str, Any]] = []
     if radius_mm is not None:
         writes.append((f"ch{channel}.wz[{d}].radius", radius_mm * INCR_PER_MM))
     if length_mm is not None:
         writes.append((f"ch{channel}.wz[{d}].laenge", length_mm * INCR_PER_MM))
-    if invalid:
-        writes.append((f"ch{channel}.wz[{d}].valid", False))
-    if not writes:
+    if not writes and not invalid:
         raise typer.BadParameter("give --radius, --length or --invalid")
+    writes.append((f"ch{channel}.wz[{d}].valid", not invalid))
 
     def write(c: Client) -> None:
         for name, value in writes:

@@ -29,7 +29,7 @@ TOOL_LIST_OFFSET, TOOL_ROW_STRIDE = 0x5000, 4  # ch<c>.wz[i].<field> at 0x5000 +
 ZERO_OFFSET_OFFSET = 0x4000  # ch<c>.ax<a>.np_grp[i].v at 0x<a>4000 + i
 #: the fields of one tool list row: (name, index in the row, type, unit, meaning)
 TOOL_ROW_FIELDS = (
-    ("valid", 0, BOOLEAN, "-", "the row holds tool data (T<i> and D<i> may name it)"),
+    ("valid", 0, BOOLEAN, "-", "the row holds tool data: T<i> and D<i> may name it"),
     ("radius", 1, REAL64, "0.1 um",
      "tool radius (P-TOOL-00004): G41/G42 compensate by it (>= 0)"),
     ("laenge", 2, REAL64, "0.1 um",

@@ -59,9 +59,9 @@ def _tool_field(i: int, name: str) -> Binder:
             case ToolField.VALID:
                 return row.valid
             case ToolField.RADIUS:
-                return row.radius_mm * INCR_PER_MM
+                return row.radius_01um
             case ToolField.LENGTH:
-                return row.length_mm * INCR_PER_MM
+                return row.length_01um
 
     return _tooling(value)
 
@@ -70,7 +70,7 @@ def _zero_offset(group: int) -> Binder:
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
         ci, ai = kernel.channel_index(obj.channel), obj.axis - 1
         return lambda: (kernel.snapshot.channels[ci].tooling.zero_offsets
-                        .offset_mm(group, ai) * INCR_PER_MM)
+                        .offset_01um(group, ai))
 
     return bind
 
@@ -79,13 +79,13 @@ FIXED_READERS: dict[str, Binder] = {
     "mc_selected_tool_r": _tooling(lambda t: t.tool_selected),
     "mc_active_tool_r": _tooling(lambda t: t.tool_active),
     "mc_active_tool_offset_r": _tooling(lambda t: t.d_active),
-    "mc_active_tool_radius_r": _tooling(lambda t: t.radius_mm * INCR_PER_MM),
-    "mc_active_tool_length_r": _tooling(lambda t: t.length_mm * INCR_PER_MM),
+    "mc_active_tool_radius_r": _tooling(lambda t: t.radius_01um),
+    "mc_active_tool_length_r": _tooling(lambda t: t.length_01um),
     "mc_active_zero_offset_r": _tooling(lambda t: t.zero_offset_group),
     "mc_tool_list_size_r": _tooling(lambda t: t.tools.size),
     "mc_zero_offset_groups_r": _tooling(lambda t: t.zero_offsets.groups),
     "active_zero_offset_group": _tooling(lambda t: t.zero_offset_group),
-    "actual_tool_radius": _tooling(lambda t: t.radius_mm * INCR_PER_MM),
+    "actual_tool_radius": _tooling(lambda t: t.radius_01um),
     "command_position_pcs": _position_pcs,
     "actual_position_pcs": _position_pcs,
 }

@@ -29,9 +29,9 @@ from .state import Channel, KernelState
 from .tooling_view import ChannelTooling
 
 INCR_PER_MM = 10_000  # the objects carry lengths in 0.1 um
-# |tool length|, radius and zero offsets the tables take: the largest position the
-# SGN32 position objects carry (2**31 - 1) * 0.1 um
-TABLE_VALUE_MAX_MM = (2**31 - 1) / INCR_PER_MM
+# |tool length|, radius and zero offsets the tables take (0.1 um): the largest position
+# the SGN32 position objects carry, 214748.3647 mm
+TABLE_VALUE_MAX_01UM = float(2**31 - 1)
 
 
 def tool_list_size(machine: MachineConfig) -> int:
@@ -43,7 +43,7 @@ def tables_from_config(machine: MachineConfig) -> ToolingTables:
     """A channel's tables at start-up: the configured tool list (``tools``) in a list of
     ``tool_entries`` rows (or more when a configured D is larger), an empty zero offset
     table of ``zero_offset_groups`` groups, and the tool change time."""
-    rows = {t.d: ToolData(True, t.radius_mm, t.length_mm) for t in machine.tools}
+    rows = {t.d: ToolData.of_mm(t.radius_mm, t.length_mm) for t in machine.tools}
     size = tool_list_size(machine)
     return ToolingTables(
         tools=ToolTable(rows, size),
@@ -78,12 +78,11 @@ def seed_modal(modal: ModalState, tables: ToolingTables, shown: ChannelTooling) 
 # ------------------------------------------------------------ writes by objects
 
 
-def _value_refused(what: str, value_mm: float, low_mm: float) -> Refusal | None:
-    if not (math.isfinite(value_mm) and low_mm <= value_mm <= TABLE_VALUE_MAX_MM):
+def _value_refused(what: str, value_01um: float, low_01um: float) -> Refusal | None:
+    if not (math.isfinite(value_01um) and low_01um <= value_01um <= TABLE_VALUE_MAX_01UM):
         return Refusal(RefusalReason.INVALID_VALUE,
-                       f"{what} = {value_mm * INCR_PER_MM:.0f} (0.1 um) is outside "
-                       f"{low_mm * INCR_PER_MM:.0f}..{TABLE_VALUE_MAX_MM * INCR_PER_MM:.0f} "
-                       "(0.1 um)")
+                       f"{what} = {value_01um:.0f} (0.1 um) is outside "
+                       f"{low_01um:.0f}..{TABLE_VALUE_MAX_01UM:.0f} (0.1 um)")
     return None
 
 
@@ -106,13 +105,12 @@ class SetToolData:
                            f"{name}: the tool list has the entries 1..{tables.tools.size}")
         value: float | bool = self.value
         if self.which != ToolField.VALID:
-            value_mm = float(self.value) / INCR_PER_MM
-            low = 0.0 if self.which == ToolField.RADIUS else -TABLE_VALUE_MAX_MM
+            value = float(self.value)
+            low = 0.0 if self.which == ToolField.RADIUS else -TABLE_VALUE_MAX_01UM
             field = "radius" if self.which == ToolField.RADIUS else "laenge"
-            refused = _value_refused(f"{name}.{field}", value_mm, low)
+            refused = _value_refused(f"{name}.{field}", value, low)
             if refused is not None:
                 return refused
-            value = value_mm
         tables.tools = tables.tools.with_field(self.index, self.which, value)
         _show_tables(runner.channel, tables)
         return None
@@ -138,12 +136,12 @@ class SetZeroOffset:
                            "(group 0 is G53: no offset)")
         channel = runner.channel
         axis = channel.axes[self.axis_index].name
-        refused = _value_refused(f"np_grp[{self.group}] {axis}",
-                                 float(self.value_incr) / INCR_PER_MM, -TABLE_VALUE_MAX_MM)
+        value = float(self.value_incr)
+        refused = _value_refused(f"np_grp[{self.group}] {axis}", value, -TABLE_VALUE_MAX_01UM)
         if refused is not None:
             return refused
         tables.zero_offsets = tables.zero_offsets.with_offset(
-            self.group, self.axis_index, len(channel.axes), float(self.value_incr) / INCR_PER_MM)
+            self.group, self.axis_index, len(channel.axes), value)
         _show_tables(channel, tables)
         return None
 

@@ -21,14 +21,16 @@ class ChannelTooling:
     shift_mm: tuple[float, ...] = ()  # program shift per channel axis (PCS = ACS - shift)
 
     @property
-    def radius_mm(self) -> float:
-        """Radius of the active D (0 for D0)."""
-        return self.tools.get(self.d_active, 0.0) if self.d_active else 0.0
+    def radius_01um(self) -> float:
+        """Radius of the active D as the table holds it (0.1 um; 0 for D0)."""
+        row = self.tools.row(self.d_active)
+        return row.radius_01um if self.d_active and row.valid else 0.0
 
     @property
-    def length_mm(self) -> float:
-        """Length of the active D (0 for D0)."""
-        return self.tools.length_mm(self.d_active)
+    def length_01um(self) -> float:
+        """Length of the active D as the table holds it (0.1 um; 0 for D0)."""
+        row = self.tools.row(self.d_active)
+        return row.length_01um if self.d_active and row.valid else 0.0
 
 
 def initial_tooling(tables: ToolingTables, axis_count: int) -> ChannelTooling:

@@ -49,8 +49,10 @@ def test_the_configured_tool_list_is_readable_by_objects(c):
 
 
 def test_tool_select_change_and_length_compensation(c):
-    c.write("ch1.wz[5].radius", 3.0 * INCR)  # writing data makes the row valid
+    c.write("ch1.wz[5].radius", 3.0 * INCR)
     c.write("ch1.wz[5].laenge", 100.0 * INCR)
+    assert c.read("ch1.wz[5].valid") is False  # data alone does not make a tool
+    c.write("ch1.wz[5].valid", True)
     status = run(c, "G0 X0 Y0 Z0\nT5 M6\nD5\nG0 Z20\nM30\n")
     assert status.state == "READY", errors(c)
     values = c.read_many([
@@ -125,6 +127,7 @@ def test_incremental_moves_ignore_a_new_offset(c):
 
 def test_radius_compensation_keeps_taking_the_radius_from_d(c):
     c.write("ch1.wz[6].radius", 2.0 * INCR)
+    c.write("ch1.wz[6].valid", True)
     status = run(c, "G0 X0 Y-10 Z0\nD6\nG41 G1 X0 Y0 F1000\nG1 X20\nG40 G1 X20 Y-10\nM30\n")
     assert status.state == "READY", errors(c)
     assert c.read("ch1.mc_active_tool_radius_r") == 2.0 * INCR

@@ -33,13 +33,32 @@ class ToolField(IntEnum):
     LENGTH = 2  # wz[i].laenge: tool length along the tool axis, P-TOOL-00003
 
 
+UM01_PER_MM = 10_000  # the tables keep what the objects wrote: 0.1 um
+
+
 @dataclass(frozen=True, slots=True)
 class ToolData:
-    """One row ``wz[i]`` of the tool list, in mm."""
+    """One row ``wz[i]`` of the tool list. The values are kept as written (0.1 um, ISG's
+    unit of P-TOOL-00003/4), so a read gives back exactly what was written."""
 
     valid: bool = False
-    radius_mm: float = 0.0
-    length_mm: float = 0.0
+    radius_01um: float = 0.0
+    length_01um: float = 0.0
+
+    @classmethod
+    def of_mm(cls, radius_mm: float, length_mm: float = 0.0, valid: bool = True) -> ToolData:
+        """A row from millimetres."""
+        return cls(valid, radius_mm * UM01_PER_MM, length_mm * UM01_PER_MM)
+
+    @property
+    def radius_mm(self) -> float:
+        """Tool radius (mm)."""
+        return self.radius_01um / UM01_PER_MM
+
+    @property
+    def length_mm(self) -> float:
+        """Tool length (mm)."""
+        return self.length_01um / UM01_PER_MM
 
 
 class ToolTable(Mapping[int, float]):
@@ -61,7 +80,7 @@ class ToolTable(Mapping[int, float]):
     @classmethod
     def from_radii(cls, radii: Mapping[int, float]) -> ToolTable:
         """A table from D number -> radius (every T number accepted)."""
-        rows = {d: ToolData(True, float(r), 0.0) for d, r in radii.items()}
+        rows = {d: ToolData.of_mm(float(r)) for d, r in radii.items()}
         return cls(rows, max(rows, default=0), checks_tools=False)
 
     def __getitem__(self, d: int) -> float:
@@ -92,16 +111,17 @@ class ToolTable(Mapping[int, float]):
         return self.row(t).valid
 
     def with_field(self, i: int, which: ToolField, value: float | bool) -> ToolTable:
-        """A new table with one field of row ``i`` changed; writing a radius or a
-        length makes the row valid."""
+        # ``value``: the flag, or a length in 0.1 um
+        """A new table with one field of row ``i`` changed (each field on its own: a
+        radius written to an empty row leaves it empty until ``valid`` is set)."""
         row = self.row(i)
         match which:
             case ToolField.VALID:
                 row = replace(row, valid=bool(value))
             case ToolField.RADIUS:
-                row = replace(row, valid=True, radius_mm=float(value))
+                row = replace(row, radius_01um=float(value))
             case ToolField.LENGTH:
-                row = replace(row, valid=True, length_mm=float(value))
+                row = replace(row, length_01um=float(value))
         rows = dict(self.rows)
         rows[i] = row
         return ToolTable(rows, self.size, self.checks_tools)
@@ -109,24 +129,35 @@ class ToolTable(Mapping[int, float]):
 
 @dataclass(frozen=True, slots=True)
 class ZeroOffsetTable:
-    """``np_grp[0..groups-1]``: the offset of each channel axis per group (mm).
-    Group 0 (G53) is always zero."""
+    """``np_grp[0..groups-1]``: the offset of each channel axis per group, kept as
+    written (0.1 um). Group 0 (G53) is always zero."""
 
     groups: int = 10
-    offsets_mm: Mapping[int, tuple[float, ...]] = field(default_factory=dict)
+    offsets_01um: Mapping[int, tuple[float, ...]] = field(default_factory=dict)
 
-    def offset_mm(self, group: int, axis: int) -> float:
-        """Offset of channel axis ``axis`` (index from 0) in ``group``."""
-        values = self.offsets_mm.get(group)
+    @classmethod
+    def of_mm(cls, groups: int, offsets_mm: Mapping[int, tuple[float, ...]]
+              ) -> ZeroOffsetTable:
+        """A table from millimetres."""
+        return cls(groups, {g: tuple(v * UM01_PER_MM for v in values)
+                            for g, values in offsets_mm.items()})
+
+    def offset_01um(self, group: int, axis: int) -> float:
+        """Offset of channel axis ``axis`` (index from 0) in ``group``, as written."""
+        values = self.offsets_01um.get(group)
         return values[axis] if values is not None and axis < len(values) else 0.0
 
-    def with_offset(self, group: int, axis: int, axis_count: int, value_mm: float
+    def offset_mm(self, group: int, axis: int) -> float:
+        """Offset of channel axis ``axis`` (index from 0) in ``group`` (mm)."""
+        return self.offset_01um(group, axis) / UM01_PER_MM
+
+    def with_offset(self, group: int, axis: int, axis_count: int, value_01um: float
                     ) -> ZeroOffsetTable:
         """A new table with one axis offset of ``group`` changed."""
-        values = list(self.offsets_mm.get(group, ()))
+        values = list(self.offsets_01um.get(group, ()))
         values += [0.0] * (axis_count - len(values))
-        values[axis] = float(value_mm)
-        offsets = dict(self.offsets_mm)
+        values[axis] = float(value_01um)
+        offsets = dict(self.offsets_01um)
         offsets[group] = tuple(values)
         return ZeroOffsetTable(self.groups, offsets)
 

@@ -19,12 +19,12 @@ from .support import decode, ends, error_of, slow
 def modal_with(offsets: dict[int, tuple[float, ...]] | None = None,
                tools: dict[int, ToolData] | None = None, change_s: float = 0.0) -> ModalState:
     """A modal state whose channel tables hold ``offsets`` and ``tools``."""
-    table = ToolTable(tools or {1: ToolData(True, 2.5, 0.0)}, 9)
-    tables = ToolingTables(table, ZeroOffsetTable(10, offsets or {}), change_s)
+    table = ToolTable(tools or {1: ToolData.of_mm(2.5)}, 9)
+    tables = ToolingTables(table, ZeroOffsetTable.of_mm(10, offsets or {}), change_s)
     return ModalState(tooling=tables)
 
 
-LENGTH = {1: ToolData(True, 2.5, 0.0), 4: ToolData(True, 3.0, 100.0)}
+LENGTH = {1: ToolData.of_mm(2.5), 4: ToolData.of_mm(3.0, 100.0)}
 
 
 @pytest.mark.parametrize("as_text", [lambda t: t, slow], ids=["hot path", "general path"])
