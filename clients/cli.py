@@ -4,7 +4,8 @@
 
 The entry module: the global options and ``main``. The commands live in ``cli_objects``
 (info, browse, read, write, watch), ``cli_machine`` (program store, run, MDI, hold,
-resume, reset, status, lookahead, check), ``cli_plot`` (plot) and ``cli_keys`` (keys new);
+resume, reset, status, lookahead, check), ``cli_plot`` (plot), ``cli_keys`` (keys new) and
+``cli_tools`` (tool, offsets);
 what they share is in ``cli_app``. Importing them here registers them on the app, in this order.
 
 A service started with ``--keys`` needs this client's key (``--key FILE`` or
@@ -38,6 +39,7 @@ from . import cli_plot  # noqa: E402,F401,I001  (plot)
 from . import cli_keys  # noqa: E402,F401,I001  (keys new)
 from . import cli_spindle  # noqa: E402,F401,I001  (spindle)
 from . import cli_manual  # noqa: E402,F401,I001  (jog, home)
+from . import cli_tools  # noqa: E402,F401,I001  (tool, offsets)
 
 __all__ = ["app", "main"]
 

@@ -14,12 +14,14 @@ from typing import Any
 from cnc_objects.objects import AddressSpace, ChannelLayout, CncObject, MachineLayout, build_objects
 from cnc_objects.objects.addressing import LOGICAL_BIT, GroupBase, index_based
 from cnc_objects.objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS, MACHINING_FIELDS
+from cnc_objects.objects.catalog_tools import build_tool_objects
 from cnc_objects.objects.directory import ObjectDirectory
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from . import __version__
 from .binding_technology import TECHNOLOGY_READERS, TECHNOLOGY_WRITERS
+from .binding_tools import tool_readers, tool_writers
 from .machine_config import MachineConfig
 from .kernel.commands import (
     Command,
@@ -47,6 +49,7 @@ from .kernel.commands import (
 from .binding_manual import MANUAL_READERS, MANUAL_WRITERS
 from .kernel.kernel import Kernel, KernelCommand, ResetCycleStats
 from .kernel.state import DecoderFlag
+from .kernel.tooling import tool_list_size
 from .notifications import NotificationCounts
 from .param_list import ParamListError, parse_axis_list
 
@@ -501,7 +504,13 @@ def build_address_space(
     """Every catalog object bound to ``kernel``, plus the COM object directories; the
     service's own figures read ``notifications`` (the hub's counts; zero without one)."""
     space = AddressSpace()
-    objects = build_objects(machine_layout(kernel))
+    layout = machine_layout(kernel)
+    objects = build_objects(layout)
+    # tools and work offsets: their tables are as large as the machine configures
+    size, groups = tool_list_size(kernel.config), kernel.config.zero_offset_groups
+    objects += build_tool_objects(layout, size, groups)
+    readers = {**READERS, **tool_readers(size, groups)}
+    writers = {**WRITERS, **tool_writers(size, groups)}
     counts = notifications if notifications is not None else NotificationCounts()
     for obj in objects:
         service = SERVICE_READERS.get(obj.element)
@@ -509,8 +518,8 @@ def build_address_space(
         if service is not None:
             read = service(counts)
         else:
-            read = READERS[obj.element](kernel, obj) if obj.access.readable else None
-        write = WRITERS[obj.element](kernel, obj) if obj.access.writable else None
+            read = readers[obj.element](kernel, obj) if obj.access.readable else None
+        write = writers[obj.element](kernel, obj) if obj.access.writable else None
         written: Callable[[Any], None] | None = None
         if read is None and write is not None:  # a command: reads give what was written
             echo = LastWritten(obj)

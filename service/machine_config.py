@@ -139,10 +139,12 @@ def parse_interpolator_functions(text: str) -> frozenset[InterpolatorFunction]:
 
 
 class ToolConfig(Strict):
-    """One entry of the tool table: D number and radius."""
+    """One entry of the tool list wz[d]: D (and T) number, radius and length."""
 
-    d: int = Field(ge=1, le=9999, description="tool offset number (D word)")
+    d: int = Field(ge=1, le=9999, description="tool offset number (D word; T names it too)")
     radius_mm: float = Field(ge=0, description="tool radius (mm)")
+    length_mm: float = Field(0.0, ge=-214748.3647, le=214748.3647,
+                             description="tool length along the tool axis (mm)")
 
 
 class SyntaxCheckConfig(Strict):
@@ -402,6 +404,12 @@ class MachineConfig(Strict):
         False, description="START of a program (AUTOMATIC) is refused while an axis of "
         "the channel is not referenced (homing, docs/manual.md); manual blocks (G74 in "
         "MDI) still run")
+    tool_entries: int = Field(32, ge=1, le=9999,
+                              description="rows wz[1..n] of each channel's tool list")
+    tool_change_time_s: float = Field(0.0, ge=0.0, le=600.0,
+                                      description="M6: time the path waits for the change (s)")
+    zero_offset_groups: int = Field(10, ge=7, le=97, description="np_grp[0..n-1] per channel "
+                                    "(P-ZERO-00003): G53, G54..G59, G159 = 7..n-1")
 
     @model_validator(mode="after")
     def _references_resolve(self) -> MachineConfig:

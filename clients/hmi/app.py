@@ -39,6 +39,7 @@ from .machine import ChannelView, Machine
 from .message_line import MessageLine
 from .program_picker import ProgramPicker
 from .session import Feed, run_sessions
+from .tooling import ToolingTable
 
 DEFAULT_TIMEOUT_S = 2.0  # an HMI should say "not reachable" quickly, not after 5 s
 Operation = Callable[[AsyncClient, ChannelView], Awaitable[str]]
@@ -88,6 +89,7 @@ class HmiApp(App[None]):
         self._lookahead_wake = asyncio.Event()
         self.channels = ChannelTable(id="channels")
         self.axes = AxesTable(id="axes")
+        self.tooling = ToolingTable(id="tooling")
         self.errors = ErrorsPanel(id="errors")
         self.lookahead = LookaheadPanel(id="lookahead")
         self.message = MessageLine(id="message")
@@ -101,6 +103,8 @@ class HmiApp(App[None]):
             yield self.channels
             yield Label("axes", classes="title")
             yield self.axes
+            yield Label("tools and work offsets", classes="title")
+            yield self.tooling
             yield self.errors
             yield self.lookahead
         yield self.message
@@ -126,7 +130,8 @@ class HmiApp(App[None]):
         self.channels.load(machine)
         self.channels.move_cursor(row=max(0, min(row, len(machine.channels) - 1)))
         self.axes.load(machine)
-        for widget in (self.channels, self.axes):
+        self.tooling.load(machine)
+        for widget in (self.channels, self.axes, self.tooling):
             widget.remove_class("stale")
         self.sub_title = f"{info.name} {info.version} at {self.endpoint}"
         self.message.say(f"connected to {self.endpoint}: {len(machine.channels)} channels")
@@ -137,13 +142,13 @@ class HmiApp(App[None]):
         blocks = [Feed(ch.obj("mc_block_count_r"), self._block_finished(ch))
                   for ch in machine.channels]
         return [*self.channels.feeds(machine), *self.axes.feeds(machine),
-                *self.errors.feeds(client, machine), *blocks]
+                *self.tooling.feeds(machine), *self.errors.feeds(client, machine), *blocks]
 
     def session_lost(self, reason: str) -> None:
         """Say that the service does not answer; the shown values are stale."""
         self.client = None
         self.sub_title = f"not connected: {self.endpoint}"
-        for widget in (self.channels, self.axes):
+        for widget in (self.channels, self.axes, self.tooling):
             widget.add_class("stale")
         self.message.say(reason, error=True)
 

@@ -56,6 +56,8 @@ from .spindle import Spindle
 from .state import MESSAGES_KEPT, Channel, ErrorEntry, DecoderFlag
 from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
+from .tooling import seed_modal, tables_from_config, tooling_of
+from .tooling_view import after_reset, initial_tooling
 
 log = logging.getLogger(__name__)
 
@@ -112,7 +114,10 @@ class ChannelRunner:
         self.error_log_name = f"errors-ch{channel.channel_id}.log"
         self._axes = tuple(a.name for a in config.axes)
         self._axis_numbers = tuple(a.logical_number for a in config.axes)
-        self._tools = {t.d: t.radius_mm for t in machine.tools}
+        # the tool list and zero offsets the decoders read and the objects write
+        self.tables = tables_from_config(machine)
+        channel.tooling = initial_tooling(self.tables, len(config.axes))
+        self._tools = self.tables.tools  # the radii, for decoders without modal tables
         self._params = params
         self._switchover = switchover
         self._buffer_blocks = config.look_ahead_blocks
@@ -273,6 +278,7 @@ class ChannelRunner:
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
         self._move(ChannelEvent.RESET)
         self._modal = None
+        ch.tooling = after_reset(ch.tooling)
         self.initialise_channel()
         return None
 
@@ -474,6 +480,7 @@ class ChannelRunner:
         feed_mm_min = self.config.prog_start.feedrate  # P-CHAN-00099: F of a block without F
         if feed_mm_min > 0.0:
             modal.feed_mm_min = feed_mm_min
+        seed_modal(modal, self.tables, self.channel.tooling)
         return modal
 
     def _show_start(self, job: Job) -> None:
@@ -500,6 +507,8 @@ class ChannelRunner:
             ch.message_count += len(new)
         if self._modal is not None and self._modal.settings != ch.machining:
             ch.machining = replace(self._modal.settings)
+        if self._modal is not None:
+            ch.tooling = tooling_of(self._modal, ch.tooling, self._axes)
 
     def _axis_limits(self) -> tuple[tuple[AxisDynamics, ...], tuple[tuple[float, float], ...]]:
         """Dynamics and software limits of the channel's axes from the effective axis

@@ -16,7 +16,7 @@ from __future__ import annotations
 import logging
 import queue
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 
 from .nc import Decoder, ModalState, NcError, NcErrorId
@@ -115,7 +115,7 @@ class DecoderFeed:
         channel_id: int,
         axes: tuple[str, ...],
         loader: ProgramLoader,
-        tools: dict[int, float],
+        tools: Mapping[int, float],
         modal: ModalState,
         capacity: int,
         keep_open: bool = False,

@@ -19,9 +19,11 @@ from cnc_objects.protocol.values import LinkState as LinkState
 from ..machine_config import ChannelConfig, MachineConfig
 from .axis_params import AxisParameters
 from .nc.technology import MachiningSettings
+from .nc.tool_data import ToolingTables
 from .plc_functions import PlcFunctions, PlcFunctionsUnit
 from .refusal import Refusal
 from .spindle import SpindleState
+from .tooling_view import ChannelTooling
 
 MESSAGES_KEPT = 8  # #MSG texts a channel shows (ch<c>.mc_message_<k>_text_r)
 
@@ -196,6 +198,7 @@ class Channel:
     plc_functions: PlcFunctionsUnit = field(default_factory=PlcFunctionsUnit)
     spindle: SpindleState = field(default_factory=SpindleState)
     manual: tuple[Any, ...] = ()  # ManualAxisView per axis (manual_mode.ManualMode sets)
+    tooling: ChannelTooling = field(default_factory=ChannelTooling)  # T, D, zero offsets
 
     @property
     def execution_mode_commanded(self) -> int:
@@ -226,6 +229,7 @@ class Channel:
             self.contour, self.execution_mode_plc_command, self.execution_mode_plc_enable,
             self.syn_chk, self.decoder_flags, self.messages, self.message_count,
             self.machining, self.prod_time_trace, self.plc_functions, self.spindle, self.manual,
+            self.tooling,
         )
 
 
@@ -278,6 +282,8 @@ class ChannelRunnerView(Protocol):
     # set when a RESET of the channel is queued: a cycle waiting for its decoder stops
     reset_pending: threading.Event
     plc: PlcFunctions  # the channel's M/S/T functions to the PLC and its spindle
+    channel: Channel  # the channel's state, as objects show it
+    tables: ToolingTables  # the channel's tool list and zero offset table (live)
     # manual mode of the channel's axes: a manual_mode.ManualMode (that module imports
     # this one, so it is named where it is used: manual_commands)
     manual: Any

@@ -32,7 +32,7 @@ from __future__ import annotations
 import logging
 import re
 import threading
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
@@ -115,7 +115,7 @@ class CheckRun:
         text_of: Callable[[str], str],
         axes: tuple[str, ...],
         axis_numbers: tuple[int, ...],
-        tools: dict[int, float],
+        tools: Mapping[int, float],
         contour_lookahead: bool,
         start_mm: tuple[float, ...],
         dynamics: Sequence[AxisDynamics],

@@ -181,6 +181,10 @@ async def test_browse_describes_objects(api: Any) -> None:
         "ch1.ax1.acc_max",
         "ch1.ax1.vel_jump_max",
         *(f"ch1.ax1.{row.element}" for row in MANUAL_ROWS if row.scope == "channel_axis"),
+        # tools and work offsets: positions in workpiece coordinates, zero offsets
+        "ch1.ax1.command_position_pcs",
+        "ch1.ax1.actual_position_pcs",
+        *(f"ch1.ax1.np_grp[{group}].v" for group in range(1, 10)),
     }
     link = found["ch1.ax1.link_state"]
     assert (link.port, link.group, link.offset, link.type, link.length, link.access) == (

@@ -43,6 +43,7 @@ from .homing_block import homing_motion, with_homing
 from .geometry import centre_from_offsets, centre_from_radius
 from .modal import G_CODES, PLANE_AXES, DistanceMode, GGroup, MCode, ModalState, Plane
 from .statements import Assign, AxisCommand, NcBlock, Word, WordKind
+from .tool_data import ToolTable, program_shift_mm
 from .variables import VariableFault
 
 
@@ -82,12 +83,16 @@ _OFFSET_LETTER = ("I", "J", "K")
 # the plain fields of the ModalState a block may change (variables excluded)
 _MODAL_FIELDS = ("position_mm", "distance", "plane", "motion", "feed_mm_min", "compensation",
                  "tool_offset", "spindle_speed_rpm", "tool", "look_ahead_params",
-                 "look_ahead_mark")
+                 "look_ahead_mark", "zero_offset_group", "spindle_tool")
 # modal G groups -> the ModalState field they set
 _MODAL_FIELD = {
     GGroup.MOTION: "motion", GGroup.PLANE: "plane",
     GGroup.COMPENSATION: "compensation", GGroup.DISTANCE: "distance",
+    GGroup.ZERO_OFFSET: "zero_offset_group",
 }
+G159 = 159  # G159 = <i>: zero offset group i (in the groups of a block)
+M_TOOL_CHANGE = 6  # M6: change to the tool T selected
+
 
 
 Groups = dict[GGroup, tuple[int, int]]  # G group -> (G number, pos)
@@ -121,6 +126,11 @@ class BlockExecutor:
         self.axis_numbers = axis_numbers or tuple(range(1, len(axes) + 1))
         self.tools = tools
         self.modal = modal
+        # the decoder reads the tool list of the modal state's tables (a channel's live
+        # list); a modal state without one takes the radii given here
+        if not modal.tooling.tools.checks_tools and not modal.tooling.tools.rows:
+            modal.tooling.tools = ToolTable.from_radii(tools)
+        self._np_index = 0  # the index of this block's G159 = <i>
         self.manual = manual
         self.items_done = 0  # items of the last block executed before it ended or failed
         index = {name: k for k, name in enumerate(axes)}
@@ -149,8 +159,15 @@ class BlockExecutor:
         """Radius of tool entry D (0.0 for D0), None when not in the table."""
         if d == 0:
             return 0.0
-        radius = self.tools.get(d)
+        radius = self.modal.tooling.tools.get(d)
         return None if radius is None else float(radius)
+
+    def program_shift(self) -> tuple[float, ...] | None:
+        """What an absolute axis word adds per channel axis (zero offset + tool
+        length), or None when nothing."""
+        modal = self.modal
+        return program_shift_mm(modal.tooling, modal.zero_offset_group, modal.tool_offset,
+                                int(modal.plane), self.axes)
 
     def execute(self, stmt: NcBlock, env: Env, on_error: ItemFailed | None = None
                 ) -> tuple[Block | None, Flow, int]:
@@ -216,6 +233,8 @@ class BlockExecutor:
         flow_pos = -1
         m_functions: list[int] = []
         for number, pos, k in m_codes:
+            if number == M_TOOL_CHANGE:
+                dwell_s += self._tool_change(pos, err)
             action = _M_FLOW.get(number)
             if action is None:
                 m_functions.append(number)
@@ -275,6 +294,8 @@ class BlockExecutor:
                 self._look_ahead_switch(value != 0.0)
             case WordKind.LOOK_AHEAD_PARAM:
                 self._look_ahead_param(item.letter, value, item.pos, err)
+            case WordKind.ZERO_OFFSET_INDEX:
+                self._zero_offset_index(value, item.pos, groups, err)
             case _:  # F S T D R
                 words[item.kind] = (value, item.pos)
 
@@ -304,6 +325,9 @@ class BlockExecutor:
         if number is None or number not in G_CODES:
             raise err(NcErrorId.UNSUPPORTED_G_CODE, f"G{value:g} is not supported", pos)
         group = G_CODES[number][0]
+        if group == GGroup.ZERO_OFFSET and group in groups:
+            raise err(NcErrorId.ZERO_OFFSETS_TWICE,
+                      f"G{number}: one zero offset (G53..G59, G159) per block", pos)
         if group in groups:
             raise err(NcErrorId.CONFLICTING_G_CODES,
                       f"G{groups[group][0]} and G{number} in one block", pos)
@@ -354,10 +378,41 @@ class BlockExecutor:
         if modal.look_ahead_mark is not None:
             modal.look_ahead_mark = params
 
+    def _zero_offset_index(self, value: float, pos: int,
+                           groups: Groups, err: ErrorAt) -> None:
+        """G159 = <i>: zero offset group i of the table (0 = G53, 1..6 = G54..G59)."""
+        if GGroup.ZERO_OFFSET in groups:
+            raise err(NcErrorId.ZERO_OFFSETS_TWICE,
+                      "G159: one zero offset (G53..G59, G159) per block", pos)
+        index = _integer(value)
+        if index is None:
+            raise err(NcErrorId.ZERO_OFFSET_INDEX_FORMAT,
+                      f"G159 = {value:g}: the zero offset group is a whole number >= 0", pos)
+        groups_max = self.modal.tooling.zero_offsets.groups - 1
+        if index > groups_max:
+            raise err(NcErrorId.ZERO_OFFSET_INDEX_RANGE,
+                      f"G159 = {index}: the zero offset table has the groups 0..{groups_max}",
+                      pos)
+        self._np_index = index
+        groups[GGroup.ZERO_OFFSET] = (G159, pos)
+
+    def _tool_change(self, pos: int, err: ErrorAt) -> float:
+        """M6: the tool T selected goes into the spindle; the path waits the tool
+        change time (returned, s)."""
+        modal = self.modal
+        if modal.tool is None:
+            raise err(NcErrorId.TOOL_CHANGE_WITHOUT_TOOL,
+                      "M6 without a tool: program T<number> before (or in) the M6 block",
+                      pos)
+        modal.spindle_tool = modal.tool
+        return modal.tooling.tool_change_time_s
+
     def _modal_groups(self, groups: Groups) -> None:
         for group, (number, _pos) in groups.items():
             field = _MODAL_FIELD.get(group)
-            if field is not None:  # G4 (DWELL) changes nothing modal
+            if number == G159:
+                self.modal.zero_offset_group = self._np_index
+            elif field is not None:  # G4 (DWELL) changes nothing modal
                 setattr(self.modal, field, G_CODES[number][1])
 
     def _technology(self, words: Words, err: ErrorAt) -> None:
@@ -381,6 +436,10 @@ class BlockExecutor:
             if t is None:
                 raise err(NcErrorId.INVALID_TOOL_NUMBER,
                           f"T{value:g} is not a valid tool number", pos)
+            if not modal.tooling.tools.knows_tool(t):
+                raise err(NcErrorId.UNKNOWN_TOOL,
+                          f"T{t}: unknown tool id (no valid entry wz[{t}] in the tool list)",
+                          pos)
             modal.tool = t
 
     def _feed(self, word: tuple[float, int], err: ErrorAt) -> None:
@@ -438,12 +497,16 @@ class BlockExecutor:
         end = list(start)
         incremental = modal.distance == DistanceMode.INCREMENTAL
         placement = modal.cs_placement
+        shift = None if incremental else self.program_shift()
+        if shift is not None and placement is not None:  # #CS lies on the zero offset
+            placement = shifted_placement(placement, shift, self.xyz)
         cs_axes = self.xyz if placement is not None else ()
         for axis, value, pos, letter in axis_words:
             if axis < 0:
                 raise err(NcErrorId.UNKNOWN_WORD, f"{letter} is not an axis of this channel", pos)
             if axis not in cs_axes:
-                end[axis] = start[axis] + value if incremental else value
+                end[axis] = (start[axis] + value if incremental
+                             else value + shift[axis] if shift is not None else value)
         if placement is not None:  # X, Y, Z are programmed in the machining coordinates
             cs_start, cs_end = self._cs_targets(placement, start, end, axis_words, incremental)
         for axis, _value, pos, letter in axis_words:
@@ -605,6 +668,15 @@ class BlockExecutor:
             pos, axis = min(hits)
             raise err(NcErrorId.AXIS_RELEASED, f"axis {self.axes[axis]} is not in the channel "
                       "(released by #AX RELEASE)", pos)
+
+
+def shifted_placement(placement: Placement, shift: tuple[float, ...],
+                      xyz: tuple[int, ...]) -> Placement:
+    """``placement`` moved by the X, Y, Z parts of ``shift`` (the #CS chain is selected
+    on top of the zero offset and the tool length)."""
+    ox, oy, oz = placement.origin_mm
+    dx, dy, dz = (shift[k] if k >= 0 else 0.0 for k in xyz)
+    return Placement((ox + dx, oy + dy, oz + dz), placement.rotation)
 
 
 def _first(text: str) -> int:

@@ -48,6 +48,11 @@ class NcErrorId(IntEnum):
     INVALID_DWELL = 20135  # G4 without a time, negative time, or with axis motion
     INVALID_HOMING = 20136  # G74 without axes, with a sequence number that is not
     # a whole number >= 1, with motion words, or with several sequence numbers
+    TOOL_CHANGE_WITHOUT_TOOL = 20137  # M6 before any T was programmed (project id)
+    UNKNOWN_TOOL = 21915  # ISG: unknown tool id (T of no valid wz[i] row)
+    ZERO_OFFSETS_TWICE = 20116  # ISG: two of G53..G59/G159 in one block
+    ZERO_OFFSET_INDEX_RANGE = 20149  # ISG: G159 = <i> beyond the zero offset table
+    ZERO_OFFSET_INDEX_FORMAT = 20582  # ISG: G159 = <i> not a whole number >= 0
     BLOCK_NUMBER_TWICE = 20841  # ISG: N programmed twice in one block (N10 N10:)
     UNKNOWN_WORD = 21220  # ISG: unknown or incomplete token (unknown address letter)
 

@@ -10,7 +10,10 @@ Any other line (other words or orders, brackets, variables, ``$``, ``#``, ``%``,
 ``/``, ``(``, lower case, ...) does not match and is decoded by the general path
 (``Decoder.slow_step``: parser, executor, control flow). While an axis is released
 (``#AX RELEASE``), a machining coordinate system is active (``#CS``) or a call pattern
-is being defined (``#PATTERN BEGIN``), every line goes there. A matching line that would be
+is being defined (``#PATTERN BEGIN``), every line goes there. Under a zero offset or a
+tool length (``G54``.., ``D``) the hot path adds the program shift to absolute words, as
+the general path does (``BlockExecutor.program_shift``; read again after every line of
+the general path, which is where G54, D or the plane change). A matching line that would be
 an error (arc end point off the circle, no F yet, I/J/K in a G1 block, a malformed
 number such as ``X1.2.3``) goes there too, untouched: the general path is the reference
 and raises the error with its exact column. So the hot path decodes only valid lines,
@@ -74,6 +77,9 @@ def run(decoder):
         comp = modal.compensation
         look_ahead = modal.look_ahead_mark  # LA_ON: the parameters in effect, else None
         radius = executor.tool_radius(modal.tool_offset) or 0.0
+        # zero offset + tool length (G54.., D): added to absolute axis words
+        shift = executor.program_shift()
+        {unpack_shift} = shift or pos
         plane, line_plane, roles, outside = executor.arc_setup(modal.plane)
         role_i, role_j, role_k = roles
         # with an axis released (#AX RELEASE) every line takes the general path, which
@@ -108,8 +114,10 @@ def run(decoder):
                         continue
                     if incremental:
 {incremental}
-                    else:
+                    elif shift is None:
 {absolute}
+                    else:
+{absolute_shifted}
                 except ValueError:  # a malformed number: the general path reports it
                     break
                 end_pos = ({end_tuple})
@@ -291,6 +299,9 @@ def loop_source(axes: tuple[str, ...], check: bool = False) -> str:
     absolute = "\n".join(
         f"{pad}e{k} = p{k} if a{k} is None else float(a{k})" for k in range(n)
     ) or f"{pad}pass"
+    absolute_shifted = "\n".join(
+        f"{pad}e{k} = p{k} if a{k} is None else float(a{k}) + s{k}" for k in range(n)
+    ) or f"{pad}pass"
     incremental = "\n".join(
         f"{pad}e{k} = p{k} if a{k} is None else p{k} + float(a{k})" for k in range(n)
     ) or f"{pad}pass"
@@ -314,7 +325,8 @@ def loop_source(axes: tuple[str, ...], check: bool = False) -> str:
         unpack_pos=unpack,
         axis_texts=", ".join(f"a{k}" for k in range(n)),
         no_axis_word=" and ".join(f"a{k} is None" for k in range(n)) or "True",
-        absolute=absolute, incremental=incremental,
+        absolute=absolute, incremental=incremental, absolute_shifted=absolute_shifted,
+        unpack_shift=", ".join(f"s{k}" for k in range(n)) + ("," if n == 1 else ""),
         end_tuple=", ".join(f"e{k}" for k in range(n)) + ("," if n == 1 else ""),
         arc_motion=arc, linear_motion=linear,
         fast_end=_FAST_END_CHECK if check else _FAST_END,

@@ -10,7 +10,7 @@ decoded with the modal state the previous one left. A program start (a ``Decoder
 is not manual) gives all axes back to the channel.
 
 Defaults after a reset: G90, G17, G01 (a motion block without F is an error until an F
-is programmed, never an accidental rapid), G40, D0, no F, S or T.
+is programmed, never an accidental rapid), G40, D0, G53, no F, S or T.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ from .blocks import Compensation, LogArea, LookAheadMark, MotionKind
 from .coordinates import CoordinateSystem, Placement
 from .patterns import OpenPattern, PatternPosition
 from .technology import MachiningSettings
+from .tool_data import ToolingTables
 from .variables import Variable
 
 
@@ -55,6 +56,19 @@ class GGroup(IntEnum):
     COMPENSATION = 3  # G40 G41 G42 (modal)
     DISTANCE = 4  # G90 G91 (modal)
     HOMING = 5  # G74 (this block only): homing of the programmed axes
+    ZERO_OFFSET = 6  # G53 G54..G59 (modal; G159 = <i> in the same group)
+
+
+class ZeroOffsetGroup(IntEnum):
+    """The zero offset groups the G functions select (ISG ``np_grp[i]``)."""
+
+    G53 = 0  # no zero offset (initial state)
+    G54 = 1
+    G55 = 2
+    G56 = 3
+    G57 = 4
+    G58 = 5
+    G59 = 6
 
 
 # the G functions this decoder knows: number -> (group, value set in the modal state)
@@ -73,6 +87,8 @@ G_CODES: dict[int, tuple[GGroup, IntEnum | None]] = {
     90: (GGroup.DISTANCE, DistanceMode.ABSOLUTE),
     91: (GGroup.DISTANCE, DistanceMode.INCREMENTAL),
     74: (GGroup.HOMING, None),
+    # G53 (no zero offset) and G54..G59: zero offset group np_grp[0..6]
+    **{g: (GGroup.ZERO_OFFSET, ZeroOffsetGroup(g - 53)) for g in range(53, 60)},
 }
 
 
@@ -123,6 +139,11 @@ class ModalState:
     # G74: channel axis index -> (reference position P-AXIS-00152 in mm, homing speed
     # in mm/s); an axis missing here homes to 0 at HOMING_DEFAULT_MM_S
     homing: dict[int, tuple[float, float]] = field(default_factory=dict)
+    # tools and work offsets (tool_data): the channel's live tables, the zero offset
+    # group selected (G53..G59, G159) and the tool in the spindle (the T of the last M6)
+    tooling: ToolingTables = field(default_factory=ToolingTables)
+    zero_offset_group: int = 0
+    spindle_tool: int = 0
 
     def start_program(self) -> None:
         """What a program start resets: no coordinate system, patterns or settings."""
@@ -135,3 +156,4 @@ class ModalState:
         self.msg_file = None
         self.look_ahead_params = self.look_ahead_defaults
         self.look_ahead_mark = None
+        self.zero_offset_group = 0  # G53 is the initial state (P-ZERO-00002 = 0)

@@ -58,7 +58,9 @@ _CONTROL = {
 }
 _WITH_CONDITION = frozenset({StmtKind.IF, StmtKind.ELSEIF, StmtKind.WHILE, StmtKind.UNTIL,
                              StmtKind.SWITCH})
-_WEIGHTINGS = (133.0, 134.0)  # G133 = <%> acceleration, G134 = <%> ramp time weighting
+# G functions followed by "= <expr>": G133/G134 (weighting), G159 (zero offset group)
+_ASSIGNED_G = {133.0: WordKind.WEIGHTING, 134.0: WordKind.WEIGHTING,
+               159.0: WordKind.ZERO_OFFSET_INDEX}
 _NOT_YET = frozenset({"DO", "ENDDO"})  # known ISG keywords of later issues
 # enhanced look-ahead (MTC200 names): the switches and the parameters set with '='
 LOOK_AHEAD_SWITCHES = {"LA_ON": 1.0, "LA_OFF": 0.0}
@@ -313,10 +315,10 @@ class LineParser:
                     )
             cur.pos += 1
             value = self._value(cur, c, pos)
-            if kind == WordKind.G and value in _WEIGHTINGS and _skip(cur) < cur.end \
+            if kind == WordKind.G and value in _ASSIGNED_G and _skip(cur) < cur.end \
                     and cur.peek() == "=" and cur.peek(1) != "=":
-                cur.pos += 1  # G133 = <percent> / G134 = <percent>
-                block.items.append(Word(WordKind.WEIGHTING, f"G{int(value)}",
+                cur.pos += 1  # G133 = <percent> / G134 = <percent> / G159 = <index>
+                block.items.append(Word(_ASSIGNED_G[value], f"G{int(value)}",
                                         ExpressionParser(cur).parse(), pos))
                 return
             if kind == WordKind.G and isinstance(value, float):

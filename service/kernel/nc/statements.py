@@ -87,6 +87,7 @@ class WordKind(IntEnum):
     WEIGHTING = 9  # G133 = <%> / G134 = <%>: acceleration / ramp time weighting
     LOOK_AHEAD = 10  # LA_ON (value 1) / LA_OFF (value 0): enhanced look-ahead
     LOOK_AHEAD_PARAM = 11  # METB = <s> / VFBT = <factor> / BBTRC = <blocks>
+    ZERO_OFFSET_INDEX = 12  # G159 = <i>: zero offset group np_grp[i]
 
 
 @final  # the decoder dispatches on type(stmt) is ...: no subclasses

@@ -1,0 +1,92 @@
+"""Tools and zero offsets in the decoder: the program shift on absolute positions, the
+plane's tool axis, #CS on top of the shift, the hot path and the general path alike."""
+
+from __future__ import annotations
+
+import pytest
+
+from cnc_objects.service.kernel.nc import ModalState, NcErrorId
+from cnc_objects.service.kernel.nc.tool_data import (
+    ToolData,
+    ToolingTables,
+    ToolTable,
+    ZeroOffsetTable,
+)
+
+from .support import decode, ends, error_of, slow
+
+
+def modal_with(offsets: dict[int, tuple[float, ...]] | None = None,
+               tools: dict[int, ToolData] | None = None, change_s: float = 0.0) -> ModalState:
+    """A modal state whose channel tables hold ``offsets`` and ``tools``."""
+    table = ToolTable(tools or {1: ToolData.of_mm(2.5)}, 9)
+    tables = ToolingTables(table, ZeroOffsetTable.of_mm(10, offsets or {}), change_s)
+    return ModalState(tooling=tables)
+
+
+LENGTH = {1: ToolData.of_mm(2.5), 4: ToolData.of_mm(3.0, 100.0)}
+
+
+@pytest.mark.parametrize("as_text", [lambda t: t, slow], ids=["hot path", "general path"])
+def test_zero_offset_and_tool_length_shift_absolute_positions(as_text):
+    program = "G54\nD4\nG0 X1 Y2 Z3\nG1 X5 F100\nG91 X1\nG90 G53 D0 X0 Y0 Z0\nM30"
+    got = ends(as_text(program), modal=modal_with({1: (10.0, 20.0, 30.0)}, LENGTH))
+    assert got == [(11.0, 22.0, 133.0), (15.0, 22.0, 133.0), (16.0, 22.0, 133.0),
+                   (0.0, 0.0, 0.0)]
+
+
+@pytest.mark.parametrize(("plane", "axis"), [(17, 2), (18, 1), (19, 0)])
+def test_the_tool_length_acts_along_the_tool_axis_of_the_plane(plane, axis):
+    [end] = ends(f"G{plane} D4 G0 X0 Y0 Z0\nM30", modal=modal_with(tools=LENGTH))
+    expected = [0.0, 0.0, 0.0]
+    expected[axis] = 100.0
+    assert end == tuple(expected)
+
+
+def test_unprogrammed_axes_keep_their_machine_position():
+    got = ends("G0 X1 Y1 Z1\nG54\nG0 X2\nM30", modal=modal_with({1: (10.0, 20.0, 30.0)}))
+    assert got == [(1.0, 1.0, 1.0), (12.0, 1.0, 1.0)]
+
+
+def test_a_machining_coordinate_system_lies_on_the_zero_offset():
+    program = "G54\n#CS ON [1, 0, 0, 0, 0, 90]\nG0 X1 Y0 Z0\n#CS OFF\nM30"
+    [end] = ends(program, modal=modal_with({1: (10.0, 0.0, 0.0)}))
+    assert end == pytest.approx((11.0, 1.0, 0.0))
+
+
+def test_g159_selects_further_groups():
+    modal = modal_with({8: (0.0, -4.0, 0.0)})
+    assert ends("G159=8 G0 Y1\nM30", modal=modal) == [(0.0, -3.0, 0.0)]
+    assert modal.zero_offset_group == 8
+
+
+def test_m6_takes_the_tool_and_waits_the_change_time():
+    modal = modal_with(change_s=1.5)
+    blocks = decode("T1\nM6\nM30", modal=modal)
+    assert [(b.tool, b.m_functions, b.dwell_s) for b in blocks[:2]] == [
+        (1, (), 0.0), (None, (6,), 1.5)]
+    assert modal.spindle_tool == 1
+
+
+@pytest.mark.parametrize(
+    ("program", "error_id", "column"),
+    [("T5", NcErrorId.UNKNOWN_TOOL, 1), ("M6", NcErrorId.TOOL_CHANGE_WITHOUT_TOOL, 1),
+     ("G0 G159=10", NcErrorId.ZERO_OFFSET_INDEX_RANGE, 4),
+     ("G159=-1", NcErrorId.ZERO_OFFSET_INDEX_FORMAT, 1),
+     ("G159=2 G54", NcErrorId.ZERO_OFFSETS_TWICE, 8)],
+)
+def test_bad_words(program, error_id, column):
+    error = error_of(program + "\nM30", modal=modal_with())
+    assert (error.id, error.line, error.column) == (error_id, 1, column)
+
+
+def test_a_failing_block_leaves_the_tool_and_the_offset_as_they_were():
+    modal = modal_with()
+    error_of("T1 M6\nG55\nG54 G159=20\nM30", modal=modal)
+    assert (modal.spindle_tool, modal.zero_offset_group) == (1, 2)
+
+
+def test_a_table_from_radii_accepts_every_tool():
+    """Decoders given plain radii (syntax tools, tests) do not check T numbers."""
+    blocks = decode("T23 M6\nM30")
+    assert blocks[0].tool == 23
