@@ -79,8 +79,9 @@ class MachineLayout:
 PLC_GROUP = 0x4020
 PLC_CHANNEL_BASE, PLC_CHANNEL_STRIDE = 0x10000, 0x1000
 PLC_AXIS_BASE, PLC_AXIS_STRIDE = 0x80000, 0x100
-# gpCh[i].bahn_state.coord_r[k] (per axis of the channel, k from 0), after the contour reply
-PLC_COORD_BASE, PLC_COORD_STRIDE = 0xE00, 0x10
+# gpCh[i].bahn_state.coord_r[k] (per axis of the channel, k from 0), after the technology
+# units and the spindle (0xD00..0xE30): room for 28 axes before the next channel's area
+PLC_COORD_BASE, PLC_COORD_STRIDE = 0xE40, 0x10
 
 # gpCh[i].contour_lookahead.response.block[0..N-1] (HLI_CONTOUR_LOOKAHEAD_BLOCK)
 CONTOUR_RESPONSE_BLOCKS = 32
