@@ -22,7 +22,11 @@ $(VENV)/.installed-test: pyproject.toml | $(BIN)/python
 run: $(VENV)/.installed
 	$(BIN)/cnc-service --endpoint $(ENDPOINT)
 
+# The checkers first (ruff: lint and import order; mypy, strict: tools/typecheck.py), then
+# the tests.
 test: $(VENV)/.installed-test
+	$(BIN)/ruff check .
+	$(BIN)/python tools/typecheck.py
 	$(BIN)/python -m pytest $(PYTEST_ARGS)
 
 bench: $(VENV)/.installed-test

@@ -172,7 +172,7 @@ async def _client_bursts(endpoint: str, count: int) -> Figure:
         for _ in range(bursts):
             t0 = clock()
             await asyncio.gather(*(c.read_address(*ADDRESS) for _ in range(IN_FLIGHT)))
-            lat.append((clock() - t0))  # a burst's latency: its last reply
+            lat.append(clock() - t0)  # a burst's latency: its last reply
         elapsed = clock() - start
     return figure(bursts * IN_FLIGHT, elapsed, lat)
 

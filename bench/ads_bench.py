@@ -24,8 +24,8 @@ import pyads
 from cnc_objects.clients import Client
 from cnc_objects.testing.process import free_loopback_ads_address, start_service
 
-from .common import BENCH_MACHINE, Figure, figure, median_figure
 from .ads_echo import serve_ads_echo
+from .common import BENCH_MACHINE, Figure, figure, median_figure
 
 LOCAL_NET_ID = "127.0.0.1.1.30"
 OBJECT = (551, 0x121301, 0x10018)  # ch1.ax1.link_state, UDINT

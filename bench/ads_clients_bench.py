@@ -47,7 +47,7 @@ def _pyads_upload_read_all(plc: pyads.Connection) -> tuple[int, float]:
         if symbol.plc_type is not None:
             symbol.read()
         else:  # a struct: pyads has no type for it; its bytes, the size from 0xF009
-            info = adsGetSymbolInfo(plc._port, plc._adr, symbol.name)  # noqa: SLF001
+            info = adsGetSymbolInfo(plc._port, plc._adr, symbol.name)
             plc.read(symbol.index_group, symbol.index_offset, ctypes.c_ubyte * info.size)
     return len(symbols), time.perf_counter() - started
 

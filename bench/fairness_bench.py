@@ -4,7 +4,8 @@ bench``, part ``fairness``; issue 25).
 A realtime service (1 ms cycle) serves ``notifications_total`` cyclic notifications (20
 connections of 1 000, every 1 ms, over five objects; every sample read by a client
 process of its own, ``tests/support/cyclic_subscribers.py``) while another client reads
-one object at a time; once over ZeroMQ, once over ADS (subscriptions and reads). Printed: that client's read latency p50 / p99 / max, idle and
+one object at a time; once over ZeroMQ, once over ADS (subscriptions and reads). Printed:
+that client's read latency p50 / p99 / max, idle and
 loaded, and the samples per second the subscribers got. Target (issue 25): p99 under
 load below 10 ms.
 """

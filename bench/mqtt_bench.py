@@ -145,7 +145,7 @@ async def throughput(endpoint: str, broker: Broker, seconds: float) -> tuple[flo
         cpu0, t0 = cpu_s(bridge.pid), time.perf_counter()
         await asyncio.sleep(seconds)  # the measurement window
         cpu1, t1 = cpu_s(bridge.pid), time.perf_counter()
-        seen = list(inbox._queue)  # noqa: SLF001
+        seen = list(inbox._queue)
         count = sum(1 for _, topic, _ in seen if not topic.endswith("/status"))
         await cnc.reset()
         return count / (t1 - t0), 100 * (cpu1 - cpu0) / (t1 - t0)

@@ -352,7 +352,7 @@ class ChannelOps(ProgramOps):
 
     async def status(self, channel: int = 1) -> ChannelStatus:
         """Mode, state, program, block and axis positions of a channel."""
-        axes = [o for o in await self.browse(f"ch{channel}.ax*.command_position_acs")]
+        axes = list(await self.browse(f"ch{channel}.ax*.command_position_acs"))
         names = [
             f"ch{channel}.{n}"
             for n in (

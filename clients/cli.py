@@ -29,17 +29,18 @@ import sys
 
 import typer
 
+# Importing a command module registers its commands; help lists them in this order.
+from . import (
+    cli_keys,  # noqa: F401  (keys new)
+    cli_machine,  # noqa: F401  (programs, channel commands, check)
+    cli_manual,  # noqa: F401  (jog, home)
+    cli_objects,  # noqa: F401  (info, browse, read, write, watch)
+    cli_plot,  # noqa: F401  (plot)
+    cli_spindle,  # noqa: F401  (spindle)
+    cli_tools,  # noqa: F401  (tool, offsets)
+)
 from .cli_app import Settings, app
 from .client import DEFAULT_ENDPOINT
-
-# Importing a command module registers its commands; help lists them in this order.
-from . import cli_objects  # noqa: E402,F401,I001  (info, browse, read, write, watch)
-from . import cli_machine  # noqa: E402,F401,I001  (programs, channel commands, check)
-from . import cli_plot  # noqa: E402,F401,I001  (plot)
-from . import cli_keys  # noqa: E402,F401,I001  (keys new)
-from . import cli_spindle  # noqa: E402,F401,I001  (spindle)
-from . import cli_manual  # noqa: E402,F401,I001  (jog, home)
-from . import cli_tools  # noqa: E402,F401,I001  (tool, offsets)
 
 __all__ = ["app", "main"]
 

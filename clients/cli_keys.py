@@ -16,7 +16,6 @@ import inspect
 import re
 import shutil
 from pathlib import Path
-from typing import Optional
 
 import typer
 import zmq.auth
@@ -49,11 +48,11 @@ def new(
     directory: Path = typer.Option(
         Path("."), "--dir", metavar="DIR", help="Where NAME.key and NAME.key_secret go."
     ),
-    role: Optional[str] = typer.Option(
+    role: str | None = typer.Option(
         None, "--role", metavar="ROLE",
         help=f"With --allow-in: what the client may do, one of {ROLE_NAMES} (default monitor).",
     ),
-    allow_in: Optional[Path] = typer.Option(
+    allow_in: Path | None = typer.Option(
         None, "--allow-in", metavar="KEYS_DIR",
         help="Put the public key into the allow-list of the service whose --keys directory "
         "is KEYS_DIR (KEYS_DIR/clients/ROLE/NAME.key) and copy its server.key beside the key.",

@@ -4,7 +4,9 @@
     cnc outputs                          cnc output NAME [-o FILE]        cnc delete-output NAME
     cnc run FILE|NAME [--channel N] [--wait] [--timeout S]
     cnc mdi "BLOCKS" [--channel N] [--wait] [--timeout S]
-    cnc hold [--channel N]               cnc resume [--channel N] [--wait] [--timeout S]        cnc reset [--channel N] [--standard]
+    cnc hold [--channel N]
+    cnc resume [--channel N] [--wait] [--timeout S]
+    cnc reset [--channel N] [--standard]
     cnc status [--channel N]
     cnc lookahead [START] [--length L] [--index I]
     cnc check FILE|NAME [--channel N] [--errors-total K] [--log] [--timeout S]

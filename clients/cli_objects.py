@@ -17,7 +17,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 from dataclasses import asdict
-from typing import Annotated, Any, Optional
+from typing import Annotated, Any
 
 import typer
 
@@ -25,21 +25,21 @@ from cnc_objects.protocol.datatypes import DataType, parse_type, parse_value
 
 from .cli_app import EXIT_USAGE, Settings, command, emit, fail, out, say_error
 from .client import AsyncClient
-from .object_info import ObjectInfo
 from .errors import AdsError, ClientValueError, NoReplyError
+from .object_info import ObjectInfo
 
 EXIT_WATCH_TIMEOUT = 5  # watch --count N --timeout S: a name got fewer than N samples
 
 # The address options of read and write, declared once.
 PortOption = Annotated[
-    Optional[str], typer.Option("--port", help="ADS port (with --group, --offset, --type).")
+    str | None, typer.Option("--port", help="ADS port (with --group, --offset, --type).")
 ]
-GroupOption = Annotated[Optional[str], typer.Option("--group", help="Index group, decimal or 0x hex.")]
+GroupOption = Annotated[str | None, typer.Option("--group", help="Index group, decimal or 0x hex.")]
 OffsetOption = Annotated[
-    Optional[str], typer.Option("--offset", help="Index offset, decimal or 0x hex.")
+    str | None, typer.Option("--offset", help="Index offset, decimal or 0x hex.")
 ]
 TypeOption = Annotated[
-    Optional[str], typer.Option("--type", help="Data type: UNS16, REAL64, STRING(84), ...")
+    str | None, typer.Option("--type", help="Data type: UNS16, REAL64, STRING(84), ...")
 ]
 _NO_UNIT = ("", "-")  # the catalog's spellings of "no unit"
 _BROWSE_COLUMNS = ("name", "port", "group", "offset", "type", "access", "unit", "description")

@@ -15,7 +15,11 @@ import typer
 
 from .cli_app import EXIT_USAGE, Settings, command, emit, err
 from .cli_machine import (
-    EXIT_CHANNEL_ERROR, ChannelOption, finish_wait, local_program, store_local,
+    EXIT_CHANNEL_ERROR,
+    ChannelOption,
+    finish_wait,
+    local_program,
+    store_local,
 )
 from .errors import AdsError, ChannelError, ClientValueError
 from .figure_png import PlotExtraMissing, require_matplotlib

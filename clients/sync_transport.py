@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 import zmq
 
 from cnc_objects.protocol.errors import ProtocolError
-from cnc_objects.protocol.frames import Response, RawSample, decode_incoming
+from cnc_objects.protocol.frames import RawSample, Response, decode_incoming
 
 from .curve import ClientCurve, HandshakeWatch
 from .errors import AdsConnectionError

@@ -26,8 +26,8 @@ from cnc_objects.protocol.constants import AdsCommand
 from cnc_objects.protocol.errors import ProtocolError
 from cnc_objects.protocol.frames import (
     Notification,
-    Response,
     RawSample,
+    Response,
     decode_incoming,
     encode_request,
 )

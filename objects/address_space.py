@@ -8,8 +8,8 @@ the message layer answers with the code and a sentence that says why.
 
 from __future__ import annotations
 
-import logging
 import fnmatch
+import logging
 import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass

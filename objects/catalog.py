@@ -20,8 +20,8 @@ from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16
 from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockType, LinkState
 
 from .addressing import GroupBase, axis_offset, channel_group
-from .catalog_technology import TECHNOLOGY_ROWS
 from .catalog_manual import MANUAL_ROWS
+from .catalog_technology import TECHNOLOGY_ROWS
 from .model import Access, CncObject
 
 

@@ -10,7 +10,7 @@ from cnc_objects.protocol.datatypes import DataType
 from cnc_objects.protocol.values import value_names
 
 
-class Access(str, Enum):
+class Access(str, Enum):  # noqa: UP042  (str() of a member must stay "Access.X", as before)
     """Who may do what with an object, in the ISG tables' spelling."""
 
     READ = "r"  # read-only: writes get ADS 0x704

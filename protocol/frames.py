@@ -26,7 +26,8 @@ object (pairs, not a map: frames allow string map keys only). Services before th
 names sent the first nine fields; a reader takes a missing tenth as ``[]``.
 The ``message`` of an error reply is a project extension: a sentence that says why, next
 to the ADS code. Notification timestamps are Windows FILETIME (100 ns since 1601-01-01),
-as in ADS: the wall-clock time at which the kernel cycle that produced the value ended. Invoke id 0 is reserved for notifications; requests use 1..2**32-1.
+as in ADS: the wall-clock time at which the kernel cycle that produced the value ended.
+Invoke id 0 is reserved for notifications; requests use 1..2**32-1.
 """
 
 from __future__ import annotations
@@ -397,7 +398,8 @@ def decode_incoming(raw: bytes) -> Response | Notification:
         raise ProtocolError("a reply is an array [invoke_id, command, result, ...]")
     invoke_id, command = obj[0], obj[1]
     result = obj[2]
-    if type(result) is int and result == 0 and type(invoke_id) is int and invoke_id > 0 and type(command) is int:
+    if (type(result) is int and result == 0 and type(invoke_id) is int and invoke_id > 0
+            and type(command) is int):
         return Response(invoke_id, command, 0, obj[3:])  # the common case, checked cheaply
     if invoke_id == 0 and command == AdsCommand.DEVICE_NOTIFICATION:
         if len(obj) != 4 or type(obj[3]) is not list:

@@ -47,8 +47,8 @@ from cnc_objects.protocol.ams import (
     AmsFrame,
     AmsHeader,
     AmsStreamParser,
-    SkippedFrame,
     FrameProblem,
+    SkippedFrame,
     encode_reply_frame,
     format_net_id,
 )

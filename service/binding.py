@@ -20,9 +20,9 @@ from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from . import __version__
+from .binding_manual import MANUAL_READERS, MANUAL_WRITERS
 from .binding_technology import TECHNOLOGY_READERS, TECHNOLOGY_WRITERS
 from .binding_tools import tool_readers, tool_writers
-from .machine_config import MachineConfig
 from .kernel.commands import (
     Command,
     Feedhold,
@@ -46,10 +46,10 @@ from .kernel.commands import (
     StartProgram,
     UpdateAxisParameters,
 )
-from .binding_manual import MANUAL_READERS, MANUAL_WRITERS
 from .kernel.kernel import Kernel, KernelCommand, ResetCycleStats
 from .kernel.state import DecoderFlag
 from .kernel.tooling import tool_list_size
+from .machine_config import MachineConfig
 from .notifications import NotificationCounts
 from .param_list import ParamListError, parse_axis_list
 

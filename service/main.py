@@ -35,7 +35,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
-from typing import NoReturn, Optional
+from typing import NoReturn
 
 import typer
 import zmq
@@ -62,7 +62,11 @@ from .output_writer import OutputLimits, OutputWriter
 from .program_service import ProgramStoreService
 from .program_store import ProgramStore, StoreError
 from .security import (
-    SecurityError, ServerCurve, endpoint_is_local, host_is_loopback, load_server_curve,
+    SecurityError,
+    ServerCurve,
+    endpoint_is_local,
+    host_is_loopback,
+    load_server_curve,
 )
 from .server import ZmqServer
 
@@ -239,7 +243,7 @@ async def _start_ads(
     "unusable program store, endpoint or ADS address in use."
 )
 def run(
-    config_file: Optional[Path] = typer.Option(
+    config_file: Path | None = typer.Option(
         None, "--config", metavar="FILE",
         help="TOML machine configuration laid over the default.",
     ),
@@ -248,41 +252,41 @@ def run(
         help="ZeroMQ endpoint to bind (tcp://127.0.0.1:* picks a free port).",
     ),
     clock: ClockKind = typer.Option(ClockKind.REALTIME, "--clock", help="Clock of the cycle task."),
-    speed: Optional[float] = typer.Option(
+    speed: float | None = typer.Option(
         None, "--speed", metavar="X",
         help="Virtual clock: times real time (default: as fast as the CPU allows while busy).",
     ),
-    cycle_ms: Optional[float] = typer.Option(
+    cycle_ms: float | None = typer.Option(
         None, "--cycle-ms", metavar="MS", help="Cycle time in ms (overrides the configuration).",
     ),
-    program_dir: Optional[Path] = typer.Option(
+    program_dir: Path | None = typer.Option(
         None, "--program-dir", metavar="DIR",
         help="Directory of the program store (default: programs/ in --data-dir, else "
         "program_store_dir or data_dir/programs of the configuration, else "
         "./cnc-data/programs in the working directory).",
     ),
-    data_dir: Optional[Path] = typer.Option(
+    data_dir: Path | None = typer.Option(
         None, "--data-dir", metavar="DIR",
         help="Data directory of this service: its programs/ is the program store, its "
         "output/ the output area.",
     ),
-    output_dir: Optional[Path] = typer.Option(
+    output_dir: Path | None = typer.Option(
         None, "--output-dir", metavar="DIR",
         help="Directory of the output area, the files the kernel writes (default: output_dir "
         "of the configuration, else output/ in the data directory, else <program dir>-output "
         "beside --program-dir).",
     ),
-    ads: Optional[str] = typer.Option(
+    ads: str | None = typer.Option(
         None, "--ads", metavar="HOST[:PORT]",
         help="Where ADS clients (pyads, TwinCAT tools) connect: AMS/TCP address, port 48898 "
         "when left out; off disables ADS (default: [ads] endpoint of the configuration, "
         "else 127.0.0.1:48898).",
     ),
-    ams_net_id: Optional[str] = typer.Option(
+    ams_net_id: str | None = typer.Option(
         None, "--ams-net-id", metavar="NETID",
         help="AMS Net ID of the service (default: [ads] net_id, else the ADS address + .1.1).",
     ),
-    keys: Optional[Path] = typer.Option(
+    keys: Path | None = typer.Option(
         None, "--keys", metavar="DIR",
         help="CURVE for ZeroMQ: DIR holds server.key_secret and the allow-list "
         "clients/<monitor|operator|admin>/*.key (default: [security] of the configuration; "

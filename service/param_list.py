@@ -339,7 +339,8 @@ def parse_channel_list(text: str, source: str) -> dict[str, Any]:
     """Parse a channel parameter list; ``source`` names it in problems.
 
     Returns ``{"axes": [{"name": "X", "logical_number": 11}, ...], "jog_of_path_only":
-    bool, "syn_chk": {"errors_total": 20, ...}, "hscs": {"finish": {"prog": ..}}}`` with each key only when the list gives it (``axes`` when any ``gruppe[0]``
+    bool, "syn_chk": {"errors_total": 20, ...}, "hscs": {"finish": {"prog": ..}}}``
+    with each key only when the list gives it (``axes`` when any ``gruppe[0]``
     key is there), axes in ``achse`` index order. Names are returned in capitals.
     ``gruppe[0].achs_anzahl`` is required with axes and must equal their number; achse
     indices run 0, 1, 2, ... without gaps; names and numbers are unique. Raises

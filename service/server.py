@@ -51,8 +51,8 @@ from .backend import Backend
 from .connection_limits import ConnectionLimits
 from .dispatch import Dispatcher
 from .limits import LimitsConfig, oversized_reply, rate_limiter, request_head
-from .rate_limit import BYTES_PER_TOKEN as _BYTES_PER_TOKEN
 from .log_throttle import ThrottledWarning
+from .rate_limit import BYTES_PER_TOKEN as _BYTES_PER_TOKEN
 from .rate_limit import RateLimiter, extra_tokens
 from .security import ServerCurve
 from .zmq_connections import ZmqConnectionWatch

@@ -21,8 +21,8 @@ from __future__ import annotations
 import ast
 import functools
 from collections.abc import Iterator
-from graphlib import CycleError, TopologicalSorter
 from dataclasses import dataclass
+from graphlib import CycleError, TopologicalSorter
 from pathlib import Path
 
 import pytest

@@ -18,7 +18,7 @@ import asyncio
 import contextlib
 import sys
 from collections.abc import Awaitable, Callable, Sequence
-from typing import Any, Optional
+from typing import Any
 
 import typer
 from textual.app import App, ComposeResult
@@ -311,8 +311,8 @@ def run(
         DEFAULT_TIMEOUT_S, "--timeout", metavar="S", min=0.01,
         help="Seconds without a reply before the service counts as unreachable.",
     ),
-    key_file: Optional[str] = key_option("The HMI's"),
-    server_key: Optional[str] = server_key_option(),
+    key_file: str | None = key_option("The HMI's"),
+    server_key: str | None = server_key_option(),
 ) -> None:
     """Terminal HMI of a cnc-objects service (keys: docs/hmi.md)."""
     try:

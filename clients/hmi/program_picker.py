@@ -18,7 +18,6 @@ from textual.containers import Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Input, Label, OptionList
 
-
 NC_PROGRAM_SUFFIXES = frozenset({".nc", ""})  # "" = no suffix (``SUB``, ``L SUB``)
 
 

@@ -18,7 +18,10 @@ from typing import Any, NoReturn, Protocol
 
 from cnc_objects.clients.client import AsyncClient, DeviceInfo
 from cnc_objects.clients.errors import (
-    AdsConnectionError, AdsError, AdsTimeoutError, AuthenticationError,
+    AdsConnectionError,
+    AdsError,
+    AdsTimeoutError,
+    AuthenticationError,
 )
 
 from . import text

@@ -20,7 +20,7 @@ import signal
 import ssl
 import sys
 from pathlib import Path
-from typing import NoReturn, Optional
+from typing import NoReturn
 
 import typer
 import zmq
@@ -77,22 +77,22 @@ def run(
         ..., "--broker", help="MQTT broker HOST[:PORT] (1883; 8883 with --tls)."
     ),
     machine: str = typer.Option(..., "--machine", help="Machine name: topics are cnc/<NAME>/..."),
-    objects: Optional[list[str]] = typer.Option(
+    objects: list[str] | None = typer.Option(
         None, "--objects",
         help="Glob of objects to publish; repeat for more; @default = the default set.",
     ),
-    writable: Optional[list[str]] = typer.Option(
+    writable: list[str] | None = typer.Option(
         None, "--writable",
         help="Glob of objects MQTT clients may write; repeat for more (default: none).",
     ),
-    username: Optional[str] = typer.Option(None, "--username", help="Broker user name."),
-    password_file: Optional[Path] = typer.Option(
+    username: str | None = typer.Option(None, "--username", help="Broker user name."),
+    password_file: Path | None = typer.Option(
         None, "--password-file", help="File whose first line is the broker password."
     ),
     tls: bool = typer.Option(
         False, "--tls", help="TLS to the broker (system CAs, or $SSL_CERT_FILE)."
     ),
-    client_id: Optional[str] = typer.Option(
+    client_id: str | None = typer.Option(
         None, "--client-id", help="MQTT client id (default cnc-mqtt-<NAME>)."
     ),
     cycle_ms: int = typer.Option(
@@ -112,8 +112,8 @@ def run(
         5.0, "--reconnect-max-s", min=0.001, help="... up to this."
     ),
     keepalive_s: int = typer.Option(30, "--keepalive", min=1, help="MQTT keepalive in seconds."),
-    key_file: Optional[str] = key_option("The bridge's"),
-    server_key: Optional[str] = server_key_option(),
+    key_file: str | None = key_option("The bridge's"),
+    server_key: str | None = server_key_option(),
     log_level: str = typer.Option("INFO", "--log-level", help="DEBUG, INFO, WARNING or ERROR."),
 ) -> None:
     """Publish CNC objects to MQTT when they change; write the ones allowed on request."""

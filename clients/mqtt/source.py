@@ -21,11 +21,11 @@ import math
 from collections.abc import Callable
 
 from ..client import AsyncClient
-from ..object_info import ObjectInfo
 from ..errors import AdsConnectionError, AdsError, AdsTimeoutError
-from .retry import Backoff, session
+from ..object_info import ObjectInfo
 from .config import BridgeConfig
 from .outbox import OFFLINE, ONLINE, Outbox
+from .retry import Backoff, session
 
 log = logging.getLogger(__name__)
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from .channel_mode import ChannelState
 from .nc import ModalState
 from .program_run import RunHost, Step
-from .state import Channel, ErrorEntry, DecoderFlag
+from .state import Channel, DecoderFlag, ErrorEntry
 from .syntax_check import CHECK_STOPPED_WARNING, CheckRun, Pause
 
 

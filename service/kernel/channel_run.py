@@ -53,7 +53,7 @@ from .program_run import (
     show_contour_state,
 )
 from .spindle import Spindle
-from .state import MESSAGES_KEPT, Channel, ErrorEntry, DecoderFlag
+from .state import MESSAGES_KEPT, Channel, DecoderFlag, ErrorEntry
 from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
 from .tooling import seed_modal, tables_from_config, tooling_of

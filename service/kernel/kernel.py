@@ -22,7 +22,7 @@ from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
 from .commands import Command, Refusal, RefusalReason, ResetChannel
-from .state import ErrorEntry, CycleStats, KernelState, Snapshot
+from .state import CycleStats, ErrorEntry, KernelState, Snapshot
 from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS
 

@@ -11,7 +11,8 @@ A run of any length stays bounded: when ``rows_max`` rows are kept, every second
 dropped and from then on only every second cycle is recorded (the stride doubles each
 time), so a long program is thinned evenly, never cut off. The file must also fit one
 download (``PROGRAM_MAX_BYTES``, 1 MB, the default of ``[limits] output_max_file_bytes``):
-the rows are thinned the same way until it does. The last cycle is always in the file, so the trace ends at the program's end point.
+the rows are thinned the same way until it does. The last cycle is always in the file,
+so the trace ends at the program's end point.
 """
 
 from __future__ import annotations

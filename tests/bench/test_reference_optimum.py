@@ -14,7 +14,13 @@ import pytest
 
 from bench import lookahead_programs as lp
 from bench.reference_optimum import (
-    Arc, AxisLimit, Line, axis_limits, optimum_time_s, plan, speed_at,
+    Arc,
+    AxisLimit,
+    Line,
+    axis_limits,
+    optimum_time_s,
+    plan,
+    speed_at,
 )
 from cnc_objects.service.kernel.nc import Decoder
 from cnc_objects.service.kernel.nc.blocks import Block, Motion, MotionKind, SourceRef
@@ -22,9 +28,9 @@ from cnc_objects.service.kernel.path import AxisDynamics, plan_time_optimal
 from cnc_objects.service.kernel.path.planner import plan_profile
 
 DEFAULT = (AxisLimit(500.0, 5000.0, 20.0),) * 3
-O = (0.0, 0.0, 0.0)
+ORIGIN = (0.0, 0.0, 0.0)
 X10 = (10.0, 0.0, 0.0)
-CORNER = [Line(O, X10, 6000.0), Line(X10, (10.0, 10.0, 0.0), 6000.0)]  # X, then Y
+CORNER = [Line(ORIGIN, X10, 6000.0), Line(X10, (10.0, 10.0, 0.0), 6000.0)]  # X, then Y
 
 
 @pytest.fixture(scope="module")
@@ -43,14 +49,14 @@ def test_default_machine_limits():
 
 def test_short_line_is_a_triangle():
     # 1 mm at F6000: a L = 5000 < 100^2, so the peak is sqrt(a L) and t = 2 sqrt(L / a)
-    [p] = plan([Line(O, (1.0, 0.0, 0.0), 6000.0)], DEFAULT)
+    [p] = plan([Line(ORIGIN, (1.0, 0.0, 0.0), 6000.0)], DEFAULT)
     assert p.v_peak_mm_s == pytest.approx(math.sqrt(5000.0), rel=1e-12)
     assert p.time_s == pytest.approx(2.0 * math.sqrt(1.0 / 5000.0), rel=1e-12)
 
 
 def test_long_line_is_a_trapezoid():
     # 10 mm at 100 mm/s: 2 x 0.02 s ramps over 2 x 1 mm, 8 mm cruise at 100 mm/s
-    [p] = plan([Line(O, (0.0, 10.0, 0.0), 6000.0)], DEFAULT)
+    [p] = plan([Line(ORIGIN, (0.0, 10.0, 0.0), 6000.0)], DEFAULT)
     assert (p.cap_mm_s, p.v_peak_mm_s, p.v_in_mm_s, p.v_out_mm_s) == (100.0, 100.0, 0.0, 0.0)
     assert p.time_s == pytest.approx(0.04 + 0.08, rel=1e-12)
 
@@ -72,7 +78,7 @@ def test_corner_takes_the_smallest_axis_jump():
 def test_full_circle_limited_by_centripetal_acceleration():
     # r = 1 mm: a = 5000/sqrt(2), cap = sqrt(r a) < 100 mm/s; ramps take r = cap^2/a mm
     r, a = 1.0, 5000.0 / math.sqrt(2.0)
-    [p] = plan([Arc(O, O, (r, 0.0), ccw=False, feed_mm_min=6000.0)], DEFAULT)
+    [p] = plan([Arc(ORIGIN, ORIGIN, (r, 0.0), ccw=False, feed_mm_min=6000.0)], DEFAULT)
     assert (p.length_mm, p.acc_mm_s2) == (pytest.approx(2 * math.pi * r), pytest.approx(a))
     assert p.cap_mm_s == pytest.approx(math.sqrt(r * a), rel=1e-12)
     expected = 2.0 * math.sqrt(r / a) + (2.0 * math.pi - 1.0) * r / math.sqrt(r * a)
@@ -90,14 +96,14 @@ def test_quarter_arcs_sweep_in_their_sense():
 
 def test_rapid_line_limited_by_axis_velocity_over_direction():
     # G0 along (0.6, 0.8): cap = 500/0.8 = 625 mm/s, a = 5000/0.8 = 6250 mm/s^2
-    [p] = plan([Line(O, (300.0, 400.0, 0.0), math.inf)], DEFAULT)
+    [p] = plan([Line(ORIGIN, (300.0, 400.0, 0.0), math.inf)], DEFAULT)
     assert (p.cap_mm_s, p.acc_mm_s2) == (pytest.approx(625.0), pytest.approx(6250.0))
     assert p.time_s == pytest.approx(2 * 625.0 / 6250.0 + (500.0 - 62.5) / 625.0, rel=1e-12)
 
 
 def test_zero_length_elements_are_skipped():
     point = (10.0, 0.0, 0.0)
-    elements = [Line(O, point, 6000.0), Line(point, point, 6000.0),
+    elements = [Line(ORIGIN, point, 6000.0), Line(point, point, 6000.0),
                 Line(point, (10.0, 10.0, 0.0), 6000.0)]
     planned = plan(elements, DEFAULT)
     assert [p.index for p in planned] == [0, 2]
@@ -143,14 +149,14 @@ UNEVEN = (AxisLimit(400.0, 3000.0, 15.0), AxisLimit(500.0, 5000.0, 20.0),
 def test_agrees_with_kernel_planner(programs, name, limits):
     elements = programs[name].elements
     blocks = _kernel_blocks(elements)
-    kernel = plan_time_optimal(blocks, _dynamics(limits), O)
+    kernel = plan_time_optimal(blocks, _dynamics(limits), ORIGIN)
     assert optimum_time_s(elements, limits) == pytest.approx(kernel, rel=1e-9)
 
 
 def test_per_element_speeds_agree_with_kernel(programs):
     elements = programs["spiral"].elements
     ours = plan(elements, DEFAULT)
-    theirs = plan_profile(_kernel_blocks(elements), _dynamics(DEFAULT), O)
+    theirs = plan_profile(_kernel_blocks(elements), _dynamics(DEFAULT), ORIGIN)
     assert len(ours) == len(theirs)
     np.testing.assert_allclose([p.v_out_mm_s for p in ours], [p.exit_mm_s for p in theirs],
                                rtol=1e-9, atol=1e-9)
@@ -174,7 +180,7 @@ def test_text_decodes_to_the_elements(programs, name):
     program = programs[name]
     motions = _decoded_motions(program.text, name)
     assert len(motions) == len(program.elements) == program.blocks
-    assert program.elements[0].start == O  # the machine's start position
+    assert program.elements[0].start == ORIGIN  # the machine's start position
     for m, e in zip(motions, program.elements):
         assert math.dist(m.start_mm, e.start) <= 1e-9
         assert math.dist(m.end_mm, e.end) <= 1e-9
@@ -227,7 +233,7 @@ def test_chords_are_1_um_on_the_circle(programs):
     # 6283 chords per circle: 2 sin(pi / 6283) mm = 0.99997 um each
     assert max(abs(x - 2.0 * math.sin(math.pi / 6283)) for x in lengths) < 2e-9
     assert max(abs(math.dist(e.end[:2], (1.0, 0.0)) - 1.0) for e in elements) < 1e-9
-    assert elements[6282].end == elements[-1].end == O  # each circle closes at the origin
+    assert elements[6282].end == elements[-1].end == ORIGIN  # each circle closes at the origin
 
 
 def test_with_la_on_wraps_the_motion_blocks(programs):

@@ -17,7 +17,12 @@ import pytest
 
 import cnc_objects.clients
 from cnc_objects.clients import (
-    AdsError, AdsTimeoutError, AsyncClient, Client, ClientValueError, NoReplyError,
+    AdsError,
+    AdsTimeoutError,
+    AsyncClient,
+    Client,
+    ClientValueError,
+    NoReplyError,
 )
 from cnc_objects.clients.transport import EARLY_HANDLES, _Transport
 from cnc_objects.objects.catalog_manual import MANUAL_ROWS

@@ -13,9 +13,6 @@ import socket
 from collections.abc import AsyncIterator
 from datetime import UTC, datetime, timedelta
 
-import aiomqtt
-import pytest
-
 from cnc_objects.clients import AsyncClient
 from cnc_objects.clients.mqtt import Bridge, BridgeConfig
 from cnc_objects.protocol.values import ChannelMode, ChannelState, LinkState
@@ -23,12 +20,11 @@ from tests.support.broker import OFFLINE, ONLINE, Broker, Watcher, free_port
 from tests.support.service import RunningService, start_service
 
 
-
 def bridge_config(endpoint: str, broker: Broker, machine: str = "m1", **options) -> BridgeConfig:
     """A bridge with test timings: it notices a lost service within 1.5 s."""
-    timings = dict(
-        service_timeout_s=1.0, probe_s=0.2, reconnect_initial_s=0.05, reconnect_max_s=0.5
-    )
+    timings = {
+        "service_timeout_s": 1.0, "probe_s": 0.2, "reconnect_initial_s": 0.05, "reconnect_max_s": 0.5
+    }
     return BridgeConfig(
         endpoint, broker.host, machine, broker_port=broker.port, **{**timings, **options}
     )
@@ -138,14 +134,16 @@ REQUESTS = [
      "reply/not-writable", {"ok": False, "code": "0x704"}),
     ("set/ch1.mc_active_feed_override_r", {"value": 1, "id": "read-only"},
      "reply/read-only", {"ok": False, "code": "0x704"}),
-    ("set/ch1.no_such_object", {"value": 1, "id": "unknown"}, "reply/unknown", {"ok": False, "code": "0x710"}),
+    ("set/ch1.no_such_object", {"value": 1, "id": "unknown"}, "reply/unknown",
+     {"ok": False, "code": "0x710"}),
     ("set/ch1.mc_command_feed_override_w", {"value": "fast", "id": "type"},
      "reply/type", {"ok": False, "code": "0x706"}),
     ("set/ch1.mc_command_feed_override_w", {"value": 2000, "id": "range"},
      "reply/range", {"ok": False, "code": "0x706"}),
     ("set/ch1.mc_command_feed_override_w", {"value": 70000, "id": "uns16"},
      "reply/uns16", {"ok": False, "code": "0x706"}),
-    ("set/ch1.mc_command_feed_override_w", {"id": "no-value"}, "reply/no-value", {"ok": False, "code": "0x70b"}),
+    ("set/ch1.mc_command_feed_override_w", {"id": "no-value"}, "reply/no-value",
+     {"ok": False, "code": "0x70b"}),
     ("set/ch1.mc_command_feed_override_w", b"{not json", "reply",
      {"ok": False, "code": "0x70b", "topic": FEED}),
     ("set/ch1.mc_command_feed_override_w", [1, 2], "reply", {"ok": False, "code": "0x70b", "topic": FEED}),

@@ -21,7 +21,6 @@ from tests.support.broker import OFFLINE, ONLINE, Broker, Watcher, running_broke
 from tests.support.service import ROOT
 
 
-
 def start_bridge(endpoint: str, broker: Broker, machine: str, *args: str) -> subprocess.Popen:
     """``cnc-mqtt`` in a subprocess (its log goes to a temporary file). It trusts the
     broker's test certificate, if any, through ``$SSL_CERT_FILE``."""

@@ -168,7 +168,8 @@ def test_replies() -> None:
 def test_topics() -> None:
     topics = Topics("mill1")
     assert topics.status == "cnc/mill1/status"
-    assert topics.value("gpCh[0].bahn_state.dist_prog_start") == "cnc/mill1/gpCh[0].bahn_state.dist_prog_start"
+    assert (topics.value("gpCh[0].bahn_state.dist_prog_start")
+            == "cnc/mill1/gpCh[0].bahn_state.dist_prog_start")
     assert topics.set_filter == "cnc/mill1/set/#"
     assert topics.object_of_set("cnc/mill1/set/ch1.x") == "ch1.x"
     assert topics.object_of_set("cnc/mill1/ch1.x") is None

@@ -18,12 +18,12 @@ from cnc_objects.testing import ServiceProcess, start_service
 
 from .test_ads_raw import (
     ADD_NOTIFICATION,
+    CH1_COM,
     COM,
     DELETE_NOTIFICATION,
     PLC,
     READ,
     READ_WRITE,
-    CH1_COM,
     RawAds,
     add_notification,
     read,

@@ -8,7 +8,7 @@ import contextlib
 from datetime import UTC, datetime, timedelta
 
 from cnc_objects.clients import AsyncClient, Sample
-from cnc_objects.protocol.values import ChannelMode, ChannelState, LinkState, value_names
+from cnc_objects.protocol.values import ChannelMode, ChannelState, value_names
 from tests.support.service import RunningService
 
 # 20 blocks of 1 mm at 6 mm/min: 200 s of kernel time; the virtual clock runs it many

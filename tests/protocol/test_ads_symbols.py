@@ -15,8 +15,6 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from cnc_objects.protocol.ads_symbols import (
-    decode_handle_info,
-    encode_handle_info,
     ENTRY_ALIGNMENT,
     AdsDataType,
     AdsDataTypeFlag,
@@ -29,10 +27,12 @@ from cnc_objects.protocol.ads_symbols import (
     UploadInfo,
     decode_datatype_entries,
     decode_datatype_entry,
+    decode_handle_info,
     decode_symbol_entries,
     decode_symbol_entry,
     decode_upload_info,
     encode_datatype_entry,
+    encode_handle_info,
     encode_symbol_entry,
     encode_symbol_version,
     encode_upload_info,

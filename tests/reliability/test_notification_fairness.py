@@ -4,7 +4,8 @@ reads are still answered at once (issue 25).
 One client process (``tests/support/cyclic_subscribers.py``) holds every notification
 the service takes (``notifications_total``, 20 000: 20 connections of 1 000 cyclic
 notifications each, every 1 ms, over five objects) and reads every sample; meanwhile
-another client reads one object at a time. Both over ZeroMQ, then both over ADS. Before the hub sampled in slices, each pass
+another client reads one object at a time. Both over ZeroMQ, then both over ADS. Before
+the hub sampled in slices, each pass
 over the 20 000 subscriptions held the event loop for 170-480 ms and the reads waited
 behind it. The bench (``make bench``, part ``fairness``) reports the real figure on the
 realtime clock; this test asserts a bound that a loaded 2-core machine keeps.

@@ -23,6 +23,8 @@ from hypothesis import HealthCheck, given, settings
 from cnc_objects.clients import Client
 from cnc_objects.protocol.constants import AdsCommand, AdsState, CncPort
 from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
+from cnc_objects.protocol.datatypes import STRING_ENCODING
+from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.frames import (
     AddNotificationRequest,
     BrowseRequest,
@@ -32,10 +34,10 @@ from cnc_objects.protocol.frames import (
     ReadWriteRequest,
     WriteControlRequest,
 )
-from cnc_objects.protocol.datatypes import STRING_ENCODING
-from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.testing import ServiceProcess, serving
+from tests.limits.wire import limited_service
 from tests.reliability import figures
+from tests.reliability.floods import AdsProbe, Flood
 from tests.reliability.health import (
     TICK_ADDRESS,
     RawConnection,
@@ -45,8 +47,6 @@ from tests.reliability.health import (
     wait_for_tick_after,
 )
 from tests.reliability.scale import Scale
-from tests.limits.wire import limited_service
-from tests.reliability.floods import AdsProbe, Flood
 from tests.reliability.wire_fuzz import (
     Expected,
     HalfSent,

@@ -16,7 +16,7 @@ import pytest
 from cnc_objects.clients import AdsError, AsyncClient, Client
 from cnc_objects.protocol import sum as sums
 from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
-from cnc_objects.testing import ServiceProcess, run_program, start_service, wait_for
+from cnc_objects.testing import ServiceProcess, run_program, wait_for
 
 COM = 553
 CH1_COM, CH2_COM = 0x120101, 0x120102

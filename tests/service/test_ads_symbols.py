@@ -16,6 +16,7 @@ import pytest
 
 from cnc_objects.objects import AddressSpace
 from cnc_objects.objects.model import Access, CncObject
+from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.protocol.ads_symbols import (
     AdsDataType,
     AdsDataTypeFlag,
@@ -32,7 +33,6 @@ from cnc_objects.protocol.ads_symbols import (
 )
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
-from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.service.ads_symbols import SymbolService
 from cnc_objects.service.binding import build_address_space
 from cnc_objects.service.config import build_config
@@ -87,7 +87,8 @@ def test_upload_info_64_bytes_describes_both_uploads(service: SymbolService, spa
     info = decode_upload_info(data)
     symbols = ok(service.read(SymbolGroup.UPLOAD, 0, 1 << 20))
     types = ok(service.read(SymbolGroup.DT_UPLOAD, 0, 1 << 20))
-    assert info.symbol_count == len(space) == 1004 + 350 + 108 + 278  # + technology units and spindle, manual mode, tools and offsets (issue 28)
+    # + technology units and spindle, manual mode, tools and offsets (issue 28)
+    assert info.symbol_count == len(space) == 1004 + 350 + 108 + 278
     assert info.symbol_size == len(symbols) == service.upload_bytes
     assert info.datatype_count == len(decode_datatype_entries(types))
     assert info.datatype_size == len(types) == service.datatype_upload_bytes

@@ -33,8 +33,8 @@ import aiomqtt
 
 HOST = "127.0.0.1"
 # predicates on a status payload, for Watcher.wait_for
-ONLINE = lambda payload: payload == b"online"  # noqa: E731
-OFFLINE = lambda payload: payload == b"offline"  # noqa: E731
+ONLINE = lambda payload: payload == b"online"
+OFFLINE = lambda payload: payload == b"offline"
 # A self-signed certificate for 127.0.0.1 and localhost (EC P-256, valid until 2126) and
 # its key, for the brokers' TLS listeners. Test data only: the key is public.
 TEST_CERT_PEM = """\

@@ -12,12 +12,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from cnc_objects.service.config import build_config
-from cnc_objects.service.machine_config import MachineConfig
 from cnc_objects.service.kernel.channel_mode import ChannelState
 from cnc_objects.service.kernel.clock import VirtualClock
 from cnc_objects.service.kernel.commands import ManualBlock, Refusal, SelectProgram, StartProgram
 from cnc_objects.service.kernel.kernel import Kernel
 from cnc_objects.service.kernel.state import Snapshot
+from cnc_objects.service.machine_config import MachineConfig
 
 _DONE_STATES = (ChannelState.READY, ChannelState.ERROR, ChannelState.SELECTED)
 

@@ -7,8 +7,18 @@ contract is in ``blocks``.
 """
 
 from .blocks import (
-    AxisExchange, AxisExchangeKind, Block, Compensation, ContourCommand, ContourKind, LogArea,
-    Motion, MotionKind, SourceRef, StopKind, next_log_area,
+    AxisExchange,
+    AxisExchangeKind,
+    Block,
+    Compensation,
+    ContourCommand,
+    ContourKind,
+    LogArea,
+    Motion,
+    MotionKind,
+    SourceRef,
+    StopKind,
+    next_log_area,
 )
 from .decoder import Decoder
 from .errors import NcError, NcErrorId

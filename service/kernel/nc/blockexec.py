@@ -39,8 +39,8 @@ from .errors import ErrorAt, NcError, NcErrorId
 from .evaluation import Env
 from .exchange import moved_axes
 from .expressions import evaluate_number
-from .homing_block import homing_motion, with_homing
 from .geometry import centre_from_offsets, centre_from_radius
+from .homing_block import homing_motion, with_homing
 from .modal import G_CODES, PLANE_AXES, DistanceMode, GGroup, MCode, ModalState, Plane
 from .statements import Assign, AxisCommand, NcBlock, Word, WordKind
 from .tool_data import ToolTable, program_shift_mm

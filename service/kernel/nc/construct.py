@@ -21,7 +21,14 @@ import os
 from typing import Any, cast
 
 from .blocks import (
-    AxisExchange, Block, Compensation, ContourCommand, LookAheadMark, Motion, MotionKind, SourceRef,
+    AxisExchange,
+    Block,
+    Compensation,
+    ContourCommand,
+    LookAheadMark,
+    Motion,
+    MotionKind,
+    SourceRef,
     StopKind,
 )
 

@@ -10,10 +10,10 @@ without motion (``contour_block``, also used for the real-time loop markers).
 from __future__ import annotations
 
 from .blocks import Block, Compensation, ContourCommand, ContourKind, StopKind, next_log_area
+from .call_stack import CallFrame
 from .construct import make_block, make_source
 from .errors import NcErrorId
 from .evaluation import evaluate_number
-from .call_stack import CallFrame
 from .running_decoder import RunningDecoder
 from .source import LogicalLine
 from .statements import ContourStatement, StmtKind

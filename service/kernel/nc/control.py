@@ -25,9 +25,9 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from .blocks import Block
+from .call_stack import CallFrame, ControlEntry
 from .errors import DecodingCancelled, NcError, NcErrorId
 from .expressions import number, truth
-from .call_stack import ControlEntry, CallFrame
 from .program import Statement, Structure
 from .rt_loop_markers import RtLoopMarkers
 from .running_decoder import RunningDecoder

@@ -18,7 +18,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .cycles.rotation import (
-    IDENTITY, Matrix, RotationOrder, Vector, apply, apply_transposed, multiply,
+    IDENTITY,
+    Matrix,
+    RotationOrder,
+    Vector,
+    apply,
+    apply_transposed,
+    multiply,
     rotation_from_angles,
 )
 

@@ -25,10 +25,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .call_stack import CallFrame, CallFrameKind
 from .check import ErrorReported, categorize
 from .errors import NcError, NcErrorId
 from .evaluation import number
-from .call_stack import CallFrame, CallFrameKind
 from .literals import nc_number
 from .patterns import PatternPosition
 from .program import Program

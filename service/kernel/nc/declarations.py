@@ -19,15 +19,21 @@ from __future__ import annotations
 import math
 import re
 
+from .call_stack import CallFrame, CallFrameKind
 from .errors import NcErrorId
 from .expressions import ExpressionParser, Node
-from .call_stack import CallFrame, CallFrameKind
 from .lexer import IDENT, VARIABLE, Cursor
 from .running_decoder import RunningDecoder
 from .source import LogicalLine, join_lines
 from .statements import Control, Declaration, InitList
 from .variables import (
-    Scope, Value, Variable, VariableFault, VarType, convert, default_value,
+    Scope,
+    Value,
+    Variable,
+    VariableFault,
+    VarType,
+    convert,
+    default_value,
 )
 
 _ENDVAR = re.compile(r"[ \t]*#[ \t]*ENDVAR\b")

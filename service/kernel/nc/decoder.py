@@ -24,6 +24,7 @@ from dataclasses import replace
 
 from .blockexec import BlockExecutor, Flow
 from .blocks import Block, LogArea
+from .call_stack import MAX_CALL_DEPTH, CallFrame, CallFrameKind
 from .check import (
     CHECK_FEED_MM_MIN,
     CheckAborted,
@@ -40,7 +41,6 @@ from .cycle_run import call_cycle
 from .declarations import declare, read_block
 from .errors import NcError, NcErrorId
 from .fastpath import decoding_loop
-from .call_stack import MAX_CALL_DEPTH, CallFrame, CallFrameKind
 from .instruction_run import pattern_error, run_instruction
 from .instructions import Instruction
 from .modal import ModalState

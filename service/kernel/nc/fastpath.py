@@ -39,7 +39,13 @@ from .blockexec import FEED_MAX_MM_MIN
 from .blocks import Block, Compensation, Motion, MotionKind, SourceRef, StopKind
 from .check import BATCH_LINES, PointBatch
 from .construct import (
-    FAST, BlockTwin, MotionTwin, SourceRefTwin, make_block, make_motion, make_source,
+    FAST,
+    BlockTwin,
+    MotionTwin,
+    SourceRefTwin,
+    make_block,
+    make_motion,
+    make_source,
 )
 from .contour import LOOP_MARKERS
 from .geometry import ARC_TOLERANCE_MM

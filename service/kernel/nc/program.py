@@ -30,7 +30,14 @@ from .instructions import Instruction
 from .parser import LineParser
 from .source import LogicalLine, SourceText, comment_directive, read_logical, strip_comments
 from .statements import (
-    CLOSER_OF, OPENERS, SPELLING, AxisCommand, ContourStatement, Control, Declaration, NcBlock,
+    CLOSER_OF,
+    OPENERS,
+    SPELLING,
+    AxisCommand,
+    ContourStatement,
+    Control,
+    Declaration,
+    NcBlock,
     StmtKind,
 )
 

@@ -15,8 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .blocks import Block, ContourCommand, ContourKind, LogArea
+from .call_stack import CallFrame, ControlEntry
 from .contour_run import contour_block
-from .call_stack import ControlEntry, CallFrame
 from .running_decoder import RunningDecoder
 from .statements import Control
 

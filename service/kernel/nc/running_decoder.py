@@ -13,9 +13,9 @@ from collections.abc import Callable
 from typing import Protocol
 
 from .blockexec import BlockExecutor
+from .call_stack import CallFrame
 from .check import SyntaxCheck
 from .evaluation import Env
-from .call_stack import CallFrame
 from .modal import ModalState
 from .parser import LineParser
 from .program import Program

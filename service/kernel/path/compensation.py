@@ -47,8 +47,15 @@ from typing import NamedTuple
 from ..nc.blocks import Block, Compensation
 from .errors import PathError, PathErrorId
 from .geometry import Arc, Element, Line
-from .offsets import (MIN_LENGTH_MM, intersect, offset_element, plane_point, plane_tangent,
-                      trim_end, trim_start)
+from .offsets import (
+    MIN_LENGTH_MM,
+    intersect,
+    offset_element,
+    plane_point,
+    plane_tangent,
+    trim_end,
+    trim_start,
+)
 
 TANGENT_SIN = 1e-9  # |sin| of the corner angle below which a transition counts as tangent
 

@@ -41,7 +41,7 @@ from cnc_objects.service.kernel.commands import (
     SetSingleBlock,
     StartProgram,
 )
-from cnc_objects.service.kernel.state import ErrorEntry, DecoderFlag, KernelState
+from cnc_objects.service.kernel.state import DecoderFlag, ErrorEntry, KernelState
 from tests.support.kernel import KernelHarness
 
 S, E = ChannelState, ChannelEvent

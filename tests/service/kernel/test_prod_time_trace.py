@@ -39,7 +39,7 @@ def test_file_fits_the_store_and_parses_back() -> None:
     assert parsed.stride > 1 and parsed.ended == "READY" and parsed.program == "p.nc"
     assert parsed.axis("x")[-1] == 5000.0 and parsed.axis("Y")[-1] == -5000.0
     assert parsed.t_s[-1] == pytest.approx(5.0)
-    spacing = set(round(d / 0.001) for d in (parsed.t_s[1:-1] - parsed.t_s[:-2]))
+    spacing = {round(d / 0.001) for d in (parsed.t_s[1:-1] - parsed.t_s[:-2])}
     assert spacing == {parsed.stride}
 
 

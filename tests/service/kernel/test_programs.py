@@ -63,7 +63,8 @@ FINISHING = {
         "G0 X10\nG2 X10 Y0 I-10 J0 F3000\nM30\n", (10, 0, 0), None, 3,
     ),
     "subprogram loop": (
-        "%main\n#VAR\nV.P.I = 0\n#ENDVAR\n$FOR V.P.I = 1, 4, 1\nLL STEP\n$ENDFOR\nM30\n%L STEP\nG91 G1 X2.5 F600\nM17\n",
+        "%main\n#VAR\nV.P.I = 0\n#ENDVAR\n$FOR V.P.I = 1, 4, 1\nLL STEP\n$ENDFOR\nM30\n"
+        "%L STEP\nG91 G1 X2.5 F600\nM17\n",
         (10, 0, 0), None, 2,
     ),
 }

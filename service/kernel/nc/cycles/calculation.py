@@ -18,7 +18,13 @@ from typing import TypeVar
 from ..errors import NcErrorId
 from ..variables import Value
 from .fitting import (
-    Degeneracy, FitError, fit_circle_2d, fit_circle_3d, fit_line, fit_plane, fit_sphere,
+    Degeneracy,
+    FitError,
+    fit_circle_2d,
+    fit_circle_3d,
+    fit_line,
+    fit_plane,
+    fit_sphere,
 )
 from .spec import BuiltinCycle, CycleContext, ParamProblem, ParamSpec
 

@@ -40,7 +40,12 @@ from ..errors import NcErrorId
 from ..literals import nc_number
 from ..variables import Value
 from .rotation import (
-    Matrix, RotationError, RotationOrder, Vector, angles_from_rotation, rotation_from_angles,
+    Matrix,
+    RotationError,
+    RotationOrder,
+    Vector,
+    angles_from_rotation,
+    rotation_from_angles,
     rotation_from_points,
 )
 from .spec import BuiltinCycle, CycleContext, ParamProblem, ParamSpec

@@ -7,8 +7,15 @@ from dataclasses import replace
 import pytest
 
 from cnc_objects.service.kernel.nc import (
-    AxisExchange, AxisExchangeKind, Block, ModalState, NcError, NcErrorId, SourceRef,
-    StopKind, check_syntax,
+    AxisExchange,
+    AxisExchangeKind,
+    Block,
+    ModalState,
+    NcError,
+    NcErrorId,
+    SourceRef,
+    StopKind,
+    check_syntax,
 )
 
 from .support import AXES, decode, decoder, error_of, slow

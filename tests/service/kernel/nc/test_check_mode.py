@@ -3,16 +3,22 @@ category and decoding goes on with the response of that category (``nc/check.py`
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import dataclasses
 from itertools import islice
+from pathlib import Path
 
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from cnc_objects.service.kernel.nc import (
-    AxisExchange, AxisExchangeKind, Block, Decoder, MotionKind, NcError, NcErrorId, StopKind,
+    AxisExchange,
+    AxisExchangeKind,
+    Block,
+    Decoder,
+    MotionKind,
+    NcError,
+    NcErrorId,
+    StopKind,
     control,
 )
 from cnc_objects.service.kernel.nc.check import CheckAborted, ErrorCategory, PointBatch
@@ -687,7 +693,7 @@ def test_junk_in_one_line_is_reported_in_that_line_only(program, errors_per_bloc
     text, junk_line = program
     run = check_run(text, errors_per_block=errors_per_block, line_by_line=line_by_line)
     lines = text.split("\n")
-    for error, category in run.check.errors:
+    for error, _category in run.check.errors:
         assert error.id != E.INTERNAL_ERROR, str(error)
         assert error.line == junk_line, str(error)
         assert 1 <= error.column <= len(lines[error.line - 1]) + 1, str(error)

@@ -9,9 +9,16 @@ from itertools import islice
 import pytest
 
 from cnc_objects.service.kernel.nc import (
-    Block, ContourCommand, ContourKind, LogArea, ModalState, NcError, NcErrorId, check_syntax,
+    Block,
+    ContourCommand,
+    ContourKind,
+    LogArea,
+    ModalState,
+    NcError,
+    NcErrorId,
+    check_syntax,
+    control,
 )
-from cnc_objects.service.kernel.nc import control
 
 from .support import AXES, decode, decoder, error_of, slow
 

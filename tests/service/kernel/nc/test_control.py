@@ -6,8 +6,7 @@ from itertools import islice
 
 import pytest
 
-from cnc_objects.service.kernel.nc import NcErrorId
-from cnc_objects.service.kernel.nc import control
+from cnc_objects.service.kernel.nc import NcErrorId, control
 
 from .support import decoder, ends, error_of
 

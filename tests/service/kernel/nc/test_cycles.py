@@ -580,7 +580,8 @@ def test_incremental_rapid_caller_is_restored_too():
 
 # ---------------------------------------------------------------- 6. SysHscSettings
 
-DESELECT_PROGRAM = "% manufacturerHscDeselectSettings.nc\nG133 = 100\nG134 = 100\n#HSC OFF\n#FILTER OFF\nM17\n"
+DESELECT_PROGRAM = ("% manufacturerHscDeselectSettings.nc\nG133 = 100\nG134 = 100\n#HSC OFF\n"
+                    "#FILTER OFF\nM17\n")
 FINISH_PROGRAM = """% manufacturerHscFinishSettings.nc
 G133 = 80
 G134 = 70

@@ -15,8 +15,19 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cnc_objects.service.kernel.nc.cycles.fitting import (
-    MAX_POINTS, Circle3dFit, CircleFit, Degeneracy, FitError, LineFit, PlaneFit, SphereFit,
-    fit_circle_2d, fit_circle_3d, fit_line, fit_plane, fit_sphere,
+    MAX_POINTS,
+    Circle3dFit,
+    CircleFit,
+    Degeneracy,
+    FitError,
+    LineFit,
+    PlaneFit,
+    SphereFit,
+    fit_circle_2d,
+    fit_circle_3d,
+    fit_line,
+    fit_plane,
+    fit_sphere,
 )
 
 EXACT = 1e-9

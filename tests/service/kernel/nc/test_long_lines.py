@@ -16,8 +16,14 @@ import pytest
 
 from cnc_objects.service.kernel.nc import Decoder, NcError
 from cnc_objects.service.kernel.nc.check import (
-    EXACT_REPOSITIONS, ErrorCategory, RepositionedLine, categorize, parse_checked, term_end,
-    term_start, without_error,
+    EXACT_REPOSITIONS,
+    ErrorCategory,
+    RepositionedLine,
+    categorize,
+    parse_checked,
+    term_end,
+    term_start,
+    without_error,
 )
 from cnc_objects.service.kernel.nc.parser import LineParser, word_table
 from cnc_objects.service.kernel.nc.source import LogicalLine

@@ -5,7 +5,13 @@ from __future__ import annotations
 import pytest
 
 from cnc_objects.service.kernel.nc import (
-    Compensation, DistanceMode, ModalState, MotionKind, NcError, NcErrorId, Plane,
+    Compensation,
+    DistanceMode,
+    ModalState,
+    MotionKind,
+    NcError,
+    NcErrorId,
+    Plane,
 )
 
 from .support import decode, decoder

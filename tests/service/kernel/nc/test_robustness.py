@@ -9,8 +9,7 @@ from itertools import islice
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from cnc_objects.service.kernel.nc import NcError, NcErrorId
-from cnc_objects.service.kernel.nc import control
+from cnc_objects.service.kernel.nc import NcError, NcErrorId, control
 
 from .support import decoder, slow
 

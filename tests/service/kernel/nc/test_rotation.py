@@ -10,9 +10,20 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from cnc_objects.service.kernel.nc.cycles.rotation import (
-    IDENTITY, Matrix, RotationError, RotationOrder, Vector, angles_from_rotation, apply,
-    apply_transposed, axis_rotation, is_rotation, multiply, rotation_from_angles,
-    rotation_from_points, transpose,
+    IDENTITY,
+    Matrix,
+    RotationError,
+    RotationOrder,
+    Vector,
+    angles_from_rotation,
+    apply,
+    apply_transposed,
+    axis_rotation,
+    is_rotation,
+    multiply,
+    rotation_from_angles,
+    rotation_from_points,
+    transpose,
 )
 
 ORDERS = list(RotationOrder)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from cnc_objects.service.kernel.nc import ModalState, NcErrorId
+from cnc_objects.service.kernel.nc import ModalState, NcError, NcErrorId
 
 from .support import decode, decoder, ends, error_of
 
@@ -123,7 +123,7 @@ def test_declaration_in_a_loop_reinitialises():
               "G0 X[V.L.X] Y[V.P.I]\n$ENDFOR\nM30"
     d = decoder(program)
     d.modal.variables_p.clear()
-    with pytest.raises(Exception):  # V.P.I is not declared
+    with pytest.raises(NcError):  # V.P.I is not declared
         list(d.blocks())
     program = "#VAR\nV.P.I\n#ENDVAR\n" + program
     assert xs(program) == [1.0, 2.0, 3.0]

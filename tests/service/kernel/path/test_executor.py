@@ -9,11 +9,29 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from cnc_objects.service.kernel.nc.blocks import StopKind
-from cnc_objects.service.kernel.path import (AxisDynamics, PathError, PathErrorId, PathExecutor,
-                                 Waiting, plan_time_optimal)
+from cnc_objects.service.kernel.path import (
+    AxisDynamics,
+    PathError,
+    PathErrorId,
+    PathExecutor,
+    Waiting,
+    plan_time_optimal,
+)
 
-from .programs import (DT, DYN, DYN_MIXED, arc, check_axis_limits, dwell, line, polyline, run,
-                       stop, technology, trapezoid_time)
+from .programs import (
+    DT,
+    DYN,
+    DYN_MIXED,
+    arc,
+    check_axis_limits,
+    dwell,
+    line,
+    polyline,
+    run,
+    stop,
+    technology,
+    trapezoid_time,
+)
 
 ORIGIN = (0.0, 0.0, 0.0)
 
@@ -151,7 +169,7 @@ def test_axis_limits_hold_with_override_changes_and_feedhold():
     trace = run(executor(dynamics=DYN_MIXED), blocks, override=override, on_cycle=on_cycle)
     check_axis_limits(trace, DYN_MIXED)
     assert trace.positions[-1] == pytest.approx(ORIGIN, abs=1e-12)
-    assert [b for b in trace.finished] == blocks
+    assert list(trace.finished) == blocks
 
 
 @settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
