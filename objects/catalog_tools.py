@@ -38,35 +38,35 @@ TOOL_ROW_FIELDS = (
 
 TOOL_TEMPLATES: tuple[ObjectTemplate, ...] = (
     ObjectTemplate(
-        "mc_selected_tool_r", Scope.CHANNEL, COM, COM_CH, 0x3400, UNS32, R, "-",
+        "mc_selected_tool_r", Scope.CHANNEL, COM, COM_CH, 0x3500, UNS32, R, "-",
         "T programmed last: the tool the next M6 changes to; 0 = none (project offset)",
     ),
     ObjectTemplate(
-        "mc_active_tool_r", Scope.CHANNEL, COM, COM_CH, 0x3401, UNS32, R, "-",
+        "mc_active_tool_r", Scope.CHANNEL, COM, COM_CH, 0x3501, UNS32, R, "-",
         "Tool in the spindle: the T of the last M6; 0 = none (project offset)",
     ),
     ObjectTemplate(
-        "mc_active_tool_offset_r", Scope.CHANNEL, COM, COM_CH, 0x3402, UNS32, R, "-",
+        "mc_active_tool_offset_r", Scope.CHANNEL, COM, COM_CH, 0x3502, UNS32, R, "-",
         "D in effect: the tool list row of radius and length; 0 = D0 (project offset)",
     ),
     ObjectTemplate(
-        "mc_active_tool_radius_r", Scope.CHANNEL, COM, COM_CH, 0x3403, REAL64, R, "0.1 um",
+        "mc_active_tool_radius_r", Scope.CHANNEL, COM, COM_CH, 0x3503, REAL64, R, "0.1 um",
         "Radius of the active D (V.G.WZ_AKT.R) (project offset)",
     ),
     ObjectTemplate(
-        "mc_active_tool_length_r", Scope.CHANNEL, COM, COM_CH, 0x3404, REAL64, R, "0.1 um",
+        "mc_active_tool_length_r", Scope.CHANNEL, COM, COM_CH, 0x3504, REAL64, R, "0.1 um",
         "Length of the active D along the tool axis (project offset)",
     ),
     ObjectTemplate(
-        "mc_active_zero_offset_r", Scope.CHANNEL, COM, COM_CH, 0x3405, UNS16, R, "-",
+        "mc_active_zero_offset_r", Scope.CHANNEL, COM, COM_CH, 0x3505, UNS16, R, "-",
         "Zero offset group in effect: 0 G53, 1..6 G54..G59, 7.. G159 = i (project offset)",
     ),
     ObjectTemplate(
-        "mc_tool_list_size_r", Scope.CHANNEL, COM, COM_CH, 0x3406, UNS32, R, "-",
+        "mc_tool_list_size_r", Scope.CHANNEL, COM, COM_CH, 0x3506, UNS32, R, "-",
         "Rows wz[1..n] of the channel's tool list (project offset)",
     ),
     ObjectTemplate(
-        "mc_zero_offset_groups_r", Scope.CHANNEL, COM, COM_CH, 0x3407, UNS16, R, "-",
+        "mc_zero_offset_groups_r", Scope.CHANNEL, COM, COM_CH, 0x3507, UNS16, R, "-",
         "Zero offset groups np_grp[0..n-1] (P-ZERO-00003) (project offset)",
     ),
     ObjectTemplate(
