@@ -239,7 +239,9 @@ class ChannelRunner:
             else:  # the first block still waits for the axes
                 self._queued_jobs.append(job)
             return None
-        if not allowed(ch.state, ChannelEvent.START) or ch.mode == ChannelMode.MANUAL:
+        # from an idle channel in any mode (MANUAL too, once no axis moves by hand): the
+        # block selects MDI, as a new mode chosen at the HMI would
+        if not allowed(ch.state, ChannelEvent.START):
             return _not_ready(ch, "a manual block needs a channel that is not working")
         if ch.mode != ChannelMode.MDI:
             ch.mode = ChannelMode.MDI
