@@ -10,11 +10,8 @@ the pointers (``gpCh[0]^.contour_lookahead``): every by-name service accepts the
 from __future__ import annotations
 
 import struct
-from collections.abc import Iterator
 
 import pytest
-
-from cnc_objects.testing import ServiceProcess, start_service
 
 from .test_ads_raw import READ, READ_WRITE, RawAds, read, read_write
 from .test_ads_read_length import ANY, INVALIDSIZE, OK, PER_ITEM, SYMBOLNOTFOUND, answer
@@ -31,18 +28,6 @@ def extended(data: bytes) -> tuple[int, int, int, str]:
     return handle, size, decoration, data[14 : 14 + length].decode()
 
 
-@pytest.fixture(scope="module")
-def service(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceProcess]:
-    running = start_service(program_dir=tmp_path_factory.mktemp("ads-handles"), ads="127.0.0.1:0")
-    yield running
-    assert running.stop() == 0, running.log_text
-
-
-@pytest.fixture
-def ads(service: ServiceProcess) -> Iterator[RawAds]:
-    connection = RawAds(service)
-    yield connection
-    connection.close()
 
 
 def test_a_large_buffer_gets_handle_size_and_type(ads: RawAds) -> None:

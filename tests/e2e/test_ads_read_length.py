@@ -10,11 +10,8 @@ Each test sends the frames byte by byte with the raw client of ``test_ads_raw``.
 from __future__ import annotations
 
 import struct
-from collections.abc import Iterator
 
 import pytest
-
-from cnc_objects.testing import ServiceProcess, start_service
 
 from .test_ads_raw import (
     ADD_NOTIFICATION,
@@ -47,18 +44,6 @@ def answer(ads: RawAds, command: int, data: bytes, port: int = PLC) -> tuple[int
     return result, got.data[8:]
 
 
-@pytest.fixture(scope="module")
-def service(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceProcess]:
-    running = start_service(program_dir=tmp_path_factory.mktemp("ads-length"), ads="127.0.0.1:0")
-    yield running
-    assert running.stop() == 0, running.log_text
-
-
-@pytest.fixture
-def ads(service: ServiceProcess) -> Iterator[RawAds]:
-    connection = RawAds(service)
-    yield connection
-    connection.close()
 
 
 @pytest.mark.parametrize("group, size", [(0xF009, None), (0xF007, 12)])

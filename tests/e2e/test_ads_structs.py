@@ -10,12 +10,7 @@ Frames are built and parsed by hand here (``test_ads_raw``, ``test_ads_symbols_r
 from __future__ import annotations
 
 import struct
-from collections.abc import Iterator
 from dataclasses import dataclass
-
-import pytest
-
-from cnc_objects.testing import ServiceProcess, start_service
 
 from .test_ads_raw import (
     ADD_NOTIFICATION,
@@ -87,18 +82,6 @@ def value(ads: RawAds, name: str) -> bytes:
     return data
 
 
-@pytest.fixture(scope="module")
-def service(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceProcess]:
-    running = start_service(program_dir=tmp_path_factory.mktemp("ads-structs"), ads="127.0.0.1:0")
-    yield running
-    assert running.stop() == 0, running.log_text
-
-
-@pytest.fixture
-def ads(service: ServiceProcess) -> Iterator[RawAds]:
-    connection = RawAds(service)
-    yield connection
-    connection.close()
 
 
 def test_a_struct_symbol_and_its_type(ads: RawAds) -> None:
