@@ -1,5 +1,10 @@
 """One channel at work: its mode and state, and the run it starts, holds and ends.
 
+(Over 600 lines, on purpose: this is the one place where the channel's commands, the
+begin and end of its runs and its state transitions meet; what stands alone lives in
+channel_transitions, program_run, channel_check, manual_mode, plc_functions and
+tooling, and each of those is called from here in a line or two.)
+
 The GEO cycle calls ``ChannelRunner.cycle`` once per cycle; commands (select, start,
 feedhold, RESET, manual block) call the other methods, also on the cycle thread, and
 answer None or a ``Refusal`` with the reason. Every change of the channel's state goes

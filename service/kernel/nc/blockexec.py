@@ -1,5 +1,9 @@
 """Executing one parsed NC block against the modal state: the reference semantics.
 
+(Over 600 lines, on purpose: one NC block's rules, from its words through the modal
+groups, tools, zero offsets and motion to its Block, read in the order they apply; the
+parts that stand alone are in tool_data, homing_block, technology and geometry.)
+
 Items run left to right (an assignment changes the variables the following words
 read). Then, in this order: G functions (at most one per group), D, F, S, T, the
 motion (G0..G3, absolute or incremental, arcs by I/J/K or R), G4 dwell, M functions.
