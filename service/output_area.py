@@ -19,7 +19,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from .program_store import ProgramInfo, StoreError, StoreFault, check_name
+from .program_store import ProgramInfo, StoreError, StoreFault, check_name, list_files
 
 _TEMP_PREFIX = ".write-"
 WHAT = "output file"  # how messages name a file of this area
@@ -41,13 +41,7 @@ class OutputArea:
 
     def list(self) -> list[ProgramInfo]:
         """Every file, sorted by name (temporary files are not listed)."""
-        found = []
-        for entry in os.scandir(self.root):
-            if entry.name.startswith(".") or not entry.is_file():
-                continue
-            st = entry.stat()
-            found.append(ProgramInfo(entry.name, st.st_size, st.st_mtime))
-        return sorted(found, key=lambda p: p.name)
+        return list_files(self.root)
 
     def read(self, name: str) -> bytes:
         """The content of ``name`` as written so far."""

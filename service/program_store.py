@@ -74,6 +74,18 @@ def check_name(name: str, what: str = "program") -> str:
     return name
 
 
+def list_files(root: Path) -> list[ProgramInfo]:
+    """The files of directory ``root``, sorted by name; names starting with a dot (the
+    temporary files of writes in progress) are not listed."""
+    found = []
+    for entry in os.scandir(root):
+        if entry.name.startswith(".") or not entry.is_file():
+            continue
+        st = entry.stat()
+        found.append(ProgramInfo(entry.name, st.st_size, st.st_mtime))
+    return sorted(found, key=lambda p: p.name)
+
+
 class ProgramStore:
     """NC programs in a directory; safe to use from several threads."""
 
@@ -154,10 +166,4 @@ class ProgramStore:
 
     def list(self) -> list[ProgramInfo]:
         """Every stored file, sorted by name (uploads in progress are not listed)."""
-        found = []
-        for entry in os.scandir(self.root):
-            if entry.name.startswith(".") or not entry.is_file():
-                continue
-            st = entry.stat()
-            found.append(ProgramInfo(entry.name, st.st_size, st.st_mtime))
-        return sorted(found, key=lambda p: p.name)
+        return list_files(self.root)
