@@ -63,10 +63,6 @@ class AxesTable(FixedColumnsTable):
                               self._cells(linked, "actual", text.mm), POSITION_CYCLE_MS))
         return feeds
 
-    def cell(self, axis: AxisView | str, column: str) -> str:
-        """The text shown for ``axis`` in ``column``."""
-        key = axis if isinstance(axis, str) else axis.key
-        return str(self.get_cell(key, column))
 
     def _cells(
         self, axes: list[AxisView], column: str, show: Callable[[Any], str]

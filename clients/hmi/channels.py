@@ -76,16 +76,7 @@ class ChannelTable(FixedColumnsTable):
             ]
         return feeds
 
-    def cell(self, channel: ChannelView | str, column: str) -> str:
-        """The text shown for ``channel`` in ``column``."""
-        key = channel if isinstance(channel, str) else channel.key
-        return str(self.get_cell(key, column))
 
-    def _setter(self, row: str) -> Callable[[str, Callable[[Any], str]], Callable[[Any], None]]:
-        def column(key: str, show: Callable[[Any], str]) -> Callable[[Any], None]:
-            # Text, not str: a str cell is parsed as markup, and names may hold brackets
-            return lambda value: self.update_cell(row, key, Text(show(value)))
-        return column
 
     def _block_part(self, row: str, part: str) -> Callable[[Any], None]:
         def apply(value: Any) -> None:

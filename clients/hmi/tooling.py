@@ -4,14 +4,11 @@ selected, D with its radius and length, and the zero offset in effect
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
-
-from rich.text import Text
 
 from . import text
 from .fixed_table import FixedColumnsTable
-from .machine import ChannelView, Machine
+from .machine import Machine
 from .session import Feed
 
 # column key, header, width
@@ -69,12 +66,4 @@ class ToolingTable(FixedColumnsTable):
             ]
         return feeds
 
-    def cell(self, channel: ChannelView | str, column: str) -> str:
-        """The text shown for ``channel`` in ``column``."""
-        key = channel if isinstance(channel, str) else channel.key
-        return str(self.get_cell(key, column))
 
-    def _setter(self, row: str) -> Callable[[str, Callable[[Any], str]], Callable[[Any], None]]:
-        def column(key: str, show: Callable[[Any], str]) -> Callable[[Any], None]:
-            return lambda value: self.update_cell(row, key, Text(show(value)))
-        return column

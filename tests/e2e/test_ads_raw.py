@@ -20,7 +20,6 @@ import socket
 import struct
 import threading
 import time
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -166,22 +165,6 @@ def read_write(group: int, offset: int, read_length: int, data: bytes) -> bytes:
 
 def add_notification(group: int, offset: int, length: int, mode: int, cycle_100ns: int) -> bytes:
     return struct.pack("<IIIIII", group, offset, length, mode, 0, cycle_100ns) + bytes(16)
-
-
-@pytest.fixture(scope="module")
-def ads_service(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceProcess]:
-    """One service for the module, ADS on any free port of 127.0.0.1."""
-    service = start_service(program_dir=tmp_path_factory.mktemp("ads-raw"), ads="127.0.0.1:0")
-    yield service
-    assert service.stop() == 0, service.log_text
-
-
-@pytest.fixture
-def ads(ads_service: ServiceProcess) -> Iterator[RawAds]:
-    """A fresh connection to the module's service."""
-    connection = RawAds(ads_service)
-    yield connection
-    connection.close()
 
 
 # --------------------------------------------------------------------------- framing
