@@ -264,17 +264,24 @@ class SpindleConfig(Strict):
 
 
 class PlcFunctionsConfig(Strict):
-    """M, S and T functions to the PLC: kinds per function, the embedded PLC's acknowledge.
+    """M, H, S and T functions to the PLC: kinds per function, the embedded PLC's acknowledge.
 
-    Keys of ``m_synch`` / ``m_prozess_zeit`` are M numbers ("8" for M8)."""
+    Keys of ``m_synch`` / ``m_prozess_zeit`` are M numbers ("8" for M8), those of
+    ``h_synch`` / ``h_prozess_zeit`` H numbers."""
 
     m_synch: dict[str, str] = Field(
         default_factory=dict, description="P-CHAN-00041 m_synch[i]: kind of M<i>")
     m_synch_default: str = Field(
         "MVS_SVS", description="kind of an M function m_synch does not list (ISG: NOT_VALID)")
+    h_synch: dict[str, str] = Field(
+        default_factory=dict, description="P-CHAN-00027 h_synch[i]: kind of H<i>")
+    h_synch_default: str = Field(
+        "MVS_SVS", description="kind of an H function h_synch does not list (ISG: NOT_VALID)")
     t_synch: str = Field("MOS", description="kind of the T word (project)")
     m_prozess_zeit: dict[str, int] = Field(
         default_factory=dict, description="P-CHAN-00040 m_prozess_zeit[i]: time of M<i> (us)")
+    h_prozess_zeit: dict[str, int] = Field(
+        default_factory=dict, description="P-CHAN-00026 h_prozess_zeit[i]: time of H<i> (us)")
     prozess_zeit_default: int = Field(
         0, ge=0, le=3_600_000_000, description="time (us) of a function m_prozess_zeit "
         "does not list; the embedded PLC acknowledges after it")
@@ -283,23 +290,35 @@ class PlcFunctionsConfig(Strict):
         "(kernelv's default); false: the PLC acknowledges over ADS")
     spindel: SpindleConfig = Field(default_factory=SpindleConfig)
 
-    @field_validator("m_synch")
+    @field_validator("m_synch", "h_synch")
     @classmethod
-    def _m_kinds(cls, value: dict[str, str]) -> dict[str, str]:
+    def _function_kinds(cls, value: dict[str, str]) -> dict[str, str]:
         for key, kind in value.items():
             if not key.isdigit():
-                raise ValueError(f"m_synch key {key!r} is not an M number")
+                raise ValueError(f"key {key!r} is not a function number")
             _sync_kind(kind)
         return value
 
-    @field_validator("m_synch_default", "t_synch")
+    @field_validator("m_prozess_zeit", "h_prozess_zeit")
+    @classmethod
+    def _function_times(cls, value: dict[str, int]) -> dict[str, int]:
+        for key, time_us in value.items():
+            if not key.isdigit():
+                raise ValueError(f"key {key!r} is not a function number")
+            if not 0 <= time_us <= 3_600_000_000:
+                raise ValueError(f"time {time_us} us of function {key} is not in 0..3600000000")
+        return value
+
+    @field_validator("m_synch_default", "h_synch_default", "t_synch")
     @classmethod
     def _kind(cls, value: str) -> str:
         return _sync_kind(value)
 
     def kind(self, type_: int, number: int) -> SyncKind:
-        """The kind of function ``number`` of type ``type_`` (1 M, 3 S, 4 T)."""
+        """The kind of function ``number`` of type ``type_`` (1 M, 2 H, 3 S, 4 T)."""
         spindle = self.spindel
+        if type_ == 2:
+            return SyncKind[self.h_synch.get(str(number), self.h_synch_default)]
         if type_ == 3:
             return SyncKind[spindle.s_synch]
         if type_ == 4:
@@ -312,7 +331,8 @@ class PlcFunctionsConfig(Strict):
 
     def prozess_zeit_s(self, type_: int, number: int) -> float:
         """The function's time in s (the embedded PLC acknowledges after it)."""
-        us = self.m_prozess_zeit.get(str(number)) if type_ == 1 else None
+        times = {1: self.m_prozess_zeit, 2: self.h_prozess_zeit}.get(type_, {})
+        us = times.get(str(number))
         return (self.prozess_zeit_default if us is None else us) / 1e6
 
 

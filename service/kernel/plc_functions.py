@@ -1,9 +1,10 @@
 """M, S and T functions on their way to the PLC, with ISG's synchronisation kinds.
 
-A decoded block's technology words (M other than program flow, S, T) are output to
+A decoded block's technology words (M other than program flow, H, S, T) are output to
 the PLC side as technology units (ISG ``gpCh[ch]^.techno_unit_std_sync[i]``); the kind
-of each function (P-CHAN-00041 ``m_synch[i]``, P-CHAN-00081 ``s_synch``, the spindle's
-``m3_synch`` ..) says when it is output and when the path waits for its acknowledge:
+of each function (P-CHAN-00041 ``m_synch[i]``, P-CHAN-00027 ``h_synch[i]``, P-CHAN-00081
+``s_synch``, the spindle's ``m3_synch`` ..) says when it is output and when the path waits
+for its acknowledge:
 
 * MOS: output when the block's motion starts, never waited for;
 * MVS_SVS: output before the motion, which starts only after the acknowledge;
@@ -34,7 +35,7 @@ class TechnoType(IntEnum):
     """What a technology unit carries (HLI_M_H_PROZESS / HLI_T_PROZESS / S data)."""
 
     M = 1  # M function: ``number`` is the M number
-    H = 2  # H function (not decoded yet)
+    H = 2  # H function: ``number`` is the H number
     S = 3  # spindle speed: ``number`` is S in rpm
     T = 4  # tool: ``number`` is the T number
 
@@ -97,6 +98,7 @@ class PlcFunctions:
 
     def _functions(self, block: Block) -> list[tuple[TechnoType, int]]:
         out = [(TechnoType.M, m) for m in block.m_functions]
+        out += [(TechnoType.H, h) for h in block.h_functions]
         if block.spindle_speed_rpm is not None:
             out.append((TechnoType.S, round(block.spindle_speed_rpm)))
         if block.tool is not None:
@@ -120,16 +122,19 @@ class PlcFunctions:
         if before:
             wait = any(k in _WAIT_BEFORE for k in kinds)
             out.append(self._part(block, before, wait))
-        out.append(replace(block, m_functions=(), spindle_speed_rpm=None, tool=None))
+        out.append(replace(block, m_functions=(), h_functions=(), spindle_speed_rpm=None,
+                           tool=None))
         if after or any(k in _WAIT_AFTER for k in kinds):
             out.append(self._part(block, after, True))
         return out
 
     def _part(self, block: Block, functions: list[tuple[TechnoType, int]], wait: bool) -> Block:
         ms = tuple(n for t, n in functions if t == TechnoType.M)
+        hs = tuple(n for t, n in functions if t == TechnoType.H)
         s = next((float(n) for t, n in functions if t == TechnoType.S), None)
         tool = next((n for t, n in functions if t == TechnoType.T), None)
-        part = replace(block, motion=None, m_functions=ms, spindle_speed_rpm=s, tool=tool,
+        part = replace(block, motion=None, m_functions=ms, h_functions=hs, spindle_speed_rpm=s,
+                       tool=tool,
                        stop=StopKind.TECHNOLOGY if wait else StopKind.NONE)
         self._extra.add(id(part))
         return part

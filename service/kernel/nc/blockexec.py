@@ -118,6 +118,18 @@ def _integer(value: float) -> int | None:
     return int(value)
 
 
+def _h_word(value: float, pos: int, h_codes: dict[int, int], err: ErrorAt) -> None:
+    """One H word: ISG rounds its value to an integer; a negative one, or the same H
+    number twice in the block (ISG 20766), is an error."""
+    number = round(value)
+    if value < 0 or number > 0xFFFF:
+        raise err(NcErrorId.INVALID_H_CODE,
+                  f"H{value:g} is not a valid H function (0..65535)", pos)
+    if number in h_codes:
+        raise err(NcErrorId.H_FUNCTION_TWICE, f"H{number} programmed twice in one block", pos)
+    h_codes[number] = pos
+
+
 class BlockExecutor:
     """Applies NC blocks to a ``ModalState`` and builds the ``Block`` objects."""
 
@@ -203,14 +215,19 @@ class BlockExecutor:
         offsets: Offsets = {}
         words: Words = {}
         m_codes: list[tuple[int, int, int]] = []  # (M number, pos, item index)
+        h_codes: dict[int, int] = {}  # H number -> pos
         self.items_done = 0
         for k, item in enumerate(stmt.items):
             try:
                 if type(item) is Assign:
                     item.target.assign(env, item.value(env))
                 else:
-                    self._word(item, evaluate_number(item.value, env, line, item.pos), err,
-                               groups, axis_words, offsets, words, m_codes, k)
+                    value = evaluate_number(item.value, env, line, item.pos)
+                    if item.kind == WordKind.H:
+                        _h_word(value, item.pos, h_codes, err)
+                    else:
+                        self._word(item, value, err, groups, axis_words, offsets, words,
+                                   m_codes, k)
             except NcError as error:
                 if on_error is None:
                     raise
@@ -256,7 +273,7 @@ class BlockExecutor:
         tool = words.get(WordKind.TOOL)
         if (motion is None and dwell_s == 0.0 and stop == StopKind.NONE and not m_functions
                 and spindle is None and tool is None and not axis_words and not offsets
-                and not homed):
+                and not homed and not h_codes):
             return None, flow, flow_pos
         line_no, column = line.locate(_first(line.text))
         block = make_block(
@@ -267,6 +284,8 @@ class BlockExecutor:
         )
         if homed:
             block = with_homing(block, homed)
+        if h_codes:
+            block = replace(block, h_functions=tuple(h_codes))
         return block, flow, flow_pos
 
     def _word(self, item: Word, value: float, err: ErrorAt, groups: Groups,

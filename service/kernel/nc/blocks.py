@@ -184,6 +184,7 @@ class Block:
     contour: ContourCommand | None = None  # #CONTOUR LOOKAHEAD, #DISTANCE, RT loop marker
     look_ahead: LookAheadMark | None = None  # decoded inside LA_ON .. LA_OFF
     homing_axes: tuple[int, ...] = ()  # G74: channel axis indices referenced at its end
+    h_functions: tuple[int, ...] = ()  # H words: technology information to the PLC
 
     @property
     def needs_stop(self) -> bool:

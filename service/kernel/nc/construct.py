@@ -93,6 +93,7 @@ def _fast_block(
     b.contour = contour
     b.look_ahead = look_ahead
     b.homing_axes = ()
+    b.h_functions = ()
     b.__class__ = Block
     return cast(Block, b)
 

@@ -244,6 +244,7 @@ _BLOCK_FAST = '''\
                 block.contour = None
                 block.look_ahead = look_ahead
                 block.homing_axes = ()
+                block.h_functions = ()
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\

@@ -68,6 +68,8 @@ LOOK_AHEAD_PARAMS = frozenset({"METB", "VFBT", "BBTRC"})
 _LOOK_AHEAD_INITIALS = frozenset("LMVB")
 
 WordTable = Mapping[str, tuple[WordKind, int]]
+# words a block may hold several of (G and M of other groups, H of other numbers)
+_REPEATABLE = frozenset({WordKind.G, WordKind.M, WordKind.H})
 # the syntax check's handler of an error in an item of an NC block: (error, start of the
 # item) -> where parsing goes on (a position, or the line with the bad term blanked, to
 # be parsed from the item's start); raises to end the line
@@ -80,7 +82,7 @@ def word_table(axes: tuple[str, ...]) -> dict[str, tuple[WordKind, int]]:
     table = {
         "F": (WordKind.FEED, -1), "S": (WordKind.SPINDLE, -1), "T": (WordKind.TOOL, -1),
         "D": (WordKind.TOOL_OFFSET, -1), "G": (WordKind.G, -1), "M": (WordKind.M, -1),
-        "R": (WordKind.RADIUS, -1),
+        "R": (WordKind.RADIUS, -1), "H": (WordKind.H, -1),
         "I": (WordKind.OFFSET, index.get("X", -1)),
         "J": (WordKind.OFFSET, index.get("Y", -1)),
         "K": (WordKind.OFFSET, index.get("Z", -1)),
@@ -91,7 +93,7 @@ def word_table(axes: tuple[str, ...]) -> dict[str, tuple[WordKind, int]]:
     return table
 
 
-RESERVED_LETTERS = frozenset("NGMFSTDLIJKRV")
+RESERVED_LETTERS = frozenset("NGMFSTDLIJKRVH")
 
 
 class LineParser:
@@ -308,7 +310,7 @@ class LineParser:
             if spec is None:
                 raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
             kind, axis = spec
-            if kind != WordKind.G and kind != WordKind.M:
+            if kind not in _REPEATABLE:
                 if c in letters:
                     raise cur.error(
                         NcErrorId.WORD_REPEATED, f"{c} programmed twice in one block"
@@ -328,7 +330,7 @@ class LineParser:
                     )
                 if G_CODES[int(value)][0] == GGroup.DWELL:
                     block.has_g4 = True
-            if kind != WordKind.G and kind != WordKind.M:
+            if kind not in _REPEATABLE:
                 letters.add(c)
             block.items.append(Word(kind, c, value, pos, axis))
         elif c == "#" and AX_WORD.match(cur.up, pos):

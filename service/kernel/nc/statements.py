@@ -88,6 +88,7 @@ class WordKind(IntEnum):
     LOOK_AHEAD = 10  # LA_ON (value 1) / LA_OFF (value 0): enhanced look-ahead
     LOOK_AHEAD_PARAM = 11  # METB = <s> / VFBT = <factor> / BBTRC = <blocks>
     ZERO_OFFSET_INDEX = 12  # G159 = <i>: zero offset group np_grp[i]
+    H = 13  # H: technology function to the PLC (ISG's H functions)
 
 
 @final  # the decoder dispatches on type(stmt) is ...: no subclasses
