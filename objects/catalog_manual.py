@@ -95,4 +95,7 @@ MANUAL_ROWS: tuple[ManualRow, ...] = (
               "TRUE once the axis is homed (G74 or homing_start_w) (project)"),
     ManualRow("homing_active_r", _AXIS, COM, COM_CH, 0x3312, BOOLEAN, R, "-",
               "TRUE while the axis's homing run is under way (project)"),
+    ManualRow("manual_offset_r", _AXIS, COM, COM_CH, 0x3313, SGN32, R, "0.1 um",
+              "Manual offset summed by G200/G201 jogs in the running program, added to the "
+              "path's output; 0 again when the program ends (project)"),
 )

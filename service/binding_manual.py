@@ -58,6 +58,7 @@ MANUAL_READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "manual_limit_warning_r": _view("limit_warning"),
     "homing_referenced_r": _view("referenced"),
     "homing_active_r": _view("homing_active"),
+    "manual_offset_r": _view("offset_incr", _int32),
 }
 
 MANUAL_WRITERS: dict[str, Callable[[Kernel, CncObject], Callable[[Any], ManualAxisCommand]]] = {

@@ -43,7 +43,7 @@ from .contour_lookahead import ContourLog
 from .decoder_feed import DecoderFeed, Job
 from .manual_mode import ManualMode
 from .nc import ModalState
-from .nc.blocks import LogArea, LookAheadMark
+from .nc.blocks import LogArea, LookAheadMark, ManualModeRequest
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
 from .path.executor import AxisDynamics, PathExecutor
 from .path.section_plan import plan_section
@@ -203,6 +203,11 @@ class ChannelRunner:
         if ch.state == ChannelState.ACTIVE:
             if not ch.waiting_for_start:
                 return _not_ready(ch, "the program is running already")
+            moving = self.manual.program_motion()
+            if moving is not None:
+                return _not_ready(ch, f"axis {moving} still moves in manual mode (G200): "
+                                  "release its jog key or wait, then START")
+            self.manual.end_g200()  # "continue motion"
             ch.waiting_for_start = False
             if self._run is not None:
                 self._run.resume()  # M0/M1 or a single-block stop
@@ -225,7 +230,7 @@ class ChannelRunner:
         if self._run is not None and self._run.ignores_feedhold:
             return None  # a dry run (MACHINE_LOCK) ignores feedhold
         self._move(ChannelEvent.HOLD)
-        if self.manual.engaged:
+        if self.manual.engaged or self.manual.in_program:
             self.manual.feedhold()
         if self._run is not None:
             self._run.hold()
@@ -318,6 +323,15 @@ class ChannelRunner:
         """G74 homed the channel axes with these indices (a run reports it)."""
         for axis_index in axes:
             self.manual.mark_referenced(axis_index)
+
+    @property
+    def manual_offsets_mm(self) -> tuple[float, ...] | None:
+        """The G200/G201 manual offsets the path's output adds (None: all 0)."""
+        return self.manual.offsets_mm
+
+    def manual_mode(self, request: ManualModeRequest) -> None:
+        """The path reached a G200/G201/G202 block."""
+        self.manual.program_request(request)
 
     def _check_jog_of_path(self) -> bool:
         """True when the channel may work; otherwise it goes to ERROR naming the axis."""
@@ -427,6 +441,7 @@ class ChannelRunner:
             self._begin_check(job, mode)
             return
         dynamics, sw_limits = self._axis_limits()
+        self.manual.clear_program()  # a run starts where the axes stand
         position = tuple(a.position_mm for a in ch.axes)
         if fresh_modal or self._modal is None:
             self._modal = self.new_modal(position)
@@ -581,11 +596,13 @@ class ChannelRunner:
         self.touched = True
         if run is None:  # the start failed (jog of path)
             return False
+        # G200/G201: the manual motions move their offsets before the path's step
+        manual_moving = self.manual.in_program and self.manual.offset_cycle()
         match run.cycle(time_s):
             case Step.BUSY:
                 return True
             case Step.WAITING:
-                return False
+                return manual_moving
             case Step.ENDED:
                 self._end_program()
             case Step.FAILED:
@@ -601,6 +618,7 @@ class ChannelRunner:
     def _drop_run(self) -> ChannelRun | None:
         """End the run at once; the modal state it reached carries on (MDI)."""
         run, self._run = self._run, None
+        self.manual.clear_program()  # the axes stand where path and manual offset put them
         if run is not None:
             modal = run.cancel()
             if modal is not None and self._modal is not None:

@@ -14,15 +14,23 @@ Jogging is refused (``Refusal`` NOT_READY, ADS 0x707, with the reason) when the 
 is not in MANUAL, is in HOLD or ERROR, or the axis is not linked to its drive.
 Out-of-range values are refused as INVALID_VALUE (ADS 0x706).
 
+In a program, ISG's G200/G201 enable manual mode for named axes (``program_request``):
+their manual motions then move a *manual offset* that the path's output adds to the
+axis (``offsets_mm``), inside the software limits of the sum; G200 while the program
+waits at its block (START ends it), G201 in parallel to the path until G202. The offsets
+last until the program ends (ISG: G202 does not clear them); a new start takes the axes
+where they stand.
+
 ``ManualMode.cycle`` runs in the GEO cycle (``ChannelRunner.cycle``), before the drives
-follow the axes. What HMI and PLC read is ``Channel.manual``: one immutable
-``ManualAxisView`` per axis, replaced when something changes.
+follow the axes; ``offset_cycle`` is its twin for G200/G201, before the path's step.
+What HMI and PLC read is ``Channel.manual``: one immutable ``ManualAxisView`` per axis,
+replaced when something changes.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import IntEnum
 
 from cnc_objects.protocol.values import ManualOperationMode
@@ -35,6 +43,7 @@ from .commands import Refusal, RefusalReason
 from .homing import HomingState
 from .manual_motion import AxisDynamicsLimits, AxisMotion
 from .manual_view import DisplayState, ManualAxisView
+from .nc.blocks import ManualModeKind, ManualModeRequest
 from .state import Channel, ErrorEntry
 
 INCREMENT_MIN_INCR = 1  # 0.1 um: the smallest jog increment
@@ -65,6 +74,8 @@ class _Axis:
     limit_warning: bool = False
     motion: AxisMotion | None = None
     homing: HomingState | None = None
+    program: ManualModeKind | None = None  # G200 / G201 enabled manual mode in a program
+    offset_mm: float = 0.0  # manual offset summed in a program (G200/G201)
 
 
 def _s32_delta(new: int, old: int) -> int:
@@ -87,6 +98,8 @@ class ManualMode:
         self._move = move
         self._report = report
         self._axes: list[_Axis] = []
+        # the manual offsets the path's output adds; None while all are 0 (no cost)
+        self.offsets_mm: tuple[float, ...] | None = None
         for axis in channel.axes:
             configured = machine.axis(axis.logical_number)
             config = configured.manual if configured is not None else ManualAxisConfig()
@@ -102,6 +115,18 @@ class ManualMode:
         ch = self._channel
         return ch.mode == ChannelMode.MANUAL and ch.state in (ChannelState.ACTIVE,
                                                                ChannelState.HOLD)
+
+    @property
+    def in_program(self) -> bool:
+        """G200/G201 enabled manual mode for an axis of the running program."""
+        return any(a.program is not None for a in self._axes)
+
+    def program_motion(self) -> str | None:
+        """The name of an axis whose G200/G201 manual motion still runs, or None."""
+        for k, axis in enumerate(self._axes):
+            if axis.program is not None and axis.motion is not None:
+                return self._channel.axes[k].name
+        return None
 
     def referenced(self, axis_index: int) -> bool:
         """The axis at ``axis_index`` of the channel has been homed."""
@@ -218,6 +243,61 @@ class ManualMode:
         self._started(axis_index)
         return None
 
+    def program_request(self, request: ManualModeRequest) -> None:
+        """A G200/G201/G202 block reached by the path: manual mode on or off for its
+        axes (G202 brakes their manual motions; the offsets stay)."""
+        enable = None if request.kind == ManualModeKind.G202 else request.kind
+        for k in request.axes:
+            axis = self._axes[k]
+            axis.program = enable
+            if enable is None and axis.motion is not None:
+                axis.motion.stop()
+        self.publish()
+
+    def end_g200(self) -> None:
+        """START after G200 ("continue motion"): manual mode ends for every axis G200
+        enabled."""
+        for axis in self._axes:
+            if axis.program == ManualModeKind.G200:
+                axis.program = None
+        self.publish()
+
+    def clear_program(self) -> None:
+        """A run begins or ends (or RESET): no axis is in G200/G201, and the offsets are
+        0 (the axes stand where path plus offset put them; a new run starts from there)."""
+        for axis in self._axes:
+            if axis.program is not None:
+                axis.motion = None
+            axis.program = None
+            axis.offset_mm = 0.0
+        self.offsets_mm = None
+        self.publish()
+
+    def offset_cycle(self) -> bool:
+        """One GEO cycle of the G200/G201 manual motions (before the path's step): each
+        moves its axis's offset, inside the software limits of path + offset. True while
+        one moves."""
+        ch = self._channel
+        moving = False
+        for k, axis in enumerate(self._axes):
+            motion = axis.motion
+            if motion is None or axis.program is None:
+                continue
+            self._offset_limits(k, motion)
+            path_mm = ch.axes[k].position_mm - axis.offset_mm
+            axis.offset_mm = motion.step(self._cycle_s)
+            if motion.hit_limit and not axis.limit_warning:
+                axis.limit_warning = True
+                self._warn_limit(k, path_mm + axis.offset_mm)
+            if motion.at_rest:
+                axis.motion = None
+            else:
+                moving = True
+        offsets = tuple(a.offset_mm for a in self._axes)
+        self.offsets_mm = offsets if any(offsets) else None
+        self.publish()
+        return moving
+
     def feedhold(self) -> None:
         """HOLD: every manual motion brakes; the goals are dropped."""
         for axis in self._axes:
@@ -282,7 +362,7 @@ class ManualMode:
     # ------------------------------------------------------------ helpers
 
     def _view(self, axis: _Axis) -> ManualAxisView:
-        manual = self._channel.mode == ChannelMode.MANUAL
+        manual = self._channel.mode == ChannelMode.MANUAL or axis.program is not None
         state = DisplayState.DEACTIVATED
         if manual:
             state = (DisplayState.ASSIGNED if axis.operation_mode != ManualOperationMode.NONE
@@ -300,6 +380,7 @@ class ManualMode:
             moving=motion is not None, limit_warning=axis.limit_warning,
             referenced=homing is not None and homing.referenced,
             homing_active=homing is not None and homing.active,
+            offset_incr=round(axis.offset_mm * _INCR_PER_MM),
         )
 
     def _jog_vel(self, axis: _Axis) -> float:
@@ -316,16 +397,30 @@ class ManualMode:
         p = self._params[axis.number]
         limits = AxisDynamicsLimits(max(vel_mm_s, 1e-6), p.acc_max_mm_s2,
                                     p.sw_limit_min_mm, p.sw_limit_max_mm)
+        start_mm = self._channel.axes[axis_index].position_mm
+        if axis.program is not None and self._channel.mode != ChannelMode.MANUAL:
+            start_mm = axis.offset_mm  # G200/G201: the motion moves the manual offset
         if axis.motion is None:
-            axis.motion = AxisMotion(self._channel.axes[axis_index].position_mm, limits)
+            axis.motion = AxisMotion(start_mm, limits)
         else:
             axis.motion.limits = limits
+        if axis.program is not None and self._channel.mode != ChannelMode.MANUAL:
+            self._offset_limits(axis_index, axis.motion)
         return axis.motion
+
+    def _offset_limits(self, axis_index: int, motion: AxisMotion) -> None:
+        """The software limits of an offset motion: those of the axis, less where the
+        path puts it now (G200's offset limits are the software limits, ISG)."""
+        axis = self._axes[axis_index]
+        p = self._params[axis.number]
+        path_mm = self._channel.axes[axis_index].position_mm - axis.offset_mm
+        motion.limits = replace(motion.limits, sw_limit_min_mm=p.sw_limit_min_mm - path_mm,
+                                sw_limit_max_mm=p.sw_limit_max_mm - path_mm)
 
     def _started(self, axis_index: int) -> None:
         """A motion began: the channel works (ACTIVE); a goal cut at a limit warns now."""
         ch = self._channel
-        if ch.state != ChannelState.ACTIVE:
+        if ch.state != ChannelState.ACTIVE and ch.mode == ChannelMode.MANUAL:
             self._move(ChannelEvent.START)
         axis = self._axes[axis_index]
         motion = axis.motion
@@ -340,9 +435,19 @@ class ManualMode:
     def _may_move(self, axis_index: int) -> Refusal | None:
         """Why the axis cannot start a manual motion now, or None."""
         ch = self._channel
-        if ch.mode != ChannelMode.MANUAL:
-            return self._not_ready(axis_index, "manual motion needs channel mode MANUAL (4); "
-                                   "select it with mc_command_mode_w")
+        program = self._axes[axis_index].program
+        if ch.mode != ChannelMode.MANUAL and program is None:
+            return self._not_ready(axis_index, "manual motion needs channel mode MANUAL (4) "
+                                   "(select it with mc_command_mode_w), or G200/G201 for the "
+                                   "axis in the running program")
+        if program is not None and ch.mode != ChannelMode.MANUAL:
+            if ch.state != ChannelState.ACTIVE:
+                return self._not_ready(axis_index, f"{program.name} manual mode moves only "
+                                       "while the program runs (ACTIVE); START first")
+            logical = ch.axes[axis_index]
+            if ch.output_suspended or (not logical.actual_link and not logical.released):
+                return self._not_ready(axis_index, "the axis is not linked to its drive")
+            return None
         if ch.state == ChannelState.HOLD:
             return self._not_ready(axis_index, "manual mode is held (feedhold); START or "
                                    "RESET first")

@@ -37,3 +37,4 @@ class ManualAxisView:
     limit_warning: bool = False  # the last manual motion stopped at a software limit
     referenced: bool = False  # the axis has been homed
     homing_active: bool = False  # the homing run of the axis is under way
+    offset_incr: int = 0  # manual offset summed by G200/G201 in the running program (0.1 um)

@@ -29,7 +29,15 @@ from .channel_mode import ChannelMode, ChannelState
 from .contour_lookahead import LOG_FULL_WARNING, ContourLog
 from .decoder_feed import DecodeEnd, DecoderFeed, Item, Job
 from .nc import ModalState, NcError
-from .nc.blocks import AxisExchange, AxisExchangeKind, Block, ContourKind, SourceRef, StopKind
+from .nc.blocks import (
+    AxisExchange,
+    AxisExchangeKind,
+    Block,
+    ContourKind,
+    ManualModeRequest,
+    SourceRef,
+    StopKind,
+)
 from .nc.contour import LOOP_MARKERS
 from .path.errors import PathErrorId
 from .path.executor import PathError, PathExecutor
@@ -76,6 +84,13 @@ class RunHost(Protocol):
 
     def referenced(self, axes: tuple[int, ...]) -> None:
         """G74 homed the channel axes with these indices."""
+
+    @property
+    def manual_offsets_mm(self) -> tuple[float, ...] | None:
+        """The G200/G201 manual offsets to add to the path's output (None: all 0)."""
+
+    def manual_mode(self, request: ManualModeRequest) -> None:
+        """The path reached a G200/G201/G202 block."""
 
 
 class ChannelRun(Protocol):
@@ -191,7 +206,10 @@ class ProgramRun:
         if full and executor.buffer_limits_speed():
             self._warn_buffer_limits()
         if output:
-            for axis, pos in zip(ch.axes, step.position_mm, strict=True):
+            offsets = self._host.manual_offsets_mm  # G200/G201 (None: no offset)
+            positions = step.position_mm if offsets is None else tuple(
+                p + o for p, o in zip(step.position_mm, offsets, strict=True))
+            for axis, pos in zip(ch.axes, positions, strict=True):
                 axis.position_mm = pos
                 axis.command_position_incr = round(pos * _INCR_PER_MM)
             ch.path_velocity_mm_s = step.path_velocity_mm_s
@@ -207,6 +225,8 @@ class ProgramRun:
             ch.block_count += 1
             if block.homing_axes and output:  # G74 done: the axes are referenced
                 self._host.referenced(block.homing_axes)
+            if block.manual_mode is not None and output:  # G200 / G201 / G202
+                self._host.manual_mode(block.manual_mode)
             if self.contour is not None and block.contour is not None and (
                     block.contour.kind == ContourKind.DISTANCE_CLEAR):
                 self.contour.distance_cleared()  # mode 2 answers in the new distances

@@ -32,6 +32,7 @@ from .blocks import (
     AxisExchangeKind,
     Block,
     Compensation,
+    ManualModeKind,
     Motion,
     MotionKind,
     StopKind,
@@ -45,6 +46,7 @@ from .exchange import moved_axes
 from .expressions import evaluate_number
 from .geometry import centre_from_offsets, centre_from_radius
 from .homing_block import homing_motion, with_homing
+from .manual_block import manual_mode_request, with_manual_mode
 from .modal import G_CODES, PLANE_AXES, DistanceMode, GGroup, MCode, ModalState, Plane
 from .statements import Assign, AxisCommand, NcBlock, Word, WordKind
 from .tool_data import ToolTable, program_shift_mm
@@ -236,6 +238,11 @@ class BlockExecutor:
         self._modal_groups(groups)
         self._technology(words, err)
         homed: tuple[int, ...] = ()
+        manual_mode = None
+        if GGroup.MANUAL_MODE in groups:  # G200/G201/G202: the axis words name the axes
+            number, g_pos = groups[GGroup.MANUAL_MODE]
+            manual_mode = manual_mode_request(number, axis_words, g_pos, len(self.axes), err)
+            axis_words = []
         if GGroup.HOMING in groups:  # G74: the axis words are places in the homing sequence
             dwell_s = 0.0
             motion, homed = homing_motion(self.modal, axis_words, groups[GGroup.HOMING][1],
@@ -269,11 +276,14 @@ class BlockExecutor:
                 continue
             stop, flow = action
             flow_pos = pos
+        if manual_mode is not None and manual_mode.kind == ManualModeKind.G200 \
+                and stop == StopKind.NONE:
+            stop = StopKind.MANUAL  # the program waits in manual mode until START
         spindle = words.get(WordKind.SPINDLE)
         tool = words.get(WordKind.TOOL)
         if (motion is None and dwell_s == 0.0 and stop == StopKind.NONE and not m_functions
                 and spindle is None and tool is None and not axis_words and not offsets
-                and not homed and not h_codes):
+                and not homed and not h_codes and manual_mode is None):
             return None, flow, flow_pos
         line_no, column = line.locate(_first(line.text))
         block = make_block(
@@ -286,6 +296,8 @@ class BlockExecutor:
             block = with_homing(block, homed)
         if h_codes:
             block = replace(block, h_functions=tuple(h_codes))
+        if manual_mode is not None:
+            block = with_manual_mode(block, manual_mode)
         return block, flow, flow_pos
 
     def _word(self, item: Word, value: float, err: ErrorAt, groups: Groups,
@@ -351,6 +363,9 @@ class BlockExecutor:
         if group == GGroup.ZERO_OFFSET and group in groups:
             raise err(NcErrorId.ZERO_OFFSETS_TWICE,
                       f"G{number}: one zero offset (G53..G59, G159) per block", pos)
+        if group == GGroup.MANUAL_MODE and group in groups:
+            raise err(NcErrorId.MANUAL_MODE_TWICE,
+                      f"G{groups[group][0]} and G{number}: one of G200/G201/G202 per block", pos)
         if group in groups:
             raise err(NcErrorId.CONFLICTING_G_CODES,
                       f"G{groups[group][0]} and G{number} in one block", pos)

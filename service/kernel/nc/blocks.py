@@ -38,6 +38,23 @@ class StopKind(IntEnum):
     OPTIONAL = 2  # M1: optional stop; this kernel always stops (no optional-stop switch)
     PROGRAM_END = 3  # M2 / M30: end of the main program
     TECHNOLOGY = 4  # M/S/T functions wait for their acknowledge (kernel.plc_functions)
+    MANUAL = 5  # G200: the program waits in manual mode until START ("continue motion")
+
+
+class ManualModeKind(IntEnum):
+    """ISG's manual mode in a program (G200 / G201 / G202)."""
+
+    G200 = 200  # this block: the program stops; the axes jog until START
+    G201 = 201  # modal: the axes jog in parallel to the path until G202
+    G202 = 202  # modal, initial: manual mode off (for the named axes, or all)
+
+
+@dataclass(frozen=True, slots=True)
+class ManualModeRequest:
+    """A G200/G201/G202 block: which axes (channel axis indices) it names."""
+
+    kind: ManualModeKind
+    axes: tuple[int, ...]
 
 
 class AxisExchangeKind(IntEnum):
@@ -185,6 +202,7 @@ class Block:
     look_ahead: LookAheadMark | None = None  # decoded inside LA_ON .. LA_OFF
     homing_axes: tuple[int, ...] = ()  # G74: channel axis indices referenced at its end
     h_functions: tuple[int, ...] = ()  # H words: technology information to the PLC
+    manual_mode: ManualModeRequest | None = None  # G200 / G201 / G202
 
     @property
     def needs_stop(self) -> bool:

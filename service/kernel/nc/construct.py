@@ -94,6 +94,7 @@ def _fast_block(
     b.look_ahead = look_ahead
     b.homing_axes = ()
     b.h_functions = ()
+    b.manual_mode = None
     b.__class__ = Block
     return cast(Block, b)
 

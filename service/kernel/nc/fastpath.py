@@ -245,6 +245,7 @@ _BLOCK_FAST = '''\
                 block.look_ahead = look_ahead
                 block.homing_axes = ()
                 block.h_functions = ()
+                block.manual_mode = None
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\

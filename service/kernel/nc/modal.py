@@ -57,6 +57,7 @@ class GGroup(IntEnum):
     DISTANCE = 4  # G90 G91 (modal)
     HOMING = 5  # G74 (this block only): homing of the programmed axes
     ZERO_OFFSET = 6  # G53 G54..G59 (modal; G159 = <i> in the same group)
+    MANUAL_MODE = 7  # G200 (this block) G201 G202 (modal): manual mode in a program
 
 
 class ZeroOffsetGroup(IntEnum):
@@ -87,6 +88,9 @@ G_CODES: dict[int, tuple[GGroup, IntEnum | None]] = {
     90: (GGroup.DISTANCE, DistanceMode.ABSOLUTE),
     91: (GGroup.DISTANCE, DistanceMode.INCREMENTAL),
     74: (GGroup.HOMING, None),
+    200: (GGroup.MANUAL_MODE, None),
+    201: (GGroup.MANUAL_MODE, None),
+    202: (GGroup.MANUAL_MODE, None),
     # G53 (no zero offset) and G54..G59: zero offset group np_grp[0..6]
     **{g: (GGroup.ZERO_OFFSET, ZeroOffsetGroup(g - 53)) for g in range(53, 60)},
 }
