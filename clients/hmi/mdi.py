@@ -92,6 +92,7 @@ class MdiHistory:
 class MdiInput(Input):
     """The MDI line; up/down recall the history, escape gives the keys back to the app."""
 
+    DEFAULT_CSS = "MdiInput.-textual-compact { padding: 0 1; }"
     BINDINGS = [
         Binding("up", "older", "Older", show=False),
         Binding("down", "newer", "Newer", show=False),
@@ -100,7 +101,7 @@ class MdiInput(Input):
 
     def __init__(self, history: MdiHistory, **kwargs: Any) -> None:
         super().__init__(placeholder="MDI: e to type a manual block, enter runs it, "
-                                     "↑/↓ history, esc leaves", **kwargs)
+                                     "↑/↓ history, esc leaves", compact=True, **kwargs)
         self.history = history
 
     def action_older(self) -> None:
