@@ -4,8 +4,8 @@ The text comes from the program store (``AsyncClient.download``) when a channel 
 a program (``mc_active_program_name_r``) or runs another file (``mc_active_file_name_r``:
 a subprogram, a cycle); the current line is ``mc_active_line_r``, the line of the block
 in execution, so the mark follows a running program block by block. The panel shows
-``WINDOW_LINES`` lines around it, with line numbers. A file that is not in the store (a
-manual block) is named instead of shown.
+``WINDOW_LINES`` lines around it, with line numbers. Manual blocks (file ``MDI``) and a
+file that is not in the store are named instead of shown.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from .session import Feed
 
 WINDOW_LINES = 9  # lines shown: the current one in the middle where the text allows
 CURRENT_STYLE = "reverse bold"
+MDI_FILE_NAME = "MDI"  # the file name the kernel gives manual blocks (mc_active_file_name_r)
 
 
 @dataclass(slots=True)
@@ -106,6 +107,9 @@ class ProgramView(Static):
 
     async def _fetch(self, name: str) -> None:
         if not name or name in self.texts or self._client is None:
+            return
+        if name == MDI_FILE_NAME:
+            self.texts[name] = "manual blocks (MDI): no program text; the MDI line has them"
             return
         try:
             data = await self._client.download(name)

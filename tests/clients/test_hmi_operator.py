@@ -75,6 +75,8 @@ async def test_mdi_line_runs_blocks_and_recalls_its_history(
         assert app.message.text == f"ch1: MDI {first}"
         assert app.channels.cell("ch1", "single") == "off" and app.is_running
         await wait_until(pilot, lambda: app.mode_bar.shown_mode == "MDI")
+        await wait_until(pilot, lambda: "manual blocks (MDI)" in str(app.program_view.render()),
+                         what=lambda: str(app.program_view.render()))
         await type_text(pilot, second)
         await pilot.press("enter")
         await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "command") == "0.5000",
