@@ -18,26 +18,32 @@ import asyncio
 import contextlib
 import sys
 from collections.abc import Awaitable, Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 import typer
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import VerticalScroll
-from textual.widgets import DataTable, Footer, Header, Label
+from textual.widgets import DataTable, Footer, Header, Input, Label
 
 from cnc_objects.clients.client import DEFAULT_ENDPOINT, AsyncClient, DeviceInfo
 from cnc_objects.clients.curve import client_curve
 from cnc_objects.clients.errors import AdsError, ClientValueError
 from cnc_objects.clients.key_options import key_option, server_key_option
+from cnc_objects.protocol.values import ChannelMode
 
 from . import control, manual_keys, text
 from .axes import AxesTable
 from .channels import ChannelTable, ErrorsPanel
+from .connection_state import ConnectionLine
 from .lookahead import MIN_GAP_S, REFRESH_S, LookaheadMode, LookaheadPanel, fetch
 from .machine import ChannelView, Machine
+from .mdi import MdiHistory, MdiInput, blocks, default_history_file
 from .message_line import MessageLine
+from .mode_select import SELECTABLE, ModeBar, select_mode
 from .program_picker import ProgramPicker
+from .program_view import ProgramView
 from .session import Feed, run_sessions
 from .tooling import ToolingTable
 
@@ -53,7 +59,7 @@ class HmiApp(App[None]):
     CSS = """
     #body { height: 1fr; }
     .title { height: 1; padding: 0 1; color: $text-muted; }
-    .stale { opacity: 60%; }
+    .stale { opacity: 60%; text-style: dim; }
     """
     ENABLE_COMMAND_PALETTE = False  # every command is a key; the footer needs the room
     BINDINGS = [
@@ -72,12 +78,18 @@ class HmiApp(App[None]):
         Binding("left_square_bracket", "jog(-1)", "Jog-", key_display="["),
         Binding("a", "jog_axis", "Jog axis"),
         Binding("i", "jog_increment", "Incr"),
+        Binding("space", "jog_release", "Jog stop", show=False),
+        Binding("e", "mdi", "MDI"),
+        *(Binding(m.key, f"select_mode('{m.mode.name}')", m.mode.name, show=False)
+          for m in SELECTABLE),
         Binding("q", "quit", "Quit"),
     ]
     _DIALOG_ACTIONS = {"quit"}  # what the keys may still do while the program dialog is open
 
     def __init__(self, endpoint: str = DEFAULT_ENDPOINT, timeout_s: float = DEFAULT_TIMEOUT_S,
-                 key_file: str | None = None, server_key: str | None = None):
+                 key_file: str | None = None, server_key: str | None = None,
+                 mdi_history: Path | None = None):
+        """``mdi_history``: the file the MDI history is kept in (None: this session only)."""
         super().__init__()
         self.endpoint = endpoint
         self.timeout_s = timeout_s
@@ -94,10 +106,17 @@ class HmiApp(App[None]):
         self.lookahead = LookaheadPanel(id="lookahead")
         self.message = MessageLine(id="message")
         self.jog_choice = manual_keys.JogChoice()  # manual mode: jog axis and increment
+        self.continuous_jog = manual_keys.ContinuousJog()
+        self.connection = ConnectionLine(endpoint, id="connection")
+        self.mode_bar = ModeBar(id="mode-bar")
+        self.program_view = ProgramView(id="program")
+        self.mdi = MdiInput(MdiHistory(mdi_history), id="mdi")
 
     def compose(self) -> ComposeResult:
         """Header, the panels, the message line, the key bindings."""
         yield Header()
+        yield self.connection
+        yield self.mode_bar
         with VerticalScroll(id="body"):
             yield Label("channels (cursor row = current channel)", classes="title")
             yield self.channels
@@ -105,8 +124,10 @@ class HmiApp(App[None]):
             yield self.axes
             yield Label("tools and work offsets", classes="title")
             yield self.tooling
+            yield self.program_view
             yield self.errors
             yield self.lookahead
+        yield self.mdi
         yield self.message
         yield Footer(compact=True)
 
@@ -131,26 +152,45 @@ class HmiApp(App[None]):
         self.channels.move_cursor(row=max(0, min(row, len(machine.channels) - 1)))
         self.axes.load(machine)
         self.tooling.load(machine)
-        for widget in (self.channels, self.axes, self.tooling):
+        for widget in self._value_widgets():
             widget.remove_class("stale")
+        self.connection.session_started(f"{info.name} {info.version}")
         self.sub_title = f"{info.name} {info.version} at {self.endpoint}"
         self.message.say(f"connected to {self.endpoint}: {len(machine.channels)} channels")
         current = self.current_channel
+        program_feeds = self.program_view.feeds(client, machine)
         if current is not None:
-            self.errors.show_channel(current)
+            self._show_current(current)
         self._lookahead_wake.set()
-        blocks = [Feed(ch.obj("mc_block_count_r"), self._block_finished(ch))
-                  for ch in machine.channels]
+        block_ends = [Feed(ch.obj("mc_block_count_r"), self._block_finished(ch))
+                      for ch in machine.channels]
+        modes = [Feed(ch.obj("mc_active_mode_r"), self._mode_changed(ch))
+                 for ch in machine.channels]
         return [*self.channels.feeds(machine), *self.axes.feeds(machine),
-                *self.tooling.feeds(machine), *self.errors.feeds(client, machine), *blocks]
+                *self.tooling.feeds(machine), *self.errors.feeds(client, machine), *block_ends,
+                *modes, *program_feeds]
 
     def session_lost(self, reason: str) -> None:
         """Say that the service does not answer; the shown values are stale."""
         self.client = None
+        self.continuous_jog.forget()
         self.sub_title = f"not connected: {self.endpoint}"
-        for widget in (self.channels, self.axes, self.tooling):
+        for widget in self._value_widgets():
             widget.add_class("stale")
+        self.connection.session_lost()
         self.message.say(reason, error=True)
+
+    def service_replied(self) -> None:
+        """A reply: the connection line's "no reply since" counts from now."""
+        self.connection.replied()
+
+    def _value_widgets(self) -> tuple[Any, ...]:
+        """The widgets that show values of the service: greyed while it does not reply."""
+        return (self.channels, self.axes, self.tooling, self.errors, self.program_view,
+                self.mode_bar)
+
+    def _mode_changed(self, channel: ChannelView) -> Callable[[int], None]:
+        return lambda mode: self.mode_bar.mode_changed(channel, mode)
 
     def feed_failed(self, feed: Feed, exc: AdsError) -> None:
         """One object could not be subscribed: say which and why."""
@@ -174,8 +214,15 @@ class HmiApp(App[None]):
     def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
         """Another current channel: its errors and look-ahead."""
         if event.data_table is self.channels and self.current_channel is not None:
-            self.errors.show_channel(self.current_channel)
+            self._show_current(self.current_channel)
             self._lookahead_wake.set()
+
+    def _show_current(self, channel: ChannelView) -> None:
+        """The panels that show the current channel only."""
+        self.errors.show_channel(channel)
+        self.mode_bar.show_channel(channel)
+        self.program_view.show_channel(channel)
+        self.mode_bar.jog_line.update(self.jog_choice.describe(channel))
 
     def action_next_channel(self) -> None:
         """Make the next channel current."""
@@ -188,6 +235,8 @@ class HmiApp(App[None]):
         """While the program dialog is open its keys are text, not commands."""
         if isinstance(self.screen, ProgramPicker) and action not in self._DIALOG_ACTIONS:
             return False
+        if self.focused is self.mdi and action not in self._DIALOG_ACTIONS:
+            return False  # the MDI line has the keys: letters are text, not commands
         return True
 
     def _command(self, what: str, operation: Operation) -> None:
@@ -214,7 +263,8 @@ class HmiApp(App[None]):
         self._command("HOLD", control.hold)
 
     def action_reset(self) -> None:
-        """RESET."""
+        """RESET (the service releases a held jog key itself)."""
+        self.continuous_jog.forget()
         self._command("RESET", control.reset)
 
     def action_single_block(self) -> None:
@@ -231,18 +281,64 @@ class HmiApp(App[None]):
         self._command("suspend axis output", control.toggle_suspend)
 
     def action_jog(self, direction: int) -> None:
-        """Jog the chosen axis one increment (selects MANUAL; docs/manual.md)."""
-        self._command("jog", lambda client, ch: manual_keys.jog(client, ch, self.jog_choice,
-                                                                 direction))
+        """Jog the chosen axis one increment, or continuously while the key repeats
+        (selects MANUAL; docs/manual.md)."""
+        if self.jog_choice.continuous:
+            self._command("jog", lambda client, ch: self.continuous_jog.press(
+                client, ch, self.jog_choice, direction))
+        else:
+            self._command("jog", lambda client, ch: manual_keys.jog(
+                client, ch, self.jog_choice, direction))
+
+    def action_jog_release(self) -> None:
+        """Release a continuous jog's key now."""
+        self.run_worker(self._report("jog stop", self.continuous_jog.release()),
+                        group="command")
 
     def action_jog_axis(self) -> None:
         """Choose the next axis of the current channel to jog."""
         if self.current_channel is not None:
             self.message.say(self.jog_choice.next_axis(self.current_channel))
+            self.mode_bar.jog_line.update(self.jog_choice.describe(self.current_channel))
 
     def action_jog_increment(self) -> None:
-        """Choose the next jog increment (1 um .. 10 mm)."""
+        """Choose the next jog step (1 um .. 10 mm, continuous)."""
         self.message.say(self.jog_choice.next_increment())
+        self.mode_bar.jog_line.update(self.jog_choice.describe(self.current_channel))
+
+    # ------------------------------------------------------------ modes and MDI
+
+    def action_select_mode(self, name: str) -> None:
+        """Command the mode ``name`` (a ``ChannelMode`` name) in the current channel;
+        MDI also puts the keys into the MDI line."""
+        mode = ChannelMode[name]
+        self._command("mode", lambda client, ch: select_mode(client, ch, mode))
+        if mode is ChannelMode.MDI:
+            self.mdi.focus()
+
+    def on_mode_bar_chosen(self, event: ModeBar.Chosen) -> None:
+        """A click on the mode bar."""
+        self.action_select_mode(event.mode.name)
+
+    def action_mdi(self) -> None:
+        """Type a manual block (the MDI line gets the keys)."""
+        self.mdi.focus()
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        """Enter in the MDI line: run it in the current channel; it joins the history."""
+        if event.input is not self.mdi:
+            return
+        line = event.value.strip()
+        if not line:
+            return
+        self.mdi.history.add(line)
+        self.mdi.value = ""
+
+        async def run(client: AsyncClient, channel: ChannelView) -> str:
+            await client.mdi(blocks(line), channel.id)
+            return f"ch{channel.id}: MDI {line}"
+
+        self._command("manual block", run)
 
     def action_select_program(self) -> None:
         """Ask for a program (the store's NC programs) and select it in the current channel."""
@@ -313,6 +409,10 @@ def run(
     ),
     key_file: str | None = key_option("The HMI's"),
     server_key: str | None = server_key_option(),
+    mdi_history: str = typer.Option(
+        str(default_history_file()), "--mdi-history", metavar="FILE",
+        help="File that keeps the MDI history between sessions ('' keeps none).",
+    ),
 ) -> None:
     """Terminal HMI of a cnc-objects service (keys: docs/hmi.md)."""
     try:
@@ -320,7 +420,8 @@ def run(
     except ClientValueError as exc:
         print(f"cnc-hmi: {exc}", file=sys.stderr)
         raise typer.Exit(2) from None
-    HmiApp(endpoint, timeout_s, key_file or None, server_key or None).run()
+    HmiApp(endpoint, timeout_s, key_file or None, server_key or None,
+           Path(mdi_history) if mdi_history else None).run()
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -61,6 +61,9 @@ class SessionListener(Protocol):
     def feed_failed(self, feed: Feed, exc: AdsError) -> None:
         """The service refused one subscription; the others go on."""
 
+    def service_replied(self) -> None:
+        """A reply came (heartbeat, sample): the service was alive just now."""
+
 
 async def run_sessions(
     endpoint: str, timeout_s: float, listener: SessionListener,
@@ -74,12 +77,13 @@ async def run_sessions(
         await client.__aenter__()
         try:
             info = await client.info()
+            listener.service_replied()
             machine = await discover(client)
             feeds = listener.session_started(client, machine, info)
             async with asyncio.TaskGroup() as group:
                 for feed in feeds:
                     group.create_task(_follow(client, feed, listener), name=f"feed {feed.name}")
-                group.create_task(_heartbeat(client), name="heartbeat")
+                group.create_task(_heartbeat(client, listener), name="heartbeat")
         except* _LOST as lost:
             reason = lost.exceptions[0]
             log.info("session with %s lost: %s", endpoint, reason)
@@ -97,6 +101,7 @@ async def run_sessions(
 async def _follow(client: AsyncClient, feed: Feed, listener: SessionListener) -> None:
     try:
         async for sample in client.subscribe(feed.name, cycle_ms=feed.cycle_ms):
+            listener.service_replied()
             result = feed.apply(sample.value)
             if inspect.isawaitable(result):
                 await result
@@ -106,11 +111,12 @@ async def _follow(client: AsyncClient, feed: Feed, listener: SessionListener) ->
         listener.feed_failed(feed, exc)
 
 
-async def _heartbeat(client: AsyncClient) -> None:
+async def _heartbeat(client: AsyncClient, listener: SessionListener) -> None:
     while True:
         await asyncio.sleep(HEARTBEAT_S)
         try:
             await client.read(HEARTBEAT_OBJECT)
+            listener.service_replied()
         except _LOST:
             # Close before the TaskGroup cancels the feeds: a closed client ends them at
             # once, instead of each waiting a timeout to delete its notification.

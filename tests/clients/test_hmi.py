@@ -366,8 +366,9 @@ async def test_jog_keys_move_the_chosen_axis_in_manual_mode(endpoint: str) -> No
         y0 = await c.read("ch1.ax2.command_position_acs")
         await pilot.press("a")  # Y
         assert app.message.text == "ch1: jog axis Y"
-        await pilot.press("i", "i")  # 1 mm -> 10 mm -> 1 um
+        await pilot.press("i", "i", "i")  # 1 mm -> 10 mm -> continuous -> 1 um
         assert app.message.text == "jog increment 0.001 mm"
+        assert app.mode_bar.jog_line.render().plain.startswith("jog ch1.Y 0.001 mm")
         await pilot.press("right_square_bracket")
         await wait_until(pilot, lambda: app.message.text == "ch1: jog Y+0.001 mm",
                          what=lambda: app.message.text)
