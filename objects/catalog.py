@@ -397,6 +397,12 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "TRUE: the cycle figures (overruns, jitter max/p50/p99, longest execution) start "
         "again from zero, for a measurement (project)",
     ),
+    ObjectTemplate(
+        "cnc_cycle_step_w", Scope.PLATFORM, COM, COM_CH, 0x1020, UNS32, W, "-",
+        "Step clock (--clock step): N runs N cycles (1..[limits] step_max_cycles); the "
+        "reply comes after the N-th cycle is published. Refused 0x707 under another "
+        "clock (project)",
+    ),
     # --- COM platform axes (offsets as TwinSharp, 0x120200 / 0x<ANo>00xx) ---------------
     ObjectTemplate(
         "command_position_acs", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x02, SGN32, R, "0.1 um",

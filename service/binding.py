@@ -47,6 +47,7 @@ from .kernel.commands import (
     UpdateAxisParameters,
 )
 from .kernel.kernel import Kernel, KernelCommand, ResetCycleStats
+from .kernel.step_clock import StepCycles
 from .kernel.state import DecoderFlag
 from .kernel.tooling import tool_list_size
 from .machine_config import MachineConfig
@@ -422,6 +423,7 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
     "bahn_mc_control.suspend_axis_output.enable_w": _channel_command(SetSuspendEnable),
     "axis_parameter_update_w": lambda kernel, obj: _axis_parameter_update,
     "cnc_cycle_stats_reset_w": lambda kernel, obj: ResetCycleStats,
+    "cnc_cycle_step_w": lambda kernel, obj: StepCycles,
     "contour_lookahead.request.start_position": _channel_command(
         lambda ci, value: SetContourRequest(ci, "start_position", value)
     ),

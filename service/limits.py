@@ -50,6 +50,7 @@ from cnc_objects.protocol.constants import (
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.frames import U32_MAX, encode_error
 
+from .kernel.step_clock import STEP_MAX_CYCLES
 from .rate_limit import RateLimiter
 
 #: Room for a request's fields around its data (a Write's header is about 30 bytes).
@@ -109,6 +110,11 @@ class LimitsConfig(BaseModel):
         1000, ge=1, le=1_000_000,
         description="errors one syntax check keeps (listed in the channel, written to "
         "dec0<c>.sc); more are counted only, and the log says how many were left out",
+    )
+    step_max_cycles: int = Field(
+        STEP_MAX_CYCLES, ge=1, le=10_000_000,
+        description="cycles one write of cnc_cycle_step_w may grant (--clock step); the "
+        "write's reply waits for all of them; more (or 0) are answered ADS 0x706",
     )
     program_max_bytes: int = Field(
         PROGRAM_MAX_BYTES, ge=1, le=MAX_DATA_BYTES - _UPLOAD_OVERHEAD_BYTES,

@@ -2,7 +2,7 @@
 
     cnc-service [--config FILE] [--endpoint URL] [--ads HOST[:PORT]|off] [--ams-net-id ID]
                 [--keys DIR] [--insecure]
-                [--clock realtime|virtual] [--speed X] [--cycle-ms MS]
+                [--clock realtime|virtual|step] [--speed X] [--cycle-ms MS]
                 [--program-dir DIR | --data-dir DIR] [--output-dir DIR] [--log-level L]
 
 Two front ends over one dispatcher: ZeroMQ (``--endpoint``) and ADS over AMS/TCP
@@ -53,6 +53,7 @@ from .config import ConfigError, ServiceConfig, load_config
 from .data_location import StoreLocation, output_area_location, program_store_location
 from .frontend_config import parse_ads_endpoint
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
+from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
 from .kernel.kernel import Kernel
 from .limits import rate_limiter
 from .notifications import NotificationCounts
@@ -83,6 +84,7 @@ class ClockKind(StrEnum):
 
     REALTIME = "realtime"  # sleep to each cycle deadline
     VIRTUAL = "virtual"  # no sleeping: kernel time runs as fast as the CPU allows (or --speed)
+    STEP = "step"  # no cycle until a client grants cycles (cnc_cycle_step_w)
 
 
 class LogLevel(StrEnum):
@@ -102,10 +104,13 @@ def _usage(message: str) -> NoReturn:
     raise typer.Exit(EXIT_USAGE)
 
 
-def make_clock(kind: ClockKind, cycle_s: float, speed: float | None) -> Clock:
+def make_clock(kind: ClockKind, cycle_s: float, speed: float | None,
+               step_max_cycles: int = STEP_MAX_CYCLES) -> Clock:
     """The clock the cycle task runs on."""
     if kind is ClockKind.REALTIME:
         return RealtimeClock(cycle_s)
+    if kind is ClockKind.STEP:
+        return StepClock(cycle_s, step_max_cycles)
     return VirtualClock(cycle_s, speed)
 
 
@@ -152,8 +157,9 @@ async def serve(
     writer = OutputWriter(outputs, OutputLimits(
         limits.output_max_files, limits.output_max_file_bytes, limits.output_max_total_bytes,
         limits.output_queue_max_bytes))
+    clock = make_clock(clock_kind, config.cycle_ms / 1000.0, speed, limits.step_max_cycles)
     kernel = Kernel(
-        config.machine, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists,
+        config.machine, clock, load, exists,
         writer.kernel_file, writer.save, check_max_errors=config.limits.check_max_errors,
     )
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows

@@ -20,9 +20,12 @@ class AcknowledgeTechnoUnit:
     def apply(self, state: KernelState) -> Refusal | None:
         if not self.value:
             return None
-        why = state.runners[self.channel_index].plc.acknowledge(self.index)
+        runner = state.runners[self.channel_index]
+        why = runner.plc.acknowledge(self.index)
         if why is not None:
             return Refusal(RefusalReason.INVALID_VALUE, why)
+        # shown at once: under the step clock the write is published between cycles
+        runner.channel.plc_functions = runner.plc.unit
         return None
 
 
@@ -34,7 +37,10 @@ class SetSpindleOverride:
     value: int
 
     def apply(self, state: KernelState) -> Refusal | None:
-        why = state.runners[self.channel_index].plc.spindle.set_override(self.value)
+        runner = state.runners[self.channel_index]
+        why = runner.plc.spindle.set_override(self.value)
         if why is not None:
             return Refusal(RefusalReason.INVALID_VALUE, why)
+        # shown at once: under the step clock the write is published between cycles
+        runner.channel.spindle = runner.plc.spindle.state
         return None

@@ -23,6 +23,7 @@ from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
 from .commands import Command, Refusal, RefusalReason, ResetChannel
 from .state import CycleStats, ErrorEntry, KernelState, Snapshot
+from .step_clock import NOT_STEPPING, STEP_RUNNING, StepClock, StepCycles
 from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS
 
@@ -72,7 +73,7 @@ def _no_answer(_result: Refusal | None) -> None:
 
 
 #: what the kernel's queue takes from the service
-KernelCommand = Command | ControlCommand | ResetCycleStats
+KernelCommand = Command | ControlCommand | ResetCycleStats | StepCycles
 #: a queued command and the callback that gets its answer
 Queued = tuple[KernelCommand | _Shutdown, Done]
 
@@ -133,8 +134,10 @@ class Kernel:
         self.axis_params: dict[int, AxisParameters] = params
         state.axis_params = params  # shared: an update reaches runners and switchover
         self.switchover = Switchover(state, params)
-        # Virtual time must give the same result cycle by cycle: GEO waits for the decoder.
-        self._deterministic = deterministic = isinstance(self._clock, VirtualClock)
+        # Virtual and stepped time must give the same result cycle by cycle: GEO waits
+        # for the decoder.
+        self._deterministic = deterministic = isinstance(self._clock,
+                                                         VirtualClock | StepClock)
         state.runners = [
             ChannelRunner(channel, cfg, self.config, self._loader, self._exists, self.cycle_s,
                           deterministic, self._files, params=params, switchover=self.switchover,
@@ -176,7 +179,8 @@ class Kernel:
 
     def start(self) -> None:
         """Start the cycle thread."""
-        self._thread = threading.Thread(target=self._run, name="cnc-geo-cycle", daemon=True)
+        run = self._run_stepped if isinstance(self._clock, StepClock) else self._run
+        self._thread = threading.Thread(target=run, name="cnc-geo-cycle", daemon=True)
         self._thread.start()
 
     def close(self, timeout_s: float = 5.0) -> None:
@@ -216,6 +220,59 @@ class Kernel:
             log.exception("cycle thread failed; the kernel is stopped")
             self.stats.running = False
             self._publish()
+
+    # ------------------------------------------------------------ step clock
+
+    def _run_stepped(self) -> None:
+        """The cycle thread under the step clock: no cycle runs until a client grants
+        some (``StepCycles``, ``cnc_cycle_step_w``). Every other command is applied at
+        once, between cycles, and published without a cycle passing: a write (a PLC's
+        acknowledge) never waits for a step. The next granted cycle then starts with it
+        applied, as a command applied at the start of that cycle would be."""
+        self._clock.start()
+        try:
+            while True:
+                if not self.stats.running and not self._paused():
+                    return
+                command, done = self._next_command(block=True)
+                if isinstance(command, _Shutdown):
+                    self._refuse_queued()
+                    return
+                if isinstance(command, StepCycles):
+                    if not self._step(command, done):
+                        return
+                    continue
+                result = self._apply(command)
+                self._publish()
+                done(result)
+        except Exception:  # a kernel fault is logged loudly; the service stays up
+            log.exception("cycle thread failed; the kernel is stopped")
+            self.stats.running = False
+            self._publish()
+
+    def _step(self, step: StepCycles, done: Done) -> bool:
+        """Run the granted cycles one by one (commands that arrive meanwhile are applied
+        at the start of the next, as under the other clocks); answer after the last one
+        is published. False when the kernel shuts down meanwhile."""
+        assert isinstance(self._clock, StepClock)
+        refusal = self._clock.check(step)
+        if refusal is not None:
+            done(refusal)
+            return True
+        for ran in range(1, step.cycles + 1):
+            started = time.perf_counter()
+            if not self._cycle():
+                done(Refusal(RefusalReason.NOT_READY, "the kernel is shutting down"))
+                return False
+            exec_us = int((time.perf_counter() - started) * 1e6)
+            if exec_us > self.stats.exec_time_max_us:
+                self.stats.exec_time_max_us = exec_us
+            if not self.stats.running:  # a STOP applied in the step's cycle ends it
+                done(Refusal(RefusalReason.NOT_READY,
+                             f"the kernel stopped after {ran} of {step.cycles} cycles"))
+                return True
+        done(None)
+        return True
 
     def _next_command(self, block: bool) -> Queued:
         if self._waiting:
@@ -285,6 +342,8 @@ class Kernel:
                 if command.value:
                     self._reset_cycle_stats()
                 return None
+            if isinstance(command, StepCycles):  # the step loop takes steps before this
+                return STEP_RUNNING if isinstance(self._clock, StepClock) else NOT_STEPPING
             return command.apply(self.state)
         except Exception:
             log.exception("command %r failed", command)
