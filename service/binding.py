@@ -47,8 +47,8 @@ from .kernel.commands import (
     UpdateAxisParameters,
 )
 from .kernel.kernel import Kernel, KernelCommand, ResetCycleStats
-from .kernel.step_clock import StepCycles
 from .kernel.state import DecoderFlag
+from .kernel.step_clock import StepCycles
 from .kernel.tooling import tool_list_size
 from .machine_config import MachineConfig
 from .notifications import NotificationCounts

@@ -53,8 +53,8 @@ from .config import ConfigError, ServiceConfig, load_config
 from .data_location import StoreLocation, output_area_location, program_store_location
 from .frontend_config import parse_ads_endpoint
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
-from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
 from .kernel.kernel import Kernel
+from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
 from .limits import rate_limiter
 from .notifications import NotificationCounts
 from .output_area import OutputArea
