@@ -5,7 +5,7 @@
 The entry module: the global options and ``main``. The commands live in ``cli_objects``
 (info, browse, read, write, watch), ``cli_machine`` (program store, run, MDI, hold,
 resume, reset, status, lookahead, check), ``cli_plot`` (plot), ``cli_keys`` (keys new) and
-``cli_tools`` (tool, offsets);
+``cli_tools`` (tool, offsets), ``cli_step`` (step);
 what they share is in ``cli_app``. Importing them here registers them on the app, in this order.
 
 A service started with ``--keys`` needs this client's key (``--key FILE`` or
@@ -37,6 +37,7 @@ from . import (
     cli_objects,  # noqa: F401  (info, browse, read, write, watch)
     cli_plot,  # noqa: F401  (plot)
     cli_spindle,  # noqa: F401  (spindle)
+    cli_step,  # noqa: F401  (step: the step clock)
     cli_tools,  # noqa: F401  (tool, offsets)
 )
 from .cli_app import Settings, app
