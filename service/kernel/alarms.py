@@ -30,7 +30,7 @@ import logging
 import time
 from collections import deque
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from cnc_objects.protocol.alarm_values import AlarmClass as AlarmClass
 from cnc_objects.protocol.alarm_values import AlarmState as AlarmState
@@ -38,8 +38,34 @@ from cnc_objects.protocol.alarm_values import Severity as Severity
 
 from .refusal import Refusal, RefusalReason
 
-if TYPE_CHECKING:  # state holds the log: no import back at run time
-    from .state import ErrorEntry
+
+class ErrorLike(Protocol):
+    """What an alarm is raised from: ``state.ErrorEntry`` (state holds the log, so the
+    log names the entry by its fields, without importing it back)."""
+
+    @property
+    def id(self) -> int:
+        """ISG-style error id."""
+
+    @property
+    def text(self) -> str:
+        """The message."""
+
+    @property
+    def file(self) -> str:
+        """NC file of the place; empty = none."""
+
+    @property
+    def line(self) -> int:
+        """Line of the place, from 1."""
+
+    @property
+    def column(self) -> int:
+        """Column of the place, from 1."""
+
+    @property
+    def warning(self) -> bool:
+        """A warning: the channel goes on."""
 
 log = logging.getLogger(__name__)
 
@@ -133,7 +159,7 @@ class AlarmLog:
         """The cycle now running: the time stamp of what it raises."""
         self._cycle, self._kernel_ns = cycle, kernel_ns
 
-    def raise_error(self, error: ErrorEntry, channel: int,
+    def raise_error(self, error: ErrorLike, channel: int,
                     alarm_class: AlarmClass | None = None) -> Alarm:
         """Raise ``error`` of ``channel`` as an alarm (its class from its id unless
         given) and return it."""
