@@ -5,6 +5,8 @@ the events of ``alarm_events``; ``cnc alarms`` (docs/alarms.md)."""
 from __future__ import annotations
 
 import asyncio
+import subprocess
+import sys
 from collections.abc import Iterator
 
 import pyads
@@ -154,3 +156,22 @@ def test_pyads_reads_the_alarm_list_by_name(ads: Ads) -> None:  # noqa: F811
     assert ads.com.read_by_name("alarm_active[1].file", pyads.PLCTYPE_STRING) == "bad.nc"
     ads.com.write_by_name("alarm_acknowledge_w", sequence, pyads.PLCTYPE_UDINT)
     assert ads.com.read_by_name("alarm_active[1].state", pyads.PLCTYPE_UINT) == 2
+
+
+def test_cnc_alarms_watch_prints_the_events(c, machine) -> None:
+    c.acknowledge_all_alarms()
+    argv = [sys.executable, "-c", "from cnc_objects.clients.cli import main; main()",
+            "--endpoint", machine.endpoint, "alarms", "--watch", "--count", "2",
+            "--watch-timeout", "60"]
+    with subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                          text=True) as watching:
+        asyncio.run(asyncio.wait_for(_subscribed(machine), 30))
+        fail_with(c)
+        c.reset(1)
+        out, err = watching.communicate(timeout=60)
+    assert watching.returncode == 0, err
+    # the list first (indented lines), then one unindented line per event
+    events = [line.split(":")[0] for line in out.splitlines()
+              if ": " in line and not line.startswith(" ")]
+    assert events == ["raised", "cleared"], out
+    assert "error 20008 ch1: bad.nc:2:1: " in out
