@@ -155,16 +155,31 @@ class AlarmOps(MixinBase):
         seen: dict[int, AlarmState] | None = None
         async for _sample in self.subscribe("alarm_changes_r"):
             listed = await self.alarms(history=True)
-            now = {a.sequence: a for a in (*listed.history, *listed.active)}
             if seen is None:  # the first sample: what is there already
-                seen = {s: a.state for s, a in now.items()}
+                seen = seen_states(listed)
                 continue
-            for sequence in sorted(now):
-                alarm = now[sequence]
-                before = seen.get(sequence)
-                for state in AlarmState:
-                    if (before is None or state > before) and state <= alarm.state:
-                        if state == AlarmState.ACKNOWLEDGED and alarm.state == AlarmState.CLEARED:
-                            continue  # a warning's acknowledge clears it: one event
-                        yield AlarmEvent(EVENT_OF_STATE[state], alarm)
-                seen[sequence] = alarm.state
+            for event in events_since(seen, listed):
+                yield event
+
+
+def seen_states(listed: AlarmList) -> dict[int, AlarmState]:
+    """The state of every alarm of ``listed`` (active and history), by sequence number:
+    where ``events_since`` starts."""
+    return {a.sequence: a.state for a in (*listed.history, *listed.active)}
+
+
+def events_since(seen: dict[int, AlarmState], listed: AlarmList) -> list[AlarmEvent]:
+    """The events that lead from ``seen`` to ``listed``, oldest alarm first; ``seen`` is
+    brought up to date. A warning's acknowledge clears it: one event, ``cleared``."""
+    now = {a.sequence: a for a in (*listed.history, *listed.active)}
+    events = []
+    for sequence in sorted(now):
+        alarm = now[sequence]
+        before = seen.get(sequence)
+        for state in AlarmState:
+            if (before is None or state > before) and state <= alarm.state:
+                if state == AlarmState.ACKNOWLEDGED and alarm.state == AlarmState.CLEARED:
+                    continue
+                events.append(AlarmEvent(EVENT_OF_STATE[state], alarm))
+        seen[sequence] = alarm.state
+    return events
