@@ -111,7 +111,7 @@ class LimitsConfig(BaseModel):
         "dec0<c>.sc); more are counted only, and the log says how many were left out",
     )
     alarm_history_max: int = Field(
-        100, ge=1, le=1000,
+        32, ge=1, le=1000,
         description="alarms the history keeps (the last ones raised, in any state); older "
         "ones leave it. Each is a slot of objects (alarm_history[k]): at most 1000",
     )

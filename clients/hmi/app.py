@@ -32,6 +32,7 @@ from cnc_objects.clients.errors import AdsError, ClientValueError
 from cnc_objects.clients.key_options import key_option, server_key_option
 
 from . import control, manual_keys, text
+from .alarms import AlarmLine, AlarmPage
 from .axes import AxesTable
 from .channels import ChannelTable, ErrorsPanel
 from .lookahead import MIN_GAP_S, REFRESH_S, LookaheadMode, LookaheadPanel, fetch
@@ -72,6 +73,7 @@ class HmiApp(App[None]):
         Binding("left_square_bracket", "jog(-1)", "Jog-", key_display="["),
         Binding("a", "jog_axis", "Jog axis"),
         Binding("i", "jog_increment", "Incr"),
+        Binding("e", "alarms", "Alarms"),
         Binding("q", "quit", "Quit"),
     ]
     _DIALOG_ACTIONS = {"quit"}  # what the keys may still do while the program dialog is open
@@ -93,6 +95,7 @@ class HmiApp(App[None]):
         self.errors = ErrorsPanel(id="errors")
         self.lookahead = LookaheadPanel(id="lookahead")
         self.message = MessageLine(id="message")
+        self.alarm_line = AlarmLine(id="alarm-line")  # the newest active alarm (alarms.py)
         self.jog_choice = manual_keys.JogChoice()  # manual mode: jog axis and increment
 
     def compose(self) -> ComposeResult:
@@ -107,6 +110,7 @@ class HmiApp(App[None]):
             yield self.tooling
             yield self.errors
             yield self.lookahead
+        yield self.alarm_line
         yield self.message
         yield Footer(compact=True)
 
@@ -142,7 +146,8 @@ class HmiApp(App[None]):
         blocks = [Feed(ch.obj("mc_block_count_r"), self._block_finished(ch))
                   for ch in machine.channels]
         return [*self.channels.feeds(machine), *self.axes.feeds(machine),
-                *self.tooling.feeds(machine), *self.errors.feeds(client, machine), *blocks]
+                *self.tooling.feeds(machine), *self.errors.feeds(client, machine), *blocks,
+                *self.alarm_line.feeds(client)]
 
     def session_lost(self, reason: str) -> None:
         """Say that the service does not answer; the shown values are stale."""
@@ -186,7 +191,8 @@ class HmiApp(App[None]):
 
     def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
         """While the program dialog is open its keys are text, not commands."""
-        if isinstance(self.screen, ProgramPicker) and action not in self._DIALOG_ACTIONS:
+        if (isinstance(self.screen, ProgramPicker | AlarmPage)
+                and action not in self._DIALOG_ACTIONS):
             return False
         return True
 
@@ -255,6 +261,10 @@ class HmiApp(App[None]):
             return await control.select_program(client, channel, name)
 
         self._command("select program", pick)
+
+    def action_alarms(self) -> None:
+        """The alarm page: active alarms and history, acknowledge (docs/alarms.md)."""
+        self.push_screen(AlarmPage(self.alarm_line, self.client))
 
     # ------------------------------------------------------------ look-ahead
 

@@ -69,7 +69,7 @@ class ErrorLike(Protocol):
 
 log = logging.getLogger(__name__)
 
-ALARM_HISTORY_MAX = 100  # [limits] alarm_history_max
+ALARM_HISTORY_MAX = 32  # [limits] alarm_history_max: 13 objects each
 ALARM_ACTIVE_MAX = 100  # [limits] alarm_active_max
 
 
