@@ -175,3 +175,18 @@ def test_cnc_alarms_watch_prints_the_events(c, machine) -> None:
               if ": " in line and not line.startswith(" ")]
     assert events == ["raised", "cleared"], out
     assert "error 20008 ch1: bad.nc:2:1: " in out
+
+
+def test_an_output_area_limit_is_a_service_alarm(tmp_path) -> None:
+    config = tmp_path / "machine.toml"
+    config.write_text("[limits]\noutput_max_file_bytes = 4096\n")
+    with serving("--config", str(config)) as service, \
+            Client(service.endpoint, timeout_s=10) as c:
+        c.upload("loop.nc", b'$WHILE 1\n#MSG SAVE ["%d padding-padding", 1]\n$ENDWHILE\nM30\n')
+        c.run_program("loop.nc", 1)
+        with pytest.raises(ChannelError):
+            c.wait_program(1, 60)
+        [alarm] = c.alarms().active
+        assert (alarm.id, alarm.alarm_class, alarm.severity) == (
+            20533, AlarmClass.SERVICE, Severity.ERROR)
+        assert alarm.where == "loop.nc:2:1" and "output_max_file_bytes" in alarm.text
