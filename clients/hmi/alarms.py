@@ -97,8 +97,8 @@ class AlarmPage(ModalScreen[None]):
         self.line = line
         self.client = client
         self.status = Static("", markup=False, id="alarm-status")
-        self.active = DataTable(id="alarm-active", cursor_type="row")
-        self.history = DataTable(id="alarm-history", cursor_type="row")
+        self.active: DataTable[str] = DataTable(id="alarm-active", cursor_type="row")
+        self.history: DataTable[str] = DataTable(id="alarm-history", cursor_type="row")
 
     def compose(self) -> Any:
         """Active alarms, history, a status line."""

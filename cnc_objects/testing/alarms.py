@@ -14,7 +14,8 @@ the service's alarm objects through the test's client (docs/alarms.md).
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from cnc_objects.protocol.alarm_values import AlarmState
 
@@ -22,6 +23,11 @@ if TYPE_CHECKING:
     from cnc_objects.clients import AlarmInfo, Client
 
 WAIT_TIMEOUT_S = 30.0  # wall time; a loaded CI machine is slow
+
+
+def _other_than(value: Any) -> Callable[[Any], bool]:
+    """A value that is not ``value`` (``wait_for``'s predicate)."""
+    return lambda changed: changed != value
 
 
 class AlarmRecorder:
@@ -63,7 +69,7 @@ class AlarmRecorder:
                 raise AssertionError(f"alarm {alarm_id} was not raised within {timeout_s:g} s;"
                                      f" raised: {self.raised_ids() or 'none'}")
             try:  # the next change of the alarms, not a sleep
-                wait_for(self.client, "alarm_changes_r", lambda v, c=changes: v != c, left_s)
+                wait_for(self.client, "alarm_changes_r", _other_than(changes), left_s)
             except TimeoutError:
                 continue  # the deadline check above names what was raised
 
