@@ -36,6 +36,8 @@ from cnc_objects.protocol.alarm_values import AlarmClass as AlarmClass
 from cnc_objects.protocol.alarm_values import AlarmState as AlarmState
 from cnc_objects.protocol.alarm_values import Severity as Severity
 
+from .axis_params import AxisErrorId
+from .nc.errors import NcErrorId
 from .refusal import Refusal, RefusalReason
 
 
@@ -74,9 +76,10 @@ ALARM_ACTIVE_MAX = 100  # [limits] alarm_active_max
 
 
 #: error ids that only a restart (the kernel's RESET) clears: the axis configuration
-RESTART_IDS = frozenset({70172, 50462, 70901})
-#: NC error ids that the service's output area causes (OUTPUT_LIMIT_REACHED, FILE_WRITE_FAILED)
-SERVICE_IDS = frozenset({20533, 20532})
+RESTART_IDS = frozenset({AxisErrorId.CLONE_MASTER_MISSING, AxisErrorId.CLONE_NOT_CREATED,
+                         AxisErrorId.CLONE_LIMITS_INCONSISTENT})
+#: NC error ids that the service's output area causes
+SERVICE_IDS = frozenset({NcErrorId.OUTPUT_LIMIT_REACHED, NcErrorId.FILE_WRITE_FAILED})
 #: the id of a failed cycle task (project id)
 KERNEL_FAULT_ID = 90001
 
@@ -92,6 +95,8 @@ def class_of(error_id: int) -> AlarmClass:
     """The class an error id belongs to, by ISG's id ranges (a table, docs/alarms.md)."""
     if error_id in SERVICE_IDS:
         return AlarmClass.SERVICE
+    if error_id in RESTART_IDS:  # 50462 too: a clone of the axis configuration
+        return AlarmClass.AXIS
     for ids, alarm_class in _CLASS_BY_THOUSANDS:
         if error_id in ids:
             return alarm_class

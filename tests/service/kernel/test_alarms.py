@@ -189,6 +189,7 @@ def test_reset_leaves_the_restart_alarms_and_other_channels() -> None:
 @pytest.mark.parametrize(("error_id", "expected"), [
     (20008, AlarmClass.DECODER), (50101, AlarmClass.PATH), (70910, AlarmClass.AXIS),
     (20533, AlarmClass.SERVICE), (20532, AlarmClass.SERVICE), (90001, AlarmClass.KERNEL),
+    (50462, AlarmClass.AXIS),
 ])
 def test_the_class_follows_the_id_ranges(error_id, expected) -> None:
     assert class_of(error_id) == expected
