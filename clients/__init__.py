@@ -12,6 +12,7 @@ from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.values import ExecutionMode
 
+from .alarm_ops import AlarmEvent, AlarmInfo, AlarmList
 from .blocking import Client
 from .channel_ops import ContourBlock, ContourReply
 from .client import (
@@ -45,6 +46,9 @@ __all__ = [
     "AdsReturnCode",
     "AdsState",
     "AdsTimeoutError",
+    "AlarmEvent",
+    "AlarmInfo",
+    "AlarmList",
     "AsyncClient",
     "AuthenticationError",
     "ChannelError",

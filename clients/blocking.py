@@ -12,6 +12,7 @@ from typing import Any
 from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.datatypes import DataType
 
+from .alarm_ops import AlarmEvent, AlarmList
 from .channel_ops import ChannelStatus, CheckResult, ContourReply, ProgramEntry
 from .client import BlockingClientBase, DeviceInfo, Sample, iterate_blocking, run_blocking
 from .object_info import ObjectInfo
@@ -20,6 +21,25 @@ from .path_trace import PathTrace
 
 class Client(BlockingClientBase):
     """Blocking client: the same methods as ``AsyncClient``. Use with ``with``."""
+
+    def acknowledge_alarm(self, sequence: int) -> None:
+        """Acknowledge the alarm numbered ``sequence`` (an error stays active until
+        RESET, a warning is cleared); an unknown number raises ``AdsError`` 0x70C."""
+        return run_blocking(self._core.acknowledge_alarm(sequence))
+
+    def acknowledge_all_alarms(self) -> None:
+        """Acknowledge every active alarm."""
+        return run_blocking(self._core.acknowledge_all_alarms())
+
+    def alarm_events(self) -> Iterator[AlarmEvent]:
+        """The alarms' events from now on, in the order they happened per alarm:
+        ``raised``, ``acknowledged``, ``cleared`` (an alarm raised and cleared between
+        two reads gives both). Leaving the loop ends the subscription."""
+        return iterate_blocking(self._core.alarm_events())
+
+    def alarms(self, history: bool = False) -> AlarmList:
+        """The active alarms (newest first); with ``history`` also the history."""
+        return run_blocking(self._core.alarms(history))
 
     def browse(self, pattern: str = "*") -> list[ObjectInfo]:
         """Descriptions of the objects whose names match the glob ``pattern``."""

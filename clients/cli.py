@@ -5,7 +5,7 @@
 The entry module: the global options and ``main``. The commands live in ``cli_objects``
 (info, browse, read, write, watch), ``cli_machine`` (program store, run, MDI, hold,
 resume, reset, status, lookahead, check), ``cli_plot`` (plot), ``cli_keys`` (keys new) and
-``cli_tools`` (tool, offsets), ``cli_step`` (step);
+``cli_tools`` (tool, offsets), ``cli_step`` (step), ``cli_alarms`` (alarms);
 what they share is in ``cli_app``. Importing them here registers them on the app, in this order.
 
 A service started with ``--keys`` needs this client's key (``--key FILE`` or
@@ -31,6 +31,7 @@ import typer
 
 # Importing a command module registers its commands; help lists them in this order.
 from . import (
+    cli_alarms,  # noqa: F401  (alarms, alarms ack)
     cli_keys,  # noqa: F401  (keys new)
     cli_machine,  # noqa: F401  (programs, channel commands, check)
     cli_manual,  # noqa: F401  (jog, home)

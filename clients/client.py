@@ -55,6 +55,7 @@ from cnc_objects.protocol.frames import (
     WriteRequest,
 )
 
+from .alarm_ops import AlarmOps
 from .channel_ops import (
     ChannelStatus,
     CheckError,
@@ -158,7 +159,7 @@ def _decode(dtype: DataType, data: bytes, what: str) -> Any:
 PathText = str | os.PathLike[str]
 
 
-class AsyncClient(TraceOps):
+class AsyncClient(TraceOps, AlarmOps):
     """Asyncio client of a cnc-objects service. Use with ``async with``.
 
     ``key_file``: this client's CURVE secret key file (``NAME.key_secret``, or ``NAME.key``

@@ -1,11 +1,11 @@
-"""What the operation mixins (``ProgramOps``, ``ChannelOps``, ``TraceOps``) need of the
-client they are mixed into: the object and raw-address requests of ``AsyncClient`` and
-its transport's pause. Declared as a Protocol so that mypy checks the mixins' bodies;
-at run time the mixins derive from ``object``."""
+"""What the operation mixins (``ProgramOps``, ``ChannelOps``, ``TraceOps``,
+``AlarmOps``) need of the client they are mixed into: the object and raw-address
+requests of ``AsyncClient`` and its transport's pause. Declared as a Protocol so that
+mypy checks the mixins' bodies; at run time the mixins derive from ``object``."""
 
 from __future__ import annotations
 
-from collections.abc import Awaitable, Iterable
+from collections.abc import AsyncIterator, Awaitable, Iterable
 from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
@@ -39,6 +39,12 @@ class ClientCore(Protocol):
 
     async def read_many(self, names: Iterable[str]) -> dict[str, Any]:
         """Read several objects in one round trip."""
+        ...
+
+    def subscribe(
+        self, name: str, on_change: bool = True, cycle_ms: int | None = None
+    ) -> AsyncIterator[Any]:
+        """Samples of ``name`` as the service sends them."""
         ...
 
     async def read_raw(self, port: int, group: int, offset: int, length: int) -> bytes:

@@ -14,12 +14,14 @@ from typing import Any
 from cnc_objects.objects import AddressSpace, ChannelLayout, CncObject, MachineLayout, build_objects
 from cnc_objects.objects.addressing import LOGICAL_BIT, GroupBase, index_based
 from cnc_objects.objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS, MACHINING_FIELDS
+from cnc_objects.objects.catalog_alarms import build_alarm_objects
 from cnc_objects.objects.catalog_tools import build_tool_objects
 from cnc_objects.objects.directory import ObjectDirectory
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from . import __version__
+from .binding_alarms import ALARM_WRITERS, alarm_readers
 from .binding_manual import MANUAL_READERS, MANUAL_WRITERS
 from .binding_technology import TECHNOLOGY_READERS, TECHNOLOGY_WRITERS
 from .binding_tools import tool_readers, tool_writers
@@ -511,8 +513,11 @@ def build_address_space(
     # tools and work offsets: their tables are as large as the machine configures
     size, groups = tool_list_size(kernel.config), kernel.config.zero_offset_groups
     objects += build_tool_objects(layout, size, groups)
-    readers = {**READERS, **tool_readers(size, groups)}
-    writers = {**WRITERS, **tool_writers(size, groups)}
+    # alarms: as many history slots as the log keeps
+    history_max = kernel.alarms.history_max
+    objects += build_alarm_objects(layout, history_max)
+    readers = {**READERS, **tool_readers(size, groups), **alarm_readers(history_max)}
+    writers = {**WRITERS, **tool_writers(size, groups), **ALARM_WRITERS}
     counts = notifications if notifications is not None else NotificationCounts()
     for obj in objects:
         service = SERVICE_READERS.get(obj.element)

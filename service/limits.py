@@ -116,6 +116,15 @@ class LimitsConfig(BaseModel):
         description="cycles one write of cnc_cycle_step_w may grant (--clock step); the "
         "write's reply waits for all of them; more (or 0) are answered ADS 0x706",
     )
+    alarm_history_max: int = Field(
+        32, ge=1, le=1000,
+        description="alarms the history keeps (the last ones raised, in any state); older "
+        "ones leave it. Each is a slot of objects (alarm_history[k]): at most 1000",
+    )
+    alarm_active_max: int = Field(
+        100, ge=1, le=100_000,
+        description="alarms the active list holds; one more clears the oldest (logged)",
+    )
     program_max_bytes: int = Field(
         PROGRAM_MAX_BYTES, ge=1, le=MAX_DATA_BYTES - _UPLOAD_OVERHEAD_BYTES,
         description="largest program the store takes in one upload (bytes; one frame "

@@ -52,6 +52,7 @@ from .binding import build_address_space
 from .config import ConfigError, ServiceConfig, load_config
 from .data_location import StoreLocation, output_area_location, program_store_location
 from .frontend_config import parse_ads_endpoint
+from .kernel.alarms import AlarmLog
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
 from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
@@ -161,6 +162,7 @@ async def serve(
     kernel = Kernel(
         config.machine, clock, load, exists,
         writer.kernel_file, writer.save, check_max_errors=config.limits.check_max_errors,
+        alarms=AlarmLog(limits.alarm_history_max, limits.alarm_active_max),
     )
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows
     space = build_address_space(kernel, counts)

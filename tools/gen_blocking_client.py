@@ -30,6 +30,7 @@ CLASSES = [
     ("path_trace.py", "TraceOps"),
     ("channel_ops.py", "ChannelOps"),
     ("channel_ops.py", "ProgramOps"),
+    ("alarm_ops.py", "AlarmOps"),
 ]
 _ASYNC_ITERATORS = ("AsyncIterator", "AsyncGenerator")
 _TYPING_NAMES = {"Any"}

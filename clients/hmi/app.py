@@ -34,6 +34,7 @@ from cnc_objects.clients.key_options import key_option, server_key_option
 from cnc_objects.protocol.values import ChannelMode
 
 from . import control, manual_keys, text
+from .alarms import AlarmLine, AlarmPage
 from .axes import AxesTable
 from .channels import ChannelTable, ErrorsPanel
 from .connection_state import ConnectionLine
@@ -80,6 +81,7 @@ class HmiApp(App[None]):
         Binding("i", "jog_increment", "Incr"),
         Binding("space", "jog_release", "Jog stop", show=False),
         Binding("e", "mdi", "MDI"),
+        Binding("A", "alarms", "Alarms"),
         *(Binding(m.key, f"select_mode('{m.mode.name}')", m.mode.name, show=False)
           for m in SELECTABLE),
         Binding("q", "quit", "Quit"),
@@ -105,6 +107,7 @@ class HmiApp(App[None]):
         self.errors = ErrorsPanel(id="errors")
         self.lookahead = LookaheadPanel(id="lookahead")
         self.message = MessageLine(id="message")
+        self.alarm_line = AlarmLine(id="alarm-line")  # the newest active alarm (alarms.py)
         self.jog_choice = manual_keys.JogChoice()  # manual mode: jog axis and increment
         self.continuous_jog = manual_keys.ContinuousJog()
         self.connection = ConnectionLine(endpoint, id="connection")
@@ -128,6 +131,7 @@ class HmiApp(App[None]):
             yield self.errors
             yield self.lookahead
         yield self.mdi
+        yield self.alarm_line
         yield self.message
         yield Footer(compact=True)
 
@@ -168,7 +172,7 @@ class HmiApp(App[None]):
                  for ch in machine.channels]
         return [*self.channels.feeds(machine), *self.axes.feeds(machine),
                 *self.tooling.feeds(machine), *self.errors.feeds(client, machine), *block_ends,
-                *modes, *program_feeds]
+                *modes, *program_feeds, *self.alarm_line.feeds(client)]
 
     def session_lost(self, reason: str) -> None:
         """Say that the service does not answer; the shown values are stale."""
@@ -187,7 +191,7 @@ class HmiApp(App[None]):
     def _value_widgets(self) -> tuple[Any, ...]:
         """The widgets that show values of the service: greyed while it does not reply."""
         return (self.channels, self.axes, self.tooling, self.errors, self.program_view,
-                self.mode_bar)
+                self.mode_bar, self.alarm_line)
 
     def _mode_changed(self, channel: ChannelView) -> Callable[[int], None]:
         return lambda mode: self.mode_bar.mode_changed(channel, mode)
@@ -233,7 +237,8 @@ class HmiApp(App[None]):
 
     def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
         """While the program dialog is open its keys are text, not commands."""
-        if isinstance(self.screen, ProgramPicker) and action not in self._DIALOG_ACTIONS:
+        if (isinstance(self.screen, ProgramPicker | AlarmPage)
+                and action not in self._DIALOG_ACTIONS):
             return False
         if self.focused is self.mdi and action not in self._DIALOG_ACTIONS:
             return False  # the MDI line has the keys: letters are text, not commands
@@ -351,6 +356,10 @@ class HmiApp(App[None]):
             return await control.select_program(client, channel, name)
 
         self._command("select program", pick)
+
+    def action_alarms(self) -> None:
+        """The alarm page: active alarms and history, acknowledge (docs/alarms.md)."""
+        self.push_screen(AlarmPage(self.alarm_line, self.client))
 
     # ------------------------------------------------------------ look-ahead
 

@@ -20,6 +20,7 @@ import socket
 
 import aiomqtt
 
+from .alarms import AlarmFeed
 from .commands import execute_set
 from .config import BridgeConfig
 from .outbox import OFFLINE, Outbox, Pending
@@ -49,7 +50,8 @@ class Bridge:
         self.config = config
         self.topics = Topics(config.machine)
         self.outbox = Outbox()
-        self.source = ServiceSource(config, self.outbox)
+        self.alarms = AlarmFeed(self.topics)
+        self.source = ServiceSource(config, self.outbox, self.alarms)
         self.mqtt: aiomqtt.Client | None = None
         self.published = 0
         self.broker_connections = 0
@@ -106,6 +108,7 @@ class Bridge:
                 async with asyncio.TaskGroup() as tasks:
                     tasks.create_task(self._publish(mqtt), name="cnc-mqtt publish")
                     tasks.create_task(self._serve_requests(mqtt), name="cnc-mqtt requests")
+                    tasks.create_task(self.alarms.publish(mqtt), name="cnc-mqtt alarms")
             except asyncio.CancelledError:
                 # A clean stop says so itself: the broker sends the will only when the
                 # connection drops without a DISCONNECT.

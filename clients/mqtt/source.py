@@ -23,6 +23,7 @@ from collections.abc import Callable
 from ..client import AsyncClient
 from ..errors import AdsConnectionError, AdsError, AdsTimeoutError
 from ..object_info import ObjectInfo
+from .alarms import AlarmFeed
 from .config import BridgeConfig
 from .outbox import OFFLINE, ONLINE, Outbox
 from .retry import Backoff, session
@@ -60,9 +61,11 @@ class ServiceSource:
     ``writable`` the lower-case names ``--writable`` resolved to in that session.
     """
 
-    def __init__(self, config: BridgeConfig, outbox: Outbox) -> None:
+    def __init__(self, config: BridgeConfig, outbox: Outbox,
+                 alarms: AlarmFeed | None = None) -> None:
         self._config = config
         self._outbox = outbox
+        self._alarms = alarms  # the alarms' messages (clients/mqtt/alarms.py)
         self.client: AsyncClient | None = None
         self.writable: frozenset[str] = frozenset()
         self.selected: list[ObjectInfo] = []
@@ -123,6 +126,8 @@ class ServiceSource:
                     self._follow(client, info, window, first_sample_of), name=f"follow {info.name}"
                 )
             tasks.create_task(self._probe(client, stack), name="probe service")
+            if self._alarms is not None:
+                tasks.create_task(self._follow_alarms(client), name="follow alarms")
             await all_first.wait()
             # The outbox holds every current value now; they go out before "online".
             self.sessions += 1
@@ -157,6 +162,15 @@ class ServiceSource:
         finally:
             if in_window:
                 window.release()
+
+    async def _follow_alarms(self, client: AsyncClient) -> None:
+        assert self._alarms is not None
+        try:
+            await self._alarms.follow(client)
+        except _LOST:
+            raise  # the session ends: reconnect
+        except AdsError as exc:  # e.g. a service without alarm objects: values go on
+            log.error("cannot follow the alarms: %s", exc)
 
     async def _probe(self, client: AsyncClient, stack: contextlib.AsyncExitStack) -> None:
         last_s = -math.inf

@@ -5,6 +5,8 @@
     cnc/<machine>/set/<object name> write requests, from any client
     cnc/<machine>/reply/<id>        the outcome of the write request that carried ``id``
     cnc/<machine>/reply             outcomes of requests without a usable id
+    cnc/<machine>/alarms/active     the active alarms (retained; clients/mqtt/alarms.py)
+    cnc/<machine>/alarms/event      one message per alarm event
 
 Object names (``ch1.ax1.link_state``, ``gpCh[0].bahn_state.dist_prog_start``) contain no
 ``/``, ``+`` or ``#``, so each is one topic level and needs no escaping.
@@ -59,6 +61,16 @@ class Topics:
     def no_id_reply(self) -> str:
         """Replies to requests that carry no usable id."""
         return f"{self.base}/reply"
+
+    @property
+    def alarm_list(self) -> str:
+        """Where the active alarms are published (retained)."""
+        return f"{self.base}/alarms/active"
+
+    @property
+    def alarm_event(self) -> str:
+        """Where each alarm event is published."""
+        return f"{self.base}/alarms/event"
 
     def value(self, name: str) -> str:
         """The topic of object ``name``'s value."""

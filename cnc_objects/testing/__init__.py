@@ -11,6 +11,8 @@ Fixtures:
 - ``cnc_shared_service``: one service for the whole session.
 - ``cnc_client``: a blocking ``Client`` connected to ``cnc_service``.
 - ``cnc_async_client``: an ``AsyncClient`` connected to ``cnc_service`` (pytest-asyncio).
+- ``cnc_alarms``: the alarms ``cnc_service`` raised during the test (``AlarmRecorder``:
+  ``raised_ids()``, ``active_ids()``, ``wait_for(id)``, ``clear()``).
 
 Helpers (imported from here on first use, so that loading the plugin stays cheap):
 ``run_program`` / ``run_program_async`` run a program to its end, ``wait_for`` /
@@ -23,6 +25,7 @@ from __future__ import annotations
 from typing import Any
 
 from .plugin import (
+    cnc_alarms,
     cnc_async_client,
     cnc_client,
     cnc_service,
@@ -35,7 +38,7 @@ from .process import ServiceProcess, serving, start_service
 _HELPERS = frozenset({"run_program", "run_program_async", "wait_for", "wait_for_async"})
 
 __all__ = [
-    "ServiceProcess", "cnc_async_client", "cnc_client", "cnc_service", "cnc_shared_service",
+    "ServiceProcess", "cnc_alarms", "cnc_async_client", "cnc_client", "cnc_service", "cnc_shared_service",
     "pytest_configure", "pytest_runtest_makereport", "run_program", "run_program_async",
     "serving", "start_service", "wait_for", "wait_for_async",
 ]

@@ -19,6 +19,8 @@ from .process import ServiceProcess, start_service
 if TYPE_CHECKING:
     from cnc_objects.clients import AsyncClient, Client
 
+    from .alarms import AlarmRecorder
+
 MARKER = "cnc_service"
 MARKER_HELP = (
     "cnc_service(config=None, programs=(), args=()): how the cnc_service fixture starts "
@@ -92,6 +94,15 @@ def cnc_client(cnc_service: ServiceProcess) -> Iterator[Client]:
 
     with Client(cnc_service.endpoint, timeout_s=CLIENT_TIMEOUT_S) as client:
         yield client
+
+
+@pytest.fixture
+def cnc_alarms(cnc_client: Client) -> AlarmRecorder:
+    """The alarms ``cnc_service`` raises during the test: ``raised_ids()``,
+    ``active_ids()``, ``wait_for(id)``, ``clear()`` (``cnc_objects.testing.alarms``)."""
+    from .alarms import AlarmRecorder
+
+    return AlarmRecorder(cnc_client)
 
 
 async def _async_client(cnc_service: ServiceProcess) -> AsyncIterator[AsyncClient]:

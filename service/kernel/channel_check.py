@@ -8,6 +8,7 @@ the ``Step`` the channel runner turns into its state (HOLD, READY, ERROR).
 
 from __future__ import annotations
 
+from .alarms import AlarmClass
 from .channel_mode import ChannelState
 from .nc import ModalState
 from .program_run import RunHost, Step
@@ -64,7 +65,8 @@ class ChannelCheck:
             err = found.error
             self._host.list_error(ErrorEntry(int(err.id), err.message, found.file,
                                                found.line, found.column, warning=True),
-                                  to_log=False, keep_last=True)
+                                  to_log=False, keep_last=True,
+                                  alarm_class=AlarmClass.CHECK)
         # errors over limits.check_max_errors are counted, not listed
         ch.error_count += p.left_out - self._left_out
         self._left_out = p.left_out
@@ -89,7 +91,8 @@ class ChannelCheck:
             if p.stopped_early:
                 self._host.list_error(ErrorEntry(
                     CHECK_STOPPED_WARNING, f"syntax check stopped after {p.error_count} errors "
-                    "(syn_chk.errors_total, P-CHAN-00019)", p.file, p.line, warning=True))
+                    "(syn_chk.errors_total, P-CHAN-00019)", p.file, p.line, warning=True),
+                    alarm_class=AlarmClass.CHECK)
             return Step.ENDED
         if p.pause != Pause.NONE:
             return Step.PAUSED

@@ -34,6 +34,7 @@ from functools import partial
 from cnc_objects.protocol.values import ExecutionMode
 
 from ..machine_config import ChannelConfig, MachineConfig
+from .alarms import AlarmClass, AlarmLog
 from .axis_params import AxisErrorId, AxisParameters
 from .channel_check import ChannelCheck
 from .channel_mode import SELECTABLE_MODES, ChannelMode, ChannelState, describe
@@ -99,6 +100,7 @@ class ChannelRunner:
         save: Callable[[str, bytes, bool], None] = lambda name, data, replace: None,
         check_max_errors: int = CHECK_MAX_ERRORS,
         on_wait: Callable[[], None] = lambda: None,
+        alarms: AlarmLog | None = None,
     ) -> None:
         """``params`` are the kernel's effective axis parameters (read at each program
         start, so a parameter update applies from the next run); ``switchover`` links
@@ -107,8 +109,10 @@ class ChannelRunner:
         ``check_max_errors``: errors a syntax check keeps ([limits] check_max_errors), the
         rest are counted only; ``on_wait``: called while a cycle waits for the decoder or
         the check (virtual clock), so that the kernel answers the cycle's commands
-        meanwhile."""
+        meanwhile; ``alarms``: the kernel's alarm log, which every listed error and
+        warning is raised in (a log of its own when not given)."""
         self._on_wait = on_wait
+        self.alarms = AlarmLog() if alarms is None else alarms
         self.channel = channel
         self.config = config
         self._loader = loader
@@ -286,6 +290,7 @@ class ChannelRunner:
         self.plc.reset()
         ch.plc_functions = self.plc.unit
         ch.errors, ch.error_count = (), 0
+        self.alarms.reset_channel(ch.channel_id)  # ISG: RESET clears the channel's errors
         ch.waiting_for_start = False
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
         self._move(ChannelEvent.RESET)
@@ -660,12 +665,13 @@ class ChannelRunner:
             run.write_trace(how, self._files)
 
     def list_error(self, error: ErrorEntry, to_log: bool = True,
-                   keep_last: bool = False) -> None:
-        """List ``error``; ``to_log``: also in the channel's error log file (not the
-        findings of a syntax check, which may be thousands: they go to dec0<c>.sc);
-        ``keep_last``: leave the last slot free (for the error or warning that ends a
-        check)."""
+                   keep_last: bool = False, alarm_class: AlarmClass | None = None) -> None:
+        """List ``error`` and raise it as an alarm; ``to_log``: also in the channel's
+        error log file (not the findings of a syntax check, which may be thousands: they
+        go to dec0<c>.sc); ``keep_last``: leave the last slot free (for the error or
+        warning that ends a check); ``alarm_class``: when not the one of its id."""
         ch = self.channel
+        self.alarms.raise_error(error, ch.channel_id, alarm_class)
         if to_log:
             log.info("channel %d: %s", ch.channel_id, error)
             self._files(self.error_log_name, f"{self.time_s:.3f} s {error}\n".encode())

@@ -347,3 +347,26 @@ class SetContourSemaphore:
         channel.contour = replace(unit, semaphor=True)
         runner.answer_contour_request()
         return None
+
+
+@dataclass(frozen=True, slots=True)
+class AcknowledgeAlarm:
+    """``alarm_acknowledge_w``: acknowledge the alarm with this sequence number."""
+
+    value: int
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        return state.alarms.acknowledge(self.value)
+
+
+@dataclass(frozen=True, slots=True)
+class AcknowledgeAllAlarms:
+    """``alarm_acknowledge_all_w``: TRUE acknowledges every active alarm; FALSE does
+    nothing (a PLC may write the bit back)."""
+
+    value: bool
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        if self.value:
+            state.alarms.acknowledge_all()
+        return None

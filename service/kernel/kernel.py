@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 from ..machine_config import MachineConfig
+from .alarms import KERNEL_FAULT_ID, AlarmClass, AlarmLog
 from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
@@ -90,6 +91,7 @@ class Kernel:
         files: Callable[..., None] = lambda name, data, replace=False: None,
         save: Callable[[str, bytes, bool], None] = lambda name, data, replace: None,
         check_max_errors: int = CHECK_MAX_ERRORS,
+        alarms: AlarmLog | None = None,
     ) -> None:
         """``loader(name)`` returns a program's text (KeyError when absent) and
         ``exists(name)`` says whether it is there: the program store, seen by the kernel,
@@ -98,8 +100,11 @@ class Kernel:
         report as the whole content), ``save(name, data, replace)`` for those an NC
         program writes (``#MSG SAVE``, a cycle's result), which may raise
         ``nc.technology.OutputLimitReached``; neither blocks. ``check_max_errors``:
-        errors one syntax check keeps ([limits] check_max_errors)."""
+        errors one syntax check keeps ([limits] check_max_errors). ``alarms``: the log
+        every channel raises its errors and warnings in (one with the default bounds
+        when not given); it outlives a kernel RESET."""
         self._check_max_errors = check_max_errors
+        self.alarms = AlarmLog() if alarms is None else alarms
         self.config = config
         self.cycle_s = config.cycle_ms / 1000.0
         self.cycle_ns = round(config.cycle_ms * 1e6)
@@ -130,6 +135,7 @@ class Kernel:
         """State, axis parameters (clones resolved), switchover and channel runners as
         at start-up; the start-up messages go to the channels' error lists."""
         state = KernelState.from_config(self.config)
+        state.alarms = self.alarms
         params, messages = initialise_axes(self.config)
         self.axis_params: dict[int, AxisParameters] = params
         state.axis_params = params  # shared: an update reaches runners and switchover
@@ -143,7 +149,7 @@ class Kernel:
                           deterministic, self._files, params=params, switchover=self.switchover,
                           save=self._save,
                           check_max_errors=self._check_max_errors,
-                          on_wait=self._reply_while_waiting)
+                          on_wait=self._reply_while_waiting, alarms=self.alarms)
             for channel, cfg in zip(state.channels, self.config.channels, strict=True)
         ]
         for message in messages:
@@ -216,8 +222,11 @@ class Kernel:
                 if exec_us > self.stats.exec_time_max_us:
                     self.stats.exec_time_max_us = exec_us
                 self._clock.wait(self.state_has_work(), self.stats, self)
-        except Exception:  # a kernel fault is logged loudly; the service stays up
+        except Exception as exc:  # a kernel fault is logged loudly; the service stays up
             log.exception("cycle thread failed; the kernel is stopped")
+            self.alarms.raise_error(ErrorEntry(
+                KERNEL_FAULT_ID, f"the kernel's cycle task failed ({exc!r}); the kernel is "
+                "stopped: restart it (ADS WriteControl RESET)"), 0, AlarmClass.KERNEL)
             self.stats.running = False
             self._publish()
 
@@ -300,6 +309,7 @@ class Kernel:
                 break
             applied.append((done, self._apply(command)))
         self.stats.cycles += 1
+        self.alarms.tick(self.stats.cycles, self.stats.cycles * self.cycle_ns)
         had_commands = bool(applied)
         if had_commands and self._deterministic and self.stats.running:
             self._held = applied  # answered at once should the work wait
@@ -358,6 +368,7 @@ class Kernel:
             case Control.RESET:
                 for runner in self.state.runners:
                     runner.reset()
+                self.alarms.restart()  # the start-up messages are raised again
                 self.state = self._initial_state()
                 self.stats.running = True
         return None

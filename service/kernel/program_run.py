@@ -25,6 +25,7 @@ from typing import Protocol
 
 from cnc_objects.protocol.values import ExecutionMode
 
+from .alarms import AlarmClass
 from .channel_mode import ChannelMode, ChannelState
 from .contour_lookahead import LOG_FULL_WARNING, ContourLog
 from .decoder_feed import DecodeEnd, DecoderFeed, Item, Job
@@ -73,8 +74,9 @@ class RunHost(Protocol):
         """The channel's output is not suspended and every axis in it is linked."""
 
     def list_error(self, error: ErrorEntry, to_log: bool = True,
-                   keep_last: bool = False) -> None:
-        """Put ``error`` (a warning here) in the channel's error list."""
+                   keep_last: bool = False, alarm_class: AlarmClass | None = None) -> None:
+        """Put ``error`` (a warning here) in the channel's error list and raise it as an
+        alarm (of ``alarm_class`` when not the one of its id)."""
 
     def show_decoder_state(self) -> None:
         """Show the #MSG texts and machining settings the decoder reached."""

@@ -17,6 +17,7 @@ from cnc_objects.protocol.values import ExecutionMode as ExecutionMode
 from cnc_objects.protocol.values import LinkState as LinkState
 
 from ..machine_config import ChannelConfig, MachineConfig
+from .alarms import AlarmLog
 from .axis_params import AxisParameters
 from .nc.technology import MachiningSettings
 from .nc.tool_data import ToolingTables
@@ -338,6 +339,7 @@ class KernelState:
     runners: list[ChannelRunnerView] = field(default_factory=list)  # per channel (kernel sets)
     # by logical axis number
     axis_params: dict[int, AxisParameters] = field(default_factory=dict)
+    alarms: AlarmLog = field(default_factory=AlarmLog)  # the kernel's (kernel sets)
 
     @classmethod
     def from_config(cls, config: MachineConfig) -> KernelState:

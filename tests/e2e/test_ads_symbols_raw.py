@@ -19,6 +19,7 @@ import pytest
 from cnc_objects.clients import Client, ObjectInfo
 from cnc_objects.testing import ServiceProcess, start_service
 from tests.e2e.test_ads_raw import READ, READ_WRITE, RawAds, read, read_write
+from tests.service.test_ads_symbols import DEFAULT_MACHINE_OBJECTS
 
 pyads = pytest.importorskip("pyads")
 
@@ -191,8 +192,9 @@ def test_upload_info_64_bytes_field_by_field(ads: RawAds, catalog: list[ObjectIn
     assert len(data) == 64
     (symbols, symbol_bytes, types, type_bytes, max_dynamic, used_dynamic, invalid_dynamic,
      code_page, flags) = struct.unpack_from("<9I", data)
-    # + technology units and spindle, manual mode, tools and offsets (issue 28)
-    assert len(catalog) == 1004 + 350 + 108 + 278
+    # + technology units and spindle, manual mode, tools and offsets (issue 28), alarms
+    # (issue 29: 6 + 13 fields x (16 active + 32 history slots))
+    assert len(catalog) == DEFAULT_MACHINE_OBJECTS
     assert symbols == len(catalog) + len(struct_names(catalog))
     assert symbol_bytes == len(read_ok(ads, SYM_UPLOAD, symbol_bytes))
     assert type_bytes == len(read_ok(ads, SYM_DT_UPLOAD, type_bytes))

@@ -41,7 +41,7 @@ def test_the_tour_has_its_steps() -> None:
     for expected in ("cnc info", "cnc run docs/examples/part.nc --wait", "cnc status",
                      "cnc plot part.nc -o part.png", "cnc lookahead", "cnc mdi -c 2 --wait",
                      "cnc check docs/examples/check-syntax.nc", "cnc reset --standard",
-                     "cnc run docs/examples/chords.nc --wait"):
+                     "cnc run docs/examples/chords.nc --wait", "cnc alarms"):
         assert any(c.startswith(expected) for c in commands), expected
     assert all(s.expected or s.command.startswith("cnc-hmi") for s in tour_steps(README)), \
         [s.command for s in tour_steps(README) if not s.expected]

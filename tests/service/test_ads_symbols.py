@@ -44,6 +44,12 @@ PYADS_SYMBOL_ENTRY_BYTES = 30 + 3 * 256  # what pyads' adsGetSymbolInfo asks for
 VALUE_BY_HANDLE = 0xF005
 PLC_GROUP = 0x4020
 
+#: The objects of the default machine: issue 27's 1004, + technology units and spindle,
+#: manual mode, tools and offsets (issue 28: 350 + 108 + 278; G200/G201's manual offset
+#: per axis: 6; the step clock's cnc_cycle_step_w: 1), alarms (issue 29: 6 + 13 fields x
+#: (16 active + 32 history slots)). A change is deliberate: count it here.
+DEFAULT_MACHINE_OBJECTS = 1004 + 350 + 108 + 278 + 6 + 1 + 6 + 13 * (16 + 32)
+
 
 @pytest.fixture(scope="module")
 def space() -> Iterator[AddressSpace]:
@@ -87,8 +93,7 @@ def test_upload_info_64_bytes_describes_both_uploads(service: SymbolService, spa
     info = decode_upload_info(data)
     symbols = ok(service.read(SymbolGroup.UPLOAD, 0, 1 << 20))
     types = ok(service.read(SymbolGroup.DT_UPLOAD, 0, 1 << 20))
-    # + technology units and spindle, manual mode, tools and offsets (issue 28)
-    assert info.symbol_count == len(space) == 1004 + 350 + 108 + 278
+    assert info.symbol_count == len(space) == DEFAULT_MACHINE_OBJECTS
     assert info.symbol_size == len(symbols) == service.upload_bytes
     assert info.datatype_count == len(decode_datatype_entries(types))
     assert info.datatype_size == len(types) == service.datatype_upload_bytes
@@ -107,7 +112,7 @@ def test_upload_info2_is_24_bytes_below_64(service: SymbolService, length: int) 
 
 def test_upload_info_0xf00c_is_the_8_byte_form(service: SymbolService) -> None:
     data = ok(service.read(SymbolGroup.UPLOAD_INFO, 0, 64))
-    assert data == struct.pack("<II", 1004 + 350 + 108 + 278, service.upload_bytes)
+    assert data == struct.pack("<II", DEFAULT_MACHINE_OBJECTS, service.upload_bytes)
     assert ok(service.read(SymbolGroup.UPLOAD_INFO, 0, 8)) == data
 
 

@@ -14,6 +14,7 @@ import pytest
 
 from cnc_objects.protocol.values import ChannelMode, ChannelState, ManualOperationMode
 from cnc_objects.service.config import build_config
+from cnc_objects.service.kernel.alarms import AlarmClass, Severity
 from cnc_objects.service.kernel.commands import (
     Feedhold,
     RefusalReason,
@@ -173,6 +174,9 @@ def test_continuous_jog_stops_exactly_at_the_software_limit_with_a_warning(k) ->
     assert ch.state == ChannelState.READY  # a warning, not an error
     [warning] = [e for e in ch.errors if e.id == ManualErrorId.SW_LIMIT_REACHED]
     assert warning.warning and "software limit" in warning.text
+    # ... and an alarm of the axes, a warning (docs/alarms.md)
+    [alarm] = [a for a in k.kernel.alarms.view.active if a.id == ManualErrorId.SW_LIMIT_REACHED]
+    assert (alarm.alarm_class, alarm.severity) == (AlarmClass.AXIS, Severity.WARNING)
     # jogging on toward the limit does not move; away from it clears the warning
     write(k, "jog_plus", False)
     write(k, "operation_mode", ManualOperationMode.INCREMENTAL)

@@ -1,0 +1,185 @@
+"""Alarms of the client (mixed into ``AsyncClient``): the active list, the history,
+acknowledge, and the events as they come (docs/alarms.md).
+
+    listed = await c.alarms()                    # active alarms, newest first
+    await c.acknowledge_alarm(listed.active[0].sequence)
+    await c.acknowledge_all_alarms()
+    async for event in c.alarm_events():         # "raised", "acknowledged", "cleared"
+        print(event)
+
+Everything goes through the alarm objects (``alarm_active[k].*``, ``alarm_history[k].*``,
+``alarm_changes_r``); events come from a subscription to ``alarm_changes_r``: at each
+change the lists are read again and compared with what was seen before.
+"""
+
+from __future__ import annotations
+
+from collections.abc import AsyncGenerator
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from typing import Any
+
+from cnc_objects.protocol.alarm_values import AlarmClass, AlarmState, Severity
+
+from .client_core import MixinBase
+
+ACTIVE_SLOTS = 16  # alarm_active[1..16] (objects.catalog_alarms.ACTIVE_SLOTS)
+_FIELDS = ("sequence", "id", "severity", "class", "channel", "state", "time",
+           "kernel_time", "cycle", "text", "file", "line", "column")
+#: what an event is called, by the state it brought
+EVENT_OF_STATE = {AlarmState.ACTIVE: "raised", AlarmState.ACKNOWLEDGED: "acknowledged",
+                  AlarmState.CLEARED: "cleared"}
+
+
+def _severity(value: int) -> Severity | int:
+    try:
+        return Severity(value)
+    except ValueError:
+        return value
+
+
+@dataclass(frozen=True, slots=True)
+class AlarmInfo:
+    """One alarm as the service shows it."""
+
+    sequence: int  # names the alarm for acknowledge_alarm
+    id: int  # ISG-style error id
+    severity: Severity | int  # OPC UA 1..1000
+    alarm_class: AlarmClass
+    channel: int  # 0 = the platform
+    state: AlarmState
+    wall_ns: int  # wall clock when raised (ns since 1970)
+    kernel_ns: int  # kernel time when raised
+    cycle: int
+    text: str
+    file: str
+    line: int
+    column: int
+
+    @classmethod
+    def from_values(cls, v: dict[str, Any]) -> AlarmInfo:
+        """From the fields of one slot (``sequence``, ``id``, ... as the objects name them)."""
+        return cls(v["sequence"], v["id"], _severity(v["severity"]), AlarmClass(v["class"]),
+                   v["channel"], AlarmState(v["state"]), v["time"], v["kernel_time"],
+                   v["cycle"], v["text"], v["file"], v["line"], v["column"])
+
+    @property
+    def time(self) -> datetime:
+        """When it was raised (UTC)."""
+        return datetime.fromtimestamp(self.wall_ns / 1e9, tz=UTC)
+
+    @property
+    def where(self) -> str:
+        """``file:line:column``, or empty when the alarm has no place in a program."""
+        return f"{self.file}:{self.line}:{self.column}" if self.file else ""
+
+    @property
+    def severity_name(self) -> str:
+        """``warning``, ``error``, ... (the number when it has no name)."""
+        s = self.severity
+        return s.name.lower() if isinstance(s, Severity) else str(s)
+
+    def as_dict(self) -> dict[str, Any]:
+        """The alarm as JSON-ready values (``cnc alarms --json``, the MQTT bridge)."""
+        return {
+            "sequence": self.sequence, "id": self.id, "severity": int(self.severity),
+            "severity_name": self.severity_name, "class": self.alarm_class.name.lower(),
+            "channel": self.channel, "state": self.state.name.lower(),
+            "time": self.time.isoformat().replace("+00:00", "Z"),
+            "kernel_time_s": self.kernel_ns / 1e9, "cycle": self.cycle, "text": self.text,
+            "file": self.file, "line": self.line, "column": self.column,
+        }
+
+    def __str__(self) -> str:
+        where = f"{self.where}: " if self.file else ""
+        return (f"#{self.sequence} {self.state.name.lower()} {self.severity_name} {self.id} "
+                f"ch{self.channel}: {where}{self.text}")
+
+
+@dataclass(frozen=True, slots=True)
+class AlarmList:
+    """The alarms at one moment: the change counter, the active alarms (newest first,
+    at most 16 of ``active_count``) and, when asked for, the history (newest first)."""
+
+    changes: int
+    active_count: int
+    active: tuple[AlarmInfo, ...]
+    history: tuple[AlarmInfo, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class AlarmEvent:
+    """An alarm was raised, acknowledged or cleared."""
+
+    kind: str  # "raised", "acknowledged", "cleared"
+    alarm: AlarmInfo
+
+    def __str__(self) -> str:
+        return f"{self.kind}: {self.alarm}"
+
+
+class AlarmOps(MixinBase):
+    """The client's alarm requests."""
+
+    async def alarms(self, history: bool = False) -> AlarmList:
+        """The active alarms (newest first); with ``history`` also the history."""
+        counts = await self.read_many(
+            ["alarm_changes_r", "alarm_active_count_r", "alarm_history_count_r"])
+        active_n = min(counts["alarm_active_count_r"], ACTIVE_SLOTS)
+        history_n = counts["alarm_history_count_r"] if history else 0
+        names = [f"alarm_active[{k}].{f}" for k in range(1, active_n + 1) for f in _FIELDS]
+        names += [f"alarm_history[{k}].{f}" for k in range(1, history_n + 1) for f in _FIELDS]
+        values = await self.read_many(names) if names else {}
+
+        def slots(element: str, n: int) -> tuple[AlarmInfo, ...]:
+            found = (AlarmInfo.from_values({f: values[f"{element}[{k}].{f}"] for f in _FIELDS})
+                     for k in range(1, n + 1))
+            return tuple(a for a in found if a.sequence)  # a list that shrank meanwhile
+
+        return AlarmList(counts["alarm_changes_r"], counts["alarm_active_count_r"],
+                         slots("alarm_active", active_n), slots("alarm_history", history_n))
+
+    async def acknowledge_alarm(self, sequence: int) -> None:
+        """Acknowledge the alarm numbered ``sequence`` (an error stays active until
+        RESET, a warning is cleared); an unknown number raises ``AdsError`` 0x70C."""
+        await self.write("alarm_acknowledge_w", sequence)
+
+    async def acknowledge_all_alarms(self) -> None:
+        """Acknowledge every active alarm."""
+        await self.write("alarm_acknowledge_all_w", True)
+
+    async def alarm_events(self) -> AsyncGenerator[AlarmEvent, None]:
+        """The alarms' events from now on, in the order they happened per alarm:
+        ``raised``, ``acknowledged``, ``cleared`` (an alarm raised and cleared between
+        two reads gives both). Leaving the loop ends the subscription."""
+        seen: dict[int, AlarmState] | None = None
+        async for _sample in self.subscribe("alarm_changes_r"):
+            listed = await self.alarms(history=True)
+            if seen is None:  # the first sample: what is there already
+                seen = seen_states(listed)
+                continue
+            for event in events_since(seen, listed):
+                yield event
+
+
+def seen_states(listed: AlarmList) -> dict[int, AlarmState]:
+    """The state of every alarm of ``listed`` (active and history), by sequence number:
+    where ``events_since`` starts."""
+    return {a.sequence: a.state for a in (*listed.history, *listed.active)}
+
+
+def events_since(seen: dict[int, AlarmState], listed: AlarmList) -> list[AlarmEvent]:
+    """The events that lead from ``seen`` to ``listed``, oldest alarm first; ``seen`` is
+    brought up to date. A warning's acknowledge clears it: one event, ``cleared``."""
+    now = {a.sequence: a for a in (*listed.history, *listed.active)}
+    events = []
+    for sequence in sorted(now):
+        alarm = now[sequence]
+        before = seen.get(sequence)
+        for state in AlarmState:
+            if (before is None or state > before) and state <= alarm.state:
+                if state == AlarmState.ACKNOWLEDGED and alarm.state == AlarmState.CLEARED:
+                    continue
+                events.append(AlarmEvent(EVENT_OF_STATE[state], alarm))
+        seen[sequence] = alarm.state
+    return events
