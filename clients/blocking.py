@@ -12,7 +12,7 @@ from typing import Any
 from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.datatypes import DataType
 
-from .channel_ops import ChannelStatus, CheckResult, ContourReply, ProgramEntry
+from .channel_ops import ChannelStatus, CheckResult, ContourReply, OnWaitReason, ProgramEntry
 from .client import BlockingClientBase, DeviceInfo, Sample, iterate_blocking, run_blocking
 from .object_info import ObjectInfo
 from .path_trace import PathTrace
@@ -213,14 +213,39 @@ class Client(BlockingClientBase):
         exceed the wire's limit and the service would drop it without a reply."""
         return run_blocking(self._core.upload(name, data))
 
-    def wait_mdi(self, before: int, channel: int = 1, timeout_s: float | None = None) -> None:
-        """Wait until the manual block written after ``before`` finished blocks is done."""
-        return run_blocking(self._core.wait_mdi(before, channel, timeout_s))
+    def wait_mdi(
+        self,
+        before: int,
+        channel: int = 1,
+        timeout_s: float | None = None,
+        *,
+        on_wait_reason: OnWaitReason | None = None,
+    ) -> None:
+        """Wait until the manual block written after ``before`` finished blocks is done
+        (``timeout_s`` and ``on_wait_reason`` as for ``wait_program``)."""
+        return run_blocking(self._core.wait_mdi(
+            before,
+            channel,
+            timeout_s,
+            on_wait_reason=on_wait_reason,
+        ))
 
-    def wait_program(self, channel: int = 1, timeout_s: float | None = None) -> None:
+    def wait_program(
+        self,
+        channel: int = 1,
+        timeout_s: float | None = None,
+        *,
+        on_wait_reason: OnWaitReason | None = None,
+    ) -> None:
         """Wait until the channel's program has ended (READY); ``ChannelError`` when the
-        channel went to ERROR, ``AdsTimeoutError`` after ``timeout_s``."""
-        return run_blocking(self._core.wait_program(channel, timeout_s))
+        channel went to ERROR, ``AdsTimeoutError`` after ``timeout_s`` (its message names
+        why the channel stands). ``on_wait_reason`` is called with each new wait reason
+        (name, sentence) seen while waiting."""
+        return run_blocking(self._core.wait_program(
+            channel,
+            timeout_s,
+            on_wait_reason=on_wait_reason,
+        ))
 
     def write(self, name: str, value: Any) -> None:
         """Write the object ``name``; returns once the kernel has applied it. A value its

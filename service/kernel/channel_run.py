@@ -63,6 +63,7 @@ from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
 from .tooling import seed_modal, tables_from_config, tooling_of
 from .tooling_view import after_reset, initial_tooling
+from .wait_reason import WaitReason, channel_wait_reason
 
 log = logging.getLogger(__name__)
 
@@ -557,7 +558,20 @@ class ChannelRunner:
         if show_technology(self.channel, self.plc, time_s, self._cycle_s):
             self.touched = True
             busy = True
+        reason = self._wait_reason()
+        if reason != self.channel.wait_reason:
+            self.channel.wait_reason = reason
+            self.touched = True
         return busy
+
+    def _wait_reason(self) -> WaitReason:
+        """Why the channel stands after this cycle (``wait_reason``)."""
+        run = self._run
+        needs_axes = self._pending_start is not None or (
+            run is not None and not isinstance(run, ChannelCheck))
+        return channel_wait_reason(
+            self.channel, WaitReason.NONE if run is None else run.wait_reason(),
+            axes_missing=needs_axes and not self.axes_ready, internal_hold=self._internal_hold)
 
     def _run_cycle(self, time_s: float) -> bool:
         self.time_s = time_s

@@ -38,6 +38,7 @@ from .path.segments import Segment
 from .plc_functions import PlcFunctions
 from .prod_time_trace import ProdTimeTrace, trace_file_name
 from .state import Channel, ErrorEntry
+from .wait_reason import WaitReason, manual_open, path_wait_reason
 
 _INCR_PER_MM = 10_000  # 0.1 um increments per mm
 PROD_TIME_STEPS_PER_CYCLE = 5_000  # virtual clock: simulated cycles per GEO cycle (PROD_TIME)
@@ -100,6 +101,9 @@ class ChannelRun(Protocol):
     def cancel(self) -> ModalState | None:
         """End the run at once (RESET, end, error); the modal state it reached."""
 
+    def wait_reason(self) -> WaitReason:
+        """Why the run stands after this cycle (``wait_reason.path_wait_reason``)."""
+
 
 class ProgramRun:
     """A real run: blocks from the decoder move the channel's axes along the path."""
@@ -155,6 +159,20 @@ class ProgramRun:
         self.feed.cancel()
         self.executor.stop_now()
         return self.feed.modal
+
+    def wait_reason(self) -> WaitReason:
+        """What the path waits for after this cycle: a stop, dwell or acknowledge at a
+        block end, override 0, or blocks from the decoder (or the operator, in extended
+        MDI)."""
+        executor, ch = self.executor, self.channel
+        waiting = executor.waiting
+        if waiting == Waiting.NONE and executor.has_motion:  # the common case, kept short
+            return WaitReason.OVERRIDE_ZERO if ch.feed_override_per_mille == 0 else WaitReason.NONE
+        more = not (self._fed_all or self._pending_error is not None or self._sync is not None)
+        return path_wait_reason(
+            waiting, executor.waiting_at, self._technology(),
+            has_motion=executor.has_motion, override_per_mille=ch.feed_override_per_mille,
+            more_blocks=more, manual_open=manual_open(ch, self.feed.keep_open))
 
     # ------------------------------------------------------------ cycle
 
