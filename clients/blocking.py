@@ -220,14 +220,17 @@ class Client(BlockingClientBase):
         timeout_s: float | None = None,
         *,
         on_wait_reason: OnWaitReason | None = None,
+        reason_settle_s: float = 0.0,
     ) -> None:
         """Wait until the manual block written after ``before`` finished blocks is done
-        (``timeout_s`` and ``on_wait_reason`` as for ``wait_program``)."""
+        (``timeout_s``, ``on_wait_reason`` and ``reason_settle_s`` as for
+        ``wait_program``)."""
         return run_blocking(self._core.wait_mdi(
             before,
             channel,
             timeout_s,
             on_wait_reason=on_wait_reason,
+            reason_settle_s=reason_settle_s,
         ))
 
     def wait_program(
@@ -236,15 +239,19 @@ class Client(BlockingClientBase):
         timeout_s: float | None = None,
         *,
         on_wait_reason: OnWaitReason | None = None,
+        reason_settle_s: float = 0.0,
     ) -> None:
         """Wait until the channel's program has ended (READY); ``ChannelError`` when the
         channel went to ERROR, ``AdsTimeoutError`` after ``timeout_s`` (its message names
         why the channel stands). ``on_wait_reason`` is called with each new wait reason
-        (name, sentence) seen while waiting."""
+        (name, sentence) once it has held for ``reason_settle_s`` of wall time (so that
+        reasons of a moment, such as the first blocks' decoding, can be left out), and
+        with ("NONE", "") at once when a reason it was told of has gone."""
         return run_blocking(self._core.wait_program(
             channel,
             timeout_s,
             on_wait_reason=on_wait_reason,
+            reason_settle_s=reason_settle_s,
         ))
 
     def write(self, name: str, value: Any) -> None:

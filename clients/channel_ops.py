@@ -424,11 +424,12 @@ class ChannelOps(ProgramOps):
         return ContourReply(values[state[1]], values[state[2]], values[state[3]], blocks)
 
     async def _wait(self, channel: int, done: Any, timeout_s: float | None,
-                    on_wait_reason: OnWaitReason | None) -> None:
+                    on_wait_reason: OnWaitReason | None, settle_s: float) -> None:
         deadline = None if timeout_s is None else time.monotonic() + timeout_s
         names = [f"ch{channel}.mc_active_state_r", f"ch{channel}.mc_manual_blocks_done_r",
                  f"ch{channel}.mc_wait_reason_r"]
-        reason_seen = WaitReason.NONE
+        reported = current = WaitReason.NONE
+        since = time.monotonic()  # when ``current`` was first seen
         while True:
             values = await self.read_many(names)
             state, done_count, reason = values[names[0]], values[names[1]], values[names[2]]
@@ -436,10 +437,14 @@ class ChannelOps(ProgramOps):
                 raise ChannelError(channel, await self.channel_errors(channel))
             if done(state, done_count):
                 return
-            if reason != reason_seen and on_wait_reason is not None:
-                on_wait_reason(*describe_wait_reason(reason))
-            reason_seen = reason
-            if deadline is not None and time.monotonic() > deadline:
+            now = time.monotonic()
+            if reason != current:
+                current, since = reason, now
+            if on_wait_reason is not None and current != reported and (
+                    current == WaitReason.NONE or now - since >= settle_s):
+                on_wait_reason(*describe_wait_reason(current))
+                reported = current
+            if deadline is not None and now > deadline:
                 why = ""
                 if reason != WaitReason.NONE:
                     name, text = describe_wait_reason(reason)
@@ -451,22 +456,27 @@ class ChannelOps(ProgramOps):
             await self._t.pause(POLL_S)
 
     async def wait_program(self, channel: int = 1, timeout_s: float | None = None, *,
-                           on_wait_reason: OnWaitReason | None = None) -> None:
+                           on_wait_reason: OnWaitReason | None = None,
+                           reason_settle_s: float = 0.0) -> None:
         """Wait until the channel's program has ended (READY); ``ChannelError`` when the
         channel went to ERROR, ``AdsTimeoutError`` after ``timeout_s`` (its message names
         why the channel stands). ``on_wait_reason`` is called with each new wait reason
-        (name, sentence) seen while waiting."""
+        (name, sentence) once it has held for ``reason_settle_s`` of wall time (so that
+        reasons of a moment, such as the first blocks' decoding, can be left out), and
+        with ("NONE", "") at once when a reason it was told of has gone."""
         await self._wait(channel, lambda state, _: state not in (_ACTIVE, _HOLD), timeout_s,
-                         on_wait_reason)
+                         on_wait_reason, reason_settle_s)
 
     async def wait_mdi(self, before: int, channel: int = 1, timeout_s: float | None = None,
-                       *, on_wait_reason: OnWaitReason | None = None) -> None:
+                       *, on_wait_reason: OnWaitReason | None = None,
+                       reason_settle_s: float = 0.0) -> None:
         """Wait until the manual block written after ``before`` finished blocks is done
-        (``timeout_s`` and ``on_wait_reason`` as for ``wait_program``)."""
+        (``timeout_s``, ``on_wait_reason`` and ``reason_settle_s`` as for
+        ``wait_program``)."""
         await self._wait(
             channel,
             lambda state, count: count > before or state not in (_ACTIVE, _HOLD),
-            timeout_s, on_wait_reason,
+            timeout_s, on_wait_reason, reason_settle_s,
         )
 
     async def syntax_check(

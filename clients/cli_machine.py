@@ -14,9 +14,9 @@
 ``--wait`` exits 0 when the program (or manual block) has finished, 4 with the channel's
 error text when the channel went to ERROR, 5 when ``--timeout`` passed first (default
 600 s; ``--timeout 0`` waits without limit), naming why the channel stands (its wait
-reason, ``ch<c>.mc_wait_reason_r``). While it waits, each change of the wait reason is
-printed as one line on stderr (``channel 1 waits: feed hold: waiting for START
-(FEED_HOLD)``; ``channel 1 goes on`` when the reason clears). ``status`` shows single
+reason, ``ch<c>.mc_wait_reason_r``). While it waits, each wait reason that has held
+for a second is printed as one line on stderr (``channel 1 waits: feed hold: waiting
+for START (FEED_HOLD)``; ``channel 1 goes on`` when it clears). ``status`` shows single
 block and the wait reason too. A channel
 in ERROR refuses ``run``, ``mdi`` and ``resume`` (exit 1, naming its errors) until
 ``cnc reset``, as a CNC does; ``cnc reset --standard`` also commands standard execution
@@ -56,6 +56,9 @@ EXIT_WAIT_TIMEOUT = 5
 ChannelOption = typer.Option(1, "--channel", "-c", min=1, help="Channel id (default 1).")
 WaitOption = typer.Option(False, "--wait", help="Return when finished; non-zero on ERROR.")
 WAIT_TIMEOUT_DEFAULT_S = 600.0  # --wait gives up after this long unless --timeout says
+# --wait prints a wait reason once it has held this long (wall time): the few cycles a
+# start waits for its first blocks, a short dwell or spindle ramp are not news
+WAIT_REASON_SETTLE_S = 1.0
 WaitTimeoutOption = typer.Option(
     WAIT_TIMEOUT_DEFAULT_S, "--timeout", min=0.0,
     help="With --wait: give up after S seconds (exit 5, naming why the channel stands); "
@@ -205,7 +208,8 @@ def wait_to_end(c: Client, channel: int, timeout_s: float | None) -> ChannelStat
     """Wait until the channel's program has ended; print the warnings it raised (the
     channel kept running) on stderr, since a run that only said "finished" would hide
     them; return the channel's status."""
-    c.wait_program(channel, wait_limit_s(timeout_s), on_wait_reason=print_wait_reason(channel))
+    c.wait_program(channel, wait_limit_s(timeout_s), on_wait_reason=print_wait_reason(channel),
+                   reason_settle_s=WAIT_REASON_SETTLE_S)
     for line in c.channel_errors(channel):
         if line.startswith("warning"):
             err.print(line, markup=False, emoji=False)
@@ -276,7 +280,8 @@ def mdi(
             before = c.mdi(text, channel)
             if wait:
                 c.wait_mdi(before, channel, wait_limit_s(timeout_s),
-                           on_wait_reason=print_wait_reason(channel))
+                           on_wait_reason=print_wait_reason(channel),
+                           reason_settle_s=WAIT_REASON_SETTLE_S)
     except (AdsError, ChannelError, ClientValueError) as exc:
         finish_wait(exc)
     emit(settings, {"channel": channel, "ok": True, "finished": wait},

@@ -10,7 +10,7 @@ attribute reads), so the reason costs next to nothing per cycle.
 
 from __future__ import annotations
 
-from cnc_objects.protocol.wait_reasons import WaitReason
+from cnc_objects.protocol.wait_reasons import WaitReason as WaitReason  # re-exported for the runs
 
 from .channel_mode import ChannelMode, ChannelState
 from .nc.blocks import Block, StopKind

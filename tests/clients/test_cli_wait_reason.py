@@ -44,7 +44,8 @@ def test_status_of_an_idle_channel_waits_for_nothing(service: ServiceProcess) ->
 def test_run_wait_times_out_naming_the_reason(service: ServiceProcess, tmp_path: Path) -> None:
     program = tmp_path / "stop.nc"
     program.write_text(M0_PROGRAM)
-    result = cnc("run", str(program), "--wait", "--timeout", "0.5", endpoint=service.endpoint)
+    # 3 s: the stop is printed once it has held for WAIT_REASON_SETTLE_S (1 s)
+    result = cnc("run", str(program), "--wait", "--timeout", "3", endpoint=service.endpoint)
     assert result.returncode == EXIT_WAIT_TIMEOUT, result.stderr
     lines = result.stderr.splitlines()
     assert M0_LINE in lines  # the change, printed while waiting
@@ -82,3 +83,14 @@ def test_run_wait_prints_each_change_of_the_reason(service: ServiceProcess,
     assert [line for line in lines if line != "channel 1 goes on"] == [
         M0_LINE, "channel 1 waits: M1 optional stop: waiting for START (OPTIONAL_STOP)"]
     assert "stops.nc finished" in out
+
+
+def test_run_wait_leaves_out_reasons_of_a_moment(service: ServiceProcess,
+                                                 tmp_path: Path) -> None:
+    """A spindle ramp and a short dwell are waits of a moment (far below the second a
+    reason must hold): the run prints its result and nothing on stderr."""
+    program = tmp_path / "short.nc"
+    program.write_text("S1000 M3\nG1 X1 F6000\nG4 X0.2\nM5\nM30\n")
+    result = cnc("run", str(program), "--wait", endpoint=service.endpoint)
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == "" and "short.nc finished" in result.stdout
