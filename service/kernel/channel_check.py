@@ -49,7 +49,7 @@ class ChannelCheck:
         self.check.cancel()
         return None
 
-    def wait_reason(self) -> WaitReason:
+    def wait_reason(self) -> int:
         """A check waits for no machine function; its pauses are the channel's HOLD
         (``wait_reason.channel_wait_reason``)."""
         return WaitReason.NONE

@@ -23,8 +23,8 @@ _WORKING = (ChannelState.ACTIVE, ChannelState.HOLD)
 
 
 def channel_wait_reason(
-    channel: Channel, path_reason: WaitReason, *, axes_missing: bool, internal_hold: bool,
-) -> WaitReason:
+    channel: Channel, path_reason: int, *, axes_missing: bool, internal_hold: bool,
+) -> int:
     """The channel's reason: ERROR, HOLD (or a paused syntax check), suspended output,
     a start waiting for its axes, else ``path_reason`` (the run's own, NONE without a
     run). ``axes_missing``: the run (or the start) needs axes that are not linked;
