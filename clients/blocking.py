@@ -13,7 +13,7 @@ from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.datatypes import DataType
 
 from .alarm_ops import AlarmEvent, AlarmList
-from .channel_ops import ChannelStatus, CheckResult, ContourReply, ProgramEntry
+from .channel_ops import ChannelStatus, CheckResult, ContourReply, OnWaitReason, ProgramEntry
 from .client import BlockingClientBase, DeviceInfo, Sample, iterate_blocking, run_blocking
 from .object_info import ObjectInfo
 from .path_trace import PathTrace
@@ -233,14 +233,46 @@ class Client(BlockingClientBase):
         exceed the wire's limit and the service would drop it without a reply."""
         return run_blocking(self._core.upload(name, data))
 
-    def wait_mdi(self, before: int, channel: int = 1, timeout_s: float | None = None) -> None:
-        """Wait until the manual block written after ``before`` finished blocks is done."""
-        return run_blocking(self._core.wait_mdi(before, channel, timeout_s))
+    def wait_mdi(
+        self,
+        before: int,
+        channel: int = 1,
+        timeout_s: float | None = None,
+        *,
+        on_wait_reason: OnWaitReason | None = None,
+        reason_settle_s: float = 0.0,
+    ) -> None:
+        """Wait until the manual block written after ``before`` finished blocks is done
+        (``timeout_s``, ``on_wait_reason`` and ``reason_settle_s`` as for
+        ``wait_program``)."""
+        return run_blocking(self._core.wait_mdi(
+            before,
+            channel,
+            timeout_s,
+            on_wait_reason=on_wait_reason,
+            reason_settle_s=reason_settle_s,
+        ))
 
-    def wait_program(self, channel: int = 1, timeout_s: float | None = None) -> None:
+    def wait_program(
+        self,
+        channel: int = 1,
+        timeout_s: float | None = None,
+        *,
+        on_wait_reason: OnWaitReason | None = None,
+        reason_settle_s: float = 0.0,
+    ) -> None:
         """Wait until the channel's program has ended (READY); ``ChannelError`` when the
-        channel went to ERROR, ``AdsTimeoutError`` after ``timeout_s``."""
-        return run_blocking(self._core.wait_program(channel, timeout_s))
+        channel went to ERROR, ``AdsTimeoutError`` after ``timeout_s`` (its message names
+        why the channel stands). ``on_wait_reason`` is called with each new wait reason
+        (name, sentence) once it has held for ``reason_settle_s`` of wall time (so that
+        reasons of a moment, such as the first blocks' decoding, can be left out), and
+        with ("NONE", "") at once when a reason it was told of has gone."""
+        return run_blocking(self._core.wait_program(
+            channel,
+            timeout_s,
+            on_wait_reason=on_wait_reason,
+            reason_settle_s=reason_settle_s,
+        ))
 
     def write(self, name: str, value: Any) -> None:
         """Write the object ``name``; returns once the kernel has applied it. A value its

@@ -17,6 +17,7 @@ RESET clears them (a CNC does not start in ERROR).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -41,6 +42,7 @@ from cnc_objects.protocol.values import (
     ExecutionMode,
     value_names,
 )
+from cnc_objects.protocol.wait_reasons import WaitReason, wait_reason_text
 
 from .client_core import MixinBase
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError
@@ -53,6 +55,15 @@ STATES = value_names(ChannelState)
 _ACTIVE, _HOLD, _ERROR = ChannelState.ACTIVE, ChannelState.HOLD, ChannelState.ERROR
 _ERROR_SLOTS = 8
 SYNCHK, MACHINE_LOCK = int(ExecutionMode.SYNCHK), int(ExecutionMode.MACHINE_LOCK)
+WAIT_REASONS = value_names(WaitReason)
+#: Called by a wait each time the channel's wait reason changes: (name, sentence), such
+#: as ("FEED_HOLD", "feed hold: waiting for START"); ("NONE", "") when it goes on.
+OnWaitReason = Callable[[str, str], None]
+
+
+def describe_wait_reason(value: int) -> tuple[str, str]:
+    """The name and sentence of a value of ``mc_wait_reason_r``."""
+    return WAIT_REASONS.get(value, str(value)), wait_reason_text(value)
 
 
 @dataclass(frozen=True, slots=True)
@@ -120,6 +131,9 @@ class ChannelStatus:
     errors: list[str]
     execution_mode: str = "standard"
     commanded_execution_mode: str = "standard"
+    single_block: bool = False  # single block is on (mc_active_single_block_r)
+    wait_reason: str = "NONE"  # why the channel stands (mc_wait_reason_r), by name
+    wait_reason_text: str = ""  # the same as a sentence; empty when it does not stand
 
 
 @dataclass(frozen=True, slots=True)
@@ -359,7 +373,7 @@ class ChannelOps(ProgramOps):
                 "mc_active_mode_r", "mc_active_state_r", "mc_active_program_name_r",
                 "mc_active_file_name_r", "mc_active_line_r", "actual_block_number",
                 "actual_path_velocity", "program_time", "mc_active_execution_mode_r",
-                "mc_command_execution_mode_r",
+                "mc_command_execution_mode_r", "mc_active_single_block_r", "mc_wait_reason_r",
             )
         ]
         axis_names = [o.name.replace("command_position_acs", "axis_name") for o in axes]
@@ -374,6 +388,9 @@ class ChannelOps(ProgramOps):
             await self.channel_errors(channel) if v[1] == _ERROR else [],
             execution_mode=describe_execution_mode(v[8]),
             commanded_execution_mode=describe_execution_mode(v[9]),
+            single_block=bool(v[10]),
+            wait_reason=describe_wait_reason(v[11])[0],
+            wait_reason_text=describe_wait_reason(v[11])[1],
         )
 
     async def contour_lookahead(
@@ -406,33 +423,60 @@ class ChannelOps(ProgramOps):
             blocks.append(ContourBlock(*entry))
         return ContourReply(values[state[1]], values[state[2]], values[state[3]], blocks)
 
-    async def _wait(self, channel: int, done: Any, timeout_s: float | None) -> None:
+    async def _wait(self, channel: int, done: Any, timeout_s: float | None,
+                    on_wait_reason: OnWaitReason | None, settle_s: float) -> None:
         deadline = None if timeout_s is None else time.monotonic() + timeout_s
-        names = [f"ch{channel}.mc_active_state_r", f"ch{channel}.mc_manual_blocks_done_r"]
+        names = [f"ch{channel}.mc_active_state_r", f"ch{channel}.mc_manual_blocks_done_r",
+                 f"ch{channel}.mc_wait_reason_r"]
+        reported = current = WaitReason.NONE
+        since = time.monotonic()  # when ``current`` was first seen
         while True:
             values = await self.read_many(names)
-            state, done_count = values[names[0]], values[names[1]]
+            state, done_count, reason = values[names[0]], values[names[1]], values[names[2]]
             if state == _ERROR:
                 raise ChannelError(channel, await self.channel_errors(channel))
             if done(state, done_count):
                 return
-            if deadline is not None and time.monotonic() > deadline:
+            now = time.monotonic()
+            if reason != current:
+                current, since = reason, now
+            if on_wait_reason is not None and current != reported and (
+                    current == WaitReason.NONE or now - since >= settle_s):
+                on_wait_reason(*describe_wait_reason(current))
+                reported = current
+            if deadline is not None and now > deadline:
+                why = ""
+                if reason != WaitReason.NONE:
+                    name, text = describe_wait_reason(reason)
+                    why = f": {text} (wait reason {name})"
                 raise AdsTimeoutError(
-                    f"channel {channel} still {STATES.get(state, state)} after {timeout_s:g} s"
+                    f"channel {channel} still {STATES.get(state, state)} after "
+                    f"{timeout_s:g} s{why}"
                 )
             await self._t.pause(POLL_S)
 
-    async def wait_program(self, channel: int = 1, timeout_s: float | None = None) -> None:
+    async def wait_program(self, channel: int = 1, timeout_s: float | None = None, *,
+                           on_wait_reason: OnWaitReason | None = None,
+                           reason_settle_s: float = 0.0) -> None:
         """Wait until the channel's program has ended (READY); ``ChannelError`` when the
-        channel went to ERROR, ``AdsTimeoutError`` after ``timeout_s``."""
-        await self._wait(channel, lambda state, _: state not in (_ACTIVE, _HOLD), timeout_s)
+        channel went to ERROR, ``AdsTimeoutError`` after ``timeout_s`` (its message names
+        why the channel stands). ``on_wait_reason`` is called with each new wait reason
+        (name, sentence) once it has held for ``reason_settle_s`` of wall time (so that
+        reasons of a moment, such as the first blocks' decoding, can be left out), and
+        with ("NONE", "") at once when a reason it was told of has gone."""
+        await self._wait(channel, lambda state, _: state not in (_ACTIVE, _HOLD), timeout_s,
+                         on_wait_reason, reason_settle_s)
 
-    async def wait_mdi(self, before: int, channel: int = 1, timeout_s: float | None = None) -> None:
-        """Wait until the manual block written after ``before`` finished blocks is done."""
+    async def wait_mdi(self, before: int, channel: int = 1, timeout_s: float | None = None,
+                       *, on_wait_reason: OnWaitReason | None = None,
+                       reason_settle_s: float = 0.0) -> None:
+        """Wait until the manual block written after ``before`` finished blocks is done
+        (``timeout_s``, ``on_wait_reason`` and ``reason_settle_s`` as for
+        ``wait_program``)."""
         await self._wait(
             channel,
             lambda state, count: count > before or state not in (_ACTIVE, _HOLD),
-            timeout_s,
+            timeout_s, on_wait_reason, reason_settle_s,
         )
 
     async def syntax_check(

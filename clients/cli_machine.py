@@ -12,7 +12,12 @@
     cnc check FILE|NAME [--channel N] [--errors-total K] [--log] [--timeout S]
 
 ``--wait`` exits 0 when the program (or manual block) has finished, 4 with the channel's
-error text when the channel went to ERROR, 5 when ``--timeout`` passed first. A channel
+error text when the channel went to ERROR, 5 when ``--timeout`` passed first (default
+600 s; ``--timeout 0`` waits without limit), naming why the channel stands (its wait
+reason, ``ch<c>.mc_wait_reason_r``). While it waits, each wait reason that has held
+for a second is printed as one line on stderr (``channel 1 waits: feed hold: waiting
+for START (FEED_HOLD)``; ``channel 1 goes on`` when it clears). ``status`` shows single
+block and the wait reason too. A channel
 in ERROR refuses ``run``, ``mdi`` and ``resume`` (exit 1, naming its errors) until
 ``cnc reset``, as a CNC does; ``cnc reset --standard`` also commands standard execution
 (no SYNCHK, MACHINE_LOCK, PROD_TIME bit; ``syn_chk.record_result`` off). ``status`` shows
@@ -39,6 +44,7 @@ from .channel_ops import (
     ChannelStatus,
     CheckError,
     CheckResult,
+    OnWaitReason,
     ProgramEntry,
 )
 from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
@@ -49,9 +55,29 @@ EXIT_WAIT_TIMEOUT = 5
 
 ChannelOption = typer.Option(1, "--channel", "-c", min=1, help="Channel id (default 1).")
 WaitOption = typer.Option(False, "--wait", help="Return when finished; non-zero on ERROR.")
+WAIT_TIMEOUT_DEFAULT_S = 600.0  # --wait gives up after this long unless --timeout says
+# --wait prints a wait reason once it has held this long (wall time): the few cycles a
+# start waits for its first blocks, a short dwell or spindle ramp are not news
+WAIT_REASON_SETTLE_S = 1.0
 WaitTimeoutOption = typer.Option(
-    None, "--timeout", min=0.0, help="With --wait: give up after S seconds (exit 5)."
+    WAIT_TIMEOUT_DEFAULT_S, "--timeout", min=0.0,
+    help="With --wait: give up after S seconds (exit 5, naming why the channel stands); "
+         "0 = no limit.",
 )
+
+
+def wait_limit_s(timeout_s: float | None) -> float | None:
+    """The wait's limit for ``--timeout``: 0 (or none given) waits without limit."""
+    return timeout_s or None
+
+
+def print_wait_reason(channel: int) -> OnWaitReason:
+    """The ``on_wait_reason`` of a ``--wait``: one line on stderr per change."""
+    def show(name: str, text: str) -> None:
+        line = f"channel {channel} goes on" if name == "NONE" else (
+            f"channel {channel} waits: {text} ({name})")
+        err.print(line, markup=False, emoji=False, highlight=False)
+    return show
 
 
 def finish_wait(exc: Exception) -> None:
@@ -182,7 +208,8 @@ def wait_to_end(c: Client, channel: int, timeout_s: float | None) -> ChannelStat
     """Wait until the channel's program has ended; print the warnings it raised (the
     channel kept running) on stderr, since a run that only said "finished" would hide
     them; return the channel's status."""
-    c.wait_program(channel, timeout_s)
+    c.wait_program(channel, wait_limit_s(timeout_s), on_wait_reason=print_wait_reason(channel),
+                   reason_settle_s=WAIT_REASON_SETTLE_S)
     for line in c.channel_errors(channel):
         if line.startswith("warning"):
             err.print(line, markup=False, emoji=False)
@@ -252,7 +279,9 @@ def mdi(
         with settings.session(f"manual block in channel {channel}") as c:
             before = c.mdi(text, channel)
             if wait:
-                c.wait_mdi(before, channel, timeout_s)
+                c.wait_mdi(before, channel, wait_limit_s(timeout_s),
+                           on_wait_reason=print_wait_reason(channel),
+                           reason_settle_s=WAIT_REASON_SETTLE_S)
     except (AdsError, ChannelError, ClientValueError) as exc:
         finish_wait(exc)
     emit(settings, {"channel": channel, "ok": True, "finished": wait},
@@ -314,7 +343,8 @@ def reset(
 
 @command()
 def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
-    """Mode, state, execution mode, program, block and axis positions of a channel.
+    """Mode, state, execution mode, single block, wait reason, program, block and axis
+    positions of a channel.
 
     The execution mode is shown by the names of its bits (SYNCHK|MACHINE_LOCK) or as
     standard; when the commanded mode differs (it takes effect at the next start), that
@@ -326,9 +356,12 @@ def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
     mode = f"execution mode {s.execution_mode}"
     if s.commanded_execution_mode != s.execution_mode:  # a mode takes effect at a start
         mode += f" (next start: {s.commanded_execution_mode})"
+    waits = f"waits: {s.wait_reason_text} ({s.wait_reason})" if s.wait_reason != "NONE" else (
+        "waits: -")
     lines = [
         f"channel {s.channel}: {s.mode}/{s.state}  program {s.program or '-'}",
         mode,
+        f"single block {'on' if s.single_block else 'off'}  {waits}",
         (f"block N{s.block_number if s.block_number >= 0 else '-'} {s.file or '-'}:{s.line}  "
          f"v={s.path_velocity_mm_s:.3f} mm/s  t={s.program_time_s:.3f} s"),
         f"positions (mm): {positions}",

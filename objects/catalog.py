@@ -18,6 +18,7 @@ from enum import Enum, IntEnum
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16, UNS32, DataType
 from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockType, LinkState
+from cnc_objects.protocol.wait_reasons import WAIT_REASON_TEXT_CHARS, WaitReason
 
 from .addressing import GroupBase, axis_offset, channel_group
 from .catalog_manual import MANUAL_ROWS
@@ -302,6 +303,20 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
     ObjectTemplate(
         "mc_manual_blocks_done_r", Scope.CHANNEL, COM, COM_CH, 0x3012, UNS32, R, "-",
         "Manual blocks (MDI writes) finished since the service started (project)",
+    ),
+    # --- COM channel wait reason (project offsets 0x36xx; docs/kernel.md "Wait reasons")
+    ObjectTemplate(
+        "mc_wait_reason_r", Scope.CHANNEL, COM, COM_CH, 0x3600, UNS32, R, "-",
+        "Why the channel stands: 0 NONE, 1 SINGLE_BLOCK, 2 PROGRAMMED_STOP (M0), "
+        "3 OPTIONAL_STOP (M1), 4 FEED_HOLD, 5 OVERRIDE_ZERO, 6 PLC_ACKNOWLEDGE, 7 SPINDLE, "
+        "8 DWELL, 9 DECODER, 10 MANUAL_BLOCK, 11 AXIS_LINK, 12 OUTPUT_SUSPENDED, "
+        "13 CHECK_PAUSE, 14 ERROR, 15 MANUAL_MODE (G200) (project, after ISG's StateBahn wait "
+        "flags)", WaitReason,
+    ),
+    ObjectTemplate(
+        "mc_wait_reason_text_r", Scope.CHANNEL, COM, COM_CH, 0x3601,
+        STRING(WAIT_REASON_TEXT_CHARS), R, "-",
+        "Why the channel stands, as a sentence; empty when it does not (project)",
     ),
     ObjectTemplate(
         "mc_error_count_r", Scope.CHANNEL, COM, COM_CH, 0x3020, UNS32, R, "-",

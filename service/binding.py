@@ -19,6 +19,7 @@ from cnc_objects.objects.catalog_tools import build_tool_objects
 from cnc_objects.objects.directory import ObjectDirectory
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.wait_reasons import wait_reason_text
 
 from . import __version__
 from .binding_alarms import ALARM_WRITERS, alarm_readers
@@ -277,6 +278,12 @@ def _syn_chk(name: str) -> Callable[[Kernel, CncObject], Getter]:
     return bind
 
 
+def _wait_reason_text(kernel: Kernel, obj: CncObject) -> Getter:
+    """``ch<c>.mc_wait_reason_text_r``: the sentence of the channel's wait reason."""
+    ci = kernel.channel_index(obj.channel)
+    return lambda: wait_reason_text(kernel.snapshot.channels[ci].wait_reason)
+
+
 def _decoder_flag(flag: DecoderFlag) -> Callable[[Kernel, CncObject], Getter]:
     """``pMC[i].StateDecoder_Data.X_...``: one display flag of the decoder."""
 
@@ -346,6 +353,8 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "mc_active_feedrate_r": _scaled("path_velocity_mm_s", 1e3),
     "program_time": _channel("program_time_s"),
     "mc_waiting_for_start_r": _channel("waiting_for_start"),
+    "mc_wait_reason_r": _channel("wait_reason"),
+    "mc_wait_reason_text_r": _wait_reason_text,
     "mc_manual_blocks_done_r": _channel("manual_blocks_done"),
     "mc_error_count_r": _channel("error_count"),
     "position_offset": _channel_axis("position_offset_incr"),

@@ -8,6 +8,7 @@ from typing import Any
 from rich.text import Text
 from textual.widgets import Static
 
+from cnc_objects.clients.channel_ops import describe_wait_reason
 from cnc_objects.clients.client import AsyncClient
 
 from . import text
@@ -24,6 +25,7 @@ COLUMNS: tuple[tuple[str, str, int], ...] = (
     ("block", "block", 20),
     ("override", "override", 8),
     ("single", "single", 6),
+    ("waits", "waits for", 16),  # the wait reason (mc_wait_reason_r), "-" when none
     ("output", "output", 9),
     ("errors", "errors", 6),
     ("spindle", "spindle", 4),
@@ -33,9 +35,16 @@ SPINDLE_MODES = {1: "M5", 2: "M3", 4: "M4", 8: "M19"}  # mc_spindle_mode_r
 MDEG_S_PER_RPM = 6000.0  # mc_spindle_active_rev_r is in 0.001 degrees/s
 
 
+def wait_reason(value: int) -> str:
+    """The wait reason's name in lower case ("feed hold"), "-" when the channel does not
+    wait."""
+    name, _ = describe_wait_reason(value)
+    return "-" if value == 0 else name.lower().replace("_", " ")
+
+
 class ChannelTable(FixedColumnsTable):
-    """Mode, state, program, block, override, single block, axis output, error count and
-    spindle (mode, actual rpm) of every channel. The cursor row is the current channel,
+    """Mode, state, program, block, override, single block, wait reason, axis output,
+    error count and spindle (mode, actual rpm) of every channel. The cursor row is the current channel,
     the one the keys act on."""
 
     DEFAULT_CSS = "ChannelTable { height: auto; max-height: 12; }"
@@ -66,6 +75,7 @@ class ChannelTable(FixedColumnsTable):
                 Feed(ch.obj("mc_active_line_r"), self._block_part(ch.key, "line")),
                 Feed(ch.obj("mc_active_feed_override_r"), cell("override", text.percent)),
                 Feed(ch.obj("mc_active_single_block_r"), cell("single", text.on_off)),
+                Feed(ch.obj("mc_wait_reason_r"), cell("waits", wait_reason)),
                 Feed(ch.suspend("state_r"),
                      cell("output", lambda v: "suspended" if v else "active")),
                 Feed(ch.obj("mc_error_count_r"), cell("errors", str)),

@@ -19,6 +19,8 @@ DEFAULT_OBJECTS: tuple[str, ...] = (
     "ch*.actual_block_number",  # N of the block in the interpolator
     "ch*.mc_active_file_name_r",  # file and line of that block
     "ch*.mc_active_line_r",
+    "ch*.mc_wait_reason_r",  # why the channel stands: 0 NONE, 1 SINGLE_BLOCK, .. (name)
+    "ch*.mc_wait_reason_text_r",  # the same as a sentence
     "ch*.ax*.command_position_acs",  # channel axes, 0.1 um
     "ax*.actual_position_acs",  # physical axes (drives), 0.1 um
     "ch*.ax*.link_state",  # 0 linked, 1 requested, 2 waiting for ack

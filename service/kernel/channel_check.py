@@ -14,6 +14,7 @@ from .nc import ModalState
 from .program_run import RunHost, Step
 from .state import Channel, DecoderFlag, ErrorEntry
 from .syntax_check import CHECK_STOPPED_WARNING, CheckRun, Pause
+from .wait_reason import WaitReason
 
 
 class ChannelCheck:
@@ -48,6 +49,11 @@ class ChannelCheck:
         """RESET: end the check (its thread stops soon after)."""
         self.check.cancel()
         return None
+
+    def wait_reason(self) -> int:
+        """A check waits for no machine function; its pauses are the channel's HOLD
+        (``wait_reason.channel_wait_reason``)."""
+        return WaitReason.NONE
 
     def cycle(self, time_s: float) -> Step:
         """One GEO cycle: show where the decoder is."""

@@ -64,9 +64,12 @@ from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
 from .tooling import seed_modal, tables_from_config, tooling_of
 from .tooling_view import after_reset, initial_tooling
+from .wait_reason import WaitReason, channel_wait_reason
 
 log = logging.getLogger(__name__)
 
+_ACTIVE = int(ChannelState.ACTIVE)
+_NOT_WAITING = int(WaitReason.NONE)
 MAX_ERRORS_KEPT = 8  # the error list keeps the first errors of a run (the first is the cause)
 _FEED_MARGIN_BLOCKS = 256  # the decoder may run this far ahead of the look-ahead buffer
 _MDI_NAME = "MDI"  # file name of manual blocks in errors and objects
@@ -136,6 +139,7 @@ class ChannelRunner:
         # the contour look-ahead log of the last program run (the PLC reads it after)
         self._contour: ContourLog | None = None
         self._internal_hold = False  # feedhold of a suspend_axis_output request
+        self._waits_for_axes = False  # the last cycle's run (or start) waited for its axes
         self._modal: ModalState | None = None  # MDI: modal state carried between blocks
         self.time_s = 0.0  # kernel time of the cycle (PROD_TIME: the simulated time)
         # set by the kernel when a RESET of this channel is queued: a cycle waiting for
@@ -577,11 +581,26 @@ class ChannelRunner:
         if show_technology(self.channel, self.plc, time_s, self._cycle_s):
             self.touched = True
             busy = True
+        reason = self._wait_reason()
+        if reason != self.channel.wait_reason:
+            self.channel.wait_reason = reason
+            self.touched = True
         return busy
+
+    def _wait_reason(self) -> int:
+        """Why the channel stands after this cycle (``wait_reason``); the running
+        channel's case first, kept short (it is every cycle's)."""
+        ch, run = self.channel, self._run
+        if ch.state == _ACTIVE and not (self._waits_for_axes or self._internal_hold):
+            return _NOT_WAITING if run is None else run.wait_reason()
+        return channel_wait_reason(
+            ch, _NOT_WAITING if run is None else run.wait_reason(),
+            axes_missing=self._waits_for_axes, internal_hold=self._internal_hold)
 
     def _run_cycle(self, time_s: float) -> bool:
         self.time_s = time_s
         ch = self.channel
+        self._waits_for_axes = False
         if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
             self.touched = False
             return False
@@ -591,6 +610,7 @@ class ChannelRunner:
         run = self._run
         if not self.axes_ready and not isinstance(run, ChannelCheck):
             # suspended, or a link waits
+            self._waits_for_axes = True
             if isinstance(run, ProdTimeRun) and self._pending_start is None:
                 run.wait_for_link()  # a real run's time runs on while a link waits
             self.touched = False

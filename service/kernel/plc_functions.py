@@ -201,6 +201,16 @@ class PlcFunctions:
         self.unit = replace(self.unit, units=units[:index] + (done,) + units[index + 1:])
         return None
 
+    @property
+    def waits_for_spindle(self) -> bool:
+        """A spindle function of the last output waits for the spindle (not there yet)."""
+        return self._spindle_waits and not self.spindle.reached
+
+    @property
+    def waits_for_plc(self) -> bool:
+        """An output function waits for the PLC's acknowledge."""
+        return any(u.pending for u in self.unit.units)
+
     def all_acknowledged(self) -> bool:
         """Nothing the path must wait for: every unit acknowledged, the spindle there."""
         if self._spindle_waits and not self.spindle.reached:

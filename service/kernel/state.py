@@ -200,6 +200,7 @@ class Channel:
     spindle: SpindleState = field(default_factory=SpindleState)
     manual: tuple[Any, ...] = ()  # ManualAxisView per axis (manual_mode.ManualMode sets)
     tooling: ChannelTooling = field(default_factory=ChannelTooling)  # T, D, zero offsets
+    wait_reason: int = 0  # WaitReason: why the channel stands (kernel.wait_reason)
 
     @property
     def execution_mode_commanded(self) -> int:
@@ -230,7 +231,7 @@ class Channel:
             self.contour, self.execution_mode_plc_command, self.execution_mode_plc_enable,
             self.syn_chk, self.decoder_flags, self.messages, self.message_count,
             self.machining, self.prod_time_trace, self.plc_functions, self.spindle, self.manual,
-            self.tooling,
+            self.tooling, self.wait_reason,
         )
 
 

@@ -64,7 +64,7 @@ async def test_publishes_every_object_then_online_and_offline_on_stop(
             values = values_of(watcher, until=before_online)
             # Every selected object's value went out before "online".
             assert set(values) == {info.name for info in bridge.source.selected}
-            assert len(values) == 125  # the default set on the default machine (docs/mqtt.md)
+            assert len(values) == 129  # the default set on the default machine (docs/mqtt.md)
             assert {"ch1.mc_active_state_r", "ch2.mc_active_mode_r", "ax3.actual_position_acs",
                     "ch1.ax1.link_state", "ch2.mc_error_8_warning_r",
                     "ch1.actual_block_number"} <= set(values)
@@ -202,7 +202,7 @@ async def test_broker_restart_republishes_current_values(endpoint: str, broker: 
             await watcher.wait_for("cnc/m1/status", ONLINE)
             value = json.loads((await watcher.wait_for("cnc/m1/ch2.ax3.command_position_acs")).payload)
             assert value["seq"] >= 2  # published again: the new broker had nothing
-            assert len(values_of(watcher)) == 125
+            assert len(values_of(watcher)) == 129
         assert bridge.broker_connections >= 2
 
 

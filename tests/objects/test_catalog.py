@@ -35,6 +35,7 @@ from cnc_objects.protocol.values import (
     LinkState,
     ManualOperationMode,
 )
+from cnc_objects.protocol.wait_reasons import WaitReason
 
 PLC = CncPort.PLC
 
@@ -281,6 +282,7 @@ ENUMERATIONS = {
     "block_type": ContourBlockType,
     "operation_mode": ManualOperationMode,  # hb_display_r.operation_mode
     "manual_operation_mode_w": ManualOperationMode,
+    "mc_wait_reason_r": WaitReason,
 }
 
 

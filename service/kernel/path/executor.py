@@ -216,6 +216,24 @@ class PathExecutor:
         return self._ipo.waiting
 
     @property
+    def waiting_at(self) -> Block | None:
+        """The block the path dwells or waits at (None while it waits for nothing)."""
+        return self._ipo.wait_block
+
+    @property
+    def running(self) -> bool:
+        """Waiting for nothing at a block end, with a segment or block end still to run
+        (``waiting`` NONE and ``has_motion``, in one look: asked every cycle)."""
+        ipo = self._ipo
+        return not ipo.waiting and (ipo.seg is not None or bool(ipo.events))
+
+    @property
+    def has_motion(self) -> bool:
+        """A segment or a block end is still to run: the path is not empty."""
+        ipo = self._ipo
+        return ipo.seg is not None or bool(ipo.events)
+
+    @property
     def override(self) -> float:
         """Feed override factor of the last cycle."""
         return self._ipo.override

@@ -14,6 +14,7 @@ from typing import Any
 import pytest
 
 from cnc_objects.protocol.values import ChannelState, ManualOperationMode
+from cnc_objects.protocol.wait_reasons import WaitReason
 from cnc_objects.service.kernel.commands import Feedhold, RefusalReason, StartProgram
 from cnc_objects.service.kernel.manual_commands import ManualAxisCommand
 from cnc_objects.service.kernel.manual_view import DisplayState
@@ -57,6 +58,7 @@ def test_g200_stops_the_program_jogs_the_axis_and_start_goes_on_with_the_offset(
     k.start("G01 X1 Y0 F600\nG200 X1\nG01 X4 Y1\nM30\n")
     stopped = k.wait_for(lambda s: s.channels[0].waiting_for_start)
     assert (_x(stopped), _view(stopped).state) == (1.0, DisplayState.ENABLED)
+    assert stopped.channels[0].wait_reason == WaitReason.MANUAL_MODE
     assert _view(stopped, 1).state == DisplayState.DEACTIVATED  # Y was not named
     _incremental(k)
     assert write(k, "jog_plus", True) is None
