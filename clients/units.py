@@ -112,8 +112,12 @@ def parse_engineering(info: ObjectInfo, text: str) -> int | float:
     try:
         info.dtype.encode(raw)  # the range, told in both units: the user gave the first
     except (TypeError, ValueError) as exc:
+        dtype = info.dtype
+        reason = (f"value {raw} out of range for {dtype.name} ({dtype.minimum}..{dtype.maximum})"
+                  if dtype.kind == "int" else str(exc))  # as the client says it for raw
         unit = info.scale.unit if info.scale is not None else info.unit
-        raise ClientValueError(f"{info.name}: {text} {unit} = {raw} ({info.unit}): {exc}") from None
+        raise ClientValueError(f"{info.name}: {text} {unit} = {raw} ({info.unit}): "
+                               f"{reason}") from None
     return raw
 
 
