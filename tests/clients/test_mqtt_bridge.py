@@ -227,7 +227,7 @@ async def test_service_restart_resubscribes(broker: Broker) -> None:
             async with AsyncClient(endpoint) as client:
                 await client.wait_mdi(await client.mdi("G01 Y5 F6000"), timeout_s=10)
             moved = await watcher.wait_value("cnc/m1/ch1.ax2.command_position_acs",
-                                              lambda v: v == 50000, since=mark)
+                                              lambda v: v == 5.0, since=mark)  # mm
             assert moved["seq"] >= 3  # first session's value, the republish, the move
         finally:
             assert second.stop() == 0
