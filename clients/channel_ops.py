@@ -47,6 +47,7 @@ from cnc_objects.protocol.wait_reasons import WaitReason, wait_reason_text
 from .client_core import MixinBase
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError
 from .execution_mode import describe_execution_mode
+from .units import engineering
 
 POLL_S = 0.01  # how often waiting re-reads the channel state (wall time)
 
@@ -380,7 +381,9 @@ class ChannelOps(ProgramOps):
         values = await self.read_many([*names, *axis_names, *(o.name for o in axes)])
         v: list[Any] = [values[n] for n in names]
         positions = {
-            values[an]: values[o.name] / 10_000 for an, o in zip(axis_names, axes, strict=True)
+            # 0.1 um -> mm by the scale the service gives, rounded to 0.1 um: no float noise
+            values[an]: engineering(o, values[o.name])
+            for an, o in zip(axis_names, axes, strict=True)
         }
         return ChannelStatus(
             channel, MODES.get(v[0], str(v[0])), STATES.get(v[1], str(v[1])), v[2], v[3], v[4],

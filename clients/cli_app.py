@@ -25,6 +25,7 @@ from rich.console import Console
 from .blocking import Client
 from .client import AsyncClient
 from .errors import AdsError, AdsTimeoutError, AuthenticationError, ClientValueError, NoReplyError
+from .units import tidy
 
 T = TypeVar("T")
 
@@ -115,8 +116,10 @@ def fail(exc: Exception) -> NoReturn:
 
 
 def emit(settings: Settings, record: dict[str, Any], human: str) -> None:
-    """Print one result: ``record`` as a JSON line with ``--json``, else ``human``."""
+    """Print one result: ``record`` as a JSON line with ``--json``, else ``human``. Floats
+    are rounded to the resolution their key's unit names (``positions_mm``), others lose
+    their float noise (clients/units.py)."""
     if settings.as_json:
-        out.print(json.dumps(record, default=str), markup=False, emoji=False)
+        out.print(json.dumps(tidy(record), default=str), markup=False, emoji=False)
     else:
         out.print(human, markup=False, emoji=False)

@@ -8,7 +8,7 @@
     cnc resume [--channel N] [--wait] [--timeout S]
     cnc reset [--channel N] [--standard]
     cnc status [--channel N]
-    cnc lookahead [START] [--length L] [--index I]
+    cnc lookahead [START] [--length MM] [--index I] [--raw]
     cnc check FILE|NAME [--channel N] [--errors-total K] [--log] [--timeout S]
 
 ``--wait`` exits 0 when the program (or manual block) has finished, 4 with the channel's
@@ -44,11 +44,13 @@ from .channel_ops import (
     ChannelStatus,
     CheckError,
     CheckResult,
+    ContourReply,
     OnWaitReason,
     ProgramEntry,
 )
 from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
+from .units import tidy
 
 EXIT_CHANNEL_ERROR = 4
 EXIT_WAIT_TIMEOUT = 5
@@ -375,28 +377,45 @@ def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
 def lookahead(
     ctx: typer.Context,
     start: float = typer.Argument(
-        0.0, help="Mode 1: index in the marked area; mode 2: path distance in 0.1 um."),
+        0.0, help="Mode 1: index in the marked area; mode 2: path distance in mm."),
     length: float = typer.Option(
         0.0, "--length", "-l", min=0.0,
-        help="0: mode 1 (by index); else mode 2: window length in 0.1 um."),
+        help="0: mode 1 (by index); else mode 2: window length in mm."),
     index: int = typer.Option(
         0, "--index", "-i", min=0, help="PLC channel index gpCh[i] (channel position from 0)."),
+    raw: bool = typer.Option(
+        False, "--raw", help="Mode 2: START and --length in the objects' own 0.1 um."),
 ) -> None:
-    """Contour look-ahead (FCT-C40): the contour elements ahead, as the PLC gets them."""
+    """Contour look-ahead (FCT-C40): the contour elements ahead, as the PLC gets them.
+
+    Mode 2 takes START and --length in mm (--raw: in 0.1 um, as the request objects
+    hold them); the table shows mm and degrees. --json gives the reply's fields as the
+    PLC reads them (distances in 0.1 um, angles in rad).
+    """
     settings: Settings = ctx.obj
-    reply = settings.call(lambda c: c.contour_lookahead(start, length, plc_channel=index),
-                          f"contour look-ahead of gpCh[{index}]")
+    unit = f"gpCh[{index}].contour_lookahead"
+
+    def ask(c: Client) -> tuple[ContourReply, float]:
+        # the factor of 0.1 um to mm, as the service describes the request's length
+        scale = c.describe(f"{unit}.request.length").scale
+        mm_per_raw = 1.0 if scale is None else scale.factor
+        if length == 0.0 or raw:
+            return c.contour_lookahead(start, length, plc_channel=index), mm_per_raw
+        return c.contour_lookahead(start / mm_per_raw, length / mm_per_raw,
+                                   plc_channel=index), mm_per_raw
+
+    reply, mm_per_raw = settings.call(ask, f"contour look-ahead of gpCh[{index}]")
     if settings.as_json:
-        out.print(json.dumps({
+        out.print(json.dumps(tidy({
             "max_dist_prog_start": reply.max_dist_prog_start,
             "count_logged_blocks": reply.count_logged_blocks,
             "f_log_is_active": reply.log_active,
             "blocks": [asdict(b) for b in reply.blocks],
-        }))
+        })))
         return
     out.print(f"gpCh[{index}]: {reply.count_logged_blocks} logged, log active "
               f"{'TRUE' if reply.log_active else 'FALSE'}, max_dist_prog_start "
-              f"{reply.max_dist_prog_start / 10_000:.4f} mm")
+              f"{reply.max_dist_prog_start * mm_per_raw:.4f} mm")
     # plain fixed-width lines: never truncated, whatever the terminal width
     out.print(f"{'k':>3} {'type':<10} {'N':>5} {'count':>5} {'start mm':>10} "
               f"{'length mm':>10} {'R prog mm':>9} {'R comp mm':>9} {'angle deg':>9} "
@@ -405,12 +424,13 @@ def lookahead(
     for k, b in enumerate(reply.blocks, start=first):
         motion = b.block_type in (1, 2, 6)
         kind = CONTOUR_BLOCK_TYPES.get(b.block_type, str(b.block_type))
-        size = f"{b.length / 10_000:.4f}" if motion else f"PARAM {b.length:g}"
+        size = f"{b.length * mm_per_raw:.4f}" if motion else f"PARAM {b.length:g}"
         number = str(b.block_number) if b.block_number >= 0 else "-"
         out.print(
             f"{k:>3} {kind:<10} "
-            f"{number:>5} {b.block_count_r:>5} {b.start_position / 10_000:>10.4f} {size:>10} "
-            f"{b.programmed_radius / 10_000:>9.4f} {b.compensated_radius / 10_000:>9.4f} "
+            f"{number:>5} {b.block_count_r:>5} {b.start_position * mm_per_raw:>10.4f} "
+            f"{size:>10} {b.programmed_radius * mm_per_raw:>9.4f} "
+            f"{b.compensated_radius * mm_per_raw:>9.4f} "
             f"{math.degrees(b.circle_angle):>9.3f} {math.degrees(b.tangent_variation):>8.3f}"
         )
 

@@ -24,6 +24,7 @@ import typer
 from .blocking import Client
 from .cli_app import EXIT_USAGE, Settings, command, emit, err, fail, say_error
 from .errors import AdsError, ClientValueError
+from .units import engineering, raw_value
 
 EXIT_WAIT_TIMEOUT = 5
 _MANUAL = 4  # ChannelMode.MANUAL
@@ -72,7 +73,8 @@ def _report(settings: Settings, c: Client, channel: int, axis: int, name: str) -
     prefix = f"ch{channel}.ax{axis}"
     values = c.read_many([f"{prefix}.command_position_acs", f"{prefix}.manual_limit_warning_r",
                           f"{prefix}.manual_moving_r", f"{prefix}.homing_referenced_r"])
-    position_mm = values[f"{prefix}.command_position_acs"] / 10_000
+    position = f"{prefix}.command_position_acs"
+    position_mm = engineering(c.describe(position), values[position])  # 0.1 um -> mm
     at_limit = values[f"{prefix}.manual_limit_warning_r"]
     if at_limit:
         err.print(f"warning: axis {name} stopped at its software limit", markup=False,
@@ -139,8 +141,9 @@ def jog(
                     no_wait = True  # it moves until --stop or the software limit
                 else:
                     c.write(f"{prefix}.manual_operation_mode_w", _INCREMENTAL)
-                    c.write(f"{prefix}.manual_increment_w",
-                            round((1.0 if increment_mm is None else increment_mm) * 10_000))
+                    increment = f"{prefix}.manual_increment_w"  # 0.1 um; the scale says
+                    c.write(increment, raw_value(c.describe(increment),
+                                                 1.0 if increment_mm is None else increment_mm))
                     c.write(key, True)
                     c.write(key, False)
             if not no_wait:

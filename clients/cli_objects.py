@@ -1,14 +1,18 @@
 """``cnc`` commands on objects: info, browse, read, write, watch.
 
     cnc info                             cnc browse [PATTERN]
-    cnc read NAME... | --port P --group G --offset O --type T
-    cnc write NAME VALUE | VALUE --port P --group G --offset O --type T
-    cnc watch NAME... [--count N] [--timeout S] [--cyclic] [--cycle-ms MS]
+    cnc read NAME... [--raw] | --port P --group G --offset O --type T
+    cnc write NAME VALUE [--raw] | VALUE --port P --group G --offset O --type T
+    cnc watch NAME... [--raw] [--count N] [--timeout S] [--cyclic] [--cycle-ms MS]
 
-A value is printed with its unit or the name of an enumeration value in parentheses
-(``ch1.mc_active_feed_override_r = 500 (0.1 %)``, ``ch1.mc_active_state_r = 3 (READY)``);
-``--json`` keeps the raw value and adds ``"unit"`` (and ``"value_name"`` for a named
-value). Negative values need no ``--``: ``cnc write ch1.x -1``. A misspelt name fails with
+A value is printed in engineering units, as the service's scale of the object says
+(``ch1.mc_active_feed_override_r = 50.0 %``, ``ch1.ax1.command_position_acs = 12.5000
+mm``), an enumeration value with its name (``ch1.mc_active_state_r = 3 (READY)``);
+``--raw`` prints the object's own value and unit (``500 (0.1 %)``). ``--json`` gives
+``"value"`` and ``"unit"`` in engineering units and ``"raw"``, ``"raw_unit"`` beside them
+(``"value_name"`` for a named value). ``write`` takes the value in the same engineering
+unit (``cnc write ch1.mc_command_feed_override_w 75`` is 75 %), ``--raw`` the object's
+own. Negative values need no ``--``: ``cnc write ch1.x -1``. A misspelt name fails with
 ADS 0x710 and the nearest names (``did you mean ...?``).
 """
 
@@ -27,6 +31,7 @@ from .cli_app import EXIT_USAGE, Settings, command, emit, fail, out, say_error
 from .client import AsyncClient
 from .errors import AdsError, ClientValueError, NoReplyError
 from .object_info import ObjectInfo
+from .units import parse_engineering, record, show
 
 EXIT_WATCH_TIMEOUT = 5  # watch --count N --timeout S: a name got fewer than N samples
 
@@ -41,31 +46,9 @@ OffsetOption = Annotated[
 TypeOption = Annotated[
     str | None, typer.Option("--type", help="Data type: UNS16, REAL64, STRING(84), ...")
 ]
-_NO_UNIT = ("", "-")  # the catalog's spellings of "no unit"
 _BROWSE_COLUMNS = ("name", "port", "group", "offset", "type", "access", "unit", "description")
-
-
-def value_name(info: ObjectInfo, value: Any) -> str | None:
-    """The name of ``value`` when ``info`` is an enumeration (``3`` -> ``READY``)."""
-    names = getattr(info, "enum", None) or {}  # services before value names send none
-    return names.get(value) if isinstance(value, int) else None
-
-
-def show_value(info: ObjectInfo, value: Any) -> str:
-    """``value`` for people: ``3 (READY)``, ``500 (0.1 %)``, or the bare value."""
-    named = value_name(info, value)
-    if named is not None:
-        return f"{value} ({named})"
-    return f"{value} ({info.unit})" if info.unit not in _NO_UNIT else str(value)
-
-
-def value_record(info: ObjectInfo, value: Any) -> dict[str, Any]:
-    """``value`` for ``--json``: raw, with the unit and, for a named value, its name."""
-    record = {"name": info.name, "value": value, "unit": info.unit}
-    named = value_name(info, value)
-    if named is not None:
-        record["value_name"] = named
-    return record
+RawOption = Annotated[bool, typer.Option(
+    "--raw", help="The object's own value and unit (0.1 um, 0.1 %), not mm, mm/min, %.")]
 
 
 def _number(text: str, what: str) -> int:
@@ -162,12 +145,14 @@ def read(
     group: GroupOption = None,
     offset: OffsetOption = None,
     dtype: TypeOption = None,
+    raw: RawOption = False,
 ) -> None:
     """Read objects by name (globs: ch1.mc_*_w), or one value by address.
 
-    A value is shown with its unit or its name in parentheses: 500 (0.1 %), 3 (READY).
-    With --json the value stays raw; "unit" and, for a named value, "value_name" are
-    fields of their own.
+    A value is shown in engineering units (12.5000 mm, 1200.000 mm/min, 50.0 %) or with
+    its name: 3 (READY); --raw shows the object's own value and unit: 500 (0.1 %). With
+    --json "value" and "unit" are in engineering units, "raw" and "raw_unit" the object's
+    own, "value_name" the name of a named value.
     """
     settings: Settings = ctx.obj
     address = _address(port, group, offset, dtype)
@@ -188,7 +173,7 @@ def read(
     except (AdsError, ClientValueError) as exc:
         fail(exc)
     for name, value in values.items():
-        emit(settings, value_record(infos[name], value), f"{name} = {show_value(infos[name], value)}")
+        emit(settings, record(infos[name], value, raw), f"{name} = {show(infos[name], value, raw)}")
 
 
 def _expanded(client: Any, names: list[str]) -> list[str]:
@@ -214,12 +199,16 @@ def write(
     group: GroupOption = None,
     offset: OffsetOption = None,
     dtype: TypeOption = None,
+    raw: Annotated[bool, typer.Option(
+        "--raw", help="VALUE is the object's own (0.1 um, 0.1 %), not mm, mm/min, %.")] = False,
 ) -> None:
     """Write an object by name (NAME VALUE) or a value by address (VALUE).
 
-    Integers in decimal or 0x hex, negative ones as they are (write ch1.x -1); booleans
-    0/1/true/false. A value its type cannot hold is refused before anything is sent
-    (exit 2).
+    An object with an engineering unit takes VALUE in it, as read shows it: mm for
+    positions, mm/min for speeds, % for overrides (write ch1.mc_command_feed_override_w
+    75); --raw takes the object's own value (750, in 0.1 %). Integers in decimal or 0x
+    hex, negative ones as they are (write ch1.x -1); booleans 0/1/true/false. A value its
+    type cannot hold is refused before anything is sent (exit 2).
     """
     settings: Settings = ctx.obj
     address = _address(port, group, offset, dtype)
@@ -240,11 +229,15 @@ def write(
                 info_: ObjectInfo = c.describe(name)
             except NoReplyError as exc:  # describing is a BROWSE; the user asked to write
                 raise exc.asking(f"WRITE {name}") from None
-            value = _parse(info_.dtype, text, info_.name)
+            if raw or info_.scale is None:
+                value = _parse(info_.dtype, text, info_.name)
+            else:
+                value = parse_engineering(info_, text)
             c.write(name, value)
     except (AdsError, ClientValueError) as exc:
         fail(exc)
-    emit(settings, {"name": info_.name, "value": value, "ok": True}, f"{info_.name} := {value}")
+    emit(settings, {**record(info_, value, raw), "ok": True},
+         f"{info_.name} := {show(info_, value, raw)}")
 
 
 @command()
@@ -259,6 +252,7 @@ def watch(
         "an object got fewer than COUNT samples by then."),
     cycle_ms: int = typer.Option(None, "--cycle-ms", min=0, help="Sampling cycle in kernel ms."),
     cyclic: bool = typer.Option(False, help="Send every cycle, not only on change."),
+    raw: RawOption = False,
 ) -> None:
     """Print samples of objects as the service sends them (until Ctrl-C, COUNT, --timeout).
 
@@ -276,10 +270,10 @@ def watch(
             async for s in samples:
                 emit(
                     settings,
-                    {**value_record(info_, s.value), "ts": s.timestamp.isoformat(),
+                    {**record(info_, s.value, raw), "ts": s.timestamp.isoformat(),
                      "seq": s.sequence},
                     f"{s.timestamp.isoformat(timespec='milliseconds')} #{s.sequence} "
-                    f"{s.name} = {show_value(info_, s.value)}",
+                    f"{s.name} = {show(info_, s.value, raw)}",
                 )
                 seen[name] += 1
                 if count and seen[name] >= count:

@@ -14,12 +14,17 @@ import typer
 from .blocking import Client
 from .cli_app import EXIT_USAGE, Settings, command, emit, err
 from .cli_machine import ChannelOption
+from .units import engineering, raw_value
 
-MDEG_S_PER_RPM = 6000.0  # 0.001 degrees/s per rpm
 MODE_NAMES = {1: "M5", 2: "M3", 4: "M4", 8: "M19"}
 SYNC_NAMES = {0: "-", 1: "MOS", 2: "MVS_SVS", 4: "MVS_SNS", 8: "MNS_SNS"}
 TYPE_NAMES = {1: "M", 2: "H", 3: "S", 4: "T"}
 TECHNO_UNITS = 16
+
+
+def _engineering(c: Client, name: str) -> Any:
+    """The value of ``name`` in engineering units (rpm, %)."""
+    return engineering(c.describe(name), c.read(name))
 
 
 def read_spindle(c: Client, channel: int) -> dict[str, Any]:
@@ -37,10 +42,11 @@ def read_spindle(c: Client, channel: int) -> dict[str, Any]:
     return {
         "channel": channel,
         "mode": MODE_NAMES.get(c.read(p + "mode_r"), "?"),
-        "programmed_rpm": c.read(p + "prog_rev_r") / MDEG_S_PER_RPM,
-        "commanded_rpm": c.read(p + "cmd_rev_r") / MDEG_S_PER_RPM,
-        "actual_rpm": c.read(p + "active_rev_r") / MDEG_S_PER_RPM,
-        "override_pct": c.read(p + "override_w") / 10.0,
+        # 0.001 deg/s -> rpm, 0.1 % -> %: by the scale the service gives for each object
+        "programmed_rpm": _engineering(c, p + "prog_rev_r"),
+        "commanded_rpm": _engineering(c, p + "cmd_rev_r"),
+        "actual_rpm": _engineering(c, p + "active_rev_r"),
+        "override_pct": _engineering(c, p + "override_w"),
         "speed_reached": bool(c.read(p + "speed_reached_r")),
         "units": units,
     }
@@ -70,7 +76,8 @@ def spindle(
 
     def act(c: Client) -> dict[str, Any]:
         if override is not None:
-            c.write(f"ch{channel}.mc_spindle_override_w", round(override * 10))
+            target = f"ch{channel}.mc_spindle_override_w"  # 0.1 %; the scale says
+            c.write(target, raw_value(c.describe(target), override))
         block = "M5" if stop else None
         if start is not None:
             block = f"S{start:g} {'M4' if ccw else 'M3'}"

@@ -6,7 +6,8 @@ read and written through their objects (docs/tools-offsets.md).
     cnc offsets show [--channel N]
     cnc offsets set GROUP AXIS=MM [AXIS=MM ...] [--channel N]
 
-Lengths are given and shown in mm; the objects carry 0.1 um. ``GROUP`` is G54..G59, or
+Lengths are given and shown in mm; the objects carry 0.1 um, converted by the scale the
+service gives for each object (clients/units.py). ``GROUP`` is G54..G59, or
 the index of ``np_grp`` (1..n-1; 7.. are the groups of ``G159 = i``). A value the
 service refuses (a negative radius, an offset beyond the position range) ends the
 command with exit 1 and the service's sentence.
@@ -23,8 +24,8 @@ import typer
 from .blocking import Client
 from .cli_app import Settings, app, emit
 from .errors import ClientValueError
+from .units import engineering, raw_value
 
-INCR_PER_MM = 10_000
 ChannelOption = typer.Option(1, "--channel", "-c", min=1, help="Channel id (default 1).")
 
 tool_app = typer.Typer(no_args_is_help=True, help="The tool list wz[i] and the active tool.")
@@ -76,7 +77,13 @@ def active_tool(c: Client, channel: int) -> ActiveTool:
         "mc_active_tool_radius_r", "mc_active_tool_length_r")]
     v = c.read_many(names)
     return ActiveTool(v[names[0]], v[names[1]], v[names[2]],
-                      v[names[3]] / INCR_PER_MM, v[names[4]] / INCR_PER_MM)
+                      in_mm(c, names[3], v[names[3]]), in_mm(c, names[4], v[names[4]]))
+
+
+def in_mm(c: Client, name: str, raw: float) -> float:
+    """The value ``raw`` of the object ``name`` (0.1 um) in mm, by the object's scale."""
+    value: float = engineering(c.describe(name), raw)
+    return value
 
 
 def _mm(value: float) -> str:
@@ -98,8 +105,10 @@ def tool_show(
                  for f in ("valid", "radius", "laenge")]
         v = c.read_many(names)
         rows = [{"channel": channel, "wz": i, "valid": v[f"ch{channel}.wz[{i}].valid"],
-                 "radius_mm": v[f"ch{channel}.wz[{i}].radius"] / INCR_PER_MM,
-                 "length_mm": v[f"ch{channel}.wz[{i}].laenge"] / INCR_PER_MM}
+                 "radius_mm": in_mm(c, f"ch{channel}.wz[{i}].radius",
+                                    v[f"ch{channel}.wz[{i}].radius"]),
+                 "length_mm": in_mm(c, f"ch{channel}.wz[{i}].laenge",
+                                    v[f"ch{channel}.wz[{i}].laenge"])}
                 for i in range(1, size + 1)]
         return active_tool(c, channel), rows
 
@@ -129,18 +138,18 @@ def tool_set(
     """Write a row of the tool list: radius and length, and the row valid (or empty it
     with --invalid)."""
     settings: Settings = ctx.obj
-    writes: list[tuple[str, Any]] = []
+    lengths_mm: list[tuple[str, float]] = []  # (object in 0.1 um, value in mm)
     if radius_mm is not None:
-        writes.append((f"ch{channel}.wz[{d}].radius", radius_mm * INCR_PER_MM))
+        lengths_mm.append((f"ch{channel}.wz[{d}].radius", radius_mm))
     if length_mm is not None:
-        writes.append((f"ch{channel}.wz[{d}].laenge", length_mm * INCR_PER_MM))
-    if not writes and not invalid:
+        lengths_mm.append((f"ch{channel}.wz[{d}].laenge", length_mm))
+    if not lengths_mm and not invalid:
         raise typer.BadParameter("give --radius, --length or --invalid")
-    writes.append((f"ch{channel}.wz[{d}].valid", not invalid))
 
     def write(c: Client) -> None:
-        for name, value in writes:
-            c.write(name, value)
+        for name, value_mm in lengths_mm:
+            c.write(name, raw_value(c.describe(name), value_mm))
+        c.write(f"ch{channel}.wz[{d}].valid", not invalid)
 
     settings.call(write, f"tool list row wz[{d}] of channel {channel}")
     emit(settings, {"channel": channel, "wz": d, "ok": True},
@@ -152,7 +161,7 @@ def offsets_show(ctx: typer.Context, channel: int = ChannelOption) -> None:
     """The active zero offset, the table, and the positions in ACS and PCS."""
     settings: Settings = ctx.obj
 
-    def read(c: Client) -> tuple[int, int, list[str], dict[str, Any]]:
+    def read(c: Client) -> tuple[int, int, list[str], dict[str, Any], float]:
         groups = c.read(f"ch{channel}.mc_zero_offset_groups_r")
         active = c.read(f"ch{channel}.mc_active_zero_offset_r")
         axes = axis_names(c, channel)
@@ -160,10 +169,12 @@ def offsets_show(ctx: typer.Context, channel: int = ChannelOption) -> None:
                  for a in range(1, len(axes) + 1)]
         names += [f"ch{channel}.ax{a}.command_position_{cs}" for a in range(1, len(axes) + 1)
                   for cs in ("acs", "pcs")]
-        return groups, active, axes, c.read_many(names)
+        # positions and offsets are in 0.1 um alike: the scale of one converts them all
+        scale = c.describe(f"ch{channel}.ax1.command_position_acs").scale
+        return groups, active, axes, c.read_many(names), 1.0 if scale is None else scale.factor
 
-    groups, active, axes, v = settings.call(read, f"zero offsets of channel {channel}")
-    positions = {name: {cs: v[f"ch{channel}.ax{a}.command_position_{cs}"] / INCR_PER_MM
+    groups, active, axes, v, mm_per_raw = settings.call(read, f"zero offsets of channel {channel}")
+    positions = {name: {cs: v[f"ch{channel}.ax{a}.command_position_{cs}"] * mm_per_raw
                         for cs in ("acs", "pcs")}
                  for a, name in enumerate(axes, start=1)}
     emit(settings, {"channel": channel, "active_group": active,
@@ -172,7 +183,7 @@ def offsets_show(ctx: typer.Context, channel: int = ChannelOption) -> None:
          + ", ".join(f"{n} ACS {_mm(p['acs'])} PCS {_mm(p['pcs'])}"
                      for n, p in positions.items()))
     for g in range(1, groups):
-        offsets = {name: v[f"ch{channel}.ax{a}.np_grp[{g}].v"] / INCR_PER_MM
+        offsets = {name: v[f"ch{channel}.ax{a}.np_grp[{g}].v"] * mm_per_raw
                    for a, name in enumerate(axes, start=1)}
         mark = "*" if g == active else " "
         emit(settings, {"channel": channel, "group": g, "name": group_name(g),
@@ -203,7 +214,8 @@ def offsets_set(
                 raise ClientValueError(f"{letter}: channel {channel} has the axes "
                                        f"{', '.join(axes)}")
             a = axes.index(letter) + 1
-            c.write(f"ch{channel}.ax{a}.np_grp[{index}].v", float(m.group(2)) * INCR_PER_MM)
+            target = f"ch{channel}.ax{a}.np_grp[{index}].v"
+            c.write(target, raw_value(c.describe(target), float(m.group(2))))
 
     settings.call(write, f"zero offset {group} of channel {channel}")
     emit(settings, {"channel": channel, "group": group, "ok": True},

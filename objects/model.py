@@ -9,6 +9,8 @@ from typing import Any
 from cnc_objects.protocol.datatypes import DataType
 from cnc_objects.protocol.values import value_names
 
+from .units import EngineeringScale, scale_of
+
 
 class Access(str, Enum):  # noqa: UP042  (str() of a member must stay "Access.X", as before)
     """Who may do what with an object, in the ISG tables' spelling."""
@@ -64,11 +66,20 @@ class CncObject:
         """``{3: "READY", ...}`` for an enumeration object; empty for any other."""
         return value_names(self.values) if self.values is not None else {}
 
+    @property
+    def scale(self) -> EngineeringScale | None:
+        """How people read the value (0.1 um -> mm); None for an object without a unit
+        or an enumeration."""
+        return None if self.values is not None else scale_of(self.unit)
+
     def describe(self) -> list[Any]:
         """The browse descriptor: [name, port, group, offset, type, length, access, unit,
-        description, value names]. The value names are ``[[value, name], ...]`` (empty
-        for an object that is not an enumeration): pairs, because msgpack maps with
-        integer keys are refused by the frame decoder (string keys only)."""
+        description, value names, engineering scale]. The value names are ``[[value,
+        name], ...]`` (empty for an object that is not an enumeration): pairs, because
+        msgpack maps with integer keys are refused by the frame decoder (string keys
+        only). The scale is ``[unit, factor, decimals]`` (objects/units.py), empty for an
+        object without one."""
+        scale = self.scale
         return [
             self.name,
             self.port,
@@ -80,4 +91,5 @@ class CncObject:
             self.unit,
             self.description,
             [[value, name] for value, name in self.value_names.items()],
+            scale.describe() if scale is not None else [],
         ]

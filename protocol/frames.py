@@ -23,7 +23,10 @@ A descriptor is ``[name, port, group, offset, type, length, access, unit, descri
 values]``; ``values`` names the numbers of an enumeration object as ``[[value, name],
 ...]`` (``[[1, "DESELECTED"], [2, "SELECTED"], ...]``) and is ``[]`` for every other
 object (pairs, not a map: frames allow string map keys only). Services before the value
-names sent the first nine fields; a reader takes a missing tenth as ``[]``.
+names sent the first nine fields; a reader takes a missing tenth as ``[]``. An eleventh,
+``scale``, is ``[unit, factor, decimals]``: how people read the value (``["mm", 0.0001,
+4]`` for 0.1 um: value in mm = raw x factor, resolution 4 decimals), ``[]`` for an object
+without one (objects/units.py); a reader takes a missing eleventh as ``[]``.
 The ``message`` of an error reply is a project extension: a sentence that says why, next
 to the ADS code. Notification timestamps are Windows FILETIME (100 ns since 1601-01-01),
 as in ADS: the wall-clock time at which the kernel cycle that produced the value ended.

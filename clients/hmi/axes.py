@@ -50,17 +50,19 @@ class AxesTable(FixedColumnsTable):
         feeds: list[Feed] = []
         for axis in axes:
             feeds += [
-                Feed(axis.obj("command_position_acs"), self._cells([axis], "command", text.mm),
-                     POSITION_CYCLE_MS),
-                Feed(axis.obj("position_offset"), self._cells([axis], "offset", text.mm),
-                     POSITION_CYCLE_MS),
+                Feed(axis.obj("command_position_acs"),
+                     self._cells([axis], "command", text.mm_shown), POSITION_CYCLE_MS,
+                     engineering=True),
+                Feed(axis.obj("position_offset"), self._cells([axis], "offset", text.mm_shown),
+                     POSITION_CYCLE_MS, engineering=True),
                 Feed(axis.obj("link_state"), self._link_part(axis, 0)),
                 Feed(axis.obj("actual_link_to_physical_axis"), self._link_part(axis, 1)),
             ]
         for drive in machine.drives:  # a drive's actual position fills each axis linked to it
             linked = [a for a in axes if a.drive == drive]
             feeds.append(Feed(f"ax{drive}.actual_position_acs",
-                              self._cells(linked, "actual", text.mm), POSITION_CYCLE_MS))
+                              self._cells(linked, "actual", text.mm_shown), POSITION_CYCLE_MS,
+                              engineering=True))
         return feeds
 
 

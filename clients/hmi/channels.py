@@ -24,6 +24,7 @@ COLUMNS: tuple[tuple[str, str, int], ...] = (
     ("program", "program", 16),
     ("block", "block", 20),
     ("override", "override", 8),
+    ("feed", "mm/min", 7),
     ("single", "single", 6),
     ("waits", "waits for", 16),  # the wait reason (mc_wait_reason_r), "-" when none
     ("output", "output", 9),
@@ -33,6 +34,7 @@ COLUMNS: tuple[tuple[str, str, int], ...] = (
 )
 SPINDLE_MODES = {1: "M5", 2: "M3", 4: "M4", 8: "M19"}  # mc_spindle_mode_r
 MDEG_S_PER_RPM = 6000.0  # mc_spindle_active_rev_r is in 0.001 degrees/s
+SPEED_CYCLE_MS = 100  # the path speed is checked for a change every 100 ms of kernel time
 
 
 def wait_reason(value: int) -> str:
@@ -73,7 +75,10 @@ class ChannelTable(FixedColumnsTable):
                 Feed(ch.obj("actual_block_number"), self._block_part(ch.key, "number")),
                 Feed(ch.obj("mc_active_file_name_r"), self._block_part(ch.key, "file")),
                 Feed(ch.obj("mc_active_line_r"), self._block_part(ch.key, "line")),
-                Feed(ch.obj("mc_active_feed_override_r"), cell("override", text.percent)),
+                Feed(ch.obj("mc_active_feed_override_r"), cell("override", text.percent_shown),
+                     engineering=True),
+                Feed(ch.obj("actual_path_velocity"), cell("feed", text.mm_min_shown),
+                     SPEED_CYCLE_MS, engineering=True),
                 Feed(ch.obj("mc_active_single_block_r"), cell("single", text.on_off)),
                 Feed(ch.obj("mc_wait_reason_r"), cell("waits", wait_reason)),
                 Feed(ch.suspend("state_r"),

@@ -23,6 +23,7 @@ from cnc_objects.clients.errors import (
     AdsTimeoutError,
     AuthenticationError,
 )
+from cnc_objects.clients.units import engineering
 
 from . import text
 from .machine import Machine, discover
@@ -40,11 +41,14 @@ _LOST = (AdsTimeoutError, AdsConnectionError)  # the service does not answer
 class Feed:
     """One subscription: ``apply`` gets each value of ``name`` (it may be a coroutine
     function: the next sample waits until it is done). ``cycle_ms``: how often the
-    service checks for a change, in kernel time (None: every cycle)."""
+    service checks for a change, in kernel time (None: every cycle). ``engineering``:
+    ``apply`` gets the value in engineering units (mm, mm/min, %), by the scale the
+    service gives for the object (clients/units.py), not the object's own value."""
 
     name: str
     apply: Callable[[Any], Awaitable[None] | None]
     cycle_ms: int | None = None
+    engineering: bool = False
 
 
 class SessionListener(Protocol):
@@ -100,9 +104,10 @@ async def run_sessions(
 
 async def _follow(client: AsyncClient, feed: Feed, listener: SessionListener) -> None:
     try:
+        info = await client.describe(feed.name) if feed.engineering else None
         async for sample in client.subscribe(feed.name, cycle_ms=feed.cycle_ms):
             listener.service_replied()
-            result = feed.apply(sample.value)
+            result = feed.apply(sample.value if info is None else engineering(info, sample.value))
             if inspect.isawaitable(result):
                 await result
     except _LOST:

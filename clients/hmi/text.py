@@ -17,6 +17,21 @@ def mm(value_01um: float) -> str:
     return f"{value_01um / UM01_PER_MM:.4f}"
 
 
+def mm_shown(value_mm: float) -> str:
+    """A position or length already in mm (a feed in engineering units), 4 decimals."""
+    return f"{value_mm:.4f}"
+
+
+def mm_min_shown(value_mm_min: float) -> str:
+    """A path speed already in mm/min, to 1 mm/min."""
+    return f"{value_mm_min:.0f}"
+
+
+def percent_shown(value_pct: float) -> str:
+    """An override already in %."""
+    return f"{value_pct:.1f} %"
+
+
 def percent(value_01pct: int) -> str:
     """An override in 0.1 % as percent."""
     return f"{value_01pct / PERMILLE_PER_PERCENT:.1f} %"

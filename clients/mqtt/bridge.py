@@ -157,7 +157,8 @@ class Bridge:
         info, sample = pending.info, pending.sample
         seq = self._seq[info.name] = self._seq.get(info.name, 0) + 1
         self.published += 1
-        payload = encode_value(sample.value, info.unit, sample.timestamp, seq, info.enum)
+        payload = encode_value(sample.value, info.unit, sample.timestamp, seq, info.enum,
+                               info.scale)
         return self.topics.value(info.name), payload
 
     async def _serve_requests(self, mqtt: aiomqtt.Client) -> None:

@@ -54,7 +54,8 @@ async def execute_set(
         if info.name.lower() not in source.writable:
             raise RequestError(REFUSED, f"{info.name} is not writable through this bridge "
                                "(not matched by --writable)")
-        value = payloads.coerce(info.dtype, request.value, info.name)
+        given = request.value if request.raw else payloads.from_engineering(info, request.value)
+        value = payloads.coerce(info.dtype, given, info.name)
         await client.write(info.name, value)
     except (RequestError, AdsError) as exc:
         log.info("write request on %s refused: %s", topic, exc)

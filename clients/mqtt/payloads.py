@@ -2,11 +2,15 @@
 
 Pure functions, no I/O. A value message is
 
-    {"value": 750, "unit": "0.1 %", "ts": "2026-11-21T10:00:00.123456Z", "seq": 17}
+    {"value": 75.0, "unit": "%", "raw": 750, "raw_unit": "0.1 %",
+     "ts": "2026-11-21T10:00:00.123456Z", "seq": 17}
     {"value": 3, "name": "READY", "ts": "2026-11-21T10:00:00.123456Z", "seq": 2}
 
-("name" for enumeration objects only, "unit" for objects that have one only), a write
-request ``{"value": 750, "id": "abc"}`` and its reply ``{"ok": true}`` or
+("name" for enumeration objects only, "unit" for objects that have one only; "value" in
+engineering units, rounded to the object's resolution, and "raw", "raw_unit" the
+object's own, for objects whose scale converts: clients/units.py), a write request
+``{"value": 75, "id": "abc"}`` (engineering units; ``{"raw": 750}``: the object's own
+value) and its reply ``{"ok": true}`` or
 ``{"ok": false, "code": "0x704", "error": "ADS 0x704 INVALIDACCESS: ..."}``. Everything
 wrong with a request becomes a ``RequestError`` carrying an ADS code, so that the bridge
 answers it like any refused write and never stops on it.
@@ -24,6 +28,8 @@ from typing import Any
 from cnc_objects.protocol.datatypes import DataType
 from cnc_objects.protocol.errors import AdsReturnCode, describe_code
 
+from ..object_info import ObjectInfo, Scale
+from ..units import converts, raw_value, scale_converts, scaled
 from .topics import MAX_ID_CHARS, check_level
 
 #: A request that is not a JSON object with a "value" (ADS: invalid parameter).
@@ -48,10 +54,12 @@ class RequestError(Exception):
 
 @dataclass(frozen=True, slots=True)
 class SetRequest:
-    """A decoded write request: the JSON value as sent, and its id (None: no id)."""
+    """A decoded write request: the JSON value as sent, and its id (None: no id).
+    ``raw``: the value is the object's own (sent as ``"raw"``), not in engineering units."""
 
     value: Any
     request_id: str | None
+    raw: bool = False
 
 
 # ------------------------------------------------------------------ values out
@@ -70,15 +78,22 @@ def json_value(value: Any) -> Any:
 
 
 def encode_value(
-    value: Any, unit: str, timestamp: datetime, seq: int, enum: Mapping[int, str] | None = None
+    value: Any, unit: str, timestamp: datetime, seq: int, enum: Mapping[int, str] | None = None,
+    scale: Scale | None = None,
 ) -> bytes:
     """The value message of one sample. ``unit`` as the service describes it: a unitless
     object ("-") gets no "unit" key. ``enum``: the object's value names (``ObjectInfo.enum``);
-    an enumeration object gets a "name" key, null for a number the set does not name."""
-    message: dict[str, Any] = {"value": json_value(value)}
+    an enumeration object gets a "name" key, null for a number the set does not name.
+    ``scale`` (``ObjectInfo.scale``): "value" and "unit" are in engineering units, with
+    "raw" and "raw_unit" the object's own; a scale in the object's unit only rounds."""
+    message: dict[str, Any] = {"value": json_value(scaled(scale, value))}
     if enum:
         message["name"] = enum.get(value)
-    if unit not in ("", _NO_UNIT):
+    if scale is not None and scale_converts(scale, unit):
+        message["unit"] = scale.unit
+        message["raw"] = json_value(scaled(None, value))  # the object's own, without noise
+        message["raw_unit"] = unit
+    elif unit not in ("", _NO_UNIT):
         message["unit"] = unit
     message["ts"] = iso_utc(timestamp)
     message["seq"] = seq
@@ -123,7 +138,8 @@ def _request_id(document: dict[str, Any]) -> str | None:
 
 def decode_set(payload: bytes) -> SetRequest:
     """Decode a write request; ``RequestError`` (with the id once known) when malformed.
-    Keys other than "value" and "id" are ignored."""
+    The value is "value" (engineering units) or "raw" (the object's own), not both; keys
+    other than "value", "raw" and "id" are ignored."""
     try:
         document = json.loads(payload.decode("utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
@@ -131,8 +147,11 @@ def decode_set(payload: bytes) -> SetRequest:
     if not isinstance(document, dict):
         raise RequestError(MALFORMED, 'the request must be a JSON object {"value": ..., "id": ...}')
     request_id = _request_id(document)
-    if "value" not in document:
-        raise RequestError(MALFORMED, 'the request has no "value"', request_id)
+    if ("value" in document) == ("raw" in document):
+        raise RequestError(MALFORMED, 'the request needs "value" (engineering units) or '
+                           '"raw" (the object\'s own value), one of them', request_id)
+    if "raw" in document:
+        return SetRequest(document["raw"], request_id, raw=True)
     return SetRequest(document["value"], request_id)
 
 
@@ -151,6 +170,17 @@ def _show(value: Any) -> str:
     """A request's value for an error message, cut short: requests come from anyone."""
     text = json.dumps(value, ensure_ascii=False)
     return text if len(text) <= 60 else text[:57] + "..."
+
+
+def from_engineering(info: ObjectInfo, value: Any) -> Any:
+    """The object's own value of a request's ``value`` in engineering units (``75`` % ->
+    ``750``); a value of an object read in its own unit, or not a number, as it is (its
+    type is checked by ``coerce``)."""
+    if not converts(info) or not isinstance(value, (int, float)) or isinstance(value, bool):
+        return value
+    if not math.isfinite(value):
+        return value
+    return raw_value(info, value)
 
 
 def coerce(dtype: DataType, value: Any, what: str) -> Any:

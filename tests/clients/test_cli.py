@@ -58,8 +58,9 @@ def test_browse_json_keys(endpoint: str) -> None:
     ]
     assert set(rows[0]) == {
         "name", "port", "group", "offset", "type", "length", "access", "unit", "description",
-        "enum",
+        "enum", "scale",
     }
+    assert rows[0]["scale"] is None  # an axis number: no engineering unit
     assert rows[0]["enum"] == {}  # JSON object keys are strings: "0" for value 0
     assert rows[2]["enum"] == {"0": "LINKED", "1": "REQUESTED", "2": "WAITING_ACK"}
     assert rows[2]["group"] == 0x121302 and rows[2]["offset"] == 0x10018
@@ -83,17 +84,18 @@ def test_read_by_name_and_address(endpoint: str) -> None:
 
 def test_write_then_read_back(service: RunningService) -> None:
     ep = service.endpoint
-    result = cnc("write", "ch1.mc_command_feed_override_w", "0x2ee", endpoint=ep)
+    result = cnc("write", "--raw", "ch1.mc_command_feed_override_w", "0x2ee", endpoint=ep)
     assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "ch1.mc_command_feed_override_w := 750"
-    assert json_lines(cnc("--json", "read", "ch1.mc_active_feed_override_r", endpoint=ep)) == [
+    assert result.stdout.strip() == "ch1.mc_command_feed_override_w := 750 (0.1 %)"
+    assert json_lines(cnc("--json", "read", "--raw", "ch1.mc_active_feed_override_r",
+                          endpoint=ep)) == [
         {"name": "ch1.mc_active_feed_override_r", "value": 750, "unit": "0.1 %"}
     ]
     result = cnc("--json", "write", "--port", "553", "--group", "0x120101", "--offset", "9",
                  "--type", "UNS16", "500", endpoint=ep)
     assert result.returncode == 0, result.stderr
     assert json_lines(cnc("--json", "read", "ch1.mc_command_feed_override_r", endpoint=ep))[0][
-        "value"
+        "raw"
     ] == 500
 
 
@@ -101,23 +103,25 @@ def test_a_glob_over_command_objects_reads_what_was_last_written(service: Runnin
     """Write-only commands (``_w``) read back their last value, so a glob taking them in
     reads as a whole."""
     ep = service.endpoint
-    assert cnc("write", "ch2.mc_command_feed_override_w", "640", endpoint=ep).returncode == 0
+    assert cnc("write", "ch2.mc_command_feed_override_w", "64", endpoint=ep).returncode == 0
     result = cnc("--json", "read", "ch2.mc_*_feed_override_*", endpoint=ep)
     assert result.returncode == 0, result.stderr
-    values = {row["name"]: row["value"] for row in json_lines(result)}
+    values = {row["name"]: (row["value"], row["raw"]) for row in json_lines(result)}
     assert values == {
-        "ch2.mc_command_feed_override_w": 640,
-        "ch2.mc_command_feed_override_r": 640,
-        "ch2.mc_active_feed_override_r": 640,
+        "ch2.mc_command_feed_override_w": (64.0, 640),
+        "ch2.mc_command_feed_override_r": (64.0, 640),
+        "ch2.mc_active_feed_override_r": (64.0, 640),
     }
-    assert cnc("write", "ch2.mc_command_feed_override_w", "1000", endpoint=ep).returncode == 0
+    assert cnc("write", "ch2.mc_command_feed_override_w", "100", endpoint=ep).returncode == 0
 
 
 def test_errors_exit_nonzero_with_one_line_naming_the_code(endpoint: str) -> None:
     cases = [
         (("write", "ch1.ax1.link_state", "1"), 1, "ADS 0x704 INVALIDACCESS"),
-        (("write", "ch1.mc_command_feed_override_w", "2000"), 1, "ADS 0x706 INVALIDDATA"),
+        (("write", "ch1.mc_command_feed_override_w", "200"), 1, "ADS 0x706 INVALIDDATA"),
         (("write", "ch1.mc_command_feed_override_w", "fast"), 2,
+         "error: ch1.mc_command_feed_override_w: 'fast' is not a number of %"),
+        (("write", "--raw", "ch1.mc_command_feed_override_w", "fast"), 2,
          "error: ch1.mc_command_feed_override_w: 'fast' is not an integer for UNS16"),
         (("read", "ch7.nothing"), 1, "ADS 0x710 SYMBOLNOTFOUND"),
         (("read", "--port", "551", "--group", "0x999", "--offset", "0", "--type", "UNS16"), 1,
@@ -210,6 +214,11 @@ def test_a_misspelt_name_gets_the_nearest_names(endpoint: str) -> None:
 
 def test_a_value_out_of_range_is_refused_by_the_client_without_an_ads_code(endpoint: str) -> None:
     result = cnc("write", "ch1.mc_command_feed_override_w", "-5", endpoint=endpoint)
+    assert result.returncode == 2
+    assert result.stderr.strip() == (
+        "error: ch1.mc_command_feed_override_w: -5 % = -50 (0.1 %): "
+        "value -50 out of range for UNS16 (0..65535)")
+    result = cnc("write", "--raw", "ch1.mc_command_feed_override_w", "-5", endpoint=endpoint)
     assert result.returncode == 2
     assert result.stderr.strip() == (
         "error: ch1.mc_command_feed_override_w: value -5 out of range for UNS16 (0..65535)")

@@ -389,3 +389,24 @@ async def test_jog_keys_move_the_chosen_axis_in_manual_mode(endpoint: str) -> No
         shown = {(k.key_display or k.key) for k in app.query("FooterKey")}
         assert {"]", "[", "a", "i"} <= shown
         await c.reset(1)
+
+
+async def test_positions_speed_and_override_in_engineering_units(service: RunningService) -> None:
+    """mm, mm/min and % by the service's scale of each object (not the HMI's own factors):
+    a 0.1 um position is 4 decimals of a mm, F1 (16.67 um/s) is 1 mm/min."""
+    ep = service.endpoint
+    async with AsyncClient(ep) as c, HmiApp(ep).run_test(size=SIZE) as pilot:
+        app = await started(pilot)
+        await c.write("ch1.mc_command_feed_override_w", 755)  # 0.1 %
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "override") == "75.5 %")
+        await c.write("ch1.mc_command_feed_override_w", 1000)
+        before = await c.mdi("G01 X12.3456 Y-0.189 F6000")
+        await c.wait_mdi(before, timeout_s=WAIT_S)
+        await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "command") == "12.3456")
+        await wait_until(pilot, lambda: app.axes.cell("ch1.ax2", "actual") == "-0.1890")
+        assert app.channels.cell("ch1", "feed") == "0"  # stands
+        await c.upload("long.nc", LONG_PROGRAM)
+        await c.run_program("long.nc")
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "feed") == "1",
+                         what=lambda: f"feed cell {app.channels.cell('ch1', 'feed')!r}")
+        await c.reset()

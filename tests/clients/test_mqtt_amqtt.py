@@ -39,7 +39,7 @@ async def test_bridge_on_amqtt(service: RunningService, amqtt_broker: Broker) ->
                 assert all(m.retain for m in late.messages)
 
             await watcher.client.publish("cnc/a1/set/ch1.mc_command_feed_override_w",
-                                         json.dumps({"value": 250, "id": "w1"}), qos=1)
+                                         json.dumps({"value": 25, "id": "w1"}), qos=1)
             reply = await watcher.wait_for("cnc/a1/reply/w1")
             assert json.loads(reply.payload) == {"ok": True}
             mark = watcher.mark()

@@ -70,7 +70,9 @@ async def test_publishes_every_object_then_online_and_offline_on_stop(
                     "ch1.actual_block_number"} <= set(values)
             # The shared service's values depend on earlier tests: check the form only.
             position = values["ch1.ax1.command_position_acs"]
-            assert isinstance(position["value"], int) and position["unit"] == "0.1 um"
+            # in engineering units, the object's own value beside it
+            assert isinstance(position["raw"], int) and position["raw_unit"] == "0.1 um"
+            assert position["unit"] == "mm" and position["value"] == position["raw"] / 10_000
             assert position["seq"] == 1
             ts = datetime.fromisoformat(position["ts"].replace("Z", "+00:00"))
             assert ts.tzinfo is not None and abs(datetime.now(UTC) - ts) < timedelta(minutes=1)
@@ -111,14 +113,14 @@ async def test_publishes_changes_from_service_notifications(broker: Broker) -> N
         async with AsyncClient(service.endpoint) as client:
             before = await client.mdi("G01 X10 F6000")
             await client.wait_mdi(before, timeout_s=10)
-        last = await watcher.wait_value("cnc/m1/ch1.ax1.command_position_acs", lambda v: v == 100000)
-        await watcher.wait_value("cnc/m1/ax1.actual_position_acs", lambda v: v == 100000)
+        last = await watcher.wait_value("cnc/m1/ch1.ax1.command_position_acs", lambda v: v == 10.0)
+        await watcher.wait_value("cnc/m1/ax1.actual_position_acs", lambda v: v == 10.0)
         moves = [json.loads(m.payload) for m in watcher.messages
                  if m.topic.value == "cnc/m1/ch1.ax1.command_position_acs"]
         assert len(moves) >= 5  # the start value, points on the way, the end
         assert [m["seq"] for m in moves] == list(range(1, len(moves) + 1))
         assert [m["ts"] for m in moves] == sorted(m["ts"] for m in moves)
-        assert moves[-1] == last
+        assert moves[-1] == last and (last["raw"], last["unit"]) == (100000, "mm")
         # The axis that did not move published nothing but its value 0.
         assert {json.loads(m.payload)["value"] for m in watcher.messages
                 if m.topic.value == "cnc/m1/ch1.ax2.command_position_acs"} == {0}
@@ -128,8 +130,9 @@ async def test_publishes_changes_from_service_notifications(broker: Broker) -> N
 FEED = "cnc/m1/set/ch1.mc_command_feed_override_w"
 # (topic suffix, payload, reply topic suffix, expected reply without "error")
 REQUESTS = [
-    ("set/ch1.mc_command_feed_override_w", {"value": 500, "id": "ok-1"}, "reply/ok-1", {"ok": True}),
-    ("set/CH1.MC_Command_Feed_Override_W", {"value": 600.0, "id": "case"}, "reply/case", {"ok": True}),
+    ("set/ch1.mc_command_feed_override_w", {"value": 50, "id": "ok-1"}, "reply/ok-1", {"ok": True}),
+    ("set/CH1.MC_Command_Feed_Override_W", {"value": 60.0, "id": "case"}, "reply/case", {"ok": True}),
+    ("set/ch1.mc_command_feed_override_w", {"raw": 650, "id": "raw"}, "reply/raw", {"ok": True}),
     ("set/ch1.mc_command_execution_mode_w", {"value": 0, "id": "not-writable"},
      "reply/not-writable", {"ok": False, "code": "0x704"}),
     ("set/ch1.mc_active_feed_override_r", {"value": 1, "id": "read-only"},
@@ -138,9 +141,9 @@ REQUESTS = [
      {"ok": False, "code": "0x710"}),
     ("set/ch1.mc_command_feed_override_w", {"value": "fast", "id": "type"},
      "reply/type", {"ok": False, "code": "0x706"}),
-    ("set/ch1.mc_command_feed_override_w", {"value": 2000, "id": "range"},
+    ("set/ch1.mc_command_feed_override_w", {"value": 200, "id": "range"},
      "reply/range", {"ok": False, "code": "0x706"}),
-    ("set/ch1.mc_command_feed_override_w", {"value": 70000, "id": "uns16"},
+    ("set/ch1.mc_command_feed_override_w", {"raw": 70000, "id": "uns16"},
      "reply/uns16", {"ok": False, "code": "0x706"}),
     ("set/ch1.mc_command_feed_override_w", {"id": "no-value"}, "reply/no-value",
      {"ok": False, "code": "0x70b"}),
@@ -151,7 +154,7 @@ REQUESTS = [
      {"ok": False, "code": "0x70b", "topic": FEED}),
     ("set/ch1.mc_command_feed_override_w", {"value": 1, "id": "a/b"}, "reply",
      {"ok": False, "code": "0x70b", "topic": FEED}),
-    ("set/ch1.mc_command_feed_override_w", {"value": 700}, "reply", {"ok": True, "topic": FEED}),
+    ("set/ch1.mc_command_feed_override_w", {"value": 70}, "reply", {"ok": True, "topic": FEED}),
 ]
 
 
@@ -171,7 +174,7 @@ async def test_writes_allowed_refused_and_malformed(service: RunningService, bro
             assert json.loads(reply.payload)["code"] == "0x704"
             await watcher.client.publish("cnc/m1/set/ch1.mc_command_feed_override_w", b"", retain=True)
             await watcher.wait_for("cnc/m1/status", ONLINE)
-            await watcher.wait_value("cnc/m1/ch1.mc_active_feed_override_r", lambda v: v == 1000)
+            await watcher.wait_value("cnc/m1/ch1.mc_active_feed_override_r", lambda v: v == 100)
 
             for suffix, payload, reply_suffix, expected in REQUESTS:
                 mark = watcher.mark()
@@ -185,11 +188,11 @@ async def test_writes_allowed_refused_and_malformed(service: RunningService, bro
                     assert error.startswith(f"ADS {expected['code']} ")
 
             # The accepted writes reached the kernel, the refused ones did not.
-            await watcher.wait_value("cnc/m1/ch1.mc_active_feed_override_r", lambda v: v == 700)
+            await watcher.wait_value("cnc/m1/ch1.mc_active_feed_override_r", lambda v: v == 70)
             active = [json.loads(m.payload)["value"] for m in watcher.messages
                       if m.topic.value == "cnc/m1/ch1.mc_active_feed_override_r"]
             changes = [v for k, v in enumerate(active) if k == 0 or v != active[k - 1]]
-            assert changes == [1000, 500, 600, 700]
+            assert changes == [100, 50, 60, 65, 70]  # in % (engineering units)
 
 
 async def test_broker_restart_republishes_current_values(endpoint: str, broker: Broker) -> None:
@@ -224,7 +227,7 @@ async def test_service_restart_resubscribes(broker: Broker) -> None:
             async with AsyncClient(endpoint) as client:
                 await client.wait_mdi(await client.mdi("G01 Y5 F6000"), timeout_s=10)
             moved = await watcher.wait_value("cnc/m1/ch1.ax2.command_position_acs",
-                                              lambda v: v == 50000, since=mark)
+                                              lambda v: v == 5.0, since=mark)  # mm
             assert moved["seq"] >= 3  # first session's value, the republish, the move
         finally:
             assert second.stop() == 0

@@ -16,6 +16,7 @@ from cnc_objects.clients.mqtt.outbox import OFFLINE, ONLINE, Outbox
 from cnc_objects.clients.mqtt.payloads import RequestError, SetRequest
 from cnc_objects.clients.mqtt.retry import Backoff
 from cnc_objects.clients.mqtt.topics import Topics
+from cnc_objects.clients.object_info import Scale
 from cnc_objects.protocol.datatypes import parse_type
 
 TS = datetime(2026, 11, 21, 10, 0, 0, 123456, tzinfo=UTC)
@@ -67,6 +68,39 @@ def test_enumeration_with_a_unit_keeps_both() -> None:
     assert (message["name"], message["unit"]) == ("OFF", "mode")
 
 
+PERCENT = Scale("%", 0.1, 1)  # what the service gives for an override in 0.1 %
+
+
+def test_a_scaled_value_goes_out_in_engineering_units_with_the_raw_beside() -> None:
+    raw = payloads.encode_value(755, "0.1 %", TS, 3, scale=PERCENT)
+    # The exact payload of docs/mqtt.md, key order included.
+    assert raw == (b'{"value": 75.5, "unit": "%", "raw": 755, "raw_unit": "0.1 %", '
+                   b'"ts": "2026-11-21T10:00:00.123456Z", "seq": 3}')
+    position = json.loads(payloads.encode_value(1890, "0.1 um", TS, 1,
+                                                scale=Scale("mm", 1e-4, 4)))
+    assert (position["value"], position["unit"], position["raw"]) == (0.189, "mm", 1890)
+
+
+def test_values_have_no_float_noise() -> None:
+    """Rounded to the object's resolution: 0.18900000000007822 s is 0.189 s."""
+    message = json.loads(payloads.encode_value(0.18900000000007822, "s", TS, 1,
+                                               scale=Scale("s", 1.0, 6)))
+    assert message == {"value": 0.189, "unit": "s", "ts": "2026-11-21T10:00:00.123456Z",
+                       "seq": 1}  # its own unit: only rounded, no "raw"
+    speed = json.loads(payloads.encode_value(3150.0000000000005, "um/s", TS, 1,
+                                             scale=Scale("mm/min", 0.06, 3)))
+    assert (speed["value"], speed["raw"]) == (189.0, 3150.0)
+
+
+def test_a_request_gives_engineering_units_or_the_raw_value() -> None:
+    assert payloads.decode_set(b'{"raw": 750, "id": "r"}') == SetRequest(750, "r", raw=True)
+    info = ObjectInfo("ch1.mc_command_feed_override_w", 553, 0x120101, 9, "UNS16", 2, "w",
+                      "0.1 %", "", scale=PERCENT)
+    assert payloads.from_engineering(info, 75) == 750
+    assert payloads.from_engineering(info, 75.5) == 755
+    assert payloads.from_engineering(info, "fast") == "fast"  # coerce refuses it, by type
+
+
 def test_timestamp_is_utc_whatever_the_zone() -> None:
     cet = TS.astimezone(timezone(timedelta(hours=1)))
     assert payloads.iso_utc(cet) == "2026-11-21T10:00:00.123456Z"
@@ -88,7 +122,8 @@ def test_decode_set_request() -> None:
         (b"{bad", 0x70B, None, "not JSON"),
         (b"[1, 2]", 0x70B, None, "JSON object"),
         (b"42", 0x70B, None, "JSON object"),
-        (b'{"id": "x"}', 0x70B, "x", 'no "value"'),
+        (b'{"id": "x"}', 0x70B, "x", 'needs "value"'),
+        (b'{"value": 75, "raw": 750, "id": "x"}', 0x70B, "x", "one of them"),
         (b'{"value": 1, "id": 5}', 0x70B, None, '"id" must be a string'),
         (b'{"value": 1, "id": ""}', 0x70B, None, "empty"),
         (b'{"value": 1, "id": "a/b"}', 0x70B, None, "'/'"),

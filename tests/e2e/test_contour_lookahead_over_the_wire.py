@@ -44,7 +44,7 @@ def test_the_walkthrough_with_the_cli(cnc_service: ServiceProcess) -> None:
     # mode 1 from the middle, mode 2 by distance, the human table
     assert [b["block_number"] for b in cli_json(e, "lookahead", "9")["blocks"]] == [
         70, 80, 90]
-    window = cli_json(e, "lookahead", "210000", "--length", "200000")["blocks"]
+    window = cli_json(e, "lookahead", "21", "--length", "20")["blocks"]
     assert [b["block_number"] for b in window] == [30, 40]
     table = cnc("lookahead", "4", endpoint=e)
     assert table.returncode == 0, table.stderr
@@ -53,7 +53,7 @@ def test_the_walkthrough_with_the_cli(cnc_service: ServiceProcess) -> None:
     # the path distance, as GEO object and PLC symbol
     values = cnc("--json", "read", "ch1.dist_prog_start", "gpCh[0].bahn_state.dist_prog_start",
                  endpoint=e)
-    distances = [r["value"] for r in json_lines(values)]
+    distances = [r["raw"] for r in json_lines(values)]  # 0.1 um, as the reply's fields
     assert distances[0] == distances[1] == pytest.approx(blocks[-1]["start_position"])
 
 

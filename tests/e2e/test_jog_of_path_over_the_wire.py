@@ -21,7 +21,7 @@ SUSPEND = "gpCh[{}].bahn_mc_control.suspend_axis_output.command_w"
 def read_mm(endpoint: str, *names: str) -> list[float]:
     result = cnc("--json", "read", *names, endpoint=endpoint)
     assert result.returncode == 0, result.stderr
-    return [r["value"] / 10_000 for r in json_lines(result)]
+    return [r["value"] for r in json_lines(result)]  # in mm, as cnc shows positions
 
 
 def ok(endpoint: str, *args: str) -> None:
@@ -55,7 +55,7 @@ def test_the_table_with_the_cli_only(cnc_service: ServiceProcess) -> None:
     plc = cnc("--json", "read", "gpAx[0].lr_state.position_offset_r",
               "gpAx[0].lr_state.link_to_ipo_r", "gpAx[3].ipo_state.link_to_lr",
               "gpAx[0].ipo_state.link_to_lr", endpoint=e)
-    assert [r["value"] for r in json_lines(plc)] == [-300_000, 11, 1, 0]
+    assert [r.get("raw", r["value"]) for r in json_lines(plc)] == [-300_000, 11, 1, 0]
 
 
 @pytest.fixture(scope="module")

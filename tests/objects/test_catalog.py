@@ -26,6 +26,7 @@ from cnc_objects.objects.catalog import (
     build_objects,
 )
 from cnc_objects.objects.model import Access, CncObject
+from cnc_objects.objects.units import EngineeringScale
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.datatypes import REAL64, SGN32, UNS16, UNS32, DataType
 from cnc_objects.protocol.values import (
@@ -267,8 +268,40 @@ def test_describe_is_the_browse_descriptor(by_name: dict[str, CncObject]) -> Non
         "0.1 %",
         obj.description,
         [],  # not an enumeration: no value names
+        ["%", 0.1, 1],  # people read it in %, value = raw x 0.1, resolution 0.1 %
     ]
     assert obj.description
+
+
+# --------------------------------------------------------------------------- engineering units
+
+
+@pytest.mark.parametrize(("name", "scale"), [
+    ("ch1.ax1.command_position_acs", ("mm", 1e-4, 4)),  # SGN32 in 0.1 um
+    ("ch1.dist_prog_start", ("mm", 1e-4, 4)),  # REAL64 in 0.1 um
+    ("ch1.ax1.manual_increment_w", ("mm", 1e-4, 4)),
+    ("ch1.actual_path_velocity", ("mm/min", 0.06, 3)),  # um/s
+    ("ch1.mc_active_feed_override_r", ("%", 0.1, 1)),  # 0.1 %
+    ("ch1.mc_spindle_cmd_rev_r", ("rpm", 1 / 6000, 3)),  # 0.001 deg/s
+    ("ch1.ax1.vel_max", ("mm/s", 1.0, 3)),  # read as it is, resolution only
+    ("ch1.program_time", ("s", 1.0, 6)),
+])
+def test_objects_carry_their_engineering_scale(
+    by_name: dict[str, CncObject], name: str, scale: tuple[str, float, int]
+) -> None:
+    obj = by_name[name]
+    assert obj.scale == EngineeringScale(*scale)
+    assert obj.describe()[10] == list(scale)
+
+
+def test_objects_without_a_unit_or_with_value_names_have_no_scale(
+    by_name: dict[str, CncObject],
+) -> None:
+    for obj in by_name.values():
+        if obj.unit in ("-", "byte", "pulses") or obj.values is not None:
+            assert obj.scale is None and obj.describe()[10] == [], obj.name
+    # every unit of the catalog is either scaled or deliberately left as it is
+    assert {o.unit for o in by_name.values() if o.scale is None} <= {"-", "byte", "pulses"}
 
 
 # --------------------------------------------------------------------------- value names

@@ -84,10 +84,10 @@ def test_the_documented_set_up_with_the_cli(tmp_path: Path) -> None:
                                         f"not write {FEED_W}; operator or admin may")
         env = {"CNC_KEY": str(tmp_path / "alice" / "alice.key"),  # the secret beside it
                "CNC_SERVER_KEY": str(keys / "server.key")}
-        wrote = cnc("--endpoint", e, "write", FEED_W, "500", env=env)
+        wrote = cnc("--endpoint", e, "write", FEED_W, "50", env=env)  # %
         assert wrote.returncode == 0, wrote.stderr
         got = cnc("--endpoint", e, "--key", monitor, "--json", "read", FEED_R)
-        assert json.loads(got.stdout)["value"] == 500
+        assert json.loads(got.stdout)["raw"] == 500
         upload = cnc("--endpoint", e, "upload", str(tmp_path / "alice" / "alice.key"), env=env)
         assert upload.returncode == 1 and "role operator may not change the program store" \
             in upload.stderr
