@@ -54,6 +54,7 @@ from .data_location import StoreLocation, output_area_location, program_store_lo
 from .frontend_config import parse_ads_endpoint
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
+from .kernel.realtime_priority import DEFAULT_RT_PRIORITY, RT_PRIORITY_MAX
 from .limits import rate_limiter
 from .notifications import NotificationCounts
 from .output_area import OutputArea
@@ -102,10 +103,12 @@ def _usage(message: str) -> NoReturn:
     raise typer.Exit(EXIT_USAGE)
 
 
-def make_clock(kind: ClockKind, cycle_s: float, speed: float | None) -> Clock:
-    """The clock the cycle task runs on."""
+def make_clock(kind: ClockKind, cycle_s: float, speed: float | None,
+               rt_priority: int = DEFAULT_RT_PRIORITY) -> Clock:
+    """The clock the cycle task runs on (``rt_priority``: the realtime clock's SCHED_FIFO
+    priority, 0 for none)."""
     if kind is ClockKind.REALTIME:
-        return RealtimeClock(cycle_s)
+        return RealtimeClock(cycle_s, rt_priority)
     return VirtualClock(cycle_s, speed)
 
 
@@ -153,7 +156,8 @@ async def serve(
         limits.output_max_files, limits.output_max_file_bytes, limits.output_max_total_bytes,
         limits.output_queue_max_bytes))
     kernel = Kernel(
-        config.machine, make_clock(clock_kind, config.cycle_ms / 1000.0, speed), load, exists,
+        config.machine, make_clock(clock_kind, config.cycle_ms / 1000.0, speed, config.rt_priority),
+        load, exists,
         writer.kernel_file, writer.save, check_max_errors=config.limits.check_max_errors,
     )
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows
@@ -259,6 +263,12 @@ def run(
     cycle_ms: float | None = typer.Option(
         None, "--cycle-ms", metavar="MS", help="Cycle time in ms (overrides the configuration).",
     ),
+    rt_priority: int | None = typer.Option(
+        None, "--rt-priority", metavar="N", min=0, max=RT_PRIORITY_MAX,
+        help="Realtime clock: SCHED_FIFO priority 1..99 of the cycle thread, with memory "
+        f"locked, where permitted; 0: a normal thread (default: rt_priority of the "
+        f"configuration, else {DEFAULT_RT_PRIORITY}).",
+    ),
     program_dir: Path | None = typer.Option(
         None, "--program-dir", metavar="DIR",
         help="Directory of the program store (default: programs/ in --data-dir, else "
@@ -307,6 +317,8 @@ def run(
     if speed is not None and (clock is not ClockKind.VIRTUAL or speed <= 0):
         _usage("--speed takes a positive factor and needs --clock virtual")
     config = _machine_config(config_file, cycle_ms)
+    if rt_priority is not None:  # typer checked the range
+        config = config.model_copy(update={"rt_priority": rt_priority})
     location = program_store_location(
         program_dir, data_dir, config.program_store_dir, config.data_dir
     )
