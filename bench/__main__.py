@@ -16,6 +16,9 @@ echo server and against the service, and ``read_list_by_name`` of 100 symbols
 the tests run, against pyads', and the time to upload and read every symbol
 (``bench/ads_clients_bench.py``).
 
+Client part (``--part client``): ``AsyncClient`` bursts and sliding window, batched and
+not, against the raw pipelined echo in the same run, in reads/s and in CPU time per read
+of each process (``bench/client_bench.py``; issue 30).
 Jitter part (``--part jitter``): the realtime cycle's lateness (p50, p99, max) and
 overruns while the service answers 5 000 reads/s and feeds 20 on-change subscriptions
 during a run (``bench/jitter_bench.py``).
@@ -205,10 +208,11 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__.split("\n")[0])
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
-    parser.add_argument("--part", choices=("all", "dispatch", "ads", "kernel", "jitter",
-                                           "virtual", "lookahead", "fairness"),
+    parser.add_argument("--part", choices=("all", "dispatch", "client", "ads", "kernel",
+                                           "jitter", "virtual", "lookahead", "fairness"),
                         default="all",
-                        help="dispatch: request dispatch (ZeroMQ); ads: pyads over AMS/TCP; "
+                        help="dispatch: request dispatch (ZeroMQ); client: AsyncClient "
+                        "batching against the raw echo, wall and CPU; ads: pyads over AMS/TCP; "
                         "kernel: decoder, interpolator, planner; jitter: the realtime cycle "
                         "under load; virtual: whole-service virtual time speed; lookahead: "
                         "machining time against the optimum; fairness: reads while the "
@@ -218,6 +222,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.part in ("all", "dispatch"):
         dispatch(args)
+    if args.part in ("all", "client"):
+        from . import client_bench
+
+        client_bench.main(args.runs, args.count * 2)
     if args.part in ("all", "ads"):
         from . import ads_bench, ads_clients_bench
 
