@@ -96,15 +96,6 @@ class QueuedRequest:
         self.port = port
         self.fields = fields  # Read: (group, offset, length); Write: (group, offset, data)
 
-    def request_bytes(self) -> int:
-        """What the item adds to the sum command's data."""
-        extra = len(self.fields[2]) if self.command == WRITE else 0
-        return _ITEM_HEAD_BYTES + extra
-
-    def reply_bytes(self) -> int:
-        """What the item adds to the sum reply's data."""
-        return _CODE_BYTES + (self.fields[2] if self.command == READ else 0)
-
 
 def runs(outbox: list[Any]) -> Iterator[Any]:
     """The outbox in order, each maximal run of ``QueuedRequest`` of one command and port
@@ -125,30 +116,39 @@ def runs(outbox: list[Any]) -> Iterator[Any]:
         yield run
 
 
-def chunks(run: list[QueuedRequest]) -> Iterator[list[QueuedRequest]]:
-    """``run`` cut into sum commands within the item and byte limits."""
+def chunks(run: list[QueuedRequest]) -> list[list[QueuedRequest]]:
+    """``run`` (one command) cut into sum commands within the item and byte limits."""
+    # what each item adds to the request's data and to the reply's: a read its length to
+    # the reply, a write its data to the request; each its head and its result code
+    reads = run[0].command == READ
+    sizes = [q.fields[2] if reads else len(q.fields[2]) for q in run]
+    if len(run) <= BATCH_MAX_ITEMS and (
+            _ITEM_HEAD_BYTES + _CODE_BYTES) * len(run) + sum(sizes) <= BATCH_MAX_BYTES:
+        return [run]  # the common case: everything fits one
+    out: list[list[QueuedRequest]] = []
     chunk: list[QueuedRequest] = []
     request_bytes = reply_bytes = 0
-    for item in run:
-        more_request, more_reply = item.request_bytes(), item.reply_bytes()
+    for item, size in zip(run, sizes):
+        more_request = _ITEM_HEAD_BYTES + (0 if reads else size)
+        more_reply = _CODE_BYTES + (size if reads else 0)
         if chunk and (len(chunk) == BATCH_MAX_ITEMS
                       or request_bytes + more_request > BATCH_MAX_BYTES
                       or reply_bytes + more_reply > BATCH_MAX_BYTES):
-            yield chunk
+            out.append(chunk)
             chunk, request_bytes, reply_bytes = [], 0, 0
         chunk.append(item)
         request_bytes += more_request
         reply_bytes += more_reply
     if chunk:
-        yield chunk
+        out.append(chunk)
+    return out
 
 
 def sum_fields(chunk: list[QueuedRequest]) -> tuple[int, int, tuple[Any, ...]]:
     """The ReadWrite that carries ``chunk``: (command, port, fields)."""
     command = chunk[0].command
     if command == READ:
-        data, read_length = sums.encode_sum_read(
-            [sums.SumItem(q.fields[0], q.fields[1], q.fields[2]) for q in chunk])
+        data, read_length = sums.encode_sum_read_addresses([q.fields for q in chunk])
     else:
         data, read_length = sums.encode_sum_write(
             [sums.SumItem(q.fields[0], q.fields[1], 0, q.fields[2]) for q in chunk])
@@ -195,12 +195,12 @@ class SumBatch:
     def _answer_reads(self, data: bytes) -> None:
         results = sums.decode_sum_read_reply([q.fields[2] for q in self.items], data)
         for item, (code, raw) in zip(self.items, results, strict=True):
-            if item.fut.done():
-                continue
+            fut = item.fut
             if code:
-                self._resend(item)  # the plain read's own answer: its sentence, or a string
-            else:
-                item.fut.set_result(Response(0, READ, 0, (raw,)))
+                if not fut.done():
+                    self._resend(item)  # the plain read's own answer: its sentence, or a string
+            elif not fut.done():
+                fut.set_result(Response(0, READ, 0, (raw,)))
 
     def _answer_writes(self, data: bytes) -> None:
         codes = sums.decode_codes(len(self.items), data)

@@ -6,6 +6,8 @@ runs under SCHED_FIFO, ahead of every normal thread of the machine, and the proc
 memory is locked (``mlockall(MCL_CURRENT | MCL_FUTURE)``) so that no page fault to swap
 or to a dropped file page stalls a cycle. Where not, the thread stays SCHED_OTHER and the
 service goes on: ``RealtimeGrant`` says what was asked, what was granted and why not.
+``serve_below`` puts the service's other threads one priority below the cycle thread:
+the cycle needs the GIL as well as the CPU.
 
 Only Linux has these calls here; elsewhere the grant says so.
 """
@@ -65,9 +67,10 @@ def _libc() -> ctypes.CDLL:
     return ctypes.CDLL(None, use_errno=True)
 
 
-def claim(grant: RealtimeGrant) -> None:
+def claim(grant: RealtimeGrant, lock_memory: bool = True) -> None:
     """Ask for SCHED_FIFO at ``grant.asked_priority`` for the CALLING thread, and lock the
-    process's memory; record in ``grant`` what was granted. Never raises."""
+    process's memory (unless ``lock_memory`` is False); record in ``grant`` what was
+    granted. Never raises."""
     grant.policy, grant.priority, grant.memory_locked = SchedPolicy.OTHER, 0, False
     grant.refusals.clear()
     if grant.asked_priority == 0:
@@ -83,6 +86,8 @@ def claim(grant: RealtimeGrant) -> None:
         grant.refusals.append(
             f"SCHED_FIFO refused: {exc.strerror} (needs root or CAP_SYS_NICE, or RLIMIT_RTPRIO "
             f">= {grant.asked_priority})")
+    if not lock_memory:
+        return
     try:
         failed = _libc().mlockall(_MCL_CURRENT | _MCL_FUTURE)
         errno = ctypes.get_errno()
@@ -95,3 +100,16 @@ def claim(grant: RealtimeGrant) -> None:
         grant.refusals.append(
             f"mlockall refused: {os.strerror(errno)} (needs CAP_IPC_LOCK or an RLIMIT_MEMLOCK "
             "above the process's size)")
+
+
+def serve_below(cycle_priority: int) -> RealtimeGrant:
+    """Put the CALLING thread (the service's event loop) under SCHED_FIFO one priority
+    below the cycle thread's, before it starts the other threads (they inherit it).
+
+    Why: the cycle thread needs the GIL as well as the CPU. A thread of the service that
+    holds the GIL and is preempted by another process of the machine keeps the cycle
+    waiting for as long as the OS runs that process (milliseconds on a busy machine);
+    under SCHED_FIFO no normal process preempts it. Never raises; 0: nothing asked."""
+    grant = RealtimeGrant(max(cycle_priority - 1, 1) if cycle_priority else 0)
+    claim(grant, lock_memory=False)
+    return grant

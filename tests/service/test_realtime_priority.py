@@ -9,6 +9,7 @@ service's size)."""
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
@@ -58,8 +59,14 @@ def test_the_cycle_thread_runs_sched_fifo_at_the_configured_priority(tmp_path: P
         assert figures["cnc_cycle_sched_policy_r"] == (
             SchedPolicy.FIFO if granted else SchedPolicy.OTHER), line
         assert figures["cnc_cycle_sched_priority_r"] == (7 if granted else 0)
+        # the service's own threads one below, so that none holding the GIL is preempted
+        # by another process (the event loop is the process's main thread)
+        assert os.sched_getscheduler(service.process.pid) == (
+            os.SCHED_FIFO if granted else os.SCHED_OTHER)
         if granted:
             assert "SCHED_FIFO priority 7" in line
+            assert os.sched_getparam(service.process.pid).sched_priority == 6
+            service.wait_for_log("service threads under SCHED_FIFO priority 6")
             # the same privilege (root) locks memory here: the log says both
             assert figures["cnc_memory_locked_r"] == ("memory locked" in line)
         assert len([ln for ln in service.log if "cycle thread under" in ln]) == 1  # once
@@ -71,6 +78,8 @@ def test_the_option_turns_it_off_and_wins_over_the_configuration(tmp_path: Path)
     with serving("--clock", "realtime", "--config", str(config), "--rt-priority", "0") as service:
         line = service.wait_for_log(GRANT_LOG)
         assert "real-time priority is off (--rt-priority 0)" in line
+        assert os.sched_getscheduler(service.process.pid) == os.SCHED_OTHER
+        assert not any("service threads under" in ln for ln in service.log)
         assert grant_objects(service.endpoint) == {
             "cnc_cycle_sched_policy_r": SchedPolicy.OTHER, "cnc_cycle_sched_priority_r": 0,
             "cnc_memory_locked_r": False}
@@ -85,6 +94,7 @@ def test_a_refusal_is_logged_and_the_service_goes_on() -> None:
         assert "SCHED_FIFO refused: Operation not permitted" in line
         assert "mlockall refused" in line
         assert "the service goes on without" in line
+        service.wait_for_log("service threads under SCHED_OTHER")
         figures = grant_objects(service.endpoint)
         assert figures == {"cnc_cycle_sched_policy_r": SchedPolicy.OTHER,
                            "cnc_cycle_sched_priority_r": 0, "cnc_memory_locked_r": False}
