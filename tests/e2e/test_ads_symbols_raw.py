@@ -191,8 +191,9 @@ def test_upload_info_64_bytes_field_by_field(ads: RawAds, catalog: list[ObjectIn
     assert len(data) == 64
     (symbols, symbol_bytes, types, type_bytes, max_dynamic, used_dynamic, invalid_dynamic,
      code_page, flags) = struct.unpack_from("<9I", data)
-    # + technology units and spindle, manual mode, tools and offsets (issue 28)
-    assert len(catalog) == 1004 + 350 + 108 + 278
+    # + technology units and spindle, manual mode, tools and offsets (issue 28), the cycle
+    # thread's real-time grant (issue 30)
+    assert len(catalog) == 1004 + 350 + 108 + 278 + 3
     assert symbols == len(catalog) + len(struct_names(catalog))
     assert symbol_bytes == len(read_ok(ads, SYM_UPLOAD, symbol_bytes))
     assert type_bytes == len(read_ok(ads, SYM_DT_UPLOAD, type_bytes))

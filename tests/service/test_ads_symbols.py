@@ -87,8 +87,9 @@ def test_upload_info_64_bytes_describes_both_uploads(service: SymbolService, spa
     info = decode_upload_info(data)
     symbols = ok(service.read(SymbolGroup.UPLOAD, 0, 1 << 20))
     types = ok(service.read(SymbolGroup.DT_UPLOAD, 0, 1 << 20))
-    # + technology units and spindle, manual mode, tools and offsets (issue 28)
-    assert info.symbol_count == len(space) == 1004 + 350 + 108 + 278
+    # + technology units and spindle, manual mode, tools and offsets (issue 28), the cycle
+    # thread's real-time grant (issue 30)
+    assert info.symbol_count == len(space) == 1004 + 350 + 108 + 278 + 3
     assert info.symbol_size == len(symbols) == service.upload_bytes
     assert info.datatype_count == len(decode_datatype_entries(types))
     assert info.datatype_size == len(types) == service.datatype_upload_bytes
@@ -107,7 +108,7 @@ def test_upload_info2_is_24_bytes_below_64(service: SymbolService, length: int) 
 
 def test_upload_info_0xf00c_is_the_8_byte_form(service: SymbolService) -> None:
     data = ok(service.read(SymbolGroup.UPLOAD_INFO, 0, 64))
-    assert data == struct.pack("<II", 1004 + 350 + 108 + 278, service.upload_bytes)
+    assert data == struct.pack("<II", 1004 + 350 + 108 + 278 + 3, service.upload_bytes)
     assert ok(service.read(SymbolGroup.UPLOAD_INFO, 0, 8)) == data
 
 
