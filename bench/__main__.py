@@ -16,6 +16,9 @@ echo server and against the service, and ``read_list_by_name`` of 100 symbols
 the tests run, against pyads', and the time to upload and read every symbol
 (``bench/ads_clients_bench.py``).
 
+Client part (``--part client``): ``AsyncClient`` bursts and sliding window, batched and
+not, against the raw pipelined echo in the same run, in reads/s and in CPU time per read
+of each process (``bench/client_bench.py``; issue 30).
 Jitter part (``--part jitter``): the realtime cycle's lateness (p50, p99, max) and
 overruns while the service answers 5 000 reads/s and feeds 20 on-change subscriptions
 during a run (``bench/jitter_bench.py``).
@@ -34,8 +37,10 @@ sequential round trips, and 64 frames in flight. Then the real ``cnc-service``
 
 * ``Client.read_address`` sequentially,
 * ``AsyncClient.read_address`` from 64 coroutines (64 reads in flight, a sliding
-  window), and in bursts (``asyncio.gather`` of 64, then the next burst); both also
-  against the raw echo, which shows the client's own share (the service's is the rest),
+  window), and in bursts (``asyncio.gather`` of 64, then the next burst: one sum read,
+  the client batches, issue 30); both also with ``batch=False`` (a frame per read), and
+  unbatched against the raw echo, which shows the client's own share (the service's is
+  the rest),
 * ``AsyncClient.read_many`` of 100 objects (one sum read each).
 
 Every figure is the median over ``--runs`` runs (default 5). Each run measures the
@@ -137,8 +142,8 @@ def client_sequential(endpoint: str, count: int) -> Figure:
     return figure(count, elapsed, lat)
 
 
-async def _client_in_flight(endpoint: str, count: int) -> Figure:
-    async with AsyncClient(endpoint) as c:
+async def _client_in_flight(endpoint: str, count: int, batch: bool) -> Figure:
+    async with AsyncClient(endpoint, batch=batch) as c:
         await asyncio.gather(*(c.read_address(*ADDRESS) for _ in range(200)))
         lat: list[float] = []
         per_worker = count // IN_FLIGHT
@@ -156,14 +161,15 @@ async def _client_in_flight(endpoint: str, count: int) -> Figure:
     return figure(per_worker * IN_FLIGHT, elapsed, lat)
 
 
-def client_in_flight(endpoint: str, count: int) -> Figure:
+def client_in_flight(endpoint: str, count: int, batch: bool = True) -> Figure:
     """AsyncClient with IN_FLIGHT reads outstanding (a sliding window: each of IN_FLIGHT
-    coroutines sends its next read when its last one is answered)."""
-    return asyncio.run(_client_in_flight(endpoint, count))
+    coroutines sends its next read when its last one is answered; with ``batch``, the
+    reads that meet in one loop turn share a sum read)."""
+    return asyncio.run(_client_in_flight(endpoint, count, batch))
 
 
-async def _client_bursts(endpoint: str, count: int) -> Figure:
-    async with AsyncClient(endpoint) as c:
+async def _client_bursts(endpoint: str, count: int, batch: bool) -> Figure:
+    async with AsyncClient(endpoint, batch=batch) as c:
         await asyncio.gather(*(c.read_address(*ADDRESS) for _ in range(200)))
         lat: list[float] = []
         bursts = count // IN_FLIGHT
@@ -177,9 +183,10 @@ async def _client_bursts(endpoint: str, count: int) -> Figure:
     return figure(bursts * IN_FLIGHT, elapsed, lat)
 
 
-def client_bursts(endpoint: str, count: int) -> Figure:
-    """AsyncClient reading in bursts: ``asyncio.gather`` of IN_FLIGHT reads, then the next."""
-    return asyncio.run(_client_bursts(endpoint, count))
+def client_bursts(endpoint: str, count: int, batch: bool = True) -> Figure:
+    """AsyncClient reading in bursts: ``asyncio.gather`` of IN_FLIGHT reads, then the next
+    (with ``batch``: one sum read per burst; without: IN_FLIGHT frames)."""
+    return asyncio.run(_client_bursts(endpoint, count, batch))
 
 
 async def _client_read_many(endpoint: str, count: int) -> tuple[Figure, int]:
@@ -201,10 +208,11 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__.split("\n")[0])
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
-    parser.add_argument("--part", choices=("all", "dispatch", "ads", "kernel", "jitter",
-                                           "virtual", "lookahead", "fairness"),
+    parser.add_argument("--part", choices=("all", "dispatch", "client", "ads", "kernel",
+                                           "jitter", "virtual", "lookahead", "fairness"),
                         default="all",
-                        help="dispatch: request dispatch (ZeroMQ); ads: pyads over AMS/TCP; "
+                        help="dispatch: request dispatch (ZeroMQ); client: AsyncClient "
+                        "batching against the raw echo, wall and CPU; ads: pyads over AMS/TCP; "
                         "kernel: decoder, interpolator, planner; jitter: the realtime cycle "
                         "under load; virtual: whole-service virtual time speed; lookahead: "
                         "machining time against the optimum; fairness: reads while the "
@@ -214,6 +222,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.part in ("all", "dispatch"):
         dispatch(args)
+    if args.part in ("all", "client"):
+        from . import client_bench
+
+        client_bench.main(args.runs, args.count * 2)
     if args.part in ("all", "ads"):
         from . import ads_bench, ads_clients_bench
 
@@ -287,8 +299,8 @@ def dispatch(args: argparse.Namespace) -> None:
         machine.write_text(BENCH_MACHINE)
         service = start_service("--clock", "realtime", "--config", str(machine))
     try:
-        keys = ("raw_seq", "raw_pipe", "seq", "flight", "bursts", "echo_flight",
-                "echo_bursts", "many")
+        keys = ("raw_seq", "raw_pipe", "seq", "flight", "bursts", "flight_plain",
+                "bursts_plain", "echo_flight", "echo_bursts", "many")
         runs: dict[str, list[Figure]] = {k: [] for k in keys}
         n_objects = 0
         ratios: dict[str, list[float]] = {k: [] for k in keys[2:]}
@@ -298,13 +310,18 @@ def dispatch(args: argparse.Namespace) -> None:
             raw_pipe = raw_pipelined(echo_endpoint, args.count * 2)
             flight = client_in_flight(service.endpoint, args.count * 2)
             bursts = client_bursts(service.endpoint, args.count * 2)
-            # the client alone: the same reads answered by the raw echo
-            echo_flight = client_in_flight(echo_endpoint, args.count * 2)
-            echo_bursts = client_bursts(echo_endpoint, args.count * 2)
+            flight_plain = client_in_flight(service.endpoint, args.count * 2, batch=False)
+            bursts_plain = client_bursts(service.endpoint, args.count * 2, batch=False)
+            # the client alone: the same reads answered by the raw echo (which answers
+            # every frame as one read: no sum commands)
+            echo_flight = client_in_flight(echo_endpoint, args.count * 2, batch=False)
+            echo_bursts = client_bursts(echo_endpoint, args.count * 2, batch=False)
             many, n_objects = asyncio.run(_client_read_many(service.endpoint, args.count // 20))
             for key, fig_, base in (("raw_seq", raw_seq, None), ("seq", seq, raw_seq),
                                     ("raw_pipe", raw_pipe, None), ("flight", flight, raw_pipe),
                                     ("bursts", bursts, raw_pipe),
+                                    ("flight_plain", flight_plain, raw_pipe),
+                                    ("bursts_plain", bursts_plain, raw_pipe),
                                     ("echo_flight", echo_flight, raw_pipe),
                                     ("echo_bursts", echo_bursts, raw_pipe),
                                     ("many", many, raw_seq)):
@@ -336,6 +353,8 @@ def _report(
         ("Client.read_address, sequential", "seq", 0.6),
         ("AsyncClient, 64 reads in flight", "flight", 0.8),
         ("AsyncClient, bursts of 64 (gather)", "bursts", 0.8),
+        ("  the same, batch=False: window", "flight_plain", None),
+        ("  the same, batch=False: bursts", "bursts_plain", None),
         ("  the client alone (raw echo): window", "echo_flight", None),
         ("  the client alone (raw echo): bursts", "echo_bursts", None),
         (f"AsyncClient.read_many({n_objects}) calls", "many", None),

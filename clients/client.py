@@ -166,6 +166,11 @@ class AsyncClient(TraceOps, AlarmOps):
     with the secret beside it), for a service started with ``--keys``; ``server_key``: the
     service's public key file (default: ``server.key`` beside ``key_file``). A key file
     that cannot be used raises ``ClientValueError`` here.
+
+    ``batch`` (default True): the reads and writes issued in one event-loop turn (an
+    ``asyncio.gather`` of 64 reads) go out as ADS sum commands, one frame for many, with
+    each request's result or error its own (``clients.batching``); False sends every
+    request as its own frame.
     """
 
     def __init__(
@@ -175,12 +180,13 @@ class AsyncClient(TraceOps, AlarmOps):
         timeout_s: float = DEFAULT_TIMEOUT_S,
         key_file: PathText | None = None,
         server_key: PathText | None = None,
+        batch: bool = True,
         _transport: AsyncTransport | SyncTransport | None = None,
     ) -> None:
         self.endpoint = endpoint
         if _transport is None:
             curve = client_curve(key_file, server_key)
-            _transport = AsyncTransport(endpoint, timeout_s, curve=curve)
+            _transport = AsyncTransport(endpoint, timeout_s, curve=curve, batch=batch)
         self._t = _transport
         self._objects: dict[str, ObjectInfo] | None = None
         self._handles: dict[str, int] = {}

@@ -32,6 +32,7 @@ from cnc_objects.protocol.frames import (
     encode_request,
 )
 
+from .batching import QueuedRequest, ReplyWaiter, SumBatch, batchable, chunks, runs, sum_fields
 from .curve import ClientCurve, HandshakeWatch
 from .errors import AdsConnectionError, AuthenticationError, NoReplyError
 
@@ -121,11 +122,16 @@ class AsyncTransport(_Transport):
     a timer per request: with many requests in flight a timer each costs more than the
     request itself. A request therefore fails between 1 and 1.25 timeouts after it was
     sent, with ``NoReplyError`` (an ``AdsTimeoutError``).
+
+    ``batch``: the reads and writes of one loop turn go out as sum commands
+    (``clients.batching``); False sends each request as its own frame.
     """
 
     def __init__(self, endpoint: str, timeout_s: float, context: zmq.Context[zmq.Socket[bytes]] | None = None,
-                 curve: ClientCurve | None = None) -> None:
+                 curve: ClientCurve | None = None, batch: bool = True) -> None:
         super().__init__(endpoint, timeout_s, curve)
+        self.batch = batch
+        self.frames_sent = 0  # request frames handed to ZeroMQ: what batching saves
         self._context = context or zmq.Context.instance()
         self._sock: zmq.Socket[bytes] | None = None
         self._watch: HandshakeWatch | None = None
@@ -133,12 +139,14 @@ class AsyncTransport(_Transport):
         self._closed: AdsConnectionError = AdsConnectionError(
             0x748, "the client is not connected; use 'async with'")
         self._loop: asyncio.AbstractEventLoop | None = None
-        # invoke id -> (future, sweep generation when sent, command id)
-        self._pending: dict[int, tuple[asyncio.Future[Response], int, int]] = {}
+        # invoke id -> (future or sum batch, sweep generation when sent, command id)
+        self._pending: dict[int, tuple[ReplyWaiter, int, int]] = {}
         self._generation = 0
         self._sample_waiters: dict[int, asyncio.Future[None]] = {}
         self._drain_scheduled = False
-        self._outbox: list[tuple[int, bytes]] = []
+        # encoded frames, and (batching) reads and writes not yet encoded
+        self._outbox: list[tuple[int, bytes] | QueuedRequest] = []
+        self._batched = False  # the outbox holds a QueuedRequest
         self._sweeper: asyncio.Task[None] | None = None
 
     async def open(self) -> None:
@@ -184,6 +192,10 @@ class AsyncTransport(_Transport):
         for fut, _, _ in self._pending.values():
             if not fut.done():
                 fut.set_exception(closed)
+        for entry in self._outbox:  # batched requests get their invoke id when sent
+            if type(entry) is QueuedRequest and not entry.fut.done():
+                entry.fut.set_exception(closed)
+        self._outbox.clear()
         for waiter in self._sample_waiters.values():
             if not waiter.done():
                 waiter.set_exception(closed)
@@ -199,6 +211,11 @@ class AsyncTransport(_Transport):
         if self._sock is None:
             raise self._closed
         fut = self._loop.create_future()  # type: ignore[union-attr]
+        if self.batch and batchable(command, fields):  # encoded at the end of the turn
+            self._outbox.append(QueuedRequest(fut, command, port, fields))
+            self._batched = True
+            self._schedule_drain()
+            return fut
         invoke_id, frame = self._frame(command, port, fields)
         self._pending[invoke_id] = (fut, self._generation, command)
         # Frames wait in the outbox until the end of this loop pass and then go out back
@@ -246,9 +263,48 @@ class AsyncTransport(_Transport):
             self._drain_scheduled = True
             self._loop.call_soon(self._drain)  # type: ignore[union-attr]
 
+    def _resend(self, item: QueuedRequest) -> None:
+        """Send a batched request again, alone (``SumBatch``)."""
+        if self._sock is None:
+            if not item.fut.done():
+                item.fut.set_exception(self._closed)
+            return
+        invoke_id, frame = self._frame(item.command, item.port, item.fields)
+        self._pending[invoke_id] = (item.fut, self._generation, item.command)
+        self._outbox.append((invoke_id, frame))
+        self._schedule_drain()
+
+    def _assemble(self, outbox: list[tuple[int, bytes] | QueuedRequest]) -> list[tuple[int, bytes]]:
+        """The outbox as frames: each run of batched reads or writes as sum commands
+        (``clients.batching``), a lone one as its plain request; in the order issued."""
+        frames: list[tuple[int, bytes]] = []
+        pending, generation = self._pending, self._generation
+        for entry in runs(outbox):
+            if type(entry) is not list:
+                frames.append(entry)
+                continue
+            for chunk in chunks(entry):
+                if len(chunk) == 1:
+                    item = chunk[0]
+                    invoke_id, frame = self._frame(item.command, item.port, item.fields)
+                    pending[invoke_id] = (item.fut, generation, item.command)
+                else:
+                    command, port, fields = sum_fields(chunk)
+                    invoke_id, frame = self._frame(command, port, fields)
+                    # timeouts name the items' command (READ), not the ReadWrite carrying it
+                    pending[invoke_id] = (SumBatch(chunk, self._resend), generation,
+                                          chunk[0].command)
+                frames.append((invoke_id, frame))
+        return frames
+
     def _flush(self) -> None:
         send, pending = self._raw_send, self._pending
-        outbox, self._outbox = self._outbox, []
+        outbox: Any = self._outbox
+        self._outbox = []
+        if self._batched:
+            self._batched = False
+            outbox = self._assemble(outbox)
+        self.frames_sent += len(outbox)
         for k, (_, frame) in enumerate(outbox):
             try:
                 send(frame, _NOBLOCK)

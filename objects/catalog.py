@@ -418,6 +418,20 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
         "reply comes after the N-th cycle is published. Refused 0x707 under another "
         "clock (project)",
     ),
+    ObjectTemplate(
+        "cnc_cycle_sched_policy_r", Scope.PLATFORM, COM, COM_CH, 0x1030, UNS16, R, "-",
+        "Scheduling policy the cycle thread got: 0 SCHED_OTHER (virtual clock, real-time "
+        "priority off or refused), 1 SCHED_FIFO (realtime clock, --rt-priority) (project)",
+    ),
+    ObjectTemplate(
+        "cnc_cycle_sched_priority_r", Scope.PLATFORM, COM, COM_CH, 0x1031, UNS16, R, "-",
+        "SCHED_FIFO priority of the cycle thread (1..99); 0 under SCHED_OTHER (project)",
+    ),
+    ObjectTemplate(
+        "cnc_memory_locked_r", Scope.PLATFORM, COM, COM_CH, 0x1032, BOOLEAN, R, "-",
+        "TRUE when the service's memory is locked in RAM (mlockall, with SCHED_FIFO) "
+        "(project)",
+    ),
     # --- COM platform axes (offsets as TwinSharp, 0x120200 / 0x<ANo>00xx) ---------------
     ObjectTemplate(
         "command_position_acs", Scope.PHYSICAL_AXIS, COM, COM_AX, 0x02, SGN32, R, "0.1 um",

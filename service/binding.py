@@ -117,6 +117,18 @@ def _lateness(fraction: float) -> Callable[[Kernel, CncObject], Getter]:
     return bind
 
 
+def _realtime_grant(attr: str) -> Callable[[Kernel, CncObject], Getter]:
+    """What the realtime clock's cycle thread was granted (``realtime_priority``), read
+    live: the thread claims it when it starts. The virtual clock asks for nothing: 0."""
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        grant = kernel.realtime_grant
+        if grant is None:
+            return lambda: 0
+        return lambda: int(getattr(grant, attr))
+
+    return bind
+
+
 def _constant(value: Callable[[Kernel], Any]) -> Callable[[Kernel, CncObject], Getter]:
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
         fixed = value(kernel)
@@ -329,6 +341,9 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "cnc_kernel_running_r": _stats("running"),
     "cnc_cycle_jitter_p50_r": _lateness(0.5),
     "cnc_cycle_jitter_p99_r": _lateness(0.99),
+    "cnc_cycle_sched_policy_r": _realtime_grant("policy"),
+    "cnc_cycle_sched_priority_r": _realtime_grant("priority"),
+    "cnc_memory_locked_r": _realtime_grant("memory_locked"),
     "command_position_acs": _per_scope(
         _physical_axis("command_position_incr"), _channel_axis("command_position_incr")
     ),

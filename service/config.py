@@ -17,6 +17,7 @@ from typing import Any
 from pydantic import Field, ValidationError
 
 from .frontend_config import AdsConfig, SecurityConfig
+from .kernel.realtime_priority import DEFAULT_RT_PRIORITY, RT_PRIORITY_MAX
 from .limits import LimitsConfig
 from .machine_config import DEFAULT_MACHINE, MachineConfig
 from .param_list import ParamListError, read_axis_list, read_channel_list
@@ -38,6 +39,12 @@ class ServiceConfig(MachineConfig):
         None, description="directory of the output area (the files the kernel writes); "
         "default: output/ in the data directory, else <program store>-output beside the "
         "store (service/data_location.py)"
+    )
+    rt_priority: int = Field(
+        DEFAULT_RT_PRIORITY, ge=0, le=RT_PRIORITY_MAX,
+        description="realtime clock: SCHED_FIFO priority (1..99) of the cycle thread, with the "
+        "service's memory locked, where the process is permitted (root, CAP_SYS_NICE); 0: a "
+        "normal thread (docs/kernel.md)",
     )
     ads: AdsConfig = Field(
         default_factory=AdsConfig, description="the ADS front end ([ads] endpoint, net_id, routes)"

@@ -217,6 +217,7 @@ def start_service(
     timeout_s: float = START_TIMEOUT_S,
     ads: bool | str = False,
     keys: bool | str | os.PathLike[str] = False,
+    wrapper: tuple[str, ...] = (),
 ) -> ServiceProcess:
     """Start ``cnc-service`` (see ``service_command``) and return once it listens.
 
@@ -227,6 +228,7 @@ def start_service(
     ``127.0.0.<n>:48898`` (another is tried when a parallel service took it first); a
     string is the ``--ads`` address. ``keys``: True makes CURVE keys of this service's
     own (``ServiceProcess.keys``, ``make_keys``); a path starts it with ``--keys PATH``.
+    ``wrapper``: a command the service runs under (``setpriv ...`` to drop privileges).
     Raises ``RuntimeError`` with the service's log when it exits before listening,
     ``TimeoutError`` when it has not listened after ``timeout_s`` (the process is killed
     then).
@@ -236,7 +238,7 @@ def start_service(
         made = make_keys(owned.name)
         try:
             service = start_service(*args, "--keys", str(made.directory), program_dir=program_dir,
-                                    cwd=cwd, timeout_s=timeout_s, ads=ads)
+                                    cwd=cwd, timeout_s=timeout_s, ads=ads, wrapper=wrapper)
         except BaseException:
             owned.cleanup()
             raise
@@ -245,11 +247,11 @@ def start_service(
     if keys is not False:
         args = (*args, "--keys", os.fspath(keys))
     if ads is False or "--ads" in args:
-        return _start(args, program_dir, cwd, timeout_s)
+        return _start(args, program_dir, cwd, timeout_s, wrapper)
     for _ in range(ADS_START_ATTEMPTS if ads is True else 1):
         address = free_loopback_ads_address() if ads is True else str(ads)
         try:
-            return _start((*args, "--ads", address), program_dir, cwd, timeout_s)
+            return _start((*args, "--ads", address), program_dir, cwd, timeout_s, wrapper)
         except RuntimeError as exc:
             if ads is not True or _ADS_BUSY not in str(exc):
                 raise
@@ -257,7 +259,8 @@ def start_service(
 
 
 def _start(args: tuple[str, ...], program_dir: str | os.PathLike[str] | None,
-           cwd: str | os.PathLike[str] | None, timeout_s: float) -> ServiceProcess:
+           cwd: str | os.PathLike[str] | None, timeout_s: float,
+           wrapper: tuple[str, ...] = ()) -> ServiceProcess:
     owned = None
     if "--program-dir" in args:
         store = Path(args[args.index("--program-dir") + 1])
@@ -269,7 +272,7 @@ def _start(args: tuple[str, ...], program_dir: str | os.PathLike[str] | None,
         store = Path(owned.name) / "programs"  # the output area goes beside it, removed too
         args = (*args, "--program-dir", str(store))
     process = subprocess.Popen(
-        service_command(*args), cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+        [*wrapper, *service_command(*args)], cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE, text=True, errors="replace",
     )
     service = ServiceProcess(process, store, owned)

@@ -10,11 +10,15 @@ command is applied at once. Kernel time is always cycles x cycle time.
 from __future__ import annotations
 
 import ctypes
+import logging
 import sys
 import time
 from typing import Protocol
 
+from .realtime_priority import DEFAULT_RT_PRIORITY, RealtimeGrant, claim
 from .state import CycleStats
+
+log = logging.getLogger(__name__)
 
 
 class Clock(Protocol):
@@ -93,15 +97,29 @@ def precise_sleep() -> None:
 
 class RealtimeClock:
     """Sleep to each deadline; a cycle that ends after the next deadline is an overrun.
-    Every cycle's lateness goes into ``lateness``."""
+    Every cycle's lateness goes into ``lateness``.
 
-    def __init__(self, cycle_s: float) -> None:
+    ``rt_priority`` (1..99): the cycle thread asks for SCHED_FIFO at this priority and
+    locks the process's memory (``realtime_priority``); 0 leaves it a normal thread.
+    ``grant`` says what it got; the first start logs it.
+    """
+
+    def __init__(self, cycle_s: float, rt_priority: int = DEFAULT_RT_PRIORITY) -> None:
         self.cycle_s = cycle_s
         self._deadline = 0.0
         self.lateness = LatenessHistogram()
+        self.grant = RealtimeGrant(rt_priority)
+        self._logged = False
 
     def start(self) -> None:
         precise_sleep()
+        claim(self.grant)  # on the cycle thread: the policy is the calling thread's
+        if not self._logged:  # once: a STOP and RUN starts the thread again, same grant
+            self._logged = True
+            if self.grant.refusals:
+                log.warning("%s", self.grant.describe())
+            else:
+                log.info("%s", self.grant.describe())
         self._deadline = time.perf_counter() + self.cycle_s
 
     def wait(self, busy: bool, stats: CycleStats, wake: WakeSource) -> None:

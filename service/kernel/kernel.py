@@ -23,6 +23,7 @@ from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
 from .commands import Command, Refusal, RefusalReason, ResetChannel
+from .realtime_priority import RealtimeGrant
 from .state import CycleStats, ErrorEntry, KernelState, Snapshot
 from .step_clock import NOT_STEPPING, STEP_RUNNING, StepClock, StepCycles
 from .switchover import Switchover
@@ -119,6 +120,8 @@ class Kernel:
         self.stats = CycleStats(cycle_us=round(config.cycle_ms * 1000))
         # cycle lateness per cycle (realtime clock only): kept by the clock, read live
         self.lateness: LatenessHistogram | None = clock.lateness
+        # what the realtime clock's cycle thread was granted (SCHED_FIFO, locked memory)
+        self.realtime_grant: RealtimeGrant | None = getattr(clock, "grant", None)
         self.snapshot: Snapshot = self.state.snapshot(0, 0, time.time_ns(), self.stats)
         self.on_cycle_end: Callable[[Snapshot], None] | None = None
         self._queue: queue.SimpleQueue[Queued] = queue.SimpleQueue()

@@ -23,6 +23,7 @@ from cnc_objects.protocol.sum import (
     decode_sum_write,
     encode_codes,
     encode_sum_read,
+    encode_sum_read_addresses,
     encode_sum_read_reply,
     encode_sum_read_write,
     encode_sum_read_write_reply,
@@ -229,3 +230,9 @@ def test_sum_read_write_request_property(quads: list[tuple[int, int, int, bytes]
 def test_sum_read_write_reply_property(results: list[tuple[int, bytes]]) -> None:
     reply = encode_sum_read_write_reply(results)
     assert decode_sum_read_write_reply(len(results), reply) == results
+
+
+def test_sum_read_of_addresses_is_the_sum_read_of_their_items() -> None:
+    addresses = [(0x121301, 0x10018, 4), (0x120101, 0x0C, 2), (0x4020, 0x10120, 300)]
+    assert encode_sum_read_addresses(addresses) == encode_sum_read(
+        [SumItem(*a) for a in addresses])
