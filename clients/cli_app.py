@@ -17,14 +17,17 @@ import contextlib
 import inspect
 import json
 from collections.abc import Callable, Iterator
-from typing import Any, NoReturn, TypeVar
+from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 
 import typer
-from rich.console import Console
+import typer.core
 
-from .blocking import Client
-from .client import AsyncClient
+from .cli_terminal import Terminal
 from .errors import AdsError, AdsTimeoutError, AuthenticationError, ClientValueError, NoReplyError
+
+if TYPE_CHECKING:  # imported where a command connects: cnc --help needs no zmq
+    from .blocking import Client
+    from .client import AsyncClient
 
 T = TypeVar("T")
 
@@ -32,14 +35,29 @@ EXIT_ADS_ERROR = 1
 EXIT_USAGE = 2
 EXIT_UNREACHABLE = 3
 
+# rich_markup_mode=None: click's plain help, without rich (docs/design-notes.md, "A quick
+# cnc"): it starts sooner, and it shows a flag as a flag (--wait, not --wait <bool>).
 app = typer.Typer(
     add_completion=False,
     no_args_is_help=True,
+    rich_markup_mode=None,
     help="Read, write, browse and watch the objects of a cnc-objects service; run and "
          "check NC programs.",
 )
-out = Console(highlight=False, soft_wrap=True)
-err = Console(stderr=True, highlight=False, soft_wrap=True)
+out = Terminal(stderr=False)
+err = Terminal(stderr=True)
+
+
+class UsageCommand(typer.core.TyperCommand):
+    """A command whose usage line names its arguments as a man page does: ``cnc run
+    [OPTIONS] PROGRAM``, an optional one in brackets (typer writes ``{PROGRAM}``)."""
+
+    def collect_usage_pieces(self, ctx: typer.Context) -> list[str]:  # type: ignore[override]
+        return [_unbraced(piece) for piece in super().collect_usage_pieces(ctx)]
+
+
+def _unbraced(piece: str) -> str:
+    return piece[1:-1] if piece.startswith("{") and piece.endswith("}") else piece
 
 
 def command(*args: Any, **kwargs: Any) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -50,6 +68,7 @@ def command(*args: Any, **kwargs: Any) -> Callable[[Callable[..., Any]], Callabl
     def register(function: Callable[..., Any]) -> Callable[..., Any]:
         text = inspect.cleandoc(function.__doc__ or "")
         help_text = "\n\n".join(" ".join(p.split()) for p in text.split("\n\n"))
+        kwargs.setdefault("cls", UsageCommand)
         return app.command(*args, help=help_text, **kwargs)(function)
 
     return register
@@ -68,11 +87,15 @@ class Settings:
 
     def client(self) -> Client:
         """A blocking client for one command (``ClientValueError`` for a bad key file)."""
+        from .blocking import Client
+
         return Client(self.endpoint, timeout_s=self.timeout_s, key_file=self.key_file,
                       server_key=self.server_key)
 
     def async_client(self) -> AsyncClient:
         """An asyncio client for one command (``ClientValueError`` for a bad key file)."""
+        from .client import AsyncClient
+
         return AsyncClient(self.endpoint, timeout_s=self.timeout_s, key_file=self.key_file,
                            server_key=self.server_key)
 

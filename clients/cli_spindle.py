@@ -7,13 +7,15 @@ The values are the channel's COM objects ``ch<c>.mc_spindle_*`` and
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
-from .blocking import Client
 from .cli_app import EXIT_USAGE, Settings, command, emit, err
 from .cli_machine import ChannelOption
+
+if TYPE_CHECKING:  # a client is made by Settings, when a command connects
+    from .blocking import Client
 
 MDEG_S_PER_RPM = 6000.0  # 0.001 degrees/s per rpm
 MODE_NAMES = {1: "M5", 2: "M3", 4: "M4", 8: "M19"}

@@ -11,7 +11,7 @@ from __future__ import annotations
 from .channel_mode import ChannelState
 from .nc import ModalState
 from .program_run import RunHost, Step
-from .state import Channel, DecoderFlag, ErrorEntry
+from .state import BLOCK_START_COLUMN, Channel, DecoderFlag, ErrorEntry
 from .syntax_check import CHECK_STOPPED_WARNING, CheckRun, Pause
 
 
@@ -89,7 +89,8 @@ class ChannelCheck:
             if p.stopped_early:
                 self._host.list_error(ErrorEntry(
                     CHECK_STOPPED_WARNING, f"syntax check stopped after {p.error_count} errors "
-                    "(syn_chk.errors_total, P-CHAN-00019)", p.file, p.line, warning=True))
+                    "(syn_chk.errors_total, P-CHAN-00019)", p.file, p.line, BLOCK_START_COLUMN,
+                    warning=True))
             return Step.ENDED
         if p.pause != Pause.NONE:
             return Step.PAUSED

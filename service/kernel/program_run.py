@@ -37,7 +37,7 @@ from .path.interpolator import StepResult, Waiting
 from .path.segments import Segment
 from .plc_functions import PlcFunctions
 from .prod_time_trace import ProdTimeTrace, trace_file_name
-from .state import Channel, ErrorEntry
+from .state import BLOCK_START_COLUMN, Channel, ErrorEntry
 
 _INCR_PER_MM = 10_000  # 0.1 um increments per mm
 PROD_TIME_STEPS_PER_CYCLE = 5_000  # virtual clock: simulated cycles per GEO cycle (PROD_TIME)
@@ -385,7 +385,8 @@ class ProgramRun:
             f"the look-ahead buffer of {self._buffer_blocks} blocks limits the path speed "
             f"to {ch.path_velocity_mm_s:.1f} mm/s (the path must be able to stop after the "
             "last buffered block): choose a larger buffer (interpolator_function, "
-            "P-CHAN-00650) or program LA_ON", ch.file_name, ch.line, warning=True))
+            "P-CHAN-00650) or program LA_ON", ch.file_name, ch.line, BLOCK_START_COLUMN,
+            warning=True))
 
     def _warn_log_full(self) -> None:
         assert self.contour is not None
