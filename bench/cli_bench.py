@@ -13,6 +13,7 @@ on a 2-core machine.
 
 from __future__ import annotations
 
+import os
 import statistics
 import subprocess
 import sys
@@ -36,71 +37,88 @@ def cnc_argv() -> list[str]:
     return [sys.executable, "-c", "from cnc_objects.clients.cli import main; main()"]
 
 
-def start_to_exit_s(argv: Sequence[str]) -> float:
-    """Wall seconds from starting ``argv`` to its exit; a failure is an error (a fast
-    failure must not pass for a fast start)."""
+@dataclass(frozen=True)
+class Start:
+    """One start of a process: wall seconds to its exit, and the CPU seconds it used (user
+    + system; on a loaded machine the wall time is mostly waiting for a core)."""
+
+    wall_s: float
+    cpu_s: float
+
+
+def start_to_exit(argv: Sequence[str]) -> Start:
+    """Start ``argv`` and wait for its exit; a failure is an error (a fast failure must
+    not pass for a fast start)."""
     started = time.perf_counter()
-    done = subprocess.run(argv, capture_output=True, text=True, timeout=60)
+    process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(process.pid, 0)
     elapsed = time.perf_counter() - started
-    if done.returncode != 0:
-        raise RuntimeError(f"{' '.join(argv)} exited {done.returncode}: {done.stderr.strip()}")
-    return elapsed
+    process.returncode = os.waitstatus_to_exitcode(status)
+    stderr = process.stderr.read().decode(errors="replace") if process.stderr else ""
+    if process.stderr:
+        process.stderr.close()
+    if process.returncode != 0:
+        raise RuntimeError(f"{' '.join(argv)} exited {process.returncode}: {stderr.strip()}")
+    return Start(elapsed, usage.ru_utime + usage.ru_stime)
 
 
 @dataclass(frozen=True)
-class StartFigures:
-    """Medians over the runs, in seconds, and the per-run ratios' medians."""
+class Figure:
+    """One measurement over the runs: medians of wall and CPU seconds, and the median of
+    the per-run ratios of the wall time to ``python -c pass``'s of the same run."""
 
-    python_s: float
-    import_zmq_s: float
-    help_s: float
-    read_s: float
-    help_ratio: float
-    read_ratio: float
+    wall_s: float
+    cpu_s: float
+    ratio: float
 
 
-def measure(runs: int = 9) -> StartFigures:
-    """``runs`` paired starts of each: python -c pass, then cnc --help; python -c 'import
-    zmq', then cnc read (against one service started for the measurement)."""
-    python = [sys.executable, "-c", "pass"]
-    import_zmq = [sys.executable, "-c", "import zmq"]
+MEASURED = ("python", "zmq", "help", "read")  # the keys of measure()'s figures
+
+
+def measure(runs: int = 9) -> dict[str, Figure]:
+    """``runs`` rounds of: python -c pass, cnc --help, python -c 'import zmq', cnc read
+    (against one service started for the measurement)."""
     cnc = cnc_argv()
     service = start_service("--clock", "realtime")
     try:
-        read = [*cnc, "--endpoint", service.endpoint, "read", READ_NAME]
-        for argv in (python, import_zmq, [*cnc, "--help"], read):  # warm the file caches
-            start_to_exit_s(argv)
-        times: dict[str, list[float]] = {k: [] for k in ("python", "zmq", "help", "read")}
-        help_ratios, read_ratios = [], []
+        argvs = {"python": [sys.executable, "-c", "pass"],
+                 "zmq": [sys.executable, "-c", "import zmq"],
+                 "help": [*cnc, "--help"],
+                 "read": [*cnc, "--endpoint", service.endpoint, "read", READ_NAME]}
+        for argv in argvs.values():  # warm the file caches
+            start_to_exit(argv)
+        starts: dict[str, list[Start]] = {k: [] for k in MEASURED}
         for _ in range(runs):
-            times["python"].append(start_to_exit_s(python))
-            times["help"].append(start_to_exit_s([*cnc, "--help"]))
-            times["zmq"].append(start_to_exit_s(import_zmq))
-            times["read"].append(start_to_exit_s(read))
-            help_ratios.append(times["help"][-1] / times["python"][-1])
-            read_ratios.append(times["read"][-1] / times["python"][-1])
+            for key in MEASURED:
+                starts[key].append(start_to_exit(argvs[key]))
     finally:
         service.stop()
-    median = {k: statistics.median(v) for k, v in times.items()}
-    return StartFigures(median["python"], median["zmq"], median["help"], median["read"],
-                        statistics.median(help_ratios), statistics.median(read_ratios))
+    baseline = [s.wall_s for s in starts["python"]]
+    return {key: Figure(statistics.median(s.wall_s for s in measured),
+                        statistics.median(s.cpu_s for s in measured),
+                        statistics.median(s.wall_s / b for s, b in zip(measured, baseline)))
+            for key, measured in starts.items()}
+
+
+LABELS = {
+    "python": "python -c pass (baseline)",
+    "zmq": "python -c 'import zmq' (baseline)",
+    "help": "cnc --help",
+    "read": f"cnc read {READ_NAME} (running service)",
+}
 
 
 def main(runs: int) -> None:
     """Measure and print the cli part's table."""
-    fig = measure(max(runs, 5))
-
-    def verdict(seconds: float) -> str:
-        return f"< {TARGET_S} s: " + ("met" if seconds < TARGET_S else "NOT met")
-
-    print(f"\ncnc start to exit: median of {max(runs, 5)} runs; ratio: median of the per-run "
-          "ratios to python -c pass")
-    print(f"\n{'measurement':44} {'ms':>8} {'ratio':>6}  target")
-    print(f"{'python -c pass (baseline)':44} {fig.python_s * 1e3:8.1f} {1.0:6.2f}")
-    zmq_label = "python -c 'import zmq' (baseline)"
-    print(f"{zmq_label:44} {fig.import_zmq_s * 1e3:8.1f} "
-          f"{fig.import_zmq_s / fig.python_s:6.2f}")
-    print(f"{'cnc --help':44} {fig.help_s * 1e3:8.1f} {fig.help_ratio:6.2f}  "
-          f"{verdict(fig.help_s)}")
-    print(f"{'cnc read ' + READ_NAME + ' (running service)':44} {fig.read_s * 1e3:8.1f} "
-          f"{fig.read_ratio:6.2f}  {verdict(fig.read_s)}")
+    runs = max(runs, 5)
+    figures = measure(runs)
+    print(f"\ncnc start to exit: median of {runs} runs; ratio: median of the per-run ratios "
+          "of the wall time to python -c pass; CPU: user + system of the process")
+    print(f"\n{'measurement':44} {'wall ms':>8} {'CPU ms':>7} {'ratio':>6}  target")
+    for key in MEASURED:
+        fig = figures[key]
+        target = ""
+        if key in ("help", "read"):
+            target = f"< {TARGET_S} s: " + ("met" if fig.wall_s < TARGET_S else "NOT met")
+        print(f"{LABELS[key]:44} {fig.wall_s * 1e3:8.1f} {fig.cpu_s * 1e3:7.1f} "
+              f"{fig.ratio:6.2f}  {target}")
