@@ -10,6 +10,8 @@ tests/clients/test_cli_help.py."""
 
 from __future__ import annotations
 
+import pytest
+
 from bench import cli_bench
 
 HELP_CPU_RATIO_MAX = 9.0  # cnc --help: about 5x python -c pass (typer and the commands)
@@ -28,7 +30,7 @@ def test_cnc_starts_quickly() -> None:
         assert fig.wall_s < WALL_S_MAX, (key, fig)
 
 
-def test_the_cli_part_prints_its_table(capsys) -> None:  # type: ignore[no-untyped-def]
+def test_the_cli_part_prints_its_table(capsys: pytest.CaptureFixture[str]) -> None:
     cli_bench.main(runs=1)  # at least 5 runs, whatever is asked
     table = capsys.readouterr().out
     for label in cli_bench.LABELS.values():

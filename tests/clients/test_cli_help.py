@@ -7,6 +7,8 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
+from collections.abc import Iterator
+from typing import Any
 
 import pytest
 import typer.main
@@ -22,7 +24,7 @@ NOT_FOR_HELP = ("numpy", "pydantic", "rich", "textual", "matplotlib", "msgpack",
 NOT_FOR_READ = ("numpy", "pydantic", "rich", "textual", "matplotlib")
 
 
-def _commands(group: typer.core.TyperGroup, prefix: tuple[str, ...] = ()):  # type: ignore[no-untyped-def]
+def _commands(group: Any, prefix: tuple[str, ...] = ()) -> Iterator[tuple[tuple[str, ...], Any]]:
     """(words, click command) of every command of ``cnc``, sub-commands included."""
     for name, command in group.commands.items():
         if isinstance(command, typer.core.TyperGroup):
@@ -31,7 +33,7 @@ def _commands(group: typer.core.TyperGroup, prefix: tuple[str, ...] = ()):  # ty
             yield (*prefix, name), command
 
 
-CNC_COMMANDS = list(_commands(typer.main.get_command(app)))  # type: ignore[arg-type]
+CNC_COMMANDS = list(_commands(typer.main.get_command(app)))
 
 
 def _help(*words: str) -> str:
