@@ -39,10 +39,12 @@ from . import (
     cli_spindle,  # noqa: F401  (spindle)
     cli_tools,  # noqa: F401  (tool, offsets)
 )
-from .cli_app import Settings, app
+from .cli_app import Settings, app, use_usage_command
 from .endpoint import DEFAULT_ENDPOINT
 
 __all__ = ["app", "main"]
+
+use_usage_command(app)  # every command registered above: arguments by name in its usage
 
 
 @app.callback()

@@ -50,14 +50,39 @@ err = Terminal(stderr=True)
 
 class UsageCommand(typer.core.TyperCommand):
     """A command whose usage line names its arguments as a man page does: ``cnc run
-    [OPTIONS] PROGRAM``, an optional one in brackets (typer writes ``{PROGRAM}``)."""
+    [OPTIONS] PROGRAM``, an optional one in brackets (typer writes ``{PROGRAM}``, and
+    ``{name}`` for an argument without a metavar)."""
 
     def collect_usage_pieces(self, ctx: typer.Context) -> list[str]:  # type: ignore[override]
-        return [_unbraced(piece) for piece in super().collect_usage_pieces(ctx)]
+        pieces = [self.options_metavar] if self.options_metavar else []
+        for param in self.get_params(ctx):
+            if param.param_type_name == "argument":
+                pieces.append(_argument_usage(param))
+            else:
+                pieces.extend(param.get_usage_pieces(ctx))
+        return pieces
 
 
-def _unbraced(piece: str) -> str:
-    return piece[1:-1] if piece.startswith("{") and piece.endswith("}") else piece
+def _argument_usage(param: Any) -> str:
+    """``PROGRAM``, ``[PATTERN]``, ``NAME...``: the metavar, else the name in capitals."""
+    name: str = param.metavar or (param.name or "").upper()
+    if param.metavar is None and param.nargs != 1:
+        name += "..."
+    if not param.required and not name.startswith("["):
+        name = f"[{name}]"
+    return name
+
+
+def use_usage_command(typer_app: typer.Typer) -> None:
+    """Every command of ``typer_app`` and of its sub-apps (``cnc tool set``) prints its
+    usage line as ``UsageCommand`` does, whichever module registered it and how; the
+    entry module calls this once every command module is imported."""
+    for info in typer_app.registered_commands:
+        if info.cls in (None, typer.core.TyperCommand):  # not a class of its own
+            info.cls = UsageCommand
+    for group in typer_app.registered_groups:
+        if group.typer_instance is not None:
+            use_usage_command(group.typer_instance)
 
 
 def command(*args: Any, **kwargs: Any) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -68,7 +93,6 @@ def command(*args: Any, **kwargs: Any) -> Callable[[Callable[..., Any]], Callabl
     def register(function: Callable[..., Any]) -> Callable[..., Any]:
         text = inspect.cleandoc(function.__doc__ or "")
         help_text = "\n\n".join(" ".join(p.split()) for p in text.split("\n\n"))
-        kwargs.setdefault("cls", UsageCommand)
         return app.command(*args, help=help_text, **kwargs)(function)
 
     return register

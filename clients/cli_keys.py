@@ -21,7 +21,7 @@ import typer
 
 from cnc_objects.protocol.roles import ROLE_NAMES, Role
 
-from .cli_app import EXIT_USAGE, Settings, UsageCommand, app, emit, say_error
+from .cli_app import EXIT_USAGE, Settings, app, emit, say_error
 from .key_files import PUBLIC_SUFFIX, SECRET_SUFFIX, SERVER_KEY_FILE
 
 CLIENTS_DIR = "clients"  # DIR/clients/<role>/<name>.key: the service's allow-list
@@ -96,7 +96,7 @@ def new(
 
 
 # typer keeps a docstring's line breaks; help reads better with one line per paragraph
-keys_app.command("new", cls=UsageCommand, help="\n\n".join(
+keys_app.command("new", help="\n\n".join(
     " ".join(p.split()) for p in inspect.cleandoc(new.__doc__ or "").split("\n\n")))(new)
 
 

@@ -42,18 +42,7 @@ from .channel_ops import (
     CheckResult,
     ProgramEntry,
 )
-from .cli_app import (
-    EXIT_USAGE,
-    Settings,
-    UsageCommand,
-    app,
-    command,
-    emit,
-    err,
-    fail,
-    out,
-    say_error,
-)
+from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
@@ -295,7 +284,7 @@ def _channel_command(method: str, done: str, request: str) -> Callable[..., None
     return command
 
 
-app.command("hold", cls=UsageCommand, help="Feedhold: the path decelerates and stops (HOLD).")(
+app.command("hold", help="Feedhold: the path decelerates and stops (HOLD).")(
     _channel_command("hold", "feedhold", "HOLD")
 )
 

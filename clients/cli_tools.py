@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from .cli_app import Settings, UsageCommand, app, emit
+from .cli_app import Settings, app, emit
 from .errors import ClientValueError
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
@@ -85,7 +85,7 @@ def _mm(value: float) -> str:
     return f"{value:.4f}"
 
 
-@tool_app.command("show", cls=UsageCommand)
+@tool_app.command("show")
 def tool_show(
     ctx: typer.Context,
     channel: int = ChannelOption,
@@ -119,7 +119,7 @@ def tool_show(
                                 f"laenge {_mm(row['length_mm']):>10} mm")
 
 
-@tool_app.command("set", cls=UsageCommand)
+@tool_app.command("set")
 def tool_set(
     ctx: typer.Context,
     d: int = typer.Argument(..., min=1, metavar="D", help="Row of the tool list (T and D number)."),
@@ -149,7 +149,7 @@ def tool_set(
          f"channel {channel}: wz[{d}] written")
 
 
-@offsets_app.command("show", cls=UsageCommand)
+@offsets_app.command("show")
 def offsets_show(ctx: typer.Context, channel: int = ChannelOption) -> None:
     """The active zero offset, the table, and the positions in ACS and PCS."""
     settings: Settings = ctx.obj
@@ -183,7 +183,7 @@ def offsets_show(ctx: typer.Context, channel: int = ChannelOption) -> None:
              + "  ".join(f"{n} {_mm(x):>10}" for n, x in offsets.items()))
 
 
-@offsets_app.command("set", cls=UsageCommand)
+@offsets_app.command("set")
 def offsets_set(
     ctx: typer.Context,
     group: str = typer.Argument(..., metavar="GROUP", help="G54..G59, or the np_grp index (G159 = i)."),

@@ -8,7 +8,7 @@ import re
 import subprocess
 import sys
 from collections.abc import Iterator
-from typing import Any
+from typing import Annotated, Any
 
 import pytest
 import typer.main
@@ -59,7 +59,33 @@ def test_every_flag_shows_as_a_flag_and_the_usage_names_the_arguments(
             assert re.search(rf"^\s+(-\w, )?{re.escape(flag)}( / --no-[\w-]+)?\s{{2}}", shown,
                              re.M), f"{flag} is not shown as a flag:\n{shown}"
         elif param.param_type_name == "argument":
-            assert param.metavar is not None and param.metavar.strip("[].") in usage
+            assert (param.metavar or param.name.upper()).strip("[].") in usage
+
+
+def test_a_command_registered_anyhow_names_its_arguments_in_capitals() -> None:
+    """Commands of other modules and sub-apps, with or without a metavar, get the same
+    usage line (``use_usage_command``)."""
+    from typer.testing import CliRunner
+
+    from cnc_objects.clients.cli_app import use_usage_command
+
+    demo, sub = typer.Typer(), typer.Typer()
+    demo.add_typer(sub, name="sub")
+
+    @demo.command()
+    def first(ident: str, more: Annotated[list[str] | None, typer.Argument()] = None) -> None:
+        """First."""
+
+    @sub.command()
+    def second(names: list[str]) -> None:
+        """Second."""
+
+    use_usage_command(demo)
+    runner = CliRunner()
+    assert "Usage: demo first [OPTIONS] IDENT [MORE...]" in runner.invoke(
+        demo, ["first", "--help"], prog_name="demo").output
+    assert "Usage: demo sub second [OPTIONS] NAMES..." in runner.invoke(
+        demo, ["sub", "second", "--help"], prog_name="demo").output
 
 
 def test_usage_lines_name_the_program() -> None:
