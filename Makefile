@@ -3,6 +3,10 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 ENDPOINT ?= tcp://127.0.0.1:5555
+# make run ADS=0.0.0.0:48898 DATA_DIR=/srv/cnc: where ADS clients connect (HOST[:PORT], off
+# disables ADS) and the data directory (programs/ and output/); empty: the service's default.
+ADS      ?=
+DATA_DIR ?=
 
 .PHONY: run test bench soak clean generate
 
@@ -20,7 +24,8 @@ $(VENV)/.installed-test: pyproject.toml | $(BIN)/python
 	touch $@ $(VENV)/.installed
 
 run: $(VENV)/.installed
-	$(BIN)/cnc-service --endpoint $(ENDPOINT)
+	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) \
+		$(if $(DATA_DIR),--data-dir $(DATA_DIR))
 
 # The checkers first (ruff: lint and import order; mypy, strict: tools/typecheck.py), then
 # the tests.

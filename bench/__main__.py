@@ -28,6 +28,9 @@ and with 20 on-change subscriptions (``bench/virtual_bench.py``).
 Fairness part (``--part fairness``): another client's read latency while one client
 holds every notification the service takes (20 000 cyclic, 1 ms), idle and loaded
 (``bench/fairness_bench.py``; target p99 < 10 ms).
+CLI part (``--part cli``): ``cnc --help`` and ``cnc read`` of one object, start to exit,
+against ``python -c pass`` and ``python -c 'import zmq'`` (``bench/cli_bench.py``; target
+< 0.25 s each).
 Dispatch part (``--part dispatch``):
 
 Baseline: a raw pyzmq ROUTER in a second process that answers each msgpack frame with a
@@ -209,14 +212,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
     parser.add_argument("--part", choices=("all", "dispatch", "client", "ads", "kernel",
-                                           "jitter", "virtual", "lookahead", "fairness"),
+                                           "jitter", "virtual", "lookahead", "fairness", "cli"),
                         default="all",
                         help="dispatch: request dispatch (ZeroMQ); client: AsyncClient "
                         "batching against the raw echo, wall and CPU; ads: pyads over AMS/TCP; "
                         "kernel: decoder, interpolator, planner; jitter: the realtime cycle "
                         "under load; virtual: whole-service virtual time speed; lookahead: "
                         "machining time against the optimum; fairness: reads while the "
-                        "notification limit is used up")
+                        "notification limit is used up; cli: cnc's start to exit")
     parser.add_argument("--jitter-s", type=float, default=20.0,
                         help="seconds of load per jitter run (issue 22 asks 60)")
     args = parser.parse_args(argv)
@@ -245,6 +248,10 @@ def main(argv: list[str] | None = None) -> int:
         from . import fairness_bench
 
         fairness_bench.main(min(args.runs, 3), 2000)
+    if args.part in ("all", "cli"):
+        from . import cli_bench
+
+        cli_bench.main(args.runs)
     if args.part in ("all", "lookahead"):
         from . import lookahead_bench
 

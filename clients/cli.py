@@ -41,21 +41,25 @@ from . import (
     cli_step,  # noqa: F401  (step: the step clock)
     cli_tools,  # noqa: F401  (tool, offsets)
 )
-from .cli_app import Settings, app
-from .client import DEFAULT_ENDPOINT
+from .cli_app import Settings, app, use_usage_command
+from .endpoint import DEFAULT_ENDPOINT
 
 __all__ = ["app", "main"]
+
+use_usage_command(app)  # every command registered above: arguments by name in its usage
 
 
 @app.callback()
 def main_options(
     ctx: typer.Context,
     endpoint: str = typer.Option(
-        os.environ.get("CNC_ENDPOINT", DEFAULT_ENDPOINT), "--endpoint", "-e",
+        os.environ.get("CNC_ENDPOINT", DEFAULT_ENDPOINT), "--endpoint", "-e", metavar="URL",
         help="Service endpoint (default: $CNC_ENDPOINT, else tcp://127.0.0.1:5555).",
     ),
     as_json: bool = typer.Option(False, "--json", help="One JSON object per line."),
-    timeout_s: float = typer.Option(5.0, "--timeout", min=0.01, help="Seconds to wait for a reply."),
+    timeout_s: float = typer.Option(
+        5.0, "--timeout", min=0.01, metavar="S",
+        help="Seconds to wait for the service's reply to each request."),
     key_file: str = typer.Option(
         None, "--key", metavar="FILE", envvar="CNC_KEY", show_envvar=False,
         help="This client's CURVE secret key file, for a service with --keys (default: "

@@ -39,10 +39,10 @@ def alarms(
     history: bool = typer.Option(False, "--history", help="Also list the history."),
     watch: bool = typer.Option(
         False, "--watch", help="After the list, print each event as it comes (until "
-        "Ctrl-C, --count or --watch-timeout)."),
+        "Ctrl-C, --count or --wait-timeout)."),
     count: int = typer.Option(0, "--count", min=0,
                               help="With --watch: stop after COUNT events (0: never)."),
-    timeout_s: float = typer.Option(None, "--watch-timeout", min=0.0,
+    timeout_s: float = typer.Option(None, "--wait-timeout", min=0.0,
                                     help="With --watch: stop after S seconds."),
 ) -> None:
     """List the active alarms, newest first: sequence number, state, severity, id,
@@ -85,7 +85,7 @@ def _watch(settings: Settings, count: int, timeout_s: float | None) -> None:
     except KeyboardInterrupt:
         raise typer.Exit(0) from None
     except TimeoutError:
-        return  # --watch-timeout: the watch ends
+        return  # --wait-timeout: the watch ends
     except (AdsError, ClientValueError) as exc:
         fail(exc)
 

@@ -17,15 +17,18 @@ import contextlib
 import inspect
 import json
 from collections.abc import Callable, Iterator
-from typing import Any, NoReturn, TypeVar
+from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 
 import typer
-from rich.console import Console
+import typer.core
 
-from .blocking import Client
-from .client import AsyncClient
+from .cli_terminal import Terminal
 from .errors import AdsError, AdsTimeoutError, AuthenticationError, ClientValueError, NoReplyError
 from .units import tidy
+
+if TYPE_CHECKING:  # imported where a command connects: cnc --help needs no zmq
+    from .blocking import Client
+    from .client import AsyncClient
 
 T = TypeVar("T")
 
@@ -33,14 +36,54 @@ EXIT_ADS_ERROR = 1
 EXIT_USAGE = 2
 EXIT_UNREACHABLE = 3
 
+# rich_markup_mode=None: click's plain help, without rich (docs/design-notes.md, "A quick
+# cnc"): it starts sooner, and it shows a flag as a flag (--wait, not --wait <bool>).
 app = typer.Typer(
     add_completion=False,
     no_args_is_help=True,
+    rich_markup_mode=None,
     help="Read, write, browse and watch the objects of a cnc-objects service; run and "
          "check NC programs.",
 )
-out = Console(highlight=False, soft_wrap=True)
-err = Console(stderr=True, highlight=False, soft_wrap=True)
+out = Terminal(stderr=False)
+err = Terminal(stderr=True)
+
+
+class UsageCommand(typer.core.TyperCommand):
+    """A command whose usage line names its arguments as a man page does: ``cnc run
+    [OPTIONS] PROGRAM``, an optional one in brackets (typer writes ``{PROGRAM}``, and
+    ``{name}`` for an argument without a metavar)."""
+
+    def collect_usage_pieces(self, ctx: typer.Context) -> list[str]:  # type: ignore[override]
+        pieces = [self.options_metavar] if self.options_metavar else []
+        for param in self.get_params(ctx):
+            if param.param_type_name == "argument":
+                pieces.append(_argument_usage(param))
+            else:
+                pieces.extend(param.get_usage_pieces(ctx))
+        return pieces
+
+
+def _argument_usage(param: Any) -> str:
+    """``PROGRAM``, ``[PATTERN]``, ``NAME...``: the metavar, else the name in capitals."""
+    name: str = param.metavar or (param.name or "").upper()
+    if param.metavar is None and param.nargs != 1:
+        name += "..."
+    if not param.required and not name.startswith("["):
+        name = f"[{name}]"
+    return name
+
+
+def use_usage_command(typer_app: typer.Typer) -> None:
+    """Every command of ``typer_app`` and of its sub-apps (``cnc tool set``) prints its
+    usage line as ``UsageCommand`` does, whichever module registered it and how; the
+    entry module calls this once every command module is imported."""
+    for info in typer_app.registered_commands:
+        if info.cls in (None, typer.core.TyperCommand):  # not a class of its own
+            info.cls = UsageCommand
+    for group in typer_app.registered_groups:
+        if group.typer_instance is not None:
+            use_usage_command(group.typer_instance)
 
 
 def command(*args: Any, **kwargs: Any) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -69,11 +112,15 @@ class Settings:
 
     def client(self) -> Client:
         """A blocking client for one command (``ClientValueError`` for a bad key file)."""
+        from .blocking import Client
+
         return Client(self.endpoint, timeout_s=self.timeout_s, key_file=self.key_file,
                       server_key=self.server_key)
 
     def async_client(self) -> AsyncClient:
         """An asyncio client for one command (``ClientValueError`` for a bad key file)."""
+        from .client import AsyncClient
+
         return AsyncClient(self.endpoint, timeout_s=self.timeout_s, key_file=self.key_file,
                            server_key=self.server_key)
 

@@ -18,12 +18,11 @@ import shutil
 from pathlib import Path
 
 import typer
-import zmq.auth
 
 from cnc_objects.protocol.roles import ROLE_NAMES, Role
 
 from .cli_app import EXIT_USAGE, Settings, app, emit, say_error
-from .curve import PUBLIC_SUFFIX, SECRET_SUFFIX, SERVER_KEY_FILE
+from .key_files import PUBLIC_SUFFIX, SECRET_SUFFIX, SERVER_KEY_FILE
 
 CLIENTS_DIR = "clients"  # DIR/clients/<role>/<name>.key: the service's allow-list
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,62}")
@@ -82,6 +81,8 @@ def new(
     allowed = _allowed_path(allow_in, granted, name, force) if allow_in is not None else None
     try:
         directory.mkdir(parents=True, exist_ok=True)
+        import zmq.auth  # here: the other commands start without zmq
+
         zmq.auth.create_certificates(directory, name)
         secret.chmod(0o600)  # pyzmq writes it with the umask's mode
     except OSError as exc:

@@ -2,18 +2,18 @@
 
     cnc upload FILE [--name NAME]        cnc download NAME [-o FILE]      cnc programs
     cnc outputs                          cnc output NAME [-o FILE]        cnc delete-output NAME
-    cnc run FILE|NAME [--channel N] [--wait] [--timeout S]
-    cnc mdi "BLOCKS" [--channel N] [--wait] [--timeout S]
+    cnc run FILE|NAME [--channel N] [--wait] [--wait-timeout S]
+    cnc mdi "BLOCKS" [--channel N] [--wait] [--wait-timeout S]
     cnc hold [--channel N]
-    cnc resume [--channel N] [--wait] [--timeout S]
+    cnc resume [--channel N] [--wait] [--wait-timeout S]
     cnc reset [--channel N] [--standard]
     cnc status [--channel N]
     cnc lookahead [START] [--length MM] [--index I] [--raw]
-    cnc check FILE|NAME [--channel N] [--errors-total K] [--log] [--timeout S]
+    cnc check FILE|NAME [--channel N] [--errors-total K] [--log] [--wait-timeout S]
 
 ``--wait`` exits 0 when the program (or manual block) has finished, 4 with the channel's
-error text when the channel went to ERROR, 5 when ``--timeout`` passed first (default
-600 s; ``--timeout 0`` waits without limit), naming why the channel stands (its wait
+error text when the channel went to ERROR, 5 when ``--wait-timeout`` passed first (default
+600 s; ``--wait-timeout 0`` waits without limit), naming why the channel stands (its wait
 reason, ``ch<c>.mc_wait_reason_r``). While it waits, each wait reason that has held
 for a second is printed as one line on stderr (``channel 1 waits: feed hold: waiting
 for START (FEED_HOLD)``; ``channel 1 goes on`` when it clears). ``status`` shows single
@@ -23,7 +23,7 @@ in ERROR refuses ``run``, ``mdi`` and ``resume`` (exit 1, naming its errors) unt
 (no SYNCHK, MACHINE_LOCK, PROD_TIME bit; ``syn_chk.record_result`` off). ``status`` shows
 the execution mode in effect and, when it differs, the one the next start takes.
 ``check`` exits 0 when the program is clean, 1 when the check found errors or was
-aborted, 2 when there is no result (bad usage, no service, an ADS error, ``--timeout``).
+aborted, 2 when there is no result (bad usage, no service, an ADS error, ``--wait-timeout``).
 """
 
 from __future__ import annotations
@@ -34,11 +34,12 @@ import sys
 from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
-from .blocking import Client
+from cnc_objects.protocol.errors import AdsReturnCode
+
 from .channel_ops import (
     CONTOUR_BLOCK_TYPES,
     ChannelStatus,
@@ -52,24 +53,27 @@ from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, s
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
 from .units import tidy
 
+if TYPE_CHECKING:  # a client is made by Settings, when a command connects
+    from .blocking import Client
+
 EXIT_CHANNEL_ERROR = 4
 EXIT_WAIT_TIMEOUT = 5
 
-ChannelOption = typer.Option(1, "--channel", "-c", min=1, help="Channel id (default 1).")
+ChannelOption = typer.Option(1, "--channel", "-c", min=1, metavar="N", help="Channel id (default 1).")
 WaitOption = typer.Option(False, "--wait", help="Return when finished; non-zero on ERROR.")
-WAIT_TIMEOUT_DEFAULT_S = 600.0  # --wait gives up after this long unless --timeout says
+WAIT_TIMEOUT_DEFAULT_S = 600.0  # --wait gives up after this long unless --wait-timeout says
 # --wait prints a wait reason once it has held this long (wall time): the few cycles a
 # start waits for its first blocks, a short dwell or spindle ramp are not news
 WAIT_REASON_SETTLE_S = 1.0
 WaitTimeoutOption = typer.Option(
-    WAIT_TIMEOUT_DEFAULT_S, "--timeout", min=0.0,
+    WAIT_TIMEOUT_DEFAULT_S, "--wait-timeout", min=0.0, metavar="S",
     help="With --wait: give up after S seconds (exit 5, naming why the channel stands); "
          "0 = no limit.",
 )
 
 
 def wait_limit_s(timeout_s: float | None) -> float | None:
-    """The wait's limit for ``--timeout``: 0 (or none given) waits without limit."""
+    """The wait's limit for ``--wait-timeout``: 0 (or none given) waits without limit."""
     return timeout_s or None
 
 
@@ -95,9 +99,19 @@ def finish_wait(exc: Exception) -> None:
 
 
 def store_local(c: Client, name: str, data: bytes | None) -> None:
-    """Upload a local program (``data`` from ``local_program``) before it is used."""
-    if data is not None:
+    """Upload a local program (``data`` from ``local_program``) before it is used. A role
+    that may not upload is refused with the role that may (the service's words) and told
+    how to do without: a program already in the store is run by its name."""
+    if data is None:
+        return
+    try:
         c.upload(name, data)
+    except AdsError as exc:
+        if exc.code != AdsReturnCode.DEVICE_INVALIDACCESS:
+            raise
+        raise AdsError(exc.code, f"{exc.detail} (a local file is uploaded first; a program "
+                       "in the store runs by its name without an upload: cnc programs lists "
+                       "them)") from None
 
 
 def local_program(program: str) -> tuple[str, bytes | None]:
@@ -116,7 +130,7 @@ def local_program(program: str) -> tuple[str, bytes | None]:
 @command()
 def upload(
     ctx: typer.Context,
-    file: Path = typer.Argument(..., help="Local NC file."),
+    file: Path = typer.Argument(..., metavar="FILE", help="Local NC file."),
     name: str = typer.Option(None, "--name", help="Name in the store (default: file name)."),
 ) -> None:
     """Upload a local NC file into the service's program store."""
@@ -135,7 +149,7 @@ def upload(
 @command()
 def download(
     ctx: typer.Context,
-    name: str = typer.Argument(..., help="Name in the store."),
+    name: str = typer.Argument(..., metavar="NAME", help="Name in the store."),
     output: Path = typer.Option(None, "--output", "-o",
                                 help="Write here (default, or '-': stdout)."),
 ) -> None:
@@ -186,7 +200,7 @@ def outputs(ctx: typer.Context) -> None:
 @command()
 def output(
     ctx: typer.Context,
-    name: str = typer.Argument(..., help="Name in the output area."),
+    name: str = typer.Argument(..., metavar="NAME", help="Name in the output area."),
     output_file: Path = typer.Option(None, "--output", "-o",
                                      help="Write here (default, or '-': stdout)."),
 ) -> None:
@@ -198,7 +212,8 @@ def output(
 
 @command("delete-output")
 def delete_output(
-    ctx: typer.Context, name: str = typer.Argument(..., help="Name in the output area."),
+    ctx: typer.Context,
+    name: str = typer.Argument(..., metavar="NAME", help="Name in the output area."),
 ) -> None:
     """Delete a file of the output area (operator or admin)."""
     settings: Settings = ctx.obj
@@ -248,7 +263,8 @@ def start_and_report(
 @command()
 def run(
     ctx: typer.Context,
-    program: str = typer.Argument(..., help="A local file (uploaded first) or a stored name."),
+    program: str = typer.Argument(
+        ..., metavar="PROGRAM", help="A local file (uploaded first) or a stored name."),
     channel: int = ChannelOption,
     wait: bool = WaitOption,
     timeout_s: float = WaitTimeoutOption,
@@ -268,7 +284,7 @@ def run(
 @command()
 def mdi(
     ctx: typer.Context,
-    blocks: str = typer.Argument(..., help="NC blocks; separate blocks with newlines or a "
+    blocks: str = typer.Argument(..., metavar="BLOCKS", help="NC blocks; separate blocks with newlines or a "
                                  "literal \\n (';' starts a comment, as in NC programs)."),
     channel: int = ChannelOption,
     wait: bool = WaitOption,
@@ -377,7 +393,7 @@ def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
 def lookahead(
     ctx: typer.Context,
     start: float = typer.Argument(
-        0.0, help="Mode 1: index in the marked area; mode 2: path distance in mm."),
+        0.0, metavar="START", help="Mode 1: index in the marked area; mode 2: path distance in mm."),
     length: float = typer.Option(
         0.0, "--length", "-l", min=0.0,
         help="0: mode 1 (by index); else mode 2: window length in mm."),
@@ -466,7 +482,8 @@ def _check_summary(result: CheckResult, channel: int) -> str:
 @command()
 def check(
     ctx: typer.Context,
-    program: str = typer.Argument(..., help="A local file (uploaded first) or a stored name."),
+    program: str = typer.Argument(
+        ..., metavar="PROGRAM", help="A local file (uploaded first) or a stored name."),
     channel: int = ChannelOption,
     errors_total: int = typer.Option(
         None, "--errors-total", min=0, max=0xFFFF,
@@ -474,7 +491,8 @@ def check(
     show_log: bool = typer.Option(
         False, "--log", help="Print the log dec0<N>.sc (with --json: one {\"log\": ...} line)."),
     timeout_s: float = typer.Option(
-        None, "--timeout", min=0.0, help="Give up after S seconds (the check is RESET; exit 2)."),
+        None, "--wait-timeout", min=0.0, metavar="S",
+        help="Give up after S seconds (the check is RESET; exit 2)."),
 ) -> None:
     """Syntax check (SYNCHK | MACHINE_LOCK): report every error, move nothing.
 

@@ -1,37 +1,39 @@
 """``cnc`` commands of manual mode: jog an axis, turn the handwheel, home axes.
 
-    cnc jog AXIS +|- [--increment MM] [--channel N] [--rapid] [--no-wait] [--timeout S]
+    cnc jog AXIS +|- [--increment MM] [--channel N] [--rapid] [--no-wait] [--wait-timeout S]
     cnc jog AXIS +|- --continuous        (the key stays pressed; --stop releases it)
     cnc jog AXIS --stop
     cnc jog AXIS +|- --handwheel PULSES  (the handwheel counter moves by PULSES)
-    cnc home AXIS... [--channel N] [--timeout S]
+    cnc home AXIS... [--channel N] [--wait-timeout S]
 
 Each command selects the channel mode MANUAL when the channel is in another mode and
 idle, then writes the axis's manual-mode objects (docs/manual.md) as an HMI would. AXIS
 is the axis name in the channel (``X``) or its index from 1. Without ``--no-wait`` the
 command waits until the axis stands and prints where; a stop at a software limit is
 told on stderr (``warning: ...``, exit 0). A refusal (channel in ERROR or HOLD, axis
-homing, value out of range) exits 1 with the kernel's sentence; ``--timeout`` exits 5.
+homing, value out of range) exits 1 with the kernel's sentence; ``--wait-timeout`` exits 5.
 """
 
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
-from .blocking import Client
 from .cli_app import EXIT_USAGE, Settings, command, emit, err, fail, say_error
 from .errors import AdsError, ClientValueError
 from .units import engineering, raw_value
+
+if TYPE_CHECKING:  # a client is made by Settings, when a command connects
+    from .blocking import Client
 
 EXIT_WAIT_TIMEOUT = 5
 _MANUAL = 4  # ChannelMode.MANUAL
 _HANDWHEEL, _CONTINUOUS, _INCREMENTAL = 1, 2, 3  # ManualOperationMode
 _POLL_S = 0.02
 _MAX_AXES = 32
-AxesArgument = typer.Argument(..., help="Axis names (X Y Z) or indices, homed together.")
+AxesArgument = typer.Argument(..., metavar="AXIS...", help="Axis names (X Y Z) or indices, homed together.")
 
 
 def _axis_index(c: Client, channel: int, axis: str) -> int:
@@ -91,8 +93,8 @@ def _report(settings: Settings, c: Client, channel: int, axis: int, name: str) -
 @command()
 def jog(
     ctx: typer.Context,
-    axis: str = typer.Argument(..., help="Axis name in the channel (X) or index from 1."),
-    direction: str = typer.Argument(None, help="+ or - (not with --stop)."),
+    axis: str = typer.Argument(..., metavar="AXIS", help="Axis name in the channel (X) or index from 1."),
+    direction: str = typer.Argument(None, metavar="[+|-]", help="+ or - (not with --stop)."),
     increment_mm: float = typer.Option(
         None, "--increment", help="Jog by increments: this distance (mm, 0.0001..10). "
         "The default when no other mode is given: 1 mm."),
@@ -102,9 +104,9 @@ def jog(
     handwheel: int = typer.Option(None, "--handwheel",
                                   help="Handwheel mode: turn the counter by PULSES."),
     rapid: bool = typer.Option(False, "--rapid", help="Press the rapid key (rapid jog speed)."),
-    channel: int = typer.Option(1, "--channel", "-c", min=1, help="Channel id (default 1)."),
+    channel: int = typer.Option(1, "--channel", "-c", min=1, metavar="N", help="Channel id (default 1)."),
     no_wait: bool = typer.Option(False, "--no-wait", help="Do not wait for standstill."),
-    timeout_s: float = typer.Option(None, "--timeout", min=0.0,
+    timeout_s: float = typer.Option(None, "--wait-timeout", min=0.0, metavar="S",
                                     help="Give up waiting after S seconds (exit 5)."),
 ) -> None:
     """Jog an axis in manual mode: by an increment (default 1 mm), continuously, or by the
@@ -157,8 +159,8 @@ def jog(
 def home(
     ctx: typer.Context,
     axes: list[str] = AxesArgument,
-    channel: int = typer.Option(1, "--channel", "-c", min=1, help="Channel id (default 1)."),
-    timeout_s: float = typer.Option(None, "--timeout", min=0.0,
+    channel: int = typer.Option(1, "--channel", "-c", min=1, metavar="N", help="Channel id (default 1)."),
+    timeout_s: float = typer.Option(None, "--wait-timeout", min=0.0, metavar="S",
                                     help="Give up waiting after S seconds (exit 5)."),
 ) -> None:
     """Home axes in manual mode (to their reference position P-AXIS-00152) and wait until

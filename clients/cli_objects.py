@@ -3,7 +3,7 @@
     cnc info                             cnc browse [PATTERN]
     cnc read NAME... [--raw] | --port P --group G --offset O --type T
     cnc write NAME VALUE [--raw] | VALUE --port P --group G --offset O --type T
-    cnc watch NAME... [--raw] [--count N] [--timeout S] [--cyclic] [--cycle-ms MS]
+    cnc watch NAME... [--raw] [--count N] [--wait-timeout S] [--cyclic] [--cycle-ms MS]
 
 A value is printed in engineering units, as the service's scale of the object says
 (``ch1.mc_active_feed_override_r = 50.0 %``, ``ch1.ax1.command_position_acs = 12.5000
@@ -18,22 +18,23 @@ ADS 0x710 and the nearest names (``did you mean ...?``).
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 from dataclasses import asdict
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from cnc_objects.protocol.datatypes import DataType, parse_type, parse_value
 
 from .cli_app import EXIT_USAGE, Settings, command, emit, fail, out, say_error
-from .client import AsyncClient
 from .errors import AdsError, ClientValueError, NoReplyError
 from .object_info import ObjectInfo
 from .units import parse_engineering, record, show
 
-EXIT_WATCH_TIMEOUT = 5  # watch --count N --timeout S: a name got fewer than N samples
+if TYPE_CHECKING:  # a client is made by Settings, when a command connects
+    from .client import AsyncClient
+
+EXIT_WATCH_TIMEOUT = 5  # watch --count N --wait-timeout S: a name got fewer than N samples
 
 # The address options of read and write, declared once.
 PortOption = Annotated[
@@ -108,7 +109,8 @@ def info(ctx: typer.Context) -> None:
 
 @command()
 def browse(
-    ctx: typer.Context, pattern: str = typer.Argument("*", help="Glob over object names.")
+    ctx: typer.Context,
+    pattern: str = typer.Argument("*", metavar="[PATTERN]", help="Glob over object names."),
 ) -> None:
     """List the objects whose names match PATTERN.
 
@@ -140,7 +142,7 @@ def browse(
 @command()
 def read(
     ctx: typer.Context,
-    names: list[str] = typer.Argument(None, help="Object names."),
+    names: list[str] = typer.Argument(None, metavar="[NAME]...", help="Object names."),
     port: PortOption = None,
     group: GroupOption = None,
     offset: OffsetOption = None,
@@ -193,8 +195,9 @@ def _expanded(client: Any, names: list[str]) -> list[str]:
 @command(context_settings={"ignore_unknown_options": True})
 def write(
     ctx: typer.Context,
-    args: list[str] = typer.Argument(..., help="NAME VALUE, or VALUE with an address. "
-                                     "Negative values as they are: write ch1.x -1."),
+    args: list[str] = typer.Argument(
+        ..., metavar="[NAME] VALUE", help="NAME VALUE, or VALUE with an address. "
+        "Negative values as they are: write ch1.x -1."),
     port: PortOption = None,
     group: GroupOption = None,
     offset: OffsetOption = None,
@@ -243,24 +246,26 @@ def write(
 @command()
 def watch(
     ctx: typer.Context,
-    names: list[str] = typer.Argument(..., help="Object names."),
+    names: list[str] = typer.Argument(..., metavar="NAME...", help="Object names."),
     count: int = typer.Option(
         0, min=0, help="Stop after COUNT samples of each object (0: never). The first "
         "sample is the current value; on change, the next ones come only when it changes."),
     timeout_s: float = typer.Option(
-        None, "--timeout", min=0.0, help="Stop after S seconds; with --count, exit 5 when "
+        None, "--wait-timeout", min=0.0, metavar="S", help="Stop after S seconds; with --count, exit 5 when "
         "an object got fewer than COUNT samples by then."),
     cycle_ms: int = typer.Option(None, "--cycle-ms", min=0, help="Sampling cycle in kernel ms."),
     cyclic: bool = typer.Option(False, help="Send every cycle, not only on change."),
     raw: RawOption = False,
 ) -> None:
-    """Print samples of objects as the service sends them (until Ctrl-C, COUNT, --timeout).
+    """Print samples of objects as the service sends them (until Ctrl-C, COUNT, --wait-timeout).
 
     Each object's first sample is its current value, sent at subscription. On change
     (the default) the next sample comes only when the value changes, so --count 2 of a
-    value that stays waits for a change: bound the wait with --timeout (exit 5 when
+    value that stays waits for a change: bound the wait with --wait-timeout (exit 5 when
     COUNT was not reached), or use --cyclic for a sample every cycle.
     """
+    import asyncio  # here: the commands that need no event loop start without it
+
     settings: Settings = ctx.obj
     seen = dict.fromkeys(names, 0)
 
@@ -280,7 +285,7 @@ def watch(
                     return
 
     async def run() -> bool:
-        """True when every object got its samples (or no COUNT), False at --timeout."""
+        """True when every object got its samples (or no COUNT), False at --wait-timeout."""
         async with settings.async_client() as c:
             infos = {}
             for name in names:  # fail on a bad name before printing anything
@@ -294,7 +299,7 @@ def watch(
                     await asyncio.gather(*(one(c, name, infos[name]) for name in names))
             except TimeoutError:
                 if not timer.expired():
-                    raise  # a request without reply, not --timeout
+                    raise  # a request without reply, not --wait-timeout
                 return not count or all(n >= count for n in seen.values())
         return True
 

@@ -4,12 +4,13 @@ The program runs as a machining time calculation (PROD_TIME) in kernel time, tra
 by cycle; no axis of the live machine moves. The PNG shows the XY path (equal scale) and
 the path speed over the path distance with the feed limit. Exit 0 written; 4 the run
 ended in ERROR (the plot shows the path up to the error; the channel stays in ERROR
-until ``cnc reset``); 5 ``--timeout`` passed; 1 ADS error; 2 usage; 3 no service.
+until ``cnc reset``); 5 ``--wait-timeout`` passed; 1 ADS error; 2 usage; 3 no service.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
@@ -23,21 +24,24 @@ from .cli_machine import (
 )
 from .errors import AdsError, ChannelError, ClientValueError
 from .figure_png import PlotExtraMissing, require_matplotlib
-from .path_plot import plot_trace
-from .path_trace import PathTrace
+
+if TYPE_CHECKING:
+    from .path_trace import PathTrace
 
 
 @command()
 def plot(
     ctx: typer.Context,
-    program: str = typer.Argument(..., help="A local file (uploaded first) or a stored name."),
+    program: str = typer.Argument(
+        ..., metavar="PROGRAM", help="A local file (uploaded first) or a stored name."),
     output: Path = typer.Option(
         None, "--output", "-o", help="PNG file to write (default: <program stem>.png)."),
     channel: int = ChannelOption,
     axes: str = typer.Option("XY", "--axes", help="The two axes of the path plot, e.g. XZ."),
     width_px: int = typer.Option(1200, "--width", min=300, max=8000, help="Width in pixels."),
     timeout_s: float = typer.Option(
-        None, "--timeout", min=0.0, help="Give up after S seconds (the run is RESET; exit 5)."),
+        None, "--wait-timeout", min=0.0, metavar="S",
+        help="Give up after S seconds (the run is RESET; exit 5)."),
 ) -> None:
     """Dry run (PROD_TIME, nothing moves) drawn into a PNG.
 
@@ -61,6 +65,8 @@ def plot(
             trace: PathTrace = c.trace_run(name, channel, timeout_s)
     except (AdsError, ChannelError, ClientValueError) as exc:
         finish_wait(exc)
+    from .path_plot import plot_trace  # numpy and matplotlib: only for the drawing
+
     try:
         png = plot_trace(trace, width_px=width_px, x_axis=axes[0], y_axis=axes[1])
     except KeyError as exc:

@@ -7,15 +7,16 @@ The values are the channel's COM objects ``ch<c>.mc_spindle_*`` and
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
-from .blocking import Client
 from .cli_app import EXIT_USAGE, Settings, command, emit, err
 from .cli_machine import ChannelOption
 from .units import engineering, raw_value
 
+if TYPE_CHECKING:  # a client is made by Settings, when a command connects
+    from .blocking import Client
 MODE_NAMES = {1: "M5", 2: "M3", 4: "M4", 8: "M19"}
 SYNC_NAMES = {0: "-", 1: "MOS", 2: "MVS_SVS", 4: "MVS_SNS", 8: "MNS_SNS"}
 TYPE_NAMES = {1: "M", 2: "H", 3: "S", 4: "T"}

@@ -17,16 +17,18 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
-from .blocking import Client
 from .cli_app import Settings, app, emit
 from .errors import ClientValueError
 from .units import engineering, raw_value
 
-ChannelOption = typer.Option(1, "--channel", "-c", min=1, help="Channel id (default 1).")
+if TYPE_CHECKING:  # a client is made by Settings, when a command connects
+    from .blocking import Client
+
+ChannelOption = typer.Option(1, "--channel", "-c", min=1, metavar="N", help="Channel id (default 1).")
 
 tool_app = typer.Typer(no_args_is_help=True, help="The tool list wz[i] and the active tool.")
 offsets_app = typer.Typer(no_args_is_help=True,
@@ -34,7 +36,7 @@ offsets_app = typer.Typer(no_args_is_help=True,
 app.add_typer(tool_app, name="tool")
 app.add_typer(offsets_app, name="offsets")
 
-ValuesArgument = typer.Argument(..., help="AXIS=MM, e.g. X=10 Y=-5.5")
+ValuesArgument = typer.Argument(..., metavar="AXIS=MM...", help="AXIS=MM, e.g. X=10 Y=-5.5")
 _GROUP = re.compile(r"^(?:G(5[4-9])|(\d+))$", re.IGNORECASE)
 _ASSIGNMENT = re.compile(r"^([A-Za-z])=([-+]?[0-9.]+(?:[eE][-+]?\d+)?)$")
 
@@ -129,7 +131,7 @@ def tool_show(
 @tool_app.command("set")
 def tool_set(
     ctx: typer.Context,
-    d: int = typer.Argument(..., min=1, help="Row of the tool list (T and D number)."),
+    d: int = typer.Argument(..., min=1, metavar="D", help="Row of the tool list (T and D number)."),
     radius_mm: float = typer.Option(None, "--radius", help="Tool radius (mm, >= 0)."),
     length_mm: float = typer.Option(None, "--length", help="Tool length (mm)."),
     invalid: bool = typer.Option(False, "--invalid", help="Empty the row (T/D refuse it)."),
@@ -195,7 +197,7 @@ def offsets_show(ctx: typer.Context, channel: int = ChannelOption) -> None:
 @offsets_app.command("set")
 def offsets_set(
     ctx: typer.Context,
-    group: str = typer.Argument(..., help="G54..G59, or the np_grp index (G159 = i)."),
+    group: str = typer.Argument(..., metavar="GROUP", help="G54..G59, or the np_grp index (G159 = i)."),
     values: list[str] = ValuesArgument,
     channel: int = ChannelOption,
 ) -> None:

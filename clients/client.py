@@ -63,13 +63,13 @@ from .channel_ops import (
     ProgramEntry,
 )
 from .curve import client_curve
+from .endpoint import DEFAULT_ENDPOINT as DEFAULT_ENDPOINT  # re-exported: its old home
 from .errors import AdsConnectionError, AdsError, ClientValueError, NoReplyError
 from .object_info import ObjectInfo
 from .path_trace import TraceOps
 from .sync_transport import SyncTransport, drive
 from .transport import AsyncTransport
 
-DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
 DEFAULT_TIMEOUT_S = 5.0
 _HANDLE_PORT = CncPort.COM  # handles are global in the service; any CNC port serves them
 SUGGESTIONS = 3  # nearest names offered for an unknown one

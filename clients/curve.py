@@ -27,10 +27,8 @@ import zmq.auth
 from zmq.utils.monitor import parse_monitor_message
 
 from .errors import AuthenticationError, ClientValueError
+from .key_files import PUBLIC_SUFFIX, SECRET_SUFFIX, SERVER_KEY_FILE
 
-PUBLIC_SUFFIX = ".key"
-SECRET_SUFFIX = ".key_secret"
-SERVER_KEY_FILE = "server.key"  # the service's public key, beside a client's key by default
 _KEY_CHARS = 40  # a CURVE key in Z85 text
 
 _EVENTS = (zmq.EVENT_HANDSHAKE_SUCCEEDED | zmq.EVENT_HANDSHAKE_FAILED_AUTH

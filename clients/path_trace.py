@@ -16,14 +16,15 @@ from __future__ import annotations
 import io
 import re
 from dataclasses import dataclass
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from .channel_ops import ChannelOps
 from .errors import AdsError, AdsTimeoutError, ChannelError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 PROD_TIME = 0x10  # execution mode bit: machining time calculation (FCT-C9)
 
@@ -75,6 +76,8 @@ class PathTrace:
 
 def parse_trace(text: str) -> PathTrace:
     """Parse a ``prodtime0<c>.csv`` file; ``ValueError`` when it is not one."""
+    import numpy as np  # here, not above: the client library (and cnc) starts without numpy
+
     lines = text.split("\n", 2)
     header = _HEADER.fullmatch(lines[0]) if lines else None
     if header is None or len(lines) < 2:

@@ -35,7 +35,9 @@ from .config import DEFAULT_OBJECTS, BridgeConfig, parse_broker
 EXIT_USAGE = 2
 _LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR")
 
-app = typer.Typer(add_completion=False, help=__doc__.split("\n\n")[0])
+# Plain help (no rich panel): each option with its value's name, its help beside it, wrapped
+# to the terminal (docs/design-notes.md, "A quick cnc").
+app = typer.Typer(add_completion=False, rich_markup_mode=None, help=__doc__.split("\n\n")[0])
 
 
 def _usage(message: str) -> NoReturn:
@@ -70,51 +72,55 @@ def _check_endpoint(endpoint: str) -> None:
 @app.command()
 def run(
     endpoint: str = typer.Option(
-        DEFAULT_ENDPOINT, "--endpoint", envvar="CNC_ENDPOINT",
+        DEFAULT_ENDPOINT, "--endpoint", envvar="CNC_ENDPOINT", metavar="URL",
         help="The cnc-service (default $CNC_ENDPOINT, else tcp://127.0.0.1:5555).",
     ),
     broker: str = typer.Option(
-        ..., "--broker", help="MQTT broker HOST[:PORT] (1883; 8883 with --tls)."
+        ..., "--broker", metavar="HOST[:PORT]", help="MQTT broker HOST[:PORT] (1883; 8883 with --tls)."
     ),
-    machine: str = typer.Option(..., "--machine", help="Machine name: topics are cnc/<NAME>/..."),
+    machine: str = typer.Option(
+        ..., "--machine", metavar="NAME", help="Machine name: topics are cnc/NAME/..."),
     objects: list[str] | None = typer.Option(
-        None, "--objects",
+        None, "--objects", metavar="GLOB",
         help="Glob of objects to publish; repeat for more; @default = the default set.",
     ),
     writable: list[str] | None = typer.Option(
-        None, "--writable",
+        None, "--writable", metavar="GLOB",
         help="Glob of objects MQTT clients may write; repeat for more (default: none).",
     ),
-    username: str | None = typer.Option(None, "--username", help="Broker user name."),
+    username: str | None = typer.Option(
+        None, "--username", metavar="USER", help="Broker user name."),
     password_file: Path | None = typer.Option(
-        None, "--password-file", help="File whose first line is the broker password."
+        None, "--password-file", metavar="FILE", help="File whose first line is the broker password."
     ),
     tls: bool = typer.Option(
         False, "--tls", help="TLS to the broker (system CAs, or $SSL_CERT_FILE)."
     ),
     client_id: str | None = typer.Option(
-        None, "--client-id", help="MQTT client id (default cnc-mqtt-<NAME>)."
+        None, "--client-id", metavar="ID", help="MQTT client id (default cnc-mqtt-NAME)."
     ),
     cycle_ms: int = typer.Option(
-        10, "--cycle-ms", min=0,
+        10, "--cycle-ms", min=0, metavar="MS",
         help="Check objects for changes every MS of kernel time (0: every cycle).",
     ),
     timeout_s: float = typer.Option(
-        2.0, "--timeout", min=0.01, help="Seconds to wait for a reply of the service."
+        2.0, "--timeout", min=0.01, metavar="S", help="Seconds to wait for a reply of the service."
     ),
     probe_s: float = typer.Option(
-        1.0, "--probe-s", min=0.01, help="Seconds between checks that the service is the same."
+        1.0, "--probe-s", min=0.01, metavar="S", help="Seconds between checks that the service is the same."
     ),
     reconnect_initial_s: float = typer.Option(
-        0.1, "--reconnect-initial-s", min=0.001, help="First reconnect delay, doubling ..."
+        0.1, "--reconnect-initial-s", min=0.001, metavar="S", help="First reconnect delay, doubling ..."
     ),
     reconnect_max_s: float = typer.Option(
-        5.0, "--reconnect-max-s", min=0.001, help="... up to this."
+        5.0, "--reconnect-max-s", min=0.001, metavar="S", help="... up to this."
     ),
-    keepalive_s: int = typer.Option(30, "--keepalive", min=1, help="MQTT keepalive in seconds."),
+    keepalive_s: int = typer.Option(
+        30, "--keepalive", min=1, metavar="S", help="MQTT keepalive in seconds."),
     key_file: str | None = key_option("The bridge's"),
     server_key: str | None = server_key_option(),
-    log_level: str = typer.Option("INFO", "--log-level", help="DEBUG, INFO, WARNING or ERROR."),
+    log_level: str = typer.Option(
+        "INFO", "--log-level", metavar="LEVEL", help="DEBUG, INFO, WARNING or ERROR."),
 ) -> None:
     """Publish CNC objects to MQTT when they change; write the ones allowed on request."""
     if log_level.upper() not in _LOG_LEVELS:

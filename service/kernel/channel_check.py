@@ -12,7 +12,7 @@ from .alarms import AlarmClass
 from .channel_mode import ChannelState
 from .nc import ModalState
 from .program_run import RunHost, Step
-from .state import Channel, DecoderFlag, ErrorEntry
+from .state import BLOCK_START_COLUMN, Channel, DecoderFlag, ErrorEntry
 from .syntax_check import CHECK_STOPPED_WARNING, CheckRun, Pause
 from .wait_reason import WaitReason
 
@@ -97,7 +97,8 @@ class ChannelCheck:
             if p.stopped_early:
                 self._host.list_error(ErrorEntry(
                     CHECK_STOPPED_WARNING, f"syntax check stopped after {p.error_count} errors "
-                    "(syn_chk.errors_total, P-CHAN-00019)", p.file, p.line, warning=True),
+                    "(syn_chk.errors_total, P-CHAN-00019)", p.file, p.line, BLOCK_START_COLUMN,
+                    warning=True),
                     alarm_class=AlarmClass.CHECK)
             return Step.ENDED
         if p.pause != Pause.NONE:

@@ -136,6 +136,9 @@ class ChannelRunner:
         self._pending_start: tuple[Job, bool, bool] | None = None  # waits for the axes
         self._queued_jobs: list[Job] = []  # manual blocks sent while the start waits
         self._run: ChannelRun | None = None  # the run from its begin to its end
+        # the execution mode in effect before a PROD_TIME run, in effect again at its end:
+        # a machining time calculation is a simulation and leaves the channel as it was
+        self._mode_before_prod_time = 0
         # the contour look-ahead log of the last program run (the PLC reads it after)
         self._contour: ContourLog | None = None
         self._internal_hold = False  # feedhold of a suspend_axis_output request
@@ -444,6 +447,8 @@ class ChannelRunner:
             mode = ch.execution_mode_commanded & ~_PROGRAM_MODES
         else:
             mode = self._active_mode()
+        if not job.manual and mode & ExecutionMode.PROD_TIME:
+            self._mode_before_prod_time = ch.execution_mode_active
         ch.execution_mode_active = mode
         ch.decoder_flags = 0
         if not job.manual and mode & _CHECK_MODES and not mode & ExecutionMode.PROD_TIME:
@@ -641,9 +646,12 @@ class ChannelRunner:
     # ------------------------------------------------------------ run ends
 
     def _drop_run(self) -> ChannelRun | None:
-        """End the run at once; the modal state it reached carries on (MDI)."""
+        """End the run at once; the modal state it reached carries on (MDI). A PROD_TIME
+        run puts back the execution mode that was in effect before it."""
         run, self._run = self._run, None
         self.manual.clear_program()  # the axes stand where path and manual offset put them
+        if isinstance(run, ProdTimeRun):
+            self.channel.execution_mode_active = self._mode_before_prod_time
         if run is not None:
             modal = run.cancel()
             if modal is not None and self._modal is not None:

@@ -46,7 +46,7 @@ from .path.interpolator import StepResult, Waiting
 from .path.segments import Segment
 from .plc_functions import PlcFunctions
 from .prod_time_trace import ProdTimeTrace, trace_file_name
-from .state import Channel, ErrorEntry
+from .state import BLOCK_START_COLUMN, Channel, ErrorEntry
 from .wait_reason import WaitReason, manual_open, path_wait_reason
 
 _NOT_WAITING, _OVERRIDE_ZERO = int(WaitReason.NONE), int(WaitReason.OVERRIDE_ZERO)
@@ -427,7 +427,8 @@ class ProgramRun:
             f"the look-ahead buffer of {self._buffer_blocks} blocks limits the path speed "
             f"to {ch.path_velocity_mm_s:.1f} mm/s (the path must be able to stop after the "
             "last buffered block): choose a larger buffer (interpolator_function, "
-            "P-CHAN-00650) or program LA_ON", ch.file_name, ch.line, warning=True))
+            "P-CHAN-00650) or program LA_ON", ch.file_name, ch.line, BLOCK_START_COLUMN,
+            warning=True))
 
     def _warn_log_full(self) -> None:
         assert self.contour is not None

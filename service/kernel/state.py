@@ -95,9 +95,15 @@ class LogicalAxis:
         self.position_mm = incr / 10_000
 
 
+BLOCK_START_COLUMN = 1  # the column of an error about a whole block: the block's start
+
+
 @dataclass(frozen=True, slots=True)
 class ErrorEntry:
-    """An error of a channel: ISG-style id, text, and where in which NC file it arose."""
+    """An error of a channel: ISG-style id, text, and where in which NC file it arose.
+
+    Lines and columns count from 1; 0 means none. An error about a whole block (not a word
+    of it) is at the block's first column, ``BLOCK_START_COLUMN``."""
 
     id: int
     text: str

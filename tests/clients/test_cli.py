@@ -282,14 +282,14 @@ def test_watch_count_on_an_unchanging_value(endpoint: str) -> None:
     once = cnc("--json", "watch", "cnc_cycle_time_r", "--count", "1", endpoint=endpoint)
     assert once.returncode == 0, once.stderr
     assert [(r["value"], r["seq"]) for r in json_lines(once)] == [(1000, 1)]
-    # A second sample comes only with a change: --timeout bounds the wait (exit 5).
-    bounded = cnc("watch", "cnc_cycle_time_r", "--count", "2", "--timeout", "0.5",
+    # A second sample comes only with a change: --wait-timeout bounds the wait (exit 5).
+    bounded = cnc("watch", "cnc_cycle_time_r", "--count", "2", "--wait-timeout", "0.5",
                   endpoint=endpoint)
     assert bounded.returncode == 5, bounded.stderr
     assert bounded.stdout.count("cnc_cycle_time_r = 1000 (us)") == 1
     assert "cnc_cycle_time_r 1 of 2" in bounded.stderr
-    # Without --count, --timeout is just how long to watch.
-    assert cnc("watch", "cnc_cycle_time_r", "--timeout", "0.3", endpoint=endpoint).returncode == 0
+    # Without --count, --wait-timeout is just how long to watch.
+    assert cnc("watch", "cnc_cycle_time_r", "--wait-timeout", "0.3", endpoint=endpoint).returncode == 0
 
 
 def test_browse_on_a_terminal_cuts_nothing(endpoint: str) -> None:

@@ -108,7 +108,7 @@ def test_check_restores_mode_and_parameters(service: RunningService, tmp_path: P
         c.write("ch1.mc_command_single_block_w", True)
         assert c.read_many(list(before)) == before
     program = nc_file(tmp_path, "example.nc", SEED_EXAMPLE)
-    result = cnc("--json", "check", program, "--errors-total", "4", "--timeout", "60",
+    result = cnc("--json", "check", program, "--errors-total", "4", "--wait-timeout", "60",
                  endpoint=ep)
     assert result.returncode == 1, result.stderr
     assert len(json_lines(result)) == 4  # the check ran with its own settings
@@ -132,7 +132,7 @@ def test_check_that_does_not_end_is_reset_after_timeout(
         c.write("ch1.mc_command_execution_mode_w", 0x80)
     endless = nc_file(tmp_path, "endless.nc",
                       "N10 $WHILE 1 == 1\nN20 G1 X1 F100\nN30 X0\nN40 $ENDWHILE\nN50 M30\n")
-    result = cnc("check", endless, "--timeout", "0.5", endpoint=ep)
+    result = cnc("check", endless, "--wait-timeout", "0.5", endpoint=ep)
     assert result.returncode == 2
     assert "did not end within 0.5 s; it is cancelled (RESET)" in result.stderr
     with Client(ep) as c:

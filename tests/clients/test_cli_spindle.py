@@ -25,7 +25,9 @@ def test_spindle_start_override_show_and_stop(service: RunningService) -> None:
 
 def test_spindle_override_out_of_range_is_a_usage_error(service: RunningService) -> None:
     bad = cnc("spindle", "--override", "151", endpoint=service.endpoint)
-    assert bad.returncode == 2 and "less than or equal to 150" in " ".join(bad.stderr.split())
+    assert bad.returncode == 2
+    assert "Invalid value for '--override': 151.0 is not in the range 0.0<=x<=150.0" in " ".join(
+        bad.stderr.split())
 
 
 def test_start_and_stop_together_are_refused(service: RunningService) -> None:

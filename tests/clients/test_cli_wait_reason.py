@@ -45,7 +45,7 @@ def test_run_wait_times_out_naming_the_reason(service: ServiceProcess, tmp_path:
     program = tmp_path / "stop.nc"
     program.write_text(M0_PROGRAM)
     # 3 s: the stop is printed once it has held for WAIT_REASON_SETTLE_S (1 s)
-    result = cnc("run", str(program), "--wait", "--timeout", "3", endpoint=service.endpoint)
+    result = cnc("run", str(program), "--wait", "--wait-timeout", "3", endpoint=service.endpoint)
     assert result.returncode == EXIT_WAIT_TIMEOUT, result.stderr
     lines = result.stderr.splitlines()
     assert M0_LINE in lines  # the change, printed while waiting
@@ -62,7 +62,7 @@ def test_run_wait_prints_each_change_of_the_reason(service: ServiceProcess,
     program = tmp_path / "stops.nc"
     program.write_text("G1 X1 F6000\nM0\nG1 X2\nM1\nG1 X3\nM30\n")
     argv = [sys.executable, "-c", "from cnc_objects.clients.cli import main; main()",
-            "--endpoint", service.endpoint, "run", str(program), "--wait", "--timeout", "60"]
+            "--endpoint", service.endpoint, "run", str(program), "--wait", "--wait-timeout", "60"]
     proc = subprocess.Popen(argv, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True)
     watchdog = threading.Timer(90, proc.kill)  # a hung cnc ends the test, not the run

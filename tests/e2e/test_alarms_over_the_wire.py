@@ -162,7 +162,7 @@ def test_cnc_alarms_watch_prints_the_events(c, machine) -> None:
     c.acknowledge_all_alarms()
     argv = [sys.executable, "-c", "from cnc_objects.clients.cli import main; main()",
             "--endpoint", machine.endpoint, "alarms", "--watch", "--count", "2",
-            "--watch-timeout", "60"]
+            "--wait-timeout", "60"]
     with subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                           text=True) as watching:
         asyncio.run(asyncio.wait_for(_subscribed(machine), 30))

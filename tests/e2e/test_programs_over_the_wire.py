@@ -135,7 +135,7 @@ def test_hold_and_resume_over_the_wire(c):
 def test_cli_run_wait_status(machine, tmp_path):
     program = tmp_path / "cli.nc"
     program.write_text("G1 X12.5 Y-3 F6000\nM30\n")
-    result = cnc("run", str(program), "--wait", "--timeout", "30", endpoint=machine.endpoint)
+    result = cnc("run", str(program), "--wait", "--wait-timeout", "30", endpoint=machine.endpoint)
     assert result.returncode == 0, result.stderr
     assert "finished" in result.stdout
     status = cnc("--json", "status", endpoint=machine.endpoint)

@@ -6,7 +6,7 @@ program store as it was: every byte of every stored file is the same afterwards.
 
 The mutants are the same every ``make test`` run (a fixed seed); ``make soak`` draws
 a new seed and prints it, so that a failure can be reproduced (``CNC_NC_SEED=<seed>``).
-A few mutants also go through the CLI: ``cnc check`` and ``cnc run --wait --timeout``.
+A few mutants also go through the CLI: ``cnc check`` and ``cnc run --wait --wait-timeout``.
 """
 
 from __future__ import annotations
@@ -172,8 +172,8 @@ def test_mutated_programs_end_in_a_defined_state(service: ServiceProcess, run_sc
     figures.record("NC outcomes", summary, NODE)
 
 
-CLI_CHECK_EXITS = {0, 1, 2}  # clean, errors or aborted, no result (--timeout)
-CLI_RUN_EXITS = {0, 4, 5}  # finished, channel ERROR, --timeout passed
+CLI_CHECK_EXITS = {0, 1, 2}  # clean, errors or aborted, no result (--wait-timeout)
+CLI_RUN_EXITS = {0, 4, 5}  # finished, channel ERROR, --wait-timeout passed
 
 
 CNC = Path(sys.executable).with_name("cnc")  # the console script of this environment
@@ -197,13 +197,13 @@ def test_mutants_through_the_cli(service: ServiceProcess, run_scale: Scale, tmp_
     for mutant in chosen:
         path = tmp_path / mutant.name
         path.write_bytes(mutant.data)
-        checked = cnc(service, "check", str(path), "--timeout", str(CHECK_TIMEOUT_S))
+        checked = cnc(service, "check", str(path), "--wait-timeout", str(CHECK_TIMEOUT_S))
         assert checked.returncode in CLI_CHECK_EXITS, (mutant, checked.stdout, checked.stderr)
         # a check ended by an error (software limit) leaves the channel in ERROR, as a run
         # does: RESET before the run
         reset = cnc(service, "reset", "--standard")
         assert reset.returncode == 0, reset.stderr
-        ran = cnc(service, "run", mutant.name, "--wait", "--timeout", str(RUN_TIMEOUT_S))
+        ran = cnc(service, "run", mutant.name, "--wait", "--wait-timeout", str(RUN_TIMEOUT_S))
         assert ran.returncode in CLI_RUN_EXITS, (mutant, ran.stdout, ran.stderr)
         for result in (checked, ran):
             assert "Traceback" not in result.stderr, result.stderr
