@@ -11,15 +11,17 @@ With ``--json`` every alarm (or event) is one JSON line.
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
+from typing import TYPE_CHECKING
 
 import typer
 
-from .alarm_ops import AlarmInfo
-from .blocking import Client
 from .cli_app import EXIT_USAGE, Settings, app, emit, fail, say_error
 from .errors import AdsError, ClientValueError
+
+if TYPE_CHECKING:  # the client library is imported when a command connects (a quick --help)
+    from .alarm_ops import AlarmInfo
+    from .blocking import Client
 
 alarms_app = typer.Typer(
     no_args_is_help=False,
@@ -67,6 +69,8 @@ def alarms(
 
 
 def _watch(settings: Settings, count: int, timeout_s: float | None) -> None:
+    import asyncio  # here, not at the top: ``cnc --help`` needs no event loop
+
     async def run() -> None:
         seen = 0
         async with settings.async_client() as c:

@@ -6,12 +6,14 @@ so the cycle counter read next is exactly that cycle (docs/kernel.md, How time a
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
-from .blocking import Client
 from .cli_app import Settings, command, emit
+
+if TYPE_CHECKING:  # the client library is imported when a command connects (a quick --help)
+    from .blocking import Client
 
 STEP_OBJECT = "cnc_cycle_step_w"
 
