@@ -38,6 +38,7 @@ from . import (
     cli_plot,  # noqa: F401  (plot)
     cli_spindle,  # noqa: F401  (spindle)
     cli_tools,  # noqa: F401  (tool, offsets)
+    cli_web_users,  # noqa: F401  (web-users set, remove, list)
 )
 from .cli_app import Settings, app
 from .client import DEFAULT_ENDPOINT

@@ -25,6 +25,7 @@ from .hub import FLUSH_S, LiveHub, Outbox
 
 STATIC_DIR = Path(__file__).with_name("static")
 HUB_KEY: web.AppKey[LiveHub] = web.AppKey("hub")
+SOCKETS_KEY: web.AppKey[list[int]] = web.AppKey("sockets")  # [open WebSockets]
 MAX_WATCHED = 2000  # names one browser may watch at once (the objects page's watch list is small)
 
 
@@ -58,6 +59,14 @@ async def no_icon(request: web.Request) -> web.StreamResponse:
     return web.Response(status=204)
 
 
+async def stats(request: web.Request) -> web.StreamResponse:
+    """What the hub costs the service: subscriptions held, samples received, sockets."""
+    hub = request.app[HUB_KEY]
+    return web.json_response({"subscriptions": hub.subscriptions,
+                              "samples_received": hub.samples_received,
+                              "sockets": request.app[SOCKETS_KEY][0]})
+
+
 async def live(request: web.Request) -> web.StreamResponse:
     """The WebSocket: ``{"watch": [names]}`` / ``{"unwatch": [names]}`` from the browser,
     ``{"values": {name: value}, "errors": {name: sentence}}`` to it."""
@@ -65,6 +74,7 @@ async def live(request: web.Request) -> web.StreamResponse:
     socket = web.WebSocketResponse(heartbeat=20.0)
     await socket.prepare(request)
     outbox = Outbox()
+    request.app[SOCKETS_KEY][0] += 1
     watched: set[str] = set()
     sender = asyncio.create_task(_send(socket, outbox), name="web socket sender")
     try:
@@ -84,6 +94,7 @@ async def live(request: web.Request) -> web.StreamResponse:
             watched.update(names)
             hub.watch(outbox, names)
     finally:
+        request.app[SOCKETS_KEY][0] -= 1
         hub.unwatch(outbox)
         sender.cancel()
         with contextlib.suppress(asyncio.CancelledError):
@@ -107,6 +118,7 @@ def make_app(link: ServiceLink, access: Access) -> web.Application:
     """The cnc-web application for the service at ``link``."""
     app = web.Application(middlewares=[session_middleware], client_max_size=api.MAX_UPLOAD_BYTES)
     app[ACCESS_KEY] = access
+    app[SOCKETS_KEY] = [0]
 
     async def service_client(app: web.Application) -> AsyncIterator[None]:
         client = AsyncClient(link.endpoint, timeout_s=link.timeout_s, key_file=link.key_file,
@@ -121,6 +133,7 @@ def make_app(link: ServiceLink, access: Access) -> web.Application:
     app.router.add_get("/", index)
     app.router.add_get("/ws", live)
     app.router.add_get("/favicon.ico", no_icon)
+    app.router.add_get("/api/stats", stats)
     app.router.add_static("/static/", STATIC_DIR)
     api.add_routes(app)
     return app
