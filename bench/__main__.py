@@ -25,6 +25,8 @@ and with 20 on-change subscriptions (``bench/virtual_bench.py``).
 Fairness part (``--part fairness``): another client's read latency while one client
 holds every notification the service takes (20 000 cyclic, 1 ms), idle and loaded
 (``bench/fairness_bench.py``; target p99 < 10 ms).
+Web part (``--part web``): cnc-web's position update rate in 10 WebSocket sessions while a
+program runs, and the realtime cycle's figures without and with it (``bench/web_bench.py``).
 Dispatch part (``--part dispatch``):
 
 Baseline: a raw pyzmq ROUTER in a second process that answers each msgpack frame with a
@@ -202,13 +204,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
     parser.add_argument("--part", choices=("all", "dispatch", "ads", "kernel", "jitter",
-                                           "virtual", "lookahead", "fairness"),
+                                           "virtual", "lookahead", "fairness", "web"),
                         default="all",
                         help="dispatch: request dispatch (ZeroMQ); ads: pyads over AMS/TCP; "
                         "kernel: decoder, interpolator, planner; jitter: the realtime cycle "
                         "under load; virtual: whole-service virtual time speed; lookahead: "
                         "machining time against the optimum; fairness: reads while the "
-                        "notification limit is used up")
+                        "notification limit is used up; web: cnc-web's live values and their cost")
     parser.add_argument("--jitter-s", type=float, default=20.0,
                         help="seconds of load per jitter run (issue 22 asks 60)")
     args = parser.parse_args(argv)
@@ -233,6 +235,10 @@ def main(argv: list[str] | None = None) -> int:
         from . import fairness_bench
 
         fairness_bench.main(min(args.runs, 3), 2000)
+    if args.part in ("all", "web"):
+        from . import web_bench
+
+        web_bench.main(min(args.runs, 3), min(args.jitter_s, 10.0))
     if args.part in ("all", "lookahead"):
         from . import lookahead_bench
 

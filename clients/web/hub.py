@@ -21,7 +21,7 @@ from cnc_objects.clients.errors import AdsConnectionError, AdsError, AdsTimeoutE
 log = logging.getLogger(__name__)
 
 FLUSH_S = 0.025  # at most 40 messages a second to one browser
-SUBSCRIPTION_CYCLE_MS = 10  # the service checks a watched object every 10 ms of kernel time
+SUBSCRIPTION_CYCLE_MS = 25  # the service checks a watched object every 25 ms of kernel time (40 Hz)
 RESUBSCRIBE_S = 1.0  # wall time before a subscription lost with the service is tried again
 
 

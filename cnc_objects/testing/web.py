@@ -20,6 +20,7 @@ import urllib.request
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 START_TIMEOUT_S = 20.0
 STOP_TIMEOUT_S = 10.0
@@ -53,10 +54,11 @@ def free_port() -> int:
 def start_web(endpoint: str, *, users_file: str | os.PathLike[str] | None = None,
               key: str | os.PathLike[str] | None = None,
               server_key: str | os.PathLike[str] | None = None,
-              cwd: str | os.PathLike[str] | None = None) -> WebProcess:
-    """Start cnc-web for the service at ``endpoint`` on a free loopback port; returns once
-    it answers HTTP (``RuntimeError`` with its output when it exits first)."""
-    port = free_port()
+              cwd: str | os.PathLike[str] | None = None, port: int | None = None) -> WebProcess:
+    """Start cnc-web for the service at ``endpoint`` on ``port`` (default: a free loopback
+    port); returns once it answers HTTP (``RuntimeError`` with its output when it exits
+    first)."""
+    port = port if port is not None else free_port()
     argv = [sys.executable, "-m", "cnc_objects.clients.web.cli", "--endpoint", endpoint,
             "--port", str(port), "--log-level", "WARNING"]
     if users_file is not None:
@@ -85,9 +87,9 @@ def start_web(endpoint: str, *, users_file: str | os.PathLike[str] | None = None
 
 
 @contextlib.contextmanager
-def serving_web(endpoint: str, **options: str | os.PathLike[str] | None) -> Iterator[WebProcess]:
+def serving_web(endpoint: str, **options: Any) -> Iterator[WebProcess]:
     """``start_web`` for a ``with`` block; stopped on leaving."""
-    web = start_web(endpoint, **options)  # type: ignore[arg-type]
+    web = start_web(endpoint, **options)
     try:
         yield web
     finally:

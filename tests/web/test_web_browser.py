@@ -13,8 +13,6 @@ import re
 from pathlib import Path
 from typing import Any
 
-import pytest
-
 from cnc_objects.clients.web.users import WebRole
 from cnc_objects.testing.web import WebProcess
 
