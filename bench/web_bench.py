@@ -44,8 +44,7 @@ CHANNEL_LEAVES = ("mc_active_mode_r", "mc_active_state_r", "mc_active_program_na
                   "mc_error_count_r", "mc_spindle_mode_r", "mc_spindle_active_rev_r",
                   "mc_spindle_override_w", "mc_active_tool_r", "mc_active_tool_offset_r",
                   "mc_active_zero_offset_r")
-AXIS_LEAVES = ("command_position_acs", "actual_position_acs", "command_position_pcs",
-               "position_offset", "link_state")
+AXIS_LEAVES = ("command_position_acs", "command_position_pcs", "position_offset", "link_state")
 CYCLE_FIGURES = ["cnc_tick_counter_r", "cnc_cycle_overruns_r", "cnc_cycle_jitter_p50_r",
                  "cnc_cycle_jitter_p99_r", "cnc_cycle_jitter_max_r", "cnc_cycle_exec_time_max_r"]
 

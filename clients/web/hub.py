@@ -20,8 +20,8 @@ from cnc_objects.clients.errors import AdsConnectionError, AdsError, AdsTimeoutE
 
 log = logging.getLogger(__name__)
 
-FLUSH_S = 0.025  # at most 40 messages a second to one browser
-SUBSCRIPTION_CYCLE_MS = 25  # the service checks a watched object every 25 ms of kernel time (40 Hz)
+FLUSH_S = 0.015  # at most ~66 messages a second to one browser
+SUBSCRIPTION_CYCLE_MS = 20  # the service checks a watched object every 20 ms of kernel time (50 Hz)
 RESUBSCRIBE_S = 1.0  # wall time before a subscription lost with the service is tried again
 
 

@@ -84,7 +84,7 @@ async def test_run_a_program_uploaded_by_the_file_input(page: Any, web: WebProce
 async def test_positions_update_at_20_hz_while_a_program_runs(page: Any, web: WebProcess,
                                                               tmp_path: Path) -> None:
     program = tmp_path / "rate.nc"
-    program.write_text("N10 G1 X60 F1200\nN20 M30\n")  # 3 s of motion
+    program.write_text("N10 G1 X100 F1200\nN20 M30\n")  # 5 s of motion
     await _open(page, web.url, "program")
     await page.set_input_files("#upload-input", str(program))
     await page.wait_for_selector("#program-list li.selected[data-name='rate.nc']", timeout=WAIT_MS)
@@ -94,7 +94,7 @@ async def test_positions_update_at_20_hz_while_a_program_runs(page: Any, web: We
     rate = await page.evaluate("""async () => {
         const before = window.cncStats.positionUpdates;
         const t0 = performance.now();
-        await new Promise(r => setTimeout(r, 1000));
+        await new Promise(r => setTimeout(r, 2000));
         return (window.cncStats.positionUpdates - before) * 1000 / (performance.now() - t0);
     }""")
     print(f"position updates in the browser: {rate:.1f} Hz")

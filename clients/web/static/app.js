@@ -8,7 +8,7 @@
 const UM01_PER_MM = 10000; // positions are in 0.1 um
 const SPINDLE_MODES = { 1: "M5", 2: "M3", 4: "M4", 8: "M19" };
 const LINK_STATES = { 0: "linked", 1: "requested", 2: "waiting ack" };
-const CONTOUR_TYPES = { 1: "linear", 2: "circular", 3: "LOG ON", 4: "LOG OFF", 5: "LOG PARAM" };
+const CONTOUR_TYPES = { 1: "linear", 2: "circular", 3: "LOG ON", 4: "LOG PARAM", 5: "LOG OFF", 6: "polynomial" }; // ContourBlockType
 const PAGES = ["machine", "program", "mdi", "lookahead", "alarms", "objects"];
 const MDI_HISTORY_KEY = "cnc-web-mdi-history";
 const MDI_HISTORY_MAX = 30;
@@ -113,7 +113,7 @@ function channelNames(ch) {
     .map((leaf) => `${c}.${leaf}`);
   names.push(`gpCh[${ch.plc_index}].bahn_mc_control.suspend_axis_output.state_r`);
   for (const ax of ch.axes) {
-    for (const leaf of ["command_position_acs", "actual_position_acs", "command_position_pcs", "position_offset", "link_state"]) {
+    for (const leaf of ["command_position_acs", "command_position_pcs", "position_offset", "link_state"]) {
       names.push(`${c}.ax${ax.index}.${leaf}`);
     }
   }
@@ -226,7 +226,7 @@ function renderMachine() {
     for (const ax of ch.axes) {
       const a = `${c}.ax${ax.index}`;
       cells(rowFor(axes, a), [
-        `${c} ${ax.name}`, mm(v(`${a}.command_position_acs`)), mm(v(`${a}.actual_position_acs`)),
+        `${c} ${ax.name}`, mm(v(`${a}.command_position_acs`)), mm(v(`${a}.command_position_pcs`)),
         mm(v(`${a}.position_offset`)), named(LINK_STATES, v(`${a}.link_state`)), ax.drive || "-",
       ]);
     }
@@ -511,11 +511,13 @@ $("#profile-draw").addEventListener("click", async () => {
     const s = trace.path_mm;
     const maxS = Math.max(...s, 1e-9);
     const maxV = Math.max(...trace.v_mm_s, ...trace.feed_limit_mm_s.filter((f) => f < 1e6), 1e-9);
-    const line = (values) => values.map((value, k) => `${(s[k] / maxS * 600).toFixed(1)},${(200 - Math.min(value, maxV) / maxV * 190).toFixed(1)}`).join(" ");
+    // over the run's cycles (time), so that the ramps keep their length on the chart
+    const last = Math.max(s.length - 1, 1);
+    const line = (values) => values.map((value, k) => `${(k / last * 600).toFixed(1)},${(200 - Math.min(value, maxV) / maxV * 190).toFixed(1)}`).join(" ");
     $("#profile-v").setAttribute("points", line(trace.v_mm_s));
     $("#profile-limit").setAttribute("points", line(trace.feed_limit_mm_s));
     $("#profile-name").textContent = program;
-    $("#profile-max").textContent = `· top ${maxV.toFixed(1)} mm/s, ${maxS.toFixed(1)} mm, ${trace.program_time_s.toFixed(3)} s`;
+    $("#profile-max").textContent = `· over ${trace.program_time_s.toFixed(3)} s; top ${maxV.toFixed(1)} mm/s, path ${maxS.toFixed(1)} mm`;
     say(`${program}: planned ${trace.program_time_s.toFixed(3)} s`);
   } catch (_) { /* shown */ }
 });
