@@ -564,7 +564,7 @@ $("#object-search").addEventListener("submit", async (event) => {
     $("#object-table tbody").replaceChildren(...data.objects.map((o) => {
       const row = el("tr");
       row.title = o.description;
-      cells(row, [o.name, `${o.port}:0x${o.group.toString(16)}:0x${o.offset.toString(16)}`, o.type, o.access, o.unit, ""]);
+      cells(row, [o.name, `${o.port}:0x${o.group.toString(16)}:0x${o.offset.toString(16)}`, o.type, o.access, o.unit]);
       const watchButton = el("button", { type: "button", textContent: "Watch" });
       watchButton.addEventListener("click", () => addWatch(o));
       row.append(el("td", {}, watchButton));
