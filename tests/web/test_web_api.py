@@ -14,7 +14,6 @@ from pathlib import Path
 from typing import Any
 
 import aiohttp
-import pytest
 
 from cnc_objects.clients.web.users import WebRole
 from cnc_objects.testing import ServiceProcess
@@ -207,4 +206,29 @@ def test_cnc_web_users_set_writes_a_hashed_file(tmp_path: Path) -> None:
     assert bad.returncode == 2 and "unknown role 'root'" in bad.stderr
 
 
-pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
+
+async def test_the_web_servers_key_bounds_every_page(tmp_path: Path) -> None:
+    """cnc-web with a monitor key: its operators' writes reach the service, which refuses
+    them in its own words; reads work."""
+    from cnc_objects.testing.process import start_service
+    from cnc_objects.testing.web import serving_web
+
+    service = start_service(keys=True, program_dir=tmp_path / "programs")
+    try:
+        assert service.keys is not None
+        with serving_web(service.endpoint, key=service.keys.client("monitor"),
+                         server_key=service.keys.server_key) as web:
+            async with _session() as http:
+                _, session = await _json(http, "GET", web.url + "/api/session")
+                assert session["role"] == "operator"  # no users file: this machine's browsers
+                status, body = await _json(
+                    http, "POST", web.url + "/api/write", session["csrf"],
+                    json={"name": "ch1.mc_command_feed_override_w", "value": 500})
+                assert status == 400
+                assert body["error"].startswith("ADS 0x704 INVALIDACCESS: role monitor may not "
+                                                "write ch1.mc_command_feed_override_w")
+                status, body = await _json(http, "GET", web.url + "/api/read",
+                                           params={"name": "ch1.mc_active_feed_override_r"})
+                assert (status, body["value"]) == (200, 1000)
+    finally:
+        service.stop()
