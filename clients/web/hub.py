@@ -23,6 +23,8 @@ log = logging.getLogger(__name__)
 FLUSH_S = 0.015  # at most ~66 messages a second to one browser
 SUBSCRIPTION_CYCLE_MS = 20  # the service checks a watched object every 20 ms of kernel time (50 Hz)
 RESUBSCRIBE_S = 1.0  # wall time before a subscription lost with the service is tried again
+HEARTBEAT_S = 1.0  # wall time between two liveness reads (a subscription alone stays silent)
+HEARTBEAT_OBJECT = "cnc_tick_counter_r"  # any readable object will do; this one is tiny
 
 
 def json_value(value: Any) -> Any:
@@ -77,6 +79,8 @@ class LiveHub:
         self._latest: dict[str, Any] = {}
         self._tasks: dict[str, asyncio.Task[None]] = {}
         self.samples_received = 0  # from the service, for the benchmark
+        self.service_lost = False  # the heartbeat's view: the service stopped answering
+        self._heartbeat = asyncio.create_task(self._watch_service(), name="web heartbeat")
 
     @property
     def subscriptions(self) -> int:
@@ -110,11 +114,33 @@ class LiveHub:
 
     async def close(self) -> None:
         """End every subscription."""
-        tasks = list(self._tasks.values())
+        self._heartbeat.cancel()
+        tasks = [self._heartbeat, *self._tasks.values()]
         self._tasks.clear()
         for task in tasks:
             task.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)
+
+    async def _watch_service(self) -> None:
+        """Notice a service that stopped answering; when it answers again (restarted: its
+        subscriptions are gone), subscribe anew to everything watched."""
+        while True:
+            await asyncio.sleep(HEARTBEAT_S)
+            try:
+                await self._client.read(HEARTBEAT_OBJECT)
+            except (AdsTimeoutError, AdsConnectionError) as exc:
+                if not self.service_lost:
+                    log.warning("service not answering: %s", exc)
+                self.service_lost = True
+                continue
+            if self.service_lost:
+                self.service_lost = False
+                log.warning("service answers again: subscribing anew to %d objects",
+                            len(self._tasks))
+                for name, task in list(self._tasks.items()):
+                    task.cancel()
+                    task.add_done_callback(_forget)
+                    self._tasks[name] = asyncio.create_task(self._follow(name), name=f"web {name}")
 
     async def _follow(self, name: str) -> None:
         while True:
@@ -133,3 +159,10 @@ class LiveHub:
                 self._tasks.pop(name, None)
                 return
             await asyncio.sleep(RESUBSCRIBE_S)
+
+
+def _forget(task: asyncio.Task[None]) -> None:
+    """Retrieve the end of a subscription left behind (its delete may fail: the service
+    that held it is gone), so that asyncio does not log it as never retrieved."""
+    if not task.cancelled():
+        task.exception()

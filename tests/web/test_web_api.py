@@ -232,3 +232,33 @@ async def test_the_web_servers_key_bounds_every_page(tmp_path: Path) -> None:
                 assert (status, body["value"]) == (200, 1000)
     finally:
         service.stop()
+
+
+async def test_live_values_come_back_after_the_service_restarts(tmp_path: Path) -> None:
+    from cnc_objects.clients import AsyncClient
+    from cnc_objects.testing.process import start_service
+    from cnc_objects.testing.web import free_port, serving_web
+
+    endpoint = f"tcp://127.0.0.1:{free_port()}"
+    service = start_service("--endpoint", endpoint, program_dir=tmp_path / "programs")
+    name = "ch1.mc_active_feed_override_r"
+    try:
+        with serving_web(endpoint) as web:
+            async with _session() as http:
+                await _json(http, "GET", web.url + "/api/session")
+                async with http.ws_connect(web.url + "/ws") as socket:
+                    await socket.send_json({"watch": [name]})
+                    first = await asyncio.wait_for(socket.receive_json(), WAIT_S)
+                    assert first["values"][name] == 1000
+                    assert service.stop() == 0
+                    service = start_service("--endpoint", endpoint,
+                                            program_dir=tmp_path / "programs")
+                    async with AsyncClient(endpoint) as client:
+                        await client.write("ch1.mc_command_feed_override_w", 500)
+
+                    async def override_500() -> None:
+                        while (await socket.receive_json()).get("values", {}).get(name) != 500:
+                            pass
+                    await asyncio.wait_for(override_500(), WAIT_S)
+    finally:
+        service.stop()
