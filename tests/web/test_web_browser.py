@@ -58,7 +58,7 @@ async def test_each_page_loads(page: Any, web: WebProcess) -> None:
     assert await page.locator("#jog tbody button").count() == 6  # X Y Z, minus and plus
 
 
-async def test_run_a_program_uploaded_by_the_file_input(page: Any, web: WebProcess,
+async def test_run_a_program_uploaded_by_the_file_input_and_drop(page: Any, web: WebProcess,
                                                         tmp_path: Path) -> None:
     program = tmp_path / "move.nc"
     program.write_text(MOVING_PROGRAM)
@@ -67,6 +67,20 @@ async def test_run_a_program_uploaded_by_the_file_input(page: Any, web: WebProce
     await page.wait_for_selector("#program-list li.selected[data-name='move.nc']", timeout=WAIT_MS)
     assert await page.locator("#program-text li").count() == 3
     await _message(page, "uploaded move.nc")
+
+    # a second program by drag and drop onto the drop box
+    await page.evaluate("""() => {
+        const data = new DataTransfer();
+        data.items.add(new File(["N10 G1 X1 F600\\nN20 M30\\n"], "dropped.nc"));
+        document.querySelector('#drop').dispatchEvent(
+            new DragEvent('drop', {dataTransfer: data, bubbles: true, cancelable: true}));
+    }""")
+    await page.wait_for_selector("#program-list li.selected[data-name='dropped.nc']",
+                                 timeout=WAIT_MS)
+    assert await page.locator("#program-text li").count() == 2
+    await page.click("#program-list li[data-name='move.nc']")
+    await page.wait_for_function(
+        "() => document.querySelector('#program-name').textContent === 'move.nc'", timeout=WAIT_MS)
 
     await page.click("#start-program")
     # the position moves: several distinct positions are drawn while the program runs
