@@ -23,8 +23,10 @@ log = logging.getLogger(__name__)
 FLUSH_S = 0.015  # at most ~66 messages a second to one browser
 SUBSCRIPTION_CYCLE_MS = 20  # the service checks a watched object every 20 ms of kernel time (50 Hz)
 RESUBSCRIBE_S = 1.0  # wall time before a subscription lost with the service is tried again
-HEARTBEAT_S = 1.0  # wall time between two liveness reads (a subscription alone stays silent)
-HEARTBEAT_OBJECT = "cnc_tick_counter_r"  # any readable object will do; this one is tiny
+HEARTBEAT_S = 1.0  # wall time between two checks that the subscriptions are alive
+HEARTBEAT_OBJECT = "cnc_tick_counter_r"  # changes every cycle: a sure beat
+BEAT_CYCLE_MS = 500  # one beat per 0.5 s of kernel time
+STALE_S = 3.0  # wall time without a beat after which the subscriptions count as gone
 
 
 def json_value(value: Any) -> Any:
@@ -122,25 +124,40 @@ class LiveHub:
         await asyncio.gather(*tasks, return_exceptions=True)
 
     async def _watch_service(self) -> None:
-        """Notice a service that stopped answering; when it answers again (restarted: its
-        subscriptions are gone), subscribe anew to everything watched."""
-        while True:
-            await asyncio.sleep(HEARTBEAT_S)
-            try:
-                await self._client.read(HEARTBEAT_OBJECT)
-            except (AdsTimeoutError, AdsConnectionError) as exc:
-                if not self.service_lost:
-                    log.warning("service not answering: %s", exc)
+        """Notice subscriptions that went silent: the service stopped, or restarted (its
+        subscriptions are gone, though reads work again at once). A subscription of its
+        own to the tick counter beats every ``BEAT_CYCLE_MS`` of kernel time; when no beat
+        came for ``STALE_S``, everything watched is subscribed anew."""
+        loop = asyncio.get_running_loop()
+        beat_at = [loop.time()]
+
+        async def beat() -> None:
+            async for _ in self._client.subscribe(HEARTBEAT_OBJECT, cycle_ms=BEAT_CYCLE_MS):
+                beat_at[0] = loop.time()
+
+        beating = asyncio.create_task(beat(), name="web heartbeat subscription")
+        try:
+            while True:
+                await asyncio.sleep(HEARTBEAT_S)
+                if loop.time() - beat_at[0] < STALE_S:
+                    continue
                 self.service_lost = True
-                continue
-            if self.service_lost:
-                self.service_lost = False
-                log.warning("service answers again: subscribing anew to %d objects",
+                try:
+                    await self._client.read(HEARTBEAT_OBJECT)  # answers: subscribe anew
+                except (AdsTimeoutError, AdsConnectionError):
+                    continue
+                log.warning("subscriptions went silent: subscribing anew to %d objects",
                             len(self._tasks))
-                for name, task in list(self._tasks.items()):
+                self.service_lost = False
+                beat_at[0] = loop.time()
+                for task in (beating, *self._tasks.values()):
                     task.cancel()
                     task.add_done_callback(_forget)
+                beating = asyncio.create_task(beat(), name="web heartbeat subscription")
+                for name in list(self._tasks):
                     self._tasks[name] = asyncio.create_task(self._follow(name), name=f"web {name}")
+        finally:
+            beating.cancel()
 
     async def _follow(self, name: str) -> None:
         while True:
@@ -161,7 +178,7 @@ class LiveHub:
             await asyncio.sleep(RESUBSCRIBE_S)
 
 
-def _forget(task: asyncio.Task[None]) -> None:
+def _forget(task: asyncio.Task[Any]) -> None:
     """Retrieve the end of a subscription left behind (its delete may fail: the service
     that held it is gone), so that asyncio does not log it as never retrieved."""
     if not task.cancelled():
