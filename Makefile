@@ -23,9 +23,21 @@ $(VENV)/.installed-test: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e '.[test,plot]'
 	touch $@ $(VENV)/.installed
 
+# `make run` starts the web HMI cnc-web beside the service, on http://127.0.0.1:$(WEB_PORT)
+# (loopback only); WEB=0 leaves it out. It ends with the service (Ctrl-C).
+WEB      ?= 1
+WEB_PORT ?= 8080
+
 run: $(VENV)/.installed
+ifeq ($(WEB),0)
 	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) \
 		$(if $(DATA_DIR),--data-dir $(DATA_DIR))
+else
+	$(BIN)/cnc-web --endpoint $(ENDPOINT) --port $(WEB_PORT) & web=$$!; \
+	trap 'kill $$web 2>/dev/null' EXIT INT TERM; \
+	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) \
+		$(if $(DATA_DIR),--data-dir $(DATA_DIR))
+endif
 
 # The checkers first (ruff: lint and import order; mypy, strict: tools/typecheck.py), then
 # the tests.

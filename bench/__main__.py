@@ -31,6 +31,8 @@ holds every notification the service takes (20 000 cyclic, 1 ms), idle and loade
 CLI part (``--part cli``): ``cnc --help`` and ``cnc read`` of one object, start to exit,
 against ``python -c pass`` and ``python -c 'import zmq'`` (``bench/cli_bench.py``; target
 < 0.25 s each).
+Web part (``--part web``): cnc-web's position update rate in 10 WebSocket sessions while a
+program runs, and the realtime cycle's figures without and with it (``bench/web_bench.py``).
 Dispatch part (``--part dispatch``):
 
 Baseline: a raw pyzmq ROUTER in a second process that answers each msgpack frame with a
@@ -212,14 +214,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
     parser.add_argument("--part", choices=("all", "dispatch", "client", "ads", "kernel",
-                                           "jitter", "virtual", "lookahead", "fairness", "cli"),
+                                           "jitter", "virtual", "lookahead", "fairness", "cli",
+                                           "web"),
                         default="all",
                         help="dispatch: request dispatch (ZeroMQ); client: AsyncClient "
                         "batching against the raw echo, wall and CPU; ads: pyads over AMS/TCP; "
                         "kernel: decoder, interpolator, planner; jitter: the realtime cycle "
                         "under load; virtual: whole-service virtual time speed; lookahead: "
                         "machining time against the optimum; fairness: reads while the "
-                        "notification limit is used up; cli: cnc's start to exit")
+                        "notification limit is used up; cli: cnc's start to exit; web: "
+                        "cnc-web's live values and their cost")
     parser.add_argument("--jitter-s", type=float, default=20.0,
                         help="seconds of load per jitter run (issue 22 asks 60)")
     args = parser.parse_args(argv)
@@ -252,6 +256,11 @@ def main(argv: list[str] | None = None) -> int:
         from . import cli_bench
 
         cli_bench.main(args.runs)
+
+    if args.part in ("all", "web"):
+        from . import web_bench
+
+        web_bench.main(min(args.runs, 3), min(args.jitter_s, 10.0))
     if args.part in ("all", "lookahead"):
         from . import lookahead_bench
 

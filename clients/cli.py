@@ -40,6 +40,7 @@ from . import (
     cli_spindle,  # noqa: F401  (spindle)
     cli_step,  # noqa: F401  (step: the step clock)
     cli_tools,  # noqa: F401  (tool, offsets)
+    cli_web_users,  # noqa: F401  (web-users set, remove, list)
 )
 from .cli_app import Settings, app, use_usage_command
 from .endpoint import DEFAULT_ENDPOINT

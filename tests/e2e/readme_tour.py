@@ -24,6 +24,7 @@ TOLERANCE_UNITS = 5.5  # of a decimal number's last digit (see above)
 # background, containers. Their own tests cover them.
 NOT_RUN = ("cnc-hmi", "mosquitto", "cnc-mqtt", "docker")
 README_ENDPOINT = "tcp://127.0.0.1:5555"
+README_WEB_PORT = 8080  # cnc-web beside the service, as `make run` starts it
 README_AMS_NET_ID, README_ADS_HOST = "127.0.0.1.1.1", "127.0.0.1"  # what `make run` serves
 _COMMENT = re.compile(r"\s+#\s.*$")
 _NUMBER = re.compile(r"-?\d+(?:\.\d+)?")

@@ -17,10 +17,12 @@ from pathlib import Path
 import pytest
 
 from cnc_objects.testing import serving
+from cnc_objects.testing.web import serving_web
 from tests.e2e.readme_tour import (
     README_ADS_HOST,
     README_AMS_NET_ID,
     README_ENDPOINT,
+    README_WEB_PORT,
     output_matches,
     python_examples,
     tour_steps,
@@ -80,7 +82,8 @@ def test_the_matcher(expected: tuple[str, ...], actual: list[str], same: bool) -
 
 def test_every_tour_command_prints_what_the_readme_shows(tmp_path: Path) -> None:
     (tmp_path / "docs").symlink_to(ROOT / "docs")
-    with serving("--clock", "realtime", cwd=tmp_path) as service:
+    with serving("--clock", "realtime", cwd=tmp_path) as service, \
+            serving_web(service.endpoint, port=README_WEB_PORT, cwd=tmp_path):  # as make run
         env = _env(service.endpoint)
         failures = []
         for step in tour_steps(README):

@@ -45,3 +45,18 @@ def test_the_pytest_plugin_is_registered_by_entry_point(wheel: Path) -> None:
     entry_points.read_string(text)
     assert dict(entry_points["pytest11"]) == {"cnc_objects": "cnc_objects.testing"}
     assert entry_points["console_scripts"]["cnc-service"] == "cnc_objects.service.main:main"
+
+
+def test_the_web_hmis_pages_and_command_are_in_the_wheel(wheel: Path) -> None:
+    """cnc-web's pages are package data: an install without them serves 404s."""
+    static = ROOT / "clients" / "web" / "static"
+    expected = {f"cnc_objects/clients/web/static/{f.name}" for f in static.iterdir()}
+    with zipfile.ZipFile(wheel) as archive:
+        names = set(archive.namelist())
+        [entry] = [n for n in names if n.endswith(".dist-info/entry_points.txt")]
+        text = archive.read(entry).decode()
+    assert {"cnc_objects/clients/web/static/index.html",
+            "cnc_objects/clients/web/static/app.js"} <= expected <= names
+    entry_points = configparser.ConfigParser()
+    entry_points.read_string(text)
+    assert entry_points["console_scripts"]["cnc-web"] == "cnc_objects.clients.web.cli:main"

@@ -1,0 +1,1 @@
+"""cnc-web: the web HMI (docs/web.md)."""

@@ -1,0 +1,645 @@
+// cnc-web: the browser side. Plain JavaScript, no build step, no library, no CDN.
+// Live values come over one WebSocket (/ws): the page says which objects it watches,
+// the server sends their newest values (one subscription per object for all browsers).
+// Every write goes through the JSON API with the session's CSRF token; a refusal is
+// shown on the message line in the service's words.
+"use strict";
+
+const UM01_PER_MM = 10000; // positions are in 0.1 um
+const SPINDLE_MODES = { 1: "M5", 2: "M3", 4: "M4", 8: "M19" };
+const LINK_STATES = { 0: "linked", 1: "requested", 2: "waiting ack" };
+const CONTOUR_TYPES = { 1: "linear", 2: "circular", 3: "LOG ON", 4: "LOG PARAM", 5: "LOG OFF", 6: "polynomial" }; // ContourBlockType
+const PAGES = ["machine", "program", "mdi", "lookahead", "alarms", "objects"];
+const MDI_HISTORY_KEY = "cnc-web-mdi-history";
+const MDI_HISTORY_MAX = 30;
+
+const state = {
+  session: null,
+  machine: null,
+  channel: 1,
+  values: {},          // object name -> newest value
+  watchErrors: {},     // object name -> why it cannot be watched
+  socket: null,
+  program: null,       // the program shown on the program page
+  programLines: [],
+  planned: null,       // {x: [], y: []} of the drawn tool path
+  live: [],            // [x, y] points of the live position while a program runs
+  objectWatch: [],     // names on the objects page's watch list
+  renderQueued: false,
+  stats: { messages: 0, positionUpdates: 0, since: performance.now() },
+};
+window.cncStats = state.stats; // read by the tests and the benchmark
+
+const $ = (sel) => document.querySelector(sel);
+const el = (tag, props = {}, ...children) => {
+  const node = Object.assign(document.createElement(tag), props);
+  for (const child of children) node.append(child);
+  return node;
+};
+
+// ------------------------------------------------------------------ message line
+
+function say(text, isError = false) {
+  const line = $("#message");
+  line.textContent = text;
+  line.classList.toggle("error", isError);
+}
+
+// ------------------------------------------------------------------ API
+
+async function api(method, path, body) {
+  const headers = {};
+  if (state.session && state.session.csrf) headers["X-CSRF-Token"] = state.session.csrf;
+  let payload = body;
+  if (body !== undefined && !(body instanceof FormData)) {
+    headers["Content-Type"] = "application/json";
+    payload = JSON.stringify(body);
+  }
+  const response = await fetch(path, { method, headers, body: payload, credentials: "same-origin" });
+  let data = {};
+  try { data = await response.json(); } catch (_) { data = {}; }
+  if (!response.ok) {
+    const why = data.error || `${response.status} ${response.statusText}`;
+    say(why, true);
+    if (response.status === 401 && state.session && state.session.sign_in_required) showLogin();
+    throw new Error(why);
+  }
+  return data;
+}
+
+// ------------------------------------------------------------------ session and sign-in
+
+async function loadSession() {
+  state.session = await api("GET", "/api/session");
+  const s = state.session;
+  $("#who").textContent = s.role ? `${s.role} · ${s.endpoint}` : "";
+  $("#logout").hidden = !(s.sign_in_required && s.role);
+  for (const control of document.querySelectorAll(".write")) control.disabled = !s.may_write;
+  return s;
+}
+
+function showLogin() {
+  for (const page of document.querySelectorAll(".page")) page.hidden = true;
+  const roles = $("#login-role");
+  roles.replaceChildren(...(state.session ? state.session.roles : []).map((r) => el("option", { value: r, textContent: r })));
+  $("#login").hidden = false;
+  say("sign in with a role's password");
+}
+
+$("#login-form").addEventListener("submit", async (event) => {
+  event.preventDefault();
+  try {
+    await api("POST", "/api/login", { role: $("#login-role").value, password: $("#login-password").value });
+    $("#login-password").value = "";
+    $("#login").hidden = true;
+    await start();
+  } catch (_) { /* shown on the message line */ }
+});
+
+$("#logout").addEventListener("click", async () => {
+  await api("POST", "/api/logout", {});
+  if (state.socket) state.socket.close();
+  location.reload();
+});
+
+// ------------------------------------------------------------------ live values
+
+function channelNames(ch) {
+  const c = `ch${ch.id}`;
+  const names = ["mc_active_mode_r", "mc_active_state_r", "mc_active_program_name_r", "actual_block_number",
+    "mc_active_file_name_r", "mc_active_line_r", "mc_active_feedrate_r", "mc_active_feed_override_r",
+    "mc_active_single_block_r", "mc_error_count_r", "mc_spindle_mode_r", "mc_spindle_active_rev_r",
+    "mc_spindle_override_w", "mc_active_tool_r", "mc_active_tool_offset_r", "mc_active_zero_offset_r"]
+    .map((leaf) => `${c}.${leaf}`);
+  names.push(`gpCh[${ch.plc_index}].bahn_mc_control.suspend_axis_output.state_r`);
+  for (const ax of ch.axes) {
+    for (const leaf of ["command_position_acs", "command_position_pcs", "position_offset", "link_state"]) {
+      names.push(`${c}.ax${ax.index}.${leaf}`);
+    }
+  }
+  return names;
+}
+
+function connectLive() {
+  const url = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws`;
+  const socket = new WebSocket(url);
+  state.socket = socket;
+  socket.addEventListener("open", () => {
+    const names = state.machine.channels.flatMap(channelNames)
+      .concat(["alarm_active_count_r", "alarm_raised_r"], state.objectWatch);
+    socket.send(JSON.stringify({ watch: names }));
+    say(`connected to ${state.session.endpoint}`);
+  });
+  socket.addEventListener("message", (event) => {
+    const message = JSON.parse(event.data);
+    state.stats.messages += 1;
+    if (message.values) {
+      const before = state.values["alarm_raised_r"];
+      Object.assign(state.values, message.values);
+      if (Object.keys(message.values).some((n) => n.endsWith("command_position_acs"))) state.stats.positionUpdates += 1;
+      if (before !== undefined && state.values["alarm_raised_r"] > before) showNewestAlarm();
+    }
+    if (message.errors) Object.assign(state.watchErrors, message.errors);
+    queueRender();
+  });
+  socket.addEventListener("close", () => {
+    say("live values lost: reconnecting…", true);
+    setTimeout(connectLive, 1000);
+  });
+}
+
+function watch(names) {
+  if (state.socket && state.socket.readyState === WebSocket.OPEN) state.socket.send(JSON.stringify({ watch: names }));
+}
+
+function unwatch(names) {
+  if (state.socket && state.socket.readyState === WebSocket.OPEN) state.socket.send(JSON.stringify({ unwatch: names }));
+}
+
+function queueRender() {
+  if (state.renderQueued) return;
+  state.renderQueued = true;
+  requestAnimationFrame(() => {
+    state.renderQueued = false;
+    render();
+  });
+}
+
+const v = (name) => state.values[name];
+const mm = (value) => (value === undefined ? "-" : (value / UM01_PER_MM).toFixed(4));
+const named = (table, value) => (value === undefined ? "-" : (table[value] || String(value)));
+
+// ------------------------------------------------------------------ rendering
+
+function render() {
+  renderMachine();
+  renderProgramLive();
+  renderJog();
+  renderWatch();
+  const active = v("alarm_active_count_r") || 0;  // the service's active alarm list
+  $("#alarm-count").textContent = active ? String(active) : "";
+}
+
+function cells(row, values) {
+  if (row.children.length !== values.length) row.replaceChildren(...values.map(() => el("td")));
+  values.forEach((value, k) => {
+    const cell = row.children[k];
+    const text = String(value);
+    if (cell.textContent !== text) cell.textContent = text;
+    if (typeof value === "string" && /^-?\d+\.\d+$/.test(value)) cell.className = "num";
+  });
+}
+
+function rowFor(tbody, key) {
+  let row = tbody.querySelector(`tr[data-key="${CSS.escape(key)}"]`);
+  if (!row) {
+    row = el("tr");
+    row.dataset.key = key;
+    tbody.append(row);
+  }
+  return row;
+}
+
+function renderMachine() {
+  const m = state.machine;
+  const channels = $("#channels tbody");
+  const axes = $("#axes tbody");
+  for (const ch of m.channels) {
+    const c = `ch${ch.id}`;
+    const line = v(`${c}.mc_active_line_r`);
+    const block = v(`${c}.actual_block_number`);
+    const feed = v(`${c}.mc_active_feedrate_r`);
+    const rev = v(`${c}.mc_spindle_active_rev_r`);
+    cells(rowFor(channels, c), [
+      ch.id, named(m.modes, v(`${c}.mc_active_mode_r`)), named(m.states, v(`${c}.mc_active_state_r`)),
+      v(`${c}.mc_active_program_name_r`) || "-",
+      block === undefined || block < 0 ? "-" : `N${block} ${v(`${c}.mc_active_file_name_r`) || ""}:${line ?? ""}`,
+      feed === undefined ? "-" : (feed * 60 / 1000).toFixed(1),
+      v(`${c}.mc_active_feed_override_r`) === undefined ? "-" : `${(v(`${c}.mc_active_feed_override_r`) / 10).toFixed(1)} %`,
+      v(`${c}.mc_active_single_block_r`) ? "on" : "off",
+      v(`gpCh[${ch.plc_index}].bahn_mc_control.suspend_axis_output.state_r`) ? "suspended" : "active",
+      named(SPINDLE_MODES, v(`${c}.mc_spindle_mode_r`)),
+      rev === undefined ? "-" : (rev / 6000).toFixed(0),
+      v(`${c}.mc_active_tool_r`) === undefined ? "-" : `T${v(`${c}.mc_active_tool_r`)} D${v(`${c}.mc_active_tool_offset_r`) ?? "-"} G${53 + (v(`${c}.mc_active_zero_offset_r`) || 0)}`,
+      v(`${c}.mc_error_count_r`) ?? "-",
+    ]);
+    for (const ax of ch.axes) {
+      const a = `${c}.ax${ax.index}`;
+      cells(rowFor(axes, a), [
+        `${c} ${ax.name}`, mm(v(`${a}.command_position_acs`)), mm(v(`${a}.command_position_pcs`)),
+        mm(v(`${a}.position_offset`)), named(LINK_STATES, v(`${a}.link_state`)), ax.drive || "-",
+      ]);
+    }
+  }
+  const c = `ch${state.channel}`;
+  const override = v(`${c}.mc_active_feed_override_r`);
+  const slider = $("#override");
+  if (override !== undefined && document.activeElement !== slider) {
+    slider.value = String(Math.round(override / 10));
+    $("#override-value").textContent = slider.value;
+  }
+  const spindle = v(`${c}.mc_spindle_override_w`);
+  const spindleSlider = $("#spindle-override");
+  if (spindle !== undefined && document.activeElement !== spindleSlider) {
+    spindleSlider.value = String(Math.round(spindle / 10));
+    $("#spindle-override-value").textContent = spindleSlider.value;
+  }
+}
+
+// ------------------------------------------------------------------ machine page controls
+
+for (const button of document.querySelectorAll("[data-command]")) {
+  button.addEventListener("click", () => command(button.dataset.command));
+}
+
+async function command(what) {
+  try {
+    await api("POST", `/api/channel/${state.channel}/${what}`, {});
+    say(`channel ${state.channel}: ${what}`);
+  } catch (_) { /* shown */ }
+}
+
+function overrideSlider(input, output, object) {
+  input.addEventListener("input", () => { output.textContent = input.value; });
+  input.addEventListener("change", async () => {
+    try {
+      await api("POST", "/api/write", { name: `ch${state.channel}.${object}`, value: Number(input.value) * 10 });
+      say(`ch${state.channel}.${object} := ${Number(input.value) * 10}`);
+    } catch (_) { /* shown */ }
+    input.blur();
+  });
+}
+overrideSlider($("#override"), $("#override-value"), "mc_command_feed_override_w");
+overrideSlider($("#spindle-override"), $("#spindle-override-value"), "mc_spindle_override_w");
+
+// ------------------------------------------------------------------ program page
+
+async function loadPrograms() {
+  const data = await api("GET", "/api/programs");
+  const list = $("#program-list");
+  list.replaceChildren(...data.programs.map((p) => {
+    const item = el("li", { textContent: `${p.name}  (${p.size_bytes} B)` });
+    item.dataset.name = p.name;
+    item.classList.toggle("selected", p.name === state.program);
+    item.addEventListener("click", () => showProgram(p.name));
+    return item;
+  }));
+}
+
+async function showProgram(name) {
+  const data = await api("GET", `/api/programs/${encodeURIComponent(name)}`);
+  state.program = name;
+  state.planned = null;
+  state.live = [];
+  $("#program-name").textContent = name;
+  for (const item of $("#program-list").children) item.classList.toggle("selected", item.dataset.name === name);
+  state.programLines = data.text.split("\n");
+  if (state.programLines.length && state.programLines[state.programLines.length - 1] === "") state.programLines.pop();
+  $("#program-text").replaceChildren(...state.programLines.map((text) => el("li", { textContent: text })));
+  drawPath();
+}
+
+async function upload(files) {
+  for (const file of files) {
+    const form = new FormData();
+    form.append("file", file, file.name);
+    try {
+      const done = await api("POST", "/api/programs", form);
+      say(`uploaded ${done.name} (${done.size_bytes} bytes)`);
+    } catch (_) { return; }
+  }
+  await loadPrograms();
+  if (files.length) await showProgram(files[files.length - 1].name);
+}
+
+$("#upload-input").addEventListener("change", (event) => upload([...event.target.files]));
+const drop = $("#drop");
+drop.addEventListener("dragover", (event) => { event.preventDefault(); drop.classList.add("over"); });
+drop.addEventListener("dragleave", () => drop.classList.remove("over"));
+drop.addEventListener("drop", (event) => {
+  event.preventDefault();
+  drop.classList.remove("over");
+  if (state.session.may_write) upload([...event.dataTransfer.files]);
+  else say("role monitor may not upload programs; operator or admin may", true);
+});
+
+function needProgram() {
+  if (!state.program) say("choose a program in the list first", true);
+  return state.program;
+}
+
+$("#select-program").addEventListener("click", async () => {
+  if (!needProgram()) return;
+  try {
+    await api("POST", `/api/channel/${state.channel}/select`, { program: state.program });
+    say(`channel ${state.channel}: ${state.program} selected`);
+  } catch (_) { /* shown */ }
+});
+
+$("#start-program").addEventListener("click", async () => {
+  if (!needProgram()) return;
+  try {
+    await api("POST", `/api/channel/${state.channel}/select`, { program: state.program });
+    state.live = [];
+    await api("POST", `/api/channel/${state.channel}/start`, {});
+    say(`channel ${state.channel}: ${state.program} started`);
+  } catch (_) { /* shown */ }
+});
+
+$("#check-program").addEventListener("click", async () => {
+  if (!needProgram()) return;
+  try {
+    say(`checking ${state.program}…`);
+    const result = await api("POST", `/api/channel/${state.channel}/check`, { program: state.program });
+    const items = $("#program-text").children;
+    for (const item of items) { item.classList.remove("error"); item.querySelector(".err")?.remove(); }
+    const found = result.errors.concat(result.aborted ? [result.aborted] : []);
+    for (const e of found) {
+      const item = e.file === state.program ? items[e.line - 1] : undefined;
+      if (!item) continue;
+      item.classList.add("error");
+      item.append(el("span", { className: "err", textContent: `← error ${e.id} (${e.category}) col ${e.column}: ${e.message}` }));
+    }
+    say(found.length ? `${state.program}: ${result.error_count} errors in ${result.lines} lines` : `${state.program}: no errors in ${result.lines} lines`, found.length > 0);
+  } catch (_) { /* shown */ }
+});
+
+$("#draw-program").addEventListener("click", async () => {
+  if (!needProgram()) return;
+  try {
+    say(`dry run of ${state.program} (no axis moves)…`);
+    const trace = await api("POST", `/api/channel/${state.channel}/trace`, { program: state.program });
+    const [xName, yName] = Object.keys(trace.positions_mm);
+    state.planned = { x: trace.positions_mm[xName] || [], y: trace.positions_mm[yName] || [] };
+    say(`${state.program}: ${trace.program_time_s.toFixed(3)} s planned, ended ${trace.ended}`);
+    drawPath();
+  } catch (_) { /* shown */ }
+});
+
+function currentXY() {
+  const ch = state.machine.channels.find((c) => c.id === state.channel);
+  if (!ch || ch.axes.length < 2) return null;
+  const x = v(`ch${ch.id}.ax${ch.axes[0].index}.command_position_acs`);
+  const y = v(`ch${ch.id}.ax${ch.axes[1].index}.command_position_acs`);
+  return x === undefined || y === undefined ? null : [x / UM01_PER_MM, y / UM01_PER_MM];
+}
+
+function drawPath() {
+  const points = [];
+  if (state.planned) state.planned.x.forEach((x, k) => points.push([x, state.planned.y[k]]));
+  const all = points.concat(state.live);
+  const here = currentXY();
+  if (here) all.push(here);
+  if (!all.length) return;
+  let [minX, minY, maxX, maxY] = [Infinity, Infinity, -Infinity, -Infinity];
+  for (const [x, y] of all) { minX = Math.min(minX, x); maxX = Math.max(maxX, x); minY = Math.min(minY, y); maxY = Math.max(maxY, y); }
+  const span = Math.max(maxX - minX, maxY - minY, 1);
+  const scale = Math.min(360 / span, 260 / span);
+  const sx = (x) => (20 + (x - minX) * scale).toFixed(2);
+  const sy = (y) => (280 - (y - minY) * scale).toFixed(2);
+  const line = (pts) => pts.map(([x, y]) => `${sx(x)},${sy(y)}`).join(" ");
+  $("#path-planned").setAttribute("points", line(points));
+  $("#path-live").setAttribute("points", line(state.live));
+  if (here) {
+    $("#path-tool").setAttribute("cx", sx(here[0]));
+    $("#path-tool").setAttribute("cy", sy(here[1]));
+  }
+}
+
+function renderProgramLive() {
+  const c = `ch${state.channel}`;
+  const here = currentXY();
+  const working = ["ACTIVE", "HOLD"].includes(named(state.machine.states, v(`${c}.mc_active_state_r`)));
+  if (here) {
+    const last = state.live[state.live.length - 1];
+    if (working && (!last || last[0] !== here[0] || last[1] !== here[1])) {
+      state.live.push(here);
+      if (state.live.length > 5000) state.live.splice(0, state.live.length - 5000);
+    }
+    $("#position-line").textContent = `X ${here[0].toFixed(4)}  Y ${here[1].toFixed(4)} mm`;
+  }
+  $("#program-state").textContent = named(state.machine.states, v(`${c}.mc_active_state_r`));
+  const block = v(`${c}.actual_block_number`);
+  $("#program-block").textContent = block === undefined || block < 0 ? "-" : `N${block} line ${v(`${c}.mc_active_line_r`)}`;
+  const items = $("#program-text").children;
+  const line = v(`${c}.mc_active_line_r`);
+  const file = v(`${c}.mc_active_file_name_r`);
+  for (let k = 0; k < items.length; k++) items[k].classList.toggle("current", file === state.program && line === k + 1);
+  if (!$("#page-program").hidden) drawPath();
+}
+
+// ------------------------------------------------------------------ MDI and jog
+
+function mdiHistory() {
+  try { return JSON.parse(localStorage.getItem(MDI_HISTORY_KEY) || "[]"); } catch (_) { return []; }
+}
+
+function showMdiHistory() {
+  $("#mdi-history").replaceChildren(...mdiHistory().map((blocks) => {
+    const item = el("li", { textContent: blocks });
+    item.addEventListener("click", () => { $("#mdi-input").value = blocks; $("#mdi-input").focus(); });
+    return item;
+  }));
+}
+
+$("#mdi-form").addEventListener("submit", async (event) => {
+  event.preventDefault();
+  const blocks = $("#mdi-input").value.trim();
+  if (!blocks) return;
+  try {
+    await api("POST", `/api/channel/${state.channel}/mdi`, { blocks });
+    const history = [blocks].concat(mdiHistory().filter((b) => b !== blocks)).slice(0, MDI_HISTORY_MAX);
+    localStorage.setItem(MDI_HISTORY_KEY, JSON.stringify(history));
+    showMdiHistory();
+    $("#mdi-input").value = "";
+    say(`channel ${state.channel}: manual block ${blocks}`);
+  } catch (_) { /* shown */ }
+});
+
+function renderJog() {
+  const ch = state.machine.channels.find((c) => c.id === state.channel);
+  const tbody = $("#jog tbody");
+  if (!ch) return;
+  if (tbody.dataset.channel !== String(ch.id)) {
+    tbody.dataset.channel = String(ch.id);
+    tbody.replaceChildren(...ch.axes.map((ax) => {
+      const minus = el("button", { type: "button", className: "write", textContent: `${ax.name} −` });
+      const plus = el("button", { type: "button", className: "write", textContent: `${ax.name} +` });
+      minus.addEventListener("click", () => jog(ax, -1));
+      plus.addEventListener("click", () => jog(ax, 1));
+      minus.disabled = plus.disabled = !state.session.may_write;
+      const position = el("td", { className: "num" });
+      position.dataset.axis = `ch${ch.id}.ax${ax.index}.command_position_acs`;
+      return el("tr", {}, el("td", {}, minus), position, el("td", {}, plus));
+    }));
+  }
+  for (const cell of tbody.querySelectorAll("td[data-axis]")) cell.textContent = `${mm(v(cell.dataset.axis))} mm`;
+}
+
+async function jog(axis, direction) {
+  try {
+    await api("POST", `/api/channel/${state.channel}/jog`, { axis: axis.index, direction, increment_mm: Number($("#jog-increment").value) });
+    say(`channel ${state.channel}: jog ${axis.name} ${direction > 0 ? "+" : "−"}${$("#jog-increment").value} mm`);
+  } catch (_) { /* shown */ }
+}
+
+// ------------------------------------------------------------------ look-ahead
+
+async function lookahead(mode) {
+  try {
+    const data = await api("GET", `/api/channel/${state.channel}/lookahead?mode=${mode}`);
+    $("#lookahead-state").textContent = `${data.count_logged_blocks} logged, log ${data.log_active ? "active" : "off"}, max_dist_prog_start ${mm(data.max_dist_prog_start)} mm`;
+    const deg = (rad) => (rad * 180 / Math.PI).toFixed(3);
+    $("#lookahead-table tbody").replaceChildren(...data.blocks.map((b, k) => {
+      const row = el("tr");
+      cells(row, [k, named(CONTOUR_TYPES, b.block_type), b.block_number, mm(b.start_position), mm(b.length),
+        mm(b.programmed_radius), mm(b.compensated_radius), deg(b.circle_angle), deg(b.tangent_variation)]);
+      return row;
+    }));
+    say(`channel ${state.channel}: ${data.blocks.length} look-ahead elements`);
+  } catch (_) { /* shown */ }
+}
+$("#lookahead-ahead").addEventListener("click", () => lookahead("ahead"));
+$("#lookahead-marked").addEventListener("click", () => lookahead("marked"));
+
+$("#profile-draw").addEventListener("click", async () => {
+  const program = state.program || v(`ch${state.channel}.mc_active_program_name_r`);
+  if (!program) { say("choose a program on the program page first", true); return; }
+  try {
+    say(`planning ${program} (dry run, no axis moves)…`);
+    const trace = await api("POST", `/api/channel/${state.channel}/trace`, { program });
+    const s = trace.path_mm;
+    const maxS = Math.max(...s, 1e-9);
+    const maxV = Math.max(...trace.v_mm_s, ...trace.feed_limit_mm_s.filter((f) => f < 1e6), 1e-9);
+    // over the run's cycles (time), so that the ramps keep their length on the chart
+    const last = Math.max(s.length - 1, 1);
+    const line = (values) => values.map((value, k) => `${(k / last * 600).toFixed(1)},${(200 - Math.min(value, maxV) / maxV * 190).toFixed(1)}`).join(" ");
+    $("#profile-v").setAttribute("points", line(trace.v_mm_s));
+    $("#profile-limit").setAttribute("points", line(trace.feed_limit_mm_s));
+    $("#profile-name").textContent = program;
+    $("#profile-max").textContent = `· over ${trace.program_time_s.toFixed(3)} s; top ${maxV.toFixed(1)} mm/s, path ${maxS.toFixed(1)} mm`;
+    say(`${program}: planned ${trace.program_time_s.toFixed(3)} s`);
+  } catch (_) { /* shown */ }
+});
+
+// ------------------------------------------------------------------ alarms
+
+async function loadAlarms() {
+  const data = await api("GET", "/api/alarms");
+  $("#alarm-none").hidden = data.alarms.length > 0;
+  $("#alarm-table tbody").replaceChildren(...data.alarms.map((a) => {
+    const ack = el("button", { type: "button", className: "write", textContent: "Acknowledge" });
+    ack.disabled = !state.session.may_write || a.state !== "active";
+    ack.addEventListener("click", async () => {
+      try {
+        await api("POST", `/api/alarms/${a.sequence}/acknowledge`, {});
+        say(`alarm #${a.sequence} (${a.id}) acknowledged`);
+        await loadAlarms();
+      } catch (_) { /* shown */ }
+    });
+    const row = el("tr");
+    cells(row, [a.sequence, a.channel || "-", a.id, a.severity, a.state, a.file ? `${a.file}:${a.line}:${a.column}` : "-", a.text]);
+    row.append(el("td", {}, ack));
+    return row;
+  }));
+  return data.alarms;
+}
+
+async function showNewestAlarm() {
+  try {
+    const alarms = await loadAlarms();
+    const newest = alarms.filter((a) => a.channel === state.channel || a.channel === 0).pop();
+    if (newest) say(`channel ${newest.channel}: ${newest.severity} ${newest.id}: ${newest.file ? `${newest.file}:${newest.line}:${newest.column}: ` : ""}${newest.text}`, newest.severity === "error");
+  } catch (_) { /* shown */ }
+}
+
+// ------------------------------------------------------------------ objects (ADS monitor)
+
+$("#object-search").addEventListener("submit", async (event) => {
+  event.preventDefault();
+  try {
+    const pattern = $("#object-pattern").value.trim() || "*";
+    const data = await api("GET", `/api/objects?pattern=${encodeURIComponent(pattern)}&limit=300`);
+    $("#object-total").textContent = `${data.objects.length} of ${data.total}`;
+    $("#object-table tbody").replaceChildren(...data.objects.map((o) => {
+      const row = el("tr");
+      row.title = o.description;
+      cells(row, [o.name, `${o.port}:0x${o.group.toString(16)}:0x${o.offset.toString(16)}`, o.type, o.access, o.unit]);
+      const watchButton = el("button", { type: "button", textContent: "Watch" });
+      watchButton.addEventListener("click", () => addWatch(o));
+      row.append(el("td", {}, watchButton));
+      return row;
+    }));
+  } catch (_) { /* shown */ }
+});
+
+const objectAccess = {};
+
+function addWatch(info) {
+  if (state.objectWatch.includes(info.name)) return;
+  objectAccess[info.name] = info.access;
+  state.objectWatch.push(info.name);
+  watch([info.name]);
+  const input = el("input", { type: "text", className: "write", placeholder: "value" });
+  const set = el("button", { type: "button", className: "write", textContent: "Write" });
+  input.disabled = set.disabled = !state.session.may_write || !info.access.includes("w");
+  set.addEventListener("click", async () => {
+    let value = input.value;
+    try { value = JSON.parse(value); } catch (_) { /* a bare string */ }
+    try {
+      await api("POST", "/api/write", { name: info.name, value });
+      say(`${info.name} := ${input.value}`);
+    } catch (_) { /* shown */ }
+  });
+  const remove = el("button", { type: "button", textContent: "×", title: "stop watching" });
+  const valueCell = el("td", { className: "num" });
+  valueCell.dataset.watch = info.name;
+  const row = el("tr", {}, el("td", { textContent: info.name }), valueCell, el("td", {}, input, set), el("td", {}, remove));
+  remove.addEventListener("click", () => {
+    state.objectWatch = state.objectWatch.filter((n) => n !== info.name);
+    unwatch([info.name]);
+    row.remove();
+  });
+  $("#watch-table tbody").append(row);
+  renderWatch();
+}
+
+function renderWatch() {
+  for (const cell of document.querySelectorAll("td[data-watch]")) {
+    const name = cell.dataset.watch;
+    const text = name in state.watchErrors ? state.watchErrors[name] : JSON.stringify(v(name) ?? "…");
+    if (cell.textContent !== text) cell.textContent = text;
+  }
+}
+
+// ------------------------------------------------------------------ pages and start
+
+function showPage() {
+  const name = PAGES.includes(location.hash.slice(1)) ? location.hash.slice(1) : "machine";
+  for (const page of PAGES) $(`#page-${page}`).hidden = page !== name;
+  for (const link of document.querySelectorAll("#nav a")) link.classList.toggle("active", link.getAttribute("href") === `#${name}`);
+  document.body.dataset.page = name;
+  const loaders = { program: loadPrograms, alarms: loadAlarms, mdi: showMdiHistory };
+  if (loaders[name]) Promise.resolve(loaders[name]()).catch(() => {});
+  queueRender();
+}
+
+$("#channel-select").addEventListener("change", (event) => {
+  state.channel = Number(event.target.value);
+  state.live = [];
+  queueRender();
+});
+
+async function start() {
+  const session = await loadSession();
+  if (!session.role) { showLogin(); return; }
+  state.machine = await api("GET", "/api/machine");
+  $("#channel-select").replaceChildren(...state.machine.channels.map((c) => el("option", { value: c.id, textContent: `channel ${c.id}` })));
+  state.channel = state.machine.channels.length ? state.machine.channels[0].id : 1;
+  window.addEventListener("hashchange", showPage);
+  showPage();
+  connectLive();
+  document.body.dataset.ready = "1"; // the tests wait for it
+}
+
+start().catch((error) => say(`cnc-web: ${error.message}`, true));
