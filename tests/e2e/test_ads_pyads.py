@@ -21,7 +21,8 @@ import pytest
 
 from cnc_objects.clients import Client
 from cnc_objects.service import __version__
-from cnc_objects.testing import ServiceProcess, run_program, start_service
+from cnc_objects.testing import ServiceProcess, run_program
+from tests.support.pyads_plc import pyads_service
 
 LOCAL_NET_ID = "127.0.0.1.1.20"  # this test process, as pyads' AMS router
 CH1_COM, CH1_GEO = 0x120101, 0x121301
@@ -48,23 +49,9 @@ class Ads:
 
 @pytest.fixture(scope="module")
 def ads(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Ads]:
-    service = start_service(program_dir=tmp_path_factory.mktemp("ads-pyads"), ads=True)
-    connections: list[pyads.Connection] = []
-    try:
-        net_id, (ip, _) = service.ams_net_id, service.ads_address  # type: ignore[misc]
-        pyads.open_port()
-        pyads.set_local_address(LOCAL_NET_ID)
-        pyads.add_route(net_id, ip)
-        for port in (851, 551, 553, 10000):
-            connection = pyads.Connection(net_id, port, ip)
-            connection.open()
-            connections.append(connection)
+    with pyads_service(tmp_path_factory.mktemp("ads-pyads"), LOCAL_NET_ID,
+                       ports=(851, 551, 553, 10000)) as (service, connections):
         yield Ads(service, *connections)
-    finally:
-        for connection in connections:
-            connection.close()
-        pyads.close_port()
-        assert service.stop() == 0, service.log_text
 
 
 def test_read_state(ads: Ads) -> None:

@@ -24,6 +24,7 @@ from cnc_objects.protocol.alarm_values import AlarmClass, AlarmState, Severity
 from cnc_objects.testing import ServiceProcess, serving
 from tests.clients.test_cli import cnc, json_lines
 from tests.e2e.test_ads_pyads import Ads, ads  # noqa: F401  (the pyads fixture)
+from tests.support.service import reset_client, serving_config
 
 BAD = "G0 X1\nG1 X10\nM30\n"  # line 2: G1 without F, NC error 20008
 
@@ -31,16 +32,14 @@ BAD = "G0 X1\nG1 X10\nM30\n"  # line 2: G1 without F, NC error 20008
 @pytest.fixture(scope="module")
 def machine(tmp_path_factory) -> Iterator[ServiceProcess]:
     """One service for this module, with a history of 3 alarms."""
-    config = tmp_path_factory.mktemp("alarms") / "machine.toml"
-    config.write_text("[limits]\nalarm_history_max = 3\n")
-    with serving("--config", str(config)) as service:
+    with serving_config(tmp_path_factory.mktemp("alarms"),
+                        "[limits]\nalarm_history_max = 3\n") as service:
         yield service
 
 
 @pytest.fixture
 def c(machine) -> Iterator[Client]:
-    with Client(machine.endpoint, timeout_s=10) as client:
-        client.reset(1)
+    with reset_client(machine) as client:
         yield client
 
 

@@ -24,6 +24,7 @@ import pytest
 
 from cnc_objects.clients import AdsError, Client
 from cnc_objects.testing import ServiceProcess, start_service
+from tests.support.pyads_plc import plc_machine, pyads_service
 
 LOCAL_NET_ID = "127.0.0.1.1.22"
 STEP = "cnc_cycle_step_w"
@@ -36,19 +37,7 @@ UNITS = 16
 INCR = 10_000  # 0.1 um per mm
 MAX_CYCLES = 5_000  # a program here takes about 500: more is a hang
 WAIT_CYCLES = 50  # the PLC takes this many cycles to acknowledge
-CONFIG = """
-[[channels]]
-id = 1
-name = "main"
-axes = [
-    {name = "X", logical_number = 1, link_to = 1},
-    {name = "Y", logical_number = 2, link_to = 2},
-    {name = "Z", logical_number = 3, link_to = 3},
-]
-[channels.techno]
-auto_acknowledge = false
-m_synch = {"10" = "MOS", "11" = "MVS_SVS", "12" = "MVS_SNS", "13" = "MNS_SNS"}
-"""
+CONFIG = plc_machine({"10": "MOS", "11": "MVS_SVS", "12": "MVS_SNS", "13": "MNS_SNS"})
 # G00 X0 first: every program runs from X0 upwards, whatever the one before left.
 PROGRAM = "G00 X0\nG01 X10 F6000\nN20 G01 X20 M{m}\nN30 G01 X30\nM30\n"
 NAMES = [CYCLE, X_POS, VELOCITY, USED] + [
@@ -89,25 +78,9 @@ class Plc:
 
 @pytest.fixture(scope="module")
 def plc(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Plc]:
-    work = tmp_path_factory.mktemp("plc-cycles")
-    config = work / "machine.toml"
-    config.write_text(CONFIG)
-    service = start_service("--clock", "step", "--config", str(config),
-                            program_dir=work / "programs", ads=True)
-    connection = None
-    try:
-        net_id, (ip, _) = service.ams_net_id, service.ads_address  # type: ignore[misc]
-        pyads.open_port()
-        pyads.set_local_address(LOCAL_NET_ID)
-        pyads.add_route(net_id, ip)
-        connection = pyads.Connection(net_id, 851, ip)
-        connection.open()
+    with pyads_service(tmp_path_factory.mktemp("plc-cycles"), LOCAL_NET_ID, "--clock", "step",
+                       config=CONFIG) as (service, (connection,)):
         yield Plc(service, connection)
-    finally:
-        if connection is not None:
-            connection.close()
-        pyads.close_port()
-        assert service.stop() == 0, service.log_text
 
 
 class Run:

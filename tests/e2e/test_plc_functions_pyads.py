@@ -21,7 +21,8 @@ import pyads
 import pytest
 
 from cnc_objects.clients import Client
-from cnc_objects.testing import ServiceProcess, start_service
+from cnc_objects.testing import ServiceProcess
+from tests.support.pyads_plc import plc_machine, pyads_service
 
 LOCAL_NET_ID = "127.0.0.1.1.21"
 WAIT_S = 20.0
@@ -30,19 +31,7 @@ USED = "gpCh[0].used_units_std_sync_r"
 X_POS = "ch1.ax1.command_position_acs"  # 0.1 um
 TIME = "cnc_kernel_time_r"  # s
 INCR = 10_000  # 0.1 um per mm
-CONFIG = """
-[[channels]]
-id = 1
-name = "main"
-axes = [
-    {name = "X", logical_number = 1, link_to = 1},
-    {name = "Y", logical_number = 2, link_to = 2},
-    {name = "Z", logical_number = 3, link_to = 3},
-]
-[channels.techno]
-auto_acknowledge = false
-m_synch = {"10" = "MOS", "11" = "MVS_SVS", "12" = "MVS_SNS", "13" = "MNS_SNS"}
-"""
+CONFIG = plc_machine({"10": "MOS", "11": "MVS_SVS", "12": "MVS_SNS", "13": "MNS_SNS"})
 PROGRAM = "G01 X10 F6000\nN20 G01 X20 M{m}\nN30 G01 X30\nM30\n"
 
 
@@ -65,25 +54,9 @@ class Plc:
 
 @pytest.fixture(scope="module")
 def plc(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Plc]:
-    work = tmp_path_factory.mktemp("plc-functions")
-    config = work / "machine.toml"
-    config.write_text(CONFIG)
-    service = start_service("--clock", "virtual", "--config", str(config),
-                            program_dir=work / "programs", ads=True)
-    connection = None
-    try:
-        net_id, (ip, _) = service.ams_net_id, service.ads_address  # type: ignore[misc]
-        pyads.open_port()
-        pyads.set_local_address(LOCAL_NET_ID)
-        pyads.add_route(net_id, ip)
-        connection = pyads.Connection(net_id, 851, ip)
-        connection.open()
+    with pyads_service(tmp_path_factory.mktemp("plc-functions"), LOCAL_NET_ID, "--clock", "virtual",
+                       config=CONFIG) as (service, (connection,)):
         yield Plc(service, connection)
-    finally:
-        if connection is not None:
-            connection.close()
-        pyads.close_port()
-        assert service.stop() == 0, service.log_text
 
 
 def _start(client: Client, m: int) -> None:

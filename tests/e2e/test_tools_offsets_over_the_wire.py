@@ -10,7 +10,8 @@ from collections.abc import Iterator
 import pytest
 
 from cnc_objects.clients import AdsError, ChannelError, Client
-from cnc_objects.testing import ServiceProcess, run_program, serving
+from cnc_objects.testing import ServiceProcess, run_program
+from tests.support.service import reset_client, serving_config
 
 INCR = 10_000  # 0.1 um per mm
 
@@ -18,16 +19,13 @@ INCR = 10_000  # 0.1 um per mm
 @pytest.fixture(scope="module")
 def machine(tmp_path_factory) -> Iterator[ServiceProcess]:
     """One service with a tool change time of 2.5 s (a machine parameter)."""
-    config = tmp_path_factory.mktemp("tools") / "machine.toml"
-    config.write_text("tool_change_time_s = 2.5\n")
-    with serving("--config", str(config)) as service:
+    with serving_config(tmp_path_factory.mktemp("tools"), "tool_change_time_s = 2.5\n") as service:
         yield service
 
 
 @pytest.fixture
 def c(machine) -> Iterator[Client]:
-    with Client(machine.endpoint, timeout_s=10) as client:
-        client.reset(1)
+    with reset_client(machine) as client:
         yield client
 
 

@@ -20,38 +20,24 @@ from cnc_objects.clients import AsyncClient, Client
 from cnc_objects.protocol.values import ExecutionMode
 from cnc_objects.protocol.wait_reasons import WAIT_REASON_TEXTS, WaitReason
 from cnc_objects.testing import ServiceProcess, serving, wait_for, wait_for_async
+from tests.support.pyads_plc import plc_machine
+from tests.support.service import reset_client, serving_config
 
 REASON, TEXT = "ch1.mc_wait_reason_r", "ch1.mc_wait_reason_text_r"
-CONFIG = """
-[[channels]]
-id = 1
-name = "main"
-axes = [
-    {name = "X", logical_number = 1, link_to = 1},
-    {name = "Y", logical_number = 2, link_to = 2},
-    {name = "Z", logical_number = 3, link_to = 3},
-]
-[channels.techno]
-auto_acknowledge = false
-m_synch = {"11" = "MVS_SVS"}
-"""
+CONFIG = plc_machine({"11": "MVS_SVS"})
 SUSPEND = "gpCh[0].bahn_mc_control.suspend_axis_output.command_w"
 LONG_DWELL = "G4 X100000\nM30\n"  # a dwell the tests never wait out
 
 
 @pytest.fixture(scope="module")
 def machine(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceProcess]:
-    work = tmp_path_factory.mktemp("wait-reasons")
-    config = work / "machine.toml"
-    config.write_text(CONFIG)
-    with serving("--config", str(config), program_dir=work / "programs") as service:
+    with serving_config(tmp_path_factory.mktemp("wait-reasons"), CONFIG) as service:
         yield service
 
 
 @pytest.fixture
 def c(machine: ServiceProcess) -> Iterator[Client]:
-    with Client(machine.endpoint, timeout_s=10) as client:
-        client.reset(1)
+    with reset_client(machine) as client:
         yield client
         client.reset(1)
 
