@@ -50,8 +50,8 @@ READ_NAMES = ["ch1.ax1.command_position_acs", "ch1.actual_path_velocity", "cnc_t
 
 
 @dataclass(frozen=True)
-class Jitter:
-    """The cycle figures of one loaded run."""
+class CycleFigures:
+    """The kernel's cycle figures over one measurement (web_bench's too)."""
 
     cycles: int
     overruns: int
@@ -59,6 +59,12 @@ class Jitter:
     p99_us: int
     max_us: int
     exec_max_us: int
+
+
+@dataclass(frozen=True)
+class Jitter(CycleFigures):
+    """The cycle figures of one loaded run."""
+
     reads: int
     samples: int
     policy: SchedPolicy  # what the cycle thread got

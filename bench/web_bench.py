@@ -34,6 +34,7 @@ from cnc_objects.testing.web import serving_web
 from tests.support.service import start_service
 
 from .common import BENCH_MACHINE
+from .jitter_bench import CycleFigures as Cycles
 from .jitter_bench import program
 
 SESSIONS = 10
@@ -47,18 +48,6 @@ CHANNEL_LEAVES = ("mc_active_mode_r", "mc_active_state_r", "mc_active_program_na
 AXIS_LEAVES = ("command_position_acs", "command_position_pcs", "position_offset", "link_state")
 CYCLE_FIGURES = ["cnc_tick_counter_r", "cnc_cycle_overruns_r", "cnc_cycle_jitter_p50_r",
                  "cnc_cycle_jitter_p99_r", "cnc_cycle_jitter_max_r", "cnc_cycle_exec_time_max_r"]
-
-
-@dataclass(frozen=True)
-class Cycles:
-    """The kernel's cycle figures over one measurement."""
-
-    cycles: int
-    overruns: int
-    p50_us: int
-    p99_us: int
-    max_us: int
-    exec_max_us: int
 
 
 @dataclass(frozen=True)

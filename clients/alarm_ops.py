@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
 
-from cnc_objects.protocol.alarm_values import AlarmClass, AlarmState, Severity
+from cnc_objects.protocol.alarm_values import AlarmClass, AlarmState, Severity, describe_alarm
 
 from .client_core import MixinBase
 
@@ -91,9 +91,8 @@ class AlarmInfo:
         }
 
     def __str__(self) -> str:
-        where = f"{self.where}: " if self.file else ""
-        return (f"#{self.sequence} {self.state.name.lower()} {self.severity_name} {self.id} "
-                f"ch{self.channel}: {where}{self.text}")
+        return describe_alarm(self.sequence, self.state.name.lower(), self.severity_name,
+                              self.id, self.channel, self.where, self.text)
 
 
 @dataclass(frozen=True, slots=True)

@@ -26,6 +26,14 @@ class AlarmClass(IntEnum):
     KERNEL = 6  # the kernel itself: the cycle task failed
 
 
+def describe_alarm(sequence: int, state: str, severity: str, alarm_id: int, channel: int,
+                   where: str, text: str) -> str:
+    """One line for an alarm, the same in the kernel's log and in every client:
+    ``#7 active error 20008 ch1: MDI:1:4: <text>`` (``where``: ``file:line:column`` or "")."""
+    place = f"{where}: " if where else ""
+    return f"#{sequence} {state} {severity} {alarm_id} ch{channel}: {place}{text}"
+
+
 class Severity(IntEnum):
     """OPC 40502 severities: lowest 1, highest 1000 (its example of three levels)."""
 

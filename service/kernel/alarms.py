@@ -35,6 +35,7 @@ from typing import Protocol
 from cnc_objects.protocol.alarm_values import AlarmClass as AlarmClass
 from cnc_objects.protocol.alarm_values import AlarmState as AlarmState
 from cnc_objects.protocol.alarm_values import Severity as Severity
+from cnc_objects.protocol.alarm_values import describe_alarm
 
 from .axis_params import AxisErrorId
 from .nc.errors import NcErrorId
@@ -127,9 +128,9 @@ class Alarm:
         return self.severity <= Severity.WARNING
 
     def __str__(self) -> str:
-        where = f"{self.file}:{self.line}:{self.column}: " if self.file else ""
-        return (f"#{self.sequence} {self.state.name.lower()} {self.severity.name.lower()} "
-                f"{self.id} ch{self.channel}: {where}{self.text}")
+        where = f"{self.file}:{self.line}:{self.column}" if self.file else ""
+        return describe_alarm(self.sequence, self.state.name.lower(),
+                              self.severity.name.lower(), self.id, self.channel, where, self.text)
 
 
 @dataclass(frozen=True, slots=True)
