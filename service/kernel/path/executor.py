@@ -148,6 +148,15 @@ class PathExecutor:
         """Run one cycle with feed override factor ``override`` (1.0 = 100 %, 0 stands)."""
         return self._ipo.step(override)
 
+    def cruise_budget(self, override: float, most: int) -> int:
+        """How many of the next cycles (at most ``most``) only cruise along the current
+        segment (``Interpolator.cruise_budget``)."""
+        return self._ipo.cruise_budget(override, most)
+
+    def cruise(self, cycles: int) -> StepResult:
+        """Run ``cycles`` cruising cycles at once; the last cycle's result."""
+        return self._ipo.cruise(cycles)
+
     def hold(self) -> None:
         """Feedhold: decelerate on the path within the limits and stand."""
         self._ipo.hold = True

@@ -165,6 +165,43 @@ class Interpolator:
                                       self.distance_base_mm + s, None)
         return self._step()
 
+    def cruise_budget(self, override: float, most: int) -> int:
+        """How many of the next cycles (at most ``most``) ``step(override)`` would run
+        on its cruising fast path: same segment, speed at the cap, no block end, the
+        braking point not reached. 0 when the next cycle is anything else."""
+        seg = self.seg
+        if (seg is None or override != self.override or self.planner.dirty or self.hold
+                or self.waiting or self.events or self.v_mm_s != seg.cap_mm_s):
+            return 0
+        return self._cruise(seg, most, apply=False)
+
+    def cruise(self, cycles: int) -> StepResult:
+        """Run ``cycles`` cycles that ``cruise_budget`` allowed, in one call, and report
+        the last: the same float operations in the same order as ``step`` (the path
+        length is summed cycle by cycle), so the result is bit for bit the same."""
+        seg = self.seg
+        assert seg is not None and self._cruise(seg, cycles, apply=True) == cycles
+        v, s = self.v_mm_s, self.s_mm
+        pos = self.position_mm = seg.point_at(s)
+        return StepResult(pos, v, seg.programmed_mm_s, [], seg.block,
+                          seg.length_mm - s + seg.block_rest_mm, self.distance_base_mm + s,
+                          None)
+
+    def _cruise(self, seg: Segment, most: int, apply: bool) -> int:
+        v = self.v_mm_s
+        ex = seg.exit_mm_s
+        s = self.s_mm
+        n = 0
+        while n < most:  # the fast path of ``step``, without the rest of the cycle
+            s_next = s + v * self.cycle_s
+            if not s_next < seg.length_mm - (v * v - ex * ex) * seg.inv_2acc:
+                break
+            s = s_next
+            n += 1
+        if apply:
+            self.s_mm = s
+        return n
+
     def _step(self) -> StepResult:
         finished: list[Block] = []
         t = self.cycle_s
