@@ -243,8 +243,8 @@ class ProgramRun:
         ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
 
     def cruise_budget(self, most: int) -> int:
-        """How many of the next cycles (at most ``most``) would do nothing but cruise
-        along the current segment: no block to feed (the buffer is full or the program
+        """How many of the next cycles (at most ``most``) would do nothing but move
+        inside the current segment: no block to feed (the buffer is full or the program
         read to its end), nothing waited for, no re-planning, single block and override
         as the path has them (event-speed virtual clock, ``Kernel``)."""
         ch, executor = self.channel, self.executor
@@ -252,7 +252,10 @@ class ProgramRun:
                 or self._pending_error is not None or executor.single_block != ch.single_block
                 or not (self._fed_all or executor.free_slots() == 0)):
             return 0
-        return executor.cruise_budget(ch.feed_override_per_mille / 1000.0, most)
+        # as ``_motion_cycle``: with the buffer full, a cycle that leaves the path held
+        # down by the buffer's end shows a warning (once), so it is a cycle of its own
+        full = not (self._buffer_warned or self._fed_all)
+        return executor.cruise_budget(ch.feed_override_per_mille / 1000.0, most, full)
 
     def cruise(self, cycles: int, time_s: float) -> None:
         """Run ``cycles`` cycles that ``cruise_budget`` allowed at once, the last at

@@ -10,7 +10,7 @@ asked for must be observed; every block change must be observed at the cycle it
 happens at under stepping.
 
 Hypothesis generates the programs (lines, arcs, look-ahead on/off, M functions, dwells)
-and the scripts; ``--soak`` runs many more examples.
+and the scripts; ``--soak`` (make soak) runs many more examples.
 """
 
 from __future__ import annotations
@@ -34,6 +34,7 @@ from cnc_objects.service.kernel.commands import (
 )
 from cnc_objects.service.kernel.kernel import Kernel
 from cnc_objects.service.kernel.state import Snapshot
+from tests.reliability import scale
 
 _DONE = (ChannelState.READY, ChannelState.ERROR)
 _RUN_TIMEOUT_S = 120.0
@@ -207,10 +208,6 @@ def scripts(draw: st.DrawFn) -> dict[int, list[Any]]:
 PERIODS = st.lists(st.sampled_from([1, 7, 10, 50, 100, 250, 1000]), min_size=0, max_size=3)
 
 
-def _soak(config: pytest.Config) -> bool:
-    return bool(config.getoption("--soak", default=False))
-
-
 @settings(max_examples=25, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(text=programs(), periods=PERIODS, script=scripts())
@@ -219,10 +216,10 @@ def test_event_speed_is_cycle_exact_against_stepping(
     assert_same(text, tuple(sorted(set(periods))), script)
 
 
-def test_longer_runs_soak(request: pytest.FixtureRequest) -> None:
-    """``--soak``: many more generated programs than ``make test`` runs."""
-    if not _soak(request.config):
-        pytest.skip("the long form runs with --soak (make soak)")
+def test_longer_runs_soak() -> None:
+    """``--soak`` (make soak) or ``CNC_SOAK=1``: many more generated programs."""
+    if not scale.soak():
+        pytest.skip("the long form runs with --soak (make soak) or CNC_SOAK=1")
     runner = settings(max_examples=300, deadline=None,
                       suppress_health_check=[HealthCheck.too_slow])(
         given(text=programs(), periods=PERIODS, script=scripts())(
