@@ -76,6 +76,8 @@ class Interpolator:
         self.override = 1.0
         self.unfinished = 0  # blocks handed over and not yet finished
         self.distance_base_mm = 0.0  # path length up to the start of ``seg``
+        # the last ``cruise_budget``: (cycles, segment, s, v before, s, v after them)
+        self._counted: tuple[int, Segment, float, float, float, float] | None = None
 
     # -- commands ---------------------------------------------------------------------
 
@@ -186,7 +188,14 @@ class Interpolator:
         cycle (the path length is summed cycle by cycle), so the result is bit for bit
         the same."""
         seg = self.seg
-        assert seg is not None and self._cruise(seg, cycles, None, apply=True) == cycles
+        assert seg is not None
+        counted = self._counted
+        if counted is not None and counted[0] == cycles and counted[1] is seg and (
+                counted[2] == self.s_mm and counted[3] == self.v_mm_s):
+            self.s_mm, self.v_mm_s = counted[4], counted[5]  # what the budget computed
+        else:
+            assert self._cruise(seg, cycles, None, apply=True) == cycles
+        self._counted = None
         v, s = self.v_mm_s, self.s_mm
         pos = self.position_mm = seg.point_at(s)
         return StepResult(pos, v, seg.programmed_mm_s, [], seg.block,
@@ -215,6 +224,8 @@ class Interpolator:
             n += 1
         if apply:
             self.s_mm, self.v_mm_s = s, v
+        else:  # ``cruise`` of the same cycles from the same state takes this over
+            self._counted = (n, seg, self.s_mm, self.v_mm_s, s, v)
         return n
 
     def _step(self) -> StepResult:
