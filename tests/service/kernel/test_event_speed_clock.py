@@ -220,12 +220,14 @@ def test_longer_runs_soak() -> None:
     """``--soak`` (make soak) or ``CNC_SOAK=1``: many more generated programs."""
     if not scale.soak():
         pytest.skip("the long form runs with --soak (make soak) or CNC_SOAK=1")
-    runner = settings(max_examples=300, deadline=None,
-                      suppress_health_check=[HealthCheck.too_slow])(
-        given(text=programs(), periods=PERIODS, script=scripts())(
-            lambda text, periods, script: assert_same(text, tuple(sorted(set(periods))),
-                                                      script)))
-    runner()
+
+    @settings(max_examples=300, deadline=None,
+              suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    @given(text=programs(), periods=PERIODS, script=scripts())
+    def many(text: str, periods: list[int], script: dict[int, list[Any]]) -> None:
+        assert_same(text, tuple(sorted(set(periods))), script)
+
+    many()
 
 
 def test_cruising_cycles_run_in_bulk() -> None:
