@@ -2,7 +2,7 @@
 
     cnc-service [--config FILE] [--endpoint URL] [--ads HOST[:PORT]|off] [--ams-net-id ID]
                 [--keys DIR] [--insecure]
-                [--clock realtime|virtual|step] [--speed X] [--cycle-ms MS]
+                [--clock realtime|virtual|virtual-step|step] [--speed X] [--cycle-ms MS]
                 [--program-dir DIR | --data-dir DIR] [--output-dir DIR] [--log-level L]
 
 Two front ends over one dispatcher: ZeroMQ (``--endpoint``) and ADS over AMS/TCP
@@ -85,7 +85,9 @@ class ClockKind(StrEnum):
     """What the cycle task runs on."""
 
     REALTIME = "realtime"  # sleep to each cycle deadline
-    VIRTUAL = "virtual"  # no sleeping: kernel time runs as fast as the CPU allows (or --speed)
+    VIRTUAL = "virtual"  # no sleeping: kernel time runs as fast as the CPU allows (or --speed),
+    # the cycles between two events in bulk
+    VIRTUAL_STEP = "virtual-step"  # the same, every cycle run and published one by one
     STEP = "step"  # no cycle until a client grants cycles (cnc_cycle_step_w)
 
 
@@ -115,7 +117,7 @@ def make_clock(kind: ClockKind, cycle_s: float, speed: float | None,
         return RealtimeClock(cycle_s, rt_priority)
     if kind is ClockKind.STEP:
         return StepClock(cycle_s, step_max_cycles)
-    return VirtualClock(cycle_s, speed)
+    return VirtualClock(cycle_s, speed, event_speed=kind is ClockKind.VIRTUAL)
 
 
 def _kernel_loader(
@@ -187,6 +189,7 @@ async def serve(
                       (limits.notifications_per_client, limits.notifications_total), counts,
                       outputs=OutputService(writer), structs=structs)
     kernel.on_cycle_end = backend.hub.kernel_cycle_end  # one hub serves both front ends
+    kernel.next_observed_ns = backend.hub.next_observed_ns  # cycles it must see
     try:
         server = ZmqServer(backend, endpoint, curve=curve, limits=limits)
     except zmq.ZMQError as exc:
@@ -333,8 +336,8 @@ def run(
         level=log_level.value, format="%(asctime)s %(levelname)s %(name)s: %(message)s",
         stream=sys.stderr,
     )
-    if speed is not None and (clock is not ClockKind.VIRTUAL or speed <= 0):
-        _usage("--speed takes a positive factor and needs --clock virtual")
+    if speed is not None and (clock is ClockKind.REALTIME or speed <= 0):
+        _usage("--speed takes a positive factor and needs --clock virtual or virtual-step")
     config = _machine_config(config_file, cycle_ms)
     if rt_priority is not None:  # typer checked the range
         config = config.model_copy(update={"rt_priority": rt_priority})

@@ -249,6 +249,12 @@ class NotificationHub:
             self._last_snapshot = snapshot
             self._loop.call_soon_threadsafe(self._sample)
 
+    def next_observed_ns(self) -> int | None:
+        """Kernel time of the next cycle ``kernel_cycle_end`` must see (None: none): the
+        event-speed virtual clock runs the cycles before it in bulk, unpublished. While a
+        pass is under way the next cycles are not looked at (they are after it)."""
+        return None if self._scheduled else self._next_due_ns
+
     def _first_sample(self, sub: Subscription) -> None:
         if sub.handle not in self._subs:
             return

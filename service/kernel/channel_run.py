@@ -602,6 +602,34 @@ class ChannelRunner:
             ch, _NOT_WAITING if run is None else run.wait_reason(),
             axes_missing=self._waits_for_axes, internal_hold=self._internal_hold)
 
+    def cruise_budget(self, most: int) -> int | None:
+        """How many of the next cycles (at most ``most``) of this channel may be run in
+        bulk (event-speed virtual clock): None when its cycles change nothing (no run,
+        the technology at rest), else what its program run's cruise allows (0: the
+        next cycle must be run as a cycle)."""
+        plc, ch = self.plc, self.channel
+        if (not plc.spindle.reached or ch.spindle is not plc.spindle.state
+                or ch.plc_functions is not plc.unit
+                or any(u.pending and u.ack_due_s is not None for u in plc.unit.units)):
+            return 0  # a ramp or an acknowledge runs in time
+        if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
+            return None
+        run = self._run
+        if (self.manual.engaged or self.manual.in_program or self._pending_start is not None or not self.axes_ready
+                or not isinstance(run, ProgramRun)):
+            return 0
+        return run.cruise_budget(most)
+
+    def cruise(self, cycles: int, time_s: float) -> None:
+        """Run ``cycles`` cycles that ``cruise_budget`` allowed, the last at ``time_s``
+        (a channel whose cycles change nothing only takes the time)."""
+        self.time_s = time_s
+        run = self._run
+        if self.channel.state in (ChannelState.ACTIVE, ChannelState.HOLD):
+            assert isinstance(run, ProgramRun)
+            run.cruise(cycles, time_s)
+            self.touched = True
+
     def _run_cycle(self, time_s: float) -> bool:
         self.time_s = time_s
         ch = self.channel

@@ -4,7 +4,9 @@
 ``VirtualClock`` does not tie kernel time to the wall: while the kernel has work it runs
 cycles back to back (or paced at ``speed`` times real time); while it is idle it waits
 for the next command, at most one cycle time, so an idle service costs no CPU and a
-command is applied at once. Kernel time is always cycles x cycle time.
+command is applied at once. Kernel time is always cycles x cycle time. With
+``event_speed`` (``--clock virtual``; ``--clock virtual-step`` is without) the kernel
+also runs the cycles between two events in bulk (``Kernel``, docs/kernel.md).
 """
 
 from __future__ import annotations
@@ -148,11 +150,15 @@ class VirtualClock:
     """Kernel time detached from the wall clock.
 
     ``speed`` None: as fast as the CPU allows while busy. ``speed`` X: X times real time.
+    ``event_speed``: the kernel may run the cycles between two events in one step
+    (unpaced only: a paced clock steps, every cycle has its wall time).
     """
 
-    def __init__(self, cycle_s: float, speed: float | None = None) -> None:
+    def __init__(self, cycle_s: float, speed: float | None = None,
+                 event_speed: bool = True) -> None:
         self.cycle_s = cycle_s
         self.speed = speed
+        self.event_speed = event_speed and speed is None
         self.lateness: LatenessHistogram | None = None  # no deadlines in virtual time
         self._deadline = 0.0
         self._busy_cycles = 0

@@ -35,6 +35,11 @@ Done = Callable[[Refusal | None], None]
 Loader = Callable[[str], str]
 
 
+#: The most cycles the event-speed virtual clock runs in one bulk step: the queue is
+#: looked at between two (a command waits at most a few ms of wall time).
+BULK_CYCLES_MAX = 10_000
+
+
 def _no_programs(name: str) -> str:
     raise KeyError(name)
 
@@ -124,6 +129,11 @@ class Kernel:
         self.realtime_grant: RealtimeGrant | None = getattr(clock, "grant", None)
         self.snapshot: Snapshot = self.state.snapshot(0, 0, time.time_ns(), self.stats)
         self.on_cycle_end: Callable[[Snapshot], None] | None = None
+        # when ``on_cycle_end`` is set: the kernel time (ns) of the next cycle it must
+        # see (None: none is due). Without it the hook sees every cycle and no cycles
+        # run in bulk.
+        self.next_observed_ns: Callable[[], int | None] | None = None
+        self._event_speed = isinstance(clock, VirtualClock) and clock.event_speed
         self._queue: queue.SimpleQueue[Queued] = queue.SimpleQueue()
         self._waiting: deque[Queued] = deque()
         self._channel_index = {c.channel_id: k for k, c in enumerate(self.state.channels)}
@@ -219,6 +229,8 @@ class Kernel:
                 if not self.stats.running and not self._paused():
                     return
                 started = time.perf_counter()
+                if self._event_speed and self._busy:
+                    self._run_in_bulk()
                 if not self._cycle():
                     return
                 exec_us = int((time.perf_counter() - started) * 1e6)
@@ -285,6 +297,43 @@ class Kernel:
                 return True
         done(None)
         return True
+
+    def _run_in_bulk(self) -> None:
+        """Event-speed virtual clock: run the cycles up to the next event in one step,
+        unpublished. An event is anything that can change the course of the run or be
+        seen: a command in the queue, a cycle an observer (the notification hub) must
+        see, and whatever makes a channel's next cycle more than cruising (a block end,
+        a block to feed, a ramp, a link, see ``ChannelRunner.cruise_budget``). The
+        state after the bulk is the state after stepping the same cycles, bit for bit;
+        the next cycle (the event's) then runs and is published as a cycle."""
+        if self._waiting or not self._queue.empty() or not self.stats.running:
+            return
+        most = BULK_CYCLES_MAX
+        if self.on_cycle_end is not None:
+            if self.next_observed_ns is None:
+                return  # the hook sees every cycle
+            due_ns = self.next_observed_ns()
+            if due_ns is not None:  # the cycles run in bulk lie before the due one
+                most = min(most, -(-due_ns // self.cycle_ns) - 1 - self.stats.cycles)
+        if most <= 0 or not self.switchover.at_rest():
+            return
+        runners = self.state.runners
+        moving = False
+        for runner in runners:
+            budget = runner.cruise_budget(most)
+            if budget is None:
+                continue  # its cycles change nothing
+            if budget <= 0:
+                return
+            most, moving = budget, True
+        if not moving:
+            return
+        self.stats.cycles += most
+        time_s = self.stats.cycles * self.cycle_s
+        for runner in runners:
+            runner.cruise(most, time_s)
+        self.state.drive_axes()
+        self.switchover.update_offsets([False] * len(runners))
 
     def _next_command(self, block: bool) -> Queued:
         if self._waiting:

@@ -128,6 +128,7 @@ class ProgramRun:
     """A real run: blocks from the decoder move the channel's axes along the path."""
 
     _waits_for_decoder = False  # PROD_TIME: every take waits for the decoder
+    _skips_cycles = True  # cruising cycles may be run in bulk (not PROD_TIME: traced)
 
     def __init__(self, host: RunHost, channel: Channel, feed: DecoderFeed,
                  executor: PathExecutor, contour: ContourLog | None, *,
@@ -228,16 +229,7 @@ class ProgramRun:
         if full and executor.buffer_limits_speed():
             self._warn_buffer_limits()
         if output:
-            offsets = self._host.manual_offsets_mm  # G200/G201 (None: no offset)
-            positions = step.position_mm if offsets is None else tuple(
-                p + o for p, o in zip(step.position_mm, offsets, strict=True))
-            for axis, pos in zip(ch.axes, positions, strict=True):
-                axis.position_mm = pos
-                axis.command_position_incr = round(pos * _INCR_PER_MM)
-            ch.path_velocity_mm_s = step.path_velocity_mm_s
-            ch.programmed_velocity_mm_s = step.programmed_velocity_mm_s
-            ch.remaining_in_block_mm = step.remaining_in_block_mm
-            ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
+            self._output(step)
         ch.program_time_s = time_s - self.started_at_s
         self._stepped(step)
         for block in step.finished:
@@ -277,6 +269,41 @@ class ProgramRun:
             if ch.mode == ChannelMode.MDI and self.feed.keep_open:
                 return Step.WAITING  # extended MDI: waiting for the next manual block
         return Step.BUSY
+
+    def _output(self, step: StepResult) -> None:
+        """The cycle's path values shown in the channel, its axes' command positions."""
+        ch = self.channel
+        offsets = self._host.manual_offsets_mm  # G200/G201 (None: no offset)
+        positions = step.position_mm if offsets is None else tuple(
+            p + o for p, o in zip(step.position_mm, offsets, strict=True))
+        for axis, pos in zip(ch.axes, positions, strict=True):
+            axis.position_mm = pos
+            axis.command_position_incr = round(pos * _INCR_PER_MM)
+        ch.path_velocity_mm_s = step.path_velocity_mm_s
+        ch.programmed_velocity_mm_s = step.programmed_velocity_mm_s
+        ch.remaining_in_block_mm = step.remaining_in_block_mm
+        ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
+
+    def cruise_budget(self, most: int) -> int:
+        """How many of the next cycles (at most ``most``) would do nothing but move
+        inside the current segment: no block to feed (the buffer is full or the program
+        read to its end), nothing waited for, no re-planning, single block and override
+        as the path has them (event-speed virtual clock, ``Kernel``)."""
+        ch, executor = self.channel, self.executor
+        if (not self._skips_cycles or self._sync is not None or self._contour_changed
+                or self._pending_error is not None or executor.single_block != ch.single_block
+                or not (self._fed_all or executor.free_slots() == 0)):
+            return 0
+        # as ``_motion_cycle``: with the buffer full, a cycle that leaves the path held
+        # down by the buffer's end shows a warning (once), so it is a cycle of its own
+        full = not (self._buffer_warned or self._fed_all)
+        return executor.cruise_budget(ch.feed_override_per_mille / 1000.0, most, full)
+
+    def cruise(self, cycles: int, time_s: float) -> None:
+        """Run ``cycles`` cycles that ``cruise_budget`` allowed at once, the last at
+        kernel time ``time_s``: the channel shows what stepping them one by one shows."""
+        self._output(self.executor.cruise(cycles))
+        self.channel.program_time_s = time_s - self.started_at_s
 
     def _technology(self) -> PlcFunctions | None:
         """The channel's technology output, None while it is suppressed (PROD_TIME)."""
@@ -445,6 +472,7 @@ class ProdTimeRun(ProgramRun):
     ``trace`` every simulated cycle is recorded (``ch<c>.prod_time_trace``)."""
 
     _waits_for_decoder = True
+    _skips_cycles = False  # each GEO cycle simulates many cycles itself
 
     def __init__(self, host: RunHost, channel: Channel, feed: DecoderFeed,
                  executor: PathExecutor, contour: ContourLog | None, *,

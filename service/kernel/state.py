@@ -336,6 +336,12 @@ class ChannelRunnerView(Protocol):
     def cycle(self, time_s: float) -> bool:
         """One GEO cycle; True while the channel has motion or decoding to do."""
 
+    def cruise_budget(self, most: int) -> int | None:
+        """Cycles (at most ``most``) that may run in bulk; None: its cycles change nothing."""
+
+    def cruise(self, cycles: int, time_s: float) -> None:
+        """Run ``cycles`` cycles that ``cruise_budget`` allowed, the last at ``time_s``."""
+
 
 @dataclass(slots=True)
 class KernelState:

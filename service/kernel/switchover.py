@@ -70,6 +70,21 @@ class Switchover:
                 progress = True
         self.in_progress = progress
 
+    def at_rest(self) -> bool:
+        """``step`` would change nothing: every channel's output is as commanded
+        (suspended or not) and every axis of a channel whose output runs is linked and
+        not released (the event-speed virtual clock runs cycles in bulk only then)."""
+        if self.in_progress:
+            return False
+        channels = self._state.channels
+        for channel in channels:
+            if channel.suspend_commanded != channel.output_suspended:
+                return False
+        for ci, axis, _drive in self._axes:
+            if axis.released or not (axis.actual_link or channels[ci].output_suspended):
+                return False
+        return True
+
     def _auto_release(self, axis: LogicalAxis) -> bool:
         params = self._params.get(axis.logical_number)
         return params is not None and params.auto_release_of_axis_link

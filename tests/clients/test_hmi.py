@@ -31,7 +31,9 @@ WAIT_S = 15.0  # generous: the machine running the tests may be busy
 # is for look-ahead mode 1.
 LONG_PROGRAM = "\n".join(
     ["N5 G90 G17", "N8 #CONTOUR LOOKAHEAD LOG ON [PARAM=7]"]
-    + [f"N{10 * k} G1 X{k} Y{k % 2} F1" for k in range(1, 21)]
+    # 40 mm blocks at 1 mm/min: 13 h of machining, seconds of wall time under the
+    # event-speed virtual clock, so that the keys catch the program running
+    + [f"N{10 * k} G1 X{40 * k} Y{k % 2} F1" for k in range(1, 21)]
     + ["N300 #CONTOUR LOOKAHEAD LOG OFF", "N310 M30", ""]
 ).encode()
 
@@ -126,7 +128,7 @@ async def test_program_keys_select_start_hold_resume_reset(service: RunningServi
         await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "command") != "0.0000",
                          what="X moves")
         await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "actual") != "0.0000")
-        assert app.channels.cell("ch1", "state") in ("ACTIVE", "HOLD")  # not ended: 1200 s
+        assert app.channels.cell("ch1", "state") in ("ACTIVE", "HOLD")  # not ended: 13 h
         assert app.channels.cell("ch1", "block").startswith("N")
 
         await pilot.press("h")

@@ -32,7 +32,11 @@ LINK = "ch1.ax1.actual_link_to_physical_axis"  # UINT, 1 in the default machine
 LENGTH = "gpCh[0].contour_lookahead.request.length"  # LREAL, read-write PLC symbol
 START = "gpCh[0].contour_lookahead.request.start_position"  # LREAL, read-write
 END_X = 40  # mm, the end of PROGRAM
-PROGRAM = f"N10 G90 G1 X25 F6000\nN20 X{END_X}\nN30 M30\n"
+# 0.02 mm blocks: every block end is a cycle the event-speed clock runs as a cycle (it
+# runs the cruise between two in bulk), so that the run lasts long enough in wall time
+# (2000 blocks to decode and plan) for a subscriber to see the axis on its way
+PROGRAM = "G90 G1 F600\n" + "".join(
+    f"X{k / 50:g}\n" for k in range(1, END_X * 50 + 1)) + "M30\n"
 WAIT_S = 20.0
 
 

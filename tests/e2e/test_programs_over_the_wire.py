@@ -120,7 +120,9 @@ def test_start_without_program_is_refused_with_a_reason(c):
 
 
 def test_hold_and_resume_over_the_wire(c):
-    c.upload("long.nc", b"G1 X300 F600\nG0 X0\nM30\n")
+    # 30 min of machining: the event-speed clock runs a 30 s move in a few ms of wall
+    # time, before the HOLD written after START could arrive
+    c.upload("long.nc", b"G1 X300 F10\nG0 X0\nM30\n")
     c.run_program("long.nc")
     c.hold(1)
     assert c.read("ch1.mc_active_state_r") == 5

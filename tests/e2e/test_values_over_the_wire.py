@@ -11,11 +11,13 @@ from cnc_objects.clients import AsyncClient, Sample
 from cnc_objects.protocol.values import ChannelMode, ChannelState, value_names
 from tests.support.service import RunningService
 
-# 20 blocks of 1 mm at 6 mm/min: 200 s of kernel time; the virtual clock runs it many
-# times faster than real time, so kernel time soon runs ahead of the wall clock.
+# 100 blocks of 1 mm at 1 mm/min: 100 min of kernel time; the virtual clock runs it many
+# times faster than real time (the event-speed clock a 1 min block in a few ms), so
+# kernel time soon runs ahead of the wall clock.
 SLOW_PROGRAM = "\n".join(
-    ["N5 G90 G17", *(f"N{10 * k} G1 X{k} F6" for k in range(1, 21)), "N300 M30", ""]
+    ["N5 G90 G17", *(f"N{10 * k} G1 X{k} F1" for k in range(1, 101)), "N3000 M30", ""]
 ).encode()
+SAMPLES_MIN = 50  # and at least this many samples of kernel time
 AHEAD_S = 2.0  # collect samples until kernel time is this far ahead of the wall clock
 LATENCY_MAX = timedelta(seconds=1)  # from the cycle's end to the client, on a busy machine
 CYCLE_S = 0.001  # the default configuration's cycle time
@@ -69,7 +71,8 @@ async def test_sample_timestamps_are_the_wall_clock_time_of_their_cycle(
                     async for sample in samples:
                         times.append((sample, datetime.now(UTC)))
                         wall_s = (datetime.now(UTC) - started).total_seconds()
-                        if sample.value - times[0][0].value > wall_s + AHEAD_S:
+                        if (sample.value - times[0][0].value > wall_s + AHEAD_S
+                                and len(times) >= SAMPLES_MIN):
                             break  # kernel time is now well ahead of the wall clock
                 done.set()
         assert await c.read("ch1.mc_active_state_r") == ChannelState.ACTIVE  # still running

@@ -98,8 +98,11 @@ class PathExecutor:
         braking curve towards a stop after that segment (the look-ahead must always be
         able to stop there). Meaningful after a cycle that started with every slot
         taken; a larger buffer or LA_ON helps."""
+        return self._limits_speed(self._ipo.seg, self._ipo.s_mm, self._ipo.v_mm_s)
+
+    def _limits_speed(self, seg: Segment | None, s_mm: float, v: float) -> bool:
+        """``buffer_limits_speed`` with the path at ``s_mm`` in ``seg`` at speed ``v``."""
         ipo = self._ipo
-        seg, v = ipo.seg, ipo.v_mm_s
         if (seg is None or v <= 0.0 or v >= seg.cap_mm_s * (1.0 - 1e-6) or ipo.hold
                 or self._closed):
             return False
@@ -109,7 +112,7 @@ class PathExecutor:
         if (tail.junction_mm_s > 0.0 or tail.stop or tail.single_stop
                 or tail.block.look_ahead is not None):  # a section's end is planned
             return False
-        reach2 = 2.0 * seg.acc_mm_s2 * (seg.length_mm - ipo.s_mm)  # v^2 the rest can take
+        reach2 = 2.0 * seg.acc_mm_s2 * (seg.length_mm - s_mm)  # v^2 the rest can take
         nxt = seg.next
         while nxt is not None:
             reach2 += nxt.two_acc_len
@@ -147,6 +150,21 @@ class PathExecutor:
     def step(self, override: float) -> StepResult:
         """Run one cycle with feed override factor ``override`` (1.0 = 100 %, 0 stands)."""
         return self._ipo.step(override)
+
+    def cruise_budget(self, override: float, most: int, watch_buffer: bool) -> int:
+        """How many of the next cycles (at most ``most``) only move inside the current
+        segment (``Interpolator.cruise_budget``); ``watch_buffer``: the cycles end
+        before the first after which ``buffer_limits_speed`` would be true."""
+        seg = self._ipo.seg
+
+        def quiet(s_mm: float, v_mm_s: float) -> bool:
+            return not self._limits_speed(seg, s_mm, v_mm_s)
+
+        return self._ipo.cruise_budget(override, most, quiet if watch_buffer else None)
+
+    def cruise(self, cycles: int) -> StepResult:
+        """Run ``cycles`` cruising cycles at once; the last cycle's result."""
+        return self._ipo.cruise(cycles)
 
     def hold(self) -> None:
         """Feedhold: decelerate on the path within the limits and stand."""

@@ -22,6 +22,7 @@ with ``#DISTANCE PROG START CLEAR`` restarts the path distance where it ends.
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from enum import IntEnum
 
@@ -75,6 +76,8 @@ class Interpolator:
         self.override = 1.0
         self.unfinished = 0  # blocks handed over and not yet finished
         self.distance_base_mm = 0.0  # path length up to the start of ``seg``
+        # the last ``cruise_budget``: (cycles, segment, s, v before, s, v after them)
+        self._counted: tuple[int, Segment, float, float, float, float] | None = None
 
     # -- commands ---------------------------------------------------------------------
 
@@ -164,6 +167,66 @@ class Interpolator:
                                       seg.length_mm - s + seg.block_rest_mm,
                                       self.distance_base_mm + s, None)
         return self._step()
+
+    def cruise_budget(self, override: float, most: int,
+                      accept: Callable[[float, float], bool] | None = None) -> int:
+        """How many of the next cycles (at most ``most``) ``step(override)`` would end
+        inside the current segment with no block end due: cruising, accelerating,
+        braking or standing in feedhold. ``accept(s_mm, v_mm_s)``, when given, is asked
+        after each cycle that does not cruise at the cap; the first cycle it refuses is
+        not counted (the caller has work to do there). 0 when the next cycle is anything
+        else."""
+        seg = self.seg
+        if (seg is None or override != self.override or self.planner.dirty
+                or self.waiting or self.events):
+            return 0
+        return self._cruise(seg, most, accept, apply=False)
+
+    def cruise(self, cycles: int) -> StepResult:
+        """Run ``cycles`` cycles that ``cruise_budget`` allowed, in one call, and report
+        the last: the same float operations in the same order as ``step`` cycle by
+        cycle (the path length is summed cycle by cycle), so the result is bit for bit
+        the same."""
+        seg = self.seg
+        assert seg is not None
+        counted = self._counted
+        if counted is not None and counted[0] == cycles and counted[1] is seg and (
+                counted[2] == self.s_mm and counted[3] == self.v_mm_s):
+            self.s_mm, self.v_mm_s = counted[4], counted[5]  # what the budget computed
+        else:
+            assert self._cruise(seg, cycles, None, apply=True) == cycles
+        self._counted = None
+        v, s = self.v_mm_s, self.s_mm
+        pos = self.position_mm = seg.point_at(s)
+        return StepResult(pos, v, seg.programmed_mm_s, [], seg.block,
+                          seg.length_mm - s + seg.block_rest_mm, self.distance_base_mm + s,
+                          None)
+
+    def _cruise(self, seg: Segment, most: int, accept: Callable[[float, float], bool] | None,
+                apply: bool) -> int:
+        """``step`` reduced to its motion inside ``seg``, for up to ``most`` cycles."""
+        s, v = self.s_mm, self.v_mm_s
+        hold, t = self.hold, self.cycle_s
+        length, acc, cap_mm_s, ex = seg.length_mm, seg.acc_mm_s2, seg.cap_mm_s, seg.exit_mm_s
+        cap = 0.0 if hold else cap_mm_s
+        n = 0
+        while n < most:
+            if not hold and v == cap_mm_s:  # the fast path of ``step``
+                s_next = s + v * t
+                if s_next < length - (v * v - ex * ex) * seg.inv_2acc:
+                    s = s_next
+                    n += 1
+                    continue
+            s_next, v_next, _left = advance(length, acc, cap, ex, s, v, t)  # as ``_step``
+            if not s_next < length or (accept is not None and not accept(s_next, v_next)):
+                break
+            s, v = s_next, v_next
+            n += 1
+        if apply:
+            self.s_mm, self.v_mm_s = s, v
+        else:  # ``cruise`` of the same cycles from the same state takes this over
+            self._counted = (n, seg, self.s_mm, self.v_mm_s, s, v)
+        return n
 
     def _step(self) -> StepResult:
         finished: list[Block] = []
