@@ -615,8 +615,8 @@ class ChannelRunner:
         if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
             return None
         run = self._run
-        if (self.manual.engaged or self.manual.in_program or self._pending_start is not None or not self.axes_ready
-                or not isinstance(run, ProgramRun)):
+        if (self.manual.engaged or self.manual.in_program or self._pending_start is not None
+                or not self.axes_ready or not isinstance(run, ProgramRun)):
             return 0
         return run.cruise_budget(most)
 
