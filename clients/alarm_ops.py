@@ -151,13 +151,11 @@ class AlarmOps(MixinBase):
         """The alarms' events from now on, in the order they happened per alarm:
         ``raised``, ``acknowledged``, ``cleared`` (an alarm raised and cleared between
         two reads gives both). Leaving the loop ends the subscription."""
-        seen: dict[int, AlarmState] | None = None
+        # what is there already, read before the subscription: an alarm raised while it
+        # opens is then told at its first sample, not taken for an old one
+        seen = seen_states(await self.alarms(history=True))
         async for _sample in self.subscribe("alarm_changes_r"):
-            listed = await self.alarms(history=True)
-            if seen is None:  # the first sample: what is there already
-                seen = seen_states(listed)
-                continue
-            for event in events_since(seen, listed):
+            for event in events_since(seen, await self.alarms(history=True)):
                 yield event
 
 

@@ -252,8 +252,10 @@ class NotificationHub:
     def next_observed_ns(self) -> int | None:
         """Kernel time of the next cycle ``kernel_cycle_end`` must see (None: none): the
         event-speed virtual clock runs the cycles before it in bulk, unpublished. While a
-        pass is under way the next cycles are not looked at (they are after it)."""
-        return None if self._scheduled else self._next_due_ns
+        pass is scheduled or under way it is now (0): the pass reads the kernel's current
+        snapshot, so the kernel must not run ahead of it in bulk (a subscriber of a value
+        that holds for seconds of a run would otherwise see the run's end only)."""
+        return 0 if self._scheduled else self._next_due_ns
 
     def _first_sample(self, sub: Subscription) -> None:
         if sub.handle not in self._subs:

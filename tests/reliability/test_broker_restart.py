@@ -51,7 +51,8 @@ async def test_the_bridge_republishes_after_every_broker_restart(run_scale: Scal
                     started = time.monotonic()
                     async with Watcher(broker, f"cnc/{MACHINE}/#") as watcher:
                         await watcher.wait_for(STATUS, ONLINE, timeout_s=REPUBLISH_TIMEOUT_S)
-                        await watcher.wait_value(OVERRIDE, lambda v, value=value: v == value,
+                        # the payload's value is in % (engineering units), raw in 0.1 %
+                        await watcher.wait_value(OVERRIDE, lambda v, value=value: v == value / 10,
                                                  timeout_s=REPUBLISH_TIMEOUT_S)
                     republished_s.append(time.monotonic() - started)
                     assert bridge.broker_connections >= cycle + 2

@@ -12,7 +12,9 @@ from cnc_objects.testing import run_program, run_program_async, wait_for, wait_f
 
 DATA = Path(__file__).parent / "data"
 HOLD = 5  # ch1.mc_active_state_r in feedhold
-LONG = b"G1 X300 F600\nM30\n"  # 30 s of kernel time
+# 30 min of kernel time: under the event-speed virtual clock a run of 30 s would be over
+# (in a few ms of wall time) before a wait that subscribes after the start has begun
+LONG = b"G1 F600\n" + b"X300\nX0\n" * 30 + b"M30\n"
 
 
 def test_run_program_runs_to_the_end_and_returns_the_status(cnc_client: Client) -> None:
