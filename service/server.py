@@ -353,7 +353,10 @@ class ZmqServer:
         return encode_error(req.invoke_id, req.COMMAND, code, message)
 
     def send(self, envelope: Envelope, payload: bytes) -> bool:
-        """Send a frame outside a drain pass; False when it could not be delivered."""
+        """Send a frame outside a drain pass; False when it could not be delivered (also
+        after ``close``: a kernel reply that comes while the service stops is dropped)."""
+        if self._sock.closed:
+            return False
         delivered = self._deliver(envelope, payload)
         self._look_for_input()
         return delivered

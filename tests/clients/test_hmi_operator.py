@@ -16,11 +16,18 @@ from cnc_objects.clients.client import AsyncClient
 from cnc_objects.clients.hmi import manual_keys, text
 from cnc_objects.clients.hmi.app import HmiApp
 from cnc_objects.clients.hmi.mdi import MdiHistory
-from tests.clients.test_hmi import LONG_PROGRAM, SIZE, WAIT_S, shown, started, wait_until
+from tests.clients.test_hmi import SIZE, WAIT_S, shown, started, wait_until
 from tests.support.broker import free_port
 from tests.support.service import RunningService, start_service
 
 NO_REPLY = re.compile(r"no reply from \S+ since (\d\d:\d\d:\d\d) \((\d+) s\)")
+
+# 1 mm blocks at F1: a minute of kernel time each, a few seconds of wall time with the
+# HMI's subscriptions (every 20 ms of kernel time) under the event-speed clock, so the
+# marked line moves while the test watches and the channel still works when F4 is pressed
+LONG_PROGRAM = "\n".join(
+    ["N5 G90 G17"] + [f"N{10 * k} G1 X{k} Y{k % 2} F1" for k in range(1, 21)]
+    + ["N310 M30", ""]).encode()
 
 
 async def type_text(pilot: Pilot, line: str) -> None:

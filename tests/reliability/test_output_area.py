@@ -196,8 +196,13 @@ def test_sigterm_ends_the_service_within_5_s_during_a_write_loop(clock: str) -> 
     assert len(content) < OUTPUT_MAX_FILE_BYTES - len(LINE), "the loop had ended already"
     assert content == LINE * (len(content) // len(LINE))  # every line whole
     assert stored == ["part.nc"]
-    assert "20532: MDI:2:1: #MSG SAVE cannot write msg_save.txt: the service is stopping" in (
-        service.log_text)
+    assert "Traceback" not in service.log_text
+    if clock == "virtual":
+        # the virtual clock runs the loop back to back, so a write always meets the stop
+        # and fails with a clear error; under the realtime clock (SCHED_FIFO where
+        # granted) the cycle thread may be between two writes when the stop comes
+        assert "20532: MDI:2:1: #MSG SAVE cannot write msg_save.txt: the service is " \
+            "stopping" in service.log_text
     figures.record(f"SIGTERM during a #MSG SAVE loop ({clock} clock): time to exit",
                    f"{stop_s:.2f} s",
                    "test_output_area.py::test_sigterm_ends_the_service_within_5_s_during_a_write_loop")
