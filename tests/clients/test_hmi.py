@@ -406,7 +406,7 @@ async def test_positions_speed_and_override_in_engineering_units(service: Runnin
         await c.wait_mdi(before, timeout_s=WAIT_S)
         await wait_until(pilot, lambda: app.axes.cell("ch1.ax1", "command") == "12.3456")
         await wait_until(pilot, lambda: app.axes.cell("ch1.ax2", "actual") == "-0.1890")
-        assert app.channels.cell("ch1", "feed") == "0"  # stands
+        await wait_until(pilot, lambda: app.channels.cell("ch1", "feed") == "0")  # stands
         await c.upload("long.nc", LONG_PROGRAM)
         await c.run_program("long.nc")
         await wait_until(pilot, lambda: app.channels.cell("ch1", "feed") == "1",

@@ -9,17 +9,15 @@ test switched on is switched off again.
 
 from __future__ import annotations
 
-import asyncio
-import contextlib
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 
-from cnc_objects.clients import AsyncClient, Client
+from cnc_objects.clients import Client
 from cnc_objects.protocol.values import ExecutionMode
 from cnc_objects.protocol.wait_reasons import WAIT_REASON_TEXTS, WaitReason
-from cnc_objects.testing import ServiceProcess, serving, wait_for, wait_for_async
+from cnc_objects.testing import ServiceProcess, serving, wait_for
 from tests.support.pyads_plc import plc_machine
 from tests.support.service import reset_client, serving_config
 
@@ -146,35 +144,26 @@ def test_suspended_axis_output_holds_the_path(c: Client) -> None:
     c.wait_program(1, 30)
 
 
-async def test_a_start_waits_for_its_axes_to_link(machine: ServiceProcess) -> None:
+def test_a_start_waits_for_its_axes_to_link(tmp_path: Path) -> None:
     """Suspended output, then released: the program's start waits while the axes link
-    again (a few cycles), which a subscription made before the release sees."""
-    async with AsyncClient(machine.endpoint) as c:
-        await c.reset(1)
-        await c.write(SUSPEND, True)
-        try:
-            await c.upload("wait.nc", b"G1 X1 F6000\nM30\n")
-            await c.run_program("wait.nc", 1)
-            await wait_for_async(c, REASON, int(WaitReason.OUTPUT_SUSPENDED))
-            seen: list[int] = []
-            subscribed = asyncio.Event()
-
-            async def collect() -> None:
-                async with contextlib.aclosing(c.subscribe(REASON)) as samples:
-                    async for sample in samples:
-                        seen.append(sample.value)
-                        subscribed.set()
-                        if sample.value == WaitReason.NONE:
-                            return
-
-            task = asyncio.create_task(collect())
-            await asyncio.wait_for(subscribed.wait(), 30)
-            await c.write(SUSPEND, False)
-            await asyncio.wait_for(task, 30)
-        finally:
-            await c.write(SUSPEND, False)
-            await c.reset(1)
-    assert seen == [WaitReason.OUTPUT_SUSPENDED, WaitReason.AXIS_LINK, WaitReason.NONE]
+    again (a few cycles). The step clock shows every one of those cycles."""
+    with serving("--clock", "step", program_dir=tmp_path / "programs") as service, \
+            Client(service.endpoint, timeout_s=10) as c:
+        c.write(SUSPEND, True)  # writes between steps are applied at once
+        c.upload("wait.nc", b"G1 X1 F6000\nM30\n")
+        c.run_program("wait.nc", 1)
+        c.write("cnc_cycle_step_w", 5)
+        assert c.read(REASON) == WaitReason.OUTPUT_SUSPENDED
+        c.write(SUSPEND, False)
+        seen: list[int] = []
+        for _ in range(1000):  # a few cycles of linking, then the path moves
+            c.write("cnc_cycle_step_w", 1)
+            reason = c.read(REASON)
+            if not seen or seen[-1] != reason:
+                seen.append(reason)
+            if reason == WaitReason.NONE:
+                break
+    assert seen == [WaitReason.AXIS_LINK, WaitReason.NONE]
 
 
 def test_a_paused_syntax_check_waits_for_start(c: Client) -> None:
