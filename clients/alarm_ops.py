@@ -117,26 +117,46 @@ class AlarmEvent:
         return f"{self.kind}: {self.alarm}"
 
 
+_CONSISTENT_READ_TRIES = 10  # reads of the lists while the alarms keep changing
+_CLASS_VALUES = frozenset(int(c) for c in AlarmClass)
+_STATE_VALUES = frozenset(int(s) for s in AlarmState)
+
+
 class AlarmOps(MixinBase):
     """The client's alarm requests."""
 
     async def alarms(self, history: bool = False) -> AlarmList:
-        """The active alarms (newest first); with ``history`` also the history."""
+        """The active alarms (newest first); with ``history`` also the history.
+
+        The lists take several reads: when the alarms changed meanwhile
+        (``alarm_changes_r`` moved), they are read again, so every alarm returned is one
+        the service listed whole."""
+        for _ in range(_CONSISTENT_READ_TRIES):
+            listed, consistent = await self._alarms_once(history)
+            if consistent:
+                break
+        return listed
+
+    async def _alarms_once(self, history: bool) -> tuple[AlarmList, bool]:
         counts = await self.read_many(
             ["alarm_changes_r", "alarm_active_count_r", "alarm_history_count_r"])
         active_n = min(counts["alarm_active_count_r"], ACTIVE_SLOTS)
         history_n = counts["alarm_history_count_r"] if history else 0
         names = [f"alarm_active[{k}].{f}" for k in range(1, active_n + 1) for f in _FIELDS]
         names += [f"alarm_history[{k}].{f}" for k in range(1, history_n + 1) for f in _FIELDS]
-        values = await self.read_many(names) if names else {}
+        values = await self.read_many([*names, "alarm_changes_r"]) if names else counts
+        consistent = values["alarm_changes_r"] == counts["alarm_changes_r"]
 
         def slots(element: str, n: int) -> tuple[AlarmInfo, ...]:
-            found = (AlarmInfo.from_values({f: values[f"{element}[{k}].{f}"] for f in _FIELDS})
-                     for k in range(1, n + 1))
-            return tuple(a for a in found if a.sequence)  # a list that shrank meanwhile
+            rows = ({f: values[f"{element}[{k}].{f}"] for f in _FIELDS} for k in range(1, n + 1))
+            # a slot emptied or rewritten between two reads is left out (and read again)
+            return tuple(AlarmInfo.from_values(v) for v in rows
+                         if v["sequence"] and v["class"] in _CLASS_VALUES
+                         and v["state"] in _STATE_VALUES)
 
         return AlarmList(counts["alarm_changes_r"], counts["alarm_active_count_r"],
-                         slots("alarm_active", active_n), slots("alarm_history", history_n))
+                         slots("alarm_active", active_n),
+                         slots("alarm_history", history_n)), consistent
 
     async def acknowledge_alarm(self, sequence: int) -> None:
         """Acknowledge the alarm numbered ``sequence`` (an error stays active until

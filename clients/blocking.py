@@ -38,7 +38,11 @@ class Client(BlockingClientBase):
         return iterate_blocking(self._core.alarm_events())
 
     def alarms(self, history: bool = False) -> AlarmList:
-        """The active alarms (newest first); with ``history`` also the history."""
+        """The active alarms (newest first); with ``history`` also the history.
+
+        The lists take several reads: when the alarms changed meanwhile
+        (``alarm_changes_r`` moved), they are read again, so every alarm returned is one
+        the service listed whole."""
         return run_blocking(self._core.alarms(history))
 
     def browse(self, pattern: str = "*") -> list[ObjectInfo]:
