@@ -149,15 +149,21 @@ def _goes_on(run: Run, acked: Row, stand_mm: float) -> None:
     assert moved.x_mm > stand_mm and moved.velocity_um_s > 0.0
 
 
+def _acknowledged_after_waiting(run: Run, x_mm: float) -> None:
+    """The path stands at ``x_mm`` while the PLC takes its cycles; the PLC acknowledges,
+    the motion goes on in the next cycle, and the program runs to its end."""
+    _waits(run, x_mm)
+    acked = run.acknowledge()
+    _goes_on(run, acked, x_mm)
+    run.finish()
+
+
 def test_mvs_svs_output_before_the_motion_which_waits_for_the_acknowledge(plc: Plc) -> None:
     run = Run(plc, 11)
     out = run.until(lambda r: r.listed)
     assert out.pending and out.used == 1
     assert out.x_mm == 10.0 and out.velocity_um_s == 0.0  # before N20's motion
-    _waits(run, 10.0)
-    acked = run.acknowledge()
-    _goes_on(run, acked, 10.0)
-    run.finish()
+    _acknowledged_after_waiting(run, 10.0)
 
 
 def test_mvs_sns_output_before_the_motion_waited_for_at_the_block_end(plc: Plc) -> None:
@@ -168,10 +174,7 @@ def test_mvs_sns_output_before_the_motion_waited_for_at_the_block_end(plc: Plc) 
     moving_pending = [r for r in run.rows if out.cycle <= r.cycle < at_end.cycle]
     assert all(r.pending and 10.0 <= r.x_mm <= 20.0 for r in moving_pending)
     assert any(10.0 < r.x_mm < 20.0 for r in moving_pending)  # it ran while pending
-    _waits(run, 20.0)  # it stopped at the block end and waits there
-    acked = run.acknowledge()
-    _goes_on(run, acked, 20.0)
-    run.finish()
+    _acknowledged_after_waiting(run, 20.0)  # it stopped at the block end and waits there
 
 
 def test_mns_sns_output_at_the_block_end_and_waited_for_there(plc: Plc) -> None:
@@ -180,10 +183,7 @@ def test_mns_sns_output_at_the_block_end_and_waited_for_there(plc: Plc) -> None:
     assert out.pending and out.x_mm == 20.0 and out.velocity_um_s == 0.0
     assert run.before(out).x_mm <= 20.0  # not output before the path got to the end
     assert not any(r.listed for r in run.rows if r.x_mm < 20.0)
-    _waits(run, 20.0)
-    acked = run.acknowledge()
-    _goes_on(run, acked, 20.0)
-    run.finish()
+    _acknowledged_after_waiting(run, 20.0)
 
 
 def test_mos_output_while_the_path_runs_on(plc: Plc) -> None:
