@@ -4,8 +4,10 @@ Each connection is wrapped in a ``ConnectionGuard`` (an asyncio protocol in fron
 aiohttp's own):
 
 - at most ``max_connections`` are open at once; one more is answered ``503 Service
-  Unavailable`` with ``Retry-After: 1`` and closed at once, before anything is read. The
-  connections already open (a browser's pages, its WebSocket) go on as before.
+  Unavailable`` with ``Retry-After: 1`` before anything is read, and closed: its sending
+  side at once, the socket when the client closes or ``REFUSED_LINGER_S`` later (what
+  it sent is discarded; closing at once would reset the connection and could lose the
+  answer). The connections already open (a browser's pages, its WebSocket) go on.
 - a connection that is not inside a request is closed when ``header_timeout_s`` passes:
   a request's line and headers must arrive within that time of the connection opening or
   of the previous response, so half-sent requests do not hold sockets. Inside a request
@@ -32,6 +34,7 @@ log = logging.getLogger(__name__)
 
 MAX_CONNECTIONS = 256  # browsers open ~6 each; file descriptors stay far below 1024
 HEADER_TIMEOUT_S = 10.0  # to send a request's headers, from the connection or last response
+REFUSED_LINGER_S = 1.0  # a refused connection's socket, after its 503, until closed
 KEEPALIVE_TIMEOUT_S = 75.0  # aiohttp's idle keep-alive (run_app's default), after ours
 
 _OVER_CAP_BODY = json.dumps({"error": "cnc-web has too many connections open: try again"})
@@ -77,7 +80,8 @@ class ConnectionGuard(asyncio.Protocol):
             log.warning("connection from %s refused: %d connections are open (the cap)",
                         transport.get_extra_info("peername"), self._count.open)
             transport.write(OVER_CAP_RESPONSE)
-            transport.close()
+            transport.write_eof()
+            self._timer = asyncio.get_running_loop().call_later(REFUSED_LINGER_S, transport.close)
             return
         self._count.open += 1
         self._transport = transport
@@ -86,13 +90,13 @@ class ConnectionGuard(asyncio.Protocol):
         self._arm()
 
     def data_received(self, data: bytes) -> None:
-        """Bytes for aiohttp (none are taken from a refused connection)."""
+        """Bytes for aiohttp (a refused connection's are discarded)."""
         if self._inner is not None:
             self._inner.data_received(data)
 
     def eof_received(self) -> bool | None:
-        """The peer closed its side."""
-        return self._inner.eof_received() if self._inner is not None else None
+        """The peer closed its side (a refused connection then closes)."""
+        return self._inner.eof_received() if self._inner is not None else False
 
     def pause_writing(self) -> None:
         """The send buffer is full (aiohttp waits)."""
