@@ -19,8 +19,11 @@ session whose role's password changed or was removed since it signed in ends the
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
 import json
-from collections.abc import Awaitable, Callable
+import logging
+from collections.abc import Awaitable, Callable, Iterator
 from dataclasses import dataclass, field
 
 from aiohttp import web
@@ -32,7 +35,10 @@ from .sessions import COOKIE_NAME, CSRF_HEADER, SESSION_MAX_AGE_S, Session, Sess
 from .signin import SignInGate
 from .users import UsersFile, WebRole, WebUsers
 
+log = logging.getLogger(__name__)
+
 Handler = Callable[[web.Request], Awaitable[web.StreamResponse]]
+SWEEP_S = 1.0  # how often open WebSockets of ended sessions are looked for
 #: What a web request needs, as the service decides it for the requests cnc-web makes.
 WRITE_ROLE = COMMAND_ROLES[AdsCommand.WRITE_CONTROL]  # objects, commands, MDI: operator
 STORE_ROLE = role_to_write(CncPort.COM, PROGRAM_STORE_GROUP)  # upload programs: admin
@@ -65,6 +71,9 @@ class Access:
     open_role: WebRole = LOOPBACK_ROLE
     sessions: SessionStore = field(default_factory=SessionStore)
     gate: SignInGate = field(default_factory=SignInGate)
+    # The connections of each session's requests under way (its WebSockets above all):
+    # closed when the session ends, so an open page stops receiving at once too.
+    _running: dict[str, set[asyncio.BaseTransport]] = field(default_factory=dict)
 
     @property
     def sign_in_required(self) -> bool:
@@ -82,11 +91,45 @@ class Access:
         session_id = request.cookies.get(COOKIE_NAME)
         session = self.sessions.get(session_id)
         users = self.users
-        if session is not None and users is not None and \
-                users.hashes.get(session.role) != session.password_hash:
-            self.sessions.end(session_id)
+        if session is not None and users is not None and _outdated(session, users):
+            self.end(session_id)
             return None
         return session
+
+    def end(self, session_id: str | None, keep: asyncio.BaseTransport | None = None) -> bool:
+        """End the session ``session_id``: in the store, and its requests under way (but
+        the one on ``keep``) lose their connection. False when there was no session."""
+        for transport in self._running.pop(session_id or "", set()) - {keep}:
+            transport.close()
+        return self.sessions.end(session_id)
+
+    def sweep(self) -> int:
+        """End every session whose role's password changed or was removed (the users
+        file is read again when it changed); how many ended. Requests find such a session
+        ended anyway; the sweep reaches the WebSockets, which make no requests."""
+        users = self.users
+        if users is None:
+            return 0
+        ended = [i for i, s in self.sessions.items() if _outdated(s, users)]
+        for session_id in ended:
+            self.end(session_id)
+        return len(ended)
+
+    @contextlib.contextmanager
+    def running(self, session_id: str, transport: asyncio.BaseTransport | None) -> Iterator[None]:
+        """While a request of ``session_id`` runs on ``transport`` (see ``end``)."""
+        if transport is None:
+            yield
+            return
+        self._running.setdefault(session_id, set()).add(transport)
+        try:
+            yield
+        finally:
+            transports = self._running.get(session_id)
+            if transports is not None:
+                transports.discard(transport)
+                if not transports:
+                    del self._running[session_id]
 
     def start_session(self, response: web.StreamResponse, role: WebRole,
                       password_hash: str | None) -> Session:
@@ -99,7 +142,13 @@ class Access:
     def end_session(self, request: web.Request, response: web.StreamResponse) -> bool:
         """Sign-out: the request's session ends in the server, its cookie is dropped."""
         response.del_cookie(COOKIE_NAME, path="/")
-        return self.sessions.end(request.cookies.get(COOKIE_NAME))
+        return self.end(request.cookies.get(COOKIE_NAME), keep=request.transport)
+
+
+def _outdated(session: Session, users: WebUsers) -> bool:
+    """True when ``session``'s role no longer has the password it signed in with."""
+    return session.password_hash is not None and \
+        users.hashes.get(session.role) != session.password_hash
 
 
 def set_session_cookie(response: web.StreamResponse, session_id: str) -> None:
@@ -137,8 +186,19 @@ async def session_middleware(request: web.Request, handler: Handler) -> web.Stre
     """Attach the request's session; refuse API calls and the WebSocket without one."""
     access = request.app[ACCESS_KEY]
     session = access.session_of(request)
-    if session is not None:
-        request[SESSION_KEY] = session
-    elif not (request.path == "/" or request.path.startswith(_OPEN_PREFIXES)):
-        raise refusal(401, "not signed in (sign in with a role's password)")
-    return await handler(request)
+    if session is None:
+        if not (request.path == "/" or request.path.startswith(_OPEN_PREFIXES)):
+            raise refusal(401, "not signed in (sign in with a role's password)")
+        return await handler(request)
+    request[SESSION_KEY] = session
+    with access.running(request.cookies[COOKIE_NAME], request.transport):
+        return await handler(request)
+
+
+async def sweep_sessions(access: Access, interval_s: float = SWEEP_S) -> None:
+    """``access.sweep()`` every ``interval_s`` (a task of the application's life)."""
+    while True:
+        await asyncio.sleep(interval_s)
+        ended = access.sweep()
+        if ended:
+            log.info("%d session(s) ended: their role's password changed or was removed", ended)

@@ -20,7 +20,7 @@ from aiohttp import WSMsgType, web
 from cnc_objects.clients.client import AsyncClient
 
 from . import api
-from .access import ACCESS_KEY, Access, session_middleware
+from .access import ACCESS_KEY, Access, session_middleware, sweep_sessions
 from .connections import connection_middleware
 from .hosts import HOSTS_KEY, AllowedHosts, host_middleware
 from .hub import FLUSH_S, LiveHub, Outbox
@@ -132,7 +132,9 @@ def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts) -> web.Appl
         async with client:
             app[api.CLIENT_KEY] = client
             app[HUB_KEY] = LiveHub(client)
+            sweeper = asyncio.create_task(sweep_sessions(access), name="cnc-web session sweep")
             yield
+            sweeper.cancel()
             await app[HUB_KEY].close()
             access.gate.close()
 

@@ -5,8 +5,9 @@ server's ``SessionStore``: the role, the CSRF token, when it began, and the pass
 with which it signed in. So a session can be ended at once, whatever the browser keeps:
 
 - sign-out removes it;
-- a changed or removed password of its role ends it at the next request (the hash it
-  signed in with is no longer the role's: ``access.py`` asks ``ended_by``);
+- a changed or removed password of its role ends it at its next request, and its open
+  WebSockets within a second (the hash it signed in with is no longer the role's:
+  ``access.py``);
 - it ends by itself ``SESSION_MAX_AGE_S`` after sign-in, and a restart of cnc-web ends all.
 
 The page reads the CSRF token from ``GET /api/session`` and sends it in the
@@ -72,6 +73,10 @@ class SessionStore:
             del self._sessions[session_id]
             return None
         return session
+
+    def items(self) -> list[tuple[str, Session]]:
+        """Every session with its id, oldest first."""
+        return list(self._sessions.items())
 
     def end(self, session_id: str | None) -> bool:
         """End the session ``session_id`` (sign-out); False when there was none."""

@@ -215,6 +215,14 @@ def _web_users(*args: str, password: str = "") -> None:
     assert run.returncode == 0, run.stderr
 
 
+async def _ends(page: aiohttp.ClientWebSocketResponse) -> None:
+    """The page's WebSocket is closed by cnc-web (its session ended)."""
+    message = await asyncio.wait_for(page.receive(), WAIT_S)
+    assert message.type in (aiohttp.WSMsgType.CLOSE, aiohttp.WSMsgType.CLOSED,
+                            aiohttp.WSMsgType.ERROR), message
+    await page.close()
+
+
 async def test_sign_out_a_new_password_and_a_removed_role_end_sessions_at_once(
         signed_web: WebProcess, users_file: Path) -> None:
     url = signed_web.url
@@ -224,17 +232,21 @@ async def test_sign_out_a_new_password_and_a_removed_role_end_sessions_at_once(
         _, operator = await _sign_in(b, url, WebRole.OPERATOR, PASSWORDS[WebRole.OPERATOR])
         _, monitor = await _sign_in(c, url, WebRole.MONITOR, PASSWORDS[WebRole.MONITOR])
         assert [await _read_with(url, k) for k in (signed_out, operator, monitor)] == [200] * 3
+        pages = [await http.ws_connect(url + "/ws") for http in (a, b, c)]  # open pages
 
         status, _ = await _json(a, "POST", url + "/api/logout")
         assert status == 200
         assert await _read_with(url, signed_out) == 401  # the cookie kept elsewhere: ended
+        await _ends(pages[0])
 
         _web_users("set", "monitor", "--file", str(users_file), password="a-new-one")
+        await _ends(pages[2])
         assert await _read_with(url, monitor) == 401
         assert await _read_with(url, operator) == 200  # another role's session goes on
         await _sign_in(d, url, WebRole.MONITOR, "a-new-one")
 
         _web_users("remove", "operator", "--file", str(users_file))
+        await _ends(pages[1])
         assert await _read_with(url, operator) == 401
         _, session = await _json(b, "GET", url + "/api/session")
         assert session["role"] is None and session["roles"] == ["monitor"]
