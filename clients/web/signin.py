@@ -4,7 +4,8 @@ An Argon2id check costs 64 MiB and some 100 ms of CPU on purpose. Run on the eve
 it would stop every other browser's reads while it runs, and parallel attempts would add
 64 MiB each. So:
 
-- hashes are checked in a pool of ``HASH_WORKERS`` threads (argon2-cffi releases the GIL);
+- hashes are checked in a pool of ``HASH_WORKERS`` threads (argon2-cffi releases the GIL)
+  of lower priority than the event loop (nice ``HASH_NICENESS``);
   at most ``MAX_WAITING`` attempts wait for it, more are answered 429 at once;
 - each client address and each role (the user name of cnc-web) has a token bucket of
   attempts: ``BURST`` at once, then one per ``REFILL_S``; an attempt without a token
@@ -15,13 +16,17 @@ it would stop every other browser's reads while it runs, and parallel attempts w
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import math
+import os
+import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 HASH_WORKERS = 1  # Argon2id checks at once (each 64 MiB, itself 4 lanes)
+HASH_NICENESS = 10  # the hashing threads' nice value: below the event loop's
 MAX_WAITING = 8  # attempts hashing or waiting for the pool; beyond: 429
 MAX_TRACKED = 10_000  # addresses remembered; beyond, full buckets are forgotten first
 
@@ -80,6 +85,13 @@ class Buckets:
         self._refilled(key).tokens -= 1
 
 
+def _yield_to_the_event_loop() -> None:
+    """Lower this hashing thread's priority (Linux: per thread; Argon2's lane threads
+    inherit it), so that the CPU goes to the event loop first when both want it."""
+    with contextlib.suppress(OSError, AttributeError):
+        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), HASH_NICENESS)
+
+
 class TooManyAttempts(Exception):
     """Refused before hashing; ``retry_after_s``: when to try again (whole seconds)."""
 
@@ -96,7 +108,8 @@ class SignInGate:
         self.addresses = Buckets(per_address)
         self.roles = Buckets(per_role)
         self.max_waiting = max_waiting
-        self._pool = ThreadPoolExecutor(workers, thread_name_prefix="cnc-web-argon2")
+        self._pool = ThreadPoolExecutor(workers, thread_name_prefix="cnc-web-argon2",
+                                        initializer=_yield_to_the_event_loop)
         self._waiting = 0
 
     def admit(self, address: str, role: str) -> None:
