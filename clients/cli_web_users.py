@@ -66,7 +66,8 @@ def set_password(role: str = typer.Argument(..., help="monitor, operator or admi
         say_error(str(exc))
         raise typer.Exit(EXIT_USAGE) from None
     save_users(file, users)
-    print(f"role {chosen.label} can sign in to cnc-web ({file}; restart cnc-web to apply)")
+    print(f"role {chosen.label} can sign in to cnc-web ({file}; a running cnc-web ends the "
+          "sessions of its old password at once)")
 
 
 @web_users_app.command("remove")
@@ -79,7 +80,8 @@ def remove(role: str = typer.Argument(..., help="monitor, operator or admin."),
         say_error(f"role {chosen.label} has no password in {file}")
         raise typer.Exit(1)
     save_users(file, users)
-    print(f"role {chosen.label} can no longer sign in ({file})")
+    print(f"role {chosen.label} can no longer sign in ({file}; a running cnc-web ends its "
+          "sessions at once)")
 
 
 @web_users_app.command("list")

@@ -59,6 +59,7 @@ class Role(IntEnum):
 
 
 ROLE_NAMES = ", ".join(r.label for r in Role)
+LOOPBACK_ROLE = Role.ADMIN  # peers on loopback when the service runs without keys
 
 #: The role each command needs, but for Write (by address: ``role_to_write``) and a sum
 #: write (per item). Commands not listed never reach the dispatcher (they do not decode).

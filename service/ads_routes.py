@@ -16,13 +16,12 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from cnc_objects.protocol.ams import format_net_id, parse_net_id
-from cnc_objects.protocol.roles import Role
+from cnc_objects.protocol.roles import LOOPBACK_ROLE, Role
 
 IpAddress = ipaddress.IPv4Address | ipaddress.IPv6Address
 
 
 ROUTE_ROLE = Role.OPERATOR  # a route's role when its configuration names none
-LOOPBACK_ROLE = Role.ADMIN  # loopback peers' role without --keys (with keys: monitor)
 
 
 @dataclass(frozen=True, slots=True)

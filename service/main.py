@@ -42,9 +42,9 @@ import zmq
 
 from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.protocol.ams import parse_net_id
-from cnc_objects.protocol.roles import Role
+from cnc_objects.protocol.roles import LOOPBACK_ROLE, Role
 
-from .ads_routes import LOOPBACK_ROLE, Route, RouteTable
+from .ads_routes import Route, RouteTable
 from .ads_server import AdsTcpServer
 from .ads_symbols import SymbolService
 from .backend import Backend

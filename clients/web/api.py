@@ -20,8 +20,9 @@ from cnc_objects.clients.hmi.machine import discover
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from . import alarms
-from .access import ACCESS_KEY, refusal, require_write, set_session_cookie
+from .access import ACCESS_KEY, STORE_ROLE, WRITE_ROLE, refusal, require_write, set_session_cookie
 from .hub import json_value
+from .signin import TooManyAttempts
 from .users import WebRole
 
 CLIENT_KEY: web.AppKey[AsyncClient] = web.AppKey("client")
@@ -82,47 +83,59 @@ def _channel(request: web.Request) -> int:
 # ---------------------------------------------------------------- session
 
 async def get_session(request: web.Request) -> web.StreamResponse:
-    """The browser's role, its CSRF token and whether it must sign in."""
+    """The browser's role, its CSRF token, what it may and whether it must sign in."""
     access = request.app[ACCESS_KEY]
-    session, cookie = access.session_of(request), None
+    session, session_id = access.session_of(request), None
     if session is None and not access.sign_in_required:
-        session, cookie = access.signer.issue(access.open_role)
-    roles = [r.label for r in access.users.roles] if access.users else [access.open_role.label]
+        session, session_id = access.sessions.issue(access.open_role, None)
+    users = access.users
+    roles = [r.label for r in users.roles] if users is not None else [access.open_role.label]
     response = web.json_response({
         "role": session.role.label if session else None,
         "csrf": session.csrf if session else None,
-        "may_write": bool(session and session.role >= WebRole.OPERATOR),
+        "may_write": bool(session and session.role.may(WRITE_ROLE)),
+        "may_upload": bool(session and session.role.may(STORE_ROLE)),
         "sign_in_required": access.sign_in_required,
         "roles": roles,
         "endpoint": _client(request).endpoint,
     })
-    if cookie is not None:
-        set_session_cookie(response, cookie)
+    if session_id is not None:
+        set_session_cookie(response, session_id)
     return response
 
 
 async def login(request: web.Request) -> web.StreamResponse:
-    """Sign in as ``role`` with its ``password``."""
+    """Sign in as ``role`` with its ``password``: 400 for a malformed request, 429 (with
+    ``Retry-After``) over the attempt limits of ``signin.py``, 401 for a wrong password;
+    the hash is checked off the event loop."""
     access = request.app[ACCESS_KEY]
     data = await _body(request)
-    if access.users is None:
+    users = access.users
+    if users is None:
         raise refusal(400, "this server has no users file: everyone on this machine is "
                            f"{access.open_role.label} without signing in")
     try:
         role = WebRole.parse(_field(data, "role", str))
     except ValueError as exc:
         raise refusal(400, str(exc)) from None
-    if not access.users.verify(role, _field(data, "password", str)):
+    password = _field(data, "password", str)
+    try:
+        access.gate.admit(request.remote or "?", role.label)
+    except TooManyAttempts as exc:
+        raise refusal(429, str(exc), {"Retry-After": str(exc.retry_after_s)}) from None
+    stored = users.hashes.get(role)
+    if not await access.gate.check(lambda: users.verify(role, password)) or stored is None:
         raise refusal(401, f"wrong password for role {role.label}")
     response = web.json_response({"role": role.label})
-    access.start_session(response, role)
+    access.start_session(response, role, stored)
     return response
 
 
 async def logout(request: web.Request) -> web.StreamResponse:
-    """End the session (the cookie is dropped)."""
+    """End the session: in the server (its cookie no longer opens anything), and the
+    cookie is dropped."""
     response = web.json_response({"role": None})
-    response.del_cookie("cnc_web_session", path="/")
+    request.app[ACCESS_KEY].end_session(request, response)
     return response
 
 
@@ -191,7 +204,7 @@ async def program_text(request: web.Request) -> web.StreamResponse:
 @_service_call
 async def upload(request: web.Request) -> web.StreamResponse:
     """Store the uploaded file (form field ``file``) under its file name."""
-    require_write(request, "upload programs")
+    require_write(request, "upload programs", STORE_ROLE)
     if request.content_length is not None and request.content_length > MAX_UPLOAD_BYTES:
         raise refusal(400, f"the upload is larger than {MAX_UPLOAD_BYTES} bytes")
     reader = await request.multipart()

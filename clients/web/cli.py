@@ -1,13 +1,16 @@
 """``cnc-web``: the web HMI of a cnc-service, at http://127.0.0.1:8080 by default.
 
     cnc-web [--endpoint URL] [--host H] [--port P] [--users FILE]
-            [--key FILE [--server-key FILE]]
+            [--key FILE [--server-key FILE]] [--allow-host NAME ...]
+            [--max-connections N] [--header-timeout S]
 
 Browsers sign in as a role with the password ``cnc web-users set ROLE`` stored in the
 users file; without that file there is no sign-in and everyone on this machine is an
-operator, which is why cnc-web then serves loopback only. Without a key (``--key``) it
-serves loopback only too, as the service does without keys. Bad usage exits 2 with one
-line on stderr. Pages, API and access: docs/web.md.
+admin (as loopback peers of a service without keys), which is why cnc-web then serves
+loopback only. Without a key (``--key``) it serves loopback only too, as the service
+does without keys. Bad usage exits 2 with one line on stderr. Requests must address
+cnc-web by one of its names (``--host``, loopback names, ``--allow-host``).
+Pages, API, access and limits: docs/web.md.
 """
 
 from __future__ import annotations
@@ -18,14 +21,14 @@ from pathlib import Path
 from typing import NoReturn
 
 import typer
-from aiohttp import web
 
 from ..client import DEFAULT_ENDPOINT
 from ..key_options import key_option, server_key_option
 from .access import Access
+from .connections import HEADER_TIMEOUT_S, MAX_CONNECTIONS, ConnectionLimits, serve
+from .hosts import AllowedHosts
 from .server import ServiceLink, is_loopback, make_app
-from .sessions import SessionSigner
-from .users import DEFAULT_USERS_FILE, load_users
+from .users import DEFAULT_USERS_FILE, UsersFile
 
 EXIT_USAGE = 2
 DEFAULT_HOST = "127.0.0.1"
@@ -53,31 +56,42 @@ def run(
         f"{DEFAULT_USERS_FILE} when it exists; without one: no sign-in, loopback only)."),
     key: str = key_option("The web server's"),
     server_key: str = server_key_option(),
+    allow_host: list[str] = typer.Option(
+        [], "--allow-host", metavar="NAME", help="Another name browsers reach cnc-web by "
+        "(its DNS name); requests naming any other host are refused (DNS rebinding)."),
+    max_connections: int = typer.Option(
+        MAX_CONNECTIONS, "--max-connections", min=1, help="Connections open at once; one "
+        "more is answered 503."),
+    header_timeout: float = typer.Option(
+        HEADER_TIMEOUT_S, "--header-timeout", min=0.1, metavar="S", help="Seconds a "
+        "connection has to send a request's headers; then it is closed."),
     log_level: str = typer.Option("INFO", "--log-level", help="DEBUG, INFO, WARNING or ERROR."),
 ) -> None:
     """Serve the web HMI."""
     logging.basicConfig(level=log_level.upper(), format="%(levelname)s %(name)s: %(message)s")
     users_file = users if users is not None else (
         DEFAULT_USERS_FILE if DEFAULT_USERS_FILE.exists() else None)
-    loaded = None
+    watched = None
     if users_file is not None:
         try:
-            loaded = load_users(users_file)
+            watched = UsersFile(users_file)
         except ValueError as exc:
             _usage(str(exc))
+    loaded = watched.current() if watched is not None else None
     if not is_loopback(host):
         if key is None:
             _usage(f"--host {host} is not loopback: without --key (the service's keys) "
                    "cnc-web serves loopback only")
         if loaded is None:
             _usage(f"--host {host} is not loopback: without a users file everyone would be "
-                   "an operator (create one: cnc web-users set operator)")
-    access = Access(SessionSigner(), loaded)
+                   "an admin (create one: cnc web-users set operator)")
+    access = Access(watched)
     signing = (f"sign-in with {users_file} ({', '.join(r.label for r in loaded.roles)})"
-               if loaded else "no sign-in (every browser of this machine is an operator)")
+               if loaded else f"no sign-in (every browser of this machine is {access.open_role.label})")
     print(f"cnc-web: http://{host}:{port} for {endpoint}; {signing}", file=sys.stderr, flush=True)
-    web.run_app(make_app(ServiceLink(endpoint, key_file=key, server_key=server_key), access),
-                host=host, port=port, print=None, access_log=None)
+    link = ServiceLink(endpoint, key_file=key, server_key=server_key)
+    serve(make_app(link, access, AllowedHosts.serving(host, allow_host)), host, port,
+          ConnectionLimits(max_connections, header_timeout))
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -20,7 +20,9 @@ from aiohttp import WSMsgType, web
 from cnc_objects.clients.client import AsyncClient
 
 from . import api
-from .access import ACCESS_KEY, Access, session_middleware
+from .access import ACCESS_KEY, Access, session_middleware, sweep_sessions
+from .connections import connection_middleware
+from .hosts import HOSTS_KEY, AllowedHosts, host_middleware
 from .hub import FLUSH_S, LiveHub, Outbox
 
 STATIC_DIR = Path(__file__).with_name("static")
@@ -114,10 +116,14 @@ async def _send(socket: web.WebSocketResponse, outbox: Outbox) -> None:
         await asyncio.sleep(FLUSH_S)  # newer values gather meanwhile: one message for all
 
 
-def make_app(link: ServiceLink, access: Access) -> web.Application:
-    """The cnc-web application for the service at ``link``."""
-    app = web.Application(middlewares=[session_middleware], client_max_size=api.MAX_UPLOAD_BYTES)
+def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts) -> web.Application:
+    """The cnc-web application for the service at ``link``, answering requests addressed
+    to ``hosts`` only. Each request passes, in order: its connection's guard (the header
+    timer stops), the Host/Origin check, the session."""
+    app = web.Application(middlewares=[connection_middleware, host_middleware, session_middleware],
+                          client_max_size=api.MAX_UPLOAD_BYTES)
     app[ACCESS_KEY] = access
+    app[HOSTS_KEY] = hosts
     app[SOCKETS_KEY] = [0]
 
     async def service_client(app: web.Application) -> AsyncIterator[None]:
@@ -126,8 +132,11 @@ def make_app(link: ServiceLink, access: Access) -> web.Application:
         async with client:
             app[api.CLIENT_KEY] = client
             app[HUB_KEY] = LiveHub(client)
+            sweeper = asyncio.create_task(sweep_sessions(access), name="cnc-web session sweep")
             yield
+            sweeper.cancel()
             await app[HUB_KEY].close()
+            access.gate.close()
 
     app.cleanup_ctx.append(service_client)
     app.router.add_get("/", index)

@@ -36,11 +36,13 @@ async def _json(http: aiohttp.ClientSession, method: str, url: str, csrf: str | 
         return response.status, await response.json()
 
 
-async def test_open_server_gives_an_operator_session_and_checks_csrf(web: WebProcess) -> None:
+async def test_open_server_gives_an_admin_session_and_checks_csrf(web: WebProcess) -> None:
+    """Without a users file every browser of this machine has the role the service gives
+    loopback peers without keys: admin."""
     async with _session() as http:
         status, session = await _json(http, "GET", web.url + "/api/session")
         assert status == 200
-        assert session["role"] == "operator" and session["may_write"] is True
+        assert session["role"] == "admin" and session["may_write"] is True
         assert session["sign_in_required"] is False
         write = {"name": "ch1.mc_command_feed_override_w", "value": 500}
         status, body = await _json(http, "POST", web.url + "/api/write", json=write)
@@ -220,7 +222,7 @@ async def test_the_web_servers_key_bounds_every_page(tmp_path: Path) -> None:
                          server_key=service.keys.server_key) as web:
             async with _session() as http:
                 _, session = await _json(http, "GET", web.url + "/api/session")
-                assert session["role"] == "operator"  # no users file: this machine's browsers
+                assert session["role"] == "admin"  # no users file: this machine's browsers
                 status, body = await _json(
                     http, "POST", web.url + "/api/write", session["csrf"],
                     json={"name": "ch1.mc_command_feed_override_w", "value": 500})

@@ -75,6 +75,7 @@ async function loadSession() {
   $("#who").textContent = s.role ? `${s.role} · ${s.endpoint}` : "";
   $("#logout").hidden = !(s.sign_in_required && s.role);
   for (const control of document.querySelectorAll(".write")) control.disabled = !s.may_write;
+  $("#upload-input").disabled = !s.may_upload;  // the program store: admin, as on the service
   return s;
 }
 
@@ -319,8 +320,8 @@ drop.addEventListener("dragleave", () => drop.classList.remove("over"));
 drop.addEventListener("drop", (event) => {
   event.preventDefault();
   drop.classList.remove("over");
-  if (state.session.may_write) upload([...event.dataTransfer.files]);
-  else say("role monitor may not upload programs; operator or admin may", true);
+  if (state.session.may_upload) upload([...event.dataTransfer.files]);
+  else say(`role ${state.session.role} may not upload programs; admin may`, true);
 });
 
 function needProgram() {
