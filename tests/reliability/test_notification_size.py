@@ -19,85 +19,28 @@ reads stay fast. The bench (``make bench``, part ``fairness``) prints the figure
 from __future__ import annotations
 
 import statistics
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
 
-from cnc_objects.objects.catalog import PLC_GROUP
-from cnc_objects.protocol.constants import CncPort, TransmissionMode
-from cnc_objects.protocol.frames import AddNotificationRequest
 from cnc_objects.service.limits import LimitsConfig
-from cnc_objects.testing import ServiceProcess, serving
-from tests.e2e.test_ads_raw import ADD_NOTIFICATION, RawAds, add_notification
-from tests.limits.wire import Raw, limits_toml, next_id
+from cnc_objects.testing import serving
+from tests.limits.wire import limits_toml
 from tests.reliability import figures
-from tests.support.notification_load import ads_read_latencies_s, p99, read_latencies_s
+from tests.support.large_notifications import (
+    ATTACK_BYTES,
+    ATTACKS,
+    REALTIME,
+    monitor,
+    read_latencies,
+)
+from tests.support.notification_load import p99
 
 NODE = "tests/reliability/test_notification_size.py"
 INVALIDWATCHSIZE = 0x717
-GPCH_OFFSET = 0x10100  # gpCh, the first symbol of the PLC memory area
-#: The attack's length by front end (the largest each wire lets through).
-ATTACK_BYTES = {"ads": 60_000, "zmq": 460_032}
-ATTACKS = 20  # 2 % of notifications_per_client
 READS = 200
-#: The clock the attack needs: 1 ms cycles in wall time, a read of the range longer
-#: than one (the virtual clock does not publish while a pass is scheduled).
-REALTIME = ("--clock", "realtime")
 #: A bound the reads keep on a loaded 2-core machine; before, they took seconds.
 P99_BOUND_S = 0.100
-
-
-class Monitor:
-    """A client that subscribes on change to ``length`` bytes of the PLC memory area and
-    never reads its samples (the service must not care)."""
-
-    def __init__(self, service: ServiceProcess, front_end: str) -> None:
-        self.front_end = front_end
-        if front_end == "ads":
-            self.ads: RawAds | None = RawAds(service)
-            self.raw: Raw | None = None
-        else:
-            self.ads, self.raw = None, Raw(service.endpoint)
-
-    def close(self) -> None:
-        """Close the connection (its notifications go with it)."""
-        if self.ads is not None:
-            self.ads.close()
-        if self.raw is not None:
-            self.raw.close()
-
-    def subscribe(self, length: int) -> tuple[int, str]:
-        """AddDeviceNotification on change, every cycle: (ADS result, ZeroMQ's message)."""
-        if self.ads is not None:
-            reply = self.ads.call(ADD_NOTIFICATION, add_notification(
-                PLC_GROUP, GPCH_OFFSET, length, TransmissionMode.SERVER_ON_CHANGE, 0),
-                port=CncPort.PLC)
-            return reply.result, ""
-        assert self.raw is not None
-        answer = self.raw.call(AddNotificationRequest(
-            next_id(), CncPort.PLC, PLC_GROUP, GPCH_OFFSET, length,
-            TransmissionMode.SERVER_ON_CHANGE, 0, 0).encode())
-        return answer[2], answer[3] if answer[2] else ""
-
-
-@contextmanager
-def monitor(service: ServiceProcess, front_end: str) -> Iterator[Monitor]:
-    """A ``Monitor`` for a ``with`` block."""
-    client = Monitor(service, front_end)
-    try:
-        yield client
-    finally:
-        client.close()
-
-
-def read_latencies(service: ServiceProcess, front_end: str) -> list[float]:
-    """``READS`` plain reads of another client on ``front_end``, one at a time."""
-    if front_end == "ads":
-        assert service.ads_address is not None and service.ams_net_id is not None
-        return ads_read_latencies_s(service.ads_address, service.ams_net_id, READS)
-    return read_latencies_s(service.endpoint, READS)
 
 
 def record(front_end: str, what: str, latencies_s: list[float]) -> None:
@@ -116,7 +59,7 @@ def test_a_notification_over_the_size_limit_is_refused_with_0x717(front_end: str
     with serving(*REALTIME, ads=front_end == "ads") as service, \
             monitor(service, front_end) as attacker:
         answers = [attacker.subscribe(length) for _ in range(ATTACKS)]
-        latencies_s = read_latencies(service, front_end)
+        latencies_s = read_latencies(service, front_end, READS)
     assert {code for code, _ in answers} == {INVALIDWATCHSIZE}, answers[:3]
     if front_end == "zmq":
         assert "notification_max_bytes" in answers[0][1], answers[0]
@@ -138,7 +81,7 @@ def test_reads_stay_fast_beside_the_largest_notifications_the_defaults_take(
             monitor(service, front_end) as attacker:
         answers = [attacker.subscribe(length) for _ in range(count)]
         assert {code for code, _ in answers} == {0}, answers[:3]
-        latencies_s = read_latencies(service, front_end)
+        latencies_s = read_latencies(service, front_end, READS)
     record(front_end, f"{count} on-change notifications of {length} bytes", latencies_s)
     assert p99(latencies_s) < P99_BOUND_S, (
         f"p99 of the reads {p99(latencies_s) * 1e3:.1f} ms (bound "
@@ -158,7 +101,7 @@ def test_reads_stay_fast_beside_large_notifications_the_limits_let_in(
             monitor(service, front_end) as attacker:
         answers = [attacker.subscribe(length) for _ in range(ATTACKS)]
         assert {code for code, _ in answers} == {0}, answers[:3]
-        latencies_s = read_latencies(service, front_end)
+        latencies_s = read_latencies(service, front_end, READS)
     record(front_end, f"{ATTACKS} on-change notifications of {length} bytes", latencies_s)
     assert p99(latencies_s) < P99_BOUND_S, (
         f"p99 of the reads {p99(latencies_s) * 1e3:.1f} ms (bound "
