@@ -14,8 +14,9 @@ Three scenarios per front end:
 
 Printed: the reads' p50 / p99 / max, how many subscriptions the service took, and how
 many reads were done (each scenario reads for at most ``BUDGET_S``: before issue 35 a
-read could take seconds). Run it on an older commit for the "before" figures: it needs
-only the service's wire.
+read could take seconds, or get no reply within ``READ_TIMEOUT_S``, which ends the
+scenario and counts as that long), and whether the service stopped on SIGINT. For the
+"before" figures, run it with ``service/`` of an older commit: it needs only the wire.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ import sys
 import time
 from dataclasses import dataclass
 
-from cnc_objects.testing import ServiceProcess, serving
+from cnc_objects.testing import ServiceProcess, start_service
 from tests.support.large_notifications import (
     ATTACK_BYTES,
     ATTACKS,
@@ -33,41 +34,52 @@ from tests.support.large_notifications import (
     monitor,
     read_latencies,
 )
-from tests.support.notification_load import p99
+from tests.support.notification_load import READ_TIMEOUT_S, p99
 
 BUDGET_S = 30.0  # wall time one scenario reads for at most
-CHUNK = 50  # reads per connection of the reader
+CHUNK = 10  # reads per connection of the reader
 #: The largest the default limits take: 64 KiB per client in notifications of 8 KiB.
 DEFAULTS = (8, 8192)
 
 
 @dataclass(frozen=True)
 class Scenario:
-    """One scenario's outcome: read latencies (s) and subscriptions taken / asked."""
+    """One scenario's outcome: read latencies (s; a read with no reply counts as
+    ``READ_TIMEOUT_S`` and ends the scenario), subscriptions taken, and whether the
+    service stopped by itself on SIGINT."""
 
     latencies_s: list[float]
     taken: int
-    asked: int
+    timed_out: bool
+    stopped: bool
 
 
-def reads_within(service: ServiceProcess, front_end: str, count: int) -> list[float]:
-    """Up to ``count`` reads, in chunks of ``CHUNK``, for at most ``BUDGET_S``."""
+def reads_within(service: ServiceProcess, front_end: str,
+                 count: int) -> tuple[list[float], bool]:
+    """Up to ``count`` reads, in chunks of ``CHUNK``, for at most ``BUDGET_S``; and
+    whether one got no reply within ``READ_TIMEOUT_S``."""
     latencies: list[float] = []
     deadline = time.monotonic() + BUDGET_S
     while len(latencies) < count and time.monotonic() < deadline:
-        latencies += read_latencies(service, front_end, CHUNK)
-    return latencies
+        try:
+            latencies += read_latencies(service, front_end, CHUNK)
+        except (TimeoutError, AssertionError):
+            return [*latencies, READ_TIMEOUT_S], True
+    return latencies, False
 
 
 def measure(front_end: str, reads: int, subscriptions: tuple[int, int]) -> Scenario:
     """A fresh realtime service; ``subscriptions`` (count, bytes) on change by one client,
     then ``reads`` reads of another."""
     count, length = subscriptions
-    with serving(*REALTIME, ads=front_end == "ads") as service, \
-            monitor(service, front_end) as attacker:
-        taken = sum(attacker.subscribe(length)[0] == 0 for _ in range(count))
-        latencies = reads_within(service, front_end, reads)
-    return Scenario(latencies, taken, count)
+    service = start_service(*REALTIME, ads=front_end == "ads")
+    try:
+        with monitor(service, front_end) as attacker:
+            taken = sum(attacker.subscribe(length)[0] == 0 for _ in range(count))
+            latencies, timed_out = reads_within(service, front_end, reads)
+    finally:
+        code = service.stop()  # killed when it does not stop within 10 s
+    return Scenario(latencies, taken, timed_out, code == 0)
 
 
 def main(runs: int, reads: int) -> None:
@@ -83,7 +95,7 @@ def main(runs: int, reads: int) -> None:
               f"memory area (851/0x4020/0x10100); realtime clock, median of {runs} runs "
               f"of up to {reads} reads ({BUDGET_S:.0f} s at most)")
         print(f"{'scenario':34} {'taken':>7} {'reads':>6} {'p50 ms':>9} {'p99 ms':>9} "
-              f"{'max ms':>9}")
+              f"{'max ms':>9}  notes")
         for label, subscriptions in scenarios.items():
             results = []
             for run in range(runs):
@@ -94,8 +106,14 @@ def main(runs: int, reads: int) -> None:
             med = statistics.median
             count, length = subscriptions
             what = f"{label} ({count} x {length} B)" if count else label
+            notes = []
+            if any(r.timed_out for r in results):
+                notes.append(f"a read had no reply in {READ_TIMEOUT_S:.0f} s")
+            if not all(r.stopped for r in results):
+                notes.append("service killed: no stop within 10 s of SIGINT")
             print(f"{what:34} {f'{results[0].taken}/{count}':>7} "
                   f"{med(len(r.latencies_s) for r in results):6.0f} "
                   f"{med(med(r.latencies_s) for r in results) * 1e3:9.2f} "
                   f"{med(p99(r.latencies_s) for r in results) * 1e3:9.2f} "
-                  f"{med(max(r.latencies_s) for r in results) * 1e3:9.1f}")
+                  f"{med(max(r.latencies_s) for r in results) * 1e3:9.1f}  "
+                  f"{'; '.join(notes)}")
