@@ -30,6 +30,7 @@ from cnc_objects.testing import ServiceProcess, start_service
 from tests.support.large_notifications import (
     ATTACK_BYTES,
     ATTACKS,
+    DEFAULTS_LARGEST,
     REALTIME,
     Monitor,
     monitor,
@@ -39,8 +40,6 @@ from tests.support.notification_load import READ_TIMEOUT_S, p99
 
 BUDGET_S = 30.0  # wall time one scenario reads for at most
 CHUNK = 10  # reads per connection of the reader
-#: The largest the default limits take: 64 KiB per client in notifications of 8 KiB.
-DEFAULTS = (8, 8192)
 
 
 @dataclass(frozen=True)
@@ -102,7 +101,7 @@ def main(runs: int, reads: int) -> None:
         scenarios = {
             "idle": (0, 0),
             "attack": (ATTACKS, ATTACK_BYTES[front_end]),
-            "defaults": DEFAULTS,
+            "defaults": DEFAULTS_LARGEST,
         }
         print(f"\n{name}: another client's reads beside on-change notifications of the PLC "
               f"memory area (851/0x4020/0x10100); realtime clock, median of {runs} runs "

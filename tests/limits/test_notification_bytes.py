@@ -16,6 +16,7 @@ from cnc_objects.service.limits import LimitsConfig
 from cnc_objects.testing import ServiceProcess
 from tests.e2e.test_ads_raw import ADD_NOTIFICATION, RawAds, add_notification
 from tests.limits.wire import NOTIFICATIONS, Raw, limited_service, next_id
+from tests.support.large_notifications import DEFAULTS_LARGEST
 
 INVALIDWATCHSIZE = 0x717
 MAX_BYTES, PER_CLIENT_BYTES = 4096, 10_000
@@ -34,7 +35,9 @@ def service(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceProcess
 def test_the_defaults_let_the_largest_symbol_be_watched_whole() -> None:
     limits = LimitsConfig()
     assert limits.notification_max_bytes == 8192  # gpCh, both channels' HLI structs
-    assert limits.notification_bytes_per_client == 8 * limits.notification_max_bytes
+    count, length = DEFAULTS_LARGEST  # what the notification-size test and bench use
+    assert (limits.notification_bytes_per_client // limits.notification_max_bytes,
+            limits.notification_max_bytes) == (count, length)
 
 
 def test_a_client_over_its_bytes_is_refused_and_deleting_frees_them(

@@ -23,13 +23,13 @@ from pathlib import Path
 
 import pytest
 
-from cnc_objects.service.limits import LimitsConfig
 from cnc_objects.testing import serving
 from tests.limits.wire import limits_toml
 from tests.reliability import figures
 from tests.support.large_notifications import (
     ATTACK_BYTES,
     ATTACKS,
+    DEFAULTS_LARGEST,
     REALTIME,
     monitor,
     read_latencies,
@@ -74,9 +74,7 @@ def test_reads_stay_fast_beside_the_largest_notifications_the_defaults_take(
     """Defaults: a client holds all the bytes it may, in notifications of the largest
     length (gpCh whole, 8 KiB, about a cycle to read): the other client's reads stay
     fast (before: p50 over 100 ms, p99 seconds)."""
-    limits = LimitsConfig()
-    length = limits.notification_max_bytes
-    count = limits.notification_bytes_per_client // length
+    count, length = DEFAULTS_LARGEST
     with serving(*REALTIME, ads=front_end == "ads") as service, \
             monitor(service, front_end) as attacker:
         answers = [attacker.subscribe(length) for _ in range(count)]

@@ -26,6 +26,10 @@ GPCH_OFFSET = 0x10100  # gpCh, the first symbol of the PLC memory area
 #: frame carries comfortably; from gpCh to the end of the area).
 ATTACK_BYTES = {"ads": 60_000, "zmq": 460_032}
 ATTACKS = 20  # 2 % of notifications_per_client
+#: The largest subscriptions the default limits take: 64 KiB per client
+#: (notification_bytes_per_client) in notifications of 8 KiB (notification_max_bytes,
+#: gpCh whole); tests/limits/test_notification_bytes.py checks the defaults say so.
+DEFAULTS_LARGEST = (8, 8192)
 #: The clock the attack needs: 1 ms cycles in wall time, a read of the range longer
 #: than one (the virtual clock does not publish while a pass is scheduled).
 REALTIME = ("--clock", "realtime")
