@@ -27,7 +27,8 @@ on the virtual clock for the pocket, a 10 000-block spiral and a one-hour part, 
 and with 20 on-change subscriptions (``bench/virtual_bench.py``).
 Fairness part (``--part fairness``): another client's read latency while one client
 holds every notification the service takes (20 000 cyclic, 1 ms), idle and loaded
-(``bench/fairness_bench.py``; target p99 < 10 ms).
+(``bench/fairness_bench.py``; target p99 < 10 ms); then beside a monitor's large
+on-change notifications of the PLC memory area (``bench/notification_size_bench.py``).
 CLI part (``--part cli``): ``cnc --help`` and ``cnc read`` of one object, start to exit,
 against ``python -c pass`` and ``python -c 'import zmq'`` (``bench/cli_bench.py``; target
 < 0.25 s each).

@@ -7,7 +7,8 @@ process of its own, ``tests/support/cyclic_subscribers.py``) while another clien
 one object at a time; once over ZeroMQ, once over ADS (subscriptions and reads). Printed:
 that client's read latency p50 / p99 / max, idle and
 loaded, and the samples per second the subscribers got. Target (issue 25): p99 under
-load below 10 ms.
+load below 10 ms. Then another client's reads beside large notifications
+(``notification_size_bench``, issue 35).
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ from tests.support.notification_load import (
     read_latencies_s,
 )
 from tests.support.service import serving
+
+from . import notification_size_bench
 
 TARGET_P99_S = 0.010
 LIMITS = LimitsConfig()
@@ -66,9 +69,11 @@ def measure_once(reads: int, front_end: str) -> Fairness:
 
 
 def main(runs: int, reads: int) -> None:
-    """Measure ``runs`` times on each front end and print the medians."""
+    """Measure ``runs`` times on each front end and print the medians; then reads beside
+    large notifications (``notification_size_bench``, issue 35)."""
     for front_end in ("zmq", "ads"):
         report(front_end, runs, reads)
+    notification_size_bench.main(runs, reads)
 
 
 def report(front_end: str, runs: int, reads: int) -> None:

@@ -43,7 +43,7 @@ from cnc_objects.protocol.errors import AdsReturnCode
 from .binding import refusal_code
 from .kernel.commands import Refusal
 from .kernel.kernel import Kernel
-from .notifications import MAX_PER_CLIENT, MAX_TOTAL, NotificationCounts, NotificationHub
+from .notifications import NotificationCounts, NotificationHub, NotificationLimits
 from .output_service import OutputService
 from .program_service import ProgramStoreService
 
@@ -85,13 +85,14 @@ class Backend:
         loop: asyncio.AbstractEventLoop,
         programs: ProgramStoreService | None = None,
         symbols: SymbolServices | None = None,
-        notification_limits: tuple[int, int] = (MAX_PER_CLIENT, MAX_TOTAL),
+        notification_limits: NotificationLimits | None = None,
         notification_counts: NotificationCounts | None = None,
         outputs: OutputService | None = None,
         structs: PlcStructs | None = None,
     ) -> None:
-        """``notification_limits``: (per client, in total), ``[limits]``
-        notifications_per_client and notifications_total; ``notification_counts``: where
+        """``notification_limits``: what notifications may hold (``[limits]``
+        notifications_per_client, notifications_total, notification_max_bytes,
+        notification_bytes_per_client; their defaults without); ``notification_counts``: where
         the hub keeps its counts (the address space serves them); ``outputs``: the
         output area (the files the kernel writes); ``structs``: the HLI's struct and
         array symbols, by name and by handle (none without)."""
@@ -103,8 +104,8 @@ class Backend:
         self.outputs = outputs
         self.symbols = symbols
         self.hub = NotificationHub(
-            self.read_value, loop, kernel.cycle_ns, lambda: kernel.snapshot,
-            *notification_limits, notification_counts,
+            self.read_value, loop, kernel.cycle_ns, kernel.reading,
+            notification_limits, notification_counts,
         )
 
     # ------------------------------------------------------------ reads

@@ -12,6 +12,10 @@ limit and the figures measured):
   wire (an AMS/TCP frame longer than that closes the connection).
 - ``notifications_per_client`` and ``notifications_total``: AddDeviceNotification beyond
   either is answered 0x716 (no more handles).
+- ``notification_max_bytes`` and ``notification_bytes_per_client``: the length one
+  notification may have, and the lengths of all a client holds summed (what one pass
+  of the notification hub reads for it); AddDeviceNotification beyond either is
+  answered 0x717 (notification size too large) and subscribes nothing.
 - ``send_hwm_messages`` / ``receive_hwm_messages``: ZeroMQ's high-water marks per client:
   replies and notifications queued for a client that does not read them (beyond: the
   reply is dropped, the notification counted as dropped), and requests read from the
@@ -51,6 +55,7 @@ from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.frames import U32_MAX, encode_error
 
 from .kernel.step_clock import STEP_MAX_CYCLES
+from .notifications import MAX_BYTES, MAX_BYTES_PER_CLIENT, NotificationLimits
 from .rate_limit import RateLimiter
 
 #: Room for a request's fields around its data (a Write's header is about 30 bytes).
@@ -81,6 +86,16 @@ class LimitsConfig(BaseModel):
     notifications_total: int = Field(
         20_000, ge=1, le=10_000_000,
         description="notifications all clients of both front ends may hold; more: 0x716",
+    )
+    notification_max_bytes: int = Field(
+        MAX_BYTES, ge=1, le=MAX_DATA_BYTES,
+        description="bytes one notification may carry (its AddDeviceNotification's "
+        "length); longer: 0x717 (notification size too large)",
+    )
+    notification_bytes_per_client: int = Field(
+        MAX_BYTES_PER_CLIENT, ge=1, le=1 << 30,
+        description="bytes all notifications of one client may carry together (their "
+        "lengths summed); one that would take it over: 0x717",
     )
     send_hwm_messages: int = Field(
         10_000, ge=1, le=1_000_000,
@@ -207,6 +222,13 @@ def rate_limiter(limits: LimitsConfig) -> RateLimiter | None:
         return None
     return RateLimiter(limits.requests_per_s_per_client, limits.request_burst,
                        limits.request_mailbox, limits.mailbox_bytes)
+
+
+def notification_limits(limits: LimitsConfig) -> NotificationLimits:
+    """What the notification hub takes from ``limits``."""
+    return NotificationLimits(limits.notifications_per_client, limits.notifications_total,
+                              limits.notification_max_bytes,
+                              limits.notification_bytes_per_client)
 
 
 def frame_hard_cap_bytes(max_frame_bytes: int) -> int:

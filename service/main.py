@@ -57,7 +57,7 @@ from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
 from .kernel.realtime_priority import DEFAULT_RT_PRIORITY, RT_PRIORITY_MAX, serve_below
 from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
-from .limits import rate_limiter
+from .limits import notification_limits, rate_limiter
 from .notifications import NotificationCounts
 from .output_area import OutputArea
 from .output_service import OutputService
@@ -186,7 +186,7 @@ async def serve(
     structs = PlcStructs(space)  # the HLI's structs and arrays over the PLC symbols
     backend = Backend(space, kernel, loop, ProgramStoreService(store),
                       SymbolService(space, structs),
-                      (limits.notifications_per_client, limits.notifications_total), counts,
+                      notification_limits(limits), counts,
                       outputs=OutputService(writer), structs=structs)
     kernel.on_cycle_end = backend.hub.kernel_cycle_end  # one hub serves both front ends
     kernel.next_observed_ns = backend.hub.next_observed_ns  # cycles it must see

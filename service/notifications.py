@@ -16,7 +16,19 @@ The kernel thread only looks at one number per cycle (when the next sample is du
 wakes the event loop when it is; all sampling and sending happens on the loop, in
 slices of at most ``SAMPLE_SLICE_S`` of loop time (``SamplingPass``): with the
 notification limit used up by one client, another client's request waits one slice, not
-a pass over every subscription. Subscriptions of one object read it once per snapshot.
+a pass over every subscription.
+A pass samples one cycle: every slice of it pins the snapshot that was the newest when
+the pass began (``Kernel.reading``: every getter on the loop's thread sees it) and reads
+each address once. A sample's data and timestamp thus come from the same cycle however
+long a read takes and however many cycles the kernel publishes meanwhile; nothing is
+read again. A slice looks at the clock by the bytes it read, not only by the
+subscriptions it took, so a large subscription ends its slice (``SLICE_CHECK_BYTES``).
+
+What one subscription may cost is bounded by ``NotificationLimits`` (``[limits]``): the
+bytes one notification carries (``notification_max_bytes``) and the bytes of all
+notifications one client holds (``notification_bytes_per_client``); beyond either,
+AddDeviceNotification is answered 0x717 (ADSERR_DEVICE_INVALIDWATCHSIZE, TwinCAT's
+"notification size too large") and nothing is subscribed.
 
 One hub serves every front end: a subscription remembers the front end's ``notify``
 function, which turns samples into that front end's frames (msgpack for ZeroMQ, a
@@ -32,7 +44,8 @@ from __future__ import annotations
 import asyncio
 import logging
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from contextlib import AbstractContextManager, contextmanager
+from dataclasses import dataclass, field
 from time import perf_counter
 from typing import Any
 
@@ -54,13 +67,42 @@ NotifyFn = Callable[[Envelope, int, list[list[Any]]], bool]
 
 CYCLIC_MODES = {TransmissionMode.SERVER_CYCLE, TransmissionMode.SERVER_CYCLE2}
 ON_CHANGE_MODES = {TransmissionMode.SERVER_ON_CHANGE, TransmissionMode.SERVER_ON_CHANGE2}
+#: Pins a snapshot (None: the kernel's newest) for the calling thread while the block
+#: lasts (``Kernel.reading``); yields it.
+PinFn = Callable[[Snapshot | None], AbstractContextManager[Snapshot]]
+#: Reads of one sampling pass by (port, group, offset, length).
+_Reads = dict[tuple[int, int, int, int], tuple[int, bytes | str]]
+
 MAX_PER_CLIENT = 1000  # default of [limits] notifications_per_client
 MAX_TOTAL = 20000  # default of [limits] notifications_total
+#: Default of [limits] notification_max_bytes: the largest symbol of the PLC memory
+#: area (gpCh, both channels' HLI structs) may be watched whole.
+MAX_BYTES = 8 << 10
+#: Default of [limits] notification_bytes_per_client: eight times ``MAX_BYTES``, or
+#: 1000 notifications (the per-client count) of 64 bytes each.
+MAX_BYTES_PER_CLIENT = 64 << 10
 #: Loop time one slice of a sampling pass may take before requests go first. Another
-#: client's read waits at most about this long behind the notifications of all clients.
+#: client's read waits at most about this long (plus one read) behind the notifications
+#: of all clients.
 SAMPLE_SLICE_S = 0.0005
 SLICE_CHECK_EVERY = 32  # subscriptions sampled between two looks at the clock
+#: Bytes read between two looks at the clock: a read's cost grows with its length (a
+#: range of the PLC memory area reads every symbol in it), so a few large subscriptions
+#: end a slice as many small ones do.
+SLICE_CHECK_BYTES = 2048
 _NEVER = 1 << 64  # a due time no kernel time reaches
+
+
+@dataclass(frozen=True, slots=True)
+class NotificationLimits:
+    """What the notifications of one client and of all clients may hold (``[limits]``
+    notifications_per_client, notifications_total: 0x716 beyond; notification_max_bytes,
+    notification_bytes_per_client: 0x717 beyond)."""
+
+    per_client: int = MAX_PER_CLIENT
+    total: int = MAX_TOTAL
+    max_bytes: int = MAX_BYTES
+    bytes_per_client: int = MAX_BYTES_PER_CLIENT
 
 
 @dataclass(slots=True)
@@ -93,11 +135,15 @@ class Subscription:
 @dataclass(slots=True)
 class SamplingPass:
     """One pass over the subscriptions, done in slices of loop time: the kernel time it
-    samples for, the subscriptions still to look at, the soonest next due time seen."""
+    samples for, the snapshot every slice reads (the newest when the pass began), the
+    subscriptions still to look at, the soonest next due time seen, and the reads so
+    far by address (every address is read once per pass)."""
 
     now_ns: int
+    snapshot: Snapshot
     todo: Iterator[Subscription]
     soonest_ns: int = 1 << 64  # _NEVER
+    reads: _Reads = field(default_factory=dict)
 
 
 #: Due time of a subscription whose first sample has not gone out yet: the cycle's sampling
@@ -113,13 +159,14 @@ class NotificationHub:
         read: ReadFn,
         loop: asyncio.AbstractEventLoop,
         kernel_cycle_ns: int,
-        current: Callable[[], Snapshot],
-        max_per_client: int = MAX_PER_CLIENT,
-        max_total: int = MAX_TOTAL,
+        pin: PinFn,
+        limits: NotificationLimits | None = None,
         counts: NotificationCounts | None = None,
     ) -> None:
+        """``read`` serves an address on the loop, from the snapshot the kernel shows
+        the calling thread; ``pin`` pins a snapshot for a block (``Kernel.reading``)."""
         self._read = read
-        self._current = current
+        self._pin = pin
         self._loop = loop
         self._kernel_cycle_ns = kernel_cycle_ns
         self._subs: dict[int, Subscription] = {}
@@ -127,21 +174,19 @@ class NotificationHub:
         # routing id or the ADS connection), so that the parts a client adds to its
         # envelope do not make it several clients.
         self._per_client: dict[Any, int] = {}
+        self._bytes_per_client: dict[Any, int] = {}  # their lengths summed, by connection
         # Subscriptions by envelope, with the front end's notify: ``clients`` without a
         # look at every subscription (the ZeroMQ probe asks every 2 s).
         self._envelopes: dict[Envelope, tuple[NotifyFn, int]] = {}
-        self.max_per_client = max_per_client
-        self.max_total = max_total
+        self.limits = limits if limits is not None else NotificationLimits()
         self.counts = counts if counts is not None else NotificationCounts()
         self._next_handle = 1
         self._next_due_ns: int | None = None
         self._scheduled = False
         self._last_snapshot: Snapshot | None = None
         self._pass: SamplingPass | None = None  # the sampling pass in progress
-        self._read_cache: dict[tuple[int, int, int, int], tuple[int, bytes | str]] = {}
-        self._cached_snapshot: Snapshot | None = None  # the snapshot the cache holds
-        self._stamp = 0  # FILETIME of the cached snapshot
-        self._caching = False  # reads are shared: only inside one slice of a pass
+        self._stamp = 0  # FILETIME of the snapshot pinned while sampling
+        self._read_bytes = 0  # bytes the slice under way has read (not shared)
         self.dropped = 0
 
     def __len__(self) -> int:
@@ -164,15 +209,19 @@ class NotificationHub:
                 AdsReturnCode.DEVICE_TRANSMODENOTSUPP,
                 f"transmission mode {mode} is not a server mode (use 3 cyclic or 4 on change)",
             )
+        refused = self._size_refusal(envelope, req.length)
+        if refused is not None:
+            return refused
         code, data = self._read(req.port, req.group, req.offset, req.length)
         if code:
             return code, data  # type: ignore[return-value]
+        limits = self.limits
         mine = self._per_client.get(envelope[0], 0)
-        if mine >= self.max_per_client:
+        if mine >= limits.per_client:
             return (AdsReturnCode.DEVICE_NOMOREHDLS,
                     f"this client holds {mine} notifications, the most one client may "
                     "([limits] notifications_per_client); delete some first")
-        if len(self._subs) >= self.max_total:
+        if len(self._subs) >= limits.total:
             return (AdsReturnCode.DEVICE_NOMOREHDLS,
                     f"the service holds {len(self._subs)} notifications, the most it takes "
                     "([limits] notifications_total); delete some first")
@@ -184,6 +233,8 @@ class NotificationHub:
         )
         self._subs[handle] = sub
         self._per_client[envelope[0]] = mine + 1
+        key = envelope[0]
+        self._bytes_per_client[key] = self._bytes_per_client.get(key, 0) + req.length
         held = self._envelopes.get(envelope)
         self._envelopes[envelope] = (notify, 1 if held is None else held[1] + 1)
         self._count()
@@ -193,13 +244,30 @@ class NotificationHub:
             self._loop.call_soon(self._first_sample, sub)
         return 0, handle
 
+    def _size_refusal(self, envelope: Envelope, length: int) -> tuple[int, str] | None:
+        """0x717 and why, when a notification of ``length`` bytes is more than one may
+        carry or than this client may still hold; None when it fits."""
+        limits = self.limits
+        if length > limits.max_bytes:
+            return (AdsReturnCode.DEVICE_INVALIDWATCHSIZE,
+                    f"a notification of {length} bytes is larger than one may be "
+                    f"({limits.max_bytes} bytes, [limits] notification_max_bytes); "
+                    "subscribe to the parts you need")
+        held = self._bytes_per_client.get(envelope[0], 0)
+        if held + length > limits.bytes_per_client:
+            return (AdsReturnCode.DEVICE_INVALIDWATCHSIZE,
+                    f"this client's notifications hold {held} bytes; {length} more exceed "
+                    f"the {limits.bytes_per_client} one client may hold ([limits] "
+                    "notification_bytes_per_client); delete some first")
+        return None
+
     def delete(self, envelope: Envelope, handle: int) -> tuple[int, str]:
         """End a subscription of this client; 0x714 when it has no such handle."""
         sub = self._subs.get(handle)
         if sub is None or sub.envelope != envelope:
             return AdsReturnCode.DEVICE_NOTIFYHNDINVALID, f"notification handle {handle} is unknown"
         del self._subs[handle]
-        self._forget_one(envelope)
+        self._forget_one(sub)
         self._count()
         self._update_due()
         return 0, ""
@@ -208,10 +276,10 @@ class NotificationHub:
         """Forget every subscription of a client that is gone."""
         if envelope[0] not in self._per_client:
             return
-        gone = [h for h, s in self._subs.items() if s.envelope == envelope]
-        for handle in gone:
-            del self._subs[handle]
-            self._forget_one(envelope)
+        gone = [s for s in self._subs.values() if s.envelope == envelope]
+        for sub in gone:
+            del self._subs[sub.handle]
+            self._forget_one(sub)
         if not gone:
             return
         self._count()
@@ -222,7 +290,8 @@ class NotificationHub:
         """Every client that holds notifications, with the ``notify`` of its front end."""
         return [(envelope, notify) for envelope, (notify, _) in self._envelopes.items()]
 
-    def _forget_one(self, envelope: Envelope) -> None:
+    def _forget_one(self, sub: Subscription) -> None:
+        envelope = sub.envelope
         notify, count = self._envelopes[envelope]
         if count > 1:
             self._envelopes[envelope] = (notify, count - 1)
@@ -232,8 +301,10 @@ class NotificationHub:
         left = self._per_client[key] - 1
         if left:
             self._per_client[key] = left
+            self._bytes_per_client[key] -= sub.length
         else:
             del self._per_client[key]
+            del self._bytes_per_client[key]
 
     def _count(self) -> None:
         self.counts.total = len(self._subs)
@@ -260,7 +331,8 @@ class NotificationHub:
     def _first_sample(self, sub: Subscription) -> None:
         if sub.handle not in self._subs:
             return
-        sample = self._take(sub, force=True)
+        with self._pinned(None) as now_ns:
+            sample = self._take(sub, now_ns, None, force=True)
         assert sample is not None  # forced: a sample whether or not the value changed
         self._emit({(sub.envelope, sub.port): (sub.notify, [sample])})
         # Only this subscription's due time changed: no need to look at all of them (with
@@ -277,37 +349,41 @@ class NotificationHub:
         if snapshot is None:
             self._scheduled = False
             return
-        self._pass = SamplingPass(snapshot.time_ns, iter(list(self._subs.values())))
+        with self._pin(None) as newest:  # the cycle due, or one published since
+            self._pass = SamplingPass(snapshot.time_ns, newest,
+                                      iter(list(self._subs.values())))
         self._continue_pass()
 
     def _continue_pass(self) -> None:
         """Sample for at most ``SAMPLE_SLICE_S`` of loop time, send what was taken, and
         come back after the loop has served what waits (requests of other clients go
-        between two slices, however many subscriptions there are)."""
+        between two slices, however many subscriptions there are). Every slice reads
+        the pass's snapshot: the pass samples one cycle, and reads each address once."""
         run = self._pass
         assert run is not None
-        subs, take, now_ns = self._subs, self._take, run.now_ns
+        subs, take, due_ns, reads = self._subs, self._take, run.now_ns, run.reads
         batches: dict[tuple[Envelope, int], tuple[NotifyFn, list[list[Any]]]] = {}
         soonest_ns = run.soonest_ns
         deadline_s = perf_counter() + SAMPLE_SLICE_S
         finished = True
-        self._read_cache.clear()  # values served by the loop may have changed meanwhile
-        self._caching = True
-        for k, sub in enumerate(run.todo, 1):
-            if subs.get(sub.handle) is not sub:
-                continue  # deleted since the pass began
-            if sub.next_due_ns <= now_ns:
-                sample = take(sub, force=False)
-                if sample is not None:
-                    batches.setdefault((sub.envelope, sub.port), (sub.notify, []))[1].append(
-                        sample)
-            if sub.next_due_ns < soonest_ns:
-                soonest_ns = sub.next_due_ns
-            if not k % SLICE_CHECK_EVERY and perf_counter() > deadline_s:
-                finished = False
-                break
-        self._caching = False
-        self._read_cache.clear()
+        self._read_bytes = 0  # read since the last look at the clock
+        with self._pinned(run.snapshot) as now_ns:
+            for k, sub in enumerate(run.todo, 1):
+                if subs.get(sub.handle) is not sub:
+                    continue  # deleted since the pass began
+                if sub.next_due_ns <= due_ns:
+                    sample = take(sub, now_ns, reads, force=False)
+                    if sample is not None:
+                        batches.setdefault((sub.envelope, sub.port), (sub.notify, []))[
+                            1].append(sample)
+                if sub.next_due_ns < soonest_ns:
+                    soonest_ns = sub.next_due_ns
+                if k % SLICE_CHECK_EVERY and self._read_bytes < SLICE_CHECK_BYTES:
+                    continue
+                self._read_bytes = 0
+                if perf_counter() > deadline_s:
+                    finished = False
+                    break
         run.soonest_ns = soonest_ns
         self._emit(batches)
         if not finished:
@@ -317,10 +393,21 @@ class NotificationHub:
         self._next_due_ns = None if soonest_ns == _NEVER else soonest_ns
         self._scheduled = False  # the next kernel cycle that is due starts the next pass
 
-    def _take(self, sub: Subscription, force: bool) -> list[Any] | None:
-        """Read one subscription; a sample list or None when on-change saw no change."""
-        snapshot, code, data = self._read_current(sub.port, sub.group, sub.offset, sub.length)
-        now_ns = snapshot.time_ns
+    @contextmanager
+    def _pinned(self, snapshot: Snapshot | None) -> Iterator[int]:
+        """Pin ``snapshot`` (None: the kernel's newest) while the block lasts, so that
+        every read in it comes from that cycle, and set ``_stamp`` to its FILETIME;
+        yields its kernel time."""
+        with self._pin(snapshot) as pinned:
+            self._stamp = filetime_from_unix_ns(pinned.wall_ns)
+            yield pinned.time_ns
+
+    def _take(self, sub: Subscription, now_ns: int, reads: _Reads | None,
+              force: bool) -> list[Any] | None:
+        """Read one subscription in the pinned snapshot of kernel time ``now_ns`` (once
+        per address in ``reads``, when given); a sample list or None when on-change saw
+        no change."""
+        code, data = self._read_shared(reads, sub.port, sub.group, sub.offset, sub.length)
         # Next due time on the subscription's own grid, never in the past.
         sub.next_due_ns = now_ns - now_ns % sub.cycle_ns + sub.cycle_ns
         if code:
@@ -331,39 +418,20 @@ class NotificationHub:
         sub.sequence += 1
         return [sub.handle, sub.sequence, self._stamp, data]
 
-    def _read_current(self, port: int, group: int, offset: int,
-                      length: int) -> tuple[Snapshot, int, bytes | str]:
-        """(snapshot, code, data) of an address in the newest snapshot. Within one slice
-        of a sampling pass (nothing else runs on the loop meanwhile) the subscriptions of
-        one object share one read per snapshot: a client may open thousands on the same
-        object. The snapshot's FILETIME is computed once (``_stamp``)."""
-        current = self._current
-        snapshot = current()
-        cache = self._read_cache
-        if snapshot is not self._cached_snapshot:
-            cache.clear()
-            self._cached_snapshot = snapshot
-            self._stamp = filetime_from_unix_ns(snapshot.wall_ns)
+    def _read_shared(self, reads: _Reads | None, port: int, group: int, offset: int,
+                     length: int) -> tuple[int, bytes | str]:
+        """(code, data) of an address in the pinned snapshot, read once per pass: the
+        subscriptions of one object share one read (a client may open thousands on
+        the same object). Values outside the snapshot (counts, alarms) are as the
+        pass's first read found them: the next pass reads them again."""
+        if reads is None:
+            return self._read(port, group, offset, length)
         key = (port, group, offset, length)
-        if self._caching:
-            hit = cache.get(key)
-            if hit is not None:
-                return snapshot, hit[0], hit[1]
-        # The read serves whatever snapshot is newest. The stamp must be that snapshot's,
-        # so read again in the rare case the kernel published one meanwhile (the cycle
-        # thread may take the GIL between any two lines here).
-        while True:
-            code, data = self._read(port, group, offset, length)
-            now = current()
-            if now is snapshot:
-                break
-            snapshot = now
-            cache.clear()
-            self._cached_snapshot = snapshot
-            self._stamp = filetime_from_unix_ns(snapshot.wall_ns)
-        if self._caching:
-            cache[key] = (code, data)
-        return snapshot, code, data
+        hit = reads.get(key)
+        if hit is None:
+            hit = reads[key] = self._read(port, group, offset, length)
+            self._read_bytes += length
+        return hit
 
     def _emit(self, batches: dict[tuple[Envelope, int], tuple[NotifyFn, list[list[Any]]]]) -> None:
         """One frame per client and port with all its samples of this cycle."""

@@ -3,7 +3,9 @@
 Every cycle: apply the queued commands (in arrival order), run the cycle's work, update
 the statistics, publish a snapshot, call the ``on_cycle_end`` hook. The service talks to
 the kernel only through ``submit`` (commands in) and ``snapshot`` (state out); nothing
-here knows about sockets, frames or addresses.
+here knows about sockets, frames or addresses. A reader that must see one cycle across
+many reads (a notification pass: each sample's data and timestamp from the same cycle)
+pins the snapshot on its thread with ``reading``.
 """
 
 from __future__ import annotations
@@ -13,7 +15,8 @@ import queue
 import threading
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from enum import Enum
 
@@ -75,6 +78,12 @@ class _Shutdown:
 _SHUTDOWN = _Shutdown()
 
 
+class _Pin(threading.local):
+    """The snapshot one thread has pinned (``Kernel.reading``); None: it reads the newest."""
+
+    snapshot: Snapshot | None = None
+
+
 def _no_answer(_result: Refusal | None) -> None:
     """The ``done`` of the shutdown entry: nobody waits for it."""
 
@@ -127,7 +136,10 @@ class Kernel:
         self.lateness: LatenessHistogram | None = clock.lateness
         # what the realtime clock's cycle thread was granted (SCHED_FIFO, locked memory)
         self.realtime_grant: RealtimeGrant | None = getattr(clock, "grant", None)
-        self.snapshot: Snapshot = self.state.snapshot(0, 0, time.time_ns(), self.stats)
+        # the newest published snapshot; readers go through ``snapshot`` (a pin may hold
+        # an older one for a thread); the cycle thread reads and writes this one only
+        self._latest: Snapshot = self.state.snapshot(0, 0, time.time_ns(), self.stats)
+        self._pin = _Pin()
         self.on_cycle_end: Callable[[Snapshot], None] | None = None
         # when ``on_cycle_end`` is set: the kernel time (ns) of the next cycle it must
         # see (None: none is due). Without it the hook sees every cycle and no cycles
@@ -179,6 +191,31 @@ class Kernel:
     def running(self) -> bool:
         """True while cycles run (ADS state RUN)."""
         return self.stats.running
+
+    @property
+    def snapshot(self) -> Snapshot:
+        """The state as readers see it: the last published cycle, or the one this thread
+        pinned with ``reading``."""
+        pinned = self._pin.snapshot
+        return self._latest if pinned is None else pinned
+
+    @contextmanager
+    def reading(self, snapshot: Snapshot | None = None) -> Iterator[Snapshot]:
+        """Pin ``snapshot`` (None: the newest published one) for the calling thread until
+        the block ends: every read of ``snapshot`` on this thread (every object's getter)
+        sees that cycle, however many cycles the kernel publishes meanwhile; other
+        threads are not affected. Yields the pinned snapshot. A nested block keeps the
+        outer pin."""
+        pin = self._pin
+        held = pin.snapshot
+        if held is not None:
+            yield held
+            return
+        pinned = pin.snapshot = self._latest if snapshot is None else snapshot
+        try:
+            yield pinned
+        finally:
+            pin.snapshot = None
 
     def channel_index(self, channel_id: int) -> int:
         """Position of the channel with logical id ``channel_id`` in the state."""
@@ -447,7 +484,7 @@ class Kernel:
         notifications) are as without the wait, so runs stay the same cycle by cycle."""
         if self._applied_snapshot is None:
             return
-        self.snapshot, self._applied_snapshot = self._applied_snapshot, None
+        self._latest, self._applied_snapshot = self._applied_snapshot, None
         held, self._held = self._held, []
         for done, result in held:
             done(result)
@@ -460,16 +497,16 @@ class Kernel:
         # which notifications carry as their timestamp (kernel time is not wall time
         # under the virtual clock, nor under load).
         return self.state.snapshot(
-            cycle, cycle * self.cycle_ns, time.time_ns(), self.stats, self.snapshot,
+            cycle, cycle * self.cycle_ns, time.time_ns(), self.stats, self._latest,
             self._changed,
         )
 
     def _publish(self) -> None:
-        self.snapshot = self._snapshot()
+        self._latest = snapshot = self._snapshot()
         self._changed = None
         hook = self.on_cycle_end
         if hook is not None:
-            hook(self.snapshot)
+            hook(snapshot)
 
     def _work(self, applied_commands: bool) -> None:
         """The cycle's work: every channel's path, then the drives follow their axes.
