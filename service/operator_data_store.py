@@ -190,7 +190,11 @@ class OperatorDataStore:
         return []
 
     def start(self) -> None:
-        """Start the writer thread."""
+        """Start the writer thread (the file's directory is made when absent)."""
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:  # each write says so again (throttled); the service runs
+            log.error("operator data: cannot make %s (%s)", self.path.parent, exc.strerror)
         self._thread = threading.Thread(target=self._run, name="operator-data-writer",
                                         daemon=True)
         self._thread.start()
