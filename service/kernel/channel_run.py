@@ -712,6 +712,10 @@ class ChannelRunner:
             self._contour.stop()
             show_contour_state(ch, self._contour)
         self._move(ChannelEvent.FAIL)
+        # the program is aborted (ISG reaction class 2): what it output waits for
+        # nobody, and the spindle stops as the path did (docs/manual.md)
+        self.plc.reset()
+        ch.plc_functions = self.plc.unit
         ch.waiting_for_start = False
         self._ended(run, f"ERROR {error.id}")
 
