@@ -26,8 +26,9 @@ RPM = 1200.0
 
 def _config(no_stop: bool = False) -> Any:
     channels = [dict(c) for c in DEFAULT_MACHINE["channels"]]
-    channels[0]["techno"] = {"m_synch": KINDS, "auto_acknowledge": False,
-                             "spindel": {"no_stop_by_channel_reset": no_stop}}
+    channels[0]["techno"] = {"m_synch": KINDS, "auto_acknowledge": False}
+    if no_stop:
+        channels[0]["techno"]["spindel"] = {"no_stop_by_channel_reset": True}
     return build_config({"channels": channels})
 
 
