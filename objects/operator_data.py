@@ -78,20 +78,29 @@ def group_name(group: int) -> str:
 
 
 def dumps(data: OperatorData) -> str:
-    """The document as indented JSON text (ends with a newline)."""
-    channels: list[dict[str, Any]] = []
+    """The document as JSON text, one tool row or offset group a line (ends with a
+    newline); ``loads`` reads it back."""
+    channels = []
     for ch in data.channels:
-        entry: dict[str, Any] = {"channel": ch.channel}
+        sections = [f'   "channel": {ch.channel}']
         if ch.tools is not None:
-            entry["tools"] = [{"wz": r.wz, "valid": r.valid, "radius_mm": r.radius_mm,
-                               "length_mm": r.length_mm} for r in ch.tools]
+            rows = [json.dumps({"wz": r.wz, "valid": r.valid, "radius_mm": r.radius_mm,
+                                "length_mm": r.length_mm}) for r in ch.tools]
+            sections.append(_section("tools", rows))
         if ch.zero_offsets is not None:
-            entry["zero_offsets"] = [{"np_grp": g.np_grp, "name": group_name(g.np_grp),
-                                      "offsets_mm": dict(g.offsets_mm)}
-                                     for g in ch.zero_offsets]
-        channels.append(entry)
-    document = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "channels": channels}
-    return json.dumps(document, indent=1) + "\n"
+            groups = [json.dumps({"np_grp": g.np_grp, "name": group_name(g.np_grp),
+                                  "offsets_mm": dict(g.offsets_mm)})
+                      for g in ch.zero_offsets]
+            sections.append(_section("zero_offsets", groups))
+        channels.append("  {\n" + ",\n".join(sections) + "\n  }")
+    return (f'{{\n "format": {json.dumps(FORMAT_NAME)},\n "version": {FORMAT_VERSION},\n'
+            ' "channels": [\n' + ",\n".join(channels) + "\n ]\n}\n")
+
+
+def _section(key: str, items: list[str]) -> str:
+    if not items:
+        return f'   "{key}": []'
+    return f'   "{key}": [\n' + ",\n".join(f"    {item}" for item in items) + "\n   ]"
 
 
 def loads(text: str) -> OperatorData:
