@@ -5,7 +5,8 @@
 The entry module: the global options and ``main``. The commands live in ``cli_objects``
 (info, browse, read, write, watch), ``cli_machine`` (program store, run, MDI, hold,
 resume, reset, status, lookahead, check), ``cli_plot`` (plot), ``cli_keys`` (keys new) and
-``cli_tools`` (tool, offsets), ``cli_step`` (step), ``cli_alarms`` (alarms);
+``cli_tools`` (tool, offsets), ``cli_tools_files`` (their export/import), ``cli_step``
+(step), ``cli_alarms`` (alarms);
 what they share is in ``cli_app``. Importing them here registers them on the app, in this order.
 
 A service started with ``--keys`` needs this client's key (``--key FILE`` or
@@ -40,6 +41,7 @@ from . import (
     cli_spindle,  # noqa: F401  (spindle)
     cli_step,  # noqa: F401  (step: the step clock)
     cli_tools,  # noqa: F401  (tool, offsets)
+    cli_tools_files,  # noqa: F401  (tool export/import, offsets export/import)
     cli_web_users,  # noqa: F401  (web-users set, remove, list)
 )
 from .cli_app import Settings, app, use_usage_command

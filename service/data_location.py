@@ -21,6 +21,9 @@ own, never the store: ``--output-dir DIR``, else ``output_dir`` of the configura
 ``<store>-output`` beside a store given by itself (``--program-dir /data/progs`` writes
 to ``/data/progs-output``). ``output_area_location`` refuses one that is the store, or
 inside it, or contains it.
+
+The operator data (tool list, zero offsets: ``operator_data_location``) is a file in the
+data directory, or beside a store given by itself.
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ DEFAULT_DATA_DIR = Path("cnc-data")
 PROGRAMS_SUBDIR = "programs"
 OUTPUT_SUBDIR = "output"
 OUTPUT_SUFFIX = "-output"
+OPERATOR_DATA_NAME = "operator-data.json"  # tool list and zero offsets (operator_data_store)
 
 
 @dataclass(frozen=True, slots=True)
@@ -95,6 +99,28 @@ def output_area_location(
         raise ValueError(f"the output area {out} ({found.source}) must not be the program "
                          f"store {programs}, nor inside it, nor contain it")
     return found
+
+
+def operator_data_location(
+    data_dir: Path | None,
+    config_data_dir: str | None,
+    store: StoreLocation,
+    cwd: Path | None = None,
+) -> StoreLocation:
+    """The file that keeps the tool list and zero offsets across restarts:
+    ``operator-data.json`` in the data directory (``--data-dir``, else ``data_dir`` of the
+    configuration, else the one the store is ``programs/`` of), else beside a store given
+    by itself (``/data/progs`` keeps ``/data/progs-operator-data.json``)."""
+    base = cwd if cwd is not None else Path.cwd()
+    if data_dir is not None:
+        return StoreLocation(_absolute(base, data_dir) / OPERATOR_DATA_NAME, "--data-dir")
+    if config_data_dir:
+        return StoreLocation(_absolute(base, Path(config_data_dir)) / OPERATOR_DATA_NAME,
+                             "data_dir of the configuration")
+    if store.data_dir is not None:
+        return StoreLocation(store.data_dir / OPERATOR_DATA_NAME, "in the data directory")
+    return StoreLocation(store.path.with_name(f"{store.path.name}-{OPERATOR_DATA_NAME}"),
+                         "beside the program store")
 
 
 def _absolute(base: Path, path: Path) -> Path:

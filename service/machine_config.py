@@ -256,6 +256,9 @@ class SpindleConfig(Strict):
     m4_synch: str = Field("MVS_SVS", description="P-CHAN-00047 spindel[0].m4_synch")
     m5_synch: str = Field("MVS_SVS", description="P-CHAN-00049 spindel[0].m5_synch")
     m19_synch: str = Field("MNS_SNS", description="P-CHAN-00043 spindel[0].m19_synch")
+    no_stop_by_channel_reset: bool = Field(
+        False, description="P-AXIS-00455 kenngr.no_stop_by_channel_reset: the spindle keeps "
+        "turning at a channel RESET (and in ERROR); by default it brakes to a stop")
 
     @field_validator("s_synch", "m3_synch", "m4_synch", "m5_synch", "m19_synch")
     @classmethod

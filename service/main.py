@@ -50,15 +50,23 @@ from .ads_symbols import SymbolService
 from .backend import Backend
 from .binding import build_address_space
 from .config import ConfigError, ServiceConfig, load_config
-from .data_location import StoreLocation, output_area_location, program_store_location
+from .data_location import (
+    OPERATOR_DATA_NAME,
+    StoreLocation,
+    operator_data_location,
+    output_area_location,
+    program_store_location,
+)
 from .frontend_config import parse_ads_endpoint
 from .kernel.alarms import AlarmLog
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
 from .kernel.realtime_priority import DEFAULT_RT_PRIORITY, RT_PRIORITY_MAX, serve_below
+from .kernel.state import Snapshot
 from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
 from .limits import notification_limits, rate_limiter
 from .notifications import NotificationCounts
+from .operator_data_store import OperatorDataStore
 from .output_area import OutputArea
 from .output_service import OutputService
 from .output_writer import OutputLimits, OutputWriter
@@ -148,11 +156,12 @@ class AdsListen:
 async def serve(
     config: ServiceConfig, endpoint: str, clock_kind: ClockKind, speed: float | None,
     store: ProgramStore, ads: AdsListen | None = None, curve: ServerCurve | None = None,
-    outputs: OutputArea | None = None,
+    outputs: OutputArea | None = None, operator_data: Path | None = None,
 ) -> int:
     """Run kernel and both front ends until SIGINT or SIGTERM (ADS when ``ads`` is given;
     ZeroMQ with CURVE when ``curve`` is given). The files the kernel writes go to
-    ``outputs`` (default: ``<store>-output`` beside the store)."""
+    ``outputs`` (default: ``<store>-output`` beside the store); the tool list and zero
+    offsets are kept in ``operator_data`` (default: beside the store)."""
     loop = asyncio.get_running_loop()
     # The cycle thread must get the GIL soon after it wakes, even while the server is busy.
     switch_s = min(0.005, config.cycle_ms / 1000.0 / 4)
@@ -176,10 +185,14 @@ async def serve(
         limits.output_queue_max_bytes))
     clock = make_clock(clock_kind, config.cycle_ms / 1000.0, speed, limits.step_max_cycles,
                        config.rt_priority)
+    if operator_data is None:
+        operator_data = store.root.with_name(f"{store.root.name}-{OPERATOR_DATA_NAME}")
+    kept = OperatorDataStore(operator_data, config.machine)
+    alarms = AlarmLog(limits.alarm_history_max, limits.alarm_active_max)
     kernel = Kernel(
         config.machine, clock, load, exists,
         writer.kernel_file, writer.save, check_max_errors=config.limits.check_max_errors,
-        alarms=AlarmLog(limits.alarm_history_max, limits.alarm_active_max),
+        alarms=alarms, tables=kept.load(alarms),
     )
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows
     space = build_address_space(kernel, counts)
@@ -188,7 +201,8 @@ async def serve(
                       SymbolService(space, structs),
                       notification_limits(limits), counts,
                       outputs=OutputService(writer), structs=structs)
-    kernel.on_cycle_end = backend.hub.kernel_cycle_end  # one hub serves both front ends
+    kernel.on_cycle_end = _both(backend.hub.kernel_cycle_end,  # one hub serves both front ends
+                                kept.observe)  # the tables, written by a thread of its own
     kernel.next_observed_ns = backend.hub.next_observed_ns  # cycles it must see
     try:
         server = ZmqServer(backend, endpoint, curve=curve, limits=limits)
@@ -210,6 +224,7 @@ async def serve(
     # as long as the service: out of the collector's way. A full collection over it held
     # the GIL for 20-40 ms under load, and the cycle waited (make bench, part jitter).
     gc.freeze()
+    kept.start()
     kernel.start()
     server.start()
     if ads_server is not None:
@@ -239,8 +254,19 @@ async def serve(
         writer.refuse_new()  # a program in a write loop stops now, its cycle with it
         kernel.close(KERNEL_STOP_S)
         writer.close(WRITER_STOP_S)  # what was queued before is written
+        kept.close(WRITER_STOP_S)  # the tables as the kernel left them are written
     log.info("stopped")
     return 0
+
+
+def _both(first: Callable[[Snapshot], None], second: Callable[[Snapshot], None]
+          ) -> Callable[[Snapshot], None]:
+    """One cycle hook that calls ``first``, then ``second``."""
+    def hook(snapshot: Snapshot) -> None:
+        first(snapshot)
+        second(snapshot)
+
+    return hook
 
 
 async def _start_ads(
@@ -352,8 +378,10 @@ def run(
     listen = _ads_listen(config, ads, ams_net_id, curve is not None, insecure)
     store = _open_store(location, config)
     outputs = _open_outputs(output_dir, config, location)
+    kept = operator_data_location(data_dir, config.data_dir, location)
+    log.info("operator data file: %s (%s)", kept.path, kept.source)
     raise typer.Exit(asyncio.run(
-        serve(config, endpoint, clock, speed, store, listen, curve, outputs)))
+        serve(config, endpoint, clock, speed, store, listen, curve, outputs, kept.path)))
 
 
 def _server_curve(config: ServiceConfig, keys: Path | None) -> ServerCurve | None:

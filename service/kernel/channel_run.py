@@ -46,6 +46,7 @@ from .manual_mode import ManualMode
 from .nc import ModalState
 from .nc.blocks import LogArea, LookAheadMark, ManualModeRequest
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
+from .nc.tool_data import ToolingTables
 from .path.executor import AxisDynamics, PathExecutor
 from .path.section_plan import plan_section
 from .plc_functions import PlcFunctions, show_technology
@@ -104,6 +105,7 @@ class ChannelRunner:
         check_max_errors: int = CHECK_MAX_ERRORS,
         on_wait: Callable[[], None] = lambda: None,
         alarms: AlarmLog | None = None,
+        tables: ToolingTables | None = None,
     ) -> None:
         """``params`` are the kernel's effective axis parameters (read at each program
         start, so a parameter update applies from the next run); ``switchover`` links
@@ -113,7 +115,9 @@ class ChannelRunner:
         rest are counted only; ``on_wait``: called while a cycle waits for the decoder or
         the check (virtual clock), so that the kernel answers the cycle's commands
         meanwhile; ``alarms``: the kernel's alarm log, which every listed error and
-        warning is raised in (a log of its own when not given)."""
+        warning is raised in (a log of its own when not given); ``tables``: the tool list
+        and zero offsets to start with (the operator data the service kept), else the
+        configured ones."""
         self._on_wait = on_wait
         self.alarms = AlarmLog() if alarms is None else alarms
         self.channel = channel
@@ -127,7 +131,7 @@ class ChannelRunner:
         self._axes = tuple(a.name for a in config.axes)
         self._axis_numbers = tuple(a.logical_number for a in config.axes)
         # the tool list and zero offsets the decoders read and the objects write
-        self.tables = tables_from_config(machine)
+        self.tables = tables_from_config(machine) if tables is None else tables
         channel.tooling = initial_tooling(self.tables, len(config.axes))
         self._tools = self.tables.tools  # the radii, for decoders without modal tables
         self._params = params
@@ -708,6 +712,10 @@ class ChannelRunner:
             self._contour.stop()
             show_contour_state(ch, self._contour)
         self._move(ChannelEvent.FAIL)
+        # the program is aborted (ISG reaction class 2): what it output waits for
+        # nobody, and the spindle stops as the path did (docs/manual.md)
+        self.plc.reset()
+        ch.plc_functions = self.plc.unit
         ch.waiting_for_start = False
         self._ended(run, f"ERROR {error.id}")
 

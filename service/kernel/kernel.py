@@ -15,7 +15,7 @@ import queue
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from enum import Enum
@@ -26,6 +26,7 @@ from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
 from .commands import Command, Refusal, RefusalReason, ResetChannel
+from .nc.tool_data import ToolingTables
 from .realtime_priority import RealtimeGrant
 from .state import CycleStats, ErrorEntry, KernelState, Snapshot
 from .step_clock import NOT_STEPPING, STEP_RUNNING, StepClock, StepCycles
@@ -107,6 +108,7 @@ class Kernel:
         save: Callable[[str, bytes, bool], None] = lambda name, data, replace: None,
         check_max_errors: int = CHECK_MAX_ERRORS,
         alarms: AlarmLog | None = None,
+        tables: Sequence[ToolingTables | None] = (),
     ) -> None:
         """``loader(name)`` returns a program's text (KeyError when absent) and
         ``exists(name)`` says whether it is there: the program store, seen by the kernel,
@@ -117,7 +119,10 @@ class Kernel:
         ``nc.technology.OutputLimitReached``; neither blocks. ``check_max_errors``:
         errors one syntax check keeps ([limits] check_max_errors). ``alarms``: the log
         every channel raises its errors and warnings in (one with the default bounds
-        when not given); it outlives a kernel RESET."""
+        when not given); it outlives a kernel RESET. ``tables``: each channel's tool
+        list and zero offsets at start (the operator data the service kept; None or
+        absent: the configured ones); a kernel RESET keeps the tables it has then."""
+        self._tables: list[ToolingTables | None] = list(tables)
         self._check_max_errors = check_max_errors
         self.alarms = AlarmLog() if alarms is None else alarms
         self.config = config
@@ -174,8 +179,10 @@ class Kernel:
                           deterministic, self._files, params=params, switchover=self.switchover,
                           save=self._save,
                           check_max_errors=self._check_max_errors,
-                          on_wait=self._reply_while_waiting, alarms=self.alarms)
-            for channel, cfg in zip(state.channels, self.config.channels, strict=True)
+                          on_wait=self._reply_while_waiting, alarms=self.alarms,
+                          tables=self._tables[k] if k < len(self._tables) else None)
+            for k, (channel, cfg) in enumerate(zip(state.channels, self.config.channels,
+                                                   strict=True))
         ]
         for message in messages:
             state.runners[message.channel_index].report(
@@ -457,6 +464,11 @@ class Kernel:
             case Control.RESET:
                 for runner in self.state.runners:
                     runner.reset()
+                # operator data outlives a restart, as ISG's tool and zero point lists do:
+                # new holders (the old decoders may still hold theirs) of the same tables
+                self._tables = [ToolingTables(r.tables.tools, r.tables.zero_offsets,
+                                              r.tables.tool_change_time_s)
+                                for r in self.state.runners]
                 self.alarms.restart()  # the start-up messages are raised again
                 self.state = self._initial_state()
                 self.stats.running = True

@@ -219,7 +219,10 @@ class PlcFunctions:
         return not any(u.pending for u in self.unit.units)
 
     def reset(self) -> None:
-        """RESET: pending functions are dropped (as acknowledged)."""
+        """RESET or ERROR of the channel: pending functions are dropped (as
+        acknowledged: nothing waits for them any more) and the spindle brakes to a stop
+        (``Spindle.stop``)."""
+        self.spindle.stop()
         self.unit = PlcFunctionsUnit(
             tuple(replace(u, acknowledged=True) for u in self.unit.units),
             self.unit.output_count)

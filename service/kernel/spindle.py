@@ -80,6 +80,15 @@ class Spindle:
             break
         self._set(mode, programmed, st.override)
 
+    def stop(self) -> None:
+        """RESET or ERROR of the channel: M05, braking with the spindle's ramp (ISG
+        P-AXIS-00455: a spindle turning by M3, M4 or M19 is stopped at a channel reset,
+        unless ``no_stop_by_channel_reset`` is set). S stays stored."""
+        st = self.state
+        if self.config.no_stop_by_channel_reset or st.mode == SpindleMode.M05:
+            return
+        self._set(SpindleMode.M05, st.programmed_rpm, st.override)
+
     def set_override(self, override: int) -> str | None:
         """Spindle override in 0.1 %; why not, or None."""
         if not 0 <= override <= OVERRIDE_MAX:
