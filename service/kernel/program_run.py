@@ -40,6 +40,7 @@ from .nc.blocks import (
     StopKind,
 )
 from .nc.contour import LOOP_MARKERS
+from .operator_switches import with_optional_stop
 from .path.errors import PathErrorId
 from .path.executor import PathError, PathExecutor
 from .path.interpolator import StepResult, Waiting
@@ -225,6 +226,7 @@ class ProgramRun:
                 self._show_contour_state()
         # the buffer is full and more blocks wait: does its end hold the speed down?
         full = not (self._buffer_warned or self._fed_all) and executor.free_slots() == 0
+        executor.set_rapid_override(ch.rapid_override_per_mille / 1000.0)
         step = executor.step(override)
         if full and executor.buffer_limits_speed():
             self._warn_buffer_limits()
@@ -279,6 +281,11 @@ class ProgramRun:
         for axis, pos in zip(ch.axes, positions, strict=True):
             axis.position_mm = pos
             axis.command_position_incr = round(pos * _INCR_PER_MM)
+        motion = step.current.motion if step.current is not None else None
+        ends = () if motion is None else motion.end_mm
+        for k, axis in enumerate(ch.axes):  # distance to go: to the block's end point
+            axis.distance_to_go_incr = round(
+                (ends[k] - step.position_mm[k]) * _INCR_PER_MM) if k < len(ends) else 0
         ch.path_velocity_mm_s = step.path_velocity_mm_s
         ch.programmed_velocity_mm_s = step.programmed_velocity_mm_s
         ch.remaining_in_block_mm = step.remaining_in_block_mm
@@ -292,6 +299,7 @@ class ProgramRun:
         ch, executor = self.channel, self.executor
         if (not self._skips_cycles or self._sync is not None or self._contour_changed
                 or self._pending_error is not None or executor.single_block != ch.single_block
+                or executor.rapid_override != ch.rapid_override_per_mille / 1000.0
                 or not (self._fed_all or executor.free_slots() == 0)):
             return 0
         # as ``_motion_cycle``: with the buffer full, a cycle that leaves the path held
@@ -375,6 +383,7 @@ class ProgramRun:
                     self._sync = item
                 return
             if isinstance(item, Block):
+                item = with_optional_stop(item, self.channel)  # M1 and its switch
                 if contour is not None:
                     contour.expect(item)
                 plc = self._technology()

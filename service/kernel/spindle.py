@@ -14,18 +14,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 
+from cnc_objects.protocol.values import SpindleMode
+
 from ..machine_config import SpindleConfig
 
+__all__ = [  # SpindleMode is the value set of protocol.values, used here
+    "DEG_S2_PER_RPM_S", "OVERRIDE_MAX", "SPINDLE_M_FUNCTIONS", "Spindle", "SpindleM",
+    "SpindleMode", "SpindleState",
+]
+
 DEG_S2_PER_RPM_S = 6.0  # 1 rpm/s = 360 degrees / 60 s per s
-
-
-class SpindleMode(IntEnum):
-    """``gpAx[..]^.ipo_state.spindle.mode_r`` (ISG)."""
-
-    M05 = 1  # stopped
-    M03 = 2  # clockwise
-    M04 = 4  # counter-clockwise
-    M19 = 8  # positioning
 
 
 class SpindleM(IntEnum):
