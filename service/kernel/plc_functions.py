@@ -165,14 +165,15 @@ class PlcFunctions:
         self._extra.discard(id(block))
         functions = self._functions(block)
         if functions:
-            self._output(functions, now_s)
+            self._output(functions, now_s, block.spindle_pos_deg)
         return extra
 
-    def _output(self, functions: list[tuple[TechnoType, int]], now_s: float) -> None:
+    def _output(self, functions: list[tuple[TechnoType, int]], now_s: float,
+                spindle_pos_deg: float | None = None) -> None:
         spindle_m = [n for t, n in functions if t == TechnoType.M and n in SPINDLE_M_FUNCTIONS]
         speed = next((n for t, n in functions if t == TechnoType.S), None)
         if spindle_m or speed is not None:
-            self.spindle.command(spindle_m, speed)
+            self.spindle.command(spindle_m, speed, spindle_pos_deg)
             kinds = [self.kind(TechnoType.M, n) for n in spindle_m]
             if speed is not None:
                 kinds.append(self.kind(TechnoType.S, speed))

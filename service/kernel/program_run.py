@@ -48,6 +48,7 @@ from .path.segments import Segment
 from .plc_functions import PlcFunctions
 from .prod_time_trace import ProdTimeTrace, trace_file_name
 from .state import BLOCK_START_COLUMN, Channel, ErrorEntry
+from .tool_life import count_cutting
 from .wait_reason import WaitReason, manual_open, path_wait_reason
 
 _NOT_WAITING, _OVERRIDE_ZERO = int(WaitReason.NONE), int(WaitReason.OVERRIDE_ZERO)
@@ -232,6 +233,7 @@ class ProgramRun:
             self._warn_buffer_limits()
         if output:
             self._output(step)
+            count_cutting(ch, step.current, 1)  # tool life (a dry run cuts nothing)
         ch.program_time_s = time_s - self.started_at_s
         self._stepped(step)
         for block in step.finished:
@@ -310,7 +312,9 @@ class ProgramRun:
     def cruise(self, cycles: int, time_s: float) -> None:
         """Run ``cycles`` cycles that ``cruise_budget`` allowed at once, the last at
         kernel time ``time_s``: the channel shows what stepping them one by one shows."""
-        self._output(self.executor.cruise(cycles))
+        step = self.executor.cruise(cycles)
+        self._output(step)
+        count_cutting(self.channel, step.current, cycles)
         self.channel.program_time_s = time_s - self.started_at_s
 
     def _technology(self) -> PlcFunctions | None:

@@ -217,6 +217,8 @@ class Channel:
     block_ignore_active: int = 0  # the mask the running program was started with
     m01_stop_enable: bool = False  # M1 stops only while TRUE (mc_command_M01_stop_enable_w)
     g00_override_mode: int = 2  # RapidOverrideMode (P-CHAN-00181), from the configuration
+    # cycles each tool (by T number) has cut: kernel.tool_life; replaced, never changed
+    tool_cut_cycles: dict[int, int] = field(default_factory=dict)
 
     @property
     def execution_mode_commanded(self) -> int:
@@ -249,7 +251,7 @@ class Channel:
             self.machining, self.prod_time_trace, self.plc_functions, self.spindle, self.manual,
             self.tooling, self.wait_reason, self.rapid_override_command,
             self.rapid_override_per_mille, self.block_ignore_command, self.block_ignore_active,
-            self.m01_stop_enable, self.g00_override_mode,
+            self.m01_stop_enable, self.g00_override_mode, self.tool_cut_cycles,
         )
 
 

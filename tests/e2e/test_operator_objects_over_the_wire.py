@@ -190,3 +190,49 @@ def test_spindle_mode_has_its_value_names(client: Client) -> None:
         info = client.describe(name)
         assert info.enum == {int(m): m.name for m in SpindleMode}
     assert client.read("ch1.mc_spindle_mode_r") == SpindleMode.M05
+
+
+def test_tool_name_wear_and_life_in_the_tool_table(client: Client) -> None:
+    client.write("ch1.wz[1].name", "Endmill 2 mm")
+    client.write("ch1.wz[1].wear", 5000.0)  # 0.5 mm: G41 compensates by 1 + 0.5 mm
+    client.write("ch1.wz[1].life_max", 0.5)
+    client.write("ch1.wz[1].life_used", 0.0)
+    assert client.read_many(["ch1.wz[1].name", "ch1.wz[1].wear", "ch1.wz[1].life_max",
+                             "ch1.wz[1].life_expired"]) == {
+        "ch1.wz[1].name": "Endmill 2 mm", "ch1.wz[1].wear": 5000.0,
+        "ch1.wz[1].life_max": 0.5, "ch1.wz[1].life_expired": False}
+    try:
+        rows = _run(client, "tool.nc",
+                    "G90 T1 M6\nG00 X5 Y-10\nD1 G41 G01 X5 Y0 F600\nG01 X15\n"
+                    "G40 G00 X0 Y0\nM30\n", ("ch1.wz[1].life_used",), cycles_per_step=10)
+        used = [r.values["ch1.wz[1].life_used"] for r in rows]
+        assert used[0] == 0.0 or rows[0].y_mm > -10.0  # nothing cut before the G01
+        at_end = max(range(len(rows)), key=lambda k: rows[k].x_mm)  # end of G01 X15
+        cutting = [r for r in rows[:at_end] if 6.0 < r.x_mm < 14.0]
+        assert cutting and all(r.y_mm == pytest.approx(1.5) for r in cutting)  # worn radius
+        assert all(b >= a for a, b in zip(used, used[1:]))
+        # about 24 mm of G01 (the approach with G41, X5..X15) at 10 mm/s; G0 adds nothing
+        assert 2.0 <= used[-1] <= 2.5
+        assert used[at_end + 1:] == [used[-1]] * len(used[at_end + 1:])  # G40 G00 back
+        assert client.read("ch1.wz[1].life_expired") is True  # 0.5 s allowed
+        client.write("ch1.wz[1].life_used", 0.0)  # a new tool
+        assert client.read("ch1.wz[1].life_used") == 0.0
+        assert client.read("ch1.wz[1].life_expired") is False
+    finally:
+        client.write("ch1.wz[1].wear", 0.0)
+        client.write("ch1.wz[1].life_max", 0.0)
+    with pytest.raises(Exception, match="0x706|INVALID"):
+        client.write("ch1.wz[1].life_max", -1.0)
+
+
+def test_m19_angle_shows_the_oriented_position(client: Client) -> None:
+    extra = ("ch1.mc_spindle_position_r", "ch1.mc_spindle_mode_r",
+             "ch1.mc_spindle_speed_reached_r")
+    rows = _run(client, "orient.nc", "S1000 M3\nG01 X1 F6000\nM19 S.POS=90\n"
+                "M19 S.POS=-45\nM30\n", extra)
+    seen = [(r.values["ch1.mc_spindle_mode_r"], r.values["ch1.mc_spindle_speed_reached_r"],
+             r.values["ch1.mc_spindle_position_r"]) for r in rows]
+    braking = [p for mode, reached, p in seen if mode == SpindleMode.M19 and not reached]
+    assert braking and all(p in (0.0, 90.0) for p in braking)  # the angle comes at standstill
+    assert (SpindleMode.M19, True, 90.0) in seen  # oriented to the first S.POS
+    assert seen[-1] == (SpindleMode.M19, True, 315.0)  # -45 degrees, in 0..360
