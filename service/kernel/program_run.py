@@ -187,13 +187,15 @@ class ProgramRun:
         acknowledge at a block end, override 0, or blocks from the decoder (or the
         operator, in extended MDI)."""
         executor, ch = self.executor, self.channel
+        override = (ch.rapid_override_per_mille if executor.in_rapid  # G0: rapid override
+                    else ch.feed_override_per_mille)
         if executor.running:  # the common case, kept short
-            return _NOT_WAITING if ch.feed_override_per_mille else _OVERRIDE_ZERO
+            return _NOT_WAITING if override else _OVERRIDE_ZERO
         waiting = executor.waiting
         more = not (self._fed_all or self._pending_error is not None or self._sync is not None)
         return path_wait_reason(
             waiting, executor.waiting_at, self._technology(),
-            has_motion=executor.has_motion, override_per_mille=ch.feed_override_per_mille,
+            has_motion=executor.has_motion, override_per_mille=override,
             more_blocks=more, manual_open=manual_open(ch, self.feed.keep_open))
 
     # ------------------------------------------------------------ cycle

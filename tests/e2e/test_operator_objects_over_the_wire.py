@@ -236,3 +236,19 @@ def test_m19_angle_shows_the_oriented_position(client: Client) -> None:
     assert braking and all(p in (0.0, 90.0) for p in braking)  # the angle comes at standstill
     assert (SpindleMode.M19, True, 90.0) in seen  # oriented to the first S.POS
     assert seen[-1] == (SpindleMode.M19, True, 315.0)  # -45 degrees, in 0..360
+
+
+def test_rapid_override_zero_stands_g0_and_feed_override_zero_does_not(
+        client: Client) -> None:
+    client.write("ch1.mc_command_feed_override_w", 0)
+    client.upload("g0.nc", b"G90 G00 X100\nG01 X101 F6000\nM30\n")
+    client.run_program("g0.nc")
+    client.write(STEP, 50)
+    moved = _read(client, ("ch1.mc_wait_reason_r",))
+    assert 0.0 < moved.x_mm < 50.0 and moved.values["ch1.mc_wait_reason_r"] == WaitReason.NONE
+    client.write("ch1.mc_command_rapid_override_w", 0)
+    client.write(STEP, 200)  # brakes to a stand on the G0
+    held = _read(client, ("ch1.mc_wait_reason_r",))
+    client.write(STEP, 10)
+    assert _read(client, ()).x_mm == held.x_mm < 100.0
+    assert held.values["ch1.mc_wait_reason_r"] == WaitReason.OVERRIDE_ZERO

@@ -158,6 +158,12 @@ class PathExecutor:
             planner.set_rapid_override(override if override >= 0.0 else 0.0)
 
     @property
+    def in_rapid(self) -> bool:
+        """The segment being run is a G0 one (the rapid override scales it)."""
+        seg = self._ipo.seg
+        return seg is not None and seg.rapid
+
+    @property
     def rapid_override(self) -> float:
         """The factor G0 blocks run with."""
         return self._planner.rapid_override
