@@ -22,10 +22,11 @@ from .addressing import GroupBase
 from .catalog_manual import ManualRow
 from .model import Access
 
-R, W = Access.READ, Access.WRITE
-_CH, _AXIS, _PLATFORM = "channel", "channel_axis", "platform"
-COM = CncPort.COM
+R, W, RW = Access.READ, Access.WRITE, Access.READ_WRITE
+_CH, _AXIS, _PLATFORM, _HLI_CH = "channel", "channel_axis", "platform", "plc_channel"
+COM, PLC = CncPort.COM, CncPort.PLC
 COM_CH = GroupBase.COM_CHANNEL
+PLC_GROUP = 0x4020  # the PLC memory area of catalog.PLC_GROUP
 PLC_ACKNOWLEDGES_CHARS = 256  # "M6 M8 M9 ...": the [plc] acknowledges list as text
 
 OPERATOR_ROWS: tuple[ManualRow, ...] = (
@@ -37,6 +38,18 @@ OPERATOR_ROWS: tuple[ManualRow, ...] = (
               "Skip levels commanded (mc_command_block_ignore_w)"),
     ManualRow("mc_active_block_ignore_r", _CH, COM, COM_CH, 0x6, UNS32, R, "-",
               "Skip levels the running (or last) program was started with"),
+    # the control unit gpCh[i].decoder_mc_control.program_block_ignore (ISG HLI,
+    # MC_CONTROL_UNS32_UNIT; offsets in the PLC's area: project)
+    ManualRow("decoder_mc_control.program_block_ignore.command_w", _HLI_CH, PLC, PLC_GROUP,
+              0x130, UNS32, RW, "-",
+              "Skip levels the PLC commands (taken at program start while enable_w)"),
+    ManualRow("decoder_mc_control.program_block_ignore.enable_w", _HLI_CH, PLC, PLC_GROUP,
+              0x134, BOOLEAN, RW, "-",
+              "TRUE: a program start takes command_w; FALSE: the HMI's request (request_r)"),
+    ManualRow("decoder_mc_control.program_block_ignore.request_r", _HLI_CH, PLC, PLC_GROUP,
+              0x138, UNS32, R, "-", "Skip levels the HMI requests (mc_command_block_ignore_w)"),
+    ManualRow("decoder_mc_control.program_block_ignore.state_r", _HLI_CH, PLC, PLC_GROUP,
+              0x13C, UNS32, R, "-", "Skip levels in effect (mc_active_block_ignore_r)"),
     # --- optional stop (TwinSharp's names; ISG HLI m01_stop_enable) ------------------------
     ManualRow("mc_command_M01_stop_enable_w", _CH, COM, COM_CH, 0x3700, BOOLEAN, W, "-",
               "TRUE: M1 stops like M0; FALSE: the path runs through M1. Read as a block "

@@ -11,7 +11,13 @@ from cnc_objects.objects import CncObject
 
 from .kernel.commands import Command
 from .kernel.kernel import Kernel
-from .kernel.operator_switches import SetBlockIgnore, SetM01StopEnable, SetRapidOverride
+from .kernel.operator_switches import (
+    SetBlockIgnore,
+    SetBlockIgnorePlc,
+    SetBlockIgnorePlcEnable,
+    SetM01StopEnable,
+    SetRapidOverride,
+)
 from .kernel.state import Channel
 
 Getter = Callable[[], Any]
@@ -58,6 +64,14 @@ OPERATOR_READERS: dict[str, Binder] = {
     "mc_command_block_ignore_r": _of_channel(lambda ch: ch.block_ignore_command),
     "mc_active_block_ignore_r": _of_channel(lambda ch: ch.block_ignore_active),
     "mc_command_M01_stop_enable_r": _of_channel(lambda ch: ch.m01_stop_enable),
+    "decoder_mc_control.program_block_ignore.command_w": _of_channel(
+        lambda ch: ch.block_ignore_plc_command),
+    "decoder_mc_control.program_block_ignore.enable_w": _of_channel(
+        lambda ch: ch.block_ignore_plc_enable),
+    "decoder_mc_control.program_block_ignore.request_r": _of_channel(
+        lambda ch: ch.block_ignore_command),
+    "decoder_mc_control.program_block_ignore.state_r": _of_channel(
+        lambda ch: ch.block_ignore_active),
     "mc_command_rapid_override_r": _of_channel(lambda ch: ch.rapid_override_command),
     "mc_active_rapid_override_r": _of_channel(lambda ch: ch.rapid_override_per_mille),
     "mc_g00_override_mode_r": _of_channel(lambda ch: ch.g00_override_mode),
@@ -85,6 +99,8 @@ def _command(make: Callable[[int, Any], Command]) -> Callable[..., Callable[[Any
 
 OPERATOR_WRITERS: dict[str, Callable[..., Callable[[Any], Command]]] = {
     "mc_command_block_ignore_w": _command(SetBlockIgnore),
+    "decoder_mc_control.program_block_ignore.command_w": _command(SetBlockIgnorePlc),
+    "decoder_mc_control.program_block_ignore.enable_w": _command(SetBlockIgnorePlcEnable),
     "mc_command_M01_stop_enable_w": _command(SetM01StopEnable),
     "mc_command_rapid_override_w": _command(SetRapidOverride),
 }

@@ -409,7 +409,7 @@ class ChannelRunner:
         self._move(ChannelEvent.START)
         ch.waiting_for_start = False
         ch.errors, ch.error_count = (), 0
-        ch.block_ignore_active = ch.block_ignore_command  # ISG: read at program start
+        ch.block_ignore_active = ch.block_ignore_commanded  # ISG: read at program start
         self._pending_start = (job, keep_open, fresh_modal)
         if self.axes_ready or self._checks_only(job):
             self._begin_pending()

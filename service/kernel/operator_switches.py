@@ -65,6 +65,15 @@ class SetRapidOverride:
         return None
 
 
+def skip_mask_refused(value: int) -> Refusal | None:
+    """Why ``value`` is no skip level mask (bits beyond level 10), or None."""
+    if value & ~SKIP_LEVELS_MASK:
+        return Refusal(RefusalReason.INVALID_VALUE,
+                       f"skip level mask 0x{value:x} has bits beyond level 10 "
+                       f"(0x{SKIP_LEVELS_MASK:x})")
+    return None
+
+
 @dataclass(frozen=True, slots=True)
 class SetBlockIgnore:
     """Command the skip levels (bit n-1 skips lines ``/n``); from the next program start."""
@@ -73,11 +82,36 @@ class SetBlockIgnore:
     value: int
 
     def apply(self, state: KernelState) -> Refusal | None:
-        if self.value & ~SKIP_LEVELS_MASK:
-            return Refusal(RefusalReason.INVALID_VALUE,
-                           f"skip level mask 0x{self.value:x} has bits beyond level 10 "
-                           f"(0x{SKIP_LEVELS_MASK:x})")
-        state.channels[self.channel_index].block_ignore_command = self.value
+        refused = skip_mask_refused(self.value)
+        if refused is None:
+            state.channels[self.channel_index].block_ignore_command = self.value
+        return refused
+
+
+@dataclass(frozen=True, slots=True)
+class SetBlockIgnorePlc:
+    """``decoder_mc_control.program_block_ignore.command_w``: the PLC's skip levels."""
+
+    channel_index: int
+    value: int
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        refused = skip_mask_refused(self.value)
+        if refused is None:
+            state.channels[self.channel_index].block_ignore_plc_command = self.value
+        return refused
+
+
+@dataclass(frozen=True, slots=True)
+class SetBlockIgnorePlcEnable:
+    """``decoder_mc_control.program_block_ignore.enable_w``: TRUE, the next program
+    start takes the PLC's ``command_w`` instead of the HMI's request."""
+
+    channel_index: int
+    value: bool
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        state.channels[self.channel_index].block_ignore_plc_enable = bool(self.value)
         return None
 
 

@@ -219,6 +219,10 @@ class Channel:
     g00_override_mode: int = 2  # RapidOverrideMode (P-CHAN-00181), from the configuration
     # cycles each tool (by T number) has cut: kernel.tool_life; replaced, never changed
     tool_cut_cycles: dict[int, int] = field(default_factory=dict)
+    # gpCh[i].decoder_mc_control.program_block_ignore (ISG control unit): the PLC's
+    # command_w counts at program start while enable_w is TRUE
+    block_ignore_plc_command: int = 0
+    block_ignore_plc_enable: bool = False
 
     @property
     def execution_mode_commanded(self) -> int:
@@ -227,6 +231,14 @@ class Channel:
         if self.execution_mode_plc_enable:
             return self.execution_mode_plc_command
         return self.execution_mode_command
+
+    @property
+    def block_ignore_commanded(self) -> int:
+        """The skip levels the next program start takes: the PLC's ``command_w`` while
+        it enables the control unit, else the HMI's ``mc_command_block_ignore_w``."""
+        if self.block_ignore_plc_enable:
+            return self.block_ignore_plc_command
+        return self.block_ignore_command
 
     @property
     def suspend_commanded(self) -> bool:
@@ -252,6 +264,7 @@ class Channel:
             self.tooling, self.wait_reason, self.rapid_override_command,
             self.rapid_override_per_mille, self.block_ignore_command, self.block_ignore_active,
             self.m01_stop_enable, self.g00_override_mode, self.tool_cut_cycles,
+            self.block_ignore_plc_command, self.block_ignore_plc_enable,
         )
 
 

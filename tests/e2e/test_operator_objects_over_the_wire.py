@@ -252,3 +252,18 @@ def test_rapid_override_zero_stands_g0_and_feed_override_zero_does_not(
     client.write(STEP, 10)
     assert _read(client, ()).x_mm == held.x_mm < 100.0
     assert held.values["ch1.mc_wait_reason_r"] == WaitReason.OVERRIDE_ZERO
+
+
+def test_the_plc_commands_the_skip_levels_through_its_control_unit(client: Client) -> None:
+    unit = "gpCh[0].decoder_mc_control.program_block_ignore"
+    client.write(f"{unit}.command_w", 1)
+    client.write(f"{unit}.enable_w", True)  # the PLC's command_w counts, not the HMI's 0
+    try:
+        rows = _run(client, "plcskip.nc", "G90 G01 X1 F6000\n/ G01 X5\nG01 Y1\nM30\n")
+        assert (rows[-1].x_mm, rows[-1].y_mm) == (1.0, 1.0)
+        assert client.read_many([f"{unit}.request_r", f"{unit}.state_r",
+                                 "ch1.mc_active_block_ignore_r"]) == {
+            f"{unit}.request_r": 0, f"{unit}.state_r": 1, "ch1.mc_active_block_ignore_r": 1}
+    finally:
+        client.write(f"{unit}.enable_w", False)
+        client.write(f"{unit}.command_w", 0)
