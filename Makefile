@@ -7,6 +7,9 @@ ENDPOINT ?= tcp://127.0.0.1:5555
 # disables ADS) and the data directory (programs/ and output/); empty: the service's default.
 ADS      ?=
 DATA_DIR ?=
+# make run CONFIG=machine.toml: the machine configuration (TOML, laid over the default;
+# docs/configuration.md); empty: the embedded default machine.
+CONFIG   ?=
 
 .PHONY: run test bench soak clean generate
 
@@ -31,12 +34,12 @@ WEB_PORT ?= 8080
 run: $(VENV)/.installed
 ifeq ($(WEB),0)
 	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) \
-		$(if $(DATA_DIR),--data-dir $(DATA_DIR))
+		$(if $(DATA_DIR),--data-dir $(DATA_DIR)) $(if $(CONFIG),--config $(CONFIG))
 else
 	$(BIN)/cnc-web --endpoint $(ENDPOINT) --port $(WEB_PORT) & web=$$!; \
 	trap 'kill $$web 2>/dev/null' EXIT INT TERM; \
 	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) \
-		$(if $(DATA_DIR),--data-dir $(DATA_DIR))
+		$(if $(DATA_DIR),--data-dir $(DATA_DIR)) $(if $(CONFIG),--config $(CONFIG))
 endif
 
 # The checkers first (ruff: lint and import order; mypy, strict: tools/typecheck.py), then

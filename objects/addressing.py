@@ -25,6 +25,7 @@ class GroupBase(IntEnum):
     GEO_HLD = 0x123300  # HLD class, + CID
     GEO_PATH_PREPARATION = 0x124300  # BAVO class, + CID
     COM_DIRECTORY = 0x130100  # COM object directory, + channel (0 = platform)
+    COM_TOOL_LIST = 0x120600  # project: the tool list's name, wear and life, + CID
 
 
 def channel_group(base: int, channel_id: int) -> int:

@@ -22,6 +22,7 @@ from cnc_objects.protocol.wait_reasons import WAIT_REASON_TEXT_CHARS, WaitReason
 
 from .addressing import GroupBase, axis_offset, channel_group
 from .catalog_manual import MANUAL_ROWS
+from .catalog_operator import OPERATOR_ROWS
 from .catalog_technology import TECHNOLOGY_ROWS
 from .model import Access, CncObject
 
@@ -623,13 +624,15 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
 TEMPLATES = TEMPLATES + tuple(
     ObjectTemplate(r.element, Scope.PLC_CHANNEL if r.hli else Scope.CHANNEL,
                    PLC if r.hli else COM, PLC_GROUP if r.hli else COM_CH, r.offset, r.dtype,
-                   r.access, r.unit, r.description)
+                   r.access, r.unit, r.description, r.values)
     for r in TECHNOLOGY_ROWS
 )
 
 
 # manual mode and homing (objects/catalog_manual.py: rows of plain data, no import back)
 TEMPLATES += tuple(ObjectTemplate(r.element, Scope(r.scope), *r[2:]) for r in MANUAL_ROWS)
+# operator switches, machine state, settings (objects/catalog_operator.py)
+TEMPLATES += tuple(ObjectTemplate(r.element, Scope(r.scope), *r[2:]) for r in OPERATOR_ROWS)
 
 
 def _instantiate(

@@ -9,9 +9,11 @@ docs/spindle-plc.md. ``catalog`` turns the rows into templates (its TEMPLATES en
 
 from __future__ import annotations
 
+from enum import IntEnum
 from typing import NamedTuple
 
 from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, UNS16, UNS32, DataType
+from cnc_objects.protocol.values import SpindleMode
 
 from .model import Access
 
@@ -37,7 +39,8 @@ TECHNO_UNIT_FIELDS = (
 
 # (element below spindle, offset, type, access, unit, text)
 SPINDLE_FIELDS = (
-    ("mode_r", 0x0, UNS16, R, "-", "1 M05, 2 M03, 4 M04, 8 M19 (ipo_state.spindle.mode_r)"),
+    ("mode_r", 0x0, UNS16, R, "-",
+     "1 M05, 2 M03, 4 M04, 8 M19, 16 PLCOPEN, 32 RPF (ipo_state.spindle.mode_r)"),
     ("override_w", 0x2, UNS16, RW, "0.1 %", "Spindle override 0..1500 (ipo_mc_control.override)"),
     ("cmd_rev_r", 0x4, SGN32, R, "0.001 deg/s",
      "Commanded speed: S x override, signed (+ M3, - M4) (lr_state.cmd_rev_r)"),
@@ -49,6 +52,10 @@ SPINDLE_FIELDS = (
     ("position_r", 0x18, REAL64, R, "deg", "Spindle position after M19 (S.POS, project)"),
 )
 
+#: the enumeration fields of the spindle and their value sets (protocol.values)
+SPINDLE_VALUES: dict[str, type[IntEnum]] = {"mode_r": SpindleMode}
+
+
 class TechnologyRow(NamedTuple):
     """One object: an HLI symbol under gpCh[i] (``hli``) or a COM object of the channel."""
 
@@ -59,6 +66,7 @@ class TechnologyRow(NamedTuple):
     access: Access
     unit: str
     description: str
+    values: type[IntEnum] | None = None  # value set of an enumeration object
 
 
 def com_name(k: int, name: str) -> str:
@@ -83,7 +91,7 @@ TECHNOLOGY_ROWS: tuple[TechnologyRow, ...] = (
     ),
     *(
         TechnologyRow(f"spindle.{name}", True, SPINDLE_OFFSET + offset, dtype, access, unit,
-                      text)
+                      text, SPINDLE_VALUES.get(name))
         for name, offset, dtype, access, unit, text in SPINDLE_FIELDS
     ),
     # the same values on the CNC ports (COM, per channel)
@@ -97,7 +105,7 @@ TECHNOLOGY_ROWS: tuple[TechnologyRow, ...] = (
     ),
     *(
         TechnologyRow(f"mc_spindle_{name}", False, COM_SPINDLE + n, dtype, access, unit,
-                      f"{text} (gpCh[i].spindle.{name})")
+                      f"{text} (gpCh[i].spindle.{name})", SPINDLE_VALUES.get(name))
         for n, (name, _offset, dtype, access, unit, text) in enumerate(SPINDLE_FIELDS)
     ),
 )

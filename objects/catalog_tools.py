@@ -14,7 +14,7 @@ lists every object with its source.
 from __future__ import annotations
 
 from cnc_objects.protocol.constants import CncPort
-from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, UNS16, UNS32
+from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16, UNS32
 
 from .addressing import GroupBase
 from .catalog import MachineLayout, ObjectTemplate, Scope, build_objects
@@ -34,6 +34,22 @@ TOOL_ROW_FIELDS = (
      "tool radius (P-TOOL-00004): G41/G42 compensate by it (>= 0)"),
     ("laenge", 2, REAL64, "0.1 um",
      "tool length (P-TOOL-00003), along the tool axis (G17: Z, G18: Y, G19: X)"),
+)
+
+#: name, wear and life of a tool list row (project: ISG's wz[i] has none of them; an
+#: external tool management keeps them there): (name, index, type, access, unit, meaning)
+#: in the project group COM 0x12060<c>, offset 8 i + index
+TOOL_EXTRA_STRIDE = 8
+TOOL_NAME_CHARS = 32
+TOOL_EXTRA_FIELDS = (
+    ("name", 0, STRING(TOOL_NAME_CHARS), RW, "-", "the tool's name"),
+    ("wear", 1, REAL64, RW, "0.1 um",
+     "radius wear: G41/G42 compensate by radius + wear (negative: the tool is worn smaller)"),
+    ("life_max", 2, REAL64, RW, "s", "cutting time the tool may run; 0 = no limit"),
+    ("life_used", 3, REAL64, RW, "s",
+     "cutting time run: counts while the tool is in the spindle (the T of the last M6) and "
+     "a G1/G2/G3 block is in the interpolator; write 0 after a regrind or a new tool"),
+    ("life_expired", 4, BOOLEAN, R, "-", "life_max set and life_used >= life_max"),
 )
 
 TOOL_TEMPLATES: tuple[ObjectTemplate, ...] = (
@@ -110,6 +126,15 @@ def table_templates(tool_entries: int, zero_offset_groups: int) -> tuple[ObjectT
         for i in range(1, tool_entries + 1)
         for name, k, dtype, unit, meaning in TOOL_ROW_FIELDS
     )
+    extras = tuple(
+        ObjectTemplate(
+            tool_row_element(i, name), Scope.CHANNEL, COM, GroupBase.COM_TOOL_LIST,
+            TOOL_EXTRA_STRIDE * i + k, dtype, access, unit,
+            f"Tool list row {i}: {meaning} (project group and offset)",
+        )
+        for i in range(1, tool_entries + 1)
+        for name, k, dtype, access, unit, meaning in TOOL_EXTRA_FIELDS
+    )
     groups = tuple(
         ObjectTemplate(
             zero_offset_element(g), Scope.CHANNEL_AXIS, COM, COM_CH, ZERO_OFFSET_OFFSET + g,
@@ -118,7 +143,7 @@ def table_templates(tool_entries: int, zero_offset_groups: int) -> tuple[ObjectT
         )
         for g in range(1, zero_offset_groups)
     )
-    return rows + groups
+    return rows + extras + groups
 
 
 def _g_function(group: int) -> str:

@@ -85,6 +85,37 @@ class ManualOperationMode(IntEnum):
     INCREMENTAL = 3  # jog mode: one increment per key press
 
 
+class SpindleMode(IntEnum):
+    """Mode of the spindle (HLI ``gpAx[..]^.ipo_state.spindle.mode_r``; the object
+    ``ch<c>.mc_spindle_mode_r``)."""
+
+    M05 = 1  # stopped
+    M03 = 2  # turning clockwise
+    M04 = 4  # turning counter-clockwise
+    M19 = 8  # positioning (orientation)
+    PLCOPEN = 16  # moved by a PLCopen function block (not offered by this kernel)
+    RPF = 32  # reference point run (not offered by this kernel)
+
+
+class CoolantState(IntEnum):
+    """Coolant as the program commanded it (``ch<c>.mc_coolant_state_r``; project: ISG
+    leaves M7/M8/M9 to the PLC)."""
+
+    OFF = 0  # M9, RESET, start-up
+    MIST = 1  # M7
+    FLOOD = 2  # M8
+    MIST_AND_FLOOD = 3  # M7 and M8
+
+
+class RapidOverrideMode(IntEnum):
+    """How the rapid override acts (P-CHAN-00181 ``g00_override_mode``)."""
+
+    NOT_USED = 0  # the feed override acts on G0 and feed blocks
+    MINIMUM_OF_G0_G1 = 1  # G0: the smaller of feed and rapid override
+    ACTIVE = 2  # G0: the rapid override only; feed blocks: the feed override
+    ACTIVE_EXTENDED = 3  # as ACTIVE (also homing and manual mode on ISG's kernel)
+
+
 def value_names(values: type[IntEnum]) -> dict[int, str]:
     """``{3: "READY", ...}``: the names of an enumeration's values."""
     return {int(member): member.name for member in values}

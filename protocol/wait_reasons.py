@@ -22,7 +22,7 @@ class WaitReason(IntEnum):
     PROGRAMMED_STOP = 2  # M0: stands until START (X_WaitContinue)
     OPTIONAL_STOP = 3  # M1: stands until START (X_WaitContinue)
     FEED_HOLD = 4  # feedhold (channel state HOLD) until START
-    OVERRIDE_ZERO = 5  # feed override 0 %: the path has motion to do and stands
+    OVERRIDE_ZERO = 5  # feed (G0: rapid) override 0 %: the path has motion and stands
     PLC_ACKNOWLEDGE = 6  # an M/H/T function waits for the PLC (X_WaitTechnoAcknowledge)
     SPINDLE = 7  # M3/M4/M5/M19/S waits for the spindle: speed reached, stopped, oriented
     DWELL = 8  # G4 dwell time runs (X_DwellTimeActive)
@@ -41,7 +41,7 @@ WAIT_REASON_TEXTS: dict[WaitReason, str] = {
     WaitReason.PROGRAMMED_STOP: "M0 programmed stop: waiting for START",
     WaitReason.OPTIONAL_STOP: "M1 optional stop: waiting for START",
     WaitReason.FEED_HOLD: "feed hold: waiting for START",
-    WaitReason.OVERRIDE_ZERO: "feed override is 0 %",
+    WaitReason.OVERRIDE_ZERO: "feed override (rapid override in G0) is 0 %",
     WaitReason.PLC_ACKNOWLEDGE: "waiting for the PLC to acknowledge an M/H/T function",
     WaitReason.SPINDLE: "waiting for the spindle (speed reached, stopped or oriented)",
     WaitReason.DWELL: "dwell time (G4) running",

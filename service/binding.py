@@ -24,6 +24,7 @@ from cnc_objects.protocol.wait_reasons import wait_reason_text
 from . import __version__
 from .binding_alarms import ALARM_WRITERS, alarm_readers
 from .binding_manual import MANUAL_READERS, MANUAL_WRITERS
+from .binding_operator import OPERATOR_READERS, OPERATOR_WRITERS
 from .binding_technology import TECHNOLOGY_READERS, TECHNOLOGY_WRITERS
 from .binding_tools import tool_readers, tool_writers
 from .kernel.commands import (
@@ -463,6 +464,8 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
 
 READERS |= TECHNOLOGY_READERS  # techno units and spindle (binding_technology)
 WRITERS |= TECHNOLOGY_WRITERS
+READERS |= OPERATOR_READERS  # switches, machine state, settings (binding_operator)
+WRITERS |= OPERATOR_WRITERS
 
 
 def _axis_parameter_update(text: str) -> Command:

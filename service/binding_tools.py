@@ -12,11 +12,13 @@ from typing import Any
 
 from cnc_objects.objects import CncObject
 from cnc_objects.objects.catalog_tools import (
+    TOOL_EXTRA_FIELDS,
     TOOL_ROW_FIELDS,
     tool_row_element,
     zero_offset_element,
 )
 
+from .binding_tool_life import tool_extra_reader, tool_extra_writer
 from .kernel.commands import Command
 from .kernel.kernel import Kernel
 from .kernel.nc.tool_data import ToolField
@@ -97,6 +99,8 @@ def tool_readers(tool_entries: int, zero_offset_groups: int) -> dict[str, Binder
     for i in range(1, tool_entries + 1):
         for name, *_ in TOOL_ROW_FIELDS:
             readers[tool_row_element(i, name)] = _tool_field(i, name)
+        for name, *_ in TOOL_EXTRA_FIELDS:  # name, wear, life (binding_tool_life)
+            readers[tool_row_element(i, name)] = tool_extra_reader(i, name)
     for g in range(1, zero_offset_groups):
         readers[zero_offset_element(g)] = _zero_offset(g)
     return readers
@@ -124,6 +128,10 @@ def tool_writers(tool_entries: int, zero_offset_groups: int) -> dict[str, WriteB
     for i in range(1, tool_entries + 1):
         for name, *_ in TOOL_ROW_FIELDS:
             writers[tool_row_element(i, name)] = _tool_write(i, name)
+        for name, *_ in TOOL_EXTRA_FIELDS:
+            extra = tool_extra_writer(i, name)
+            if extra is not None:
+                writers[tool_row_element(i, name)] = extra
     for g in range(1, zero_offset_groups):
         writers[zero_offset_element(g)] = _zero_offset_write(g)
     return writers

@@ -339,6 +339,27 @@ class PlcFunctionsConfig(Strict):
         return (self.prozess_zeit_default if us is None else us) / 1e6
 
 
+class PlcConfig(Strict):
+    """``[plc]``: the short form for a real PLC, laid over every channel's ``techno``
+    (docs/configuration.md "A real PLC in three lines")."""
+
+    acknowledges: tuple[str, ...] = Field(
+        (), description="functions the PLC acknowledges over ADS, e.g. [\"M6\", \"M8\", "
+        "\"M9\"]; the embedded PLC acknowledges the others (auto_acknowledge)")
+
+    @field_validator("acknowledges")
+    @classmethod
+    def _functions(cls, value: tuple[str, ...]) -> tuple[str, ...]:
+        for name in value:
+            if len(name) < 2 or name[0].upper() not in "MH" or not name[1:].isdigit():
+                raise ValueError(f"{name!r} is not an M or H function (write e.g. \"M8\")")
+        return tuple(f"{n[0].upper()}{int(n[1:])}" for n in value)
+
+    def numbers(self, letter: str) -> frozenset[int]:
+        """The numbers of the acknowledged functions of ``letter`` ("M" or "H")."""
+        return frozenset(int(n[1:]) for n in self.acknowledges if n[0] == letter)
+
+
 class ChannelConfig(Strict):
     """A channel and its axes."""
 
@@ -352,6 +373,10 @@ class ChannelConfig(Strict):
     feed_override_max: int = Field(
         1000, ge=0, le=0xFFFF, description="largest accepted feed override (0.1 %)"
     )
+    g00_override_mode: Literal["NOT_USED", "MINIMUM_OF_G0_G1", "ACTIVE", "ACTIVE_EXTENDED"] = \
+        Field("ACTIVE", description="P-CHAN-00181 g00_override_mode: how the rapid override "
+              "acts on G0 (ISG's default is NOT_USED; this project's is ACTIVE: the feed "
+              "override no longer slows G0)")
     interpolator_function: str = Field(
         "FCT_IPO_DEFAULT",
         description="P-CHAN-00650: interpolator functions, e.g. 'FCT_IPO_DEFAULT | "
@@ -431,6 +456,8 @@ class MachineConfig(Strict):
                               description="rows wz[1..n] of each channel's tool list")
     tool_change_time_s: float = Field(0.0, ge=0.0, le=600.0,
                                       description="M6: time the path waits for the change (s)")
+    plc: PlcConfig = Field(default_factory=PlcConfig, description="[plc]: what a real PLC "
+                           "acknowledges, for every channel (docs/configuration.md)")
     zero_offset_groups: int = Field(10, ge=7, le=97, description="np_grp[0..n-1] per channel "
                                     "(P-ZERO-00003): G53, G54..G59, G159 = 7..n-1")
 

@@ -153,7 +153,7 @@ class ChannelRunner:
         # the decoder or the check (virtual clock) stops waiting; cleared by ``reset``
         self.reset_pending = threading.Event()
         self._check_max_errors = check_max_errors  # errors kept per check
-        self.plc = PlcFunctions(config.techno, Spindle(config.techno.spindel))
+        self.plc = PlcFunctions(config.techno, Spindle(config.techno.spindel), machine.plc)
         channel.spindle, channel.plc_functions = self.plc.spindle.state, self.plc.unit
         self.touched = False  # the last cycle changed the channel's state
         # #MSG texts from the decoder thread (deque appends are thread-safe)
@@ -304,6 +304,8 @@ class ChannelRunner:
         self.alarms.reset_channel(ch.channel_id)  # ISG: RESET clears the channel's errors
         ch.waiting_for_start = False
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
+        for axis in ch.axes:
+            axis.distance_to_go_incr = 0  # no block in the interpolator
         self._move(ChannelEvent.RESET)
         self._modal = None
         ch.tooling = after_reset(ch.tooling)
@@ -411,6 +413,7 @@ class ChannelRunner:
         self._move(ChannelEvent.START)
         ch.waiting_for_start = False
         ch.errors, ch.error_count = (), 0
+        ch.block_ignore_active = ch.block_ignore_commanded  # ISG: read at program start
         self._pending_start = (job, keep_open, fresh_modal)
         if self.axes_ready or self._checks_only(job):
             self._begin_pending()
@@ -473,6 +476,7 @@ class ChannelRunner:
             section_planner=partial(plan_section, dynamics=dynamics,
                                     buffer_blocks=self._buffer_blocks, cycle_s=self._cycle_s),
             interrupted=self._waiting,
+            skip_levels=ch.block_ignore_active,
         )
         feed.add(job)
         for more in self._queued_jobs:

@@ -14,6 +14,7 @@ from typing import Any, ClassVar, Protocol
 from .axis_params import update_axis
 from .channel_mode import ChannelState
 from .contour_lookahead import RequestError, check_request
+from .operator_switches import rapid_override_per_mille
 from .refusal import Refusal as Refusal  # the commands' answer, imported from here too
 from .refusal import RefusalReason as RefusalReason
 from .state import ExecutionMode, KernelState
@@ -76,6 +77,7 @@ class SetFeedOverride:
             )
         channel.feed_override_command = self.value
         channel.feed_override_per_mille = self.value
+        channel.rapid_override_per_mille = rapid_override_per_mille(channel)  # G0 may follow
         return None
 
 

@@ -124,6 +124,7 @@ class DecoderFeed:
         surroundings: Surroundings | None = None,
         section_planner: SectionPlanner | None = None,
         interrupted: Callable[[], bool] = lambda: False,
+        skip_levels: int = 0,
     ) -> None:
         """``contour_lookahead``: FCT_CONTOUR_LAH is enabled (P-CHAN-00650), so the
         decoder accepts ``#CONTOUR LOOKAHEAD``; ``surroundings``: the file store, message
@@ -134,6 +135,7 @@ class DecoderFeed:
         waiting (a decoder in a loop without blocks would hold the cycle until its loop
         guard)."""
         self._interrupted = interrupted
+        self._skip_levels = skip_levels  # lines /n skipped: bit n-1 (block skip switch)
         self._surroundings = surroundings
         self._sections = SectionCollector(section_planner) if section_planner else None
         self._axes = axes
@@ -230,6 +232,7 @@ class DecoderFeed:
             text, job.name, axes=self._axes, loader=self._loader, tools=self._tools,
             modal=self.modal, manual=job.manual, axis_numbers=self._axis_numbers,
             contour_lookahead=self._contour_lookahead, surroundings=self._surroundings,
+            skip_levels=self._skip_levels,
         )
         decoder.cancelled = self._cancel.is_set
         yield from decoder.blocks()

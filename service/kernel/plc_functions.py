@@ -22,11 +22,14 @@ while ``auto_acknowledge`` is on.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from enum import IntEnum
 from typing import Protocol
 
-from ..machine_config import PlcFunctionsConfig, SyncKind
+from cnc_objects.protocol.values import CoolantState
+
+from ..machine_config import PlcConfig, PlcFunctionsConfig, SyncKind
 from .nc.blocks import Block, StopKind
 from .spindle import SPINDLE_M_FUNCTIONS, Spindle, SpindleState
 
@@ -70,6 +73,7 @@ class PlcFunctionsUnit:
 
     units: tuple[TechnoUnit, ...] = ()  # techno_unit_std_sync[0..]
     output_count: int = 0  # functions output since the channel started
+    coolant: CoolantState = CoolantState.OFF  # M7/M8 output, M9 or RESET: OFF
 
     @property
     def used_units(self) -> int:
@@ -77,15 +81,28 @@ class PlcFunctionsUnit:
         return sum(1 for u in self.units if u.pending)
 
 
+# M7 mist on, M8 flood on, M9 both off: the coolant state after each (project: ISG
+# leaves coolant to the PLC; the state follows the output, RESET switches it off)
+_COOLANT: dict[int, Callable[[CoolantState], CoolantState]] = {
+    7: lambda c: CoolantState(c | CoolantState.MIST),
+    8: lambda c: CoolantState(c | CoolantState.FLOOD),
+    9: lambda c: CoolantState.OFF,
+}
+
 UNITS_KEPT = 16  # acknowledged units stay readable until this many are listed
 
 
 class PlcFunctions:
     """A channel's technology output, acknowledges and waits (GEO side)."""
 
-    def __init__(self, config: PlcFunctionsConfig, spindle: Spindle) -> None:
+    def __init__(self, config: PlcFunctionsConfig, spindle: Spindle,
+                 plc_acknowledges: PlcConfig | None = None) -> None:
         self.config = config
         self.spindle = spindle
+        # [plc] acknowledges: (type, number) the real PLC acknowledges over ADS
+        acks = plc_acknowledges or PlcConfig()
+        self._plc_acks = frozenset({(TechnoType.M, n) for n in acks.numbers("M")}
+                                   | {(TechnoType.H, n) for n in acks.numbers("H")})
         self.unit = PlcFunctionsUnit()
         self._extra: set[int] = set()  # ids of the pre/post blocks ``split`` made
         self._spindle_waits = False  # a spindle function waits for the spindle
@@ -148,20 +165,25 @@ class PlcFunctions:
         self._extra.discard(id(block))
         functions = self._functions(block)
         if functions:
-            self._output(functions, now_s)
+            self._output(functions, now_s, block.spindle_pos_deg)
         return extra
 
-    def _output(self, functions: list[tuple[TechnoType, int]], now_s: float) -> None:
+    def _output(self, functions: list[tuple[TechnoType, int]], now_s: float,
+                spindle_pos_deg: float | None = None) -> None:
         spindle_m = [n for t, n in functions if t == TechnoType.M and n in SPINDLE_M_FUNCTIONS]
         speed = next((n for t, n in functions if t == TechnoType.S), None)
         if spindle_m or speed is not None:
-            self.spindle.command(spindle_m, speed)
+            self.spindle.command(spindle_m, speed, spindle_pos_deg)
             kinds = [self.kind(TechnoType.M, n) for n in spindle_m]
             if speed is not None:
                 kinds.append(self.kind(TechnoType.S, speed))
             self._spindle_waits = any(k not in _NO_WAIT for k in kinds)
         units = list(self.unit.units)
         count = self.unit.output_count
+        coolant = self.unit.coolant
+        for type_, number in functions:
+            if type_ == TechnoType.M and number in _COOLANT:
+                coolant = _COOLANT[number](coolant)
         for type_, number in functions:
             if type_ == TechnoType.M and number in SPINDLE_M_FUNCTIONS:
                 continue  # acknowledged by the spindle
@@ -171,13 +193,14 @@ class PlcFunctions:
             # S is acknowledged by the spindle: listed for the PLC as information
             acked = sync == SyncKind.MOS or type_ == TechnoType.S
             due = None
-            if not acked and self.config.auto_acknowledge:
+            if (not acked and self.config.auto_acknowledge
+                    and (type_, number) not in self._plc_acks):
                 due = now_s + self.config.prozess_zeit_s(int(type_), number)
             units.append(TechnoUnit(type_, number, sync, now_s, acked, due))
             count += 1
         while len(units) > UNITS_KEPT and not units[0].pending:
             units.pop(0)
-        self.unit = PlcFunctionsUnit(tuple(units), count)
+        self.unit = PlcFunctionsUnit(tuple(units), count, coolant)
 
     def tick(self, now_s: float, cycle_s: float) -> None:
         """One cycle: the embedded PLC acknowledges what is due, the spindle ramps."""

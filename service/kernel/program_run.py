@@ -40,6 +40,7 @@ from .nc.blocks import (
     StopKind,
 )
 from .nc.contour import LOOP_MARKERS
+from .operator_switches import with_optional_stop
 from .path.errors import PathErrorId
 from .path.executor import PathError, PathExecutor
 from .path.interpolator import StepResult, Waiting
@@ -47,6 +48,7 @@ from .path.segments import Segment
 from .plc_functions import PlcFunctions
 from .prod_time_trace import ProdTimeTrace, trace_file_name
 from .state import BLOCK_START_COLUMN, Channel, ErrorEntry
+from .tool_life import count_cutting
 from .wait_reason import WaitReason, manual_open, path_wait_reason
 
 _NOT_WAITING, _OVERRIDE_ZERO = int(WaitReason.NONE), int(WaitReason.OVERRIDE_ZERO)
@@ -185,13 +187,15 @@ class ProgramRun:
         acknowledge at a block end, override 0, or blocks from the decoder (or the
         operator, in extended MDI)."""
         executor, ch = self.executor, self.channel
+        override = (ch.rapid_override_per_mille if executor.in_rapid  # G0: rapid override
+                    else ch.feed_override_per_mille)
         if executor.running:  # the common case, kept short
-            return _NOT_WAITING if ch.feed_override_per_mille else _OVERRIDE_ZERO
+            return _NOT_WAITING if override else _OVERRIDE_ZERO
         waiting = executor.waiting
         more = not (self._fed_all or self._pending_error is not None or self._sync is not None)
         return path_wait_reason(
             waiting, executor.waiting_at, self._technology(),
-            has_motion=executor.has_motion, override_per_mille=ch.feed_override_per_mille,
+            has_motion=executor.has_motion, override_per_mille=override,
             more_blocks=more, manual_open=manual_open(ch, self.feed.keep_open))
 
     # ------------------------------------------------------------ cycle
@@ -225,11 +229,13 @@ class ProgramRun:
                 self._show_contour_state()
         # the buffer is full and more blocks wait: does its end hold the speed down?
         full = not (self._buffer_warned or self._fed_all) and executor.free_slots() == 0
+        executor.set_rapid_override(ch.rapid_override_per_mille / 1000.0)
         step = executor.step(override)
         if full and executor.buffer_limits_speed():
             self._warn_buffer_limits()
         if output:
             self._output(step)
+            count_cutting(ch, step.current, 1)  # tool life (a dry run cuts nothing)
         ch.program_time_s = time_s - self.started_at_s
         self._stepped(step)
         for block in step.finished:
@@ -279,6 +285,11 @@ class ProgramRun:
         for axis, pos in zip(ch.axes, positions, strict=True):
             axis.position_mm = pos
             axis.command_position_incr = round(pos * _INCR_PER_MM)
+        motion = step.current.motion if step.current is not None else None
+        ends = () if motion is None else motion.end_mm
+        for k, axis in enumerate(ch.axes):  # distance to go: to the block's end point
+            axis.distance_to_go_incr = round(
+                (ends[k] - step.position_mm[k]) * _INCR_PER_MM) if k < len(ends) else 0
         ch.path_velocity_mm_s = step.path_velocity_mm_s
         ch.programmed_velocity_mm_s = step.programmed_velocity_mm_s
         ch.remaining_in_block_mm = step.remaining_in_block_mm
@@ -292,6 +303,7 @@ class ProgramRun:
         ch, executor = self.channel, self.executor
         if (not self._skips_cycles or self._sync is not None or self._contour_changed
                 or self._pending_error is not None or executor.single_block != ch.single_block
+                or executor.rapid_override != ch.rapid_override_per_mille / 1000.0
                 or not (self._fed_all or executor.free_slots() == 0)):
             return 0
         # as ``_motion_cycle``: with the buffer full, a cycle that leaves the path held
@@ -302,7 +314,9 @@ class ProgramRun:
     def cruise(self, cycles: int, time_s: float) -> None:
         """Run ``cycles`` cycles that ``cruise_budget`` allowed at once, the last at
         kernel time ``time_s``: the channel shows what stepping them one by one shows."""
-        self._output(self.executor.cruise(cycles))
+        step = self.executor.cruise(cycles)
+        self._output(step)
+        count_cutting(self.channel, step.current, cycles)
         self.channel.program_time_s = time_s - self.started_at_s
 
     def _technology(self) -> PlcFunctions | None:
@@ -375,6 +389,7 @@ class ProgramRun:
                     self._sync = item
                 return
             if isinstance(item, Block):
+                item = with_optional_stop(item, self.channel)  # M1 and its switch
                 if contour is not None:
                     contour.expect(item)
                 plc = self._technology()

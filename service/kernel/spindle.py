@@ -4,7 +4,7 @@ ISG: "spindle rotation is activated if M03 or M04 is programmed and a valid spee
 set"; S alone stores the speed; M05 is the state after start-up. The actual speed
 follows the commanded one (S x override, limited to the spindle's maximum) with the
 spindle's acceleration (P-AXIS-00008 ``getriebe[i].dynamik.a_max``, degrees/s^2).
-M19 orients to ``S.POS`` (0 degrees here: the position word is not decoded): the
+M19 orients to ``S.POS`` of its block (``M19 S.POS=90``; 0 degrees without it): the
 spindle brakes to standstill and is then at its position. ``reached`` is the spindle's
 own acknowledge of the last function (speed reached, stopped, oriented).
 """
@@ -14,18 +14,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 
+from cnc_objects.protocol.values import SpindleMode
+
 from ..machine_config import SpindleConfig
 
+__all__ = [  # SpindleMode is the value set of protocol.values, used here
+    "DEG_S2_PER_RPM_S", "OVERRIDE_MAX", "SPINDLE_M_FUNCTIONS", "Spindle", "SpindleM",
+    "SpindleMode", "SpindleState",
+]
+
 DEG_S2_PER_RPM_S = 6.0  # 1 rpm/s = 360 degrees / 60 s per s
-
-
-class SpindleMode(IntEnum):
-    """``gpAx[..]^.ipo_state.spindle.mode_r`` (ISG)."""
-
-    M05 = 1  # stopped
-    M03 = 2  # clockwise
-    M04 = 4  # counter-clockwise
-    M19 = 8  # positioning
 
 
 class SpindleM(IntEnum):
@@ -64,14 +62,19 @@ class Spindle:
         self.config = config
         self.acc_rpm_s = config.a_max / DEG_S2_PER_RPM_S
         self.state = SpindleState(name=config.bezeichnung)
+        self._orient_deg = 0.0  # S.POS of the last M19
 
     @property
     def reached(self) -> bool:
         """The spindle has done what was commanded last."""
         return self.state.reached
 
-    def command(self, m_functions: list[int], speed_rpm: int | None) -> None:
-        """Apply the spindle M functions and S of one block (M19 > M3/M4/M5 > S)."""
+    def command(self, m_functions: list[int], speed_rpm: int | None,
+                position_deg: float | None = None) -> None:
+        """Apply the spindle M functions and S of one block (M19 > M3/M4/M5 > S);
+        ``position_deg``: the block's S.POS, where an M19 orients to (default 0)."""
+        if SpindleM.ORIENT in m_functions:
+            self._orient_deg = 0.0 if position_deg is None else position_deg
         st = self.state
         programmed = st.programmed_rpm if speed_rpm is None else float(speed_rpm)
         mode = st.mode
@@ -118,6 +121,6 @@ class Spindle:
         reached = actual == st.commanded_rpm
         position = st.position_deg
         if st.mode == SpindleMode.M19 and reached:
-            position = 0.0  # S.POS (default 0 degrees): oriented at standstill
+            position = self._orient_deg  # S.POS (default 0 degrees): oriented at standstill
         self.state = SpindleState(st.name, st.mode, st.programmed_rpm, st.override,
                                   st.commanded_rpm, actual, position, reached)

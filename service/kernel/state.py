@@ -15,6 +15,7 @@ from typing import Any, NamedTuple, Protocol
 # Defined with the wire's value sets; the kernel's modules import them from here.
 from cnc_objects.protocol.values import ExecutionMode as ExecutionMode
 from cnc_objects.protocol.values import LinkState as LinkState
+from cnc_objects.protocol.values import RapidOverrideMode
 
 from ..machine_config import ChannelConfig, MachineConfig
 from .alarms import AlarmLog
@@ -79,6 +80,7 @@ class LogicalAxis:
     position_offset_incr: int = 0  # command position - physical position (jog of path)
     offset_live: bool = False  # the axis took its drive over from another logical axis
     released: bool = False  # left the channel by #AX RELEASE
+    distance_to_go_incr: int = 0  # to the end of the block in the interpolator (0.1 um)
 
     def frozen(self) -> LogicalAxis:
         """A copy for the snapshot."""
@@ -86,6 +88,7 @@ class LogicalAxis:
             self.name, self.logical_number, self.requested_link, self.actual_link,
             self.link_state, self.position_mm, self.command_position_incr, self.output_incr,
             self.position_offset_incr, self.offset_live, self.released,
+            self.distance_to_go_incr,
         )
 
     def set_position_incr(self, incr: int) -> None:
@@ -207,6 +210,19 @@ class Channel:
     manual: tuple[Any, ...] = ()  # ManualAxisView per axis (manual_mode.ManualMode sets)
     tooling: ChannelTooling = field(default_factory=ChannelTooling)  # T, D, zero offsets
     wait_reason: int = 0  # WaitReason: why the channel stands (kernel.wait_reason)
+    # operator switches and the rapid override (docs/kernel.md "Operator switches")
+    rapid_override_command: int = 1000  # 0.1 %, mc_command_rapid_override_w
+    rapid_override_per_mille: int = 1000  # 0.1 %, in effect on G0 (P-CHAN-00181 mode)
+    block_ignore_command: int = 0  # skip levels /1../10 (bit n-1), mc_command_block_ignore_w
+    block_ignore_active: int = 0  # the mask the running program was started with
+    m01_stop_enable: bool = False  # M1 stops only while TRUE (mc_command_M01_stop_enable_w)
+    g00_override_mode: int = 2  # RapidOverrideMode (P-CHAN-00181), from the configuration
+    # cycles each tool (by T number) has cut: kernel.tool_life; replaced, never changed
+    tool_cut_cycles: dict[int, int] = field(default_factory=dict)
+    # gpCh[i].decoder_mc_control.program_block_ignore (ISG control unit): the PLC's
+    # command_w counts at program start while enable_w is TRUE
+    block_ignore_plc_command: int = 0
+    block_ignore_plc_enable: bool = False
 
     @property
     def execution_mode_commanded(self) -> int:
@@ -215,6 +231,14 @@ class Channel:
         if self.execution_mode_plc_enable:
             return self.execution_mode_plc_command
         return self.execution_mode_command
+
+    @property
+    def block_ignore_commanded(self) -> int:
+        """The skip levels the next program start takes: the PLC's ``command_w`` while
+        it enables the control unit, else the HMI's ``mc_command_block_ignore_w``."""
+        if self.block_ignore_plc_enable:
+            return self.block_ignore_plc_command
+        return self.block_ignore_command
 
     @property
     def suspend_commanded(self) -> bool:
@@ -237,7 +261,10 @@ class Channel:
             self.contour, self.execution_mode_plc_command, self.execution_mode_plc_enable,
             self.syn_chk, self.decoder_flags, self.messages, self.message_count,
             self.machining, self.prod_time_trace, self.plc_functions, self.spindle, self.manual,
-            self.tooling, self.wait_reason,
+            self.tooling, self.wait_reason, self.rapid_override_command,
+            self.rapid_override_per_mille, self.block_ignore_command, self.block_ignore_active,
+            self.m01_stop_enable, self.g00_override_mode, self.tool_cut_cycles,
+            self.block_ignore_plc_command, self.block_ignore_plc_enable,
         )
 
 
@@ -448,4 +475,5 @@ def _channel_from_config(config: ChannelConfig, machine: MachineConfig) -> Chann
         suspend_command_w=suspended,
         suspend_request_r=suspended,
         syn_chk=config.syn_chk,
+        g00_override_mode=RapidOverrideMode[config.g00_override_mode],
     )

@@ -86,6 +86,9 @@ def _value_refused(what: str, value_01um: float, low_01um: float) -> Refusal | N
     return None
 
 
+LIFE_MAX_S = 1e9  # the longest tool life accepted (s): about 32 years of cutting
+
+
 @dataclass(frozen=True, slots=True)
 class SetToolData:
     """Write one field of ``wz[index]`` of a channel's tool list (radius and laenge in
@@ -94,7 +97,7 @@ class SetToolData:
     channel_index: int
     index: int
     which: ToolField
-    value: float | bool
+    value: float | bool | str
 
     def apply(self, state: KernelState) -> Refusal | None:
         runner = state.runners[self.channel_index]
@@ -103,14 +106,23 @@ class SetToolData:
         if not 1 <= self.index <= tables.tools.size:
             return Refusal(RefusalReason.INVALID_VALUE,
                            f"{name}: the tool list has the entries 1..{tables.tools.size}")
-        value: float | bool = self.value
-        if self.which != ToolField.VALID:
-            value = float(self.value)
-            low = 0.0 if self.which == ToolField.RADIUS else -TABLE_VALUE_MAX_01UM
-            field = "radius" if self.which == ToolField.RADIUS else "laenge"
-            refused = _value_refused(f"{name}.{field}", value, low)
-            if refused is not None:
-                return refused
+        value: float | bool | str = self.value
+        match self.which:
+            case ToolField.VALID | ToolField.NAME:
+                pass
+            case ToolField.LIFE_MAX:
+                value = float(self.value)
+                if not 0.0 <= value <= LIFE_MAX_S:  # NaN fails too
+                    return Refusal(RefusalReason.INVALID_VALUE,
+                                   f"{name}.life_max: {value:g} s is outside 0..{LIFE_MAX_S:g}")
+            case _:
+                value = float(self.value)
+                low = 0.0 if self.which == ToolField.RADIUS else -TABLE_VALUE_MAX_01UM
+                field = {ToolField.RADIUS: "radius", ToolField.WEAR: "wear"}.get(
+                    self.which, "laenge")
+                refused = _value_refused(f"{name}.{field}", value, low)
+                if refused is not None:
+                    return refused
         tables.tools = tables.tools.with_field(self.index, self.which, value)
         _show_tables(runner.channel, tables)
         return None

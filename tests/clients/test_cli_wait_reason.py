@@ -61,6 +61,8 @@ def test_run_wait_prints_each_change_of_the_reason(service: ServiceProcess,
     on: a "goes on" line may or may not come there."""
     program = tmp_path / "stops.nc"
     program.write_text("G1 X1 F6000\nM0\nG1 X2\nM1\nG1 X3\nM30\n")
+    with Client(service.endpoint, timeout_s=10) as c:  # M1 stops only with its switch on
+        c.write("ch1.mc_command_M01_stop_enable_w", True)
     argv = [sys.executable, "-c", "from cnc_objects.clients.cli import main; main()",
             "--endpoint", service.endpoint, "run", str(program), "--wait", "--wait-timeout", "60"]
     proc = subprocess.Popen(argv, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -79,6 +81,8 @@ def test_run_wait_prints_each_change_of_the_reason(service: ServiceProcess,
         out, rest = proc.communicate(timeout=60)
     finally:
         watchdog.cancel()
+        with Client(service.endpoint, timeout_s=10) as c:
+            c.write("ch1.mc_command_M01_stop_enable_w", False)
     assert proc.returncode == 0, rest
     assert [line for line in lines if line != "channel 1 goes on"] == [
         M0_LINE, "channel 1 waits: M1 optional stop: waiting for START (OPTIONAL_STOP)"]

@@ -80,11 +80,15 @@ def test_single_block_waits_for_start_after_a_block(c: Client) -> None:
 @pytest.mark.parametrize(("stop", "reason"), [
     ("M0", WaitReason.PROGRAMMED_STOP), ("M1", WaitReason.OPTIONAL_STOP)])
 def test_m0_and_m1_wait_for_start(c: Client, stop: str, reason: WaitReason) -> None:
-    run(c, f"G1 X1 F6000\n{stop}\nG1 X2\nM30\n")
-    expect(c, reason)
-    c.start(1)
-    c.wait_program(1, 30)
-    assert c.read(REASON) == WaitReason.NONE
+    undo = switched(c, "ch1.mc_command_M01_stop_enable_w", True, False)  # M1 needs it
+    try:
+        run(c, f"G1 X1 F6000\n{stop}\nG1 X2\nM30\n")
+        expect(c, reason)
+        c.start(1)
+        c.wait_program(1, 30)
+        assert c.read(REASON) == WaitReason.NONE
+    finally:
+        undo()
 
 
 def test_feed_hold_waits_for_start(c: Client) -> None:

@@ -33,8 +33,11 @@ from cnc_objects.protocol.values import (
     ChannelMode,
     ChannelState,
     ContourBlockType,
+    CoolantState,
     LinkState,
     ManualOperationMode,
+    RapidOverrideMode,
+    SpindleMode,
 )
 from cnc_objects.protocol.wait_reasons import WaitReason
 
@@ -316,6 +319,10 @@ ENUMERATIONS = {
     "operation_mode": ManualOperationMode,  # hb_display_r.operation_mode
     "manual_operation_mode_w": ManualOperationMode,
     "mc_wait_reason_r": WaitReason,
+    "mode_r": SpindleMode,  # gpCh[i].spindle.mode_r
+    "mc_spindle_mode_r": SpindleMode,
+    "mc_coolant_state_r": CoolantState,
+    "mc_g00_override_mode_r": RapidOverrideMode,
 }
 
 

@@ -283,7 +283,8 @@ class BlockExecutor:
         tool = words.get(WordKind.TOOL)
         if (motion is None and dwell_s == 0.0 and stop == StopKind.NONE and not m_functions
                 and spindle is None and tool is None and not axis_words and not offsets
-                and not homed and not h_codes and manual_mode is None):
+                and not homed and not h_codes and manual_mode is None
+                and WordKind.SPINDLE_POS not in words):
             return None, flow, flow_pos
         line_no, column = line.locate(_first(line.text))
         block = make_block(
@@ -296,6 +297,11 @@ class BlockExecutor:
             block = with_homing(block, homed)
         if h_codes:
             block = replace(block, h_functions=tuple(h_codes))
+        if WordKind.SPINDLE_POS in words:  # S.POS: the angle of the block's M19
+            angle, pos = words[WordKind.SPINDLE_POS]
+            if not math.isfinite(angle):
+                raise err(NcErrorId.VALUE_OUT_OF_RANGE, f"S.POS={angle} is not a number", pos)
+            block = replace(block, spindle_pos_deg=angle % 360.0)
         if manual_mode is not None:
             block = with_manual_mode(block, manual_mode)
         return block, flow, flow_pos

@@ -203,6 +203,7 @@ class Block:
     homing_axes: tuple[int, ...] = ()  # G74: channel axis indices referenced at its end
     h_functions: tuple[int, ...] = ()  # H words: technology information to the PLC
     manual_mode: ManualModeRequest | None = None  # G200 / G201 / G202
+    spindle_pos_deg: float | None = None  # S.POS: where an M19 of the block orients to
 
     @property
     def needs_stop(self) -> bool:

@@ -95,6 +95,7 @@ def _fast_block(
     b.homing_axes = ()
     b.h_functions = ()
     b.manual_mode = None
+    b.spindle_pos_deg = None
     b.__class__ = Block
     return cast(Block, b)
 

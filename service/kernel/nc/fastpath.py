@@ -246,6 +246,7 @@ _BLOCK_FAST = '''\
                 block.homing_axes = ()
                 block.h_functions = ()
                 block.manual_mode = None
+                block.spindle_pos_deg = None
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\

@@ -94,6 +94,7 @@ def word_table(axes: tuple[str, ...]) -> dict[str, tuple[WordKind, int]]:
 
 
 RESERVED_LETTERS = frozenset("NGMFSTDLIJKRVH")
+_SPINDLE_POS = re.compile(r"S\.POS(?![A-Z0-9_])")  # the spindle's position word (M19)
 
 
 class LineParser:
@@ -305,6 +306,8 @@ class LineParser:
             self._call(cur, block)
         elif c == "N":
             block.number = self._block_number(cur, block.number)
+        elif c == "S" and _SPINDLE_POS.match(cur.up, pos):
+            self._spindle_pos(cur, block, letters, pos)
         elif "A" <= c <= "Z" or c == "_":
             spec = table.get(c)
             if spec is None:
@@ -344,6 +347,20 @@ class LineParser:
                             f"#{word} must stand alone in its NC line")
         else:
             raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")
+
+    def _spindle_pos(self, cur: Cursor, block: NcBlock, letters: set[str], pos: int) -> None:
+        """``S.POS = <expr>``: the position (degrees) of an M19 in the same block."""
+        if "S.POS" in letters:
+            raise cur.error(NcErrorId.WORD_REPEATED, "S.POS programmed twice in one block", pos)
+        m = _SPINDLE_POS.match(cur.up, pos)
+        assert m is not None  # checked by the caller
+        cur.pos = m.end()
+        if _skip(cur) >= cur.end or cur.peek() != "=" or cur.peek(1) == "=":
+            raise cur.error(NcErrorId.EXPRESSION_SYNTAX, "'=' expected after S.POS", pos)
+        cur.pos += 1
+        block.items.append(Word(WordKind.SPINDLE_POS, "S.POS", ExpressionParser(cur).parse(),
+                                pos))
+        letters.add("S.POS")
 
     def _look_ahead_word(self, cur: Cursor, block: NcBlock) -> bool:
         """``LA_ON`` / ``LA_OFF`` or ``METB|VFBT|BBTRC = <expr>`` at the cursor: parsed

@@ -89,6 +89,7 @@ class WordKind(IntEnum):
     LOOK_AHEAD_PARAM = 11  # METB = <s> / VFBT = <factor> / BBTRC = <blocks>
     ZERO_OFFSET_INDEX = 12  # G159 = <i>: zero offset group np_grp[i]
     H = 13  # H: technology function to the PLC (ISG's H functions)
+    SPINDLE_POS = 14  # S.POS = <degrees>: the position M19 orients the spindle to
 
 
 @final  # the decoder dispatches on type(stmt) is ...: no subclasses

@@ -31,6 +31,9 @@ class ToolField(IntEnum):
     VALID = 0  # wz[i].valid: the row holds tool data
     RADIUS = 1  # wz[i].radius: tool radius (G41/G42), P-TOOL-00004
     LENGTH = 2  # wz[i].laenge: tool length along the tool axis, P-TOOL-00003
+    NAME = 3  # wz[i].name: the tool's name (project)
+    WEAR = 4  # wz[i].wear: radius wear, added to the radius G41/G42 use (project)
+    LIFE_MAX = 5  # wz[i].life_max: cutting time the tool may run, s; 0 = no limit (project)
 
 
 UM01_PER_MM = 10_000  # the tables keep what the objects wrote: 0.1 um
@@ -44,6 +47,9 @@ class ToolData:
     valid: bool = False
     radius_01um: float = 0.0
     length_01um: float = 0.0
+    name: str = ""  # the operator's name of the tool (project)
+    wear_01um: float = 0.0  # radius wear: compensation uses radius + wear (project)
+    life_max_s: float = 0.0  # cutting time allowed; 0 = no limit (project)
 
     @classmethod
     def of_mm(cls, radius_mm: float, length_mm: float = 0.0, valid: bool = True) -> ToolData:
@@ -87,7 +93,7 @@ class ToolTable(Mapping[int, float]):
         row = self.rows.get(d)
         if row is None or not row.valid:
             raise KeyError(d)
-        return row.radius_mm
+        return (row.radius_01um + row.wear_01um) / UM01_PER_MM  # worn tool: radius + wear
 
     def __iter__(self) -> Iterator[int]:
         return (d for d, row in sorted(self.rows.items()) if row.valid)
@@ -110,7 +116,7 @@ class ToolTable(Mapping[int, float]):
             return True
         return self.row(t).valid
 
-    def with_field(self, i: int, which: ToolField, value: float | bool) -> ToolTable:
+    def with_field(self, i: int, which: ToolField, value: float | bool | str) -> ToolTable:
         # ``value``: the flag, or a length in 0.1 um
         """A new table with one field of row ``i`` changed (each field on its own: a
         radius written to an empty row leaves it empty until ``valid`` is set)."""
@@ -122,6 +128,12 @@ class ToolTable(Mapping[int, float]):
                 row = replace(row, radius_01um=float(value))
             case ToolField.LENGTH:
                 row = replace(row, length_01um=float(value))
+            case ToolField.NAME:
+                row = replace(row, name=str(value))
+            case ToolField.WEAR:
+                row = replace(row, wear_01um=float(value))
+            case ToolField.LIFE_MAX:
+                row = replace(row, life_max_s=float(value))
         rows = dict(self.rows)
         rows[i] = row
         return ToolTable(rows, self.size, self.checks_tools)

@@ -151,6 +151,23 @@ class PathExecutor:
         """Run one cycle with feed override factor ``override`` (1.0 = 100 %, 0 stands)."""
         return self._ipo.step(override)
 
+    def set_rapid_override(self, override: float) -> None:
+        """The factor G0 blocks run with (1.0 = 100 %), from this cycle on."""
+        planner = self._planner
+        if override != planner.rapid_override:
+            planner.set_rapid_override(override if override >= 0.0 else 0.0)
+
+    @property
+    def in_rapid(self) -> bool:
+        """The segment being run is a G0 one (the rapid override scales it)."""
+        seg = self._ipo.seg
+        return seg is not None and seg.rapid
+
+    @property
+    def rapid_override(self) -> float:
+        """The factor G0 blocks run with."""
+        return self._planner.rapid_override
+
     def cruise_budget(self, override: float, most: int, watch_buffer: bool) -> int:
         """How many of the next cycles (at most ``most``) only move inside the current
         segment (``Interpolator.cruise_budget``); ``watch_buffer``: the cycles end

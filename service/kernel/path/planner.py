@@ -75,6 +75,7 @@ class LookAhead:
         self.head: Segment | None = None
         self.tail: Segment | None = None
         self.override = 1.0
+        self.rapid_override = 1.0  # the factor G0 segments take instead (P-CHAN-00181)
         self.dirty = False  # segments appended since the last backward pass
 
     def __iter__(self) -> Iterator[Segment]:
@@ -84,7 +85,7 @@ class LookAhead:
             seg = seg.next
 
     def _cap(self, seg: Segment) -> float:
-        cap = seg.speed_mm_s * self.override
+        cap = seg.speed_mm_s * (self.rapid_override if seg.rapid else self.override)
         return cap if cap < seg.axis_speed_mm_s else seg.axis_speed_mm_s
 
     def _junction(self, seg: Segment) -> None:
@@ -164,6 +165,14 @@ class LookAhead:
     def set_override(self, override: float) -> None:
         """New feed override: new caps everywhere, full backward pass."""
         self.override = override
+        for seg in self:
+            seg.cap_mm_s = self._cap(seg)
+            self._junction(seg)
+        self.replan()
+
+    def set_rapid_override(self, override: float) -> None:
+        """New rapid override (the factor of G0 segments): new caps, full backward pass."""
+        self.rapid_override = override
         for seg in self:
             seg.cap_mm_s = self._cap(seg)
             self._junction(seg)

@@ -34,7 +34,7 @@ class Segment:
         "speed_mm_s", "axis_speed_mm_s", "programmed_mm_s", "tangent_start", "tangent_end",
         "block_rest_mm", "events", "stop", "single_stop", "cap_mm_s", "corner_mm_s",
         "junction_mm_s", "entry_mm_s", "exit_mm_s", "planned", "prev", "next",
-        "la_exit_mm_s", "vfbt",
+        "la_exit_mm_s", "vfbt", "rapid",
     )
 
     def __init__(self, element: Element, block: Block, dynamics: Sequence[AxisDynamics],
@@ -51,6 +51,7 @@ class Segment:
                                      speed_mm_s=min(limits.speed_mm_s, mark.max_mm_s))
         self.element = element
         self.block = block
+        self.rapid = rapid  # G0: the rapid override scales it (planner.LookAhead._cap)
         self.point_at = element.point_at
         self.length_mm = element.length_mm
         self.acc_mm_s2 = limits.acc_mm_s2

@@ -1,0 +1,106 @@
+"""Binds the operator's switches, the channel's machine state and the settings objects
+(objects.catalog_operator) to the kernel: reads from the snapshot or the configuration,
+writes as kernel commands (kernel.operator_switches)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from cnc_objects.objects import CncObject
+
+from .kernel.commands import Command
+from .kernel.kernel import Kernel
+from .kernel.operator_switches import (
+    SetBlockIgnore,
+    SetBlockIgnorePlc,
+    SetBlockIgnorePlcEnable,
+    SetM01StopEnable,
+    SetRapidOverride,
+)
+from .kernel.state import Channel
+
+Getter = Callable[[], Any]
+Binder = Callable[[Kernel, CncObject], Getter]
+
+
+def _of_channel(value: Callable[[Channel], Any]) -> Binder:
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        ci = kernel.channel_index(obj.channel)
+        return lambda: value(kernel.snapshot.channels[ci])
+
+    return bind
+
+
+def _all_referenced(ch: Channel) -> bool:
+    return all(view.referenced for view in ch.manual)
+
+
+def _referencing_required(kernel: Kernel, obj: CncObject) -> Getter:
+    ci = kernel.channel_index(obj.channel)
+    needed = kernel.config.programs_need_referenced_axes
+    return lambda: needed and not _all_referenced(kernel.snapshot.channels[ci])
+
+
+def _distance_to_go(kernel: Kernel, obj: CncObject) -> Getter:
+    ci, ai = kernel.channel_index(obj.channel), obj.axis - 1
+    return lambda: kernel.snapshot.channels[ci].axes[ai].distance_to_go_incr
+
+
+def _configured(value: Callable[[Kernel, CncObject], Any]) -> Binder:
+    """A setting: constant while the service runs."""
+    def bind(kernel: Kernel, obj: CncObject) -> Getter:
+        fixed = value(kernel, obj)
+        return lambda: fixed
+
+    return bind
+
+
+def _channel_config(kernel: Kernel, obj: CncObject) -> Any:
+    return kernel.config.channels[kernel.channel_index(obj.channel)]
+
+
+OPERATOR_READERS: dict[str, Binder] = {
+    "mc_command_block_ignore_r": _of_channel(lambda ch: ch.block_ignore_command),
+    "mc_active_block_ignore_r": _of_channel(lambda ch: ch.block_ignore_active),
+    "mc_command_M01_stop_enable_r": _of_channel(lambda ch: ch.m01_stop_enable),
+    "decoder_mc_control.program_block_ignore.command_w": _of_channel(
+        lambda ch: ch.block_ignore_plc_command),
+    "decoder_mc_control.program_block_ignore.enable_w": _of_channel(
+        lambda ch: ch.block_ignore_plc_enable),
+    "decoder_mc_control.program_block_ignore.request_r": _of_channel(
+        lambda ch: ch.block_ignore_command),
+    "decoder_mc_control.program_block_ignore.state_r": _of_channel(
+        lambda ch: ch.block_ignore_active),
+    "mc_command_rapid_override_r": _of_channel(lambda ch: ch.rapid_override_command),
+    "mc_active_rapid_override_r": _of_channel(lambda ch: ch.rapid_override_per_mille),
+    "mc_g00_override_mode_r": _of_channel(lambda ch: ch.g00_override_mode),
+    "mc_coolant_state_r": _of_channel(lambda ch: int(ch.plc_functions.coolant)),
+    "mc_all_axes_referenced_r": _of_channel(_all_referenced),
+    "mc_referencing_required_r": _referencing_required,
+    "distance_to_go_pcs": _distance_to_go,
+    "cnc_programs_need_referenced_axes_r": _configured(
+        lambda k, o: k.config.programs_need_referenced_axes),
+    "cnc_tool_change_time_r": _configured(lambda k, o: k.config.tool_change_time_s),
+    "cnc_plc_acknowledges_r": _configured(lambda k, o: " ".join(k.config.plc.acknowledges)),
+    "mc_feed_override_max_r": _configured(lambda k, o: _channel_config(k, o).feed_override_max),
+    "mc_plc_auto_acknowledge_r": _configured(
+        lambda k, o: _channel_config(k, o).techno.auto_acknowledge),
+}
+
+
+def _command(make: Callable[[int, Any], Command]) -> Callable[..., Callable[[Any], Command]]:
+    def bind(kernel: Kernel, obj: CncObject) -> Callable[[Any], Command]:
+        ci = kernel.channel_index(obj.channel)
+        return lambda value: make(ci, value)
+
+    return bind
+
+
+OPERATOR_WRITERS: dict[str, Callable[..., Callable[[Any], Command]]] = {
+    "mc_command_block_ignore_w": _command(SetBlockIgnore),
+    "decoder_mc_control.program_block_ignore.command_w": _command(SetBlockIgnorePlc),
+    "decoder_mc_control.program_block_ignore.enable_w": _command(SetBlockIgnorePlcEnable),
+    "mc_command_M01_stop_enable_w": _command(SetM01StopEnable),
+    "mc_command_rapid_override_w": _command(SetRapidOverride),
+}

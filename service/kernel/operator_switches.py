@@ -1,0 +1,127 @@
+"""The operator's switches of a channel: rapid override, block skip, optional stop.
+
+ISG sources (docs/kernel.md "Operator switches"):
+
+- rapid override: P-CHAN-00181 ``g00_override_mode`` says how it acts on G0 blocks:
+  NOT_USED the feed override acts on G0 too; MINIMUM_OF_G0_G1 the smaller of feed and
+  rapid override; ACTIVE (and ACTIVE_EXTENDED) the rapid override alone. Feed blocks
+  always take the feed override;
+- block skip: ``mc_command_block_ignore_w`` (COM 0x4), a bit mask of the skip levels
+  ``/1``..``/10`` (bit n-1; ``/`` alone is level 1), read at program start as the
+  control unit ``gpCh[i].decoder_mc_control.program_block_ignore`` is;
+- optional stop: M1 stops only while the switch is on (HLI control unit
+  ``m01_stop_enable``, TwinSharp's ``mc_command_M01_stop_enable_w``); read when the
+  block enters the look-ahead buffer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from cnc_objects.protocol.values import RapidOverrideMode
+
+from .nc.blocks import Block, StopKind
+from .refusal import Refusal, RefusalReason
+from .state import Channel, KernelState
+
+RAPID_OVERRIDE_MAX = 1000  # 0.1 %: G0 never runs faster than the axes' rapid speed
+SKIP_LEVELS_MASK = 0x3FF  # skip levels 1..10
+
+
+def rapid_override_per_mille(ch: Channel) -> int:
+    """The override G0 blocks run with (0.1 %), from the channel's g00_override_mode."""
+    feed, rapid = ch.feed_override_per_mille, ch.rapid_override_command
+    match ch.g00_override_mode:
+        case RapidOverrideMode.NOT_USED:
+            return feed
+        case RapidOverrideMode.MINIMUM_OF_G0_G1:
+            return min(feed, rapid)
+        case _:
+            return rapid
+
+
+def with_optional_stop(block: Block, ch: Channel) -> Block:
+    """``block`` as the path runs it: an M1 whose switch is off does not stop."""
+    if block.stop == StopKind.OPTIONAL and not ch.m01_stop_enable:
+        return replace(block, stop=StopKind.NONE)
+    return block
+
+
+@dataclass(frozen=True, slots=True)
+class SetRapidOverride:
+    """Command the channel's rapid override (0.1 %); in effect from this cycle."""
+
+    channel_index: int
+    value: int
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        ch = state.channels[self.channel_index]
+        if not 0 <= self.value <= RAPID_OVERRIDE_MAX:
+            return Refusal(RefusalReason.INVALID_VALUE,
+                           f"rapid override {self.value / 10:g} % is outside "
+                           f"0..{RAPID_OVERRIDE_MAX / 10:g} %")
+        ch.rapid_override_command = self.value
+        ch.rapid_override_per_mille = rapid_override_per_mille(ch)
+        return None
+
+
+def skip_mask_refused(value: int) -> Refusal | None:
+    """Why ``value`` is no skip level mask (bits beyond level 10), or None."""
+    if value & ~SKIP_LEVELS_MASK:
+        return Refusal(RefusalReason.INVALID_VALUE,
+                       f"skip level mask 0x{value:x} has bits beyond level 10 "
+                       f"(0x{SKIP_LEVELS_MASK:x})")
+    return None
+
+
+@dataclass(frozen=True, slots=True)
+class SetBlockIgnore:
+    """Command the skip levels (bit n-1 skips lines ``/n``); from the next program start."""
+
+    channel_index: int
+    value: int
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        refused = skip_mask_refused(self.value)
+        if refused is None:
+            state.channels[self.channel_index].block_ignore_command = self.value
+        return refused
+
+
+@dataclass(frozen=True, slots=True)
+class SetBlockIgnorePlc:
+    """``decoder_mc_control.program_block_ignore.command_w``: the PLC's skip levels."""
+
+    channel_index: int
+    value: int
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        refused = skip_mask_refused(self.value)
+        if refused is None:
+            state.channels[self.channel_index].block_ignore_plc_command = self.value
+        return refused
+
+
+@dataclass(frozen=True, slots=True)
+class SetBlockIgnorePlcEnable:
+    """``decoder_mc_control.program_block_ignore.enable_w``: TRUE, the next program
+    start takes the PLC's ``command_w`` instead of the HMI's request."""
+
+    channel_index: int
+    value: bool
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        state.channels[self.channel_index].block_ignore_plc_enable = bool(self.value)
+        return None
+
+
+@dataclass(frozen=True, slots=True)
+class SetM01StopEnable:
+    """Switch the optional stop: TRUE, M1 stops; FALSE, the path runs through M1."""
+
+    channel_index: int
+    value: bool
+
+    def apply(self, state: KernelState) -> Refusal | None:
+        state.channels[self.channel_index].m01_stop_enable = bool(self.value)
+        return None
