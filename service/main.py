@@ -179,6 +179,7 @@ async def serve(
     kernel = Kernel(
         config.machine, clock, load, exists,
         writer.kernel_file, writer.save, check_max_errors=config.limits.check_max_errors,
+        idle_steps_max=limits.decoder_idle_steps_max,
         alarms=AlarmLog(limits.alarm_history_max, limits.alarm_active_max),
     )
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows

@@ -65,6 +65,7 @@ from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRu
 from .tooling import seed_modal, tables_from_config, tooling_of
 from .tooling_view import after_reset, initial_tooling
 from .wait_reason import WaitReason, channel_wait_reason
+from .workers import Workers
 
 log = logging.getLogger(__name__)
 
@@ -104,6 +105,8 @@ class ChannelRunner:
         check_max_errors: int = CHECK_MAX_ERRORS,
         on_wait: Callable[[], None] = lambda: None,
         alarms: AlarmLog | None = None,
+        workers: Workers | None = None,
+        idle_steps_max: int | None = None,
     ) -> None:
         """``params`` are the kernel's effective axis parameters (read at each program
         start, so a parameter update applies from the next run); ``switchover`` links
@@ -113,7 +116,11 @@ class ChannelRunner:
         rest are counted only; ``on_wait``: called while a cycle waits for the decoder or
         the check (virtual clock), so that the kernel answers the cycle's commands
         meanwhile; ``alarms``: the kernel's alarm log, which every listed error and
-        warning is raised in (a log of its own when not given)."""
+        warning is raised in (a log of its own when not given); ``workers``: the
+        kernel's worker registry, which runs the decoder and check threads (one of its
+        own when not given); ``idle_steps_max``: the decoder's endless-program guard
+        ([limits] decoder_idle_steps_max; None: ``nc.work_guard.IDLE_STEPS_MAX``)."""
+        self.workers = Workers() if workers is None else workers
         self._on_wait = on_wait
         self.alarms = AlarmLog() if alarms is None else alarms
         self.channel = channel
@@ -160,6 +167,7 @@ class ChannelRunner:
             hscs={mode.upper(): HscProgram(c.prog, c.tolerance * 1e-4)  # 0.1 um -> mm
                   for mode, c in config.hscs},
             kinematics=False,  # this kernel configures no kinematic transformation
+            idle_steps_max=idle_steps_max,
         )
         self._programs_need_referenced_axes = machine.programs_need_referenced_axes
         self.manual = ManualMode(channel, machine, params, cycle_s, self._move, self.report)
@@ -468,7 +476,7 @@ class ChannelRunner:
             contour_lookahead=self.config.contour_lookahead, surroundings=self._surroundings,
             section_planner=partial(plan_section, dynamics=dynamics,
                                     buffer_blocks=self._buffer_blocks, cycle_s=self._cycle_s),
-            interrupted=self._waiting,
+            interrupted=self._waiting, workers=self.workers,
         )
         feed.add(job)
         for more in self._queued_jobs:
@@ -571,6 +579,7 @@ class ChannelRunner:
             surroundings=self._surroundings,
             modal=self.new_modal(tuple(a.position_mm for a in ch.axes)),
             max_errors=self._check_max_errors, interrupted=self._waiting,
+            workers=self.workers,
         )
         self._run = ChannelCheck(self, ch, check, started_at_s=self.time_s,
                                  deterministic=self._deterministic)

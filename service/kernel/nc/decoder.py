@@ -22,6 +22,7 @@ import logging
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import replace
 
+from . import work_guard
 from .blockexec import BlockExecutor, Flow
 from .blocks import Block, LogArea
 from .call_stack import MAX_CALL_DEPTH, CallFrame, CallFrameKind
@@ -61,7 +62,6 @@ from .statements import (
 )
 from .technology import HSCS_MODES, Surroundings
 from .variables import Scope, Value, Variable, VarType
-from . import work_guard
 
 log = logging.getLogger(__name__)
 
