@@ -135,6 +135,18 @@ async def test_while_with_only_a_message_hits_the_endless_program_guard(tmp_path
     assert "20000 steps" in values["ch1.mc_error_1_text_r"]
 
 
+def _fifo_priorities(pid: int) -> list[int]:
+    """The SCHED_FIFO priority of every thread of process ``pid`` (0: SCHED_OTHER)."""
+    priorities = []
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            fifo = os.sched_getscheduler(int(tid)) == os.SCHED_FIFO
+            priorities.append(os.sched_getparam(int(tid)).sched_priority if fifo else 0)
+        except (ProcessLookupError, FileNotFoundError):  # a thread that just ended
+            continue
+    return priorities
+
+
 def _fifo_permitted() -> bool:
     try:
         param = os.sched_getparam(0)
@@ -153,17 +165,28 @@ async def test_sigterm_ends_the_realtime_service_while_such_programs_decode() ->
     then one more left decoding, then SIGTERM: the service ends within
     ``SIGTERM_EXIT_S``. (The decoders once ran at the cycle's priority, and a few of
     them starved the service's threads: SIGTERM never ended it.)"""
-    service = start_service("--clock", "realtime", "--rt-priority", "60")
+    # with CURVE keys: the service's ZAP thread (ZeroMQ's authentication) is one of the
+    # threads the shutdown waits for
+    service = start_service("--clock", "realtime", "--rt-priority", "60", keys=True)
     try:
         grant = service.wait_for_log(r"cycle thread under", timeout_s=10.0)
         if "SCHED_FIFO priority 60" not in grant:
             pytest.skip(f"the service got no real-time priority: {grant}")
-        async with AsyncClient(service.endpoint, timeout_s=30.0) as c:
-            for _ in range(3):
+        assert service.keys is not None
+        threads_idle = len(_fifo_priorities(service.process.pid))
+        async with AsyncClient(service.endpoint, timeout_s=30.0,
+                               key_file=service.keys.client("operator")) as c:
+            for _ in range(ROUNDS):
                 await c.mdi(nested_calls())
                 await c.reset()
             await c.mdi(nested_calls())
             assert await c.read("ch1.mc_active_state_r") == ChannelState.ACTIVE
+            # one decoder more than at rest (the run's), and only the cycle thread at
+            # the cycle's priority: the others below it, the decoder below the service's
+            priorities = _fifo_priorities(service.process.pid)
+            assert len(priorities) == threads_idle + 1, priorities
+            assert sorted(priorities)[-2:] == [59, 60], priorities
+            assert sorted(priorities)[0] < 59, priorities
         sent_s = time.monotonic()
         service.process.send_signal(signal.SIGTERM)
         try:
