@@ -36,28 +36,13 @@ from cnc_objects.service.kernel.commands import (
 )
 from cnc_objects.testing import serving, start_service
 from cnc_objects.testing.helpers import wait_for_async
+from tests.support.endless_programs import many_labels, nested_calls
 from tests.support.kernel import KernelHarness
 
 THREAD_END_S = 2.0  # a cancelled run's decoder thread has ended within this (bound)
 SIGTERM_EXIT_S = 2.0  # SIGTERM ends the service within this
 ROUNDS = 10
 ENDLESS_PROGRAM = 20226  # the decoder's endless-program guard (ISG-style id)
-
-
-def nested_calls(depth: int = 19, fan: int = 4) -> str:
-    """An MDI of local subprograms ``depth`` deep, each calling the next ``fan`` times:
-    fan**depth calls, no loop, no block (the innermost only returns)."""
-    lines = ["LL S1"]
-    for k in range(1, depth + 1):
-        lines.append(f"%L S{k}")
-        lines += [f"LL S{k + 1}"] * (fan if k < depth else 0)
-        lines.append("M17")
-    return "\n".join(lines) + "\n"
-
-
-def many_labels(count: int = 90_000) -> str:
-    """``count`` label lines and a backward ``$GOTO`` to the first: endless, no block."""
-    return "".join(f"N{k}\n" for k in range(1, count + 1)) + "$GOTO N1\nM30\n"
 
 
 def _decoders() -> set[threading.Thread]:
