@@ -257,8 +257,8 @@ class DecoderFeed:
                             sections.note(block)
                         if not self._put(block):
                             return
-                    elif not self._put_all(sections.push(block)):
-                        return
+                    elif self._cancel.is_set() or not self._put_all(sections.push(block)):
+                        return  # (a block collected into a section is not put: look here)
                     if block.stop == StopKind.PROGRAM_END:  # nothing after M30 is decoded
                         self._put(DecodeEnd())
                         return

@@ -182,3 +182,11 @@ async def test_sigterm_ends_the_realtime_service_while_such_programs_decode() ->
         assert code == 0, f"SIGTERM: exit {code} after {took_s:.1f} s"
     finally:
         service.stop()
+
+
+def test_reset_ends_an_endless_look_ahead_section(kernel: KernelHarness) -> None:
+    """Under LA_ON the decoder collects a section's blocks before it hands any over (up
+    to 500 000): it looks for the RESET at each block it collects."""
+    kernel.programs["la.nc"] = "G1 F1000\nLA_ON\n$WHILE 1\nG1 X1\nG1 X0\n$ENDWHILE\nM30\n"
+    assert kernel.command(SelectProgram(0, "la.nc")) is None
+    _start_then_reset(kernel, StartProgram(0, True))
