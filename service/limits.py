@@ -54,6 +54,7 @@ from cnc_objects.protocol.constants import (
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.frames import U32_MAX, encode_error
 
+from .kernel.nc.work_guard import IDLE_STEPS_MAX
 from .kernel.step_clock import STEP_MAX_CYCLES
 from .notifications import MAX_BYTES, MAX_BYTES_PER_CLIENT, NotificationLimits
 from .rate_limit import RateLimiter
@@ -125,6 +126,12 @@ class LimitsConfig(BaseModel):
         1000, ge=1, le=1_000_000,
         description="errors one syntax check keeps (listed in the channel, written to "
         "dec0<c>.sc); more are counted only, and the log says how many were left out",
+    )
+    decoder_idle_steps_max: int = Field(
+        IDLE_STEPS_MAX, ge=1_000, le=1_000_000_000,
+        description="the decoder's endless-program guard: steps of work (statements, calls, "
+        "jumps, lines without a block) without a single block before the program ends "
+        "with error 20226 (a few seconds of decoding at the default)",
     )
     step_max_cycles: int = Field(
         STEP_MAX_CYCLES, ge=1, le=10_000_000,

@@ -192,6 +192,7 @@ async def serve(
     kernel = Kernel(
         config.machine, clock, load, exists,
         writer.kernel_file, writer.save, check_max_errors=config.limits.check_max_errors,
+        idle_steps_max=limits.decoder_idle_steps_max,
         alarms=alarms, tables=kept.load(alarms),
     )
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows

@@ -66,6 +66,7 @@ from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRu
 from .tooling import seed_modal, tables_from_config, tooling_of
 from .tooling_view import after_reset, initial_tooling
 from .wait_reason import WaitReason, channel_wait_reason
+from .workers import Workers
 
 log = logging.getLogger(__name__)
 
@@ -106,6 +107,8 @@ class ChannelRunner:
         on_wait: Callable[[], None] = lambda: None,
         alarms: AlarmLog | None = None,
         tables: ToolingTables | None = None,
+        workers: Workers | None = None,
+        idle_steps_max: int | None = None,
     ) -> None:
         """``params`` are the kernel's effective axis parameters (read at each program
         start, so a parameter update applies from the next run); ``switchover`` links
@@ -117,7 +120,10 @@ class ChannelRunner:
         meanwhile; ``alarms``: the kernel's alarm log, which every listed error and
         warning is raised in (a log of its own when not given); ``tables``: the tool list
         and zero offsets to start with (the operator data the service kept), else the
-        configured ones."""
+        configured ones; ``workers``: the kernel's worker registry, which runs the decoder and check threads (one of its
+        own when not given); ``idle_steps_max``: the decoder's endless-program guard
+        ([limits] decoder_idle_steps_max; None: ``nc.work_guard.IDLE_STEPS_MAX``)."""
+        self.workers = Workers() if workers is None else workers
         self._on_wait = on_wait
         self.alarms = AlarmLog() if alarms is None else alarms
         self.channel = channel
@@ -164,6 +170,7 @@ class ChannelRunner:
             hscs={mode.upper(): HscProgram(c.prog, c.tolerance * 1e-4)  # 0.1 um -> mm
                   for mode, c in config.hscs},
             kinematics=False,  # this kernel configures no kinematic transformation
+            idle_steps_max=idle_steps_max,
         )
         self._programs_need_referenced_axes = machine.programs_need_referenced_axes
         self.manual = ManualMode(channel, machine, params, cycle_s, self._move, self.report)
@@ -475,7 +482,7 @@ class ChannelRunner:
             contour_lookahead=self.config.contour_lookahead, surroundings=self._surroundings,
             section_planner=partial(plan_section, dynamics=dynamics,
                                     buffer_blocks=self._buffer_blocks, cycle_s=self._cycle_s),
-            interrupted=self._waiting,
+            interrupted=self._waiting, workers=self.workers,
             skip_levels=ch.block_ignore_active,
         )
         feed.add(job)
@@ -579,6 +586,7 @@ class ChannelRunner:
             surroundings=self._surroundings,
             modal=self.new_modal(tuple(a.position_mm for a in ch.axes)),
             max_errors=self._check_max_errors, interrupted=self._waiting,
+            workers=self.workers,
         )
         self._run = ChannelCheck(self, ch, check, started_at_s=self.time_s,
                                  deterministic=self._deterministic)

@@ -25,6 +25,7 @@ from .nc.errors import DecodingCancelled
 from .nc.technology import Surroundings
 from .path.errors import PathError
 from .path.section_plan import SectionPlan
+from .workers import Workers
 
 log = logging.getLogger(__name__)
 
@@ -125,6 +126,7 @@ class DecoderFeed:
         section_planner: SectionPlanner | None = None,
         interrupted: Callable[[], bool] = lambda: False,
         skip_levels: int = 0,
+        workers: Workers | None = None,
     ) -> None:
         """``contour_lookahead``: FCT_CONTOUR_LAH is enabled (P-CHAN-00650), so the
         decoder accepts ``#CONTOUR LOOKAHEAD``; ``surroundings``: the file store, message
@@ -133,7 +135,8 @@ class DecoderFeed:
         ``interrupted``: called at each poll while ``take`` waits (the kernel answers
         the cycle's commands then); True once a RESET is queued, so that ``take`` stops
         waiting (a decoder in a loop without blocks would hold the cycle until its loop
-        guard)."""
+        guard); ``workers``: the kernel's worker registry, which starts, counts and at
+        the end joins the SDA thread (one of its own when not given)."""
         self._interrupted = interrupted
         self._skip_levels = skip_levels  # lines /n skipped: bit n-1 (block skip switch)
         self._surroundings = surroundings
@@ -152,10 +155,8 @@ class DecoderFeed:
         self._markers: set[int] = set()
         self.decoded_all = False  # the SDA thread has queued its last item
         self._outstanding = 0  # jobs added whose end the GEO side has not taken yet
-        self._thread = threading.Thread(
-            target=self._run, name=f"cnc-sda-ch{channel_id}", daemon=True
-        )
-        self._thread.start()
+        workers = Workers() if workers is None else workers
+        self._thread = workers.start(f"cnc-sda-ch{channel_id}", self._run, self.cancel)
 
     # ------------------------------------------------------------ GEO side
 
@@ -259,8 +260,8 @@ class DecoderFeed:
                             sections.note(block)
                         if not self._put(block):
                             return
-                    elif not self._put_all(sections.push(block)):
-                        return
+                    elif self._cancel.is_set() or not self._put_all(sections.push(block)):
+                        return  # (a block collected into a section is not put: look here)
                     if block.stop == StopKind.PROGRAM_END:  # nothing after M30 is decoded
                         self._put(DecodeEnd())
                         return

@@ -27,11 +27,12 @@ from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
 from .commands import Command, Refusal, RefusalReason, ResetChannel
 from .nc.tool_data import ToolingTables
-from .realtime_priority import RealtimeGrant
+from .realtime_priority import RealtimeGrant, worker_priority
 from .state import CycleStats, ErrorEntry, KernelState, Snapshot
 from .step_clock import NOT_STEPPING, STEP_RUNNING, StepClock, StepCycles
 from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS
+from .workers import Workers
 
 log = logging.getLogger(__name__)
 
@@ -109,6 +110,7 @@ class Kernel:
         check_max_errors: int = CHECK_MAX_ERRORS,
         alarms: AlarmLog | None = None,
         tables: Sequence[ToolingTables | None] = (),
+        idle_steps_max: int | None = None,
     ) -> None:
         """``loader(name)`` returns a program's text (KeyError when absent) and
         ``exists(name)`` says whether it is there: the program store, seen by the kernel,
@@ -121,9 +123,17 @@ class Kernel:
         every channel raises its errors and warnings in (one with the default bounds
         when not given); it outlives a kernel RESET. ``tables``: each channel's tool
         list and zero offsets at start (the operator data the service kept; None or
-        absent: the configured ones); a kernel RESET keeps the tables it has then."""
+        absent: the configured ones); a kernel RESET keeps the tables it has then.
+        ``idle_steps_max``: the decoder's endless-program guard ([limits]
+        decoder_idle_steps_max; None: the default).
+
+        The kernel owns its threads: the cycle thread and the workers (``workers``: the
+        decoders and syntax checks), which run below the cycle's priority and which
+        ``close`` cancels and joins."""
         self._tables: list[ToolingTables | None] = list(tables)
         self._check_max_errors = check_max_errors
+        self._idle_steps_max = idle_steps_max
+        self.workers = Workers()
         self.alarms = AlarmLog() if alarms is None else alarms
         self.config = config
         self.cycle_s = config.cycle_ms / 1000.0
@@ -180,7 +190,8 @@ class Kernel:
                           save=self._save,
                           check_max_errors=self._check_max_errors,
                           on_wait=self._reply_while_waiting, alarms=self.alarms,
-                          tables=self._tables[k] if k < len(self._tables) else None)
+                          tables=self._tables[k] if k < len(self._tables) else None,
+                          workers=self.workers, idle_steps_max=self._idle_steps_max)
             for k, (channel, cfg) in enumerate(zip(state.channels, self.config.channels,
                                                    strict=True))
         ]
@@ -247,15 +258,17 @@ class Kernel:
         self._thread.start()
 
     def close(self, timeout_s: float = 5.0) -> None:
-        """Stop the cycle thread and wait for it; queued commands are refused."""
+        """Stop the cycle thread and wait for it, then cancel and join the workers, all
+        within ``timeout_s``; queued commands are refused."""
         self._closed = True
-        if self._thread is None:
-            return
-        self._queue.put((_SHUTDOWN, _no_answer))
-        self._thread.join(timeout_s)
-        if self._thread.is_alive():
-            log.error("cycle thread did not stop within %.1f s", timeout_s)
-        self._thread = None
+        deadline = time.monotonic() + timeout_s
+        if self._thread is not None:
+            self._queue.put((_SHUTDOWN, _no_answer))
+            self._thread.join(timeout_s)
+            if self._thread.is_alive():
+                log.error("cycle thread did not stop within %.1f s", timeout_s)
+            self._thread = None
+        self.workers.close(max(deadline - time.monotonic(), 0.0))
 
     # ------------------------------------------------------------ cycle thread
 
@@ -268,6 +281,8 @@ class Kernel:
 
     def _run(self) -> None:
         self._clock.start()
+        # workers started from here on run below the cycle (and the service's threads)
+        self.workers.priority = worker_priority(self.realtime_grant)
         try:
             while True:
                 if not self.stats.running and not self._paused():
@@ -298,6 +313,8 @@ class Kernel:
         acknowledge) never waits for a step. The next granted cycle then starts with it
         applied, as a command applied at the start of that cycle would be."""
         self._clock.start()
+        # workers started from here on run below the cycle (and the service's threads)
+        self.workers.priority = worker_priority(self.realtime_grant)
         try:
             while True:
                 if not self.stats.running and not self._paused():

@@ -7,7 +7,10 @@ memory is locked (``mlockall(MCL_CURRENT | MCL_FUTURE)``) so that no page fault 
 or to a dropped file page stalls a cycle. Where not, the thread stays SCHED_OTHER and the
 service goes on: ``RealtimeGrant`` says what was asked, what was granted and why not.
 ``serve_below`` puts the service's other threads one priority below the cycle thread:
-the cycle needs the GIL as well as the CPU.
+the cycle needs the GIL as well as the CPU. The kernel's workers (decoder, syntax
+check) run below both (``worker_priority``, ``run_as_worker``): only the cycle thread
+has the cycle's priority, and a worker that computes without pause never starves the
+service's threads (the event loop, ZeroMQ's, the shutdown).
 
 Only Linux has these calls here; elsewhere the grant says so.
 """
@@ -28,6 +31,9 @@ log = logging.getLogger(__name__)
 #: below the kernel's own watchdog and migration threads (99).
 DEFAULT_RT_PRIORITY = 60
 RT_PRIORITY_MAX = 99
+#: The kernel's workers run this far below the cycle thread: one below the service's
+#: threads (which run one below the cycle), so that they preempt a busy worker.
+WORKERS_BELOW_CYCLE = 2
 
 _MCL_CURRENT = 1  # sys/mman.h (Linux)
 _MCL_FUTURE = 2
@@ -113,3 +119,32 @@ def serve_below(cycle_priority: int) -> RealtimeGrant:
     grant = RealtimeGrant(max(cycle_priority - 1, 1) if cycle_priority else 0)
     claim(grant, lock_memory=False)
     return grant
+
+
+def worker_priority(cycle: RealtimeGrant | None) -> int:
+    """The SCHED_FIFO priority of the kernel's workers when the cycle thread got
+    ``cycle``: ``WORKERS_BELOW_CYCLE`` below it; 0 (SCHED_OTHER) when the cycle thread
+    has no real-time priority or the difference leaves none."""
+    if cycle is None or cycle.policy is not SchedPolicy.FIFO:
+        return 0
+    return max(cycle.priority - WORKERS_BELOW_CYCLE, 0)
+
+
+def run_as_worker(priority: int) -> bool:
+    """Put the CALLING thread under SCHED_FIFO at ``priority``, or SCHED_OTHER for 0.
+
+    A thread inherits its creator's policy: a worker started from the cycle thread would
+    run at the cycle's priority, above every thread of the service. Lowering one's own
+    priority is always permitted; False (logged) where the call is refused anyway, or
+    where Linux's calls are missing. Never raises."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        if priority > 0:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+        elif os.sched_getscheduler(0) != os.SCHED_OTHER:
+            os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
+    except OSError as exc:
+        log.warning("worker thread keeps its scheduling policy: %s", exc.strerror)
+        return False
+    return True

@@ -44,12 +44,14 @@ from ..machine_config import SyntaxCheckConfig
 from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, Compensation, StopKind
 from .nc.check import CheckAborted, ErrorCategory, PointBatch
+from .nc.errors import DecodingCancelled
 from .nc.source import SourceText, strip_comments
 from .nc.technology import Surroundings
 from .path.endpoints import first_violation
 from .path.errors import PathError
 from .path.limits import AxisDynamics
 from .path.segments import PathPreparation
+from .workers import Workers
 
 log = logging.getLogger(__name__)
 
@@ -128,9 +130,12 @@ class CheckRun:
         modal: ModalState | None = None,
         max_errors: int = CHECK_MAX_ERRORS,
         interrupted: Callable[[], bool] = lambda: False,
+        workers: Workers | None = None,
     ) -> None:
-        """``max_errors``: errors kept (listed and logged) per check, the limit
-        ``check_max_errors``; the rest are counted only. ``interrupted``: called at each
+        """``workers``: the kernel's worker registry, which starts, counts and at the
+        end joins the check's thread (one of its own when not given). ``max_errors``:
+        errors kept (listed and logged) per check, the limit ``check_max_errors``; the
+        rest are counted only. ``interrupted``: called at each
         poll while ``advance`` waits (the kernel answers the cycle's commands then); True
         once a RESET is queued: ``advance`` stops waiting for the check then."""
         self._interrupted = interrupted
@@ -168,9 +173,8 @@ class CheckRun:
         self._position = start_mm  # where the last checked block ended
         self._prep: PathPreparation | None = None  # blocks under radius compensation
         self._surroundings = surroundings  # cycle parameters (files and messages: none)
-        self._thread = threading.Thread(target=self._run, name=f"cnc-check-ch{channel_id}",
-                                        daemon=True)
-        self._thread.start()
+        workers = Workers() if workers is None else workers
+        self._thread = workers.start(f"cnc-check-ch{channel_id}", self._run, self.cancel)
 
     # ------------------------------------------------------------ GEO side
 
@@ -218,6 +222,9 @@ class CheckRun:
         with self._cond:
             self._cancelled = True
             self._cond.notify_all()
+
+    def _is_cancelled(self) -> bool:
+        return self._cancelled
 
     @property
     def pause(self) -> Pause:
@@ -299,6 +306,7 @@ class CheckRun:
             )
             self._sources[self.name] = decoder.source
             self._decoder = decoder
+            decoder.cancelled = self._is_cancelled  # RESET ends even a check without errors
             if self._record:
                 self._log.append(check_log.header_line(self.name, self.channel_id))
             items: Iterator[Block | PointBatch] = decoder.blocks()  # batches in a check
@@ -311,7 +319,7 @@ class CheckRun:
                 elif self._block(item):
                     break
             self._flush_prep()
-        except CheckAborted:
+        except (CheckAborted, DecodingCancelled):
             pass
         except KeyError as exc:
             self._end_with(CheckedError(NcError(

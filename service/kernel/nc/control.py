@@ -13,11 +13,10 @@ caller pulls them.
 
 A real-time loop entered while the contour look-ahead's marked area is open gets
 marker Blocks at its passes (``rt_loop_markers.RtLoopMarkers``): ``run`` returns them.
-They do not count as blocks for the endless-loop guard.
+They do not count as blocks for the endless-program guard.
 
-A decode-time loop that runs ``MAX_IDLE_LOOP_PASSES`` passes without producing a
-single block is stopped with ENDLESS_LOOP (``$WHILE TRUE`` without motion would
-otherwise hang the SDA task).
+The endless-program guard and the look for a RESET are not the loops' business: the
+decoding loop counts every step of work, loops or not (``work_guard``).
 """
 
 from __future__ import annotations
@@ -26,7 +25,7 @@ from collections.abc import Callable
 
 from .blocks import Block
 from .call_stack import CallFrame, ControlEntry
-from .errors import DecodingCancelled, NcError, NcErrorId
+from .errors import NcError, NcErrorId
 from .expressions import number, truth
 from .program import Statement, Structure
 from .rt_loop_markers import RtLoopMarkers
@@ -34,9 +33,6 @@ from .running_decoder import RunningDecoder
 from .source import LogicalLine
 from .statements import LOOPS, SPELLING, Control, Goto, StmtKind
 from .variables import Value
-
-MAX_IDLE_LOOP_PASSES = 1_000_000  # loop passes without a block before ENDLESS_LOOP
-CANCEL_CHECK_PASSES = 1024  # idle loop passes between two looks at ``decoder.cancelled``
 
 #: a control statement's handler: (frame, statement, index after it) -> marker Block or None
 Handler = Callable[[CallFrame, Control, int], Block | None]
@@ -47,8 +43,6 @@ class ControlFlow:
 
     def __init__(self, decoder: RunningDecoder) -> None:
         self.decoder = decoder
-        self.idle_passes = 0
-        self.blocks_at_last_pass = -1
         self.markers = RtLoopMarkers(decoder)
         k = StmtKind
         self.handlers: dict[StmtKind, Handler] = {
@@ -68,22 +62,6 @@ class ControlFlow:
         return self.handlers[stmt.kind](frame, stmt, after)
 
     # ------------------------------------------------------------ helpers
-
-    def loop_pass(self, stmt_line: LogicalLine, pos: int) -> None:
-        """Count one pass of a decode-time loop; too many without a block is an error."""
-        emitted = self.decoder.emitted
-        if emitted != self.blocks_at_last_pass:
-            self.blocks_at_last_pass = emitted
-            self.idle_passes = 0
-        self.idle_passes += 1
-        if not self.idle_passes % CANCEL_CHECK_PASSES and self.decoder.cancelled():
-            raise DecodingCancelled  # RESET: the SDA thread ends now, not at the guard
-        if self.idle_passes > MAX_IDLE_LOOP_PASSES:
-            raise stmt_line.error(
-                NcErrorId.ENDLESS_LOOP,
-                f"endless loop: {MAX_IDLE_LOOP_PASSES} passes without a motion or other block",
-                pos,
-            )
 
     def _cond(self, stmt: Control) -> bool:
         if stmt.expr is None:  # #RT WHILE without condition
@@ -180,7 +158,6 @@ class ControlFlow:
         if top is None:
             raise self._mismatch(frame, stmt, NcErrorId.LOOP_END_WITHOUT_BEGIN, opener)
         frame.control.pop()
-        self.loop_pass(stmt.line, stmt.pos)
         if opener == StmtKind.RT_WHILE:
             self.markers.closed(frame, top)
         frame.index = top.index  # the loop statement tests its condition again
@@ -215,7 +192,6 @@ class ControlFlow:
         value = number(opener.target(self.decoder), opener.line, opener.pos, "a number in $FOR")
         opener.target.assign(self.decoder, value + top.step)
         if self._in_range(opener, top.end, top.step):
-            self.loop_pass(stmt.line, stmt.pos)
             frame.index = top.body
         else:
             frame.control.pop()
@@ -233,7 +209,6 @@ class ControlFlow:
             frame.control.pop()
             frame.index = after
         else:
-            self.loop_pass(stmt.line, stmt.pos)
             frame.index = top.body
 
     # ------------------------------------------------------------ $SWITCH
@@ -316,8 +291,6 @@ class ControlFlow:
         target = program.find_label(frame.section, goto.label, here)
         if target is None:
             raise line.error(NcErrorId.LABEL_NOT_FOUND, f"label {goto.label} not found", goto.pos)
-        if target <= here:
-            self.loop_pass(line, goto.pos)
         while frame.control:
             entry = frame.control[-1]
             structure = self._structure(frame, entry.stmt, entry.index)

@@ -22,6 +22,7 @@ import logging
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import replace
 
+from . import work_guard
 from .blockexec import BlockExecutor, Flow
 from .blocks import Block, LogArea
 from .call_stack import MAX_CALL_DEPTH, CallFrame, CallFrameKind
@@ -39,7 +40,7 @@ from .contour_run import execute_contour
 from .control import ControlFlow
 from .cycle_run import call_cycle
 from .declarations import declare, read_block
-from .errors import NcError, NcErrorId
+from .errors import DecodingCancelled, NcError, NcErrorId
 from .fastpath import decoding_loop
 from .instruction_run import pattern_error, run_instruction
 from .instructions import Instruction
@@ -147,10 +148,12 @@ class Decoder:
         self._control = ControlFlow(self)
         self.finished = False
         self._started = False
-        self.emitted = 0  # grows whenever blocks were yielded (the loop guard watches it)
         self.own_variables: set[int] = set()  # ids of the variables this decoder declared
         # the run's owner sets this to learn of a RESET (``DecodingCancelled``)
         self.cancelled: Callable[[], bool] = _never
+        # the endless-program guard's limit (work_guard): steps without a block
+        limit = self.surroundings.idle_steps_max
+        self.idle_steps_max = work_guard.IDLE_STEPS_MAX if limit is None else limit
         self._executed: Block | None = None  # check mode: the Block of the line's words
 
     @property
@@ -265,6 +268,25 @@ class Decoder:
         for declaration in declarations:
             declare(self, frame, declaration)
         frame.index = next_index
+
+    # ------------------------------------------------------------ the work counter
+
+    def look(self, idle_steps: int) -> None:
+        """The decoding loop's look at the run, every ``LOOK_EVERY_STEPS`` steps
+        (``work_guard``): ``DecodingCancelled`` after a RESET; ENDLESS_LOOP once
+        ``idle_steps`` (steps since the last block) exceed the limit. The syntax check
+        reports that error and ends (``finished``): nothing after it would ever run."""
+        if self.cancelled():
+            raise DecodingCancelled  # RESET: the SDA thread ends now
+        if idle_steps <= self.idle_steps_max:
+            return
+        frame = self.frames[-1]
+        program = frame.program
+        error = work_guard.endless_program(program.src, program.name, frame.index, self.idle_steps_max)
+        if self.check is None:
+            raise error
+        self.check.report(error, ErrorCategory.RESOURCE)
+        self.finished = True
 
     # ------------------------------------------------------------ the general path
 

@@ -114,7 +114,7 @@ class NcErrorId(IntEnum):
     BREAK_OUTSIDE_LOOP = 20223  # $BREAK/$CONTINUE outside a loop or $SWITCH
     FOR_STEP_ZERO = 20224  # $FOR with step 0 would never end
     UNKNOWN_CONTROL_KEYWORD = 20225  # $WORD that is not a control statement
-    ENDLESS_LOOP = 20226  # 1,000,000 loop passes without a single block
+    ENDLESS_LOOP = 20226  # endless program: 1,000,000 steps of work without a block (work_guard)
     LABEL_NOT_FOUND = 20227  # $GOTO to a label the program does not define
     BAD_GOTO_TARGET = 20839  # ISG: character after $GOTO not permitted
 

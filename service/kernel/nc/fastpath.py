@@ -50,6 +50,7 @@ from .construct import (
 from .contour import LOOP_MARKERS
 from .geometry import ARC_TOLERANCE_MM
 from .modal import DistanceMode
+from .work_guard import LOOK_EVERY_STEPS
 
 # a number: at most 20 digits and dots, so always finite; float() rejects "1.2.3"
 _NUM = r"([-+]?[0-9.]{1,20}+)[ \t]*+"
@@ -63,8 +64,13 @@ def run(decoder):
     manual = decoder.manual
     executor = decoder.executor
     slow_step = decoder.slow_step
+    look = decoder.look
     match = MATCH
     new = NEW
+    # the work counter (work_guard): steps so far, the step of the last block, the step
+    # of the next look at the run (RESET, the endless-program guard)
+    work = progress = 0
+    look_at = LOOK_EVERY
     while True:
         # (re)load the running frame and the modal state: the general path may have
         # called, returned, jumped or changed G90/G91, the plane, F, D, ...
@@ -91,7 +97,6 @@ def run(decoder):
         # with an axis released (#AX RELEASE) every line takes the general path, which
         # rejects the words of released axes
         fast_end = {fast_end}
-        emitted = False
 {setup}
         try:
             while i < fast_end:
@@ -109,7 +114,11 @@ def run(decoder):
                     else:
                         feed_k = feed
                     if {no_axis_word} and t_i is None and t_j is None and t_k is None:
-                        # modal words only (N, G, F): no block
+                        # modal words only (N, G, F): no block, a step of idle work;
+                        # the general path takes the line when it is time to look
+                        work += 1
+                        if work >= look_at:
+                            break
                         if gcode is not None:
                             kind = k
                             modal.motion = k
@@ -198,17 +207,21 @@ def run(decoder):
             raise decoder.fault(exc, frame, i) from exc
         frame.index = i
 {flush}
-        if emitted:
-            decoder.emitted += 1  # only the change matters (ControlFlow.loop_pass)
         # the line the hot path did not take: the general path
         block = slow_step(frame)
+        work += 1
         if block is not None:
-            # a real-time loop marker is no block of the program: the loop guard ignores it
+            # a real-time loop marker is no block of the program: the guard ignores it
             if block.contour is None or block.contour.kind not in LOOP_MARKERS:
-                decoder.emitted += 1
+                progress = work
             yield block
         if decoder.finished:
             return
+        if work >= look_at:
+            look_at = work + LOOK_EVERY
+            look(work - progress)  # raises on RESET and at the guard
+            if decoder.finished:  # syntax check: the guard's error reported, the end
+                return
 '''
 
 _MOTION_FAST = '''\
@@ -259,17 +272,17 @@ _BLOCK_PLAIN = '''\
 _EMIT_BLOCK = '''\
 {block}
                 i += 1
-                emitted = True
+                progress = work
                 yield block'''
 
 # check mode (syntax check, dry run): a record per moving line instead of a Block
 # (``motion`` is the arc centre, 0 for a straight line: its record has centre None);
-# ``emitted`` as where the normal loop yields a Block, so the loop guard sees the same
+# ``progress`` as where the normal loop yields a Block, so the guard sees the same
 _EMIT_RECORD = '''\
                 if motion is not None:
                     record((i, k, end_pos, motion or None))
                 i += 1
-                emitted = True'''
+                progress = work'''
 
 _SETUP_RECORDS = '''\
         start_i = i
@@ -359,6 +372,7 @@ def decoding_loop(axes: tuple[str, ...], check: bool = False) -> Callable[..., I
         "BLOCK": Block, "NO_STOP": StopKind.NONE, "MAKE_MOTION": make_motion,
         "MAKE_BLOCK": make_block, "MAKE_SOURCE": make_source, "LOOP_MARKERS": LOOP_MARKERS,
         "POINT_BATCH": PointBatch, "BATCH_LINES": BATCH_LINES, "COMP_OFF": Compensation.OFF,
+        "LOOK_EVERY": LOOK_EVERY_STEPS,
     }
     code = compile(loop_source(axes, check),
                    f"<decoding loop {''.join(axes)}{' check' if check else ''}>", "exec")

@@ -33,7 +33,6 @@ class RunningDecoder(Env, Protocol):
     frames: list[CallFrame]  # the call frames, the running one last
     manual: bool  # decoding a manual block (MDI), not a program
     contour_lookahead: bool  # the channel has FCT_CONTOUR_LAH (P-CHAN-00650)
-    emitted: int  # grows whenever blocks were yielded (the endless-loop guard watches it)
     own_variables: set[int]  # ids of the variables this decoder declared
     cancelled: Callable[[], bool]  # True once the run is cancelled (RESET)
 

@@ -66,10 +66,13 @@ class Surroundings:
     or raises ``OutputLimitReached``; ``show_message(text)`` puts a ``#MSG`` into the
     channel's message list; ``hscs`` maps a mode of ``HSCS_MODES`` to its program and
     tolerance; ``kinematics``: the channel has a kinematic transformation configured
-    (needed to rotate the tool). The defaults drop files and messages.
+    (needed to rotate the tool); ``idle_steps_max``: steps of work without a block before
+    the endless-program guard ends the decoding (``work_guard``, ``[limits]
+    decoder_idle_steps_max``). The defaults drop files and messages.
     """
 
     write_file: Callable[[str, str, bool], None] = _ignore
     show_message: Callable[[str], None] = _ignore
     hscs: Mapping[str, HscProgram] = field(default_factory=dict)
     kinematics: bool = False
+    idle_steps_max: int | None = None  # the endless-program guard; None: IDLE_STEPS_MAX

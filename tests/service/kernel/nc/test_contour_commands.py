@@ -17,7 +17,7 @@ from cnc_objects.service.kernel.nc import (
     NcError,
     NcErrorId,
     check_syntax,
-    control,
+    work_guard,
 )
 
 from .support import AXES, decode, decoder, error_of, slow
@@ -415,7 +415,7 @@ def test_an_endless_real_time_loop_gives_markers_as_long_as_pulled():
 
 
 def test_markers_do_not_count_for_the_endless_loop_guard(monkeypatch):
-    monkeypatch.setattr(control, "MAX_IDLE_LOOP_PASSES", 50)
+    monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 50)
     d = decoder("#CONTOUR LOOKAHEAD LOG ON\nG0 X1\n#RT WHILE\n#RT ENDWHILE\nM30",
                 contour_lookahead=True)
     got = []
@@ -424,7 +424,8 @@ def test_markers_do_not_count_for_the_endless_loop_guard(monkeypatch):
             got.append(block)
     assert (info.value.id, info.value.line) == (NcErrorId.ENDLESS_LOOP, 4)
     assert trace(got)[:3] == [("LOG_ON", None), ("X", 1.0), ("PASS", 1, 1)]
-    assert len(got) == 2 + 51  # the markers of the passes the guard let through
+    # the markers of the passes (2 steps each) up to the first look past the limit
+    assert len(got) == 2 + work_guard.LOOK_EVERY_STEPS // 2
 
 
 # ---------------------------------------------------------------- paths, syntax check

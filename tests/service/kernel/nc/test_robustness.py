@@ -9,7 +9,7 @@ from itertools import islice
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from cnc_objects.service.kernel.nc import NcError, NcErrorId, control
+from cnc_objects.service.kernel.nc import NcError, NcErrorId, work_guard
 
 from .support import decoder, slow
 
@@ -52,7 +52,7 @@ def _outcome(text: str, limit: int = MAX_BLOCKS, **kw):
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(text=nc_text, manual=st.booleans())
 def test_garbage_raises_only_nc_errors(monkeypatch, text, manual):
-    monkeypatch.setattr(control, "MAX_IDLE_LOOP_PASSES", 200)
+    monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 200)
     files = {"s.nc": text}
     _outcome(text, manual=manual, files=files)
 
