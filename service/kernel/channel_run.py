@@ -120,9 +120,10 @@ class ChannelRunner:
         meanwhile; ``alarms``: the kernel's alarm log, which every listed error and
         warning is raised in (a log of its own when not given); ``tables``: the tool list
         and zero offsets to start with (the operator data the service kept), else the
-        configured ones; ``workers``: the kernel's worker registry, which runs the decoder and check threads (one of its
-        own when not given); ``idle_steps_max``: the decoder's endless-program guard
-        ([limits] decoder_idle_steps_max; None: ``nc.work_guard.IDLE_STEPS_MAX``)."""
+        configured ones; ``workers``: the kernel's worker registry, which runs the
+        decoder and check threads (one of its own when not given); ``idle_steps_max``:
+        the decoder's endless-program guard ([limits] decoder_idle_steps_max; None:
+        ``nc.work_guard.IDLE_STEPS_MAX``)."""
         self.workers = Workers() if workers is None else workers
         self._on_wait = on_wait
         self.alarms = AlarmLog() if alarms is None else alarms
