@@ -73,6 +73,11 @@ from .transport import AsyncTransport
 DEFAULT_TIMEOUT_S = 5.0
 _HANDLE_PORT = CncPort.COM  # handles are global in the service; any CNC port serves them
 SUGGESTIONS = 3  # nearest names offered for an unknown one
+# How often the service checks an on-change subscription when the caller names no
+# cycle_ms: 10 kernel cycles of 1 ms, 100 samples/s at most for an object that changes
+# every cycle (a moving axis sent 1000/s before; issue 36). cycle_ms=0: every cycle.
+DEFAULT_ON_CHANGE_CYCLE_MS = 10
+DEFAULT_CYCLIC_CYCLE_MS = 100  # a cyclic subscription without cycle_ms
 T = TypeVar("T")
 
 
@@ -364,13 +369,14 @@ class AsyncClient(TraceOps, AlarmOps):
     ) -> AsyncGenerator[Sample, None]:
         """Samples of ``name`` as the service sends them (server-side notification).
 
-        ``on_change``: a sample when the value changed, checked every ``cycle_ms`` (default:
-        every kernel cycle); otherwise one every ``cycle_ms`` (default 100 ms) of kernel
-        time. The first sample is the current value. Leaving the loop deletes the
-        subscription.
+        ``on_change``: a sample when the value changed, checked every ``cycle_ms`` of kernel
+        time (default 10 ms; 0: every kernel cycle, so that a value held for one cycle is
+        seen); otherwise one every ``cycle_ms`` (default 100 ms). The first sample is the
+        current value. Leaving the loop deletes the subscription.
         """
         mode = TransmissionMode.SERVER_ON_CHANGE if on_change else TransmissionMode.SERVER_CYCLE
-        cycle = cycle_ms if cycle_ms is not None else (0 if on_change else 100)
+        default = DEFAULT_ON_CHANGE_CYCLE_MS if on_change else DEFAULT_CYCLIC_CYCLE_MS
+        cycle = cycle_ms if cycle_ms is not None else default
         try:
             info = await self._object(name)
             reply = await self._call(
