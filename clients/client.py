@@ -28,7 +28,6 @@ let the client in (its key refused, or keys that do not fit) raises
 from __future__ import annotations
 
 import contextlib
-import difflib
 import os
 from collections.abc import AsyncGenerator, AsyncIterator, Coroutine, Iterable, Iterator
 from dataclasses import dataclass
@@ -148,6 +147,8 @@ def _ads_state(state: AdsState | int | str) -> int:
 
 def _suggest(name: str, known: Iterable[str]) -> str:
     """ ``; did you mean a, b or c?`` for the names nearest to ``name``, else ``""``."""
+    import difflib  # only when a name is unknown: not on every client's start
+
     names = {k.lower(): k for k in known}
     nearest = [names[k] for k in difflib.get_close_matches(name.lower(), names, SUGGESTIONS)]
     if not nearest:
