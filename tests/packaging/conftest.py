@@ -25,8 +25,9 @@ def wheel(wheel_build: tuple[Path, str]) -> Path:
 
 @pytest.fixture(scope="session")
 def wheel_build(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
-    """(the wheel, what the build printed): ``pip wheel --no-deps --no-build-isolation`` of a copy of this checkout, offline
-    (``--no-index``): the build uses the setuptools installed with the test extra."""
+    """(the wheel, what the build printed): ``pip wheel --no-deps --no-build-isolation``
+    of a copy of this checkout, offline (``--no-index``): the build uses the setuptools
+    installed with the test extra."""
     source = tmp_path_factory.mktemp("source") / "cnc-objects"
     shutil.copytree(ROOT, source, ignore=_NOT_SOURCE, symlinks=True)
     out = tmp_path_factory.mktemp("wheel")
