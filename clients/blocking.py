@@ -159,9 +159,16 @@ class Client(BlockingClientBase):
             timeout_s=timeout_s,
         ))
 
-    def jog_stop(self, axis: str | int, channel: int = 1) -> AxisState:
-        """Release both jog keys of ``axis`` (a continuous jog stops)."""
-        return run_blocking(self._core.jog_stop(axis, channel))
+    def jog_stop(
+        self,
+        axis: str | int,
+        channel: int = 1,
+        wait: bool = True,
+        timeout_s: float | None = None,
+    ) -> AxisState:
+        """Release both jog keys of ``axis`` (a continuous jog stops); with ``wait``
+        (default) returns once it stands."""
+        return run_blocking(self._core.jog_stop(axis, channel, wait, timeout_s))
 
     def mdi(self, blocks: str, channel: int = 1) -> int:
         """Run ``blocks`` as manual blocks; returns the count of finished manual blocks

@@ -85,7 +85,7 @@ def jog(
     try:
         with settings.session(f"jog of {axis} in channel {channel}") as c:
             if stop:
-                state = c.jog_stop(axis, channel)
+                state = c.jog_stop(axis, channel, wait=not no_wait, timeout_s=timeout_s)
             else:
                 state = c.jog(axis, direction, increment_mm=increment_mm, continuous=continuous,
                               handwheel_pulses=handwheel, rapid=rapid, channel=channel,

@@ -120,12 +120,16 @@ class ManualOps(MixinBase):
             await self._wait_standstill(channel, k, timeout_s)
         return await self.axis_state(k, channel)
 
-    async def jog_stop(self, axis: str | int, channel: int = 1) -> AxisState:
-        """Release both jog keys of ``axis`` (a continuous jog stops)."""
+    async def jog_stop(self, axis: str | int, channel: int = 1, wait: bool = True,
+                       timeout_s: float | None = None) -> AxisState:
+        """Release both jog keys of ``axis`` (a continuous jog stops); with ``wait``
+        (default) returns once it stands."""
         k = await self.axis_index(axis, channel)
         p = f"ch{channel}.ax{k}."
         await self.write(p + "manual_jog_plus_w", False)
         await self.write(p + "manual_jog_minus_w", False)
+        if wait:
+            await self._wait_standstill(channel, k, timeout_s)
         return await self.axis_state(k, channel)
 
     async def home(self, axes: Iterable[str | int] | str | int, channel: int = 1,

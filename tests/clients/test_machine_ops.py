@@ -10,7 +10,7 @@ import contextlib
 import pytest
 
 from cnc_objects.clients import AsyncClient, Client, ClientValueError
-from cnc_objects.testing import ServiceProcess, wait_for
+from cnc_objects.testing import ServiceProcess
 
 OVERRIDE_R, OVERRIDE_W = "ch1.mc_active_feed_override_r", "ch1.mc_command_feed_override_w"
 POSITION = "ch1.ax1.command_position_acs"
@@ -63,10 +63,9 @@ def test_continuous_jog_until_stopped(cnc_client: Client) -> None:
     c = cnc_client
     c.jog("Z", "+", continuous=True)  # returns at once, the key left pressed
     assert c.read("ch1.ax3.manual_jog_plus_w")
-    c.jog_stop("Z")
+    stopped = c.jog_stop("Z", timeout_s=TIMEOUT_S)  # waits until it stands
     assert not c.read("ch1.ax3.manual_jog_plus_w")
-    wait_for(c, "ch1.ax3.manual_moving_r", False)
-    assert c.axis_state("Z").position_mm > 0
+    assert not stopped.moving and stopped.position_mm > 0
 
 
 def test_tools_and_zero_offsets_in_mm(cnc_client: Client) -> None:
