@@ -6,7 +6,7 @@ loop, no thread). Async generators (``subscribe``) become plain iterators."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
 from cnc_objects.protocol.constants import AdsState
@@ -15,8 +15,11 @@ from cnc_objects.protocol.datatypes import DataType
 from .alarm_ops import AlarmEvent, AlarmList
 from .channel_ops import ChannelStatus, CheckResult, ContourReply, OnWaitReason, ProgramEntry
 from .client import BlockingClientBase, DeviceInfo, Sample, iterate_blocking, run_blocking
+from .manual_ops import AxisState
 from .object_info import ObjectInfo
 from .path_trace import PathTrace
+from .spindle_ops import SpindleStatus
+from .tooling_ops import ActiveTool, ToolRow, ZeroOffsets
 
 
 class Client(BlockingClientBase):
@@ -31,6 +34,10 @@ class Client(BlockingClientBase):
         """Acknowledge every active alarm."""
         return run_blocking(self._core.acknowledge_all_alarms())
 
+    def active_tool(self, channel: int = 1) -> ActiveTool:
+        """T selected, T in the spindle, D, and radius and length of D (mm)."""
+        return run_blocking(self._core.active_tool(channel))
+
     def alarm_events(self) -> Iterator[AlarmEvent]:
         """The alarms' events from now on, in the order they happened per alarm:
         ``raised``, ``acknowledged``, ``cleared`` (an alarm raised and cleared between
@@ -44,6 +51,19 @@ class Client(BlockingClientBase):
         (``alarm_changes_r`` moved), they are read again, so every alarm returned is one
         the service listed whole."""
         return run_blocking(self._core.alarms(history))
+
+    def axis_index(self, axis: str | int, channel: int = 1) -> int:
+        """The index (from 1) of ``axis``, given by name (any case) or index;
+        ``ClientValueError`` naming the channel's axes when it has none such."""
+        return run_blocking(self._core.axis_index(axis, channel))
+
+    def axis_names(self, channel: int = 1) -> list[str]:
+        """The axis names of ``channel``, by axis index from 1."""
+        return run_blocking(self._core.axis_names(channel))
+
+    def axis_state(self, axis: str | int, channel: int = 1) -> AxisState:
+        """Position (mm), motion, limit warning and homing of an axis."""
+        return run_blocking(self._core.axis_state(axis, channel))
 
     def browse(self, pattern: str = "*") -> list[ObjectInfo]:
         """Descriptions of the objects whose names match the glob ``pattern``."""
@@ -96,9 +116,59 @@ class Client(BlockingClientBase):
         """Feedhold: the path decelerates and stops (HOLD)."""
         return run_blocking(self._core.hold(channel))
 
+    def home(
+        self,
+        axes: Iterable[str | int] | str | int,
+        channel: int = 1,
+        timeout_s: float | None = None,
+    ) -> list[AxisState]:
+        """Home ``axes`` (one axis or several, started together) in manual mode, to their
+        reference positions (P-AXIS-00152); returns once all are referenced."""
+        return run_blocking(self._core.home(axes, channel, timeout_s))
+
     def info(self) -> DeviceInfo:
         """Device name and version (ReadDeviceInfo) and ADS state (ReadState)."""
         return run_blocking(self._core.info())
+
+    def jog(
+        self,
+        axis: str | int,
+        direction: str | int = "+",
+        *,
+        increment_mm: float | None = None,
+        continuous: bool = False,
+        handwheel_pulses: int | None = None,
+        rapid: bool = False,
+        channel: int = 1,
+        wait: bool = True,
+        timeout_s: float | None = None,
+    ) -> AxisState:
+        """Jog ``axis`` in ``direction`` (``"+"``/``"-"`` or 1/-1) in manual mode: by
+        ``increment_mm`` (the default: one increment of 1 mm), ``continuous``ly (the key
+        stays pressed until ``jog_stop``; no wait), or by ``handwheel_pulses``. With
+        ``wait`` (default) returns once the axis stands; ``rapid`` presses the rapid key."""
+        return run_blocking(self._core.jog(
+            axis,
+            direction,
+            increment_mm=increment_mm,
+            continuous=continuous,
+            handwheel_pulses=handwheel_pulses,
+            rapid=rapid,
+            channel=channel,
+            wait=wait,
+            timeout_s=timeout_s,
+        ))
+
+    def jog_stop(
+        self,
+        axis: str | int,
+        channel: int = 1,
+        wait: bool = True,
+        timeout_s: float | None = None,
+    ) -> AxisState:
+        """Release both jog keys of ``axis`` (a continuous jog stops); with ``wait``
+        (default) returns once it stands."""
+        return run_blocking(self._core.jog_stop(axis, channel, wait, timeout_s))
 
     def mdi(self, blocks: str, channel: int = 1) -> int:
         """Run ``blocks`` as manual blocks; returns the count of finished manual blocks
@@ -115,17 +185,20 @@ class Client(BlockingClientBase):
         """Every file in the store, sorted by name."""
         return run_blocking(self._core.programs())
 
-    def read(self, name: str) -> Any:
-        """Read the object ``name``."""
-        return run_blocking(self._core.read(name))
+    def read(self, name: str, units: bool = False) -> Any:
+        """Read the object ``name``: its own value (0.1 um, 0.1 %, as the catalog says),
+        or with ``units`` in engineering units (mm, %, rpm: ``ObjectInfo.scale``, its
+        unit ``ObjectInfo.engineering_unit``), rounded to the object's resolution."""
+        return run_blocking(self._core.read(name, units))
 
     def read_address(self, port: int, group: int, offset: int, dtype: DataType | str) -> Any:
         """Read the value at an ADS address, decoded as ``dtype`` (``"UNS16"``, ...)."""
         return run_blocking(self._core.read_address(port, group, offset, dtype))
 
-    def read_many(self, names: Iterable[str]) -> dict[str, Any]:
-        """Read several objects in one sum-read round trip (handles cached per name)."""
-        return run_blocking(self._core.read_many(names))
+    def read_many(self, names: Iterable[str], units: bool = False) -> dict[str, Any]:
+        """Read several objects in one sum-read round trip (handles cached per name);
+        ``units`` as for ``read``."""
+        return run_blocking(self._core.read_many(names, units))
 
     def read_raw(self, port: int, group: int, offset: int, length: int) -> bytes:
         """Read ``length`` raw bytes at an ADS address."""
@@ -164,28 +237,75 @@ class Client(BlockingClientBase):
         A channel in ERROR refuses (ADS 0x707, naming its errors) until RESET."""
         return run_blocking(self._core.run_program(name, channel))
 
+    def set_spindle_override(self, percent: float, channel: int = 1) -> None:
+        """Set the spindle override (%, 0..150)."""
+        return run_blocking(self._core.set_spindle_override(percent, channel))
+
+    def set_tool(
+        self,
+        d: int,
+        radius_mm: float | None = None,
+        length_mm: float | None = None,
+        valid: bool = True,
+        channel: int = 1,
+    ) -> None:
+        """Write row ``d`` of the tool list: radius and length (mm, those given), and the
+        row valid (``valid=False`` empties it)."""
+        return run_blocking(self._core.set_tool(d, radius_mm, length_mm, valid, channel))
+
+    def set_zero_offset(
+        self,
+        group: str | int,
+        offsets_mm: Mapping[str, float],
+        channel: int = 1,
+    ) -> None:
+        """Write the offsets (mm, by axis name) of one group (``"G54"`` or the
+        ``np_grp`` index)."""
+        return run_blocking(self._core.set_zero_offset(group, offsets_mm, channel))
+
+    def spindle(self, channel: int = 1) -> SpindleStatus:
+        """The spindle's values and the listed technology units of ``channel``."""
+        return run_blocking(self._core.spindle(channel))
+
     def start(self, channel: int = 1) -> None:
         """START: run the selected program, or resume after feedhold, M0 or single block."""
         return run_blocking(self._core.start(channel))
 
+    def start_spindle(
+        self,
+        rpm: float,
+        ccw: bool = False,
+        channel: int = 1,
+        timeout_s: float | None = None,
+    ) -> None:
+        """Start the spindle at ``rpm`` by the manual block ``S<rpm> M3`` (``ccw``: M4);
+        returns when the block is done (with the embedded defaults: speed reached)."""
+        return run_blocking(self._core.start_spindle(rpm, ccw, channel, timeout_s))
+
     def status(self, channel: int = 1) -> ChannelStatus:
         """Mode, state, program, block and axis positions of a channel."""
         return run_blocking(self._core.status(channel))
+
+    def stop_spindle(self, channel: int = 1, timeout_s: float | None = None) -> None:
+        """Stop the spindle by the manual block M5; returns at standstill."""
+        return run_blocking(self._core.stop_spindle(channel, timeout_s))
 
     def subscribe(
         self,
         name: str,
         on_change: bool = True,
         cycle_ms: int | None = None,
+        units: bool = False,
     ) -> Iterator[Sample]:
         """Samples of ``name`` as the service sends them (server-side notification).
 
-        ``on_change``: a sample when the value changed, checked every ``cycle_ms`` (default:
-        every kernel cycle); otherwise one every ``cycle_ms`` (default 100 ms) of kernel
-        time. The first sample is the current value. Leaving the loop deletes the
-        subscription.
+        ``on_change``: a sample when the value changed, checked every ``cycle_ms`` of kernel
+        time (default 10 ms; 0: every kernel cycle, so that a value held for one cycle is
+        seen); otherwise one every ``cycle_ms`` (default 100 ms). The first sample is the
+        current value. Leaving the loop deletes the subscription. ``units``: the samples'
+        values in engineering units, as for ``read``.
         """
-        return iterate_blocking(self._core.subscribe(name, on_change, cycle_ms))
+        return iterate_blocking(self._core.subscribe(name, on_change, cycle_ms, units))
 
     def syntax_check(
         self,
@@ -212,6 +332,10 @@ class Client(BlockingClientBase):
         to ERROR without a check (the start failed).
         """
         return run_blocking(self._core.syntax_check(program, channel, errors_total, timeout_s))
+
+    def tools(self, channel: int = 1) -> list[ToolRow]:
+        """Every row of the channel's tool list, empty ones included."""
+        return run_blocking(self._core.tools(channel))
 
     def trace_run(
         self,
@@ -278,10 +402,12 @@ class Client(BlockingClientBase):
             reason_settle_s=reason_settle_s,
         ))
 
-    def write(self, name: str, value: Any) -> None:
-        """Write the object ``name``; returns once the kernel has applied it. A value its
-        type cannot hold raises ``ClientValueError`` before anything is sent."""
-        return run_blocking(self._core.write(name, value))
+    def write(self, name: str, value: Any, units: bool = False) -> None:
+        """Write the object ``name``; returns once the kernel has applied it. With
+        ``units``, ``value`` is in engineering units (``write(override, 50, units=True)``
+        writes 500 (0.1 %)). A value its type cannot hold raises ``ClientValueError``
+        before anything is sent."""
+        return run_blocking(self._core.write(name, value, units))
 
     def write_address(
         self,
@@ -303,3 +429,7 @@ class Client(BlockingClientBase):
     def write_raw(self, port: int, group: int, offset: int, data: bytes) -> None:
         """Write raw bytes at an ADS address."""
         return run_blocking(self._core.write_raw(port, group, offset, data))
+
+    def zero_offsets(self, channel: int = 1) -> ZeroOffsets:
+        """The zero offset table, the active group and the positions (mm)."""
+        return run_blocking(self._core.zero_offsets(channel))

@@ -16,78 +16,41 @@ homing, value out of range) exits 1 with the kernel's sentence; ``--wait-timeout
 
 from __future__ import annotations
 
-import time
 from typing import TYPE_CHECKING, Any
 
 import typer
 
 from .cli_app import EXIT_USAGE, Settings, command, emit, err, fail, say_error
-from .errors import AdsError, ClientValueError
-from .units import engineering, raw_value
+from .errors import AdsError, AdsTimeoutError, ClientValueError, NoReplyError
 
-if TYPE_CHECKING:  # a client is made by Settings, when a command connects
-    from .blocking import Client
+if TYPE_CHECKING:  # the client library is imported when a command connects
+    from .manual_ops import AxisState
 
 EXIT_WAIT_TIMEOUT = 5
-_MANUAL = 4  # ChannelMode.MANUAL
-_HANDWHEEL, _CONTINUOUS, _INCREMENTAL = 1, 2, 3  # ManualOperationMode
-_POLL_S = 0.02
-_MAX_AXES = 32
 AxesArgument = typer.Argument(..., metavar="AXIS...", help="Axis names (X Y Z) or indices, homed together.")
 
 
-def _axis_index(c: Client, channel: int, axis: str) -> int:
-    """The index (from 1) of ``axis``, given by name or by index."""
-    names: list[str] = []
-    for k in range(1, _MAX_AXES + 1):
-        try:
-            names.append(c.read(f"ch{channel}.ax{k}.axis_name"))
-        except (AdsError, ClientValueError, KeyError):
-            break
-    if axis.isdigit() and 1 <= int(axis) <= len(names):
-        return int(axis)
-    for k, name in enumerate(names, start=1):
-        if name.upper() == axis.upper():
-            return k
-    say_error(f"channel {channel} has no axis {axis!r} (axes: {', '.join(names)})")
-    raise typer.Exit(EXIT_USAGE)
-
-
-def _manual_mode(c: Client, channel: int) -> None:
-    """Select MANUAL unless the channel is in it (the kernel refuses while it works)."""
-    if c.read(f"ch{channel}.mc_active_mode_r") != _MANUAL:
-        c.write(f"ch{channel}.mc_command_mode_w", _MANUAL)
-
-
-def _wait_standstill(c: Client, prefix: str, timeout_s: float | None,
-                     also: str | None = None) -> None:
-    """Poll until the axis's manual motion is over (and ``also`` is FALSE)."""
-    deadline = None if timeout_s is None else time.monotonic() + timeout_s
-    names = [f"{prefix}.manual_moving_r"] + ([also] if also else [])
-    while any(c.read_many(names).values()):
-        if deadline is not None and time.monotonic() > deadline:
-            say_error(f"{prefix} still moves after {timeout_s:g} s")
-            raise typer.Exit(EXIT_WAIT_TIMEOUT)
-        time.sleep(_POLL_S)
-
-
-def _report(settings: Settings, c: Client, channel: int, axis: int, name: str) -> None:
-    prefix = f"ch{channel}.ax{axis}"
-    values = c.read_many([f"{prefix}.command_position_acs", f"{prefix}.manual_limit_warning_r",
-                          f"{prefix}.manual_moving_r", f"{prefix}.homing_referenced_r"])
-    position = f"{prefix}.command_position_acs"
-    position_mm = engineering(c.describe(position), values[position])  # 0.1 um -> mm
-    at_limit = values[f"{prefix}.manual_limit_warning_r"]
-    if at_limit:
-        err.print(f"warning: axis {name} stopped at its software limit", markup=False,
+def _report(settings: Settings, state: AxisState) -> None:
+    if state.limit_warning:
+        err.print(f"warning: axis {state.axis} stopped at its software limit", markup=False,
                   emoji=False)
     record: dict[str, Any] = {
-        "channel": channel, "axis": name, "position_mm": position_mm,
-        "moving": values[f"{prefix}.manual_moving_r"], "limit_warning": at_limit,
-        "referenced": values[f"{prefix}.homing_referenced_r"],
+        "channel": state.channel, "axis": state.axis, "position_mm": state.position_mm,
+        "moving": state.moving, "limit_warning": state.limit_warning,
+        "referenced": state.referenced,
     }
-    state = "moving" if record["moving"] else "stands"
-    emit(settings, record, f"channel {channel}: axis {name} {state} at {position_mm:.4f} mm")
+    moves = "moving" if state.moving else "stands"
+    emit(settings, record,
+         f"channel {state.channel}: axis {state.axis} {moves} at {state.position_mm:.4f} mm")
+
+
+def _fail(exc: AdsError | ClientValueError) -> None:
+    """A wait that timed out exits 5 (a request without reply is no wait: 3), else as
+    ``fail``."""
+    if isinstance(exc, AdsTimeoutError) and not isinstance(exc, NoReplyError):
+        say_error(str(exc))
+        raise typer.Exit(EXIT_WAIT_TIMEOUT)
+    fail(exc)
 
 
 @command()
@@ -121,38 +84,15 @@ def jog(
         raise typer.Exit(EXIT_USAGE)
     try:
         with settings.session(f"jog of {axis} in channel {channel}") as c:
-            k = _axis_index(c, channel, axis)
-            name = c.read(f"ch{channel}.ax{k}.axis_name")
-            prefix = f"ch{channel}.ax{k}"
-            key = f"{prefix}.manual_jog_{'plus' if direction == '+' else 'minus'}_w"
             if stop:
-                c.write(f"{prefix}.manual_jog_plus_w", False)
-                c.write(f"{prefix}.manual_jog_minus_w", False)
+                state = c.jog_stop(axis, channel, wait=not no_wait, timeout_s=timeout_s)
             else:
-                _manual_mode(c, channel)
-                c.write(f"{prefix}.manual_rapid_w", rapid)
-                if handwheel is not None:
-                    c.write(f"{prefix}.manual_operation_mode_w", _HANDWHEEL)
-                    counter = c.read(f"{prefix}.manual_handwheel_counter_w")
-                    sign = 1 if direction == "+" else -1
-                    wrapped = (counter + sign * handwheel + 2**31) % 2**32 - 2**31
-                    c.write(f"{prefix}.manual_handwheel_counter_w", wrapped)
-                elif continuous:
-                    c.write(f"{prefix}.manual_operation_mode_w", _CONTINUOUS)
-                    c.write(key, True)
-                    no_wait = True  # it moves until --stop or the software limit
-                else:
-                    c.write(f"{prefix}.manual_operation_mode_w", _INCREMENTAL)
-                    increment = f"{prefix}.manual_increment_w"  # 0.1 um; the scale says
-                    c.write(increment, raw_value(c.describe(increment),
-                                                 1.0 if increment_mm is None else increment_mm))
-                    c.write(key, True)
-                    c.write(key, False)
-            if not no_wait:
-                _wait_standstill(c, prefix, timeout_s)
-            _report(settings, c, channel, k, name)
+                state = c.jog(axis, direction, increment_mm=increment_mm, continuous=continuous,
+                              handwheel_pulses=handwheel, rapid=rapid, channel=channel,
+                              wait=not no_wait, timeout_s=timeout_s)
+            _report(settings, state)
     except (AdsError, ClientValueError) as exc:
-        fail(exc)
+        _fail(exc)
 
 
 @command()
@@ -168,14 +108,7 @@ def home(
     settings: Settings = ctx.obj
     try:
         with settings.session(f"homing in channel {channel}") as c:
-            indices = [_axis_index(c, channel, a) for a in axes]
-            _manual_mode(c, channel)
-            for k in indices:
-                c.write(f"ch{channel}.ax{k}.homing_start_w", True)
-            for k in indices:
-                prefix = f"ch{channel}.ax{k}"
-                _wait_standstill(c, prefix, timeout_s, also=f"{prefix}.homing_active_r")
-            for k in indices:
-                _report(settings, c, channel, k, c.read(f"ch{channel}.ax{k}.axis_name"))
+            for state in c.home(axes, channel, timeout_s):
+                _report(settings, state)
     except (AdsError, ClientValueError) as exc:
-        fail(exc)
+        _fail(exc)

@@ -253,7 +253,8 @@ def watch(
     timeout_s: float = typer.Option(
         None, "--wait-timeout", min=0.0, metavar="S", help="Stop after S seconds; with --count, exit 5 when "
         "an object got fewer than COUNT samples by then."),
-    cycle_ms: int = typer.Option(None, "--cycle-ms", min=0, help="Sampling cycle in kernel ms."),
+    cycle_ms: int = typer.Option(None, "--cycle-ms", min=0, help="Sampling cycle in kernel ms "
+                                 "(default 10 on change, 0: every cycle; 100 with --cyclic)."),
     cyclic: bool = typer.Option(False, help="Send every cycle, not only on change."),
     raw: RawOption = False,
 ) -> None:

@@ -7,50 +7,16 @@ The values are the channel's COM objects ``ch<c>.mc_spindle_*`` and
 
 from __future__ import annotations
 
+from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 import typer
 
 from .cli_app import EXIT_USAGE, Settings, command, emit, err
 from .cli_machine import ChannelOption
-from .units import engineering, raw_value
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
     from .blocking import Client
-MODE_NAMES = {1: "M5", 2: "M3", 4: "M4", 8: "M19"}
-SYNC_NAMES = {0: "-", 1: "MOS", 2: "MVS_SVS", 4: "MVS_SNS", 8: "MNS_SNS"}
-TYPE_NAMES = {1: "M", 2: "H", 3: "S", 4: "T"}
-TECHNO_UNITS = 16
-
-
-def _engineering(c: Client, name: str) -> Any:
-    """The value of ``name`` in engineering units (rpm, %)."""
-    return engineering(c.describe(name), c.read(name))
-
-
-def read_spindle(c: Client, channel: int) -> dict[str, Any]:
-    """The spindle's values and the listed technology units of ``channel``."""
-    p = f"ch{channel}.mc_spindle_"
-    units = []
-    for k in range(TECHNO_UNITS):
-        q = f"ch{channel}.mc_techno_{k}_"
-        kind = c.read(q + "typ")
-        if not kind:
-            break
-        units.append({"type": TYPE_NAMES.get(kind, str(kind)), "number": c.read(q + "nr"),
-                      "sync": SYNC_NAMES.get(c.read(q + "synch"), "?"),
-                      "pending": bool(c.read(q + "state"))})
-    return {
-        "channel": channel,
-        "mode": MODE_NAMES.get(c.read(p + "mode_r"), "?"),
-        # 0.001 deg/s -> rpm, 0.1 % -> %: by the scale the service gives for each object
-        "programmed_rpm": _engineering(c, p + "prog_rev_r"),
-        "commanded_rpm": _engineering(c, p + "cmd_rev_r"),
-        "actual_rpm": _engineering(c, p + "active_rev_r"),
-        "override_pct": _engineering(c, p + "override_w"),
-        "speed_reached": bool(c.read(p + "speed_reached_r")),
-        "units": units,
-    }
 
 
 @command()
@@ -77,14 +43,12 @@ def spindle(
 
     def act(c: Client) -> dict[str, Any]:
         if override is not None:
-            target = f"ch{channel}.mc_spindle_override_w"  # 0.1 %; the scale says
-            c.write(target, raw_value(c.describe(target), override))
-        block = "M5" if stop else None
-        if start is not None:
-            block = f"S{start:g} {'M4' if ccw else 'M3'}"
-        if block is not None:  # waits until the block is done (M3/M4: speed reached)
-            c.wait_mdi(c.mdi(block, channel), channel, settings.timeout_s)
-        return read_spindle(c, channel)
+            c.set_spindle_override(override, channel)
+        if start is not None:  # waits until the block is done (M3/M4: speed reached)
+            c.start_spindle(start, ccw, channel, settings.timeout_s)
+        elif stop:
+            c.stop_spindle(channel, settings.timeout_s)
+        return asdict(c.spindle(channel))
 
     s = settings.call(act, f"spindle of channel {channel}")
     lines = [

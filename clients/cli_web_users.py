@@ -13,11 +13,16 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from .cli_app import EXIT_USAGE, app, say_error
-from .web.users import DEFAULT_USERS_FILE, WebRole, WebUsers, load_users, save_users
+
+if TYPE_CHECKING:  # imported by the commands that use them (argon2: not on every start)
+    from .web.users import WebRole, WebUsers
+
+DEFAULT_FILE_TEXT = "cnc-data/web-users.json"  # shown in --help; users.DEFAULT_USERS_FILE
 
 web_users_app = typer.Typer(
     add_completion=False, no_args_is_help=True,
@@ -25,11 +30,20 @@ web_users_app = typer.Typer(
 )
 app.add_typer(web_users_app, name="web-users")
 
-FileOption = typer.Option(DEFAULT_USERS_FILE, "--file", metavar="FILE",
-                          help=f"The web users file (default {DEFAULT_USERS_FILE}).")
+FileOption = typer.Option(None, "--file", metavar="FILE", show_default=False,
+                          help=f"The web users file (default {DEFAULT_FILE_TEXT}).")
+
+
+def _file(path: Path | None) -> Path:
+    """The file given, else the users' default file."""
+    from .web.users import DEFAULT_USERS_FILE
+
+    return DEFAULT_USERS_FILE if path is None else path
 
 
 def _role(name: str) -> WebRole:
+    from .web.users import WebRole
+
     try:
         return WebRole.parse(name)
     except ValueError as exc:
@@ -38,6 +52,8 @@ def _role(name: str) -> WebRole:
 
 
 def _load(path: Path) -> WebUsers:
+    from .web.users import WebUsers, load_users
+
     if not path.exists():
         return WebUsers()
     try:
@@ -45,6 +61,12 @@ def _load(path: Path) -> WebUsers:
     except ValueError as exc:
         say_error(str(exc))
         raise typer.Exit(EXIT_USAGE) from None
+
+
+def _save(path: Path, users: WebUsers) -> None:
+    from .web.users import save_users
+
+    save_users(path, users)
 
 
 def _password(role: WebRole) -> str:
@@ -56,36 +78,37 @@ def _password(role: WebRole) -> str:
 
 @web_users_app.command("set")
 def set_password(role: str = typer.Argument(..., help="monitor, operator or admin."),
-                 file: Path = FileOption) -> None:
+                 file: Path | None = FileOption) -> None:
     """Set (or change) the password of ROLE."""
-    chosen = _role(role)
-    users = _load(file)
+    chosen, path = _role(role), _file(file)
+    users = _load(path)
     try:
         users.set_password(chosen, _password(chosen))
     except ValueError as exc:
         say_error(str(exc))
         raise typer.Exit(EXIT_USAGE) from None
-    save_users(file, users)
-    print(f"role {chosen.label} can sign in to cnc-web ({file}; a running cnc-web ends the "
+    _save(path, users)
+    print(f"role {chosen.label} can sign in to cnc-web ({path}; a running cnc-web ends the "
           "sessions of its old password at once)")
 
 
 @web_users_app.command("remove")
 def remove(role: str = typer.Argument(..., help="monitor, operator or admin."),
-           file: Path = FileOption) -> None:
+           file: Path | None = FileOption) -> None:
     """Remove the password of ROLE: it can no longer sign in."""
-    chosen = _role(role)
-    users = _load(file)
+    chosen, path = _role(role), _file(file)
+    users = _load(path)
     if not users.remove(chosen):
-        say_error(f"role {chosen.label} has no password in {file}")
+        say_error(f"role {chosen.label} has no password in {path}")
         raise typer.Exit(1)
-    save_users(file, users)
-    print(f"role {chosen.label} can no longer sign in ({file}; a running cnc-web ends its "
+    _save(path, users)
+    print(f"role {chosen.label} can no longer sign in ({path}; a running cnc-web ends its "
           "sessions at once)")
 
 
 @web_users_app.command("list")
-def list_roles(file: Path = FileOption) -> None:
+def list_roles(file: Path | None = FileOption) -> None:
     """The roles that can sign in."""
-    users = _load(file)
-    print(" ".join(r.label for r in users.roles) or f"no role can sign in ({file})")
+    path = _file(file)
+    users = _load(path)
+    print(" ".join(r.label for r in users.roles) or f"no role can sign in ({path})")

@@ -28,7 +28,6 @@ let the client in (its key refused, or keys that do not fit) raises
 from __future__ import annotations
 
 import contextlib
-import difflib
 import os
 from collections.abc import AsyncGenerator, AsyncIterator, Coroutine, Iterable, Iterator
 from dataclasses import dataclass
@@ -65,14 +64,21 @@ from .channel_ops import (
 from .curve import client_curve
 from .endpoint import DEFAULT_ENDPOINT as DEFAULT_ENDPOINT  # re-exported: its old home
 from .errors import AdsConnectionError, AdsError, ClientValueError, NoReplyError
+from .machine_ops import MachineOps
 from .object_info import ObjectInfo
 from .path_trace import TraceOps
 from .sync_transport import SyncTransport, drive
 from .transport import AsyncTransport
+from .units import engineering, raw_value
 
 DEFAULT_TIMEOUT_S = 5.0
 _HANDLE_PORT = CncPort.COM  # handles are global in the service; any CNC port serves them
 SUGGESTIONS = 3  # nearest names offered for an unknown one
+# How often the service checks an on-change subscription when the caller names no
+# cycle_ms: 10 kernel cycles of 1 ms, 100 samples/s at most for an object that changes
+# every cycle (a moving axis sent 1000/s before; issue 36). cycle_ms=0: every cycle.
+DEFAULT_ON_CHANGE_CYCLE_MS = 10
+DEFAULT_CYCLIC_CYCLE_MS = 100  # a cyclic subscription without cycle_ms
 T = TypeVar("T")
 
 
@@ -141,6 +147,8 @@ def _ads_state(state: AdsState | int | str) -> int:
 
 def _suggest(name: str, known: Iterable[str]) -> str:
     """ ``; did you mean a, b or c?`` for the names nearest to ``name``, else ``""``."""
+    import difflib  # only when a name is unknown: not on every client's start
+
     names = {k.lower(): k for k in known}
     nearest = [names[k] for k in difflib.get_close_matches(name.lower(), names, SUGGESTIONS)]
     if not nearest:
@@ -156,10 +164,17 @@ def _decode(dtype: DataType, data: bytes, what: str) -> Any:
         raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, f"{what}: {exc}") from None
 
 
+def _raw(info: ObjectInfo, value: Any) -> Any:
+    """``value`` given in engineering units as the object's own (a number only)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ClientValueError(f"{info.name}: units=True takes a number, not {value!r}")
+    return raw_value(info, value)
+
+
 PathText = str | os.PathLike[str]
 
 
-class AsyncClient(TraceOps, AlarmOps):
+class AsyncClient(TraceOps, AlarmOps, MachineOps):
     """Asyncio client of a cnc-objects service. Use with ``async with``.
 
     ``key_file``: this client's CURVE secret key file (``NAME.key_secret``, or ``NAME.key``
@@ -276,14 +291,17 @@ class AsyncClient(TraceOps, AlarmOps):
         """Read ``length`` raw bytes at an ADS address."""
         return self._data(await self._call(ReadRequest, port, group, offset, length))
 
-    async def read(self, name: str) -> Any:
-        """Read the object ``name``."""
+    async def read(self, name: str, units: bool = False) -> Any:
+        """Read the object ``name``: its own value (0.1 um, 0.1 %, as the catalog says),
+        or with ``units`` in engineering units (mm, %, rpm: ``ObjectInfo.scale``, its
+        unit ``ObjectInfo.engineering_unit``), rounded to the object's resolution."""
         try:
             info = await self._object(name)
             reply = await self._call(ReadRequest, info.port, info.group, info.offset, info.length)
         except NoReplyError as exc:  # the first read of a name browses: name the READ
             raise exc.asking(f"READ {name}") from None
-        return _decode(info.dtype, self._payload(reply), info.name)
+        value = _decode(info.dtype, self._payload(reply), info.name)
+        return engineering(info, value) if units else value
 
     async def write_address(
         self, port: int, group: int, offset: int, dtype: DataType | str, value: Any
@@ -304,24 +322,32 @@ class AsyncClient(TraceOps, AlarmOps):
         """Write raw bytes at an ADS address."""
         await self._call(WriteRequest, port, group, offset, data)
 
-    async def write(self, name: str, value: Any) -> None:
-        """Write the object ``name``; returns once the kernel has applied it. A value its
-        type cannot hold raises ``ClientValueError`` before anything is sent."""
+    async def write(self, name: str, value: Any, units: bool = False) -> None:
+        """Write the object ``name``; returns once the kernel has applied it. With
+        ``units``, ``value`` is in engineering units (``write(override, 50, units=True)``
+        writes 500 (0.1 %)). A value its type cannot hold raises ``ClientValueError``
+        before anything is sent."""
         try:
             info = await self._object(name)
+            if units:
+                value = _raw(info, value)
             data = _encode(info.dtype, value, info.name)
             await self._call(WriteRequest, info.port, info.group, info.offset, data)
         except NoReplyError as exc:
             raise exc.asking(f"WRITE {name}") from None
 
-    async def read_many(self, names: Iterable[str]) -> dict[str, Any]:
-        """Read several objects in one sum-read round trip (handles cached per name)."""
+    async def read_many(self, names: Iterable[str], units: bool = False) -> dict[str, Any]:
+        """Read several objects in one sum-read round trip (handles cached per name);
+        ``units`` as for ``read``."""
         names = list(names)
         try:
-            return await self._read_many(names)
+            values = await self._read_many(names)
         except NoReplyError as exc:
             shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
             raise exc.asking(f"READ {shown}") from None
+        if units:
+            return {n: engineering(await self._object(n), v) for n, v in values.items()}
+        return values
 
     async def _read_many(self, names: list[str]) -> dict[str, Any]:
         infos = [await self._object(n) for n in names]
@@ -360,17 +386,20 @@ class AsyncClient(TraceOps, AlarmOps):
             self._handles[name] = int.from_bytes(raw, "little")
 
     async def subscribe(
-        self, name: str, on_change: bool = True, cycle_ms: int | None = None
+        self, name: str, on_change: bool = True, cycle_ms: int | None = None,
+        units: bool = False,
     ) -> AsyncGenerator[Sample, None]:
         """Samples of ``name`` as the service sends them (server-side notification).
 
-        ``on_change``: a sample when the value changed, checked every ``cycle_ms`` (default:
-        every kernel cycle); otherwise one every ``cycle_ms`` (default 100 ms) of kernel
-        time. The first sample is the current value. Leaving the loop deletes the
-        subscription.
+        ``on_change``: a sample when the value changed, checked every ``cycle_ms`` of kernel
+        time (default 10 ms; 0: every kernel cycle, so that a value held for one cycle is
+        seen); otherwise one every ``cycle_ms`` (default 100 ms). The first sample is the
+        current value. Leaving the loop deletes the subscription. ``units``: the samples'
+        values in engineering units, as for ``read``.
         """
         mode = TransmissionMode.SERVER_ON_CHANGE if on_change else TransmissionMode.SERVER_CYCLE
-        cycle = cycle_ms if cycle_ms is not None else (0 if on_change else 100)
+        default = DEFAULT_ON_CHANGE_CYCLE_MS if on_change else DEFAULT_CYCLIC_CYCLE_MS
+        cycle = cycle_ms if cycle_ms is not None else default
         try:
             info = await self._object(name)
             reply = await self._call(
@@ -384,9 +413,10 @@ class AsyncClient(TraceOps, AlarmOps):
         try:
             while True:
                 raw = await self._t.next_sample(handle)
+                value = _decode(info.dtype, raw.data, info.name)
                 yield Sample(
                     info.name,
-                    _decode(info.dtype, raw.data, info.name),
+                    engineering(info, value) if units else value,
                     filetime_to_datetime(raw.timestamp),
                     raw.sequence,
                 )

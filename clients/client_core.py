@@ -1,5 +1,5 @@
 """What the operation mixins (``ProgramOps``, ``ChannelOps``, ``TraceOps``,
-``AlarmOps``) need of the client they are mixed into: the object and raw-address
+``AlarmOps``, ``MachineOps``) need of the client they are mixed into: the object and raw-address
 requests of ``AsyncClient`` and its transport's pause. Declared as a Protocol so that
 mypy checks the mixins' bodies; at run time the mixins derive from ``object``."""
 
@@ -29,20 +29,25 @@ class ClientCore(Protocol):
         """Descriptions of the objects whose names match ``pattern``."""
         ...
 
-    async def read(self, name: str) -> Any:
+    async def describe(self, name: str) -> ObjectInfo:
+        """What the service says about the object ``name``."""
+        ...
+
+    async def read(self, name: str, units: bool = False) -> Any:
         """Read the object ``name``."""
         ...
 
-    async def write(self, name: str, value: Any) -> None:
+    async def write(self, name: str, value: Any, units: bool = False) -> None:
         """Write the object ``name``."""
         ...
 
-    async def read_many(self, names: Iterable[str]) -> dict[str, Any]:
+    async def read_many(self, names: Iterable[str], units: bool = False) -> dict[str, Any]:
         """Read several objects in one round trip."""
         ...
 
     def subscribe(
-        self, name: str, on_change: bool = True, cycle_ms: int | None = None
+        self, name: str, on_change: bool = True, cycle_ms: int | None = None,
+        units: bool = False,
     ) -> AsyncIterator[Any]:
         """Samples of ``name`` as the service sends them."""
         ...

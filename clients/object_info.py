@@ -59,6 +59,12 @@ class ObjectInfo:
     scale: Scale | None = None
 
     @property
+    def engineering_unit(self) -> str:
+        """The unit of the value in engineering units (``read(name, units=True)``): the
+        scale's (mm for 0.1 um), else the object's own."""
+        return self.scale.unit if self.scale is not None else self.unit
+
+    @property
     def dtype(self) -> DataType:
         """The object's data type."""
         return parse_type(self.type)

@@ -31,6 +31,10 @@ CLASSES = [
     ("channel_ops.py", "ChannelOps"),
     ("channel_ops.py", "ProgramOps"),
     ("alarm_ops.py", "AlarmOps"),
+    ("machine_ops.py", "MachineOps"),
+    ("tooling_ops.py", "ToolingOps"),
+    ("manual_ops.py", "ManualOps"),
+    ("spindle_ops.py", "SpindleOps"),
 ]
 _ASYNC_ITERATORS = ("AsyncIterator", "AsyncGenerator")
 _TYPING_NAMES = {"Any"}

@@ -41,7 +41,7 @@ _LOST = (AdsTimeoutError, AdsConnectionError)  # the service does not answer
 class Feed:
     """One subscription: ``apply`` gets each value of ``name`` (it may be a coroutine
     function: the next sample waits until it is done). ``cycle_ms``: how often the
-    service checks for a change, in kernel time (None: every cycle). ``engineering``:
+    service checks for a change, in kernel time (None: the client's default, 10 ms). ``engineering``:
     ``apply`` gets the value in engineering units (mm, mm/min, %), by the scale the
     service gives for the object (clients/units.py), not the object's own value."""
 

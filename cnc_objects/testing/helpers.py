@@ -80,7 +80,7 @@ async def wait_for_async(
     """
     matches, wanted = _matcher(expected)
     seen: deque[Any] = deque(maxlen=_SEEN)
-    samples = client.subscribe(name)
+    samples = client.subscribe(name, cycle_ms=0)  # every cycle: see a one-cycle value
     deadline = asyncio.timeout(timeout_s)
     try:
         async with contextlib.aclosing(samples), deadline:

@@ -17,6 +17,10 @@ ACKNOWLEDGED   (stays)                 CLEARED
 CLEARED        (stays)                 (stays)
 =============  ======================  =======================================
 
+One alarm per fault: a fault (id, channel, place in the program) that is already active
+raises no second alarm; reported again more gravely (a syntax check's warning, then the
+run's error), the new alarm replaces the old one, which is CLEARED (issue 36).
+
 A warning needs no RESET (ISG: "internal remedy, no action"), so its acknowledge clears
 it; an error holds the channel until RESET, as ISG's remedy class 2/5 says. The active
 list holds ACTIVE and ACKNOWLEDGED alarms; the history the last ``history_max`` alarms
@@ -168,11 +172,17 @@ class AlarmLog:
     def raise_error(self, error: ErrorLike, channel: int,
                     alarm_class: AlarmClass | None = None) -> Alarm:
         """Raise ``error`` of ``channel`` as an alarm (its class from its id unless
-        given) and return it."""
+        given) and return it; the active alarm of the same fault when there is one as
+        grave (see the module docstring)."""
         cls = class_of(error.id) if alarm_class is None else alarm_class
         severity = Severity.WARNING if error.warning else (
             Severity.FATAL if cls == AlarmClass.KERNEL or error.id in RESTART_IDS
             else Severity.ERROR)
+        same = self._active_fault(error, channel)
+        if same is not None:
+            if severity <= same.severity:
+                return same
+            self._set_state(same.sequence, AlarmState.CLEARED)  # the graver one replaces it
         self._sequence += 1
         alarm = Alarm(self._sequence, error.id, severity, cls, channel, time.time_ns(),
                       self._kernel_ns, self._cycle, error.text, error.file, error.line,
@@ -191,6 +201,15 @@ class AlarmLog:
             self._set_state(oldest, AlarmState.CLEARED)
         self._publish()
         return alarm
+
+    def _active_fault(self, error: ErrorLike, channel: int) -> Alarm | None:
+        """The active alarm of the fault ``error`` of ``channel``: the same id and place."""
+        for sequence in self._active:
+            alarm = self._alarms[sequence]
+            if (alarm.id, alarm.channel, alarm.file, alarm.line, alarm.column) == (
+                    error.id, channel, error.file, error.line, error.column):
+                return alarm
+        return None
 
     def acknowledge(self, sequence: int) -> Refusal | None:
         """Acknowledge the alarm numbered ``sequence``: an error stays active until

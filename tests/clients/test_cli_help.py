@@ -19,9 +19,10 @@ from tests.clients.test_cli import cnc
 
 # Heavy modules a command needs only where it uses them (plot: numpy, matplotlib; the
 # HMI: textual; service configuration: pydantic; fancy output: rich).
+# (argon2: the web users' password hashes, for `cnc web-users` only; issue 36.)
 NOT_FOR_HELP = ("numpy", "pydantic", "rich", "textual", "matplotlib", "msgpack", "zmq",
-                "asyncio")
-NOT_FOR_READ = ("numpy", "pydantic", "rich", "textual", "matplotlib")
+                "asyncio", "argon2")
+NOT_FOR_READ = ("numpy", "pydantic", "rich", "textual", "matplotlib", "argon2")
 
 
 def _commands(group: Any, prefix: tuple[str, ...] = ()) -> Iterator[tuple[tuple[str, ...], Any]]:
@@ -136,6 +137,13 @@ def _imported_by(*argv: str) -> set[str]:
                             text=True, timeout=60)
     line = next(x for x in result.stderr.splitlines() if x.startswith("MODULES "))
     return set(line.split()[1:])
+
+
+def test_web_users_help_names_the_default_file() -> None:
+    from cnc_objects.clients.cli_web_users import DEFAULT_FILE_TEXT
+    from cnc_objects.clients.web.users import DEFAULT_USERS_FILE
+
+    assert DEFAULT_FILE_TEXT == str(DEFAULT_USERS_FILE)  # the help says the file used
 
 
 def test_help_imports_no_client_library_and_no_heavy_module() -> None:

@@ -78,6 +78,54 @@ def tour_steps(readme: Path) -> list[TourStep]:
     return steps
 
 
+#: The MQTT step's commands the ordered tour plays itself (``tour_items``): a broker of
+#: the test's own instead of ``mosquitto``, and its client instead of the Mosquitto tools.
+BROKER_WORDS = ("mosquitto ", "cnc-mqtt", "mosquitto_sub", "mosquitto_pub")
+NOT_RUN_IN_ORDER = ("cnc-hmi", "docker")
+
+
+@dataclass(frozen=True)
+class PythonStep:
+    """A Python example of the tour and the output the README shows after it."""
+
+    section: str
+    code: str
+    expected: tuple[str, ...]
+
+
+def tour_items(readme: Path) -> list[TourStep | PythonStep]:
+    """Every shell command (the MQTT step's included) and every Python example of the
+    tour, in the order the README shows them: what a reader types, one after another."""
+    items: list[TourStep | PythonStep] = []
+    section, block, lines, pending = "", None, [], None
+    for line in tour_text(readme).splitlines():
+        if block is None and line.startswith("## "):
+            section = line[3:]
+        if line.startswith("```"):
+            if block is None:
+                block = line[3:].strip()
+                continue
+            if block == "sh":
+                command, expected = None, []
+                for entry in [*lines, "$ "]:
+                    if entry.startswith("$ "):
+                        if command and not any(w in command for w in NOT_RUN_IN_ORDER):
+                            items.append(TourStep(section, command, tuple(expected)))
+                        command, expected = _COMMENT.sub("", entry[2:]).strip(), []
+                    else:
+                        expected.append(entry)
+            elif block == "python":
+                pending = PythonStep(section, "\n".join(lines) + "\n", ())
+            elif block == "text" and pending is not None:
+                items.append(PythonStep(pending.section, pending.code, tuple(lines)))
+                pending = None
+            block, lines = None, []
+            continue
+        if block is not None:
+            lines.append(line)
+    return items
+
+
 def python_examples(readme: Path) -> list[tuple[str, tuple[str, ...]]]:
     """Each Python example of the tour and the output shown in the ``text`` block after it."""
     text = tour_text(readme)

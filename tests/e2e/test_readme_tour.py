@@ -8,25 +8,32 @@ containers in the background; their own tests cover them.
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
 import os
 import re
+import shlex
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
-from cnc_objects.testing import serving
+from cnc_objects.testing import ServiceProcess, serving
 from cnc_objects.testing.web import serving_web
 from tests.e2e.readme_tour import (
     README_ADS_HOST,
     README_AMS_NET_ID,
     README_ENDPOINT,
     README_WEB_PORT,
+    PythonStep,
+    _line_matches,
     output_matches,
     python_examples,
+    tour_items,
     tour_steps,
 )
+from tests.support.broker import Watcher, running_broker
 from tests.support.service import ROOT
 
 README = ROOT / "README.md"
@@ -99,20 +106,122 @@ def test_every_tour_command_prints_what_the_readme_shows(tmp_path: Path) -> None
 
 
 def test_the_python_examples_print_what_the_readme_shows(tmp_path: Path) -> None:
-    """The ZeroMQ client and the pyads example, each run as a script as written, with the
+    """The ZeroMQ client, the pyads and the machine functions' examples, each run as a
+    script as written (on a fresh service: the tour's state is the next test's), with the
     addresses of `make run` replaced by those of the test's service (ADS on a loopback
     address of its own: AdsLib dials port 48898 of the address it is given)."""
     examples = python_examples(README)
-    assert len(examples) == 2 and "pyads" in examples[1][0]
+    assert len(examples) == 3 and "pyads" in examples[1][0] and "units=True" in examples[2][0]
     with serving("--clock", "realtime", cwd=tmp_path, ads=True) as service:
-        host = service.ads_address[0]  # type: ignore[index]
         for k, (code, shown) in enumerate(examples):
             script = tmp_path / f"example{k}.py"
-            script.write_text(code.replace(README_ENDPOINT, service.endpoint)
-                              .replace(f'"{README_AMS_NET_ID}"', f'"{service.ams_net_id}"')
-                              .replace(f'"{README_ADS_HOST}"', f'"{host}"'))
+            script.write_text(_python_script(code, service))
             done = subprocess.run([sys.executable, str(script)], cwd=tmp_path,
                                   env=_env(service.endpoint), capture_output=True, text=True,
                                   timeout=60)
             assert done.returncode == 0, done.stderr
             assert output_matches(shown, done.stdout.splitlines()), done.stdout
+
+
+# ------------------------------------------------------------------ the tour in order
+
+_CNC_MQTT_BROKER = "--broker localhost"
+
+
+def _python_script(code: str, service: ServiceProcess) -> str:
+    """An example as written, with the addresses of `make run` replaced by the service's."""
+    host = service.ads_address[0]  # type: ignore[index]
+    return (code.replace(README_ENDPOINT, service.endpoint)
+            .replace(f'"{README_AMS_NET_ID}"', f'"{service.ams_net_id}"')
+            .replace(f'"{README_ADS_HOST}"', f'"{host}"'))
+
+
+async def _shown_by_the_broker(watcher: Watcher, since: int, expected: tuple[str, ...],
+                               timeout_s: float = 20.0) -> list[str]:
+    """The README's lines of a subscriber (``topic payload``) that no message since
+    ``since`` matched within ``timeout_s``: empty when all came."""
+    missing = [e for e in expected if e.strip()]
+    with contextlib.suppress(TimeoutError):
+        async with asyncio.timeout(timeout_s):
+            while missing:
+                seen = [f"{m.topic.value} {m.payload.decode()}"  # type: ignore[union-attr]
+                        for m in watcher.messages[since:]]
+                missing = [e for e in missing if not any(_line_matches(e, s) for s in seen)]
+                if missing:
+                    watcher._arrived.clear()
+                    await watcher._arrived.wait()
+    return missing
+
+
+async def test_the_whole_tour_in_order_leaks_no_state(tmp_path: Path) -> None:
+    """Issue 36: every step of the tour as a reader takes it, one after another against
+    one service: the shell commands, the MQTT bridge's (a broker of the test's own for
+    ``mosquitto``, its client for ``mosquitto_sub``/``mosquitto_pub``) and the Python
+    examples, the pyads one included. A step that leaves state behind (the MQTT step's
+    feed override of 50 %) makes a later one print otherwise than the README shows."""
+    (tmp_path / "docs").symlink_to(ROOT / "docs")
+    failures: list[str] = []
+    bridge: subprocess.Popen[bytes] | None = None
+    with serving("--clock", "realtime", cwd=tmp_path, ads=True) as service, \
+            serving_web(service.endpoint, port=README_WEB_PORT, cwd=tmp_path):
+        env = _env(service.endpoint)
+        async with running_broker() as broker, contextlib.AsyncExitStack() as stack:
+            watcher: Watcher | None = None
+            try:
+                for item in tour_items(README):
+                    if isinstance(item, PythonStep):
+                        script = tmp_path / "example.py"
+                        script.write_text(_python_script(item.code, service))
+                        done = await asyncio.to_thread(
+                            subprocess.run, [sys.executable, str(script)], cwd=tmp_path,
+                            env=env, capture_output=True, text=True, timeout=120)
+                        printed = done.stdout + done.stderr
+                        if not output_matches(item.expected, done.stdout.splitlines()):
+                            failures.append(f"{item.section}: Python example prints:\n{printed}"
+                                            "\nREADME shows:\n" + "\n".join(item.expected))
+                        continue
+                    command = item.command
+                    if command.startswith("mosquitto "):
+                        continue  # the test's broker
+                    if command.startswith("cnc-mqtt"):
+                        argv = command.rstrip("& ").replace(
+                            _CNC_MQTT_BROKER, f"--broker {broker.host}:{broker.port}")
+                        bridge = subprocess.Popen(["bash", "-c", f"exec {argv}"], cwd=tmp_path,
+                                                  env=env, stdout=subprocess.DEVNULL,
+                                                  stderr=subprocess.DEVNULL)
+                        continue
+                    if command.startswith("mosquitto_sub"):
+                        topic_filter = shlex.split(command)[-1]
+                        watcher = await stack.enter_async_context(Watcher(broker, topic_filter))
+                        missing = await _shown_by_the_broker(watcher, 0, item.expected)
+                        if missing:
+                            topics = {line.split()[0] for line in missing}
+                            failures.append(f"$ {command}\nno message shows:\n" + "\n".join(missing)
+                                            + "\nseen on those topics:\n" + "\n".join(
+                                                f"{m.topic.value} {m.payload!r}"
+                                                for m in watcher.messages
+                                                if m.topic.value in topics))
+                        continue
+                    if command.startswith("mosquitto_pub"):
+                        assert watcher is not None, "mosquitto_pub before mosquitto_sub"
+                        words = shlex.split(command)
+                        since = watcher.mark()
+                        await watcher.client.publish(words[words.index("-t") + 1],
+                                                     words[words.index("-m") + 1], qos=1)
+                        missing = await _shown_by_the_broker(watcher, since, item.expected)
+                        if missing:
+                            failures.append(f"$ {command}\nno message shows:\n" + "\n".join(missing))
+                        continue
+                    done = await asyncio.to_thread(
+                        subprocess.run, ["bash", "-c", command], cwd=tmp_path, env=env,
+                        text=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=120)
+                    printed = done.stdout.replace(service.endpoint, README_ENDPOINT)
+                    if not output_matches(item.expected, printed.splitlines()):
+                        failures.append(f"$ {command}\nREADME shows:\n" + "\n".join(item.expected)
+                                        + f"\nprinted (exit {done.returncode}):\n{printed}")
+            finally:
+                if bridge is not None:
+                    bridge.terminate()
+                    bridge.wait(timeout=10)
+    assert bridge is not None and watcher is not None, "the tour has no MQTT step"
+    assert not failures, f"{len(failures)} step(s) print otherwise:\n\n" + "\n\n".join(failures)

@@ -18,9 +18,16 @@ _NOT_SOURCE = shutil.ignore_patterns(".git", ".venv", "build", "dist", "*.egg-in
 
 
 @pytest.fixture(scope="session")
-def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """``pip wheel --no-deps --no-build-isolation`` of a copy of this checkout, offline
-    (``--no-index``): the build uses the setuptools installed with the test extra."""
+def wheel(wheel_build: tuple[Path, str]) -> Path:
+    """The wheel of this checkout (see ``wheel_build``)."""
+    return wheel_build[0]
+
+
+@pytest.fixture(scope="session")
+def wheel_build(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """(the wheel, what the build printed): ``pip wheel --no-deps --no-build-isolation``
+    of a copy of this checkout, offline (``--no-index``): the build uses the setuptools
+    installed with the test extra."""
     source = tmp_path_factory.mktemp("source") / "cnc-objects"
     shutil.copytree(ROOT, source, ignore=_NOT_SOURCE, symlinks=True)
     out = tmp_path_factory.mktemp("wheel")
@@ -33,4 +40,4 @@ def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
         "pip wheel failed (the test extra must bring setuptools>=77 and wheel):\n"
         f"{built.stdout}{built.stderr}")
     [path] = out.glob("*.whl")
-    return path
+    return path, built.stdout + built.stderr

@@ -37,6 +37,15 @@ def test_every_module_of_the_package_folders_is_in_the_wheel(wheel: Path) -> Non
     assert not missing, sorted(missing)
 
 
+def test_the_build_says_nothing_of_packages_it_was_not_told_of(
+    wheel_build: tuple[Path, str]
+) -> None:
+    """Issue 36: `make run` on a clean clone printed setuptools' 40-line warning that the
+    folder of cnc-web's pages is importable but absent from the ``packages`` list."""
+    _, printed = wheel_build
+    assert "absent from the `packages` configuration" not in printed, printed
+
+
 def test_the_pytest_plugin_is_registered_by_entry_point(wheel: Path) -> None:
     with zipfile.ZipFile(wheel) as archive:
         [name] = [n for n in archive.namelist() if n.endswith(".dist-info/entry_points.txt")]

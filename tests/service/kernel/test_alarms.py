@@ -138,6 +138,31 @@ def test_the_findings_of_a_syntax_check_are_check_alarms(harness) -> None:
                      [(20113, 5), (20500, 8), (20310, 11), (20151, 14), (20121, 17)]]
 
 
+def test_a_fault_checked_then_run_is_one_alarm_the_error(harness) -> None:
+    """Issue 36: a syntax check, then a run of the same program, listed 21220 twice (as
+    the check's warning and as the run's error)."""
+    assert harness.command(SetExecutionMode(0, SYNCHK | MACHINE_LOCK)) is None
+    harness.run("G1 X10 F100\nG1 Y10 Q7\nM30\n", "bad.nc")
+    checked = [a for a in _alarms(harness).active if a.id == 21220]
+    assert [a.severity for a in checked] == [Severity.WARNING]
+    assert harness.command(SetExecutionMode(0, 0)) is None
+    run = harness.run("G1 X10 F100\nG1 Y10 Q7\nM30\n", "bad.nc")
+    assert run.channel.state == ChannelState.ERROR
+    view = _alarms(harness)
+    faults = [(a.id, a.severity, a.line) for a in view.active if a.id == 21220]
+    assert faults == [(21220, Severity.ERROR, 2)]
+    replaced = next(a for a in view.history if a.sequence == checked[0].sequence)
+    assert replaced.state == AlarmState.CLEARED  # the warning stays in the history
+
+
+def test_a_fault_raised_again_while_active_is_not_listed_twice() -> None:
+    log = AlarmLog()
+    first = log.raise_error(ErrorEntry(21309, "checked", warning=True), channel=1)
+    assert log.raise_error(ErrorEntry(21309, "checked", warning=True), channel=1) is first
+    log.raise_error(ErrorEntry(21309, "checked", warning=True), channel=2)  # another channel
+    assert [(a.id, a.channel) for a in log.view.active] == [(21309, 2), (21309, 1)]
+
+
 def test_a_kernel_reset_clears_every_alarm(harness) -> None:
     from cnc_objects.service.kernel.kernel import Control, ControlCommand
 
