@@ -30,12 +30,18 @@ from cnc_objects.objects.operator_data import (
 )
 
 from .cli_app import Settings, emit, fail
-from .cli_tools import ChannelOption, axis_names, in_mm, offsets_app, tool_app
+from .cli_tools import ChannelOption, offsets_app, tool_app
 from .errors import ClientValueError
-from .units import raw_value
+from .units import engineering, raw_value
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
     from .blocking import Client
+
+def in_mm(c: Client, name: str, raw: float) -> float:
+    """The value ``raw`` of the object ``name`` (0.1 um) in mm, by the object's scale."""
+    value: float = engineering(c.describe(name), raw)
+    return value
+
 
 FileArgument = typer.Argument(..., metavar="FILE", help="Operator data file (JSON); - is "
                               "standard output (export) or input (import).")
@@ -142,7 +148,7 @@ def tool_import(ctx: typer.Context, file: str = FileArgument,
 
 def _groups(c: Client, channel: int) -> tuple[list[str], dict[int, OffsetGroup]]:
     count: int = c.read(f"ch{channel}.mc_zero_offset_groups_r")
-    axes = [a.upper() for a in axis_names(c, channel)]
+    axes = [a.upper() for a in c.axis_names(channel)]
     names = [f"ch{channel}.ax{a}.np_grp[{g}].v" for g in range(1, count)
              for a in range(1, len(axes) + 1)]
     v = c.read_many(names)
