@@ -31,6 +31,9 @@ limit and the figures measured):
   are closed and logged (throttled). ZeroMQ buffers incomplete frames inside libzmq,
   where no budget can be kept: there the bound is the cap times the frame hard cap
   (``zmq_receive_bound_bytes``), held at most ``frame_timeout_s``.
+- ``idle_connection_s``: a full table closes the keyless connection idle longest (idle
+  at least this long) for a newcomer; keyed connections keep their seats
+  (``connection_limits``).
 
 Handles (0xF003 handle by name) are not a per-client resource: a handle is the stable
 number of an object, the same for every client, and releasing one frees nothing, so
@@ -161,6 +164,12 @@ class LimitsConfig(BaseModel):
         64, ge=1, le=100_000,
         description="open connections each front end (ZeroMQ, ADS) serves at once; one "
         "more is closed at once (logged)",
+    )
+    idle_connection_s: float = Field(
+        5.0, ge=0, le=86_400,
+        description="seconds without a request after which a keyless connection (no CURVE "
+        "key, no ADS route) gives its seat to a newcomer when the table is full; keyed "
+        "ones never do",
     )
     frame_timeout_s: float = Field(
         10.0, gt=0, le=3600,
