@@ -1,7 +1,7 @@
 """``cnc`` commands of manual mode: jog an axis, turn the handwheel, home axes.
 
     cnc jog AXIS +|- [--increment MM] [--channel N] [--rapid] [--no-wait] [--wait-timeout S]
-    cnc jog AXIS +|- --continuous        (the key stays pressed; --stop releases it)
+    cnc jog AXIS +|- --continuous        (held, renewed, until the axis stands or Ctrl-C)
     cnc jog AXIS --stop
     cnc jog AXIS +|- --handwheel PULSES  (the handwheel counter moves by PULSES)
     cnc home AXIS... [--channel N] [--wait-timeout S]
@@ -23,6 +23,7 @@ import typer
 
 from .cli_app import EXIT_USAGE, Settings, command, emit, err, fail, say_error
 from .errors import AdsError, ClientValueError
+from .jog_hold import RENEW_S
 from .units import engineering, raw_value
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
@@ -71,6 +72,26 @@ def _wait_standstill(c: Client, prefix: str, timeout_s: float | None,
         time.sleep(_POLL_S)
 
 
+def _hold(c: Client, prefix: str, key: str, timeout_s: float | None) -> None:
+    """Press ``key`` and hold it, renewed every ``RENEW_S`` (the service's dead-man
+    releases a key that is not: docs/manual.md), until the axis stands (its software
+    limit), Ctrl-C or ``timeout_s``; then release it."""
+    deadline = None if timeout_s is None else time.monotonic() + timeout_s
+    c.write(key, True)
+    try:
+        renew_at_s = time.monotonic() + RENEW_S
+        while c.read(f"{prefix}.manual_moving_r"):
+            now_s = time.monotonic()
+            if deadline is not None and now_s > deadline:
+                return  # released below: the timeout ends the jog
+            if now_s >= renew_at_s:
+                c.write(key, True)
+                renew_at_s = now_s + RENEW_S
+            time.sleep(_POLL_S)
+    finally:
+        c.write(key, False)
+
+
 def _report(settings: Settings, c: Client, channel: int, axis: int, name: str) -> None:
     prefix = f"ch{channel}.ax{axis}"
     values = c.read_many([f"{prefix}.command_position_acs", f"{prefix}.manual_limit_warning_r",
@@ -99,7 +120,8 @@ def jog(
         None, "--increment", help="Jog by increments: this distance (mm, 0.0001..10). "
         "The default when no other mode is given: 1 mm."),
     continuous: bool = typer.Option(False, "--continuous",
-                                    help="Continuous jog: press the key and leave it pressed."),
+                                    help="Continuous jog: hold the key (renewed) until the "
+                                    "axis stands at its limit, Ctrl-C or --wait-timeout."),
     stop: bool = typer.Option(False, "--stop", help="Release the axis's jog keys."),
     handwheel: int = typer.Option(None, "--handwheel",
                                   help="Handwheel mode: turn the counter by PULSES."),
@@ -139,8 +161,8 @@ def jog(
                     c.write(f"{prefix}.manual_handwheel_counter_w", wrapped)
                 elif continuous:
                     c.write(f"{prefix}.manual_operation_mode_w", _CONTINUOUS)
-                    c.write(key, True)
-                    no_wait = True  # it moves until --stop or the software limit
+                    _hold(c, prefix, key, timeout_s)
+                    no_wait = True  # held until it stood
                 else:
                     c.write(f"{prefix}.manual_operation_mode_w", _INCREMENTAL)
                     increment = f"{prefix}.manual_increment_w"  # 0.1 um; the scale says

@@ -15,6 +15,7 @@ An asyncio ``Protocol`` on the service's event loop. Frames are cut from the str
   a frame too short for an AMS header, or not an AMS command, is skipped (logged): there
   is no invoke id to answer;
 - a frame longer than the maximum closes this connection only;
+- when the connection closes, the jog keys it pressed are released (``jog_holds``);
 - every ADS request goes to the dispatcher; payloads that do not decode get the ADS
   error the decoder names (0x701 unknown command, 0x705 wrong size), with the length
   the client expects for that command.
@@ -228,6 +229,8 @@ class AmsConnection(asyncio.Protocol):
         if self._rate is not None:
             self._rate.forget(self)
         self._server.connections.discard(self)
+        # its jog keys are released at once (the dead-man, ``jog_holds``)
+        self._server.dispatcher.backend.connection_ended(self, f"from {self.peer} closed")
         hub = self._server.hub
         for envelope in self._envelopes:
             hub.drop_client(envelope)

@@ -187,7 +187,8 @@ async def serve(
     backend = Backend(space, kernel, loop, ProgramStoreService(store),
                       SymbolService(space, structs),
                       (limits.notifications_per_client, limits.notifications_total), counts,
-                      outputs=OutputService(writer), structs=structs)
+                      outputs=OutputService(writer), structs=structs,
+                      jog_hold_timeout_s=limits.jog_hold_timeout_s)
     kernel.on_cycle_end = backend.hub.kernel_cycle_end  # one hub serves both front ends
     kernel.next_observed_ns = backend.hub.next_observed_ns  # cycles it must see
     try:

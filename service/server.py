@@ -156,6 +156,7 @@ class ZmqServer:
                 sock, int(self.endpoint.rsplit(":", 1)[1]),
                 ConnectionLimits("ZeroMQ", limits), self._loop, self._auth is not None)
             self._seats = self.connections.by_routing_id
+            self.connections.ended = self._ended
             if self._auth is not None:
                 self._auth.door = self.connections.door
         self.hub = backend.hub
@@ -315,6 +316,10 @@ class ZmqServer:
                 self._deliver(envelope, probe)
         self._look_for_input()
         self._probe_timer = self._loop.call_later(PROBE_S, self._probe)
+
+    def _ended(self, routing_id: bytes) -> None:
+        """A connection ended (``zmq_connections``): the jog keys it held are released."""
+        self.dispatcher.backend.connection_ended(routing_id, f"0x{routing_id.hex()} closed")
 
     def _gone(self, envelope: Envelope) -> None:
         """Forget a client ZeroMQ says is gone: its notifications, its waiting requests."""

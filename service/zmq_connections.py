@@ -12,8 +12,10 @@ may be reused) is never taken for an open connection, and the descriptor must st
 a TCP socket on the front end's own port.
 
 Which connection a message came from: its ``ZMQ_SRCFD`` (read once per routing id,
-``seat_of``), so each request marks its connection's seat used, and a CURVE
-connection's seat becomes keyed with its first request.
+``seat_of``), so each request marks its connection's seat used, a CURVE connection's
+seat becomes keyed with its first request, and the end of a connection (its
+``DISCONNECTED``: the peer closed, was killed, or libzmq's heartbeat gave up on it) is
+told by its routing id (``ended``): the backend releases the jog keys it held.
 
 A full table makes room by closing an idle keyless connection; when it cannot, the
 newcomer is told so in its handshake: the ZAP handler (``security.ZapAuthenticator``,
@@ -41,6 +43,7 @@ import logging
 import os
 import socket
 import threading
+from collections.abc import Callable
 
 import zmq
 from zmq.utils.monitor import parse_monitor_message
@@ -82,6 +85,8 @@ class ZmqConnectionWatch:
         self._waiting: dict[int, _Waiting] = {}  # descriptor -> over the cap, in handshake
         self._routing: dict[int, bytes] = {}  # descriptor -> routing id, once it sent
         self.by_routing_id: dict[bytes, Seat] = {}  # for the server's drain
+        # told (on the loop) the routing id of each connection that ended after it sent
+        self.ended: Callable[[bytes], None] | None = None
         self._refused = 0  # connections refused over the cap, since start
 
     @property
@@ -187,8 +192,12 @@ class ZmqConnectionWatch:
         if seat is not None:
             self.limits.release(seat, 0)
         routing_id = self._routing.pop(fd, None)
-        if routing_id is not None and self.by_routing_id.get(routing_id) is seat:
+        if routing_id is None:
+            return
+        if self.by_routing_id.get(routing_id) is seat:
             del self.by_routing_id[routing_id]
+        if self.ended is not None:  # this may run on the ZAP thread (``door``)
+            self._loop.call_soon_threadsafe(self.ended, routing_id)
 
     @property
     def open(self) -> int:
