@@ -180,10 +180,15 @@ class ZmqConnectionWatch:
                 _shut_down(fd)
 
     def _seat(self, fd: int, peer: str, force: bool = False) -> Seat | None:
-        seat = self.limits.admit(peer, False, lambda: _shut_down(fd), False, force)
+        seat = self.limits.admit(peer, False, lambda: self._evict(fd), False, force)
         if seat is not None:
             self._seats[fd] = seat
         return seat
+
+    def _evict(self, fd: int) -> None:
+        """Close the connection on ``fd`` to free its seat, if ``fd`` is still ours."""
+        if _peer_of(fd, self._port) is not None:
+            _shut_down(fd)
 
     def _gone(self, fd: int) -> None:
         """``fd``'s connection ended: free its seat (or its place in the waiting room)."""
