@@ -22,9 +22,10 @@ newcomer is told so in its handshake: the ZAP handler (``security.ZapAuthenticat
 also without CURVE) asks ``door`` and refuses it with ZAP status 500
 (``ZAP_STATUS_TABLE_FULL``), which the client's monitor reports and the client library
 names ("connection table full"). ZAP tells the peer's IP address, not its descriptor: a
-refusal is owed per address and served to the next handshake from there; should it hit
-another connection of that address than the one over the cap, that one passes instead
-and takes the seat when it sends (the count stays right). Connections over the cap
+handshake is taken for the connection from that address accepted first whose handshake
+has not come yet (handshakes come in the order of their connections); should it be
+another one, the one over the cap passes instead and takes a seat with its first
+request (made by closing an idle keyless one, else over the cap by one). Connections over the cap
 that wait for their handshake are bounded too: beyond a second table's worth they are
 shut down at once.
 
@@ -56,16 +57,6 @@ _WATCHED = zmq.EVENT_ACCEPTED | zmq.EVENT_DISCONNECTED
 _SRCFD = int(zmq.SRCFD)
 
 
-class _Waiting:
-    """A connection over the cap, waiting for its handshake's refusal."""
-
-    __slots__ = ("host", "owed")
-
-    def __init__(self, host: str) -> None:
-        self.host = host
-        self.owed = True  # no handshake from its address refused on its account yet
-
-
 class ZmqConnectionWatch:
     """Seats the connections of ``router`` (bound to ``port``) in ``limits``; refuses
     those over ``limits.max_connections`` (through ``door``, or at once)."""
@@ -82,7 +73,10 @@ class ZmqConnectionWatch:
         self._monitor = router.get_monitor_socket(_WATCHED)
         self._lock = threading.Lock()  # the ZAP thread drains too (``door``)
         self._seats: dict[int, Seat] = {}  # descriptor -> seat of an admitted connection
-        self._waiting: dict[int, _Waiting] = {}  # descriptor -> over the cap, in handshake
+        self._waiting: dict[int, str] = {}  # descriptor -> peer, over the cap, in handshake
+        # descriptor -> peer host of each connection whose handshake has not reached ZAP
+        # yet, in the order accepted (the order their ZAP requests come in)
+        self._tickets: dict[int, str] = {}
         self._routing: dict[int, bytes] = {}  # descriptor -> routing id, once it sent
         self.by_routing_id: dict[bytes, Seat] = {}  # for the server's drain
         # told (on the loop) the routing id of each connection that ended after it sent
@@ -111,17 +105,24 @@ class ZmqConnectionWatch:
 
     def door(self, host: str, keyed: bool) -> bool:
         """The ZAP handler's question for a handshake from ``host`` (called on its
-        thread), ``keyed`` when it brings a key of the allow-list: False when a
-        connection from there is over the cap and no room can be made for it (the
-        handshake is refused, ZAP 500)."""
+        thread), ``keyed`` when it brings a key of the allow-list: False when the
+        connection is over the cap and no room can be made for it (the handshake is
+        refused, ZAP 500). ZAP names the address only: the handshake is taken for the
+        connection from ``host`` accepted first whose handshake has not come yet."""
         with self._lock:
             self._drain()
-            for waiting in self._waiting.values():
-                if waiting.owed and waiting.host == host:
-                    waiting.owed = False  # answered: refused, or a seat freed for it
-                    # keyed: a keyless one goes; this one is seated by its first message
-                    return keyed and self.limits.make_room(True)
-        return True
+            fd = next((f for f, h in self._tickets.items() if h == host), None)
+            if fd is None or fd not in self._waiting:
+                if fd is not None:
+                    del self._tickets[fd]
+                return True
+            del self._tickets[fd]
+            if not (keyed and self.limits.make_room(True)):
+                return False  # over the cap
+            seat = self._seat(fd, self._waiting.pop(fd), force=True)  # a keyless one left
+            if seat is not None:
+                seat.keyed = True
+            return True
 
     def seat_of(self, routing_id: bytes, frame: zmq.Frame, keyed: bool) -> Seat | None:
         """The seat of the connection a message (``frame``) with a new ``routing_id``
@@ -133,18 +134,17 @@ class ZmqConnectionWatch:
             return None
         with self._lock:
             self._drain()
+            self._tickets.pop(fd, None)  # it passed its handshake
             seat = self._seats.get(fd)
-            if seat is None and self._waiting.pop(fd, None) is not None:
-                seat = self._seat(fd, self._waiting_host(fd), force=True)  # it is in
+            peer = self._waiting.pop(fd, None)
+            if seat is None and peer is not None:  # in, over the cap: room if there is
+                seat = self._seat(fd, peer, force=not self.limits.make_room(keyed))
             if seat is None:
                 return None
             seat.keyed = keyed
             self._routing[fd] = routing_id
             self.by_routing_id[routing_id] = seat
             return seat
-
-    def _waiting_host(self, fd: int) -> str:
-        return _peer_of(fd, self._port) or "?"
 
     def _drain_locked(self) -> None:
         with self._lock:
@@ -171,11 +171,14 @@ class ZmqConnectionWatch:
             if peer is None:
                 continue  # no longer our connection: its DISCONNECTED is on its way
             if self._seat(fd, peer) is not None:
+                if self._zap:
+                    self._tickets[fd] = _host(peer)
                 continue
             self._refused += 1
             self.limits.over_cap.note(peer)
             if self._zap and len(self._waiting) < self.limits.max_connections:
-                self._waiting[fd] = _Waiting(peer.rsplit(":", 1)[0].strip("[]"))
+                self._waiting[fd] = peer
+                self._tickets[fd] = _host(peer)
             else:
                 _shut_down(fd)
 
@@ -193,6 +196,7 @@ class ZmqConnectionWatch:
     def _gone(self, fd: int) -> None:
         """``fd``'s connection ended: free its seat (or its place in the waiting room)."""
         self._waiting.pop(fd, None)
+        self._tickets.pop(fd, None)
         seat = self._seats.pop(fd, None)
         if seat is not None:
             self.limits.release(seat, 0)
@@ -208,6 +212,11 @@ class ZmqConnectionWatch:
     def open(self) -> int:
         """Connections open now (as far as the events read so far tell)."""
         return len(self._seats)
+
+
+def _host(peer: str) -> str:
+    """The host of ``host:port`` as ZAP names it (no brackets)."""
+    return peer.rsplit(":", 1)[0].strip("[]")
 
 
 def _borrow(fd: int) -> socket.socket:
