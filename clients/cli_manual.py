@@ -23,7 +23,6 @@ import typer
 
 from .cli_app import EXIT_USAGE, Settings, command, emit, err, fail, say_error
 from .errors import AdsError, ClientValueError
-from .jog_hold import RENEW_S
 from .units import engineering, raw_value
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
@@ -76,6 +75,8 @@ def _hold(c: Client, prefix: str, key: str, timeout_s: float | None) -> None:
     """Press ``key`` and hold it, renewed every ``RENEW_S`` (the service's dead-man
     releases a key that is not: docs/manual.md), until the axis stands (its software
     limit), Ctrl-C or ``timeout_s``; then release it."""
+    from .jog_hold import RENEW_S  # here: ``cnc --help`` imports no asyncio
+
     deadline = None if timeout_s is None else time.monotonic() + timeout_s
     c.write(key, True)
     try:
