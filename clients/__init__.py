@@ -46,6 +46,7 @@ if TYPE_CHECKING:
         ChannelError,
         ClientValueError,
         NoReplyError,
+        ServiceFullError,
     )
     from .execution_mode import describe_execution_mode
     from .path_trace import PathTrace
@@ -64,7 +65,7 @@ _SOURCES = {
     ), f"{__name__}.client"),
     **dict.fromkeys((
         "AdsConnectionError", "AdsError", "AdsTimeoutError", "AuthenticationError",
-        "ChannelError", "ClientValueError", "NoReplyError",
+        "ChannelError", "ClientValueError", "NoReplyError", "ServiceFullError",
     ), f"{__name__}.errors"),
     "describe_execution_mode": f"{__name__}.execution_mode",
     "PathTrace": f"{__name__}.path_trace",
@@ -113,6 +114,7 @@ __all__ = [
     "PathTrace",
     "ProgramEntry",
     "Sample",
+    "ServiceFullError",
     "describe_execution_mode",
     "filetime_to_datetime",
 ]

@@ -219,6 +219,12 @@ class Client(BlockingClientBase):
         """ADS ReadWrite at an address: ``data`` in, up to ``read_length`` bytes out."""
         return run_blocking(self._core.read_write_raw(port, group, offset, data, read_length))
 
+    def renew_jog(self, axis: str | int, direction: str | int = "+", channel: int = 1) -> None:
+        """Renew the held continuous jog key of ``axis`` in ``direction`` (write it TRUE
+        again: a key already pressed is no new press). The blocking client's way to hold
+        a continuous jog longer than ``[limits] jog_hold_timeout_s``."""
+        return run_blocking(self._core.renew_jog(axis, direction, channel))
+
     def reset(self, channel: int = 1) -> None:
         """RESET the channel from any state."""
         return run_blocking(self._core.reset(channel))

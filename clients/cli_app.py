@@ -23,7 +23,14 @@ import typer
 import typer.core
 
 from .cli_terminal import Terminal
-from .errors import AdsError, AdsTimeoutError, AuthenticationError, ClientValueError, NoReplyError
+from .errors import (
+    AdsError,
+    AdsTimeoutError,
+    AuthenticationError,
+    ClientValueError,
+    NoReplyError,
+    ServiceFullError,
+)
 from .units import tidy
 
 if TYPE_CHECKING:  # imported where a command connects: cnc --help needs no zmq
@@ -155,7 +162,7 @@ def say_error(text: str) -> None:
 def fail(exc: Exception) -> NoReturn:
     """End the command for ``exc``: one line on stderr and the exit code of its kind."""
     say_error(str(exc))
-    if isinstance(exc, (AdsTimeoutError, AuthenticationError)):
+    if isinstance(exc, (AdsTimeoutError, AuthenticationError, ServiceFullError)):
         raise typer.Exit(EXIT_UNREACHABLE)
     if isinstance(exc, AdsError):
         raise typer.Exit(EXIT_ADS_ERROR)

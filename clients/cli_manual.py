@@ -1,7 +1,7 @@
 """``cnc`` commands of manual mode: jog an axis, turn the handwheel, home axes.
 
     cnc jog AXIS +|- [--increment MM] [--channel N] [--rapid] [--no-wait] [--wait-timeout S]
-    cnc jog AXIS +|- --continuous        (the key stays pressed; --stop releases it)
+    cnc jog AXIS +|- --continuous        (held, renewed, until the axis stands or Ctrl-C)
     cnc jog AXIS --stop
     cnc jog AXIS +|- --handwheel PULSES  (the handwheel counter moves by PULSES)
     cnc home AXIS... [--channel N] [--wait-timeout S]
@@ -24,10 +24,32 @@ from .cli_app import EXIT_USAGE, Settings, command, emit, err, fail, say_error
 from .errors import AdsError, AdsTimeoutError, ClientValueError, NoReplyError
 
 if TYPE_CHECKING:  # the client library is imported when a command connects
+    from .blocking import Client
     from .manual_ops import AxisState
 
 EXIT_WAIT_TIMEOUT = 5
 AxesArgument = typer.Argument(..., metavar="AXIS...", help="Axis names (X Y Z) or indices, homed together.")
+
+
+def _hold(c: Client, axis: str, direction: str, channel: int,
+          timeout_s: float | None) -> AxisState:
+    """Hold the jog key pressed by ``c.jog(..., continuous=True)``, renewed every
+    ``RENEW_S`` (the service's dead-man releases a key that is not: docs/manual.md), until
+    the axis stands (its software limit), Ctrl-C or ``timeout_s``; then release it."""
+    import time
+
+    from .jog_hold import RENEW_S  # here: ``cnc --help`` imports no asyncio
+
+    deadline = None if timeout_s is None else time.monotonic() + timeout_s
+    try:
+        while c.axis_state(axis, channel).moving:
+            if deadline is not None and time.monotonic() > deadline:
+                break  # released below: the timeout ends the jog
+            time.sleep(RENEW_S)
+            c.renew_jog(axis, direction, channel)
+    finally:
+        state = c.jog_stop(axis, channel, wait=False)
+    return state
 
 
 def _report(settings: Settings, state: AxisState) -> None:
@@ -62,7 +84,8 @@ def jog(
         None, "--increment", help="Jog by increments: this distance (mm, 0.0001..10). "
         "The default when no other mode is given: 1 mm."),
     continuous: bool = typer.Option(False, "--continuous",
-                                    help="Continuous jog: press the key and leave it pressed."),
+                                    help="Continuous jog: hold the key (renewed) until the "
+                                    "axis stands at its limit, Ctrl-C or --wait-timeout."),
     stop: bool = typer.Option(False, "--stop", help="Release the axis's jog keys."),
     handwheel: int = typer.Option(None, "--handwheel",
                                   help="Handwheel mode: turn the counter by PULSES."),
@@ -90,6 +113,8 @@ def jog(
                 state = c.jog(axis, direction, increment_mm=increment_mm, continuous=continuous,
                               handwheel_pulses=handwheel, rapid=rapid, channel=channel,
                               wait=not no_wait, timeout_s=timeout_s)
+                if continuous:
+                    state = _hold(c, axis, direction, channel, timeout_s)
             _report(settings, state)
     except (AdsError, ClientValueError) as exc:
         _fail(exc)

@@ -12,7 +12,8 @@ silence), so a refused client would only ever time out. ``HandshakeWatch`` reads
 socket's monitor events (``EVENT_HANDSHAKE_*``) and turns a failure into an
 ``AuthenticationError`` naming the cause: the key refused (not in the allow-list), a
 server key that is not the service's, a key given to a service without CURVE or none
-given to one with it.
+given to one with it; or into a ``ServiceFullError`` when the service had no room for
+the connection (its ZAP status 500, with or without keys).
 """
 
 from __future__ import annotations
@@ -26,7 +27,9 @@ import zmq
 import zmq.auth
 from zmq.utils.monitor import parse_monitor_message
 
-from .errors import AuthenticationError, ClientValueError
+from cnc_objects.protocol.constants import ZAP_STATUS_TABLE_FULL
+
+from .errors import AdsConnectionError, AuthenticationError, ClientValueError, ServiceFullError
 from .key_files import PUBLIC_SUFFIX, SECRET_SUFFIX, SERVER_KEY_FILE
 
 _KEY_CHARS = 40  # a CURVE key in Z85 text
@@ -116,7 +119,7 @@ class HandshakeWatch:
         self._endpoint = endpoint
         self._curve = curve
         self.succeeded = False  # a handshake succeeded (the last one seen)
-        self.failure: AuthenticationError | None = None  # why the last one failed
+        self.failure: AdsConnectionError | None = None  # why the last one failed
         self._vague = 0  # handshakes in a row that ended without detail
 
     @property
@@ -124,7 +127,7 @@ class HandshakeWatch:
         """The monitor's file descriptor (edge-triggered, as every ZeroMQ socket's)."""
         return self._monitor.FD
 
-    def check(self) -> AuthenticationError | None:
+    def check(self) -> AdsConnectionError | None:
         """Read every event that waits; the failure of the last handshake, if it failed."""
         while True:
             try:
@@ -160,8 +163,13 @@ class HandshakeWatch:
             pass  # the socket is closed already
         self._monitor.close(linger=0)
 
-    def _explain(self, event: int, value: int) -> AuthenticationError:
+    def _explain(self, event: int, value: int) -> AdsConnectionError:
         where, curve = self._endpoint, self._curve
+        if event == zmq.EVENT_HANDSHAKE_FAILED_AUTH and value == ZAP_STATUS_TABLE_FULL:
+            return ServiceFullError(
+                f"the service at {where} refused this connection: its connection table is "
+                "full ([limits] connections_per_front_end, all seats keyed or busy); not a "
+                "key problem: try again later (docs/security.md)")
         if event == zmq.EVENT_HANDSHAKE_FAILED_AUTH:
             key = f"the public key of {curve.key_file}" if curve is not None else "it"
             text = (f"the service at {where} refused this client's key (CURVE): {key} is "

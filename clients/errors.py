@@ -61,6 +61,16 @@ class AuthenticationError(AdsConnectionError):
         super().__init__(AdsReturnCode.DEVICE_ACCESSDENIED, message)
 
 
+class ServiceFullError(AdsConnectionError):
+    """The service had no room for this connection (ADS 0x708 DEVICE_BUSY): its
+    connection table is full of keyed or busy connections (``[limits]
+    connections_per_front_end``). Not a key problem; try again later, or ask the
+    service's operator for a larger table. The connection is closed."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(AdsReturnCode.DEVICE_BUSY, message)
+
+
 class ClientValueError(ValueError):
     """The client refused a value before sending anything: outside its type's range, of
     the wrong Python type, an unknown type or ADS state name. Not an ``AdsError``: no

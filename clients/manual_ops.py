@@ -1,7 +1,7 @@
 """Manual mode of the client, in mm (mixed into ``AsyncClient``): jog and home axes.
 
     await c.jog("X", "+", increment_mm=0.5)       # MANUAL, one increment, waits, says where
-    await c.jog("Y", "-", continuous=True)        # the key stays pressed ...
+    await c.jog("Y", "-", continuous=True)        # the key stays pressed, renewed ...
     await c.jog_stop("Y")                         # ... until released
     await c.jog("Z", "+", handwheel_pulses=40)    # the handwheel counter moves by 40
     states = await c.home(["X", "Y"])             # homed together; waits until referenced
@@ -13,6 +13,12 @@ scale the service gives for each object. What the kernel refuses (channel in ERR
 HOLD, the axis homing, a value out of range) raises ``AdsError`` with its sentence; a
 wait longer than ``timeout_s`` raises ``AdsTimeoutError``. ``cnc jog`` and ``cnc home``
 are these methods.
+
+A continuous jog is held only while it is renewed (the service's dead-man, docs/manual.md):
+``AsyncClient.jog(..., continuous=True)`` renews the key in the background until
+``jog_stop`` (or the connection ends); the blocking ``Client`` has no background, so its
+caller calls ``renew_jog`` at least every ``jog_hold.RENEW_S`` (``cnc jog --continuous``
+does) or the service releases the key after ``[limits] jog_hold_timeout_s``.
 """
 
 from __future__ import annotations
@@ -20,12 +26,17 @@ from __future__ import annotations
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, cast
 
 from cnc_objects.protocol.values import ChannelMode, ManualOperationMode
 
 from .client_core import MixinBase
 from .errors import AdsTimeoutError, ClientValueError
 from .units import engineering
+
+if TYPE_CHECKING:
+    from .client import AsyncClient
+    from .jog_hold import HeldJog
 
 POLL_S = 0.02  # how often a wait re-reads the axis (wall time)
 MAX_AXES = 32  # axes looked for in a channel
@@ -108,7 +119,7 @@ class ManualOps(MixinBase):
             await self.write(p + "manual_handwheel_counter_w", wrapped)
         elif continuous:
             await self.write(p + "manual_operation_mode_w", int(ManualOperationMode.CONTINUOUS))
-            await self.write(key, True)
+            await self._hold(key)
             wait = False  # it moves until jog_stop or the software limit
         else:
             await self.write(p + "manual_operation_mode_w", int(ManualOperationMode.INCREMENTAL))
@@ -126,11 +137,52 @@ class ManualOps(MixinBase):
         (default) returns once it stands."""
         k = await self.axis_index(axis, channel)
         p = f"ch{channel}.ax{k}."
-        await self.write(p + "manual_jog_plus_w", False)
-        await self.write(p + "manual_jog_minus_w", False)
+        for key in (p + "manual_jog_plus_w", p + "manual_jog_minus_w"):
+            held = self._held_jogs().pop(key, None)
+            if held is not None:
+                await held.release()  # stops its renewals, writes FALSE
+            else:
+                await self.write(key, False)
         if wait:
             await self._wait_standstill(channel, k, timeout_s)
         return await self.axis_state(k, channel)
+
+    async def renew_jog(self, axis: str | int, direction: str | int = "+",
+                        channel: int = 1) -> None:
+        """Renew the held continuous jog key of ``axis`` in ``direction`` (write it TRUE
+        again: a key already pressed is no new press). The blocking client's way to hold
+        a continuous jog longer than ``[limits] jog_hold_timeout_s``."""
+        key_name = _DIRECTIONS.get(direction)
+        if key_name is None:
+            raise ClientValueError(f"renew_jog: direction {direction!r}: give + or - (1 or -1)")
+        k = await self.axis_index(axis, channel)
+        await self.write(f"ch{channel}.ax{k}.manual_jog_{key_name}_w", True)
+
+    def _held_jogs(self) -> dict[str, HeldJog]:
+        """The keys this client holds and renews in the background (AsyncClient only)."""
+        held: dict[str, HeldJog] | None = getattr(self, "_jogs_held", None)
+        if held is None:
+            held = {}
+            self._jogs_held = held
+        return held
+
+    async def _hold(self, key: str) -> None:
+        """Press ``key``; the ``AsyncClient`` renews it in the background until
+        ``jog_stop``. The blocking client drives its calls without a loop: its caller
+        renews (``renew_jog``)."""
+        from .sync_transport import SyncTransport
+
+        if isinstance(getattr(self, "_t", None), SyncTransport):  # the blocking client
+            await self.write(key, True)
+            return
+        from .jog_hold import HeldJog  # here: the blocking client imports no asyncio
+
+        old = self._held_jogs().pop(key, None)
+        if old is not None:
+            await old.release()
+        held = HeldJog(cast("AsyncClient", self), key)
+        await held.__aenter__()
+        self._held_jogs()[key] = held
 
     async def home(self, axes: Iterable[str | int] | str | int, channel: int = 1,
                    timeout_s: float | None = None) -> list[AxisState]:

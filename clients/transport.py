@@ -34,7 +34,7 @@ from cnc_objects.protocol.frames import (
 
 from .batching import QueuedRequest, ReplyWaiter, SumBatch, batchable, chunks, runs, sum_fields
 from .curve import ClientCurve, HandshakeWatch
-from .errors import AdsConnectionError, AuthenticationError, NoReplyError
+from .errors import AdsConnectionError, AuthenticationError, NoReplyError, ServiceFullError
 
 log = logging.getLogger(__name__)
 
@@ -187,7 +187,7 @@ class AsyncTransport(_Transport):
             self._watch = None
         self._sock.close(linger=0)
         self._sock = None
-        if isinstance(closed, AuthenticationError):  # later requests say why, too
+        if isinstance(closed, (AuthenticationError, ServiceFullError)):  # later ones say why
             self._closed = closed
         for fut, _, _ in self._pending.values():
             if not fut.done():

@@ -158,3 +158,9 @@ class OutputAreaOffset(IntEnum):
     LIST = 1  # Read: one line per file, "name<TAB>size_bytes<TAB>mtime_unix_s\n" (UTF-8)
     DOWNLOAD = 3  # ReadWrite: name in, content out (read length >= size)
     DELETE = 4  # Write: name (operator and admin)
+
+#: The ZAP status the service's handshake refuses a ZeroMQ connection with when its
+#: connection table is full ([limits] connections_per_front_end). ZeroMQ carries only
+#: the status code to the client (its monitor's EVENT_HANDSHAKE_FAILED_AUTH value); the
+#: service answers a key not in the allow-list with 400, so 500 means "no room".
+ZAP_STATUS_TABLE_FULL = 500

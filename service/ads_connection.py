@@ -15,6 +15,7 @@ An asyncio ``Protocol`` on the service's event loop. Frames are cut from the str
   a frame too short for an AMS header, or not an AMS command, is skipped (logged): there
   is no invoke id to answer;
 - a frame longer than the maximum closes this connection only;
+- when the connection closes, the jog keys it pressed are released (``jog_holds``);
 - every ADS request goes to the dispatcher; payloads that do not decode get the ADS
   error the decoder names (0x701 unknown command, 0x705 wrong size), with the length
   the client expects for that command.
@@ -28,7 +29,9 @@ A peer that does not read what it is sent is not read either, until it catches u
 notifications are dropped meanwhile, so a slow client cannot grow the service's memory.
 
 What connections hold is bounded (``connection_limits``, ``[limits]``): a connection
-beyond ``connections_per_front_end`` is closed as soon as it connects; a frame still
+beyond ``connections_per_front_end`` takes the seat of the keyless connection (a peer
+of the loopback rule) idle longest, if idle ``idle_connection_s``, or else is closed as
+soon as it connects; a frame still
 incomplete ``frame_timeout_s`` after its first byte closes its connection; a read that
 takes the incomplete frames of all connections over ``receive_buffer_bytes_total``
 closes the connection it came from. Each is logged (throttled); the others are served.
@@ -57,7 +60,7 @@ from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
 from cnc_objects.protocol.roles import Role
 
 from .ads_routes import Admission, RouteTable
-from .connection_limits import ConnectionLimits
+from .connection_limits import ConnectionLimits, Seat
 from .dispatch import Dispatcher
 from .log_throttle import ThrottledWarning
 from .notifications import NotificationHub
@@ -106,7 +109,7 @@ class AmsConnection(asyncio.Protocol):
         self._held: deque[AmsFrame | SkippedFrame] | None = None  # waiting for the rate
         self._held_timer: asyncio.TimerHandle | None = None
         self._limits = server.limits
-        self._admitted = False  # counted by the limits (released when lost)
+        self._seat: Seat | None = None  # counted by the limits (released when lost)
         self._buffered = 0  # bytes of the incomplete frame, as the limits account them
         self._frame_started_s: float | None = None  # first byte of the incomplete frame
         self._frame_timer: asyncio.TimerHandle | None = None
@@ -124,10 +127,12 @@ class AmsConnection(asyncio.Protocol):
             log.warning("ADS connection from %s refused: no route for this address", self.peer)
             transport.close()
             return
-        if not self._limits.admit(self.peer):
+        # keyed: a peer by route (not the loopback rule): it never gives up its seat
+        seat = self._limits.admit(self.peer, self._admission.roles is not None, self.close)
+        if seat is None:  # the table is full: closed at once, as a full router does
             transport.close()
             return
-        self._admitted = True
+        self._seat = seat
         self._server.connections.add(self)
         log.debug("ADS connection from %s", self.peer)
 
@@ -135,6 +140,8 @@ class AmsConnection(asyncio.Protocol):
         """Answer every frame ``data`` completes, in order."""
         parser = self._parser
         items = parser.feed(data)
+        if items and self._seat is not None:
+            self._seat.used_s = perf_counter()  # not idle: keeps its seat
         if (parser.buffered or self._buffered) and not self._account(items):
             return
         if self._held is not None:  # earlier frames wait for the rate: these behind them
@@ -214,14 +221,16 @@ class AmsConnection(asyncio.Protocol):
             if timer is not None:
                 timer.cancel()
         self._held_timer = self._frame_timer = None
-        if self._admitted:
-            self._admitted = False
-            self._limits.release(self._buffered)
+        if self._seat is not None:
+            self._limits.release(self._seat, self._buffered)
+            self._seat = None
             self._buffered = 0
         self._held = None
         if self._rate is not None:
             self._rate.forget(self)
         self._server.connections.discard(self)
+        # its jog keys are released at once (the dead-man, ``jog_holds``)
+        self._server.dispatcher.backend.connection_ended(self, f"from {self.peer} closed")
         hub = self._server.hub
         for envelope in self._envelopes:
             hub.drop_client(envelope)

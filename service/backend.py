@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import asyncio
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from functools import partial
 from typing import Any, Protocol
 
@@ -41,6 +41,7 @@ from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from .binding import refusal_code
+from .jog_holds import JOG_HOLD_TIMEOUT_S, JogHolds
 from .kernel.commands import Refusal
 from .kernel.kernel import Kernel
 from .notifications import NotificationCounts, NotificationHub, NotificationLimits
@@ -89,13 +90,15 @@ class Backend:
         notification_counts: NotificationCounts | None = None,
         outputs: OutputService | None = None,
         structs: PlcStructs | None = None,
+        jog_hold_timeout_s: float = JOG_HOLD_TIMEOUT_S,
     ) -> None:
         """``notification_limits``: what notifications may hold (``[limits]``
         notifications_per_client, notifications_total, notification_max_bytes,
         notification_bytes_per_client; their defaults without); ``notification_counts``: where
         the hub keeps its counts (the address space serves them); ``outputs``: the
         output area (the files the kernel writes); ``structs``: the HLI's struct and
-        array symbols, by name and by handle (none without)."""
+        array symbols, by name and by handle (none without); ``jog_hold_timeout_s``:
+        a jog key not renewed for this long is released (``jog_holds``)."""
         self.space = space
         self.structs = structs if structs is not None else PlcStructs(AddressSpace())
         self.kernel = kernel
@@ -103,6 +106,8 @@ class Backend:
         self.programs = programs
         self.outputs = outputs
         self.symbols = symbols
+        # jog keys held by their connections (the dead-man, ``jog_holds``)
+        self.jog_holds = JogHolds(loop, kernel.submit, jog_hold_timeout_s)
         self.hub = NotificationHub(
             self.read_value, loop, kernel.cycle_ns, kernel.reading,
             notification_limits, notification_counts,
@@ -242,11 +247,18 @@ class Backend:
             return self.structs.decode_memory_write(offset, data)  # a struct at its address
         return _one(decoded)
 
+    def connection_ended(self, holder: Hashable, how: str) -> None:
+        """A front end's connection ``holder`` is gone: the jog keys it holds are
+        released (``jog_holds``)."""
+        self.jog_holds.ended(holder, how)
+
     def apply_writes(
-        self, items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None]
+        self, items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None],
+        holder: Hashable = None,
     ) -> None:
         """Queue the writes for the kernel; ``finish`` gets (code, message) per item on the
-        loop once the cycle thread has applied all of them."""
+        loop once the cycle thread has applied all of them. ``holder``: the connection
+        that writes (a jog key it presses is held by it, ``jog_holds``)."""
         results: list[tuple[int, str]] = [(0, "")] * len(items)
         remaining = [len(items)]
         if not items:
@@ -263,8 +275,11 @@ class Backend:
             if remaining[0] == 0:
                 loop.call_soon_threadsafe(finish, results)
 
+        holds = self.jog_holds
         for k, (entry, value) in enumerate(items):
             assert entry.write is not None  # decode_writes gives writable entries only
+            if holds.is_held(entry):  # before the kernel has it: a release comes after
+                holds.written(holder, entry, value)
             self.kernel.submit(entry.write(value), partial(applied, k))
 
 

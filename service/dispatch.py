@@ -246,7 +246,7 @@ class Dispatcher:
             else:
                 self._send(envelope, self._ok(envelope, req))
 
-        self.backend.apply_writes(writes, finish)
+        self.backend.apply_writes(writes, finish, envelope[0])
         return None
 
     def _read_state(self, envelope: Envelope, req: Any) -> Reply:
@@ -379,7 +379,7 @@ class Dispatcher:
                 codes[k] = codes[k] or code
             self._send(envelope, self._ok(envelope, req, sums.encode_codes(codes)))
 
-        self.backend.apply_writes(writes, finish)
+        self.backend.apply_writes(writes, finish, envelope[0])
         return None
 
     def _sum_read_write(self, envelope: Envelope, req: ReadWriteRequest) -> Reply:

@@ -35,6 +35,11 @@ limit and the figures measured):
   are closed and logged (throttled). ZeroMQ buffers incomplete frames inside libzmq,
   where no budget can be kept: there the bound is the cap times the frame hard cap
   (``zmq_receive_bound_bytes``), held at most ``frame_timeout_s``.
+- ``jog_hold_timeout_s``: a pressed jog key not written TRUE again for this long is
+  released; a key is released at once when its connection ends (``jog_holds``).
+- ``idle_connection_s``: a full table closes the keyless connection idle longest (idle
+  at least this long) for a newcomer; keyed connections keep their seats
+  (``connection_limits``).
 
 Handles (0xF003 handle by name) are not a per-client resource: a handle is the stable
 number of an object, the same for every client, and releasing one frees nothing, so
@@ -54,6 +59,7 @@ from cnc_objects.protocol.constants import (
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.frames import U32_MAX, encode_error
 
+from .jog_holds import JOG_HOLD_TIMEOUT_S
 from .kernel.nc.work_guard import IDLE_STEPS_MAX
 from .kernel.step_clock import STEP_MAX_CYCLES
 from .notifications import MAX_BYTES, MAX_BYTES_PER_CLIENT, NotificationLimits
@@ -183,6 +189,18 @@ class LimitsConfig(BaseModel):
         64, ge=1, le=100_000,
         description="open connections each front end (ZeroMQ, ADS) serves at once; one "
         "more is closed at once (logged)",
+    )
+    jog_hold_timeout_s: float = Field(
+        JOG_HOLD_TIMEOUT_S, ge=0, le=3600,
+        description="seconds a pressed jog key (manual_jog_plus_w/minus_w TRUE) holds "
+        "without being written TRUE again; then it is released (0: only when its "
+        "connection ends)",
+    )
+    idle_connection_s: float = Field(
+        5.0, ge=0, le=86_400,
+        description="seconds without a request after which a keyless connection (no CURVE "
+        "key, no ADS route) gives its seat to a newcomer when the table is full; keyed "
+        "ones never do",
     )
     frame_timeout_s: float = Field(
         10.0, gt=0, le=3600,

@@ -201,7 +201,8 @@ async def serve(
     backend = Backend(space, kernel, loop, ProgramStoreService(store),
                       SymbolService(space, structs),
                       notification_limits(limits), counts,
-                      outputs=OutputService(writer), structs=structs)
+                      outputs=OutputService(writer), structs=structs,
+                      jog_hold_timeout_s=limits.jog_hold_timeout_s)
     kernel.on_cycle_end = _both(backend.hub.kernel_cycle_end,  # one hub serves both front ends
                                 kept.observe)  # the tables, written by a thread of its own
     kernel.next_observed_ns = backend.hub.next_observed_ns  # cycles it must see

@@ -20,7 +20,10 @@ wait for a busy event loop) with a credentials callback: a known key is admitted
 User-Id ``<role>/<name>``, which ZeroMQ attaches to every message of that connection
 (``zmq.Frame.get("User-Id")``); the server maps it to the role and the dispatcher decides.
 An unknown key is refused and logged with the peer's address. ``ZAP_ENFORCE_DOMAIN``
-makes libzmq refuse every client should the handler ever be missing.
+makes libzmq refuse every client should the handler ever be missing. The same handler
+(with or without CURVE) refuses a handshake when the connection table is full, with a
+status of its own (``zmq_connections``), so that the client is told so and not that its
+key was refused.
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ from __future__ import annotations
 import ipaddress
 import logging
 import stat
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +40,7 @@ import zmq.auth
 from zmq.auth.thread import ThreadAuthenticator
 from zmq.utils import z85
 
+from cnc_objects.protocol.constants import ZAP_STATUS_TABLE_FULL
 from cnc_objects.protocol.roles import ROLE_NAMES, Role
 
 log = logging.getLogger(__name__)
@@ -115,22 +119,42 @@ class ServerCurve:
 
 
 class ZapAuthenticator(ThreadAuthenticator):
-    """pyzmq's ZAP thread with our allow-list as the CURVE credentials callback."""
+    """pyzmq's ZAP thread with our allow-list as the CURVE credentials callback, and the
+    connection table's ``door``: a handshake it turns away is refused with ZAP status
+    ``ZAP_STATUS_TABLE_FULL`` (500), which the client's monitor reports as such. Without
+    an allow-list (a service without keys) NULL handshakes pass ZAP only for the door."""
 
-    def __init__(self, context: zmq.Context[zmq.Socket[bytes]], allow_list: AllowList) -> None:
+    def __init__(self, context: zmq.Context[zmq.Socket[bytes]],
+                 allow_list: AllowList | None = None) -> None:
         super().__init__(context, log=logging.getLogger(f"{__name__}.zap"))
-        self._allow = allow_list
+        self._allow = allow_list if allow_list is not None else AllowList((), "none")
+        self._curve = allow_list is not None
         self._peer = "?"  # the address of the ZAP request being handled
+        # the connection table's question for a handshake from an address (ZAP thread)
+        self.door: Callable[[str, bool], bool] | None = None
 
     def start(self) -> None:
         """Start the thread and answer CURVE requests of our domain from the allow-list."""
         super().start()
-        self.configure_curve_callback(ZAP_DOMAIN, self)
+        if self._curve:
+            self.configure_curve_callback(ZAP_DOMAIN, self)
 
     async def handle_zap_message(self, msg: list[bytes]) -> None:
-        """Note the peer's address (ZAP frame 4) for the callback's log, then authenticate."""
+        """Note the peer's address (ZAP frame 4) for the callback's log; refuse the
+        handshake when the table is full, else authenticate."""
         self._peer = msg[3].decode("utf-8", "replace") if len(msg) > 3 else "?"
+        door = self.door
+        if door is not None and len(msg) > 1 and not door(self._peer, self._keyed(msg)):
+            self._send_zap_reply(msg[1], str(ZAP_STATUS_TABLE_FULL).encode(),
+                                 b"connection table full")
+            return
         await super().handle_zap_message(msg)
+
+    def _keyed(self, msg: list[bytes]) -> bool:
+        """Does the ZAP request ``msg`` bring a CURVE key of the allow-list?"""
+        if not self._curve or len(msg) != 7 or msg[5] != b"CURVE" or len(msg[6]) != 32:
+            return False
+        return z85.encode(msg[6]) in self._allow.by_key
 
     def callback(self, domain: str, key: bytes) -> bool:
         """The credentials callback: is the Z85 public ``key`` in the allow-list?"""

@@ -11,8 +11,9 @@ its mailbox (``rate_limit``), a full mailbox is answered 0x502; frames that do n
 decode get an error reply (or are dropped, logged, when not even the invoke id can be
 read), everything else gets an answer from the dispatcher. Replies to a client that
 does not read wait up to the send high-water mark, then are dropped (counted, logged
-now and then). Connections beyond ``connections_per_front_end`` are shut down as they
-come, and a frame (or greeting) incomplete after ``frame_timeout_s`` ends its
+now and then). A connection beyond ``connections_per_front_end`` takes the seat of an
+idle keyless one or is refused in its handshake ("connection table full", ZAP 500;
+``zmq_connections``), and a frame (or greeting) incomplete after ``frame_timeout_s`` ends its
 connection through libzmq's heartbeat (``zmq_connections``). A vanished client's
 notifications are dropped: ZeroMQ says a client is gone when a send to it fails, so
 clients with notifications get an empty notification frame every ``PROBE_S`` (a client
@@ -48,13 +49,13 @@ from cnc_objects.protocol.frames import decode_request, encode_error, encode_not
 from cnc_objects.protocol.roles import Role
 
 from .backend import Backend
-from .connection_limits import ConnectionLimits
+from .connection_limits import ConnectionLimits, Seat
 from .dispatch import Dispatcher
 from .limits import LimitsConfig, oversized_reply, rate_limiter, request_head
 from .log_throttle import ThrottledWarning
 from .rate_limit import BYTES_PER_TOKEN as _BYTES_PER_TOKEN
 from .rate_limit import RateLimiter, extra_tokens
-from .security import ServerCurve
+from .security import ZAP_DOMAIN, ServerCurve, ZapAuthenticator
 from .zmq_connections import ZmqConnectionWatch
 
 log = logging.getLogger(__name__)
@@ -120,13 +121,17 @@ class ZmqServer:
             "(send_hwm_messages)", DROP_LOG_S)
         self._unreadable = ThrottledWarning(log, "dropped a frame with no readable invoke id",
                                             DROP_LOG_S)
-        self._auth = None
+        self._auth: ZapAuthenticator | None = None
         self._roles: dict[str, Role] | None = None  # User-Id -> role; None: no CURVE
         if curve is not None:  # the ZAP handler must answer before the first client comes
             self._auth = curve.authenticator(self._context)
             self._auth.start()
             curve.secure(sock)
             self._roles = curve.allow_list.roles_by_user
+        elif endpoint.startswith("tcp://"):  # ZAP only to say "connection table full"
+            self._auth = ZapAuthenticator(self._context)
+            self._auth.start()
+            sock.zap_domain = ZAP_DOMAIN.encode()
         try:
             sock.bind(endpoint)
         except zmq.ZMQError:
@@ -145,10 +150,15 @@ class ZmqServer:
         self.endpoint = sock.getsockopt_string(zmq.LAST_ENDPOINT)
         # Open connections, capped ([limits] connections_per_front_end); TCP only.
         self.connections: ZmqConnectionWatch | None = None
+        self._seats: dict[bytes, Seat] = {}  # routing id -> its connection's seat
         if self.endpoint.startswith("tcp://"):
             self.connections = ZmqConnectionWatch(
                 sock, int(self.endpoint.rsplit(":", 1)[1]),
-                ConnectionLimits("ZeroMQ", limits), self._loop)
+                ConnectionLimits("ZeroMQ", limits), self._loop, self._auth is not None)
+            self._seats = self.connections.by_routing_id
+            self.connections.ended = self._ended
+            if self._auth is not None:
+                self._auth.door = self.connections.door
         self.hub = backend.hub
         self.dispatcher = Dispatcher(backend, self)
         self._dispatch = self.dispatcher.dispatch
@@ -192,6 +202,7 @@ class ZmqServer:
         recv, deliver, dispatch = self._raw_recv, self._deliver, self._dispatch
         roles, dispatch_as = self._roles, self.dispatcher.dispatch_as
         max_frame_bytes, rate, now_s = self._max_frame_bytes, self.rate, perf_counter()
+        seats, watch = self._seats, self.connections
         for _ in range(DRAIN_BATCH):
             try:
                 part = recv(_NOBLOCK, False)  # a zmq.Frame: .more is cheaper than RCVMORE
@@ -204,6 +215,11 @@ class ZmqServer:
                 part = recv(_NOBLOCK, False)
                 frames.append(part.bytes)
             envelope, raw = tuple(frames[:-1]), frames[-1]
+            seat = seats.get(frames[0])
+            if seat is None and watch is not None:  # a new connection: which one
+                seat = watch.seat_of(frames[0], part, role is not None)
+            if seat is not None:
+                seat.used_s = now_s  # not idle: keeps its seat
             # Limits count per connection: its routing id, not the parts a client adds.
             if len(raw) > max_frame_bytes or (
                     rate is not None and not rate.admit(frames[0], now_s)):
@@ -300,6 +316,10 @@ class ZmqServer:
                 self._deliver(envelope, probe)
         self._look_for_input()
         self._probe_timer = self._loop.call_later(PROBE_S, self._probe)
+
+    def _ended(self, routing_id: bytes) -> None:
+        """A connection ended (``zmq_connections``): the jog keys it held are released."""
+        self.dispatcher.backend.connection_ended(routing_id, f"0x{routing_id.hex()} closed")
 
     def _gone(self, envelope: Envelope) -> None:
         """Forget a client ZeroMQ says is gone: its notifications, its waiting requests."""

@@ -14,7 +14,9 @@ standstill only).
   (``manual_jog_plus_w`` TRUE) at the first press and releases it (FALSE) when the
   repeats stop: ``FIRST_REPEAT_S`` after the first press (the keyboard's delay before it
   repeats), ``REPEAT_GAP_S`` after a repeat. Space releases at once, and so do RESET and
-  a key of the other direction or axis (``ContinuousJog``).
+  a key of the other direction or axis (``ContinuousJog``). While held, the key is
+  written TRUE again every ``RENEW_S`` (the service's dead-man releases a key that is
+  not renewed, docs/manual.md).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from dataclasses import dataclass
 
 from cnc_objects.clients.client import AsyncClient
 from cnc_objects.clients.errors import AdsError
+from cnc_objects.clients.jog_hold import RENEW_S
 from cnc_objects.protocol.values import ChannelMode, ManualOperationMode
 
 from .machine import AxisView, ChannelView
@@ -161,12 +164,20 @@ class ContinuousJog:
             self._releaser = None
 
     async def _release_when_repeats_stop(self) -> None:
+        renew_at_s = time.monotonic() + RENEW_S
         while (held := self.held) is not None:
-            left_s = held.release_at_s - time.monotonic()
+            now_s = time.monotonic()
+            left_s = held.release_at_s - now_s
             if left_s <= 0:
                 try:
                     await self.release()
                 except AdsError as exc:  # no one awaits this task: log, never raise
                     log.warning("jog key %s not released: %s", held.key, exc)
                 return
-            await asyncio.sleep(left_s)
+            if now_s >= renew_at_s:  # the service's dead-man releases a key not renewed
+                renew_at_s = now_s + RENEW_S
+                try:
+                    await held.client.write(held.key, True)
+                except AdsError as exc:
+                    log.warning("jog key %s not renewed: %s", held.key, exc)
+            await asyncio.sleep(min(left_s, max(renew_at_s - time.monotonic(), 0.0)))

@@ -183,8 +183,15 @@ class ManualMode:
     def jog(self, axis_index: int, direction: int, pressed: bool) -> Refusal | None:
         """``manual_jog_plus_w`` / ``manual_jog_minus_w``: the key pressed (TRUE) or
         released (FALSE). Continuous: moves while pressed; increments: one increment per
-        press. Releasing is always accepted."""
+        press. TRUE while the key is pressed changes nothing (a client renews its hold
+        so, ``service.jog_holds``) unless a continuous jog was stopped by something else
+        than the limit (feedhold, drive given up): that is a new press, checked as one.
+        Releasing is always accepted."""
         axis = self._axes[axis_index]
+        if pressed and (axis.jog_plus if direction > 0 else axis.jog_minus) and (
+                axis.operation_mode != ManualOperationMode.CONTINUOUS
+                or axis.motion is not None or axis.limit_warning):
+            return None  # held already: a renewal of the service's dead-man, not a press
         if not pressed:
             self._set_key(axis, direction, False)
             if (axis.operation_mode == ManualOperationMode.CONTINUOUS

@@ -161,6 +161,7 @@ async def test_continuous_jog_moves_while_the_key_repeats(
 
         # Held (the first repeat is a long way off): space releases it at once.
         monkeypatch.setattr(manual_keys, "FIRST_REPEAT_S", 600.0)
+        monkeypatch.setattr(manual_keys, "REPEAT_GAP_S", 600.0)  # renewed meanwhile
         await pilot.press("left_square_bracket")
         await wait_until(pilot, lambda: app.continuous_jog.held is not None)
         assert app.continuous_jog.held.key == "ch1.ax1.manual_jog_minus_w"

@@ -333,3 +333,25 @@ def test_suspending_the_axis_output_stops_a_jog_and_refuses_the_next(k) -> None:
     assert refusal is not None and "not linked" in refusal.message
     assert k.command(SetSuspendCommand(0, False)) is None
     k.wait_for(lambda s: not s.channels[0].output_suspended)
+
+
+def test_true_on_a_pressed_key_renews_it_and_is_no_new_press(k) -> None:
+    """The service's dead-man has a held key renewed by TRUE written again: no further
+    increment, a continuous jog runs on (and one stopped at the limit stays there)."""
+    manual(k)
+    write(k, "operation_mode", ManualOperationMode.INCREMENTAL)
+    write(k, "increment", 10_000)  # 1 mm
+    record_until_rest(k, ("jog_plus", True))
+    assert x_incr(k) == 10_000
+    record_until_rest(k, ("jog_plus", True))  # a renewal: no second increment
+    assert x_incr(k) == 10_000 and view(k).jog_plus
+    assert write(k, "jog_plus", False) is None
+    record_until_rest(k, ("jog_plus", True))  # a new press after the release
+    assert x_incr(k) == 20_000
+    assert write(k, "jog_plus", False) is None
+    write(k, "operation_mode", ManualOperationMode.CONTINUOUS)
+    record_until_rest(k, ("jog_plus", True))  # runs to the software limit
+    assert x_incr(k) == LIMIT_MAX_MM * 10_000 and view(k).limit_warning
+    state = k.kernel.snapshot.channels[0].state
+    assert write(k, "jog_plus", True) is None  # renewed at the limit: nothing starts
+    assert not view(k).moving and k.kernel.snapshot.channels[0].state == state
