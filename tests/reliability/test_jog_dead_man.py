@@ -148,3 +148,37 @@ async def test_held_jog_renews_until_the_block_ends(tmp_path: Path) -> None:
                     await asyncio.sleep(HOLD_TIMEOUT_S / 10)
             assert await client.read(KEY) is False
         assert "not renewed" not in service.log_text
+
+
+async def test_the_async_client_s_continuous_jog_is_renewed_until_jog_stop(
+        tmp_path: Path) -> None:
+    """``AsyncClient.jog(..., continuous=True)`` holds the key past several hold timeouts
+    (renewed in the background); ``jog_stop`` releases it and the axis stands."""
+    config = limits_toml(tmp_path / "c.toml", jog_hold_timeout_s=HOLD_TIMEOUT_S)
+    with serving("--config", str(config), "--clock", "realtime") as service:
+        async with AsyncClient(service.endpoint, timeout_s=20) as client:
+            state = await client.jog("X", "+", continuous=True)
+            assert state.moving
+            until = time.monotonic() + 4 * HOLD_TIMEOUT_S
+            while time.monotonic() < until:
+                assert await client.read(MOVING) is True
+                await asyncio.sleep(HOLD_TIMEOUT_S / 10)
+            stopped = await client.jog_stop("X", timeout_s=PRESS_TIMEOUT_S)
+            assert (stopped.moving, await client.read(KEY)) == (False, False)
+        assert "not renewed" not in service.log_text
+
+
+def test_the_blocking_client_renews_a_continuous_jog_with_renew_jog(tmp_path: Path) -> None:
+    """The blocking ``Client`` has no background: ``renew_jog`` keeps the key held past
+    the hold timeout; without it the service releases the key."""
+    config = limits_toml(tmp_path / "c.toml", jog_hold_timeout_s=HOLD_TIMEOUT_S)
+    with serving("--config", str(config), "--clock", "realtime") as service, \
+            Client(service.endpoint, timeout_s=20) as client:
+        assert client.jog("X", "+", continuous=True).moving
+        until = time.monotonic() + 4 * HOLD_TIMEOUT_S
+        while time.monotonic() < until:
+            assert client.read(MOVING) is True
+            client.renew_jog("X", "+")
+            time.sleep(HOLD_TIMEOUT_S / 5)
+        stopped_s = _wait(client, moving=False, timeout_s=HOLD_TIMEOUT_S + STOP_BOUND_S)
+        assert stopped_s >= HOLD_TIMEOUT_S * 0.5  # released by the dead-man, not at once
