@@ -1,7 +1,9 @@
 """``cnc-web``: the web HMI of a cnc-service, at http://127.0.0.1:8080 by default.
 
     cnc-web [--endpoint URL] [--host H] [--port P] [--users FILE]
-            [--key FILE [--server-key FILE]]
+            [--key FILE [--server-key FILE]] [--watch-per-page N] [--watch-per-session N]
+            [--watch-total N] [--watch-names-per-s N] [--subscribes-in-flight N]
+            [--unwatch-linger-s S]
 
 Browsers sign in as a role with the password ``cnc web-users set ROLE`` stored in the
 users file; without that file there is no sign-in and everyone on this machine is an
@@ -22,6 +24,7 @@ from aiohttp import web
 
 from ..client import DEFAULT_ENDPOINT
 from ..key_options import key_option, server_key_option
+from . import budgets as watch
 from .access import Access
 from .server import ServiceLink, is_loopback, make_app
 from .sessions import SessionSigner
@@ -54,6 +57,26 @@ def run(
     key: str = key_option("The web server's"),
     server_key: str = server_key_option(),
     log_level: str = typer.Option("INFO", "--log-level", help="DEBUG, INFO, WARNING or ERROR."),
+    watch_per_page: int = typer.Option(
+        watch.NAMES_PER_PAGE, "--watch-per-page", min=1,
+        help="Objects one page (WebSocket) may watch at once; more are refused to it."),
+    watch_per_session: int = typer.Option(
+        watch.NAMES_PER_SESSION, "--watch-per-session", min=1,
+        help="Objects the pages of one session may watch at once; more are refused to it."),
+    watch_total: int = typer.Option(
+        watch.NAMES_TOTAL, "--watch-total", min=1,
+        help="Objects cnc-web subscribes to for all pages (keep it under the service's "
+        "[limits] notifications_per_client)."),
+    watch_names_per_s: float = typer.Option(
+        watch.NAMES_PER_S, "--watch-names-per-s", min=1.0,
+        help="Names a page's watch/unwatch messages may carry per second; a page over it "
+        "waits (its messages are read later)."),
+    subscribes_in_flight: int = typer.Option(
+        watch.SUBSCRIBES_IN_FLIGHT, "--subscribes-in-flight", min=1,
+        help="Subscribe requests out to the service at once (others wait in cnc-web)."),
+    unwatch_linger_s: float = typer.Option(
+        watch.LINGER_S, "--unwatch-linger-s", min=0.0,
+        help="Seconds a subscription nobody watches is kept for a page that comes back."),
 ) -> None:
     """Serve the web HMI."""
     logging.basicConfig(level=log_level.upper(), format="%(levelname)s %(name)s: %(message)s")
@@ -76,8 +99,10 @@ def run(
     signing = (f"sign-in with {users_file} ({', '.join(r.label for r in loaded.roles)})"
                if loaded else "no sign-in (every browser of this machine is an operator)")
     print(f"cnc-web: http://{host}:{port} for {endpoint}; {signing}", file=sys.stderr, flush=True)
-    web.run_app(make_app(ServiceLink(endpoint, key_file=key, server_key=server_key), access),
-                host=host, port=port, print=None, access_log=None)
+    budgets = watch.WatchBudgets(watch_per_page, watch_per_session, watch_total,
+                                 watch_names_per_s, subscribes_in_flight, unwatch_linger_s)
+    web.run_app(make_app(ServiceLink(endpoint, key_file=key, server_key=server_key), access,
+                         budgets), host=host, port=port, print=None, access_log=None)
 
 
 def main(argv: list[str] | None = None) -> None:

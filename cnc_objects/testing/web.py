@@ -54,10 +54,11 @@ def free_port() -> int:
 def start_web(endpoint: str, *, users_file: str | os.PathLike[str] | None = None,
               key: str | os.PathLike[str] | None = None,
               server_key: str | os.PathLike[str] | None = None,
-              cwd: str | os.PathLike[str] | None = None, port: int | None = None) -> WebProcess:
+              cwd: str | os.PathLike[str] | None = None, port: int | None = None,
+              args: tuple[str, ...] = ()) -> WebProcess:
     """Start cnc-web for the service at ``endpoint`` on ``port`` (default: a free loopback
-    port); returns once it answers HTTP (``RuntimeError`` with its output when it exits
-    first)."""
+    port), with further options ``args`` (``("--watch-per-page", "5")``); returns once it
+    answers HTTP (``RuntimeError`` with its output when it exits first)."""
     port = port if port is not None else free_port()
     argv = [sys.executable, "-m", "cnc_objects.clients.web.cli", "--endpoint", endpoint,
             "--port", str(port), "--log-level", "WARNING"]
@@ -67,6 +68,7 @@ def start_web(endpoint: str, *, users_file: str | os.PathLike[str] | None = None
         argv += ["--key", os.fspath(key)]
     if server_key is not None:
         argv += ["--server-key", os.fspath(server_key)]
+    argv += args
     log = open(Path(os.environ.get("TMPDIR", "/tmp")) / f"cnc-web-{port}.log", "w+b")
     process = subprocess.Popen(argv, cwd=cwd, stdin=subprocess.DEVNULL, stdout=log,
                                stderr=subprocess.STDOUT)
