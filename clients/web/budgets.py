@@ -30,6 +30,7 @@ Defaults and what a page gets: docs/web.md, section "Watch budgets".
 from __future__ import annotations
 
 import asyncio
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -58,10 +59,10 @@ class WatchBudgets:
                      "subscribes_in_flight"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be at least 1")
-        if self.names_per_s <= 0:
-            raise ValueError("names_per_s must be more than 0")
-        if self.linger_s < 0:
-            raise ValueError("linger_s must not be negative")
+        if not (math.isfinite(self.names_per_s) and self.names_per_s > 0):
+            raise ValueError(f"names_per_s must be a number more than 0, not {self.names_per_s}")
+        if not (math.isfinite(self.linger_s) and self.linger_s >= 0):
+            raise ValueError(f"linger_s must be a number 0 or more, not {self.linger_s}")
 
     def refusal(self, budget: str) -> str:
         """The sentence a page gets for a name over ``budget`` (a field's name)."""

@@ -80,6 +80,11 @@ def run(
 ) -> None:
     """Serve the web HMI."""
     logging.basicConfig(level=log_level.upper(), format="%(levelname)s %(name)s: %(message)s")
+    try:
+        budgets = watch.WatchBudgets(watch_per_page, watch_per_session, watch_total,
+                                     watch_names_per_s, subscribes_in_flight, unwatch_linger_s)
+    except ValueError as exc:
+        _usage(str(exc))
     users_file = users if users is not None else (
         DEFAULT_USERS_FILE if DEFAULT_USERS_FILE.exists() else None)
     loaded = None
@@ -99,8 +104,6 @@ def run(
     signing = (f"sign-in with {users_file} ({', '.join(r.label for r in loaded.roles)})"
                if loaded else "no sign-in (every browser of this machine is an operator)")
     print(f"cnc-web: http://{host}:{port} for {endpoint}; {signing}", file=sys.stderr, flush=True)
-    budgets = watch.WatchBudgets(watch_per_page, watch_per_session, watch_total,
-                                 watch_names_per_s, subscribes_in_flight, unwatch_linger_s)
     web.run_app(make_app(ServiceLink(endpoint, key_file=key, server_key=server_key), access,
                          budgets), host=host, port=port, print=None, access_log=None)
 

@@ -114,10 +114,14 @@ class LiveHub:
     async def watch(self, outbox: Outbox, names: list[str]) -> None:
         """Send ``outbox`` every value of ``names`` (the current one first); a name the
         service does not have, or over a budget, is refused in ``outbox``'s errors."""
+        unreadable: str | None = None  # the catalogue could not be read: why
         for name in dict.fromkeys(names):
             if name in outbox.names:
                 continue
-            refused = await self._refusal(outbox, name)
+            try:
+                refused = unreadable or await self._refusal(outbox, name)
+            except AdsError as exc:  # the service did not give its catalogue: once is enough
+                refused = unreadable = str(exc)
             if refused is not None:
                 outbox.refuse(name, refused)
                 continue
