@@ -7,6 +7,7 @@ no reply) with its sentence as ``error``: the page shows the service's own words
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 from collections.abc import Awaitable, Callable
@@ -78,9 +79,13 @@ def _finite(data: dict[str, Any], name: str, default: float) -> float:
     """The number ``name`` of a request body (``default`` when absent), refused 400 when
     it is not a finite number: NaN and infinities included, as JSON numbers or strings."""
     value = data.get(name, default)
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise refusal(400, f"'{name}' is not a finite number: {value!r}")
-    return float(value)
+    number = math.nan
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        with contextlib.suppress(OverflowError):  # an integer beyond any float stays NaN
+            number = float(value)
+    if not math.isfinite(number):
+        raise refusal(400, f"'{name}' is not a finite number: {str(value)[:40]}")
+    return number
 
 
 def _query_count(request: web.Request, name: str, default: int) -> int:
