@@ -4,6 +4,7 @@
 
 - unknown names: another session's slowest read while one WebSocket message names 200
   objects that do not exist;
+- the same with 20 pages of 2 000 unknown names each;
 - a greedy page: what a second session gets while one WebSocket watches 1 000 objects;
 - churn: an operator's RESET through cnc-web (median, max) while 4 WebSockets watch and unwatch 2 000
   names over and over;
@@ -68,6 +69,32 @@ async def unknown_names(url: str) -> None:
         await socket.close()
     print(f"200 unknown names: all refused after {answered_s:.2f} s; another session's "
           f"slowest read meanwhile {slowest * 1000:.0f} ms")
+
+
+async def many_pages(url: str) -> None:
+    async with _session() as other:
+        await _csrf(other, url)
+        done = asyncio.Event()
+        reader = asyncio.create_task(_slowest_read_s(other, url, done))
+
+        async def page(k: int) -> None:
+            async with _session() as http:
+                await _csrf(http, url)
+                async with http.ws_connect(url + "/ws") as socket:
+                    names = [f"ch1.no_such_object_{k}_{i}" for i in range(2000)]
+                    await socket.send_json({"watch": names})
+                    errors: dict[str, Any] = {}
+                    while len(errors) < len(names):
+                        errors.update((await socket.receive_json()).get("errors", {}))
+
+        started = time.perf_counter()
+        await asyncio.gather(*(page(k) for k in range(20)))
+        answered_s = time.perf_counter() - started
+        done.set()
+        slowest = await reader
+    print(f"20 pages x 2000 unknown names: all refused after {answered_s:.2f} s; another "
+          f"session's slowest read meanwhile {slowest * 1000:.0f} ms (its client shares "
+          "this process's loop with the 20 pages)")
 
 
 async def greedy_page(url: str, names: list[str]) -> None:
@@ -176,6 +203,7 @@ async def main() -> None:
         with serving_web(service.endpoint) as web:
             await bad_input(web.url)
             await unknown_names(web.url)
+            await many_pages(web.url)
             await greedy_page(web.url, names)
         with serving_web(service.endpoint) as web:
             await churn(web.url, names)
