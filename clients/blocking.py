@@ -112,6 +112,12 @@ class Client(BlockingClientBase):
         before this request (ADS 0x70C when there is no such file)."""
         return run_blocking(self._core.download_output(name))
 
+    def find(self, name: str) -> ObjectInfo | None:
+        """The object ``name`` (any case) from the cached catalogue, or None: unlike
+        ``describe``, no search for the nearest names (a gateway checking many names its
+        users sent can refuse each unknown one in a dictionary look-up)."""
+        return run_blocking(self._core.find(name))
+
     def hold(self, channel: int = 1) -> None:
         """Feedhold: the path decelerates and stops (HOLD)."""
         return run_blocking(self._core.hold(channel))

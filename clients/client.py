@@ -15,7 +15,8 @@
         ...
 
 Objects are found by name through one browse of the service's catalog, cached for the
-life of the connection; an unknown name fails with ADS 0x710 and the nearest names
+life of the connection (single flight: calls that need it meanwhile wait for that one
+browse; ``find`` looks a name up and no more); an unknown name fails with ADS 0x710 and the nearest names
 ("did you mean ..."). What the service refuses raises ``AdsError`` naming its ADS code;
 a request without reply raises ``NoReplyError`` (an ``AdsTimeoutError``) naming what was
 asked (``no reply to READ ch1.x within 5 s from tcp://...``). What the client refuses
@@ -27,6 +28,7 @@ let the client in (its key refused, or keys that do not fit) raises
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import os
 from collections.abc import AsyncGenerator, AsyncIterator, Coroutine, Iterable, Iterator
@@ -204,6 +206,7 @@ class AsyncClient(TraceOps, AlarmOps, MachineOps):
             _transport = AsyncTransport(endpoint, timeout_s, curve=curve, batch=batch)
         self._t = _transport
         self._objects: dict[str, ObjectInfo] | None = None
+        self._catalogue_waiters: list[asyncio.Future[None]] | None = None  # a browse is out
         self._handles: dict[str, int] = {}
 
     async def __aenter__(self) -> AsyncClient:
@@ -240,14 +243,48 @@ class AsyncClient(TraceOps, AlarmOps, MachineOps):
         """What the service says about the object ``name`` (cached per connection)."""
         return await self._object(name)
 
+    async def find(self, name: str) -> ObjectInfo | None:
+        """The object ``name`` (any case) from the cached catalogue, or None: unlike
+        ``describe``, no search for the nearest names (a gateway checking many names its
+        users sent can refuse each unknown one in a dictionary look-up)."""
+        return (await self._catalogue()).get(name.lower())
+
     async def _object(self, name: str) -> ObjectInfo:
-        if self._objects is None:
-            self._objects = {o.name.lower(): o for o in await self.browse("*")}
-        info = self._objects.get(name.lower())
+        catalogue = await self._catalogue()
+        info = catalogue.get(name.lower())
         if info is None:
-            hint = _suggest(name, (o.name for o in self._objects.values()))
+            hint = _suggest(name, (o.name for o in catalogue.values()))
             raise AdsError(AdsReturnCode.DEVICE_SYMBOLNOTFOUND, f"no object {name!r}{hint}")
         return info
+
+    async def _catalogue(self) -> dict[str, ObjectInfo]:
+        """The service's objects by lower-case name: one browse for the connection's life,
+        single flight: calls that come while it is out wait for it (a cold ``gather`` of
+        500 reads browses once, not 500 times)."""
+        while self._objects is None:
+            if self._catalogue_waiters is not None:  # another call browses: wait for it
+                waiter = asyncio.get_running_loop().create_future()  # only an event loop overlaps calls
+                self._catalogue_waiters.append(waiter)
+                await waiter  # its error is ours; a cancelled browse: try again
+                continue
+            self._catalogue_waiters, error = [], None
+            try:
+                self._objects = {o.name.lower(): o for o in await self.browse("*")}
+            except asyncio.CancelledError:
+                raise  # the waiters try again (one of them browses)
+            except Exception as exc:  # the waiters get the same error as this call
+                error = exc
+                raise
+            finally:
+                waiters, self._catalogue_waiters = self._catalogue_waiters, None
+                for waiter in waiters:
+                    if waiter.done():
+                        continue
+                    if error is None:
+                        waiter.set_result(None)
+                    else:
+                        waiter.set_exception(error)
+        return self._objects
 
     # ------------------------------------------------------------ API
 

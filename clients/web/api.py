@@ -7,7 +7,9 @@ no reply) with its sentence as ``error``: the page shows the service's own words
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import math
 from collections.abc import Awaitable, Callable
 from typing import Any
 
@@ -31,6 +33,7 @@ TRACE_TIMEOUT_S = 60.0  # wall time for the dry run that draws a program's tool 
 MANUAL_MODE = 4  # ChannelMode.MANUAL
 JOG_INCREMENTAL = 3  # ManualOperationMode: jog by increments
 UM01_PER_MM = 10_000
+MAX_COUNT_DIGITS = 9  # a count in a query (``limit``): more digits than any catalogue needs
 
 Handler = Callable[[web.Request], Awaitable[web.StreamResponse]]
 
@@ -71,6 +74,27 @@ def _field(data: dict[str, Any], name: str, kind: type) -> Any:
     if not isinstance(value, kind) or isinstance(value, bool) and kind is not bool:
         raise refusal(400, f"'{name}' is missing or not a {kind.__name__}")
     return value
+
+
+def _finite(data: dict[str, Any], name: str, default: float) -> float:
+    """The number ``name`` of a request body (``default`` when absent), refused 400 when
+    it is not a finite number: NaN and infinities included, as JSON numbers or strings."""
+    value = data.get(name, default)
+    number = math.nan
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        with contextlib.suppress(OverflowError):  # an integer beyond any float stays NaN
+            number = float(value)
+    if not math.isfinite(number):
+        raise refusal(400, f"'{name}' is not a finite number: {str(value)[:40]}")
+    return number
+
+
+def _query_count(request: web.Request, name: str, default: int) -> int:
+    """The whole number >= 0 of the query parameter ``name``, else 400."""
+    text = request.query.get(name, str(default))
+    if not (text.isascii() and text.isdigit() and len(text) <= MAX_COUNT_DIGITS):
+        raise refusal(400, f"'{name}' is not a whole number >= 0: {text[:40]!r}")
+    return int(text)
 
 
 def _channel(request: web.Request) -> int:
@@ -160,7 +184,7 @@ async def machine(request: web.Request) -> web.StreamResponse:
 async def objects(request: web.Request) -> web.StreamResponse:
     """The objects whose names match ``pattern`` (glob; ``*`` for all), at most ``limit``."""
     pattern = request.query.get("pattern", "*") or "*"
-    limit = int(request.query.get("limit", "500"))
+    limit = _query_count(request, "limit", 500)
     found = await _client(request).browse(pattern)
     rows = [dataclasses.asdict(o) | {"enum": {str(k): v for k, v in o.enum.items()}}
             for o in found[:limit]]
@@ -263,13 +287,24 @@ async def jog(request: web.Request) -> web.StreamResponse:
     data = await _body(request)
     axis = _field(data, "axis", int)
     direction = _field(data, "direction", int)
-    increment_mm = float(data.get("increment_mm", 1.0))
+    increment_mm = _finite(data, "increment_mm", 1.0)
     require_write(request, f"jog in channel {channel}")
     c, prefix = _client(request), f"ch{channel}.ax{axis}"
+    # every check before the first write: a refused jog leaves the channel's mode alone
+    increment = await c.find(f"{prefix}.manual_increment_w")
+    if increment is None:
+        raise refusal(400, f"no axis {axis} in channel {channel}")
+    increment_um01 = round(increment_mm * UM01_PER_MM)
+    low, high = increment.dtype.minimum, increment.dtype.maximum
+    if low is not None and high is not None and not low <= increment_um01 <= high:
+        raise refusal(400, f"'increment_mm' {increment_mm} is out of range "
+                           f"({low / UM01_PER_MM}..{high / UM01_PER_MM} mm)")
+    if direction not in (1, -1):
+        raise refusal(400, f"'direction' is +1 or -1, not {direction}")
     if await c.read(f"ch{channel}.mc_active_mode_r") != MANUAL_MODE:
         await c.write(f"ch{channel}.mc_command_mode_w", MANUAL_MODE)
     await c.write(f"{prefix}.manual_operation_mode_w", JOG_INCREMENTAL)
-    await c.write(f"{prefix}.manual_increment_w", round(increment_mm * UM01_PER_MM))
+    await c.write(f"{prefix}.manual_increment_w", increment_um01)
     key = f"{prefix}.manual_jog_{'plus' if direction > 0 else 'minus'}_w"
     await c.write(key, True)
     await c.write(key, False)

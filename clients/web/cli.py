@@ -3,6 +3,8 @@
     cnc-web [--endpoint URL] [--host H] [--port P] [--users FILE]
             [--key FILE [--server-key FILE]] [--allow-host NAME ...]
             [--max-connections N] [--header-timeout S]
+            [--watch-per-page N] [--watch-per-session N] [--watch-total N]
+            [--watch-names-per-s N] [--subscribes-in-flight N] [--unwatch-linger-s S]
 
 Browsers sign in as a role with the password ``cnc web-users set ROLE`` stored in the
 users file; without that file there is no sign-in and everyone on this machine is an
@@ -24,6 +26,7 @@ import typer
 
 from ..client import DEFAULT_ENDPOINT
 from ..key_options import key_option, server_key_option
+from . import budgets as watch
 from .access import Access
 from .connections import HEADER_TIMEOUT_S, MAX_CONNECTIONS, ConnectionLimits, serve
 from .hosts import AllowedHosts
@@ -66,9 +69,34 @@ def run(
         HEADER_TIMEOUT_S, "--header-timeout", min=0.1, metavar="S", help="Seconds a "
         "connection has to send a request's headers; then it is closed."),
     log_level: str = typer.Option("INFO", "--log-level", help="DEBUG, INFO, WARNING or ERROR."),
+    watch_per_page: int = typer.Option(
+        watch.NAMES_PER_PAGE, "--watch-per-page", min=1,
+        help="Objects one page (WebSocket) may watch at once; more are refused to it."),
+    watch_per_session: int = typer.Option(
+        watch.NAMES_PER_SESSION, "--watch-per-session", min=1,
+        help="Objects the pages of one session may watch at once; more are refused to it."),
+    watch_total: int = typer.Option(
+        watch.NAMES_TOTAL, "--watch-total", min=1,
+        help="Objects cnc-web subscribes to for all pages (keep it under the service's "
+        "[limits] notifications_per_client)."),
+    watch_names_per_s: float = typer.Option(
+        watch.NAMES_PER_S, "--watch-names-per-s", min=1.0,
+        help="Names a page's watch/unwatch messages may carry per second; a page over it "
+        "waits (its messages are read later)."),
+    subscribes_in_flight: int = typer.Option(
+        watch.SUBSCRIBES_IN_FLIGHT, "--subscribes-in-flight", min=1,
+        help="Subscribe requests out to the service at once (others wait in cnc-web)."),
+    unwatch_linger_s: float = typer.Option(
+        watch.LINGER_S, "--unwatch-linger-s", min=0.0,
+        help="Seconds a subscription nobody watches is kept for a page that comes back."),
 ) -> None:
     """Serve the web HMI."""
     logging.basicConfig(level=log_level.upper(), format="%(levelname)s %(name)s: %(message)s")
+    try:
+        budgets = watch.WatchBudgets(watch_per_page, watch_per_session, watch_total,
+                                     watch_names_per_s, subscribes_in_flight, unwatch_linger_s)
+    except ValueError as exc:
+        _usage(str(exc))
     users_file = users if users is not None else (
         DEFAULT_USERS_FILE if DEFAULT_USERS_FILE.exists() else None)
     watched = None
@@ -90,7 +118,7 @@ def run(
                if loaded else f"no sign-in (every browser of this machine is {access.open_role.label})")
     print(f"cnc-web: http://{host}:{port} for {endpoint}; {signing}", file=sys.stderr, flush=True)
     link = ServiceLink(endpoint, key_file=key, server_key=server_key)
-    serve(make_app(link, access, AllowedHosts.serving(host, allow_host)), host, port,
+    serve(make_app(link, access, AllowedHosts.serving(host, allow_host), budgets), host, port,
           ConnectionLimits(max_connections, header_timeout))
 
 

@@ -8,27 +8,24 @@ on clean-up it closes both.
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import ipaddress
-import json
 from collections.abc import AsyncIterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from aiohttp import WSMsgType, web
+from aiohttp import web
 
 from cnc_objects.clients.client import AsyncClient
 
 from . import api
 from .access import ACCESS_KEY, Access, session_middleware, sweep_sessions
+from .budgets import WatchBudgets
 from .connections import connection_middleware
 from .hosts import HOSTS_KEY, AllowedHosts, host_middleware
-from .hub import FLUSH_S, LiveHub, Outbox
+from .hub import LiveHub
+from .live import HUB_KEY, SOCKETS_KEY, live
 
 STATIC_DIR = Path(__file__).with_name("static")
-HUB_KEY: web.AppKey[LiveHub] = web.AppKey("hub")
-SOCKETS_KEY: web.AppKey[list[int]] = web.AppKey("sockets")  # [open WebSockets]
-MAX_WATCHED = 2000  # names one browser may watch at once (the objects page's watch list is small)
 
 
 @dataclass(frozen=True)
@@ -69,57 +66,12 @@ async def stats(request: web.Request) -> web.StreamResponse:
                               "sockets": request.app[SOCKETS_KEY][0]})
 
 
-async def live(request: web.Request) -> web.StreamResponse:
-    """The WebSocket: ``{"watch": [names]}`` / ``{"unwatch": [names]}`` from the browser,
-    ``{"values": {name: value}, "errors": {name: sentence}}`` to it."""
-    hub = request.app[HUB_KEY]
-    socket = web.WebSocketResponse(heartbeat=20.0)
-    await socket.prepare(request)
-    outbox = Outbox()
-    request.app[SOCKETS_KEY][0] += 1
-    watched: set[str] = set()
-    sender = asyncio.create_task(_send(socket, outbox), name="web socket sender")
-    try:
-        async for message in socket:
-            if message.type != WSMsgType.TEXT:
-                continue
-            try:
-                command = json.loads(message.data)
-                names = [str(n) for n in command.get("watch", [])]
-                dropped = [str(n) for n in command.get("unwatch", [])]
-            except (ValueError, AttributeError, TypeError):
-                await socket.send_json({"errors": {"": "not a watch message"}})
-                continue
-            hub.unwatch(outbox, dropped)
-            watched.difference_update(dropped)
-            names = names[: max(0, MAX_WATCHED - len(watched))]
-            watched.update(names)
-            hub.watch(outbox, names)
-    finally:
-        request.app[SOCKETS_KEY][0] -= 1
-        hub.unwatch(outbox)
-        sender.cancel()
-        with contextlib.suppress(asyncio.CancelledError):
-            await sender
-    return socket
-
-
-async def _send(socket: web.WebSocketResponse, outbox: Outbox) -> None:
-    while not socket.closed:
-        await outbox.ready.wait()
-        message = outbox.take()
-        if message:
-            try:
-                await socket.send_json(message)
-            except ConnectionError:
-                return
-        await asyncio.sleep(FLUSH_S)  # newer values gather meanwhile: one message for all
-
-
-def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts) -> web.Application:
+def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts,
+             budgets: WatchBudgets | None = None) -> web.Application:
     """The cnc-web application for the service at ``link``, answering requests addressed
-    to ``hosts`` only. Each request passes, in order: its connection's guard (the header
-    timer stops), the Host/Origin check, the session."""
+    to ``hosts`` only (``budgets``: what pages may watch; default ``WatchBudgets()``).
+    Each request passes, in order: its connection's guard (the header timer stops), the
+    Host/Origin check, the session."""
     app = web.Application(middlewares=[connection_middleware, host_middleware, session_middleware],
                           client_max_size=api.MAX_UPLOAD_BYTES)
     app[ACCESS_KEY] = access
@@ -131,7 +83,7 @@ def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts) -> web.Appl
                              server_key=link.server_key)
         async with client:
             app[api.CLIENT_KEY] = client
-            app[HUB_KEY] = LiveHub(client)
+            app[HUB_KEY] = LiveHub(client, budgets=budgets)
             sweeper = asyncio.create_task(sweep_sessions(access), name="cnc-web session sweep")
             yield
             sweeper.cancel()
