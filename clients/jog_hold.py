@@ -20,12 +20,16 @@ import asyncio
 import contextlib
 import logging
 from types import TracebackType
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 from .errors import AdsConnectionError, AdsError
 
-if TYPE_CHECKING:  # the CLI imports RENEW_S without the client
-    from .client import AsyncClient
+
+class KeyWriter(Protocol):
+    """What a held key needs of a client: ``AsyncClient.write`` (a protocol, so that the
+    client's own mixins hold keys without an import circle)."""
+
+    async def write(self, name: str, value: Any, units: bool = False) -> None: ...
 
 log = logging.getLogger(__name__)
 
@@ -40,7 +44,7 @@ class HeldJog:
     ``AdsError`` from ``async with``; a renewal it refuses (the channel was held, reset,
     the key released by someone else and pressed in vain) ends the renewals, logged."""
 
-    def __init__(self, client: AsyncClient, key: str, renew_s: float = RENEW_S) -> None:
+    def __init__(self, client: KeyWriter, key: str, renew_s: float = RENEW_S) -> None:
         self.client = client
         self.key = key
         self.renew_s = renew_s

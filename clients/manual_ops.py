@@ -26,7 +26,7 @@ from __future__ import annotations
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING
 
 from cnc_objects.protocol.values import ChannelMode, ManualOperationMode
 
@@ -35,7 +35,6 @@ from .errors import AdsTimeoutError, ClientValueError
 from .units import engineering
 
 if TYPE_CHECKING:
-    from .client import AsyncClient
     from .jog_hold import HeldJog
 
 POLL_S = 0.02  # how often a wait re-reads the axis (wall time)
@@ -180,7 +179,7 @@ class ManualOps(MixinBase):
         old = self._held_jogs().pop(key, None)
         if old is not None:
             await old.release()
-        held = HeldJog(cast("AsyncClient", self), key)
+        held = HeldJog(self, key)
         await held.__aenter__()
         self._held_jogs()[key] = held
 

@@ -75,6 +75,9 @@ _Reads = dict[tuple[int, int, int, int], tuple[int, bytes | str]]
 
 MAX_PER_CLIENT = 1000  # default of [limits] notifications_per_client
 MAX_TOTAL = 20000  # default of [limits] notifications_total
+#: The length of an AddDeviceNotification that does not know the value's size (ads-client
+#: sends it by handle): the value's own size is taken.
+UNKNOWN_LENGTH = 0xFFFF_FFFF
 #: Default of [limits] notification_max_bytes: the largest symbol of the PLC memory
 #: area (gpCh, both channels' HLI structs) may be watched whole.
 MAX_BYTES = 8 << 10
@@ -209,12 +212,20 @@ class NotificationHub:
                 AdsReturnCode.DEVICE_TRANSMODENOTSUPP,
                 f"transmission mode {mode} is not a server mode (use 3 cyclic or 4 on change)",
             )
-        refused = self._size_refusal(envelope, req.length)
-        if refused is not None:
-            return refused
+        if req.length != UNKNOWN_LENGTH:  # refused before anything is read
+            refused = self._size_refusal(envelope, req.length)
+            if refused is not None:
+                return refused
         code, data = self._read(req.port, req.group, req.offset, req.length)
         if code:
             return code, data  # type: ignore[return-value]
+        # "I do not know the size" (0xFFFFFFFF, by handle): the value's own size, which
+        # the limits count and every pass reads
+        length = len(data) if req.length == UNKNOWN_LENGTH else req.length
+        if req.length == UNKNOWN_LENGTH:
+            refused = self._size_refusal(envelope, length)
+            if refused is not None:
+                return refused
         limits = self.limits
         mine = self._per_client.get(envelope[0], 0)
         if mine >= limits.per_client:
@@ -228,13 +239,13 @@ class NotificationHub:
         handle = self._next_handle
         self._next_handle += 1
         sub = Subscription(
-            handle, envelope, notify, req.port, req.group, req.offset, req.length,
+            handle, envelope, notify, req.port, req.group, req.offset, length,
             mode in ON_CHANGE_MODES, max(cycle_ns, self._kernel_cycle_ns), FIRST_SAMPLE_PENDING,
         )
         self._subs[handle] = sub
         self._per_client[envelope[0]] = mine + 1
         key = envelope[0]
-        self._bytes_per_client[key] = self._bytes_per_client.get(key, 0) + req.length
+        self._bytes_per_client[key] = self._bytes_per_client.get(key, 0) + length
         held = self._envelopes.get(envelope)
         self._envelopes[envelope] = (notify, 1 if held is None else held[1] + 1)
         self._count()

@@ -189,6 +189,7 @@ async def test_browse_describes_objects(api: Any) -> None:
         # tools and work offsets: positions in workpiece coordinates, zero offsets
         "ch1.ax1.command_position_pcs",
         "ch1.ax1.actual_position_pcs",
+        "ch1.ax1.distance_to_go_pcs",
         *(f"ch1.ax1.np_grp[{group}].v" for group in range(1, 10)),
     }
     link = found["ch1.ax1.link_state"]
