@@ -19,7 +19,7 @@ from aiohttp import WSMsgType, web
 
 from cnc_objects.clients.client import AsyncClient
 
-from . import api
+from . import api, machine_api
 from .access import ACCESS_KEY, Access, session_middleware, sweep_sessions
 from .connections import connection_middleware
 from .hosts import HOSTS_KEY, AllowedHosts, host_middleware
@@ -129,6 +129,7 @@ def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts) -> web.Appl
     async def service_client(app: web.Application) -> AsyncIterator[None]:
         client = AsyncClient(link.endpoint, timeout_s=link.timeout_s, key_file=link.key_file,
                              server_key=link.server_key)
+        client.reset_hint = "Reset, beside the MDI line"
         async with client:
             app[api.CLIENT_KEY] = client
             app[HUB_KEY] = LiveHub(client)
@@ -145,4 +146,5 @@ def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts) -> web.Appl
     app.router.add_get("/api/stats", stats)
     app.router.add_static("/static/", STATIC_DIR)
     api.add_routes(app)
+    machine_api.add_routes(app)
     return app
