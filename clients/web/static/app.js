@@ -9,7 +9,8 @@ const UM01_PER_MM = 10000; // positions are in 0.1 um
 const SPINDLE_MODES = { 1: "M5", 2: "M3", 4: "M4", 8: "M19" };
 const LINK_STATES = { 0: "linked", 1: "requested", 2: "waiting ack" };
 const CONTOUR_TYPES = { 1: "linear", 2: "circular", 3: "LOG ON", 4: "LOG PARAM", 5: "LOG OFF", 6: "polynomial" }; // ContourBlockType
-const PAGES = ["machine", "program", "mdi", "lookahead", "alarms", "objects"];
+const PAGES = ["machine", "program", "mdi", "tools", "lookahead", "alarms", "objects"];
+const WORKING_STATES = ["ACTIVE", "HOLD"];
 const MDI_HISTORY_KEY = "cnc-web-mdi-history";
 const MDI_HISTORY_MAX = 30;
 
@@ -22,8 +23,11 @@ const state = {
   socket: null,
   program: null,       // the program shown on the program page
   programLines: [],
-  planned: null,       // {x: [], y: []} of the drawn tool path
-  live: [],            // [x, y] points of the live position while a program runs
+  planned: null,       // {x: [], y: []} of the planned tool path (machine coordinates)
+  planning: null,      // the dry run under way (a Promise), awaited before a start
+  live: [],            // [x, y] machine positions of the tool while a program runs
+  extent: null,        // [minX, minY, maxX, maxY] of the tool path view: grows, never shrinks
+  page: "machine",
   objectWatch: [],     // names on the objects page's watch list
   renderQueued: false,
   stats: { messages: 0, positionUpdates: 0, since: performance.now() },
@@ -47,7 +51,7 @@ function say(text, isError = false) {
 
 // ------------------------------------------------------------------ API
 
-async function api(method, path, body) {
+async function api(method, path, body, quiet = false) {
   const headers = {};
   if (state.session && state.session.csrf) headers["X-CSRF-Token"] = state.session.csrf;
   let payload = body;
@@ -60,7 +64,7 @@ async function api(method, path, body) {
   try { data = await response.json(); } catch (_) { data = {}; }
   if (!response.ok) {
     const why = data.error || `${response.status} ${response.statusText}`;
-    say(why, true);
+    if (!quiet) say(why, true);
     if (response.status === 401 && state.session && state.session.sign_in_required) showLogin();
     throw new Error(why);
   }
@@ -114,7 +118,8 @@ function channelNames(ch) {
     .map((leaf) => `${c}.${leaf}`);
   names.push(`gpCh[${ch.plc_index}].bahn_mc_control.suspend_axis_output.state_r`);
   for (const ax of ch.axes) {
-    for (const leaf of ["command_position_acs", "command_position_pcs", "position_offset", "link_state"]) {
+    for (const leaf of ["command_position_acs", "command_position_pcs", "position_offset", "link_state",
+      "homing_referenced_r", "manual_jog_plus_w", "manual_jog_minus_w"]) {
       names.push(`${c}.ax${ax.index}.${leaf}`);
     }
   }
@@ -169,14 +174,17 @@ function queueRender() {
 const v = (name) => state.values[name];
 const mm = (value) => (value === undefined ? "-" : (value / UM01_PER_MM).toFixed(4));
 const named = (table, value) => (value === undefined ? "-" : (table[value] || String(value)));
+const referenced = (value) => (value === undefined ? "-" : (value ? "yes" : "no"));
 
 // ------------------------------------------------------------------ rendering
 
+// Only the visible page is drawn: a frame costs what one page costs, not all of them.
+const RENDERERS = { machine: () => renderMachine(), program: () => renderProgramPage(), mdi: () => renderJog(), objects: () => renderWatch() };
+
 function render() {
-  renderMachine();
-  renderProgramLive();
-  renderJog();
-  renderWatch();
+  recordLivePath();  // the path so far is kept whatever page is shown
+  const renderer = RENDERERS[state.page];
+  if (renderer) renderer();
   const active = v("alarm_active_count_r") || 0;  // the service's active alarm list
   $("#alarm-count").textContent = active ? String(active) : "";
 }
@@ -229,6 +237,7 @@ function renderMachine() {
       cells(rowFor(axes, a), [
         `${c} ${ax.name}`, mm(v(`${a}.command_position_acs`)), mm(v(`${a}.command_position_pcs`)),
         mm(v(`${a}.position_offset`)), named(LINK_STATES, v(`${a}.link_state`)), ax.drive || "-",
+        referenced(v(`${a}.homing_referenced_r`)),
       ]);
     }
   }
@@ -291,12 +300,39 @@ async function showProgram(name) {
   const data = await api("GET", `/api/programs/${encodeURIComponent(name)}`);
   state.program = name;
   state.planned = null;
-  state.live = [];
+  state.extent = null;
+  if (!working()) state.live = [];
   $("#program-name").textContent = name;
   for (const item of $("#program-list").children) item.classList.toggle("selected", item.dataset.name === name);
   state.programLines = data.text.split("\n");
   if (state.programLines.length && state.programLines[state.programLines.length - 1] === "") state.programLines.pop();
   $("#program-text").replaceChildren(...state.programLines.map((text) => el("li", { textContent: text })));
+  state.shownLine = null;
+  drawPath();
+  state.planning = loadPlanned(name);
+  await state.planning;
+}
+
+// The planned path is drawn as soon as a program is shown: a dry run in the channel
+// (cnc-web keeps the last ones, so a program started from the page shows it while it runs).
+async function loadPlanned(name) {
+  $("#path-note").textContent = "planning…";
+  try {
+    const trace = await api("POST", `/api/channel/${state.channel}/trace`, { program: name }, true);
+    if (state.program !== name) return;
+    setPlanned(trace);
+    $("#path-note").textContent = `planned ${trace.program_time_s.toFixed(3)} s`;
+  } catch (error) {
+    if (state.program === name) $("#path-note").textContent = `no planned path: ${error.message}`;
+  } finally {
+    state.planning = null;
+  }
+}
+
+function setPlanned(trace) {
+  const [xName, yName] = Object.keys(trace.positions_mm);
+  state.planned = { x: trace.positions_mm[xName] || [], y: trace.positions_mm[yName] || [] };
+  state.extent = null;
   drawPath();
 }
 
@@ -324,13 +360,14 @@ drop.addEventListener("drop", (event) => {
   else say(`role ${state.session.role} may not upload programs; admin may`, true);
 });
 
-function needProgram() {
+async function needProgram() {
   if (!state.program) say("choose a program in the list first", true);
+  if (state.planning) await state.planning;  // the channel is busy with the dry run until then
   return state.program;
 }
 
 $("#select-program").addEventListener("click", async () => {
-  if (!needProgram()) return;
+  if (!await needProgram()) return;
   try {
     await api("POST", `/api/channel/${state.channel}/select`, { program: state.program });
     say(`channel ${state.channel}: ${state.program} selected`);
@@ -338,7 +375,7 @@ $("#select-program").addEventListener("click", async () => {
 });
 
 $("#start-program").addEventListener("click", async () => {
-  if (!needProgram()) return;
+  if (!await needProgram()) return;
   try {
     await api("POST", `/api/channel/${state.channel}/select`, { program: state.program });
     state.live = [];
@@ -348,7 +385,7 @@ $("#start-program").addEventListener("click", async () => {
 });
 
 $("#check-program").addEventListener("click", async () => {
-  if (!needProgram()) return;
+  if (!await needProgram()) return;
   try {
     say(`checking ${state.program}…`);
     const result = await api("POST", `/api/channel/${state.channel}/check`, { program: state.program });
@@ -366,67 +403,147 @@ $("#check-program").addEventListener("click", async () => {
 });
 
 $("#draw-program").addEventListener("click", async () => {
-  if (!needProgram()) return;
+  if (!await needProgram()) return;
   try {
     say(`dry run of ${state.program} (no axis moves)…`);
     const trace = await api("POST", `/api/channel/${state.channel}/trace`, { program: state.program });
-    const [xName, yName] = Object.keys(trace.positions_mm);
-    state.planned = { x: trace.positions_mm[xName] || [], y: trace.positions_mm[yName] || [] };
+    setPlanned(trace);
     say(`${state.program}: ${trace.program_time_s.toFixed(3)} s planned, ended ${trace.ended}`);
-    drawPath();
   } catch (_) { /* shown */ }
 });
 
-function currentXY() {
-  const ch = state.machine.channels.find((c) => c.id === state.channel);
+function currentChannel() {
+  return state.machine.channels.find((c) => c.id === state.channel);
+}
+
+function working() {
+  return WORKING_STATES.includes(named(state.machine.states, v(`ch${state.channel}.mc_active_state_r`)));
+}
+
+function currentXY(cs = "acs") {
+  const ch = currentChannel();
   if (!ch || ch.axes.length < 2) return null;
-  const x = v(`ch${ch.id}.ax${ch.axes[0].index}.command_position_acs`);
-  const y = v(`ch${ch.id}.ax${ch.axes[1].index}.command_position_acs`);
+  const x = v(`ch${ch.id}.ax${ch.axes[0].index}.command_position_${cs}`);
+  const y = v(`ch${ch.id}.ax${ch.axes[1].index}.command_position_${cs}`);
   return x === undefined || y === undefined ? null : [x / UM01_PER_MM, y / UM01_PER_MM];
 }
 
-function drawPath() {
-  const points = [];
-  if (state.planned) state.planned.x.forEach((x, k) => points.push([x, state.planned.y[k]]));
-  const all = points.concat(state.live);
+// What lies between machine and workpiece coordinates now (zero offset and tool
+// length: machine - workpiece), and the name of the coordinates the path is drawn in.
+function pathFrame() {
+  const acs = currentXY("acs");
+  const pcs = currentXY("pcs");
+  const shift = acs && pcs ? [acs[0] - pcs[0], acs[1] - pcs[1]] : [0, 0];
+  const group = v(`ch${state.channel}.mc_active_zero_offset_r`) || 0;
+  const workpiece = group !== 0 || shift[0] !== 0 || shift[1] !== 0;
+  return { shift, name: workpiece ? `workpiece coordinates (G${53 + group})` : "machine coordinates (G53)" };
+}
+
+function recordLivePath() {
   const here = currentXY();
-  if (here) all.push(here);
-  if (!all.length) return;
-  let [minX, minY, maxX, maxY] = [Infinity, Infinity, -Infinity, -Infinity];
-  for (const [x, y] of all) { minX = Math.min(minX, x); maxX = Math.max(maxX, x); minY = Math.min(minY, y); maxY = Math.max(maxY, y); }
-  const span = Math.max(maxX - minX, maxY - minY, 1);
-  const scale = Math.min(360 / span, 260 / span);
-  const sx = (x) => (20 + (x - minX) * scale).toFixed(2);
-  const sy = (y) => (280 - (y - minY) * scale).toFixed(2);
-  const line = (pts) => pts.map(([x, y]) => `${sx(x)},${sy(y)}`).join(" ");
-  $("#path-planned").setAttribute("points", line(points));
-  $("#path-live").setAttribute("points", line(state.live));
-  if (here) {
-    $("#path-tool").setAttribute("cx", sx(here[0]));
-    $("#path-tool").setAttribute("cy", sy(here[1]));
+  if (!here || !working()) return;
+  const last = state.live[state.live.length - 1];
+  if (!last || last[0] !== here[0] || last[1] !== here[1]) {
+    state.live.push(here);
+    if (state.live.length > 5000) state.live.splice(0, state.live.length - 5000);
   }
 }
 
-function renderProgramLive() {
-  const c = `ch${state.channel}`;
-  const here = currentXY();
-  const working = ["ACTIVE", "HOLD"].includes(named(state.machine.states, v(`${c}.mc_active_state_r`)));
-  if (here) {
-    const last = state.live[state.live.length - 1];
-    if (working && (!last || last[0] !== here[0] || last[1] !== here[1])) {
-      state.live.push(here);
-      if (state.live.length > 5000) state.live.splice(0, state.live.length - 5000);
-    }
-    $("#position-line").textContent = `X ${here[0].toFixed(4)}  Y ${here[1].toFixed(4)} mm`;
+function niceStep(span) {
+  const raw = span / 5;
+  const power = 10 ** Math.floor(Math.log10(raw));
+  return [1, 2, 5, 10].map((f) => f * power).find((step) => step >= raw);
+}
+
+const PLOT = { left: 46, top: 10, width: 344, height: 262 }; // inside the 400 x 300 view box
+
+function drawPath() {
+  const frame = pathFrame();
+  const [dx, dy] = frame.shift;
+  const toView = ([x, y]) => [x - dx, y - dy];
+  const planned = state.planned ? state.planned.x.map((x, k) => toView([x, state.planned.y[k]])) : [];
+  const live = state.live.map(toView);
+  const acs = currentXY();
+  const here = acs ? toView(acs) : null;
+  // The view holds the planned path from the start and grows when the tool leaves it:
+  // it never shrinks to the path so far. A new offset (G53 -> G54) starts it anew.
+  const key = `${dx},${dy}`;
+  let e = state.extentKey === key ? state.extent : null;
+  for (const [x, y] of planned.concat(live, here ? [here] : [])) {
+    e = e ? [Math.min(e[0], x), Math.min(e[1], y), Math.max(e[2], x), Math.max(e[3], y)] : [x, y, x, y];
   }
+  if (!e) return;
+  state.extent = e;
+  state.extentKey = key;
+  const span = Math.max((e[2] - e[0]) * PLOT.height / PLOT.width, e[3] - e[1], 1) * 1.1;
+  const scale = PLOT.height / span; // px per mm, the same on both axes
+  const [cx, cy] = [(e[0] + e[2]) / 2, (e[1] + e[3]) / 2];
+  const sx = (x) => PLOT.left + PLOT.width / 2 + (x - cx) * scale;
+  const sy = (y) => PLOT.top + PLOT.height / 2 - (y - cy) * scale;
+  drawGrid(frame.name, scale, cx, cy, sx, sy);
+  const line = (pts) => pts.map(([x, y]) => `${sx(x).toFixed(2)},${sy(y).toFixed(2)}`).join(" ");
+  $("#path-planned").setAttribute("points", line(planned));
+  $("#path-live").setAttribute("points", line(live));
+  if (here) {
+    $("#path-tool").setAttribute("cx", sx(here[0]).toFixed(2));
+    $("#path-tool").setAttribute("cy", sy(here[1]).toFixed(2));
+  }
+}
+
+// The axes, the grid and its labels in mm: drawn again only when the view changes.
+function drawGrid(frameName, scale, cx, cy, sx, sy) {
+  const key = `${frameName} ${scale} ${cx} ${cy}`;
+  if (state.gridKey === key) return;
+  state.gridKey = key;
+  const step = niceStep(PLOT.width / scale);
+  const [x0, x1] = [cx - PLOT.width / 2 / scale, cx + PLOT.width / 2 / scale];
+  const [y0, y1] = [cy - PLOT.height / 2 / scale, cy + PLOT.height / 2 / scale];
+  const digits = step < 1 ? Math.ceil(-Math.log10(step)) : 0;
+  const parts = [];
+  const bottom = PLOT.top + PLOT.height;
+  for (let x = Math.ceil(x0 / step) * step; x <= x1; x += step) {
+    const px = sx(x).toFixed(1);
+    parts.push(`<line class="${Math.abs(x) < step / 1e6 ? "axis" : "tick"}" x1="${px}" y1="${PLOT.top}" x2="${px}" y2="${bottom}"/>`,
+      `<text x="${px}" y="${bottom + 12}" text-anchor="middle">${x.toFixed(digits)}</text>`);
+  }
+  for (let y = Math.ceil(y0 / step) * step; y <= y1; y += step) {
+    const py = sy(y).toFixed(1);
+    parts.push(`<line class="${Math.abs(y) < step / 1e6 ? "axis" : "tick"}" x1="${PLOT.left}" y1="${py}" x2="${PLOT.left + PLOT.width}" y2="${py}"/>`,
+      `<text x="${PLOT.left - 4}" y="${py}" text-anchor="end" dominant-baseline="middle">${y.toFixed(digits)}</text>`);
+  }
+  parts.push(`<rect class="frame" x="${PLOT.left}" y="${PLOT.top}" width="${PLOT.width}" height="${PLOT.height}"/>`,
+    `<text class="axis-name" x="${PLOT.left + PLOT.width - 2}" y="${bottom - 4}" text-anchor="end">X mm</text>`,
+    `<text class="axis-name" x="${PLOT.left + 4}" y="${PLOT.top + 12}">Y mm</text>`);
+  $("#path-grid").innerHTML = parts.join("");
+  $("#path-frame").textContent = `· ${frameName}`;
+  $("#path-scale").textContent = `grid ${step.toFixed(digits)} mm`;
+}
+
+function renderProgramPage() {
+  const c = `ch${state.channel}`;
+  // in step with the channel: its running program is shown, opened while it runs too
+  const active = v(`${c}.mc_active_program_name_r`);
+  if (active && !state.following && (!state.program || (working() && active !== state.program))) {
+    state.following = true;
+    showProgram(active).catch(() => {}).finally(() => { state.following = false; });
+  }
+  const here = currentXY(pathFrame().name.startsWith("workpiece") ? "pcs" : "acs");
+  if (here) $("#position-line").textContent = `X ${here[0].toFixed(4)}  Y ${here[1].toFixed(4)} mm`;
   $("#program-state").textContent = named(state.machine.states, v(`${c}.mc_active_state_r`));
   const block = v(`${c}.actual_block_number`);
   $("#program-block").textContent = block === undefined || block < 0 ? "-" : `N${block} line ${v(`${c}.mc_active_line_r`)}`;
   const items = $("#program-text").children;
-  const line = v(`${c}.mc_active_line_r`);
-  const file = v(`${c}.mc_active_file_name_r`);
-  for (let k = 0; k < items.length; k++) items[k].classList.toggle("current", file === state.program && line === k + 1);
-  if (!$("#page-program").hidden) drawPath();
+  const line = v(`${c}.mc_active_file_name_r`) === state.program ? v(`${c}.mc_active_line_r`) : null;
+  if (line !== state.shownLine) {
+    items[state.shownLine - 1]?.classList.remove("current");
+    const item = items[line - 1];
+    if (item) {
+      item.classList.add("current");
+      item.scrollIntoView({ block: "nearest" });
+    }
+    state.shownLine = line;
+  }
+  drawPath();
 }
 
 // ------------------------------------------------------------------ MDI and jog
@@ -457,31 +574,217 @@ $("#mdi-form").addEventListener("submit", async (event) => {
   } catch (_) { /* shown */ }
 });
 
+const jogMode = () => $("#jog-mode").value;
+
+$("#jog-mode").addEventListener("change", () => {
+  const mode = jogMode();
+  $("#jog-increment-label").hidden = mode !== "increment";
+  $("#jog-rapid-label").hidden = mode !== "continuous";
+  $("#jog-handwheel-label").hidden = mode !== "handwheel";
+});
+
+function jogButton(ch, ax, direction) {
+  const side = direction > 0 ? "plus" : "minus";
+  const button = el("button", { type: "button", className: "write jog", textContent: `${ax.name} ${direction > 0 ? "+" : "−"}` });
+  button.dataset.key = `ch${ch.id}.ax${ax.index}.manual_jog_${side}_w`;
+  button.disabled = !state.session.may_write;
+  button.addEventListener("click", () => {
+    if (jogMode() === "increment") stepJog(ax, direction);
+    else if (jogMode() === "handwheel") turnHandwheel(ax, direction);
+  });
+  // continuous jog: held while the pointer or the key is down
+  button.addEventListener("pointerdown", (event) => {
+    if (jogMode() !== "continuous") return;
+    button.setPointerCapture(event.pointerId);
+    holdJog(ax, direction);
+  });
+  for (const name of ["pointerup", "pointercancel", "lostpointercapture"]) button.addEventListener(name, releaseJog);
+  button.addEventListener("keydown", (event) => {
+    if (jogMode() !== "continuous" || (event.key !== " " && event.key !== "Enter")) return;
+    event.preventDefault();
+    if (!event.repeat) holdJog(ax, direction);
+  });
+  button.addEventListener("keyup", (event) => {
+    if (event.key === " " || event.key === "Enter") releaseJog();
+  });
+  return button;
+}
+
 function renderJog() {
-  const ch = state.machine.channels.find((c) => c.id === state.channel);
+  const ch = currentChannel();
   const tbody = $("#jog tbody");
   if (!ch) return;
   if (tbody.dataset.channel !== String(ch.id)) {
     tbody.dataset.channel = String(ch.id);
     tbody.replaceChildren(...ch.axes.map((ax) => {
-      const minus = el("button", { type: "button", className: "write", textContent: `${ax.name} −` });
-      const plus = el("button", { type: "button", className: "write", textContent: `${ax.name} +` });
-      minus.addEventListener("click", () => jog(ax, -1));
-      plus.addEventListener("click", () => jog(ax, 1));
-      minus.disabled = plus.disabled = !state.session.may_write;
-      const position = el("td", { className: "num" });
-      position.dataset.axis = `ch${ch.id}.ax${ax.index}.command_position_acs`;
-      return el("tr", {}, el("td", {}, minus), position, el("td", {}, plus));
+      const a = `ch${ch.id}.ax${ax.index}`;
+      const home = el("button", { type: "button", className: "write", textContent: `Home ${ax.name}` });
+      home.disabled = !state.session.may_write;
+      home.addEventListener("click", () => homeAxes([ax]));
+      const cell = (name, format) => {
+        const td = el("td", { className: "num" });
+        td.dataset.value = name;
+        td.dataset.format = format;
+        return td;
+      };
+      return el("tr", {}, el("td", {}, jogButton(ch, ax, -1)), cell(`${a}.command_position_acs`, "mm"),
+        cell(`${a}.command_position_pcs`, "mm"), el("td", {}, jogButton(ch, ax, 1)),
+        cell(`${a}.homing_referenced_r`, "referenced"), el("td", {}, home));
     }));
   }
-  for (const cell of tbody.querySelectorAll("td[data-axis]")) cell.textContent = `${mm(v(cell.dataset.axis))} mm`;
+  for (const cell of tbody.querySelectorAll("td[data-value]")) {
+    const value = v(cell.dataset.value);
+    const text = cell.dataset.format === "mm" ? mm(value) : referenced(value);
+    if (cell.textContent !== text) cell.textContent = text;
+  }
+  for (const button of tbody.querySelectorAll("button[data-key]")) button.classList.toggle("held", v(button.dataset.key) === true);
+  $("#mdi-state").textContent = `channel ${ch.id}: ${named(state.machine.states, v(`ch${ch.id}.mc_active_state_r`))}`;
 }
 
-async function jog(axis, direction) {
+async function stepJog(axis, direction) {
   try {
     await api("POST", `/api/channel/${state.channel}/jog`, { axis: axis.index, direction, increment_mm: Number($("#jog-increment").value) });
     say(`channel ${state.channel}: jog ${axis.name} ${direction > 0 ? "+" : "−"}${$("#jog-increment").value} mm`);
   } catch (_) { /* shown */ }
+}
+
+async function turnHandwheel(axis, direction) {
+  const pulses = direction * Number($("#jog-pulses").value);
+  try {
+    await api("POST", `/api/channel/${state.channel}/handwheel`, { axis: axis.index, pulses, resolution_mm: Number($("#jog-resolution").value) });
+    say(`channel ${state.channel}: handwheel ${axis.name} ${pulses > 0 ? "+" : ""}${pulses} pulses × ${$("#jog-resolution").value} mm`);
+  } catch (_) { /* shown */ }
+}
+
+async function homeAxes(axes) {
+  try {
+    await api("POST", `/api/channel/${state.channel}/home`, { axes: axes.map((a) => a.index) });
+    say(`channel ${state.channel}: homing ${axes.map((a) => a.name).join(" ")}`);
+  } catch (_) { /* shown */ }
+}
+$("#home-all").addEventListener("click", () => { const ch = currentChannel(); if (ch) homeAxes(ch.axes); });
+
+// The dead-man: a continuous jog lives on its own WebSocket (/ws/jog). cnc-web releases
+// the key when told (key-up, pointer-up, blur, page hidden), when the socket closes, and
+// when the page stops renewing it (a hung page): the machine never jogs on unwatched.
+const jogLink = { socket: null, opening: null, held: false, timer: null, renewS: 0.25 };
+
+function jogSocket() {
+  if (jogLink.socket && jogLink.socket.readyState <= WebSocket.OPEN) return jogLink.opening;
+  const scheme = location.protocol === "https:" ? "wss" : "ws";
+  const socket = new WebSocket(`${scheme}://${location.host}/ws/jog?csrf=${encodeURIComponent(state.session.csrf || "")}`);
+  jogLink.socket = socket;
+  jogLink.opening = new Promise((resolve, reject) => {
+    socket.addEventListener("open", () => resolve(socket));
+    socket.addEventListener("error", () => reject(new Error("the jog connection was refused")));
+  });
+  socket.addEventListener("message", (event) => {
+    const message = JSON.parse(event.data);
+    if (message.renew_s) jogLink.renewS = message.renew_s;
+    if (message.error) {
+      stopRenewing();
+      say(message.error, true);
+    }
+  });
+  socket.addEventListener("close", () => {
+    stopRenewing();
+    if (jogLink.socket === socket) jogLink.socket = null;
+  });
+  return jogLink.opening;
+}
+
+function stopRenewing() {
+  clearInterval(jogLink.timer);
+  jogLink.timer = null;
+}
+
+async function holdJog(axis, direction) {
+  jogLink.held = true;
+  let socket;
+  try { socket = await jogSocket(); } catch (error) { say(error.message, true); return; }
+  if (!jogLink.held) return;  // released before the socket was open
+  socket.send(JSON.stringify({ press: { channel: state.channel, axis: axis.index, direction, rapid: $("#jog-rapid").checked } }));
+  say(`channel ${state.channel}: jog ${axis.name} ${direction > 0 ? "+" : "−"} held`);
+  stopRenewing();
+  jogLink.timer = setInterval(() => {
+    if (socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify({ renew: true }));
+  }, jogLink.renewS * 1000);
+}
+
+function releaseJog() {
+  if (!jogLink.held) return;
+  jogLink.held = false;
+  stopRenewing();
+  if (jogLink.socket && jogLink.socket.readyState === WebSocket.OPEN) jogLink.socket.send(JSON.stringify({ release: true }));
+}
+window.addEventListener("blur", releaseJog);
+window.addEventListener("pagehide", releaseJog);
+document.addEventListener("visibilitychange", () => { if (document.hidden) releaseJog(); });
+
+// ------------------------------------------------------------------ tools and offsets
+
+function numberInput(value) {
+  const input = el("input", { type: "number", step: "any", className: "write", value: String(value) });
+  input.disabled = !state.session.may_write;
+  return input;
+}
+
+function finite(inputs) {
+  const values = inputs.map((input) => Number(input.value));
+  if (inputs.some((input) => input.value.trim() === "") || !values.every(Number.isFinite)) {
+    say("give a number of mm in every field", true);
+    return null;
+  }
+  return values;
+}
+
+async function loadTools() {
+  const c = state.channel;
+  const [tools, offsets] = await Promise.all([api("GET", `/api/channel/${c}/tools`), api("GET", `/api/channel/${c}/offsets`)]);
+  $("#tool-active").textContent = `· channel ${c}: T${tools.active_tool} in the spindle (T${tools.selected_tool} selected), D${tools.d}`;
+  $("#tool-table tbody").replaceChildren(...tools.rows.map((row) => {
+    const valid = el("input", { type: "checkbox", className: "write", checked: row.valid });
+    valid.disabled = !state.session.may_write;
+    const radius = numberInput(row.radius_mm);
+    const length = numberInput(row.length_mm);
+    const save = el("button", { type: "button", className: "write", textContent: "Save" });
+    save.disabled = !state.session.may_write;
+    save.addEventListener("click", async () => {
+      const values = finite([radius, length]);
+      if (!values) return;
+      try {
+        await api("POST", `/api/channel/${c}/tools/${row.d}`, { radius_mm: values[0], length_mm: values[1], valid: valid.checked });
+        say(`channel ${c}: wz[${row.d}] written`);
+        await loadTools();
+      } catch (_) { /* shown */ }
+    });
+    const tr = el("tr", {}, el("td", { textContent: `D${row.d}` }), el("td", {}, valid), el("td", {}, radius), el("td", {}, length), el("td", {}, save));
+    tr.dataset.d = String(row.d);
+    tr.classList.toggle("active-row", row.d === tools.d);
+    return tr;
+  }));
+  $("#offset-active").textContent = `· channel ${c}: G${53 + offsets.active} in effect`;
+  $("#offset-table thead tr").replaceChildren(el("th", { textContent: "group" }),
+    ...offsets.axes.map((name) => el("th", { textContent: `${name} mm` })), el("th"));
+  $("#offset-table tbody").replaceChildren(...offsets.rows.map((row) => {
+    const inputs = row.offsets_mm.map(numberInput);
+    const save = el("button", { type: "button", className: "write", textContent: "Save" });
+    save.disabled = !state.session.may_write;
+    save.addEventListener("click", async () => {
+      const values = finite(inputs);
+      if (!values) return;
+      const offsetsMm = Object.fromEntries(values.map((value, k) => [String(k + 1), value]));
+      try {
+        await api("POST", `/api/channel/${c}/offsets/${row.group}`, { offsets_mm: offsetsMm });
+        say(`channel ${c}: zero offset ${row.name} written`);
+        await loadTools();
+      } catch (_) { /* shown */ }
+    });
+    const tr = el("tr", {}, el("td", { textContent: row.name }), ...inputs.map((input) => el("td", {}, input)), el("td", {}, save));
+    tr.dataset.group = String(row.group);
+    tr.classList.toggle("active-row", row.group === offsets.active);
+    return tr;
+  }));
 }
 
 // ------------------------------------------------------------------ look-ahead
@@ -525,9 +828,14 @@ $("#profile-draw").addEventListener("click", async () => {
 
 // ------------------------------------------------------------------ alarms
 
+const alarmTime = (iso) => (iso ? new Date(iso).toLocaleString() : "-");
+const alarmCells = (a) => [a.sequence, alarmTime(a.time), a.channel || "-", a.id, a.severity, a.state,
+  a.file ? `${a.file}:${a.line}:${a.column}` : "-", a.text];
+
 async function loadAlarms() {
   const data = await api("GET", "/api/alarms");
   $("#alarm-none").hidden = data.alarms.length > 0;
+  $("#alarm-ack-all").disabled = !state.session.may_write || !data.alarms.some((a) => a.state === "active");
   $("#alarm-table tbody").replaceChildren(...data.alarms.map((a) => {
     const ack = el("button", { type: "button", className: "write", textContent: "Acknowledge" });
     ack.disabled = !state.session.may_write || a.state !== "active";
@@ -539,12 +847,30 @@ async function loadAlarms() {
       } catch (_) { /* shown */ }
     });
     const row = el("tr");
-    cells(row, [a.sequence, a.channel || "-", a.id, a.severity, a.state, a.file ? `${a.file}:${a.line}:${a.column}` : "-", a.text]);
+    cells(row, alarmCells(a));
     row.append(el("td", {}, ack));
     return row;
   }));
+  if (state.page === "alarms") loadAlarmHistory().catch(() => {});
   return data.alarms;
 }
+
+async function loadAlarmHistory() {
+  const data = await api("GET", "/api/alarms/history");
+  $("#alarm-history tbody").replaceChildren(...data.alarms.map((a) => {
+    const row = el("tr");
+    cells(row, alarmCells(a));
+    return row;
+  }));
+}
+
+$("#alarm-ack-all").addEventListener("click", async () => {
+  try {
+    await api("POST", "/api/alarms/acknowledge-all", {});
+    say("all alarms acknowledged (an error stays until RESET)");
+    await loadAlarms();
+  } catch (_) { /* shown */ }
+});
 
 async function showNewestAlarm() {
   try {
@@ -620,7 +946,8 @@ function showPage() {
   for (const page of PAGES) $(`#page-${page}`).hidden = page !== name;
   for (const link of document.querySelectorAll("#nav a")) link.classList.toggle("active", link.getAttribute("href") === `#${name}`);
   document.body.dataset.page = name;
-  const loaders = { program: loadPrograms, alarms: loadAlarms, mdi: showMdiHistory };
+  state.page = name;
+  const loaders = { program: loadPrograms, alarms: loadAlarms, mdi: showMdiHistory, tools: loadTools };
   if (loaders[name]) Promise.resolve(loaders[name]()).catch(() => {});
   queueRender();
 }
@@ -628,6 +955,8 @@ function showPage() {
 $("#channel-select").addEventListener("change", (event) => {
   state.channel = Number(event.target.value);
   state.live = [];
+  state.extent = null;
+  if (state.page === "tools") loadTools().catch(() => {});
   queueRender();
 });
 
