@@ -296,9 +296,12 @@ async def trace(request: web.Request) -> web.StreamResponse:
     (PROD_TIME, no axis moves), thinned to at most ``MAX_TRACE_POINTS`` points. The last
     ``TRACES_KEPT`` answers are kept per channel, program and stored version, so that a
     page opened while the program runs (the channel busy) still gets its planned path;
-    such an answer changes nothing and is given to every role."""
+    such an answer changes nothing and is given to every role. With ``"automatic":
+    true`` (the page plans each program it shows) a dry run that ends in ERROR is
+    followed by RESET: looking at a program with errors leaves the channel as it was."""
     channel = _channel(request)
-    program = _field(await _body(request), "program", str)
+    data = await _body(request)
+    program = _field(data, "program", str)
     c = _client(request)
     stored = next((e for e in await c.programs() if e.name == program), None)
     key = (channel, program, stored.size_bytes, stored.mtime_s) if stored else None
@@ -307,6 +310,8 @@ async def trace(request: web.Request) -> web.StreamResponse:
         return web.json_response(kept[key])
     require_write(request, f"dry-run {program} to draw its path")
     run = await c.trace_run(program, channel, timeout_s=TRACE_TIMEOUT_S)
+    if data.get("automatic") is True and run.ended != "READY":
+        await c.reset(channel)
     step = max(1, len(run.t_s) // MAX_TRACE_POINTS)
     answer = {
         "program": run.program, "ended": run.ended, "program_time_s": run.program_time_s,

@@ -309,8 +309,16 @@ async function showProgram(name) {
   $("#program-text").replaceChildren(...state.programLines.map((text) => el("li", { textContent: text })));
   state.shownLine = null;
   drawPath();
-  state.planning = loadPlanned(name);
-  await state.planning;
+  await planShown(name);
+}
+
+// One dry run at a time in the channel: a plan waits for the one before it, and a
+// program no longer shown is not planned at all.
+function planShown(name) {
+  const mine = (state.planning || Promise.resolve()).then(() => (state.program === name ? loadPlanned(name) : undefined));
+  state.planning = mine;
+  mine.finally(() => { if (state.planning === mine) state.planning = null; });
+  return mine;
 }
 
 // The planned path is drawn as soon as a program is shown: a dry run in the channel
@@ -318,14 +326,13 @@ async function showProgram(name) {
 async function loadPlanned(name) {
   $("#path-note").textContent = "planning…";
   try {
-    const trace = await api("POST", `/api/channel/${state.channel}/trace`, { program: name }, true);
+    const trace = await api("POST", `/api/channel/${state.channel}/trace`, { program: name, automatic: true }, true);
     if (state.program !== name) return;
     setPlanned(trace);
-    $("#path-note").textContent = `planned ${trace.program_time_s.toFixed(3)} s`;
+    $("#path-note").textContent = trace.ended === "READY" ? `planned ${trace.program_time_s.toFixed(3)} s`
+      : `planned up to ${trace.ended} (Syntax check tells where)`;
   } catch (error) {
     if (state.program === name) $("#path-note").textContent = `no planned path: ${error.message}`;
-  } finally {
-    state.planning = null;
   }
 }
 
@@ -522,10 +529,15 @@ function drawGrid(frameName, scale, cx, cy, sx, sy) {
 function renderProgramPage() {
   const c = `ch${state.channel}`;
   // in step with the channel: its running program is shown, opened while it runs too
+  // (once per run: another program may be looked at meanwhile)
   const active = v(`${c}.mc_active_program_name_r`);
-  if (active && !state.following && (!state.program || (working() && active !== state.program))) {
+  if (!working()) state.followed = null;
+  const newRun = working() && active && active !== state.followed;
+  if (active && !state.following && (!state.program || newRun)) {
     state.following = true;
-    showProgram(active).catch(() => {}).finally(() => { state.following = false; });
+    if (working()) state.followed = active;
+    if (active === state.program) state.following = false;
+    else showProgram(active).catch(() => {}).finally(() => { state.following = false; });
   }
   const here = currentXY(pathFrame().name.startsWith("workpiece") ? "pcs" : "acs");
   if (here) $("#position-line").textContent = `X ${here[0].toFixed(4)}  Y ${here[1].toFixed(4)} mm`;
