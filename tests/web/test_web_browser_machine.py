@@ -129,11 +129,13 @@ async def test_tool_path_has_axes_scale_and_the_planned_path_in_workpiece_coordi
         "() => /workpiece coordinates \\(G54\\)/.test(document.querySelector('#path-frame').textContent)",
         timeout=WAIT_MS)
     await page.wait_for_function(
-        "() => document.querySelector('#position-line').textContent.split(/\\s+/).join(' ') === 'X 0.0000 Y 0.0000 mm'",
+        "() => document.querySelector('#position-line').textContent.split(/\\s+/).join(' ')"
+        " === 'X 0.0000 Y 0.0000 mm'",
         timeout=WAIT_MS)
     # planned and run paths are drawn in one frame: the planned end is where the tool is
     end, tool = await page.evaluate("""() => [
-        document.querySelector('#path-planned').getAttribute('points').split(' ').pop().split(',').map(Number),
+        document.querySelector('#path-planned').getAttribute('points').split(' ').pop()
+            .split(',').map(Number),
         ['cx', 'cy'].map(a => Number(document.querySelector('#path-tool').getAttribute(a)))]""")
     assert abs(end[0] - tool[0]) < 0.5 and abs(end[1] - tool[1]) < 0.5
     # the machine page shows both: machine X 10 (the offset), workpiece X 0
