@@ -286,6 +286,10 @@ class ProgramOps(MixinBase):
 class ChannelOps(ProgramOps):
     """Select, start, hold, resume, reset, manual blocks, status, waiting."""
 
+    #: how the user gives RESET, named in the refusals of a channel in ERROR (cnc-web
+    #: names its Reset button)
+    reset_hint = "cnc reset"
+
     async def run_program(self, name: str, channel: int = 1) -> None:
         """Select ``name`` (AUTOMATIC) and START it; returns once the channel is ACTIVE.
         A channel in ERROR refuses (ADS 0x707, naming its errors) until RESET."""
@@ -316,7 +320,7 @@ class ChannelOps(ProgramOps):
         errors = await self.channel_errors(channel)
         listed = "; ".join(errors) if errors else "no error text"
         return (f"channel {channel} is in ERROR ({listed}); {what} needs a RESET first, "
-                "which clears the error (cnc reset)")
+                f"which clears the error ({self.reset_hint})")
 
     async def hold(self, channel: int = 1) -> None:
         """Feedhold: the path decelerates and stops (HOLD)."""

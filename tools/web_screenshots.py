@@ -4,8 +4,10 @@
 
 Starts its own service (realtime clock) and cnc-web on free loopback ports, uploads
 docs/examples/part.nc, contour-lookahead.nc and check-syntax.nc, and shows each page with
-something on it: the pocket running, the syntax check's errors on their lines, the
-look-ahead's elements and speed profile, an alarm, watched objects. Needs Debian's
+something on it: the pocket running (in G54, with its planned path), the syntax check's
+errors on their lines, the look-ahead's elements and speed profile, jog and MDI with a
+channel in ERROR, the tool list and zero offsets, alarms and their history, watched
+objects. Needs Debian's
 chromium and the test extra (playwright).
 """
 
@@ -48,6 +50,21 @@ async def _shots(url: str, out: Path, chromium: str) -> list[Path]:
             await page.screenshot(path=str(path))
             made.append(path)
 
+        await _show(page, url, "tools")  # an offset for G54 and a tool, as an operator sets them
+        await _until(page, "() => document.querySelectorAll('#offset-table tbody tr').length > 0")
+        row = page.locator("#offset-table tbody tr[data-group='1'] input")
+        await row.nth(0).fill("20")
+        await row.nth(1).fill("10")
+        await page.click("#offset-table tbody tr[data-group='1'] button")
+        await _until(page, "() => /G54 written/.test(document.querySelector('#message').textContent)")
+        tool = page.locator("#tool-table tbody tr[data-d='4'] input")
+        await tool.nth(0).check()
+        await tool.nth(1).fill("3")
+        await tool.nth(2).fill("55.5")
+        await page.click("#tool-table tbody tr[data-d='4'] button")
+        await _until(page, "() => /wz\\[4\\] written/.test(document.querySelector('#message').textContent)")
+        await shot("tools")
+
         await _show(page, url, "program")
         await page.set_input_files("#upload-input", [str(EXAMPLES / n) for n in (
             "check-syntax.nc", "contour-lookahead.nc", "pocket-la-on.nc")])
@@ -60,7 +77,6 @@ async def _shots(url: str, out: Path, chromium: str) -> list[Path]:
 
         await page.click("#program-list li[data-name='pocket-la-on.nc']")
         await _until(page, "() => document.querySelector('#program-name').textContent === 'pocket-la-on.nc'")
-        await page.click("#draw-program")
         await _until(page, "() => document.querySelector('#path-planned').getAttribute('points')")
         await page.click("#start-program")
         await _until(page, "() => document.querySelector('#path-live').getAttribute('points')"
@@ -94,15 +110,29 @@ async def _shots(url: str, out: Path, chromium: str) -> list[Path]:
         await shot("lookahead")
 
         await _show(page, url, "mdi")
-        for block in ("G90 G1 X10 Y10 F3000", "G91 G1 X5 F600", "G1 Q7"):
-            await page.evaluate("() => document.querySelector('#message').textContent = ''")
+        await page.select_option("#jog-mode", "continuous")
+        await page.click("#home-all")
+        await _until(page, "() => [...document.querySelectorAll('#jog td[data-format=referenced]')]"
+                           ".every(td => td.textContent === 'yes')")
+        # a block in G54, then one with an error, then one refused in ERROR (naming Reset)
+        waits = ("() => document.querySelector('#jog td[data-value$=command_position_pcs]')"
+                 ".textContent === '10.0000'",
+                 "() => /ERROR/.test(document.querySelector('#mdi-state').textContent)",
+                 "() => /Reset/.test(document.querySelector('#message').textContent)")
+        for block, done in zip(("G54 G90 G1 X10 Y10 F3000", "G1 Q7", "G1 X1"), waits, strict=True):
             await page.fill("#mdi-input", block)
             await page.click("#mdi-form button")
-            await _until(page, "() => document.querySelector('#message').textContent !== ''")
+            await _until(page, done)
             print(f"MDI {block}: {await page.text_content('#message')}")
         await shot("mdi")
         await _show(page, url, "alarms")
+        await page.click("#alarm-ack-all")
+        await _until(page, "() => /acknowledged/.test(document.querySelector('#message').textContent)")
+        await _until(page, "() => document.querySelectorAll('#alarm-history tbody tr').length > 0")
         await shot("alarms")
+        await _show(page, url, "mdi")
+        await page.click("#mdi-reset")
+        await _until(page, "() => !/ERROR/.test(document.querySelector('#mdi-state').textContent)")
 
         await _show(page, url, "objects")
         await page.fill("#object-pattern", "ch1.ax1.*position*")

@@ -163,15 +163,17 @@ def current_session(request: web.Request) -> Session:
     return session
 
 
-def require_write(request: web.Request, what: str, needed: WebRole = WRITE_ROLE) -> Session:
+def require_write(request: web.Request, what: str, needed: WebRole = WRITE_ROLE,
+                  token: str | None = None) -> Session:
     """The request's session when its role covers ``needed`` (``what``: the request, for
     the refusal); else the refusal is raised: 403 with the service's sentence, or a CSRF
-    mismatch."""
+    mismatch. ``token``: the CSRF token when it cannot come as a header (a WebSocket's
+    handshake carries it in its query)."""
     session = current_session(request)
     if not session.role.may(needed):
         raise refusal(403, f"ADS 0x704 INVALIDACCESS: role {session.role.label} may not {what}; "
                            f"{roles_that_may(needed)} may")
-    if not csrf_matches(session, request.headers.get(CSRF_HEADER)):
+    if not csrf_matches(session, token if token is not None else request.headers.get(CSRF_HEADER)):
         raise refusal(403, f"refused: {what} came without this session's CSRF token "
                            "(reload the page)")
     return session

@@ -328,23 +328,44 @@ async def check(request: web.Request) -> web.StreamResponse:
 @_service_call
 async def trace(request: web.Request) -> web.StreamResponse:
     """The tool path and the planned speed profile of ``program``: a dry run
-    (PROD_TIME, no axis moves), thinned to at most ``MAX_TRACE_POINTS`` points."""
+    (PROD_TIME, no axis moves), thinned to at most ``MAX_TRACE_POINTS`` points. The last
+    ``TRACES_KEPT`` answers are kept per channel, program and stored version, so that a
+    page opened while the program runs (the channel busy) still gets its planned path;
+    such an answer changes nothing and is given to every role. With ``"automatic":
+    true`` (the page plans each program it shows) a dry run that ends in ERROR is
+    followed by RESET: looking at a program with errors leaves the channel as it was."""
     channel = _channel(request)
-    program = _field(await _body(request), "program", str)
+    data = await _body(request)
+    program = _field(data, "program", str)
+    c = _client(request)
+    stored = next((e for e in await c.programs() if e.name == program), None)
+    key = (channel, program, stored.size_bytes, stored.mtime_s) if stored else None
+    kept = request.app[TRACES_KEY]
+    if key is not None and key in kept:
+        return web.json_response(kept[key])
     require_write(request, f"dry-run {program} to draw its path")
-    run = await _client(request).trace_run(program, channel, timeout_s=TRACE_TIMEOUT_S)
+    run = await c.trace_run(program, channel, timeout_s=TRACE_TIMEOUT_S)
+    if data.get("automatic") is True and run.ended != "READY":
+        await c.reset(channel)
     step = max(1, len(run.t_s) // MAX_TRACE_POINTS)
-    return web.json_response({
+    answer = {
         "program": run.program, "ended": run.ended, "program_time_s": run.program_time_s,
         "positions_mm": {k: v[::step].round(4).tolist() for k, v in run.positions_mm.items()},
         "path_mm": run.path_mm[::step].round(4).tolist(),
         "v_mm_s": run.v_mm_s[::step].round(3).tolist(),
         "feed_limit_mm_s": run.feed_limit_mm_s[::step].round(3).tolist(),
         "line": run.line[::step].tolist(),
-    })
+    }
+    if key is not None:
+        kept[key] = answer
+        while len(kept) > TRACES_KEPT:
+            del kept[next(iter(kept))]  # the oldest
+    return web.json_response(answer)
 
 
 MAX_TRACE_POINTS = 4000  # enough for a smooth drawing, small enough for a tablet
+TRACES_KEPT = 16  # dry-run answers kept (each at most ~200 kB of JSON)
+TRACES_KEY: web.AppKey[dict[tuple[int, str, int, float], dict[str, Any]]] = web.AppKey("traces")
 
 
 @_service_call
@@ -390,6 +411,7 @@ async def alarm_acknowledge(request: web.Request) -> web.StreamResponse:
 
 def add_routes(app: web.Application) -> None:
     """The API's routes."""
+    app[TRACES_KEY] = {}
     get, post = web.get, web.post
     app.add_routes([
         get("/api/session", get_session), post("/api/login", login), post("/api/logout", logout),

@@ -17,7 +17,7 @@ from aiohttp import web
 
 from cnc_objects.clients.client import AsyncClient
 
-from . import api
+from . import api, machine_api
 from .access import ACCESS_KEY, Access, session_middleware, sweep_sessions
 from .budgets import WatchBudgets
 from .connections import connection_middleware
@@ -81,6 +81,7 @@ def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts,
     async def service_client(app: web.Application) -> AsyncIterator[None]:
         client = AsyncClient(link.endpoint, timeout_s=link.timeout_s, key_file=link.key_file,
                              server_key=link.server_key)
+        client.reset_hint = "Reset, beside the MDI line"
         async with client:
             app[api.CLIENT_KEY] = client
             app[HUB_KEY] = LiveHub(client, budgets=budgets)
@@ -97,4 +98,5 @@ def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts,
     app.router.add_get("/api/stats", stats)
     app.router.add_static("/static/", STATIC_DIR)
     api.add_routes(app)
+    machine_api.add_routes(app)
     return app

@@ -18,7 +18,7 @@ from cnc_objects.testing.web import WebProcess
 
 from .conftest import PASSWORDS
 
-PAGES = ("machine", "program", "mdi", "lookahead", "alarms", "objects")
+PAGES = ("machine", "program", "mdi", "tools", "lookahead", "alarms", "objects")
 WAIT_MS = 30_000
 # 30 mm at F1200 (20 mm/s): 1.5 s of motion, long enough to be seen moving.
 MOVING_PROGRAM = "N10 G1 X30 Y10 F1200\nN20 G1 X0 Y0\nN30 M30\n"
@@ -55,7 +55,7 @@ async def test_each_page_loads(page: Any, web: WebProcess) -> None:
         "() => document.querySelector('#axes tbody tr td:nth-child(2)').textContent === '0.0000'",
         timeout=WAIT_MS)
     await _open(page, web.url, "mdi")
-    assert await page.locator("#jog tbody button").count() == 6  # X Y Z, minus and plus
+    assert await page.locator("#jog tbody button.jog").count() == 6  # X Y Z, minus and plus
 
 
 async def test_run_a_program_uploaded_by_the_file_input_and_drop(page: Any, web: WebProcess,

@@ -1,4 +1,6 @@
 // cnc-web: the browser side. Plain JavaScript, no build step, no library, no CDN.
+// app.js holds the state, the API, the live values and most pages; toolpath.js, jog.js
+// and tools.js (classic scripts loaded after it) the tool path, jog and the tools page.
 // Live values come over one WebSocket (/ws): the page says which objects it watches,
 // the server sends their newest values (one subscription per object for all browsers).
 // Every write goes through the JSON API with the session's CSRF token; a refusal is
@@ -9,7 +11,8 @@ const UM01_PER_MM = 10000; // positions are in 0.1 um
 const SPINDLE_MODES = { 1: "M5", 2: "M3", 4: "M4", 8: "M19" };
 const LINK_STATES = { 0: "linked", 1: "requested", 2: "waiting ack" };
 const CONTOUR_TYPES = { 1: "linear", 2: "circular", 3: "LOG ON", 4: "LOG PARAM", 5: "LOG OFF", 6: "polynomial" }; // ContourBlockType
-const PAGES = ["machine", "program", "mdi", "lookahead", "alarms", "objects"];
+const PAGES = ["machine", "program", "mdi", "tools", "lookahead", "alarms", "objects"];
+const WORKING_STATES = ["ACTIVE", "HOLD"];
 const MDI_HISTORY_KEY = "cnc-web-mdi-history";
 const MDI_HISTORY_MAX = 30;
 
@@ -22,8 +25,11 @@ const state = {
   socket: null,
   program: null,       // the program shown on the program page
   programLines: [],
-  planned: null,       // {x: [], y: []} of the drawn tool path
-  live: [],            // [x, y] points of the live position while a program runs
+  planned: null,       // {x: [], y: []} of the planned tool path (machine coordinates)
+  planning: null,      // the dry run under way (a Promise), awaited before a start
+  live: [],            // [x, y] machine positions of the tool while a program runs
+  extent: null,        // [minX, minY, maxX, maxY] of the tool path view: grows, never shrinks
+  page: "machine",
   objectWatch: [],     // names on the objects page's watch list
   renderQueued: false,
   stats: { messages: 0, positionUpdates: 0, since: performance.now() },
@@ -47,7 +53,7 @@ function say(text, isError = false) {
 
 // ------------------------------------------------------------------ API
 
-async function api(method, path, body) {
+async function api(method, path, body, quiet = false) {
   const headers = {};
   if (state.session && state.session.csrf) headers["X-CSRF-Token"] = state.session.csrf;
   let payload = body;
@@ -60,7 +66,7 @@ async function api(method, path, body) {
   try { data = await response.json(); } catch (_) { data = {}; }
   if (!response.ok) {
     const why = data.error || `${response.status} ${response.statusText}`;
-    say(why, true);
+    if (!quiet) say(why, true);
     if (response.status === 401 && state.session && state.session.sign_in_required) showLogin();
     throw new Error(why);
   }
@@ -114,7 +120,8 @@ function channelNames(ch) {
     .map((leaf) => `${c}.${leaf}`);
   names.push(`gpCh[${ch.plc_index}].bahn_mc_control.suspend_axis_output.state_r`);
   for (const ax of ch.axes) {
-    for (const leaf of ["command_position_acs", "command_position_pcs", "position_offset", "link_state"]) {
+    for (const leaf of ["command_position_acs", "command_position_pcs", "position_offset", "link_state",
+      "homing_referenced_r", "manual_jog_plus_w", "manual_jog_minus_w"]) {
       names.push(`${c}.ax${ax.index}.${leaf}`);
     }
   }
@@ -169,14 +176,17 @@ function queueRender() {
 const v = (name) => state.values[name];
 const mm = (value) => (value === undefined ? "-" : (value / UM01_PER_MM).toFixed(4));
 const named = (table, value) => (value === undefined ? "-" : (table[value] || String(value)));
+const referenced = (value) => (value === undefined ? "-" : (value ? "yes" : "no"));
 
 // ------------------------------------------------------------------ rendering
 
+// Only the visible page is drawn: a frame costs what one page costs, not all of them.
+const RENDERERS = { machine: () => renderMachine(), program: () => renderProgramPage(), mdi: () => renderJog(), objects: () => renderWatch() };
+
 function render() {
-  renderMachine();
-  renderProgramLive();
-  renderJog();
-  renderWatch();
+  recordLivePath();  // the path so far is kept whatever page is shown
+  const renderer = RENDERERS[state.page];
+  if (renderer) renderer();
   const active = v("alarm_active_count_r") || 0;  // the service's active alarm list
   $("#alarm-count").textContent = active ? String(active) : "";
 }
@@ -229,6 +239,7 @@ function renderMachine() {
       cells(rowFor(axes, a), [
         `${c} ${ax.name}`, mm(v(`${a}.command_position_acs`)), mm(v(`${a}.command_position_pcs`)),
         mm(v(`${a}.position_offset`)), named(LINK_STATES, v(`${a}.link_state`)), ax.drive || "-",
+        referenced(v(`${a}.homing_referenced_r`)),
       ]);
     }
   }
@@ -291,12 +302,46 @@ async function showProgram(name) {
   const data = await api("GET", `/api/programs/${encodeURIComponent(name)}`);
   state.program = name;
   state.planned = null;
-  state.live = [];
+  state.extent = null;
+  if (!working()) state.live = [];
   $("#program-name").textContent = name;
   for (const item of $("#program-list").children) item.classList.toggle("selected", item.dataset.name === name);
   state.programLines = data.text.split("\n");
   if (state.programLines.length && state.programLines[state.programLines.length - 1] === "") state.programLines.pop();
   $("#program-text").replaceChildren(...state.programLines.map((text) => el("li", { textContent: text })));
+  state.shownLine = null;
+  drawPath();
+  await planShown(name);
+}
+
+// One dry run at a time in the channel: a plan waits for the one before it, and a
+// program no longer shown is not planned at all.
+function planShown(name) {
+  const mine = (state.planning || Promise.resolve()).then(() => (state.program === name ? loadPlanned(name) : undefined));
+  state.planning = mine;
+  mine.finally(() => { if (state.planning === mine) state.planning = null; });
+  return mine;
+}
+
+// The planned path is drawn as soon as a program is shown: a dry run in the channel
+// (cnc-web keeps the last ones, so a program started from the page shows it while it runs).
+async function loadPlanned(name) {
+  $("#path-note").textContent = "planning…";
+  try {
+    const trace = await api("POST", `/api/channel/${state.channel}/trace`, { program: name, automatic: true }, true);
+    if (state.program !== name) return;
+    setPlanned(trace);
+    $("#path-note").textContent = trace.ended === "READY" ? `planned ${trace.program_time_s.toFixed(3)} s`
+      : `planned up to ${trace.ended} (Syntax check tells where)`;
+  } catch (error) {
+    if (state.program === name) $("#path-note").textContent = `no planned path: ${error.message}`;
+  }
+}
+
+function setPlanned(trace) {
+  const [xName, yName] = Object.keys(trace.positions_mm);
+  state.planned = { x: trace.positions_mm[xName] || [], y: trace.positions_mm[yName] || [] };
+  state.extent = null;
   drawPath();
 }
 
@@ -324,13 +369,14 @@ drop.addEventListener("drop", (event) => {
   else say(`role ${state.session.role} may not upload programs; admin may`, true);
 });
 
-function needProgram() {
+async function needProgram() {
   if (!state.program) say("choose a program in the list first", true);
+  if (state.planning) await state.planning;  // the channel is busy with the dry run until then
   return state.program;
 }
 
 $("#select-program").addEventListener("click", async () => {
-  if (!needProgram()) return;
+  if (!await needProgram()) return;
   try {
     await api("POST", `/api/channel/${state.channel}/select`, { program: state.program });
     say(`channel ${state.channel}: ${state.program} selected`);
@@ -338,7 +384,7 @@ $("#select-program").addEventListener("click", async () => {
 });
 
 $("#start-program").addEventListener("click", async () => {
-  if (!needProgram()) return;
+  if (!await needProgram()) return;
   try {
     await api("POST", `/api/channel/${state.channel}/select`, { program: state.program });
     state.live = [];
@@ -348,7 +394,7 @@ $("#start-program").addEventListener("click", async () => {
 });
 
 $("#check-program").addEventListener("click", async () => {
-  if (!needProgram()) return;
+  if (!await needProgram()) return;
   try {
     say(`checking ${state.program}…`);
     const result = await api("POST", `/api/channel/${state.channel}/check`, { program: state.program });
@@ -366,67 +412,61 @@ $("#check-program").addEventListener("click", async () => {
 });
 
 $("#draw-program").addEventListener("click", async () => {
-  if (!needProgram()) return;
+  if (!await needProgram()) return;
   try {
     say(`dry run of ${state.program} (no axis moves)…`);
     const trace = await api("POST", `/api/channel/${state.channel}/trace`, { program: state.program });
-    const [xName, yName] = Object.keys(trace.positions_mm);
-    state.planned = { x: trace.positions_mm[xName] || [], y: trace.positions_mm[yName] || [] };
+    setPlanned(trace);
     say(`${state.program}: ${trace.program_time_s.toFixed(3)} s planned, ended ${trace.ended}`);
-    drawPath();
   } catch (_) { /* shown */ }
 });
 
-function currentXY() {
-  const ch = state.machine.channels.find((c) => c.id === state.channel);
+function currentChannel() {
+  return state.machine.channels.find((c) => c.id === state.channel);
+}
+
+function working() {
+  return WORKING_STATES.includes(named(state.machine.states, v(`ch${state.channel}.mc_active_state_r`)));
+}
+
+function currentXY(cs = "acs") {
+  const ch = currentChannel();
   if (!ch || ch.axes.length < 2) return null;
-  const x = v(`ch${ch.id}.ax${ch.axes[0].index}.command_position_acs`);
-  const y = v(`ch${ch.id}.ax${ch.axes[1].index}.command_position_acs`);
+  const x = v(`ch${ch.id}.ax${ch.axes[0].index}.command_position_${cs}`);
+  const y = v(`ch${ch.id}.ax${ch.axes[1].index}.command_position_${cs}`);
   return x === undefined || y === undefined ? null : [x / UM01_PER_MM, y / UM01_PER_MM];
 }
 
-function drawPath() {
-  const points = [];
-  if (state.planned) state.planned.x.forEach((x, k) => points.push([x, state.planned.y[k]]));
-  const all = points.concat(state.live);
-  const here = currentXY();
-  if (here) all.push(here);
-  if (!all.length) return;
-  let [minX, minY, maxX, maxY] = [Infinity, Infinity, -Infinity, -Infinity];
-  for (const [x, y] of all) { minX = Math.min(minX, x); maxX = Math.max(maxX, x); minY = Math.min(minY, y); maxY = Math.max(maxY, y); }
-  const span = Math.max(maxX - minX, maxY - minY, 1);
-  const scale = Math.min(360 / span, 260 / span);
-  const sx = (x) => (20 + (x - minX) * scale).toFixed(2);
-  const sy = (y) => (280 - (y - minY) * scale).toFixed(2);
-  const line = (pts) => pts.map(([x, y]) => `${sx(x)},${sy(y)}`).join(" ");
-  $("#path-planned").setAttribute("points", line(points));
-  $("#path-live").setAttribute("points", line(state.live));
-  if (here) {
-    $("#path-tool").setAttribute("cx", sx(here[0]));
-    $("#path-tool").setAttribute("cy", sy(here[1]));
-  }
-}
-
-function renderProgramLive() {
+function renderProgramPage() {
   const c = `ch${state.channel}`;
-  const here = currentXY();
-  const working = ["ACTIVE", "HOLD"].includes(named(state.machine.states, v(`${c}.mc_active_state_r`)));
-  if (here) {
-    const last = state.live[state.live.length - 1];
-    if (working && (!last || last[0] !== here[0] || last[1] !== here[1])) {
-      state.live.push(here);
-      if (state.live.length > 5000) state.live.splice(0, state.live.length - 5000);
-    }
-    $("#position-line").textContent = `X ${here[0].toFixed(4)}  Y ${here[1].toFixed(4)} mm`;
+  // in step with the channel: its running program is shown, opened while it runs too
+  // (once per run: another program may be looked at meanwhile)
+  const active = v(`${c}.mc_active_program_name_r`);
+  if (!working()) state.followed = null;
+  const newRun = working() && active && active !== state.followed;
+  if (active && !state.following && (!state.program || newRun)) {
+    state.following = true;
+    if (working()) state.followed = active;
+    if (active === state.program) state.following = false;
+    else showProgram(active).catch(() => {}).finally(() => { state.following = false; });
   }
+  const here = currentXY(pathFrame().name.startsWith("workpiece") ? "pcs" : "acs");
+  if (here) $("#position-line").textContent = `X ${here[0].toFixed(4)}  Y ${here[1].toFixed(4)} mm`;
   $("#program-state").textContent = named(state.machine.states, v(`${c}.mc_active_state_r`));
   const block = v(`${c}.actual_block_number`);
   $("#program-block").textContent = block === undefined || block < 0 ? "-" : `N${block} line ${v(`${c}.mc_active_line_r`)}`;
   const items = $("#program-text").children;
-  const line = v(`${c}.mc_active_line_r`);
-  const file = v(`${c}.mc_active_file_name_r`);
-  for (let k = 0; k < items.length; k++) items[k].classList.toggle("current", file === state.program && line === k + 1);
-  if (!$("#page-program").hidden) drawPath();
+  const line = v(`${c}.mc_active_file_name_r`) === state.program ? v(`${c}.mc_active_line_r`) : null;
+  if (line !== state.shownLine) {
+    items[state.shownLine - 1]?.classList.remove("current");
+    const item = items[line - 1];
+    if (item) {
+      item.classList.add("current");
+      item.scrollIntoView({ block: "nearest" });
+    }
+    state.shownLine = line;
+  }
+  drawPath();
 }
 
 // ------------------------------------------------------------------ MDI and jog
@@ -456,33 +496,6 @@ $("#mdi-form").addEventListener("submit", async (event) => {
     say(`channel ${state.channel}: manual block ${blocks}`);
   } catch (_) { /* shown */ }
 });
-
-function renderJog() {
-  const ch = state.machine.channels.find((c) => c.id === state.channel);
-  const tbody = $("#jog tbody");
-  if (!ch) return;
-  if (tbody.dataset.channel !== String(ch.id)) {
-    tbody.dataset.channel = String(ch.id);
-    tbody.replaceChildren(...ch.axes.map((ax) => {
-      const minus = el("button", { type: "button", className: "write", textContent: `${ax.name} −` });
-      const plus = el("button", { type: "button", className: "write", textContent: `${ax.name} +` });
-      minus.addEventListener("click", () => jog(ax, -1));
-      plus.addEventListener("click", () => jog(ax, 1));
-      minus.disabled = plus.disabled = !state.session.may_write;
-      const position = el("td", { className: "num" });
-      position.dataset.axis = `ch${ch.id}.ax${ax.index}.command_position_acs`;
-      return el("tr", {}, el("td", {}, minus), position, el("td", {}, plus));
-    }));
-  }
-  for (const cell of tbody.querySelectorAll("td[data-axis]")) cell.textContent = `${mm(v(cell.dataset.axis))} mm`;
-}
-
-async function jog(axis, direction) {
-  try {
-    await api("POST", `/api/channel/${state.channel}/jog`, { axis: axis.index, direction, increment_mm: Number($("#jog-increment").value) });
-    say(`channel ${state.channel}: jog ${axis.name} ${direction > 0 ? "+" : "−"}${$("#jog-increment").value} mm`);
-  } catch (_) { /* shown */ }
-}
 
 // ------------------------------------------------------------------ look-ahead
 
@@ -525,9 +538,14 @@ $("#profile-draw").addEventListener("click", async () => {
 
 // ------------------------------------------------------------------ alarms
 
+const alarmTime = (iso) => (iso ? new Date(iso).toLocaleString() : "-");
+const alarmCells = (a) => [a.sequence, alarmTime(a.time), a.channel || "-", a.id, a.severity, a.state,
+  a.file ? `${a.file}:${a.line}:${a.column}` : "-", a.text];
+
 async function loadAlarms() {
   const data = await api("GET", "/api/alarms");
   $("#alarm-none").hidden = data.alarms.length > 0;
+  $("#alarm-ack-all").disabled = !state.session.may_write || !data.alarms.some((a) => a.state === "active");
   $("#alarm-table tbody").replaceChildren(...data.alarms.map((a) => {
     const ack = el("button", { type: "button", className: "write", textContent: "Acknowledge" });
     ack.disabled = !state.session.may_write || a.state !== "active";
@@ -539,12 +557,30 @@ async function loadAlarms() {
       } catch (_) { /* shown */ }
     });
     const row = el("tr");
-    cells(row, [a.sequence, a.channel || "-", a.id, a.severity, a.state, a.file ? `${a.file}:${a.line}:${a.column}` : "-", a.text]);
+    cells(row, alarmCells(a));
     row.append(el("td", {}, ack));
     return row;
   }));
+  if (state.page === "alarms") loadAlarmHistory().catch(() => {});
   return data.alarms;
 }
+
+async function loadAlarmHistory() {
+  const data = await api("GET", "/api/alarms/history");
+  $("#alarm-history tbody").replaceChildren(...data.alarms.map((a) => {
+    const row = el("tr");
+    cells(row, alarmCells(a));
+    return row;
+  }));
+}
+
+$("#alarm-ack-all").addEventListener("click", async () => {
+  try {
+    await api("POST", "/api/alarms/acknowledge-all", {});
+    say("all alarms acknowledged (an error stays until RESET)");
+    await loadAlarms();
+  } catch (_) { /* shown */ }
+});
 
 async function showNewestAlarm() {
   try {
@@ -620,7 +656,8 @@ function showPage() {
   for (const page of PAGES) $(`#page-${page}`).hidden = page !== name;
   for (const link of document.querySelectorAll("#nav a")) link.classList.toggle("active", link.getAttribute("href") === `#${name}`);
   document.body.dataset.page = name;
-  const loaders = { program: loadPrograms, alarms: loadAlarms, mdi: showMdiHistory };
+  state.page = name;
+  const loaders = { program: loadPrograms, alarms: loadAlarms, mdi: showMdiHistory, tools: loadTools };
   if (loaders[name]) Promise.resolve(loaders[name]()).catch(() => {});
   queueRender();
 }
@@ -628,6 +665,8 @@ function showPage() {
 $("#channel-select").addEventListener("change", (event) => {
   state.channel = Number(event.target.value);
   state.live = [];
+  state.extent = null;
+  if (state.page === "tools") loadTools().catch(() => {});
   queueRender();
 });
 
@@ -643,4 +682,5 @@ async function start() {
   document.body.dataset.ready = "1"; // the tests wait for it
 }
 
-start().catch((error) => say(`cnc-web: ${error.message}`, true));
+// after every deferred script (toolpath.js, jog.js, tools.js) has run
+document.addEventListener("DOMContentLoaded", () => start().catch((error) => say(`cnc-web: ${error.message}`, true)));

@@ -1,0 +1,95 @@
+// cnc-web: the tool path of the program page (XY): the planned path, the path run so far
+// and the tool, on equal scales with axes and a grid in mm, in workpiece coordinates while
+// an offset is in effect. A classic script after app.js: it shares its state and helpers.
+"use strict";
+
+// What lies between machine and workpiece coordinates now (zero offset and tool
+// length: machine - workpiece), and the name of the coordinates the path is drawn in.
+function pathFrame() {
+  const acs = currentXY("acs");
+  const pcs = currentXY("pcs");
+  const shift = acs && pcs ? [acs[0] - pcs[0], acs[1] - pcs[1]] : [0, 0];
+  const group = v(`ch${state.channel}.mc_active_zero_offset_r`) || 0;
+  const workpiece = group !== 0 || shift[0] !== 0 || shift[1] !== 0;
+  return { shift, name: workpiece ? `workpiece coordinates (G${53 + group})` : "machine coordinates (G53)" };
+}
+
+function recordLivePath() {
+  const here = currentXY();
+  if (!here || !working()) return;
+  const last = state.live[state.live.length - 1];
+  if (!last || last[0] !== here[0] || last[1] !== here[1]) {
+    state.live.push(here);
+    if (state.live.length > 5000) state.live.splice(0, state.live.length - 5000);
+  }
+}
+
+function niceStep(span) {
+  const raw = span / 5;
+  const power = 10 ** Math.floor(Math.log10(raw));
+  return [1, 2, 5, 10].map((f) => f * power).find((step) => step >= raw);
+}
+
+const PLOT = { left: 46, top: 10, width: 344, height: 262 }; // inside the 400 x 300 view box
+
+function drawPath() {
+  const frame = pathFrame();
+  const [dx, dy] = frame.shift;
+  const toView = ([x, y]) => [x - dx, y - dy];
+  const planned = state.planned ? state.planned.x.map((x, k) => toView([x, state.planned.y[k]])) : [];
+  const live = state.live.map(toView);
+  const acs = currentXY();
+  const here = acs ? toView(acs) : null;
+  // The view holds the planned path from the start and grows when the tool leaves it:
+  // it never shrinks to the path so far. A new offset (G53 -> G54) starts it anew.
+  const key = `${dx},${dy}`;
+  let e = state.extentKey === key ? state.extent : null;
+  for (const [x, y] of planned.concat(live, here ? [here] : [])) {
+    e = e ? [Math.min(e[0], x), Math.min(e[1], y), Math.max(e[2], x), Math.max(e[3], y)] : [x, y, x, y];
+  }
+  if (!e) return;
+  state.extent = e;
+  state.extentKey = key;
+  const span = Math.max((e[2] - e[0]) * PLOT.height / PLOT.width, e[3] - e[1], 1) * 1.1;
+  const scale = PLOT.height / span; // px per mm, the same on both axes
+  const [cx, cy] = [(e[0] + e[2]) / 2, (e[1] + e[3]) / 2];
+  const sx = (x) => PLOT.left + PLOT.width / 2 + (x - cx) * scale;
+  const sy = (y) => PLOT.top + PLOT.height / 2 - (y - cy) * scale;
+  drawGrid(frame.name, scale, cx, cy, sx, sy);
+  const line = (pts) => pts.map(([x, y]) => `${sx(x).toFixed(2)},${sy(y).toFixed(2)}`).join(" ");
+  $("#path-planned").setAttribute("points", line(planned));
+  $("#path-live").setAttribute("points", line(live));
+  if (here) {
+    $("#path-tool").setAttribute("cx", sx(here[0]).toFixed(2));
+    $("#path-tool").setAttribute("cy", sy(here[1]).toFixed(2));
+  }
+}
+
+// The axes, the grid and its labels in mm: drawn again only when the view changes.
+function drawGrid(frameName, scale, cx, cy, sx, sy) {
+  const key = `${frameName} ${scale} ${cx} ${cy}`;
+  if (state.gridKey === key) return;
+  state.gridKey = key;
+  const step = niceStep(PLOT.width / scale);
+  const [x0, x1] = [cx - PLOT.width / 2 / scale, cx + PLOT.width / 2 / scale];
+  const [y0, y1] = [cy - PLOT.height / 2 / scale, cy + PLOT.height / 2 / scale];
+  const digits = step < 1 ? Math.ceil(-Math.log10(step)) : 0;
+  const parts = [];
+  const bottom = PLOT.top + PLOT.height;
+  for (let x = Math.ceil(x0 / step) * step; x <= x1; x += step) {
+    const px = sx(x).toFixed(1);
+    parts.push(`<line class="${Math.abs(x) < step / 1e6 ? "axis" : "tick"}" x1="${px}" y1="${PLOT.top}" x2="${px}" y2="${bottom}"/>`,
+      `<text x="${px}" y="${bottom + 12}" text-anchor="middle">${x.toFixed(digits)}</text>`);
+  }
+  for (let y = Math.ceil(y0 / step) * step; y <= y1; y += step) {
+    const py = sy(y).toFixed(1);
+    parts.push(`<line class="${Math.abs(y) < step / 1e6 ? "axis" : "tick"}" x1="${PLOT.left}" y1="${py}" x2="${PLOT.left + PLOT.width}" y2="${py}"/>`,
+      `<text x="${PLOT.left - 4}" y="${py}" text-anchor="end" dominant-baseline="middle">${y.toFixed(digits)}</text>`);
+  }
+  parts.push(`<rect class="frame" x="${PLOT.left}" y="${PLOT.top}" width="${PLOT.width}" height="${PLOT.height}"/>`,
+    `<text class="axis-name" x="${PLOT.left + PLOT.width - 2}" y="${bottom - 4}" text-anchor="end">X mm</text>`,
+    `<text class="axis-name" x="${PLOT.left + 4}" y="${PLOT.top + 12}">Y mm</text>`);
+  $("#path-grid").innerHTML = parts.join("");
+  $("#path-frame").textContent = `· ${frameName}`;
+  $("#path-scale").textContent = `grid ${step.toFixed(digits)} mm`;
+}
