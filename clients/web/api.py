@@ -200,11 +200,15 @@ async def read(request: web.Request) -> web.StreamResponse:
 
 @_service_call
 async def write(request: web.Request) -> web.StreamResponse:
-    """Write ``value`` to the object ``name``."""
+    """Write ``value`` to the object ``name``; with ``"units": true`` the value is in
+    engineering units (mm, %, rpm: the object's scale), converted by the client."""
     data = await _body(request)
     name = _field(data, "name", str)
+    units = data.get("units", False)
+    if not isinstance(units, bool):
+        raise refusal(400, "'units' is not a boolean")
     require_write(request, f"write {name}")
-    await _client(request).write(name, data.get("value"))
+    await _client(request).write(name, data.get("value"), units=units)
     return web.json_response({"ok": True})
 
 

@@ -121,7 +121,7 @@ async def test_a_refusal_is_shown_in_the_services_words(page: Any, web: WebProce
     await page.click("#object-search button")
     await page.click("#object-table tbody tr button")
     row = page.locator("#watch-table tbody tr")
-    await row.locator("input").fill("2000")
+    await row.locator("input").fill("200")  # in %, the object's engineering unit
     await row.locator("button", has_text="Write").click()
     text = await _message(page, "INVALIDDATA")
     assert text == "ADS 0x706 INVALIDDATA: feed override 200 % is outside 0..100 %"
@@ -130,6 +130,36 @@ async def test_a_refusal_is_shown_in_the_services_words(page: Any, web: WebProce
     value = await page.evaluate(
         "async () => (await (await fetch('/api/read?name=ch1.mc_active_feed_override_r')).json()).value")
     assert value == 1000
+
+
+async def test_the_objects_page_shows_and_writes_engineering_units(page: Any,
+                                                                   web: WebProcess) -> None:
+    """Values in mm, %, rpm as the catalog's scale says (issue 36), the raw value in the
+    cell's title; a write in % is the object's 0.1 %."""
+    await _open(page, web.url, "objects")
+    await page.fill("#object-pattern", "ch1.mc_command_feed_override_w")
+    await page.click("#object-search button")
+    assert "%" in await page.locator("#object-table tbody tr td").nth(4).inner_text()
+    await page.click("#object-table tbody tr button")
+    await page.fill("#object-pattern", "ch1.mc_active_feed_override_r")
+    await page.click("#object-search button")
+    await page.click("#object-table tbody tr button")
+    watched = page.locator("#watch-table tbody tr")
+    await watched.nth(0).locator("input").fill("62.5")
+    await watched.nth(0).locator("button", has_text="Write").click()
+    cell = watched.nth(1).locator("td").nth(1)
+    await page.wait_for_function(
+        "() => document.querySelectorAll('#watch-table tbody tr')[1]"
+        ".querySelectorAll('td')[1].textContent === '62.5 %'", timeout=WAIT_MS)
+    assert await cell.get_attribute("title") == "raw 625 0.1 %"
+    value = await page.evaluate(
+        "async () => (await (await fetch('/api/read?name=ch1.mc_active_feed_override_r')).json()).value")
+    assert value == 625
+    await watched.nth(0).locator("input").fill("100")
+    await watched.nth(0).locator("button", has_text="Write").click()
+    await page.wait_for_function(
+        "() => document.querySelectorAll('#watch-table tbody tr')[1]"
+        ".querySelectorAll('td')[1].textContent === '100.0 %'", timeout=WAIT_MS)
 
 
 async def test_a_monitor_finds_every_write_disabled_and_refused(page: Any,

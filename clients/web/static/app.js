@@ -601,7 +601,8 @@ $("#object-search").addEventListener("submit", async (event) => {
     $("#object-table tbody").replaceChildren(...data.objects.map((o) => {
       const row = el("tr");
       row.title = o.description;
-      cells(row, [o.name, `${o.port}:0x${o.group.toString(16)}:0x${o.offset.toString(16)}`, o.type, o.access, o.unit]);
+      cells(row, [o.name, `${o.port}:0x${o.group.toString(16)}:0x${o.offset.toString(16)}`, o.type, o.access,
+        o.scale ? `${o.scale.unit} (${o.unit})` : o.unit]);
       const watchButton = el("button", { type: "button", textContent: "Watch" });
       watchButton.addEventListener("click", () => addWatch(o));
       row.append(el("td", {}, watchButton));
@@ -611,21 +612,33 @@ $("#object-search").addEventListener("submit", async (event) => {
 });
 
 const objectAccess = {};
+// The engineering scale of each watched object, from browse ([unit, factor, decimals]
+// of the catalog): values are shown and written in mm, %, rpm, as the CLI does.
+const objectScale = {};
+const objectRawUnit = {};
+
+function engineeringText(name, value) {
+  const scale = objectScale[name];
+  if (!scale || typeof value !== "number") return JSON.stringify(value ?? "…");
+  return `${(value * scale.factor).toFixed(scale.decimals)} ${scale.unit}`;
+}
 
 function addWatch(info) {
   if (state.objectWatch.includes(info.name)) return;
   objectAccess[info.name] = info.access;
+  objectScale[info.name] = info.scale;
+  objectRawUnit[info.name] = info.unit;
   state.objectWatch.push(info.name);
   watch([info.name]);
-  const input = el("input", { type: "text", className: "write", placeholder: "value" });
+  const input = el("input", { type: "text", className: "write", placeholder: info.scale ? `value in ${info.scale.unit}` : "value" });
   const set = el("button", { type: "button", className: "write", textContent: "Write" });
   input.disabled = set.disabled = !state.session.may_write || !info.access.includes("w");
   set.addEventListener("click", async () => {
     let value = input.value;
     try { value = JSON.parse(value); } catch (_) { /* a bare string */ }
     try {
-      await api("POST", "/api/write", { name: info.name, value });
-      say(`${info.name} := ${input.value}`);
+      await api("POST", "/api/write", { name: info.name, value, units: Boolean(info.scale) });
+      say(`${info.name} := ${input.value}${info.scale ? " " + info.scale.unit : ""}`);
     } catch (_) { /* shown */ }
   });
   const remove = el("button", { type: "button", textContent: "×", title: "stop watching" });
@@ -644,8 +657,11 @@ function addWatch(info) {
 function renderWatch() {
   for (const cell of document.querySelectorAll("td[data-watch]")) {
     const name = cell.dataset.watch;
-    const text = name in state.watchErrors ? state.watchErrors[name] : JSON.stringify(v(name) ?? "…");
-    if (cell.textContent !== text) cell.textContent = text;
+    const text = name in state.watchErrors ? state.watchErrors[name] : engineeringText(name, v(name));
+    if (cell.textContent !== text) {
+      cell.textContent = text;
+      cell.title = objectScale[name] ? `raw ${JSON.stringify(v(name))} ${objectRawUnit[name]}` : "";
+    }
   }
 }
 
