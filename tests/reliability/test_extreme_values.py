@@ -34,6 +34,10 @@ ALLOWED = {0, E.DEVICE_SRVNOTSUPP, E.DEVICE_INVALIDSIZE, E.DEVICE_INVALIDDATA,
            E.DEVICE_NOTREADY, E.DEVICE_NOTFOUND, E.DEVICE_BUSY}
 #: Objects whose value the CNC changes itself after a write (documented in the catalog).
 SELF_RESETTING = {"semaphor_rw"}  # TRUE: the CNC answers and resets it to FALSE
+#: Kept in whole kernel cycles (a tool's cutting time counts cycles): a value reads back
+#: as the nearest whole number of cycles times the cycle time (-0 and a subnormal as 0).
+IN_CYCLES = {"life_used"}
+CYCLE_S = 0.001  # the test service's cycle time (the default machine's 1 ms)
 _INT_FORMATS = {1: "b", 2: "h", 4: "i", 8: "q"}
 
 
@@ -93,6 +97,9 @@ def expected_back(info: ObjectInfo, data: bytes) -> bytes:
     """What a taken write must read back as."""
     if info.name.rsplit(".", 1)[-1] in SELF_RESETTING:
         return b"\x00"
+    if info.name.rsplit(".", 1)[-1] in IN_CYCLES:
+        (value,) = struct.unpack("<d", data)
+        return struct.pack("<d", round(value / CYCLE_S) * CYCLE_S)
     if info.type.startswith("STRING"):
         text = data.split(b"\x00", 1)[0]
         return text.ljust(info.length, b"\x00")
