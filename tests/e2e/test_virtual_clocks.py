@@ -22,17 +22,22 @@ async def _run(endpoint: str) -> tuple[dict[str, float], int, float, list[float]
     async with AsyncClient(endpoint, timeout_s=60) as c, AsyncClient(endpoint) as watcher:
         await c.upload("part.nc", PART.encode())
         samples: list[float] = []
-        first = asyncio.Event()
+        first, back = asyncio.Event(), asyncio.Event()
 
         async def watch() -> None:
             async for sample in watcher.subscribe("ch1.ax1.command_position_acs"):
                 samples.append(sample.value)
                 first.set()
+                if sample.value == 0 and max(samples) > 0:
+                    back.set()  # out and home again
 
         task = asyncio.create_task(watch())
         await asyncio.wait_for(first.wait(), 10)
         await c.run_program("part.nc")
         await c.wait_program(timeout_s=60)
+        # the sample of X back at 0 comes within the subscription's interval (10 ms of
+        # kernel time) after that cycle, which may be after the program's end
+        await asyncio.wait_for(back.wait(), 10)
         status = await c.status()
         blocks = await c.read("ch1.actual_block_count")
         task.cancel()
