@@ -12,7 +12,6 @@ renews keeps jogging.
 from __future__ import annotations
 
 import asyncio
-import selectors
 import signal
 import subprocess
 import sys
@@ -27,6 +26,7 @@ from cnc_objects.clients.jog_hold import HeldJog
 from cnc_objects.testing import ServiceProcess, serving
 from tests.limits.wire import limits_toml
 from tests.reliability import figures
+from tests.support.child_output import read_line
 
 NODE = "tests/reliability/test_jog_dead_man.py"
 CHILD = Path(__file__).with_name("jog_child.py")
@@ -66,23 +66,13 @@ def _wait(client: Client, moving: bool, timeout_s: float) -> float:
     return time.monotonic() - start
 
 
-def _read_line(process: subprocess.Popen[str], timeout_s: float) -> str:
-    with selectors.DefaultSelector() as selector:
-        selector.register(process.stdout, selectors.EVENT_READ)  # type: ignore[arg-type]
-        if not selector.select(timeout_s):
-            raise AssertionError(f"the child said nothing within {timeout_s:g} s")
-    line = process.stdout.readline().strip()  # type: ignore[union-attr]
-    assert line, f"the child ended with {process.wait()}"
-    return line
-
-
 def _killed_stops(service: ServiceProcess, child_args: list[str], wire: str) -> None:
     with Client(service.endpoint, timeout_s=20) as client:
         _manual_continuous(client)
         child = subprocess.Popen([sys.executable, str(CHILD), *child_args],
                                  stdout=subprocess.PIPE, text=True, cwd=ROOT)
         try:
-            assert _read_line(child, PRESS_TIMEOUT_S) == "pressed"
+            assert read_line(child, PRESS_TIMEOUT_S) == "pressed"
             _wait(client, True, PRESS_TIMEOUT_S)
         finally:
             killed_at = time.monotonic()

@@ -13,7 +13,6 @@ requests on the wire) and once killed while idle.
 
 from __future__ import annotations
 
-import selectors
 import signal
 import subprocess
 import sys
@@ -30,6 +29,7 @@ from cnc_objects.testing import ServiceProcess, serving
 from tests.reliability import figures
 from tests.reliability.health import RawConnection, assert_well, poll_until, vitals
 from tests.reliability.scale import Scale
+from tests.support.child_output import read_line
 
 PER_CLIENT = 1000  # default [limits] notifications_per_client
 TOTAL = 20_000  # default [limits] notifications_total
@@ -80,7 +80,7 @@ def test_a_killed_client_frees_its_notifications(
                  str(PER_CLIENT), *(str(v) for v in address), traffic],
                 stdout=subprocess.PIPE, text=True)
             try:
-                line = _read_line(child, SUBSCRIBE_TIMEOUT_S)
+                line = read_line(child, SUBSCRIBE_TIMEOUT_S)
                 assert line == f"subscribed {TOTAL}", line
                 assert client.read(COUNT) == baseline + TOTAL
                 # the service's total is taken: a fresh client gets no notification
@@ -103,13 +103,3 @@ def test_a_killed_client_frees_its_notifications(
     figures.record(f"SIGKILLed client ({traffic}), {TOTAL} notifications: freed within",
                    f"{max(freed_s):.1f} s ({run_scale.killed_clients} kills)", NODE)
 
-
-def _read_line(process: subprocess.Popen[str], timeout_s: float) -> str:
-    """The process' next stdout line within ``timeout_s`` (its exit fails the test)."""
-    with selectors.DefaultSelector() as selector:
-        selector.register(process.stdout, selectors.EVENT_READ)  # type: ignore[arg-type]
-        if not selector.select(timeout_s):
-            raise AssertionError(f"the child said nothing within {timeout_s:g} s")
-    line = process.stdout.readline().strip()  # type: ignore[union-attr]
-    assert line, f"the child ended with {process.wait()}"
-    return line
