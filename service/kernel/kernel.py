@@ -421,7 +421,8 @@ class Kernel:
         """
         applied: list[tuple[Done, Refusal | None]] = []
         shutting_down = False
-        while self.stats.running:
+        # (asked first: an empty queue's get raises, which costs more than an idle cycle)
+        while self.stats.running and (self._waiting or not self._queue.empty()):
             try:
                 command, done = self._next_command(block=False)
             except queue.Empty:
