@@ -32,6 +32,9 @@ on-change notifications of the PLC memory area (``bench/notification_size_bench.
 CLI part (``--part cli``): ``cnc --help`` and ``cnc read`` of one object, start to exit,
 against ``python -c pass`` and ``python -c 'import zmq'`` (``bench/cli_bench.py``; target
 < 0.25 s each).
+Idle part (``--part idle``): the kernel's idle cycle in microseconds, resting and with
+its whole work, and an idle realtime ``cnc-service``'s CPU % and memory, against a bare
+1 ms sleep loop (``bench/idle_bench.py``; issue 36).
 Web part (``--part web``): cnc-web's position update rate in 10 WebSocket sessions while a
 program runs, and the realtime cycle's figures without and with it (``bench/web_bench.py``).
 Dispatch part (``--part dispatch``):
@@ -216,7 +219,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
     parser.add_argument("--part", choices=("all", "dispatch", "client", "ads", "kernel",
                                            "jitter", "virtual", "lookahead", "fairness", "cli",
-                                           "web"),
+                                           "web", "idle"),
                         default="all",
                         help="dispatch: request dispatch (ZeroMQ); client: AsyncClient "
                         "batching against the raw echo, wall and CPU; ads: pyads over AMS/TCP; "
@@ -224,9 +227,12 @@ def main(argv: list[str] | None = None) -> int:
                         "under load; virtual: whole-service virtual time speed; lookahead: "
                         "machining time against the optimum; fairness: reads while the "
                         "notification limit is used up; cli: cnc's start to exit; web: "
-                        "cnc-web's live values and their cost")
+                        "cnc-web's live values and their cost; idle: an idle service's CPU "
+                        "and its kernel's idle cycle")
     parser.add_argument("--jitter-s", type=float, default=20.0,
                         help="seconds of load per jitter run (issue 22 asks 60)")
+    parser.add_argument("--idle-s", type=float, default=15.0,
+                        help="seconds of an idle service per idle run")
     args = parser.parse_args(argv)
     if args.part in ("all", "dispatch"):
         dispatch(args)
@@ -257,6 +263,11 @@ def main(argv: list[str] | None = None) -> int:
         from . import cli_bench
 
         cli_bench.main(args.runs)
+
+    if args.part in ("all", "idle"):
+        from . import idle_bench
+
+        idle_bench.main(min(args.runs, 3), args.idle_s)
 
     if args.part in ("all", "web"):
         from . import web_bench

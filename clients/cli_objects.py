@@ -32,6 +32,7 @@ from .object_info import ObjectInfo
 from .units import parse_engineering, record, show
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
+    from .blocking import Client
     from .client import AsyncClient
 
 EXIT_WATCH_TIMEOUT = 5  # watch --count N --wait-timeout S: a name got fewer than N samples
@@ -169,13 +170,35 @@ def read(
                 emit(settings, {"port": p, "group": g, "offset": o, "type": t.name, "value": value},
                      f"{p}:0x{g:x}:0x{o:x} = {value}")
                 return
-            names = _expanded(c, names)
-            values = c.read_many(names) if len(names) > 1 else {names[0]: c.read(names[0])}
-            infos = {n: c.describe(n) for n in values}
+            alone = _read_alone(c, names[0]) if len(names) == 1 else None
+            if alone is not None:
+                values, infos = {names[0]: alone[1]}, {names[0]: alone[0]}
+            else:
+                names = _expanded(c, names)
+                values = c.read_many(names) if len(names) > 1 else {names[0]: c.read(names[0])}
+                infos = {n: c.describe(n) for n in values}
     except (AdsError, ClientValueError) as exc:
         fail(exc)
     for name, value in values.items():
         emit(settings, record(infos[name], value, raw), f"{name} = {show(infos[name], value, raw)}")
+
+
+def _read_alone(client: Client, name: str) -> tuple[ObjectInfo, Any] | None:
+    """The description and value of the one object ``name`` (no glob) from a browse of
+    that name alone and a read by address: two small round trips, where a read by name
+    first loads the whole catalog (some 2 700 descriptions, a third of a ``cnc read``'s
+    time). None when the browse does not find exactly that name (a glob, an unknown name,
+    another case): the caller's read by name then says what it says (did you mean ...)."""
+    if "*" in name or "?" in name:
+        return None
+    try:
+        found = [info for info in client.browse(name) if info.name == name]
+        if len(found) != 1:
+            return None
+        info = found[0]
+        return info, client.read_address(info.port, info.group, info.offset, info.dtype)
+    except NoReplyError as exc:  # the user asked for a READ, not for a BROWSE
+        raise exc.asking(f"READ {name}") from None
 
 
 def _expanded(client: Any, names: list[str]) -> list[str]:

@@ -34,7 +34,7 @@ import os
 from collections.abc import AsyncGenerator, AsyncIterator, Coroutine, Iterable, Iterator
 from dataclasses import dataclass
 from datetime import datetime
-from typing import Any, Self, TypeVar, cast
+from typing import TYPE_CHECKING, Any, Self, TypeVar, cast
 
 from cnc_objects.protocol import sum as sums
 from cnc_objects.protocol.constants import AdsState, CncPort, TransmissionMode
@@ -70,8 +70,10 @@ from .machine_ops import MachineOps
 from .object_info import ObjectInfo
 from .path_trace import TraceOps
 from .sync_transport import SyncTransport, drive
-from .transport import AsyncTransport
 from .units import engineering, raw_value
+
+if TYPE_CHECKING:  # imported where used: the blocking client (cnc read) loads no asyncio
+    from .transport import AsyncTransport
 
 DEFAULT_TIMEOUT_S = 5.0
 _HANDLE_PORT = CncPort.COM  # handles are global in the service; any CNC port serves them
@@ -202,6 +204,8 @@ class AsyncClient(TraceOps, AlarmOps, MachineOps):
     ) -> None:
         self.endpoint = endpoint
         if _transport is None:
+            from .transport import AsyncTransport
+
             curve = client_curve(key_file, server_key)
             _transport = AsyncTransport(endpoint, timeout_s, curve=curve, batch=batch)
         self._t = _transport

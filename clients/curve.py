@@ -19,13 +19,12 @@ the connection (its ZAP status 500, with or without keys).
 from __future__ import annotations
 
 import os
+import struct
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import zmq
-import zmq.auth
-from zmq.utils.monitor import parse_monitor_message
 
 from cnc_objects.protocol.constants import ZAP_STATUS_TABLE_FULL
 
@@ -40,6 +39,10 @@ _MECHANISM_MISMATCH = zmq.PROTOCOL_ERROR_ZMTP_MECHANISM_MISMATCH
 # A handshake that ends without detail (the peer closed) is a refusal only when it keeps
 # ending so: once may be a service stopping mid-handshake. ZeroMQ retries every 100 ms.
 VAGUE_FAILURES = 3
+# A monitor event's first frame: 16-bit event id, 32-bit value, native order, no padding
+# (zmq_socket_monitor). Parsed here: pyzmq's parse_monitor_message lives in a module that
+# imports zmq.asyncio and asyncio, which a blocking client (``cnc read``) never needs.
+_EVENT_FRAME = struct.Struct("=HI")
 
 
 @dataclass(frozen=True)
@@ -98,6 +101,8 @@ def load_client_curve(
 def _read(path: Path, what: str) -> tuple[bytes, bytes | None]:
     if not path.is_file():
         raise ClientValueError(f"the {what} {path} does not exist")
+    import zmq.auth  # here: only a client given keys needs it (it loads asyncio)
+
     try:
         public, secret = zmq.auth.load_certificate(path)
     except OSError as exc:
@@ -131,10 +136,10 @@ class HandshakeWatch:
         """Read every event that waits; the failure of the last handshake, if it failed."""
         while True:
             try:
-                message = parse_monitor_message(self._monitor.recv_multipart(zmq.NOBLOCK))
+                frames = self._monitor.recv_multipart(zmq.NOBLOCK)
             except zmq.Again:
                 return self.failure
-            event = message["event"]
+            event, value = _EVENT_FRAME.unpack(frames[0])
             if event == zmq.EVENT_HANDSHAKE_SUCCEEDED:
                 self.succeeded, self.failure, self._vague = True, None, 0
                 continue
@@ -143,7 +148,7 @@ class HandshakeWatch:
                 self._vague += 1
                 if self._vague < VAGUE_FAILURES:
                     continue
-            self.failure = self._explain(event, message["value"])
+            self.failure = self._explain(event, value)
 
     def wait(self, timeout_s: float) -> bool:
         """Block until a handshake succeeded or failed for good (True), or ``timeout_s``

@@ -19,7 +19,7 @@ from cnc_objects.protocol.frames import RawSample, Response, decode_incoming
 
 from .curve import ClientCurve, HandshakeWatch
 from .errors import AdsConnectionError
-from .transport import _NOBLOCK, _new_socket, _Transport
+from .transport_base import _NOBLOCK, _new_socket, _Transport
 
 log = logging.getLogger(__name__)
 T = TypeVar("T")

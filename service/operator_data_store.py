@@ -151,6 +151,7 @@ class OperatorDataStore:
         self.path = path
         self._machine = machine
         self._shown: list[Tables] | None = None  # the tables the last observe saw
+        self._channels_seen: object = None  # the channels of the snapshot it saw last
         self._latest: list[Tables] | None = None  # to be written (None: nothing new)
         self._changed = threading.Condition()
         self._stopping = False
@@ -201,7 +202,11 @@ class OperatorDataStore:
 
     def observe(self, snapshot: Snapshot) -> None:
         """The cycle hook: note tables that changed since the last call (cheap: identity
-        only; the writer thread does the rest)."""
+        only; the writer thread does the rest). A kernel at rest republishes the same
+        channels: one comparison then."""
+        if snapshot.channels is self._channels_seen:
+            return
+        self._channels_seen = snapshot.channels
         shown = self._shown
         if shown is not None and all(
             c.tooling.tools is t and c.tooling.zero_offsets is z

@@ -111,6 +111,7 @@ class Kernel:
         alarms: AlarmLog | None = None,
         tables: Sequence[ToolingTables | None] = (),
         idle_steps_max: int | None = None,
+        rest_when_idle: bool = True,
     ) -> None:
         """``loader(name)`` returns a program's text (KeyError when absent) and
         ``exists(name)`` says whether it is there: the program store, seen by the kernel,
@@ -125,7 +126,9 @@ class Kernel:
         list and zero offsets at start (the operator data the service kept; None or
         absent: the configured ones); a kernel RESET keeps the tables it has then.
         ``idle_steps_max``: the decoder's endless-program guard ([limits]
-        decoder_idle_steps_max; None: the default).
+        decoder_idle_steps_max; None: the default). ``rest_when_idle`` False: every cycle
+        does its whole work, also at rest (the reference the resting cycles must equal,
+        value for value; see ``_work``).
 
         The kernel owns its threads: the cycle thread and the workers (``workers``: the
         decoders and syntax checks), which run below the cycle's priority and which
@@ -145,6 +148,12 @@ class Kernel:
         self._save = save
         self._busy = False
         self._changed: list[bool] | None = None  # channels the cycle touched; None = all
+        # The last cycle's work changed nothing and nothing is busy: the next cycle without
+        # commands may be a resting one (``_rests``); its drives stay as published.
+        self._quiet = False
+        self._resting = False  # the last cycle rested: so do the next ones, until a command
+        self._rest_when_idle = rest_when_idle
+        self._drives_changed = True
         self.state = self._initial_state()
         self.stats = CycleStats(cycle_us=round(config.cycle_ms * 1000))
         # cycle lateness per cycle (realtime clock only): kept by the clock, read live
@@ -412,7 +421,8 @@ class Kernel:
         """
         applied: list[tuple[Done, Refusal | None]] = []
         shutting_down = False
-        while self.stats.running:
+        # (asked first: an empty queue's get raises, which costs more than an idle cycle)
+        while self.stats.running and (self._waiting or not self._queue.empty()):
             try:
                 command, done = self._next_command(block=False)
             except queue.Empty:
@@ -457,6 +467,9 @@ class Kernel:
         return True
 
     def _apply(self, command: KernelCommand) -> Refusal | None:
+        # A command may change anything: the cycles after it do their whole work again
+        # (the step clock applies commands between cycles, not in ``_cycle``).
+        self._resting = self._quiet = False
         try:
             if isinstance(command, ControlCommand):
                 self._control(command.control)
@@ -527,12 +540,13 @@ class Kernel:
         # under the virtual clock, nor under load).
         return self.state.snapshot(
             cycle, cycle * self.cycle_ns, time.time_ns(), self.stats, self._latest,
-            self._changed,
+            self._changed, self._drives_changed,
         )
 
     def _publish(self) -> None:
         self._latest = snapshot = self._snapshot()
         self._changed = None
+        self._drives_changed = True
         hook = self.on_cycle_end
         if hook is not None:
             hook(snapshot)
@@ -540,10 +554,22 @@ class Kernel:
     def _work(self, applied_commands: bool) -> None:
         """The cycle's work: every channel's path, then the drives follow their axes.
         Notes which channels changed, so the snapshot copies only those (commands may
-        have touched any channel: then all are copied)."""
+        have touched any channel: then all are copied).
+
+        A resting cycle (``_rests``) only takes the time: the idle machine's cycles cost
+        next to nothing, as the realtime clock runs them a thousand times a second."""
         time_s = self.stats.cycles * self.cycle_s
-        busy = False
         runners = self.state.runners
+        if self._resting or (self._quiet and self._rests()):
+            # Nothing but a command changes a machine at rest (``_rests``): once one cycle
+            # rested, the next ones do too, without asking again (``_apply`` ends the rest).
+            self._resting = True
+            for runner in runners:
+                runner.cruise(1, time_s)  # a channel whose cycles change nothing: the time
+            self._changed = [False] * len(runners)
+            self._drives_changed = False
+            return
+        busy = False
         switched = [False] * len(runners)
         self.switchover.step(switched)
         changed = []
@@ -555,6 +581,18 @@ class Kernel:
         self._busy = busy or self.switchover.in_progress
         if not applied_commands:
             self._changed = [a or b for a, b in zip(changed, switched, strict=True)]
+        self._quiet = self._rest_when_idle and not (
+            applied_commands or self._busy or any(changed) or any(switched))
+
+    def _rests(self) -> bool:
+        """The next cycle's work would change nothing: the last cycle's changed nothing
+        (``_quiet``), no link or suspend handshake is under way, and no channel runs,
+        ramps its spindle or waits for a timed acknowledge (``cruise_budget`` None, the
+        rule the event-speed clock's bulk follows). Every value a client can see is then
+        the same after the cycle but the cycle counter and the times; a command, or
+        anything that is not at rest, makes the next cycle a full one."""
+        return self.switchover.at_rest() and all(
+            runner.cruise_budget(1) is None for runner in self.state.runners)
 
     def state_has_work(self) -> bool:
         """True while a channel moves or decodes: the virtual clock runs cycles back to

@@ -432,25 +432,28 @@ class KernelState:
         stats: CycleStats,
         previous: Snapshot | None = None,
         changed: list[bool] | None = None,
+        drives_changed: bool = True,
     ) -> Snapshot:
         """Frozen copies of everything readable.
 
         With ``previous`` and ``changed`` (one flag per channel), a channel that did not
         change this cycle keeps its frozen copy from ``previous``: an idle channel costs
-        nothing per cycle. Without them every channel is copied. ``time_ns`` and
+        nothing per cycle. Without them every channel is copied; the physical axes are
+        copied unless ``drives_changed`` is False (with ``previous``). ``time_ns`` and
         ``wall_ns``: kernel time and wall-clock time of the cycle (see ``Snapshot``).
         """
         if previous is None or changed is None:
             channels = tuple(c.frozen() for c in self.channels)
+        elif not any(changed):
+            channels = previous.channels
         else:
             channels = tuple(
                 c.frozen() if touched else old
                 for c, touched, old in zip(self.channels, changed, previous.channels, strict=True)
             )
-        return Snapshot(
-            cycle, time_ns, wall_ns, stats.frozen(), channels,
-            tuple(p.frozen() for p in self.physical_axes),
-        )
+        drives = (previous.physical_axes if previous is not None and not drives_changed
+                  else tuple(p.frozen() for p in self.physical_axes))
+        return Snapshot(cycle, time_ns, wall_ns, stats.frozen(), channels, drives)
 
 
 def _channel_from_config(config: ChannelConfig, machine: MachineConfig) -> Channel:

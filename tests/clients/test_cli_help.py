@@ -23,6 +23,9 @@ from tests.clients.test_cli import cnc
 NOT_FOR_HELP = ("numpy", "pydantic", "rich", "textual", "matplotlib", "msgpack", "zmq",
                 "asyncio", "argon2")
 NOT_FOR_READ = ("numpy", "pydantic", "rich", "textual", "matplotlib", "argon2")
+# A read runs on the blocking client: no event loop (asyncio, hence zmq.asyncio), no TLS
+# (ssl, which asyncio loads), no CURVE key files (zmq.auth) without keys (issue 36).
+NOT_FOR_BLOCKING_READ = ("asyncio", "ssl", "zmq.asyncio", "zmq.auth", "zmq.utils.monitor")
 
 
 def _commands(group: Any, prefix: tuple[str, ...] = ()) -> Iterator[tuple[tuple[str, ...], Any]]:
@@ -130,8 +133,13 @@ def test_cnc_mqtt_help_is_plain_and_names_the_values() -> None:
 
 def _imported_by(*argv: str) -> set[str]:
     """The top-level modules loaded by ``cnc argv`` by the time it exits."""
+    return {m.split(".")[0] for m in _modules_of(*argv)}
+
+
+def _modules_of(*argv: str) -> set[str]:
+    """Every module (dotted names) loaded by ``cnc argv`` by the time it exits."""
     code = ("import atexit, sys; atexit.register(lambda: print('MODULES', "
-            "' '.join(sorted({m.split('.')[0] for m in sys.modules})), file=sys.stderr)); "
+            "' '.join(sorted(sys.modules)), file=sys.stderr)); "
             "from cnc_objects.clients.cli import main; main()")
     result = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True,
                             text=True, timeout=60)
@@ -156,3 +164,13 @@ def test_a_read_imports_what_it_talks_with_and_nothing_heavy(endpoint: str) -> N
     loaded = _imported_by("--endpoint", endpoint, "read", "cnc_cycle_time_r")
     assert {"zmq", "msgpack"} <= loaded
     assert not loaded & set(NOT_FOR_READ), sorted(loaded & set(NOT_FOR_READ))
+
+
+def test_a_read_loads_no_event_loop_no_tls_and_not_the_catalog(endpoint: str) -> None:
+    """``cnc read NAME`` starts in under 0.25 s (issue 36 point 10): the blocking client
+    without asyncio, ssl or CURVE's key loading, and none of the service's catalog
+    modules (``objects`` builds them on first use only)."""
+    loaded = _modules_of("--endpoint", endpoint, "read", "cnc_cycle_time_r")
+    assert "cnc_objects.clients.sync_transport" in loaded  # the probe sees the client
+    assert not loaded & set(NOT_FOR_BLOCKING_READ), sorted(loaded & set(NOT_FOR_BLOCKING_READ))
+    assert not {m for m in loaded if m.startswith("cnc_objects.objects.catalog")}
