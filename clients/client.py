@@ -28,7 +28,6 @@ let the client in (its key refused, or keys that do not fit) raises
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import os
 from collections.abc import AsyncGenerator, AsyncIterator, Coroutine, Iterable, Iterator
@@ -73,6 +72,8 @@ from .sync_transport import SyncTransport, drive
 from .units import engineering, raw_value
 
 if TYPE_CHECKING:  # imported where used: the blocking client (cnc read) loads no asyncio
+    import asyncio
+
     from .transport import AsyncTransport
 
 DEFAULT_TIMEOUT_S = 5.0
@@ -267,16 +268,17 @@ class AsyncClient(TraceOps, AlarmOps, MachineOps):
         500 reads browses once, not 500 times)."""
         while self._objects is None:
             if self._catalogue_waiters is not None:  # another call browses: wait for it
-                waiter = asyncio.get_running_loop().create_future()  # only an event loop overlaps calls
+                import asyncio  # only an event loop overlaps calls (the blocking client's don't)
+
+                waiter = asyncio.get_running_loop().create_future()
                 self._catalogue_waiters.append(waiter)
                 await waiter  # its error is ours; a cancelled browse: try again
                 continue
             self._catalogue_waiters, error = [], None
             try:
                 self._objects = {o.name.lower(): o for o in await self.browse("*")}
-            except asyncio.CancelledError:
-                raise  # the waiters try again (one of them browses)
-            except Exception as exc:  # the waiters get the same error as this call
+            except Exception as exc:  # the waiters get the same error as this call (a
+                # cancelled browse is no Exception: they try again, one of them browses)
                 error = exc
                 raise
             finally:
