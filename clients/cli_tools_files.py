@@ -45,7 +45,7 @@ def in_mm(c: Client, name: str, raw: float) -> float:
 
 FileArgument = typer.Argument(..., metavar="FILE", help="Operator data file (JSON); - is "
                               "standard output (export) or input (import).")
-_TOOL_FIELDS = ("valid", "radius", "laenge")
+_TOOL_FIELDS = ("valid", "radius", "laenge", "name", "wear", "life_max")
 
 
 def _write_text(path: str, text: str) -> None:
@@ -85,14 +85,15 @@ def _tool_rows(c: Client, channel: int) -> tuple[int, dict[int, ToolRow]]:
     v = c.read_many(names)
     rows = {}
     for i in range(1, size + 1):
-        radius, length = (f"ch{channel}.wz[{i}].{f}" for f in ("radius", "laenge"))
-        rows[i] = ToolRow(i, v[f"ch{channel}.wz[{i}].valid"], in_mm(c, radius, v[radius]),
-                          in_mm(c, length, v[length]))
+        p = f"ch{channel}.wz[{i}]."
+        rows[i] = ToolRow(i, v[p + "valid"], in_mm(c, p + "radius", v[p + "radius"]),
+                          in_mm(c, p + "laenge", v[p + "laenge"]), v[p + "name"],
+                          in_mm(c, p + "wear", v[p + "wear"]), float(v[p + "life_max"]))
     return size, rows
 
 
 def _empty(row: ToolRow) -> bool:
-    return not row.valid and row.radius_mm == 0.0 and row.length_mm == 0.0
+    return row == ToolRow(row.wz, False, 0.0, 0.0)
 
 
 @tool_app.command("export")
@@ -131,8 +132,11 @@ def tool_import(ctx: typer.Context, file: str = FileArgument,
             if not row.valid:  # emptied first: the old data is never a valid tool meanwhile
                 c.write(f"{prefix}.valid", False)
             for name, mm in ((f"{prefix}.radius", row.radius_mm),
-                             (f"{prefix}.laenge", row.length_mm)):
+                             (f"{prefix}.laenge", row.length_mm),
+                             (f"{prefix}.wear", row.wear_mm)):
                 c.write(name, raw_value(c.describe(name), mm))
+            c.write(f"{prefix}.name", row.name)
+            c.write(f"{prefix}.life_max", row.life_max_s)
             if row.valid:
                 c.write(f"{prefix}.valid", True)
             written += 1

@@ -13,7 +13,7 @@ lists every object with its source.
 
 from __future__ import annotations
 
-from cnc_objects.protocol.constants import CncPort
+from cnc_objects.protocol.constants import TOOL_NAME_CHARS, CncPort
 from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16, UNS32
 
 from .addressing import GroupBase
@@ -40,7 +40,6 @@ TOOL_ROW_FIELDS = (
 #: external tool management keeps them there): (name, index, type, access, unit, meaning)
 #: in the project group COM 0x12060<c>, offset 8 i + index
 TOOL_EXTRA_STRIDE = 8
-TOOL_NAME_CHARS = 32
 TOOL_EXTRA_FIELDS = (
     ("name", 0, STRING(TOOL_NAME_CHARS), RW, "-", "the tool's name"),
     ("wear", 1, REAL64, RW, "0.1 um",

@@ -8,12 +8,15 @@ file"). Pure data: text in, dataclasses out, and back; the service and the CLI d
 
     {"format": "cnc-objects operator data", "version": 1,
      "channels": [{"channel": 1,
-                   "tools": [{"wz": 5, "valid": true, "radius_mm": 3.0, "length_mm": 42.0}],
+                   "tools": [{"wz": 5, "valid": true, "radius_mm": 3.0, "length_mm": 42.0,
+                              "name": "drill 6", "wear_mm": 0.01, "life_max_s": 600.0}],
                    "zero_offsets": [{"np_grp": 2, "name": "G55",
                                      "offsets_mm": {"X": 100.0, "Y": 50.0, "Z": -10.0}}]}]}
 
 A channel entry may leave out ``tools`` or ``zero_offsets`` (a tools export has no
-offsets): what is left out is not touched when the file is imported. Values are in mm.
+offsets): what is left out is not touched when the file is imported. Values are in mm;
+a tool's ``name``, ``wear_mm`` and ``life_max_s`` (project fields) are written where set
+and read as empty / 0 where absent.
 """
 
 from __future__ import annotations
@@ -23,6 +26,9 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
+
+from cnc_objects.protocol.constants import TOOL_LIFE_MAX_S as LIFE_MAX_S
+from cnc_objects.protocol.constants import TOOL_NAME_CHARS
 
 FORMAT_NAME = "cnc-objects operator data"
 FORMAT_VERSION = 1
@@ -42,6 +48,9 @@ class ToolRow:
     valid: bool
     radius_mm: float
     length_mm: float
+    name: str = ""  # the operator's name of the tool (project, wz[i].name)
+    wear_mm: float = 0.0  # radius wear (project, wz[i].wear)
+    life_max_s: float = 0.0  # cutting time allowed, 0 = no limit (project, wz[i].life_max)
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,8 +93,7 @@ def dumps(data: OperatorData) -> str:
     for ch in data.channels:
         sections = [f'   "channel": {ch.channel}']
         if ch.tools is not None:
-            rows = [json.dumps({"wz": r.wz, "valid": r.valid, "radius_mm": r.radius_mm,
-                                "length_mm": r.length_mm}) for r in ch.tools]
+            rows = [json.dumps(_tool_fields(r)) for r in ch.tools]
             sections.append(_section("tools", rows))
         if ch.zero_offsets is not None:
             groups = [json.dumps({"np_grp": g.np_grp, "name": group_name(g.np_grp),
@@ -95,6 +103,19 @@ def dumps(data: OperatorData) -> str:
         channels.append("  {\n" + ",\n".join(sections) + "\n  }")
     return (f'{{\n "format": {json.dumps(FORMAT_NAME)},\n "version": {FORMAT_VERSION},\n'
             ' "channels": [\n' + ",\n".join(channels) + "\n ]\n}\n")
+
+
+def _tool_fields(row: ToolRow) -> dict[str, Any]:
+    """A row's fields; name, wear and tool life only where set (older files lack them)."""
+    fields: dict[str, Any] = {"wz": row.wz, "valid": row.valid, "radius_mm": row.radius_mm,
+                              "length_mm": row.length_mm}
+    if row.name:
+        fields["name"] = row.name
+    if row.wear_mm:
+        fields["wear_mm"] = row.wear_mm
+    if row.life_max_s:
+        fields["life_max_s"] = row.life_max_s
+    return fields
 
 
 def _section(key: str, items: list[str]) -> str:
@@ -144,9 +165,17 @@ def _tool(entry: Any, where: str) -> ToolRow:
     valid = entry.get("valid", True)
     if not isinstance(valid, bool):
         raise OperatorDataError(f"{where}.valid: true or false")
+    name = entry.get("name", "")
+    if not isinstance(name, str) or len(name) >= TOOL_NAME_CHARS:  # the STRING's NUL
+        raise OperatorDataError(f"{where}.name: text of at most {TOOL_NAME_CHARS - 1} "
+                                "characters")
+    life = entry.get("life_max_s", 0.0)
+    if isinstance(life, bool) or not isinstance(life, int | float) or not 0 <= life <= LIFE_MAX_S:
+        raise OperatorDataError(f"{where}.life_max_s: seconds in 0..{LIFE_MAX_S:g}, not {life!r}")
     return ToolRow(_int(entry, "wz", where, low=1), valid,
                    _mm(entry.get("radius_mm", 0.0), f"{where}.radius_mm", low=0.0),
-                   _mm(entry.get("length_mm", 0.0), f"{where}.length_mm"))
+                   _mm(entry.get("length_mm", 0.0), f"{where}.length_mm"),
+                   name, _mm(entry.get("wear_mm", 0.0), f"{where}.wear_mm"), float(life))
 
 
 def _group(entry: Any, where: str) -> OffsetGroup:

@@ -130,6 +130,12 @@ MAX_DATA_BYTES = 1 << 20
 #: ADS file service for NC programs). Offsets are ``ProgramStoreOffset``.
 PROGRAM_STORE_GROUP = 0x150000
 
+#: The longest tool life a tool list row takes (s, ``wz[i].life_max``): about 32 years
+#: of cutting (the kernel refuses more, the operator data file too).
+TOOL_LIFE_MAX_S = 1e9
+#: Bytes of a tool's name ``wz[i].name`` (STRING, NUL-terminated: one less character).
+TOOL_NAME_CHARS = 32
+
 #: Largest program the store accepts in one upload (bytes); one frame carries it whole.
 PROGRAM_MAX_BYTES = 1_000_000
 

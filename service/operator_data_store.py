@@ -94,7 +94,8 @@ def _tool_table(rows: Sequence[ToolRow], size: int, channel: int) -> ToolTable:
             raise OperatorDataError(f"channel {channel}: wz[{row.wz}] is beyond the tool "
                                     f"list (1..{size})")
         table[row.wz] = ToolData(row.valid, _value_01um(row.radius_mm),
-                                 _value_01um(row.length_mm))
+                                 _value_01um(row.length_mm), row.name,
+                                 _value_01um(row.wear_mm), row.life_max_s)
     return ToolTable(table, size)
 
 
@@ -120,7 +121,8 @@ def data_of(tables: Sequence[Tables], machine: MachineConfig) -> OperatorData:
     channels = []
     for (tools, zero), cfg in zip(tables, machine.channels, strict=True):
         axes = [a.name.upper() for a in cfg.axes]
-        rows = tuple(ToolRow(i, r.valid, r.radius_mm, r.length_mm)
+        rows = tuple(ToolRow(i, r.valid, r.radius_mm, r.length_mm, r.name,
+                             r.wear_01um / UM01_PER_MM, r.life_max_s)
                      for i, r in sorted(tools.rows.items()))
         groups = tuple(OffsetGroup(g, {a: zero.offset_mm(g, k) for k, a in enumerate(axes)})
                        for g in sorted(zero.offsets_01um))

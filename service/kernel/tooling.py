@@ -14,6 +14,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from cnc_objects.protocol.constants import TOOL_LIFE_MAX_S
+
 from ..machine_config import MachineConfig
 from .commands import Refusal, RefusalReason
 from .nc.modal import ModalState
@@ -86,7 +88,7 @@ def _value_refused(what: str, value_01um: float, low_01um: float) -> Refusal | N
     return None
 
 
-LIFE_MAX_S = 1e9  # the longest tool life accepted (s): about 32 years of cutting
+LIFE_MAX_S = TOOL_LIFE_MAX_S  # the longest tool life accepted (s)
 
 
 @dataclass(frozen=True, slots=True)

@@ -16,7 +16,7 @@ INCR = 10_000  # 0.1 um per mm
 
 def tool_rows(c: Client) -> dict[str, object]:
     return c.read_many(f"ch1.wz[{i}].{f}" for i in range(1, 33)
-                       for f in ("valid", "radius", "laenge"))
+                       for f in ("valid", "radius", "laenge", "name", "wear", "life_max"))
 
 
 def offsets(c: Client) -> dict[str, object]:
@@ -28,17 +28,22 @@ def test_tool_export_and_import_round_trip(service: ServiceProcess, tmp_path: Pa
     e = service.endpoint
     assert cnc("tool", "set", "5", "--radius", "3", "--length", "42", endpoint=e).returncode == 0
     with Client(e, timeout_s=10) as c:
+        c.write("ch1.wz[5].name", "end mill 6")
+        c.write("ch1.wz[5].wear", 0.01 * INCR)
         before = tool_rows(c)
     done = cnc("tool", "export", str(file), endpoint=e)
     assert done.returncode == 0, done.stderr
     document = json.loads(file.read_text())
     [channel] = document["channels"]
-    assert {"wz": 5, "valid": True, "radius_mm": 3.0, "length_mm": 42.0} in channel["tools"]
+    assert {"wz": 5, "valid": True, "radius_mm": 3.0, "length_mm": 42.0,
+            "name": "end mill 6", "wear_mm": 0.01} in channel["tools"]
     assert "zero_offsets" not in channel  # a tools export leaves the offsets alone
     # the operator changes the table: a new row, a row emptied, a length changed
     for args in (("7", "--radius", "1", "--length", "9"), ("2", "--invalid"),
                  ("5", "--length", "40")):
         assert cnc("tool", "set", *args, endpoint=e).returncode == 0
+    with Client(e, timeout_s=10) as c:
+        c.write("ch1.wz[5].name", "renamed")
     imported = cnc("tool", "import", str(file), endpoint=e)
     assert imported.returncode == 0, imported.stderr
     assert "3 rows written" in imported.stdout

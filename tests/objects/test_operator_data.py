@@ -47,6 +47,14 @@ def test_one_row_a_line() -> None:
     assert '{"np_grp": 2, "name": "G55", "offsets_mm": {"X": 100.0}}' in text
 
 
+def test_name_wear_and_life_are_written_where_set_and_read_back() -> None:
+    row = ToolRow(5, True, 3.0, 42.0, "drill 6", 0.02, 600.0)
+    text = dumps(OperatorData((ChannelData(1, (row,)),)))
+    assert ('"wz": 5, "valid": true, "radius_mm": 3.0, "length_mm": 42.0, "name": "drill 6", '
+            '"wear_mm": 0.02, "life_max_s": 600.0}') in text
+    assert loads(text).channels[0].tools == (row,)
+
+
 HEAD = '{"format": "cnc-objects operator data", "version": 1, "channels": '
 
 
@@ -62,6 +70,9 @@ HEAD = '{"format": "cnc-objects operator data", "version": 1, "channels": '
      "channels[0].tools[0].length_mm: a number of mm"),
     (HEAD + '[{"channel": 1, "tools": [{"wz": 1, "length_mm": 1e9}]}]}', "is outside"),
     (HEAD + '[{"channel": 1, "tools": [{"wz": 1}, {"wz": 1}]}]}', "a wz is listed twice"),
+    (HEAD + '[{"channel": 1, "tools": [{"wz": 1, "name": 7}]}]}', "tools[0].name: text of at most 31"),
+    (HEAD + '[{"channel": 1, "tools": [{"wz": 1, "life_max_s": -1}]}]}', "life_max_s: seconds in 0..1e+09"),
+    (HEAD + '[{"channel": 1, "tools": [{"wz": 1, "wear_mm": "x"}]}]}', "wear_mm: a number of mm"),
     (HEAD + '[{"channel": 1, "zero_offsets": [{"np_grp": 1}]}]}', "offsets_mm: an object"),
     (HEAD + '[{"channel": 1, "zero_offsets": [{"np_grp": 1, "offsets_mm": {"X": NaN}}]}]}',
      "offsets_mm.X: a number of mm"),

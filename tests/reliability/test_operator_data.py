@@ -31,18 +31,23 @@ def write_operator_data(c: Client, length_mm: float = 42.0) -> None:
     c.write("ch1.wz[5].radius", 3.0 * INCR)
     c.write("ch1.wz[5].laenge", length_mm * INCR)
     c.write("ch1.wz[5].valid", True)
+    c.write("ch1.wz[5].name", "drill 6")  # the project's fields of the row are kept too
+    c.write("ch1.wz[5].wear", 0.02 * INCR)
+    c.write("ch1.wz[5].life_max", 600.0)
     for axis, mm in G55_MM.items():
         c.write(f"ch1.ax{axis}.np_grp[{G55}].v", mm * INCR)
 
 
 def read_operator_data(c: Client) -> dict[str, object]:
-    names = ["ch1.wz[5].valid", "ch1.wz[5].radius", "ch1.wz[5].laenge",
+    names = ["ch1.wz[5].valid", "ch1.wz[5].radius", "ch1.wz[5].laenge", "ch1.wz[5].name",
+             "ch1.wz[5].wear", "ch1.wz[5].life_max",
              *(f"ch1.ax{a}.np_grp[{G55}].v" for a in G55_MM)]
     return c.read_many(names)
 
 
 EXPECTED = {"ch1.wz[5].valid": True, "ch1.wz[5].radius": 3.0 * INCR,
-            "ch1.wz[5].laenge": 42.0 * INCR,
+            "ch1.wz[5].laenge": 42.0 * INCR, "ch1.wz[5].name": "drill 6",
+            "ch1.wz[5].wear": 0.02 * INCR, "ch1.wz[5].life_max": 600.0,
             **{f"ch1.ax{a}.np_grp[{G55}].v": mm * INCR for a, mm in G55_MM.items()}}
 
 
@@ -87,7 +92,8 @@ def test_tool_length_and_g55_survive_a_restart_and_a_kernel_reset(tmp_path: Path
     assert document["format"] == "cnc-objects operator data"
     channel = document["channels"][0]
     assert channel["channel"] == 1
-    assert {"wz": 5, "valid": True, "radius_mm": 3.0, "length_mm": 42.0} in channel["tools"]
+    assert {"wz": 5, "valid": True, "radius_mm": 3.0, "length_mm": 42.0, "name": "drill 6",
+            "wear_mm": 0.02, "life_max_s": 600.0} in channel["tools"]
     assert {"np_grp": 2, "name": "G55", "offsets_mm": {"X": 100.0, "Y": 50.0, "Z": -10.0}} \
         in channel["zero_offsets"]
 
