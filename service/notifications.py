@@ -17,9 +17,11 @@ wakes the event loop when it is; all sampling and sending happens on the loop, i
 slices of at most ``SAMPLE_SLICE_S`` of loop time (``SamplingPass``): with the
 notification limit used up by one client, another client's request waits one slice, not
 a pass over every subscription.
-A pass samples one cycle: every slice of it pins the snapshot that was the newest when
-the pass began (``Kernel.reading``: every getter on the loop's thread sees it) and reads
-each address once. A sample's data and timestamp thus come from the same cycle however
+A pass samples one cycle, the due one: the kernel keeps each due cycle's published
+snapshot for its pass and runs on (issue 37: the event-speed clock runs in bulk to the
+next due cycle meanwhile); every slice of the pass pins that snapshot
+(``Kernel.reading``: every getter on the loop's thread sees it) and reads each address
+once. A sample's data and timestamp thus come from the same cycle however
 long a read takes and however many cycles the kernel publishes meanwhile; nothing is
 read again. A slice looks at the clock by the bytes it read, not only by the
 subscriptions it took, so a large subscription ends its slice (``SLICE_CHECK_BYTES``).
@@ -95,7 +97,6 @@ SLICE_CHECK_EVERY = 32  # subscriptions sampled between two looks at the clock
 #: range of the PLC memory area reads every symbol in it), so a few large subscriptions
 #: end a slice as many small ones do.
 SLICE_CHECK_BYTES = 2048
-_NEVER = 1 << 64  # a due time no kernel time reaches
 #: Due cycles the kernel keeps for passes not yet begun. While this many wait, the
 #: event-speed clock takes its cycles one by one (the loop is behind); a due cycle beyond
 #: it pushes out the oldest waiting one (the newest values go out, none older).
@@ -144,14 +145,13 @@ class Subscription:
 @dataclass(slots=True)
 class SamplingPass:
     """One pass over the subscriptions, done in slices of loop time: the kernel time it
-    samples for, the snapshot every slice reads (the newest when the pass began), the
-    subscriptions still to look at, the soonest next due time seen, and the reads so
-    far by address (every address is read once per pass)."""
+    samples for, the snapshot every slice reads (that due cycle's, kept by the kernel),
+    the subscriptions still to look at, and the reads so far by address (every address
+    is read once per pass)."""
 
     now_ns: int
     snapshot: Snapshot
     todo: Iterator[Subscription]
-    soonest_ns: int = 1 << 64  # _NEVER
     reads: _Reads = field(default_factory=dict)
 
 
@@ -190,7 +190,6 @@ class NotificationHub:
         self.limits = limits if limits is not None else NotificationLimits()
         self.counts = counts if counts is not None else NotificationCounts()
         self._next_handle = 1
-        self._next_due_ns: int | None = None
         # The due grid, shared with the cycle thread: every due time is a multiple of a
         # subscription's cycle_ns. The loop replaces the tuple (never changes it) when a
         # cycle time comes or goes; ``_period_counts`` counts subscriptions per cycle time.
@@ -301,7 +300,6 @@ class NotificationHub:
         del self._subs[handle]
         self._forget_one(sub)
         self._count()
-        self._update_due()
         return 0, ""
 
     def drop_client(self, envelope: Envelope) -> None:
@@ -316,7 +314,6 @@ class NotificationHub:
             return
         self._count()
         log.info("client gone: dropped %d notifications", len(gone))
-        self._update_due()
 
     def clients(self) -> list[tuple[Envelope, NotifyFn]]:
         """Every client that holds notifications, with the ``notify`` of its front end."""
@@ -401,13 +398,6 @@ class NotificationHub:
             sample = self._take(sub, now_ns, None, force=True)
         assert sample is not None  # forced: a sample whether or not the value changed
         self._emit({(sub.envelope, sub.port): (sub.notify, [sample])})
-        # Only this subscription's due time changed: no need to look at all of them (with
-        # thousands opened back to back that made opening them quadratic).
-        due = self._next_due_ns
-        if due is None or sub.next_due_ns < due:
-            self._next_due_ns = sub.next_due_ns
-        if self._pass is not None:  # the pass in progress sets the due time when done
-            self._pass.soonest_ns = min(self._pass.soonest_ns, sub.next_due_ns)
 
     def _sample(self) -> None:
         """Begin a sampling pass over every subscription for the oldest due cycle the
@@ -456,7 +446,6 @@ class NotificationHub:
         run = self._pass
         assert run is not None
         subs, take, due_ns, reads = self._subs, self._take, run.now_ns, run.reads
-        soonest_ns = run.soonest_ns
         finished = True
         self._read_bytes = 0  # read since the last look at the clock
         with self._pinned(run.snapshot) as now_ns:
@@ -468,17 +457,12 @@ class NotificationHub:
                     if sample is not None:
                         batches.setdefault((sub.envelope, sub.port), (sub.notify, []))[
                             1].append(sample)
-                if sub.next_due_ns < soonest_ns:
-                    soonest_ns = sub.next_due_ns
                 if k % SLICE_CHECK_EVERY and self._read_bytes < SLICE_CHECK_BYTES:
                     continue
                 self._read_bytes = 0
                 if perf_counter() > deadline_s:
                     finished = False
                     break
-        run.soonest_ns = soonest_ns
-        if finished:
-            self._next_due_ns = None if soonest_ns == _NEVER else soonest_ns
         return finished
 
     @contextmanager
@@ -528,8 +512,6 @@ class NotificationHub:
             if samples and not notify(envelope, port, samples):
                 self.dropped += len(samples)
 
-    def _update_due(self) -> None:
-        self._next_due_ns = min((s.next_due_ns for s in self._subs.values()), default=None)
 
 
 def _after(now_ns: int, periods: tuple[int, ...]) -> int | None:
