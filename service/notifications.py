@@ -17,9 +17,11 @@ wakes the event loop when it is; all sampling and sending happens on the loop, i
 slices of at most ``SAMPLE_SLICE_S`` of loop time (``SamplingPass``): with the
 notification limit used up by one client, another client's request waits one slice, not
 a pass over every subscription.
-A pass samples one cycle: every slice of it pins the snapshot that was the newest when
-the pass began (``Kernel.reading``: every getter on the loop's thread sees it) and reads
-each address once. A sample's data and timestamp thus come from the same cycle however
+A pass samples one cycle, the due one: the kernel keeps each due cycle's published
+snapshot for its pass and runs on (issue 37: the event-speed clock runs in bulk to the
+next due cycle meanwhile); every slice of the pass pins that snapshot
+(``Kernel.reading``: every getter on the loop's thread sees it) and reads each address
+once. A sample's data and timestamp thus come from the same cycle however
 long a read takes and however many cycles the kernel publishes meanwhile; nothing is
 read again. A slice looks at the clock by the bytes it read, not only by the
 subscriptions it took, so a large subscription ends its slice (``SLICE_CHECK_BYTES``).
@@ -43,6 +45,8 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import threading
+from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager
 from dataclasses import dataclass, field
@@ -93,7 +97,10 @@ SLICE_CHECK_EVERY = 32  # subscriptions sampled between two looks at the clock
 #: range of the PLC memory area reads every symbol in it), so a few large subscriptions
 #: end a slice as many small ones do.
 SLICE_CHECK_BYTES = 2048
-_NEVER = 1 << 64  # a due time no kernel time reaches
+#: Due cycles the kernel keeps for passes not yet begun. While this many wait, the
+#: event-speed clock takes its cycles one by one (the loop is behind); a due cycle beyond
+#: it pushes out the oldest waiting one (the newest values go out, none older).
+PASSES_PENDING_MAX = 64
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,14 +145,13 @@ class Subscription:
 @dataclass(slots=True)
 class SamplingPass:
     """One pass over the subscriptions, done in slices of loop time: the kernel time it
-    samples for, the snapshot every slice reads (the newest when the pass began), the
-    subscriptions still to look at, the soonest next due time seen, and the reads so
-    far by address (every address is read once per pass)."""
+    samples for, the snapshot every slice reads (that due cycle's, kept by the kernel),
+    the subscriptions still to look at, and the reads so far by address (every address
+    is read once per pass)."""
 
     now_ns: int
     snapshot: Snapshot
     todo: Iterator[Subscription]
-    soonest_ns: int = 1 << 64  # _NEVER
     reads: _Reads = field(default_factory=dict)
 
 
@@ -184,9 +190,22 @@ class NotificationHub:
         self.limits = limits if limits is not None else NotificationLimits()
         self.counts = counts if counts is not None else NotificationCounts()
         self._next_handle = 1
-        self._next_due_ns: int | None = None
+        # The due grid, shared with the cycle thread: every due time is a multiple of a
+        # subscription's cycle_ns. The loop replaces the tuple (never changes it) when a
+        # cycle time comes or goes; ``_period_counts`` counts subscriptions per cycle time.
+        self._periods: tuple[int, ...] = ()
+        self._period_counts: dict[int, int] = {}
+        # cycle thread only: the kernel time of the next due cycle, the grid it was taken
+        # from, and the last cycle seen
+        self._kernel_due_ns: int | None = None
+        self._due_from: tuple[int, ...] = ()
+        self._seen_ns = 0
+        # Due cycles' snapshots the passes still have to sample, oldest first (the kernel
+        # appends, the loop takes), and whether a pass is scheduled or under way: both
+        # under ``_handover``.
+        self._due_snapshots: deque[Snapshot] = deque(maxlen=PASSES_PENDING_MAX)
+        self._handover = threading.Lock()
         self._scheduled = False
-        self._last_snapshot: Snapshot | None = None
         self._pass: SamplingPass | None = None  # the sampling pass in progress
         self._stamp = 0  # FILETIME of the snapshot pinned while sampling
         self._read_bytes = 0  # bytes the slice under way has read (not shared)
@@ -243,6 +262,7 @@ class NotificationHub:
             mode in ON_CHANGE_MODES, max(cycle_ns, self._kernel_cycle_ns), FIRST_SAMPLE_PENDING,
         )
         self._subs[handle] = sub
+        self._count_period(sub.cycle_ns, 1)
         self._per_client[envelope[0]] = mine + 1
         key = envelope[0]
         self._bytes_per_client[key] = self._bytes_per_client.get(key, 0) + length
@@ -280,7 +300,6 @@ class NotificationHub:
         del self._subs[handle]
         self._forget_one(sub)
         self._count()
-        self._update_due()
         return 0, ""
 
     def drop_client(self, envelope: Envelope) -> None:
@@ -295,13 +314,25 @@ class NotificationHub:
             return
         self._count()
         log.info("client gone: dropped %d notifications", len(gone))
-        self._update_due()
 
     def clients(self) -> list[tuple[Envelope, NotifyFn]]:
         """Every client that holds notifications, with the ``notify`` of its front end."""
         return [(envelope, notify) for envelope, (notify, _) in self._envelopes.items()]
 
+    def _count_period(self, cycle_ns: int, change: int) -> None:
+        """Count a subscription of ``cycle_ns`` in (1) or out (-1) of the due grid; the
+        grid the cycle thread reads is replaced when a cycle time comes or goes."""
+        counts = self._period_counts
+        held = counts.get(cycle_ns, 0) + change
+        if held:
+            counts[cycle_ns] = held
+        else:
+            del counts[cycle_ns]
+        if held in (0, 1) and (held == 0 or change > 0):
+            self._periods = tuple(sorted(counts))
+
     def _forget_one(self, sub: Subscription) -> None:
+        self._count_period(sub.cycle_ns, -1)
         envelope = sub.envelope
         notify, count = self._envelopes[envelope]
         if count > 1:
@@ -324,20 +355,41 @@ class NotificationHub:
     # ------------------------------------------------------------ sampling
 
     def kernel_cycle_end(self, snapshot: Snapshot) -> None:
-        """Called by the cycle thread after each cycle: wake the loop when a sample is due."""
-        due = self._next_due_ns
-        if due is not None and snapshot.time_ns >= due and not self._scheduled:
+        """Called by the cycle thread after each published cycle: keep a due cycle's
+        snapshot for its pass and wake the loop (once, while no pass is scheduled). The
+        kernel goes on at once: the pass reads the snapshot kept, whatever the kernel
+        has run meanwhile."""
+        now_ns = self._seen_ns = snapshot.time_ns
+        due = self._kernel_due()
+        if due is None or now_ns < due:
+            return
+        self._kernel_due_ns = _after(now_ns, self._due_from)
+        with self._handover:
+            self._due_snapshots.append(snapshot)
+            if self._scheduled:
+                return
             self._scheduled = True
-            self._last_snapshot = snapshot
-            self._loop.call_soon_threadsafe(self._sample)
+        self._loop.call_soon_threadsafe(self._sample)
 
     def next_observed_ns(self) -> int | None:
         """Kernel time of the next cycle ``kernel_cycle_end`` must see (None: none): the
-        event-speed virtual clock runs the cycles before it in bulk, unpublished. While a
-        pass is scheduled or under way it is now (0): the pass reads the kernel's current
-        snapshot, so the kernel must not run ahead of it in bulk (a subscriber of a value
-        that holds for seconds of a run would otherwise see the run's end only)."""
-        return 0 if self._scheduled else self._next_due_ns
+        event-speed virtual clock runs the cycles before it in bulk, unpublished, also
+        while passes are pending (each reads the snapshot of its own due cycle). Every
+        subscription's due times lie on the grid of its cycle time, so the next due
+        cycle is the grid's next point. Only when ``PASSES_PENDING_MAX`` due cycles wait
+        for the loop is it now (0): the kernel takes single cycles until the loop is
+        back."""
+        if len(self._due_snapshots) >= PASSES_PENDING_MAX:
+            return 0
+        return self._kernel_due()
+
+    def _kernel_due(self) -> int | None:
+        """(cycle thread) The next due kernel time on the current grid."""
+        periods = self._periods
+        if periods is not self._due_from:  # a cycle time came or went: a new grid
+            self._due_from = periods
+            self._kernel_due_ns = _after(self._seen_ns, periods)
+        return self._kernel_due_ns
 
     def _first_sample(self, sub: Subscription) -> None:
         if sub.handle not in self._subs:
@@ -346,36 +398,54 @@ class NotificationHub:
             sample = self._take(sub, now_ns, None, force=True)
         assert sample is not None  # forced: a sample whether or not the value changed
         self._emit({(sub.envelope, sub.port): (sub.notify, [sample])})
-        # Only this subscription's due time changed: no need to look at all of them (with
-        # thousands opened back to back that made opening them quadratic).
-        due = self._next_due_ns
-        if due is None or sub.next_due_ns < due:
-            self._next_due_ns = sub.next_due_ns
-        if self._pass is not None:  # the pass in progress sets the due time when done
-            self._pass.soonest_ns = min(self._pass.soonest_ns, sub.next_due_ns)
 
     def _sample(self) -> None:
-        """Begin a sampling pass over every subscription (the kernel said one is due)."""
-        snapshot = self._last_snapshot
-        if snapshot is None:
-            self._scheduled = False
-            return
-        with self._pin(None) as newest:  # the cycle due, or one published since
-            self._pass = SamplingPass(snapshot.time_ns, newest,
-                                      iter(list(self._subs.values())))
-        self._continue_pass()
+        """Begin a sampling pass over every subscription for the oldest due cycle the
+        kernel kept; when none is left, the next due cycle schedules the next pass."""
+        if self._next_pass():
+            self._continue_pass()
+
+    def _next_pass(self) -> bool:
+        """Begin the pass of the oldest due cycle kept; False (and none scheduled) when
+        none is left."""
+        with self._handover:
+            if not self._due_snapshots:
+                self._scheduled = False
+                return False
+            snapshot = self._due_snapshots.popleft()
+        self._pass = SamplingPass(snapshot.time_ns, snapshot, iter(list(self._subs.values())))
+        return True
 
     def _continue_pass(self) -> None:
         """Sample for at most ``SAMPLE_SLICE_S`` of loop time, send what was taken, and
         come back after the loop has served what waits (requests of other clients go
-        between two slices, however many subscriptions there are). Every slice reads
-        the pass's snapshot: the pass samples one cycle, and reads each address once."""
+        between two slices, however many subscriptions there are). Every pass reads its
+        due cycle's snapshot and each address once. The passes of further due cycles
+        kept go on in the same slice: their samples share the slice's frames (each with
+        its own cycle's timestamp), one frame per client, not one per cycle."""
+        batches: dict[tuple[Envelope, int], tuple[NotifyFn, list[list[Any]]]] = {}
+        deadline_s = perf_counter() + SAMPLE_SLICE_S
+        while True:
+            if not self._slice(batches, deadline_s):
+                self._emit(batches)
+                self._loop.call_soon(self._continue_pass)
+                return
+            self._pass = None
+            if perf_counter() > deadline_s:
+                self._emit(batches)
+                self._loop.call_soon(self._sample)  # the next due cycle kept, if any
+                return
+            if not self._next_pass():
+                self._emit(batches)
+                return
+
+    def _slice(self, batches: dict[tuple[Envelope, int], tuple[NotifyFn, list[list[Any]]]],
+               deadline_s: float) -> bool:
+        """Go on with the pass under way until ``deadline_s``, adding its samples to
+        ``batches``; True when the pass is done."""
         run = self._pass
         assert run is not None
         subs, take, due_ns, reads = self._subs, self._take, run.now_ns, run.reads
-        batches: dict[tuple[Envelope, int], tuple[NotifyFn, list[list[Any]]]] = {}
-        soonest_ns = run.soonest_ns
-        deadline_s = perf_counter() + SAMPLE_SLICE_S
         finished = True
         self._read_bytes = 0  # read since the last look at the clock
         with self._pinned(run.snapshot) as now_ns:
@@ -387,22 +457,13 @@ class NotificationHub:
                     if sample is not None:
                         batches.setdefault((sub.envelope, sub.port), (sub.notify, []))[
                             1].append(sample)
-                if sub.next_due_ns < soonest_ns:
-                    soonest_ns = sub.next_due_ns
                 if k % SLICE_CHECK_EVERY and self._read_bytes < SLICE_CHECK_BYTES:
                     continue
                 self._read_bytes = 0
                 if perf_counter() > deadline_s:
                     finished = False
                     break
-        run.soonest_ns = soonest_ns
-        self._emit(batches)
-        if not finished:
-            self._loop.call_soon(self._continue_pass)
-            return
-        self._pass = None
-        self._next_due_ns = None if soonest_ns == _NEVER else soonest_ns
-        self._scheduled = False  # the next kernel cycle that is due starts the next pass
+        return finished
 
     @contextmanager
     def _pinned(self, snapshot: Snapshot | None) -> Iterator[int]:
@@ -451,5 +512,8 @@ class NotificationHub:
             if samples and not notify(envelope, port, samples):
                 self.dropped += len(samples)
 
-    def _update_due(self) -> None:
-        self._next_due_ns = min((s.next_due_ns for s in self._subs.values()), default=None)
+
+
+def _after(now_ns: int, periods: tuple[int, ...]) -> int | None:
+    """The first kernel time after ``now_ns`` on the grid of ``periods`` (None: empty)."""
+    return min((now_ns - now_ns % p + p for p in periods), default=None)
