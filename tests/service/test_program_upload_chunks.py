@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import struct
+import time
 from pathlib import Path
 
 import pytest
@@ -118,3 +119,39 @@ def test_a_connection_that_ends_mid_upload_leaves_nothing() -> None:
         service.wait_for_log("upload of 'gone.nc' abandoned after 6000 bytes: the connection ended")
         assert leftovers(service.program_dir) == []
         assert not (service.program_dir / "gone.nc").exists()
+
+
+def peak_rss_bytes(pid: int) -> int:
+    """The peak resident memory of process ``pid`` (VmHWM)."""
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmHWM:"):
+            return int(line.split()[1]) * 1024
+    raise AssertionError(f"no VmHWM for process {pid}")
+
+
+def test_a_200_mb_cam_program_lands_whole(tmp_path: Path) -> None:
+    """The size CAM writes: 200 MB of G1 lines, made on the fly, land byte for byte; the
+    service's memory does not grow with the program (chunks go to the file)."""
+    block = g1_program(1_000_000)
+    local = tmp_path / "finish.nc"
+    digest = hashlib.sha256()
+    with local.open("wb") as f:
+        for k in range(200):
+            part = b"(block %d)\n" % k + block
+            f.write(part)
+            digest.update(part)
+    program = local.read_bytes()
+    with serving() as service, Client(service.endpoint) as cnc:
+        before = peak_rss_bytes(service.process.pid)
+        started = time.perf_counter()
+        cnc.upload("finish.nc", program)
+        elapsed_s = time.perf_counter() - started
+        after = peak_rss_bytes(service.process.pid)
+        stored = service.program_dir / "finish.nc"
+        assert stored.stat().st_size == len(program) > 200_000_000
+        with stored.open("rb") as f:
+            assert hashlib.file_digest(f, "sha256").digest() == digest.digest()
+        assert leftovers(service.program_dir) == []
+        print(f"\n200 MB upload: {len(program) / elapsed_s / 1e6:.0f} MB/s, service peak RSS "
+              f"{before / 1e6:.0f} -> {after / 1e6:.0f} MB")
+        assert after - before < 50_000_000  # not the program's 200 MB
