@@ -87,16 +87,16 @@ def test_a_bad_name_is_refused_at_the_open() -> None:
 
 
 def test_an_upload_beyond_the_program_limit_is_abandoned(tmp_path: Path) -> None:
-    with limited_service(tmp_path, program_max_bytes=700_000) as service, \
+    with limited_service(tmp_path, program_max_bytes=2_000_000) as service, \
             Client(service.endpoint) as cnc:
         cnc.upload("p.nc", b"M30\n")
         with pytest.raises(AdsError) as caught:
-            cnc.upload("p.nc", g1_program(800_000))
-        assert caught.value.code == INVALIDSIZE and "at most 700000" in str(caught.value)
+            cnc.upload("p.nc", g1_program(2_500_000))
+        assert caught.value.code == INVALIDSIZE and "at most 2000000" in str(caught.value)
         assert leftovers(service.program_dir) == []
         assert cnc.download("p.nc") == b"M30\n"
-        cnc.upload("q.nc", g1_program(600_000))  # below the limit: in chunks, whole
-        assert (service.program_dir / "q.nc").stat().st_size > 600_000
+        cnc.upload("q.nc", g1_program(1_500_000))  # below the limit: in chunks, whole
+        assert (service.program_dir / "q.nc").stat().st_size > 1_500_000
 
 
 def test_an_upload_beyond_the_store_total_is_abandoned(tmp_path: Path) -> None:
