@@ -6,7 +6,7 @@ loop, no thread). Async generators (``subscribe``) become plain iterators."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from typing import Any
 
 from cnc_objects.protocol.constants import AdsState
@@ -367,11 +367,19 @@ class Client(BlockingClientBase):
         """
         return run_blocking(self._core.trace_run(program, channel, timeout_s))
 
-    def upload(self, name: str, data: bytes) -> None:
+    def upload(
+        self,
+        name: str,
+        data: bytes,
+        progress: Callable[[int, int], None] | None = None,
+    ) -> None:
         """Store ``data`` as ``name``, replacing an older version atomically. A program
-        larger than the store takes is refused here (ADS 0x705): sent, its frame would
-        exceed the wire's limit and the service would drop it without a reply."""
-        return run_blocking(self._core.upload(name, data))
+        larger than one chunk (``UPLOAD_CHUNK_BYTES``) goes in chunks, one frame each,
+        so its size is bounded by the store's ``[limits] program_max_bytes`` only, not by
+        a frame; ``progress(sent_bytes, total_bytes)`` is called after each chunk. A
+        failed chunk abandons the upload on the service (nothing is left behind) and
+        raises its ``AdsError``."""
+        return run_blocking(self._core.upload(name, data, progress))
 
     def wait_mdi(
         self,

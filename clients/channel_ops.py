@@ -16,6 +16,7 @@ RESET clears them (a CNC does not start in ERROR).
 
 from __future__ import annotations
 
+import struct
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, fields
@@ -26,8 +27,8 @@ from cnc_objects.protocol.check_log import check_log_name
 from cnc_objects.protocol.constants import (
     MAX_DATA_BYTES,
     OUTPUT_AREA_GROUP,
-    PROGRAM_MAX_BYTES,
     PROGRAM_STORE_GROUP,
+    UPLOAD_CHUNK_BYTES,
     CncPort,
 )
 from cnc_objects.protocol.constants import OutputAreaOffset as OutOp
@@ -45,7 +46,7 @@ from cnc_objects.protocol.values import (
 from cnc_objects.protocol.wait_reasons import WaitReason, wait_reason_text
 
 from .client_core import MixinBase
-from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError
+from .errors import AdsError, AdsTimeoutError, ChannelError
 from .execution_mode import describe_execution_mode
 from .units import engineering
 
@@ -233,6 +234,9 @@ def parse_check_log(text: str, program: str = "") -> CheckResult:
                        end.group(4).startswith(check_log.STOPPED), int(end.group(3)), left_out)
 
 
+_U64 = struct.Struct("<Q")
+
+
 def _name_bytes(name: str) -> bytes:
     return name.encode(STRING_ENCODING) + b"\x00"
 
@@ -240,14 +244,31 @@ def _name_bytes(name: str) -> bytes:
 class ProgramOps(MixinBase):
     """Upload, list, download and delete programs of the service's store."""
 
-    async def upload(self, name: str, data: bytes) -> None:
+    async def upload(
+        self, name: str, data: bytes, progress: Callable[[int, int], None] | None = None,
+    ) -> None:
         """Store ``data`` as ``name``, replacing an older version atomically. A program
-        larger than the store takes is refused here (ADS 0x705): sent, its frame would
-        exceed the wire's limit and the service would drop it without a reply."""
-        if len(data) > PROGRAM_MAX_BYTES:
-            raise ClientValueError(f"program {name!r} has {len(data):,} bytes; the store "
-                                   f"takes at most {PROGRAM_MAX_BYTES:,}")
-        await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD, _name_bytes(name) + data)
+        larger than one chunk (``UPLOAD_CHUNK_BYTES``) goes in chunks, one frame each,
+        so its size is bounded by the store's ``[limits] program_max_bytes`` only, not by
+        a frame; ``progress(sent_bytes, total_bytes)`` is called after each chunk. A
+        failed chunk abandons the upload on the service (nothing is left behind) and
+        raises its ``AdsError``."""
+        if len(data) <= UPLOAD_CHUNK_BYTES:
+            await self.write_raw(
+                CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD, _name_bytes(name) + data)
+            if progress is not None:
+                progress(len(data), len(data))
+            return
+        await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_OPEN, _name_bytes(name))
+        view = memoryview(data)
+        for start in range(0, len(data), UPLOAD_CHUNK_BYTES):
+            chunk = view[start:start + UPLOAD_CHUNK_BYTES]
+            await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_CHUNK,
+                                 _U64.pack(start) + chunk)
+            if progress is not None:
+                progress(start + len(chunk), len(data))
+        await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_COMMIT,
+                             _U64.pack(len(data)))
 
     async def download(self, name: str) -> bytes:
         """The stored content of ``name``."""

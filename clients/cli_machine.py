@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from cnc_objects.protocol.constants import UPLOAD_CHUNK_BYTES
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from .channel_ops import (
@@ -50,6 +51,7 @@ from .channel_ops import (
     ProgramEntry,
 )
 from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
+from .cli_progress import upload_progress
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
 from .units import tidy
 
@@ -141,7 +143,8 @@ def upload(
         say_error(f"cannot read {file}: {exc.strerror}")
         raise typer.Exit(EXIT_USAGE) from None
     target = name or file.name
-    settings.call(lambda c: c.upload(target, data), f"upload of {target}")
+    with upload_progress(f"upload {target}", len(data), UPLOAD_CHUNK_BYTES) as progress:
+        settings.call(lambda c: c.upload(target, data, progress), f"upload of {target}")
     emit(settings, {"name": target, "size_bytes": len(data), "ok": True},
           f"uploaded {target} ({len(data)} bytes)")
 

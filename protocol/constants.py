@@ -139,6 +139,14 @@ TOOL_NAME_CHARS = 32
 #: Largest program the store accepts in one upload (bytes); one frame carries it whole.
 PROGRAM_MAX_BYTES = 1_000_000
 
+#: Largest program the store takes by default (``[limits] program_max_bytes``): a CAM
+#: finishing program of 200 MB fits; beyond one frame a program goes in chunks.
+PROGRAM_STORE_MAX_BYTES = 256 << 20
+
+#: Bytes the program store holds in all its programs together (``[limits]
+#: store_max_total_bytes``); a chunked upload that would exceed it is abandoned (0x70A).
+STORE_MAX_TOTAL_BYTES = 4 << 30
+
 #: Longest program name (characters): ISG file names are STRING(84) with the NUL.
 PROGRAM_NAME_MAX_CHARS = 83
 
@@ -150,6 +158,16 @@ class ProgramStoreOffset(IntEnum):
     UPLOAD = 2  # Write: name (CP1252), NUL, content; replaces atomically
     DOWNLOAD = 3  # ReadWrite: name in, content out (read length >= size)
     DELETE = 4  # Write: name
+    # A program larger than one frame goes in chunks, one upload per connection at a time
+    # (``service/program_uploads``): the store keeps it in a temporary file until the commit.
+    UPLOAD_OPEN = 5  # Write: name (CP1252), NUL; abandons this connection's earlier upload
+    UPLOAD_CHUNK = 6  # Write: position (u64 LE, = bytes sent so far), then the bytes
+    UPLOAD_COMMIT = 7  # Write: total size (u64 LE); the program replaces the old atomically
+    UPLOAD_ABANDON = 8  # Write: nothing; the temporary file is removed
+
+
+#: Bytes of one chunk of a chunked upload the client sends (``UPLOAD_CHUNK``).
+UPLOAD_CHUNK_BYTES = 256 * 1024
 
 
 #: Index group of the output area on the COM port (project-defined): the files the kernel

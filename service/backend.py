@@ -249,8 +249,10 @@ class Backend:
 
     def connection_ended(self, holder: Hashable, how: str) -> None:
         """A front end's connection ``holder`` is gone: the jog keys it holds are
-        released (``jog_holds``)."""
+        released (``jog_holds``), its program upload in chunks is abandoned."""
         self.jog_holds.ended(holder, how)
+        if self.programs is not None:
+            self.programs.uploads.connection_ended(holder)
 
     def apply_writes(
         self, items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None],

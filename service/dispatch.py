@@ -229,7 +229,7 @@ class Dispatcher:
 
     def _write(self, envelope: Envelope, req: WriteRequest) -> Reply:
         if (programs := self._store(req.port, req.group)) is not None:
-            return self._reply(envelope, req, programs.write(req.offset, req.data))
+            return self._reply(envelope, req, programs.write(req.offset, req.data, envelope[0]))
         if (outputs := self._output_area(req.port, req.group)) is not None:
             return self._reply(envelope, req, outputs.write(req.offset, req.data))
         code, message, writes = self.backend.decode_writes(

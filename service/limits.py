@@ -49,12 +49,13 @@ there is nothing to limit.
 from __future__ import annotations
 
 import msgpack
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field
 
 from cnc_objects.protocol.constants import (
     MAX_DATA_BYTES,
     PROGRAM_MAX_BYTES,
-    PROGRAM_NAME_MAX_CHARS,
+    PROGRAM_STORE_MAX_BYTES,
+    STORE_MAX_TOTAL_BYTES,
 )
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.frames import U32_MAX, encode_error
@@ -67,8 +68,8 @@ from .rate_limit import RateLimiter
 
 #: Room for a request's fields around its data (a Write's header is about 30 bytes).
 FRAME_FIELDS_BYTES = 4096
-#: A program upload's frame: name, NUL and fields around the program.
-_UPLOAD_OVERHEAD_BYTES = PROGRAM_NAME_MAX_CHARS + 1 + 64
+#: The largest store the ``[limits]`` take (bytes): 1 TiB.
+STORE_MAX_TOTAL_BYTES_LIMIT = 1 << 40
 #: Bytes a client's waiting requests may hold (at least two frames of the largest size).
 MAILBOX_BYTES = 16 << 20
 #: How many bytes of a frame are looked at for its invoke id and command.
@@ -154,9 +155,14 @@ class LimitsConfig(BaseModel):
         description="alarms the active list holds; one more clears the oldest (logged)",
     )
     program_max_bytes: int = Field(
-        PROGRAM_MAX_BYTES, ge=1, le=MAX_DATA_BYTES - _UPLOAD_OVERHEAD_BYTES,
-        description="largest program the store takes in one upload (bytes; one frame "
-        "carries it whole); larger: 0x705",
+        PROGRAM_STORE_MAX_BYTES, ge=1, le=STORE_MAX_TOTAL_BYTES_LIMIT,
+        description="largest program the store takes (bytes; a program larger than a frame "
+        "goes in chunks, docs/limits.md); larger: 0x705, the upload is abandoned",
+    )
+    store_max_total_bytes: int = Field(
+        STORE_MAX_TOTAL_BYTES, ge=1, le=STORE_MAX_TOTAL_BYTES_LIMIT,
+        description="bytes all programs of the store hold together, uploads in progress "
+        "included; an upload beyond: 0x70A, the upload is abandoned",
     )
     program_max_files: int = Field(
         1000, ge=1, le=1_000_000,
@@ -212,16 +218,6 @@ class LimitsConfig(BaseModel):
         description="bytes of incomplete frames all ADS connections may hold together; "
         "the connection that would take it over is closed (logged)",
     )
-
-    @model_validator(mode="after")
-    def _upload_fits_a_frame(self) -> LimitsConfig:
-        needed = self.program_max_bytes + _UPLOAD_OVERHEAD_BYTES
-        if self.max_frame_bytes < needed:
-            raise ValueError(
-                f"max_frame_bytes {self.max_frame_bytes} cannot carry an upload of "
-                f"program_max_bytes {self.program_max_bytes}: make it at least {needed}"
-            )
-        return self
 
     @property
     def frame_hard_cap_bytes(self) -> int:

@@ -455,7 +455,8 @@ def _open_store(location: StoreLocation, config: ServiceConfig) -> ProgramStore:
     """The program store at ``location`` (created when absent), announced in the log."""
     try:
         store = ProgramStore(location.path, config.limits.program_max_bytes,
-                             config.limits.program_max_files)
+                             config.limits.program_max_files,
+                             config.limits.store_max_total_bytes)
     except OSError as exc:
         _usage(f"cannot use program directory {location.path}: {exc.strerror}")
     log.info("program store: %s (%s)", store.root, location.source)

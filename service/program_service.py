@@ -9,6 +9,8 @@ an oversized upload or a short read buffer 0x705, a full store 0x70A.
 from __future__ import annotations
 
 import logging
+import struct
+from collections.abc import Hashable
 
 from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.protocol.datatypes import STRING_ENCODING
@@ -16,6 +18,7 @@ from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.file_listing import encode_listing
 
 from .program_store import ProgramStore, StoreError, StoreFault
+from .program_uploads import ProgramUploads
 
 log = logging.getLogger(__name__)
 
@@ -28,7 +31,11 @@ FAULT_CODES: dict[StoreFault, AdsReturnCode] = {
     StoreFault.TOO_LARGE: _E.DEVICE_INVALIDSIZE,
     StoreFault.FULL: _E.DEVICE_NOMEMORY,
     StoreFault.IO: _E.DEVICE_ERROR,
+    StoreFault.OUT_OF_ORDER: _E.DEVICE_INVALIDDATA,
+    StoreFault.NO_UPLOAD: _E.DEVICE_INVALIDSTATE,
 }
+
+_U64 = struct.Struct("<Q")
 
 
 def request_name(data: bytes) -> str:
@@ -49,6 +56,7 @@ class ProgramStoreService:
 
     def __init__(self, store: ProgramStore) -> None:
         self.store = store
+        self.uploads = ProgramUploads(store)
 
     def read(self, offset: int, length: int) -> Result:
         """ADS Read: the program list."""
@@ -59,8 +67,8 @@ class ProgramStoreService:
             return _E.DEVICE_INVALIDSIZE, f"the list has {len(listing)} bytes; read asked {length}"
         return 0, listing
 
-    def write(self, offset: int, data: bytes) -> Result:
-        """ADS Write: upload or delete."""
+    def write(self, offset: int, data: bytes, holder: Hashable = None) -> Result:
+        """ADS Write: upload (whole, or in chunks for connection ``holder``) or delete."""
         try:
             match offset:
                 case Op.UPLOAD:
@@ -71,6 +79,18 @@ class ProgramStoreService:
                     log.info("program %r uploaded (%d bytes)", request_name(name), len(content))
                 case Op.DELETE:
                     self.store.delete(request_name(data))
+                case Op.UPLOAD_OPEN:
+                    self.uploads.open(holder, request_name(data))
+                case Op.UPLOAD_CHUNK:
+                    if len(data) < _U64.size:
+                        return _E.DEVICE_INVALIDSIZE, "a chunk is its position (u64), then bytes"
+                    self.uploads.write(holder, _U64.unpack_from(data)[0], data[_U64.size:])
+                case Op.UPLOAD_COMMIT:
+                    if len(data) != _U64.size:
+                        return _E.DEVICE_INVALIDSIZE, "a commit is the total size (u64)"
+                    self.uploads.commit(holder, _U64.unpack(data)[0])
+                case Op.UPLOAD_ABANDON:
+                    self.uploads.abandon(holder, "the client abandoned it")
                 case _:
                     return _unknown(offset, "take a write")
         except StoreError as exc:

@@ -21,7 +21,11 @@ from dataclasses import dataclass
 from enum import IntEnum
 from pathlib import Path
 
-from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES, PROGRAM_NAME_MAX_CHARS
+from cnc_objects.protocol.constants import (
+    PROGRAM_MAX_BYTES,
+    PROGRAM_NAME_MAX_CHARS,
+    STORE_MAX_TOTAL_BYTES,
+)
 
 _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*")
 _TEMP_PREFIX = ".upload-"
@@ -35,6 +39,8 @@ class StoreFault(IntEnum):
     TOO_LARGE = 3  # the content exceeds the size bound
     FULL = 4  # the store holds its maximum number of files
     IO = 5  # the file system refused
+    OUT_OF_ORDER = 6  # a chunked upload's chunk or total does not follow what arrived
+    NO_UPLOAD = 7  # a chunk or commit without an upload open on the connection
 
 
 class StoreError(Exception):
@@ -90,12 +96,14 @@ class ProgramStore:
     """NC programs in a directory; safe to use from several threads."""
 
     def __init__(
-        self, root: Path, max_bytes: int = PROGRAM_MAX_BYTES, max_files: int = 1000
+        self, root: Path, max_bytes: int = PROGRAM_MAX_BYTES, max_files: int = 1000,
+        max_total_bytes: int = STORE_MAX_TOTAL_BYTES,
     ) -> None:
         self.root = Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
         self.max_bytes = max_bytes
         self.max_files = max_files
+        self.max_total_bytes = max_total_bytes
         self._lock = threading.Lock()  # serialises writers; readers need no lock
 
     def _path(self, name: str) -> Path:
@@ -116,6 +124,21 @@ class ProgramStore:
                     StoreFault.FULL, f"the store holds {self.max_files} files; delete some first"
                 )
             self._replace(name, data)
+
+    def used_bytes(self) -> int:
+        """Bytes the stored programs hold together."""
+        return sum(p.size_bytes for p in self.list())
+
+    def replace_with(self, name: str, temp: Path) -> None:
+        """Make the finished temporary file ``temp`` (in ``root``) the program ``name``,
+        replacing any earlier content atomically (a chunked upload's commit)."""
+        path = self._path(name)
+        with self._lock:
+            if not path.exists() and len(self.list()) >= self.max_files:
+                raise StoreError(
+                    StoreFault.FULL, f"the store holds {self.max_files} files; delete some first"
+                )
+            os.replace(temp, path)
 
     def _replace(self, name: str, data: bytes) -> None:
         path = self._path(name)

@@ -38,7 +38,7 @@ CLASSES = [
 ]
 _ASYNC_ITERATORS = ("AsyncIterator", "AsyncGenerator")
 _TYPING_NAMES = {"Any"}
-_ABC_NAMES = {"Iterable", "Iterator", "Mapping", "Sequence"}
+_ABC_NAMES = {"Callable", "Iterable", "Iterator", "Mapping", "Sequence"}
 _LINE_MAX = 99
 _BASE_NAMES = ("BlockingClientBase", "iterate_blocking", "run_blocking")
 

@@ -6,7 +6,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from cnc_objects.clients import AdsError, ChannelError, Client, ClientValueError
+from cnc_objects.clients import AdsError, ChannelError, Client
 from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES, PROGRAM_STORE_GROUP, CncPort
 from cnc_objects.testing import ServiceProcess, run_program, serving, wait_for
 from tests.clients.test_cli import cnc, json_lines
@@ -49,12 +49,10 @@ def test_bad_names_are_refused_and_change_nothing(c, name, code):
     assert c.programs() == before
 
 
-def test_oversized_upload_is_refused_and_keeps_the_old_version(c):
+def test_a_program_larger_than_a_frame_goes_in_chunks(c):
     c.upload("big.nc", b"M30\n")
-    with pytest.raises(ClientValueError) as info:  # refused before it is sent
-        c.upload("big.nc", b";" * (PROGRAM_MAX_BYTES + 1))
-    assert "the store takes at most" in str(info.value)
-    assert c.download("big.nc") == b"M30\n"
+    c.upload("big.nc", b";" * (PROGRAM_MAX_BYTES + 1))  # in chunks, replacing the old
+    assert ("big.nc", PROGRAM_MAX_BYTES + 1) in [(p.name, p.size_bytes) for p in c.programs()]
 
 
 def test_missing_program_is_not_found(c):

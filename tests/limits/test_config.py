@@ -5,7 +5,7 @@ from __future__ import annotations
 import msgpack
 import pytest
 
-from cnc_objects.protocol.constants import MAX_DATA_BYTES, PROGRAM_MAX_BYTES
+from cnc_objects.protocol.constants import MAX_DATA_BYTES, PROGRAM_STORE_MAX_BYTES
 from cnc_objects.service.config import ConfigError, build_config
 from cnc_objects.service.limits import LimitsConfig, oversized_reply, request_head
 
@@ -16,7 +16,7 @@ def test_every_limit_has_a_default_and_a_description() -> None:
     assert limits.max_frame_bytes == MAX_DATA_BYTES + 4096
     assert limits.frame_hard_cap_bytes == 2 * limits.max_frame_bytes
     assert (limits.notifications_per_client, limits.notifications_total) == (1000, 20_000)
-    assert limits.program_max_bytes == PROGRAM_MAX_BYTES
+    assert limits.program_max_bytes == PROGRAM_STORE_MAX_BYTES >= 200_000_000
     for name, field in LimitsConfig.model_fields.items():
         assert field.description, f"[limits] {name} has no description"
 
@@ -33,8 +33,8 @@ def test_a_limit_is_set_in_the_configuration() -> None:
     ({"notifications_total": 0}, "limits.notifications_total"),
     ({"requests_per_s_per_client": -1}, "limits.requests_per_s_per_client"),
     ({"handles_per_client": 10}, "limits.handles_per_client"),  # handles cost nothing
-    ({"max_frame_bytes": 100_000}, "cannot carry an upload of program_max_bytes"),
-    ({"program_max_bytes": MAX_DATA_BYTES}, "limits.program_max_bytes"),
+    ({"program_max_bytes": 2 << 40}, "limits.program_max_bytes"),
+    ({"store_max_total_bytes": 0}, "limits.store_max_total_bytes"),
 ])
 def test_a_bad_limit_is_refused_naming_the_key(limits: dict, words: str) -> None:
     with pytest.raises(ConfigError) as caught:

@@ -103,7 +103,8 @@ def test_a_reader_never_sees_half_a_file(store):
 
 def test_the_store_has_no_path_for_kernel_writes(store):
     """Only upload and delete change the store: the files the kernel writes go to the
-    output area (service/output_writer.py), so the store offers no append to reach."""
+    output area (service/output_writer.py), so the store offers no append to reach
+    (a chunked upload appends to its own temporary file, ``program_uploads``)."""
     assert [name for name in dir(store) if not name.startswith("_")] == [
-        "delete", "exists", "list", "max_bytes", "max_files", "read", "read_text", "root",
-        "write"]
+        "delete", "exists", "list", "max_bytes", "max_files", "max_total_bytes", "read",
+        "read_text", "replace_with", "root", "used_bytes", "write"]
