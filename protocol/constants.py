@@ -136,7 +136,8 @@ TOOL_LIFE_MAX_S = 1e9
 #: Bytes of a tool's name ``wz[i].name`` (STRING, NUL-terminated: one less character).
 TOOL_NAME_CHARS = 32
 
-#: Largest program the store accepts in one upload (bytes); one frame carries it whole.
+#: Largest file one frame carries whole (bytes): a one-frame upload or download of a
+#: program, one file of the output area; a larger program is uploaded in chunks.
 PROGRAM_MAX_BYTES = 1_000_000
 
 #: Largest program the store takes by default (``[limits] program_max_bytes``): a CAM
