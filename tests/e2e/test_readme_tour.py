@@ -74,7 +74,10 @@ def test_every_file_the_tour_uses_is_in_docs_examples() -> None:
     (("a = 1",), ["a = 1"], True),
     (("a = 1",), ["a = 2"], False),
     (("t = 0.306 s",), ["t = 0.309 s"], True),  # a few cycles later
-    (("t = 0.306 s",), ["t = 0.318 s"], False),
+    (("t = 0.306 s",), ["t = 0.318 s"], True),  # a loaded machine: later, never earlier
+    (("t = 0.306 s",), ["t = 0.299 s"], False),
+    (("t = 0.306 s",), ["t = 0.340 s"], False),
+    (("x = 0.306 mm",), ["x = 0.318 mm"], False),  # only durations come late
     (("n = 306",), ["n = 307"], False),  # whole numbers are exact
     (("name  type",), ["name\ttype"], True),
     (("... #1 x = 5",), ["2026-11-25T10:00:00.000+00:00 #1 x = 5"], True),
