@@ -6,7 +6,7 @@ TwinCAT reads them without a table. One comment per member says what it is.
 
 from __future__ import annotations
 
-from enum import IntEnum
+from enum import IntEnum, IntFlag
 
 
 class AdsCommand(IntEnum):
@@ -101,6 +101,36 @@ class AmsPort(IntEnum):
     """AMS ports beside the CNC tasks that an ADS router answers on."""
 
     SYSTEM_SERVICE = 10000  # the TwinCAT system service: ReadState, ReadDeviceInfo
+
+
+class SystemServiceGroup(IntEnum):
+    """The TwinCAT system service's file functions (index groups at ``AmsPort.SYSTEM_SERVICE``,
+    each an ADS ReadWrite; the index offset is the file handle, or the open flags): what
+    Tc2_System's FB_FileOpen / FB_FileRead / FB_FileWrite / FB_FileClose / FB_FileDelete and
+    AdsLib's ``AdsFile`` send. Served on the program store (``service/ads_file_service``)."""
+
+    FOPEN = 120  # offset: mode | path << 16; write: the file name; read: the handle (u32)
+    FCLOSE = 121  # offset: the handle
+    FREAD = 122  # offset: the handle; read: up to read length bytes (fewer at the end)
+    FWRITE = 123  # offset: the handle; write: the bytes
+    FDELETE = 131  # offset: path << 16; write: the file name
+
+
+class FileOpenMode(IntFlag):
+    """``nMode`` of FB_FileOpen (FOPEN_MODE*), the low 16 bits of an FOPEN's index offset."""
+
+    READ = 0x1  # "r"
+    WRITE = 0x2  # "w": an empty file, replacing an older one
+    APPEND = 0x4  # "a"
+    PLUS = 0x8  # "+": read and write
+    BINARY = 0x10  # "b"
+    TEXT = 0x20  # "t": CR LF translation on Windows
+
+
+#: ``ePath`` of FB_FileOpen (E_OpenPath): the high 16 bits of an FOPEN's index offset.
+#: PATH_GENERIC (1) is the only path served: the program store.
+FILE_PATH_GENERIC = 1
+FILE_PATH_SHIFT = 16
 
 
 class AmsStateFlag(IntEnum):

@@ -40,6 +40,7 @@ from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
 
+from .ads_file_service import FileService
 from .binding import refusal_code
 from .jog_holds import JOG_HOLD_TIMEOUT_S, JogHolds
 from .kernel.commands import Refusal
@@ -104,6 +105,8 @@ class Backend:
         self.kernel = kernel
         self.loop = loop
         self.programs = programs
+        # TwinCAT's file functions (port 10000) on the same store and its uploads
+        self.files = FileService(programs.uploads) if programs is not None else None
         self.outputs = outputs
         self.symbols = symbols
         # jog keys held by their connections (the dead-man, ``jog_holds``)
@@ -249,10 +252,13 @@ class Backend:
 
     def connection_ended(self, holder: Hashable, how: str) -> None:
         """A front end's connection ``holder`` is gone: the jog keys it holds are
-        released (``jog_holds``), its program upload in chunks is abandoned."""
+        released (``jog_holds``), its program upload in chunks is abandoned, the files it
+        opened with FOPEN are closed (a write among them abandoned)."""
         self.jog_holds.ended(holder, how)
         if self.programs is not None:
             self.programs.uploads.connection_ended(holder)
+        if self.files is not None:
+            self.files.connection_ended(holder)
 
     def apply_writes(
         self, items: list[tuple[Entry, Any]], finish: Callable[[list[tuple[int, str]]], None],

@@ -33,6 +33,7 @@ from cnc_objects.protocol.constants import (
     SUM_COMMAND_MAX_ITEMS,
     AdsCommand,
     AdsState,
+    AmsPort,
     CncPort,
 )
 from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
@@ -65,6 +66,7 @@ DEVICE_NAME = "cnc-objects"
 _CONTROLS = {AdsState.RUN: Control.RUN, AdsState.STOP: Control.STOP, AdsState.RESET: Control.RESET}
 _ADMIN = Role.ADMIN
 _READ_WRITE = AdsCommand.READ_WRITE
+_SYSTEM_SERVICE = AmsPort.SYSTEM_SERVICE
 
 Reply = bytes | None
 
@@ -106,6 +108,7 @@ class Dispatcher:
         self.kernel = backend.kernel
         self.programs = backend.programs
         self.outputs = backend.outputs
+        self.files = backend.files
         self.hub = backend.hub
         self._loop = backend.loop
         self._front = front
@@ -298,6 +301,10 @@ class Dispatcher:
             if req.group == RIG.SUM_WRITE and role is not _ADMIN:
                 return self._sum_write(envelope, req, role)
             return handler(envelope, req)
+        if req.port == _SYSTEM_SERVICE and self.files is not None \
+                and self.files.serves(req.group):
+            return self._reply(envelope, req, self.files.read_write(
+                envelope[0], req.group, req.offset, req.data, req.read_length, role))
         if (programs := self._store(req.port, req.group)) is not None:
             return self._reply(
                 envelope, req, programs.read_write(req.offset, req.data, req.read_length)
