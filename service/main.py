@@ -460,6 +460,10 @@ def _open_store(location: StoreLocation, config: ServiceConfig) -> ProgramStore:
     except OSError as exc:
         _usage(f"cannot use program directory {location.path}: {exc.strerror}")
     log.info("program store: %s (%s)", store.root, location.source)
+    removed = store.remove_unfinished_uploads()
+    if removed:
+        log.warning("program store: removed %d unfinished upload(s) a stopped service left",
+                    removed)
     return store
 
 

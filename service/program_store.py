@@ -109,6 +109,19 @@ class ProgramStore:
     def _path(self, name: str) -> Path:
         return self.root / check_name(name)
 
+    def remove_unfinished_uploads(self) -> int:
+        """Remove the temporary files of uploads a stopped service left (killed in the
+        middle of a chunked upload: nothing else would ever remove them, and they count
+        against no limit); how many. Called at start, before any client connects."""
+        removed = 0
+        for temp in self.root.glob(f"{_TEMP_PREFIX}*"):
+            try:
+                temp.unlink()
+                removed += 1
+            except OSError:  # gone meanwhile, or not ours to remove: left alone
+                continue
+        return removed
+
     def write(self, name: str, data: bytes) -> None:
         """Store ``data`` under ``name``, replacing any earlier content atomically."""
         path = self._path(name)

@@ -13,7 +13,7 @@ import pytest
 from cnc_objects.clients import AdsError, Client
 from cnc_objects.protocol.constants import PROGRAM_STORE_GROUP, CncPort
 from cnc_objects.protocol.constants import ProgramStoreOffset as Op
-from cnc_objects.testing import serving
+from cnc_objects.testing import serving, start_service
 from tests.limits.wire import limited_service
 
 INVALIDSIZE, INVALIDDATA, NOMEMORY, INVALIDSTATE = 0x705, 0x706, 0x70A, 0x712
@@ -119,6 +119,25 @@ def test_a_connection_that_ends_mid_upload_leaves_nothing() -> None:
         service.wait_for_log("upload of 'gone.nc' abandoned after 6000 bytes: the connection ended")
         assert leftovers(service.program_dir) == []
         assert not (service.program_dir / "gone.nc").exists()
+
+
+def test_a_service_killed_mid_upload_leaves_a_temporary_file_the_next_one_removes(
+        tmp_path: Path) -> None:
+    store = tmp_path / "programs"
+    killed = start_service(program_dir=store)
+    try:
+        with Client(killed.endpoint) as cnc:
+            raw(cnc, Op.UPLOAD_OPEN, b"cut.nc\x00")
+            raw(cnc, Op.UPLOAD_CHUNK, struct.pack("<Q", 0) + b"G1 X1\n" * 1000)
+            killed.process.kill()  # SIGKILL: no chance to abandon anything
+            killed.process.wait(timeout=10)
+    finally:
+        killed.stop()
+    assert len(leftovers(store)) == 1
+    with serving(program_dir=store) as service:
+        assert leftovers(store) == []
+        assert "removed 1 unfinished upload(s) a stopped service left" in service.log_text
+        assert not (store / "cut.nc").exists()
 
 
 def peak_rss_bytes(pid: int) -> int:
