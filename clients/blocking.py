@@ -103,9 +103,12 @@ class Client(BlockingClientBase):
         """What the service says about the object ``name`` (cached per connection)."""
         return run_blocking(self._core.describe(name))
 
-    def download(self, name: str) -> bytes:
-        """The stored content of ``name``."""
-        return run_blocking(self._core.download(name))
+    def download(self, name: str, progress: Callable[[int, int], None] | None = None) -> bytes:
+        """The stored content of ``name``. A program larger than one frame comes with the
+        system service's file functions (FOPEN, then FREAD frame by frame, FCLOSE: as a
+        TwinCAT client reads a file), so its size is bounded by the store only;
+        ``progress(received_bytes, total_bytes)`` is called after each frame."""
+        return run_blocking(self._core.download(name, progress))
 
     def download_output(self, name: str) -> bytes:
         """The content of output file ``name``, with every write the kernel queued for it

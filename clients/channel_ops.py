@@ -25,11 +25,17 @@ from typing import Any
 from cnc_objects.protocol import check_log
 from cnc_objects.protocol.check_log import check_log_name
 from cnc_objects.protocol.constants import (
+    FILE_PATH_GENERIC,
+    FILE_PATH_SHIFT,
     MAX_DATA_BYTES,
     OUTPUT_AREA_GROUP,
+    PROGRAM_MAX_BYTES,
     PROGRAM_STORE_GROUP,
     UPLOAD_CHUNK_BYTES,
+    AmsPort,
     CncPort,
+    FileOpenMode,
+    SystemServiceGroup,
 )
 from cnc_objects.protocol.constants import OutputAreaOffset as OutOp
 from cnc_objects.protocol.constants import ProgramStoreOffset as Op
@@ -235,6 +241,7 @@ def parse_check_log(text: str, program: str = "") -> CheckResult:
 
 
 _U64 = struct.Struct("<Q")
+_U32 = struct.Struct("<I")
 
 
 def _name_bytes(name: str) -> bytes:
@@ -270,11 +277,53 @@ class ProgramOps(MixinBase):
         await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_COMMIT,
                              _U64.pack(len(data)))
 
-    async def download(self, name: str) -> bytes:
-        """The stored content of ``name``."""
-        return await self.read_write_raw(
-            CncPort.COM, PROGRAM_STORE_GROUP, Op.DOWNLOAD, _name_bytes(name), MAX_DATA_BYTES
-        )
+    async def download(
+        self, name: str, progress: Callable[[int, int], None] | None = None,
+    ) -> bytes:
+        """The stored content of ``name``. A program larger than one frame comes with the
+        system service's file functions (FOPEN, then FREAD frame by frame, FCLOSE: as a
+        TwinCAT client reads a file), so its size is bounded by the store only;
+        ``progress(received_bytes, total_bytes)`` is called after each frame."""
+        try:
+            data = await self.read_write_raw(
+                CncPort.COM, PROGRAM_STORE_GROUP, Op.DOWNLOAD, _name_bytes(name), MAX_DATA_BYTES
+            )
+        except AdsError as exc:
+            if exc.code != AdsReturnCode.DEVICE_INVALIDSIZE:  # larger than one frame
+                raise
+        else:
+            if progress is not None:
+                progress(len(data), len(data))
+            return data
+        return await self._download_in_frames(name, progress)
+
+    async def _download_in_frames(
+        self, name: str, progress: Callable[[int, int], None] | None,
+    ) -> bytes:
+        total_bytes = next((p.size_bytes for p in await self.programs() if p.name == name), 0)
+        opened = await self.read_write_raw(
+            AmsPort.SYSTEM_SERVICE, SystemServiceGroup.FOPEN,
+            FileOpenMode.READ | FileOpenMode.BINARY | FILE_PATH_GENERIC << FILE_PATH_SHIFT,
+            _name_bytes(name), _U32.size)
+        handle = _U32.unpack(opened)[0]
+        parts: list[bytes] = []
+        received = 0
+        try:
+            while True:
+                part = await self.read_write_raw(
+                    AmsPort.SYSTEM_SERVICE, SystemServiceGroup.FREAD, handle, b"",
+                    PROGRAM_MAX_BYTES)
+                if part:
+                    parts.append(part)
+                    received += len(part)
+                    if progress is not None:
+                        progress(received, max(total_bytes, received))
+                if len(part) < PROGRAM_MAX_BYTES:  # the end
+                    break
+        finally:
+            await self.read_write_raw(
+                AmsPort.SYSTEM_SERVICE, SystemServiceGroup.FCLOSE, handle, b"", 0)
+        return b"".join(parts)
 
     async def programs(self) -> list[ProgramEntry]:
         """Every file in the store, sorted by name."""

@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from cnc_objects.protocol.constants import UPLOAD_CHUNK_BYTES
+from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES, UPLOAD_CHUNK_BYTES
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from .channel_ops import (
@@ -51,7 +51,7 @@ from .channel_ops import (
     ProgramEntry,
 )
 from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
-from .cli_progress import upload_progress
+from .cli_progress import download_progress, upload_progress
 from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
 from .units import tidy
 
@@ -158,7 +158,8 @@ def download(
 ) -> None:
     """Download a program of the program store."""
     settings: Settings = ctx.obj
-    data = settings.call(lambda c: c.download(name), f"download of {name}")
+    with download_progress(f"download {name}", PROGRAM_MAX_BYTES) as progress:
+        data = settings.call(lambda c: c.download(name, progress), f"download of {name}")
     save_download(settings, name, data, output)
 
 

@@ -102,10 +102,18 @@ class ProgramStoreService:
         if offset != Op.DOWNLOAD:
             return _unknown(offset, "answer a read-write")
         try:
-            content = self.store.read(request_name(data))
+            name = request_name(data)
+            size_bytes = self.store.size_bytes(name)  # a CAM program is not read to refuse it
+            if size_bytes > read_length:
+                return (
+                    _E.DEVICE_INVALIDSIZE,
+                    f"the program has {size_bytes} bytes; read length was {read_length} (a "
+                    "program larger than one frame is read with FOPEN/FREAD at port 10000)",
+                )
+            content = self.store.read(name)
         except StoreError as exc:
             return FAULT_CODES[exc.fault], str(exc)
-        if len(content) > read_length:
+        if len(content) > read_length:  # grew since: replaced in between
             return (
                 _E.DEVICE_INVALIDSIZE,
                 f"the program has {len(content)} bytes; read length was {read_length}",

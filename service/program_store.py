@@ -174,6 +174,16 @@ class ProgramStore:
         except OSError as exc:
             raise StoreError(StoreFault.IO, f"cannot read {name!r}: {exc.strerror}") from None
 
+    def size_bytes(self, name: str) -> int:
+        """The size of ``name`` in bytes, without reading it."""
+        path = self._path(name)
+        try:
+            return path.stat().st_size
+        except FileNotFoundError:
+            raise StoreError(StoreFault.NOT_FOUND, f"no program {name!r} in the store") from None
+        except OSError as exc:
+            raise StoreError(StoreFault.IO, f"cannot read {name!r}: {exc.strerror}") from None
+
     def read_text(self, name: str) -> str:
         """The content of ``name`` as text: UTF-8, or CP1252 (ISG's encoding) when not."""
         data = self.read(name)

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import hashlib
 import struct
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -54,6 +56,28 @@ def test_a_program_larger_than_a_frame_lands_whole_with_progress() -> None:
         assert seen[-1] == (len(program), len(program)) and len(seen) > 10
         assert [s for s, _ in seen] == sorted(s for s, _ in seen)
         assert leftovers(service.program_dir) == []
+
+
+def test_a_program_larger_than_a_frame_downloads_whole_in_frames(tmp_path: Path) -> None:
+    program = g1_program(2_500_000)  # three frames of FREAD
+    seen: list[tuple[int, int]] = []
+    with serving(program_dir=tmp_path / "programs") as service, \
+            Client(service.endpoint) as cnc:
+        (service.program_dir / "cam.nc").write_bytes(program)
+        (service.program_dir / "small.nc").write_bytes(b"G1 X1\nM30\n")
+        assert cnc.download("cam.nc", lambda got, total: seen.append((got, total))) == program
+        assert seen == [(1_000_000, len(program)), (2_000_000, len(program)),
+                        (len(program), len(program))]
+        assert cnc.download("small.nc") == b"G1 X1\nM30\n"  # one frame, as before
+        with pytest.raises(AdsError) as missing:
+            cnc.download("none.nc")
+        assert missing.value.code == 0x70C
+        done = subprocess.run(
+            [sys.executable, "-c", "from cnc_objects.clients.cli import main; main()",
+             "--endpoint", service.endpoint, "download", "cam.nc", "-o", str(tmp_path / "got.nc")],
+            capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, done.stderr
+        assert (tmp_path / "got.nc").read_bytes() == program
 
 
 def test_a_chunk_out_of_order_or_a_wrong_total_abandons_the_upload() -> None:
