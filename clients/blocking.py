@@ -7,6 +7,7 @@ loop, no thread). Async generators (``subscribe``) become plain iterators."""
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator, Mapping
+from pathlib import Path
 from typing import Any
 
 from cnc_objects.protocol.constants import AdsState
@@ -383,6 +384,17 @@ class Client(BlockingClientBase):
         failed chunk abandons the upload on the service (nothing is left behind) and
         raises its ``AdsError``."""
         return run_blocking(self._core.upload(name, data, progress))
+
+    def upload_file(
+        self,
+        name: str,
+        path: str | Path,
+        progress: Callable[[int, int], None] | None = None,
+    ) -> int:
+        """``upload`` of the file at ``path``, read a chunk at a time: a CAM program of
+        hundreds of MB never lies in this process's memory whole. Returns its size in
+        bytes. A read error of the file abandons the upload (``OSError`` raised)."""
+        return run_blocking(self._core.upload_file(name, path, progress))
 
     def wait_mdi(
         self,

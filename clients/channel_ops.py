@@ -16,10 +16,12 @@ RESET clears them (a CNC does not start in ERROR).
 
 from __future__ import annotations
 
+import os
 import struct
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, fields
+from pathlib import Path
 from typing import Any
 
 from cnc_objects.protocol import check_log
@@ -276,6 +278,34 @@ class ProgramOps(MixinBase):
                 progress(start + len(chunk), len(data))
         await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_COMMIT,
                              _U64.pack(len(data)))
+
+    async def upload_file(
+        self, name: str, path: str | Path,
+        progress: Callable[[int, int], None] | None = None,
+    ) -> int:
+        """``upload`` of the file at ``path``, read a chunk at a time: a CAM program of
+        hundreds of MB never lies in this process's memory whole. Returns its size in
+        bytes. A read error of the file abandons the upload (``OSError`` raised)."""
+        with open(path, "rb") as file:
+            size_bytes = os.fstat(file.fileno()).st_size
+            if size_bytes <= UPLOAD_CHUNK_BYTES:
+                await self.upload(name, file.read(), progress)
+                return size_bytes
+            await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_OPEN,
+                                 _name_bytes(name))
+            sent = 0
+            try:
+                while chunk := file.read(UPLOAD_CHUNK_BYTES):
+                    await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_CHUNK,
+                                         _U64.pack(sent) + chunk)
+                    sent += len(chunk)
+                    if progress is not None:
+                        progress(sent, max(size_bytes, sent))
+            except OSError:
+                await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_ABANDON, b"")
+                raise
+        await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_COMMIT, _U64.pack(sent))
+        return sent
 
     async def download(
         self, name: str, progress: Callable[[int, int], None] | None = None,

@@ -137,16 +137,23 @@ def upload(
 ) -> None:
     """Upload a local NC file into the service's program store."""
     settings: Settings = ctx.obj
-    try:
-        data = file.read_bytes()
+    try:  # read a chunk at a time while it goes (a CAM program of hundreds of MB)
+        size_bytes = file.stat().st_size
+        if not file.is_file():
+            raise IsADirectoryError(21, "Is a directory")
     except OSError as exc:
         say_error(f"cannot read {file}: {exc.strerror}")
         raise typer.Exit(EXIT_USAGE) from None
     target = name or file.name
-    with upload_progress(f"upload {target}", len(data), UPLOAD_CHUNK_BYTES) as progress:
-        settings.call(lambda c: c.upload(target, data, progress), f"upload of {target}")
-    emit(settings, {"name": target, "size_bytes": len(data), "ok": True},
-          f"uploaded {target} ({len(data)} bytes)")
+    with upload_progress(f"upload {target}", size_bytes, UPLOAD_CHUNK_BYTES) as progress:
+        try:
+            sent = settings.call(lambda c: c.upload_file(target, file, progress),
+                                 f"upload of {target}")
+        except OSError as exc:
+            say_error(f"cannot read {file}: {exc.strerror}")
+            raise typer.Exit(EXIT_USAGE) from None
+    emit(settings, {"name": target, "size_bytes": sent, "ok": True},
+          f"uploaded {target} ({sent} bytes)")
 
 
 @command()

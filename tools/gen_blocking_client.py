@@ -171,11 +171,13 @@ def _imports(methods: list[Method], offered: dict[str, dict[str, tuple[str, str]
             else:
                 raise SystemExit(f"{m.module}.{m.name} uses {name}, which {m.module}.py "
                                  "does not define or import")
-    lines = []
-    if abc:
-        lines.append(f"from collections.abc import {', '.join(sorted(abc))}")
     typing.add("Any")
-    lines.append(f"from typing import {', '.join(sorted(typing))}")
+    standard = {m: wanted.pop(m) for m in list(wanted)
+                if m.split(".")[0] in sys.stdlib_module_names}  # isort's first group
+    if abc:
+        standard["collections.abc"] = abc
+    standard["typing"] = typing
+    lines = [_wrap(f"from {m} import ", sorted(standard[m]), "") for m in sorted(standard)]
     absolute = sorted(m for m in wanted if not m.startswith("."))
     relative = sorted(m for m in wanted if m.startswith("."))
     for group in (absolute, relative):

@@ -8,6 +8,7 @@ import struct
 import subprocess
 import sys
 import time
+import tracemalloc
 from pathlib import Path
 
 import pytest
@@ -55,6 +56,28 @@ def test_a_program_larger_than_a_frame_lands_whole_with_progress() -> None:
         assert [(p.name, p.size_bytes) for p in cnc.programs()] == [("cam.nc", len(program))]
         assert seen[-1] == (len(program), len(program)) and len(seen) > 10
         assert [s for s, _ in seen] == sorted(s for s, _ in seen)
+        assert leftovers(service.program_dir) == []
+
+
+def test_a_file_uploads_a_chunk_at_a_time_without_lying_in_memory_whole(tmp_path: Path) -> None:
+    program = g1_program(40_000_000)
+    local = tmp_path / "cam.nc"
+    local.write_bytes(program)
+    seen: list[tuple[int, int]] = []
+    with serving(program_dir=tmp_path / "programs") as service, \
+            Client(service.endpoint) as cnc:
+        tracemalloc.start()
+        try:
+            sent = cnc.upload_file("cam.nc", local, lambda got, total: seen.append((got, total)))
+            peak_bytes = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        assert sent == len(program) and seen[-1] == (len(program), len(program))
+        assert peak_bytes < 4_000_000, peak_bytes  # a few chunks, not 40 MB
+        stored = (service.program_dir / "cam.nc").read_bytes()
+        assert hashlib.sha256(stored).digest() == hashlib.sha256(program).digest()
+        with pytest.raises(IsADirectoryError):
+            cnc.upload_file("dir.nc", tmp_path)
         assert leftovers(service.program_dir) == []
 
 
