@@ -105,12 +105,17 @@ def _call(ads: RawAds, group: int, offset: int, read_length: int, data: bytes) -
     return code, reply.data[8:8 + length]
 
 
+def _handle(ads: RawAds, name: bytes, flags: int) -> int:
+    """FOPEN of ``name``: its handle (the open must succeed)."""
+    code, data = _call(ads, FOPEN, flags, 4, name + b"\x00")
+    assert code == 0, hex(code)
+    return int(struct.unpack("<I", data)[0])
+
+
 def test_handles_belong_to_their_connection_and_bad_ones_are_refused(
         ads: RawAds, ads_service: ServiceProcess) -> None:
     (ads_service.program_dir / "part.nc").write_bytes(b"G1 X1\nM30\n")
-    code, data = _call(ads, FOPEN, MODE_READ | PATH_GENERIC, 4, b"part.nc\x00")
-    assert code == 0
-    handle = struct.unpack("<I", data)[0]
+    handle = _handle(ads, b"part.nc", MODE_READ | PATH_GENERIC)
     assert _call(ads, FREAD, handle, 2_000_000, b"")[0] == 0x705  # more than one frame
     assert _call(ads, FWRITE, handle, 0, b"G0\n")[0] == 0x706  # open for reading
     other = RawAds(ads_service)
@@ -129,9 +134,7 @@ def test_a_connection_closed_in_the_middle_of_a_write_leaves_nothing(
     (ads_service.program_dir / "kept.nc").write_bytes(b"G1 X2\nM30\n")
     connection = RawAds(ads_service)
     try:
-        code, data = _call(connection, FOPEN, MODE_WRITE | PATH_GENERIC, 4, b"kept.nc\x00")
-        assert code == 0
-        handle = struct.unpack("<I", data)[0]
+        handle = _handle(connection, b"kept.nc", MODE_WRITE | PATH_GENERIC)
         assert _call(connection, FWRITE, handle, 0, b"G1 X9\n" * 1000) == (0, b"")
         assert len(leftovers(ads_service.program_dir)) == 1
     finally:
@@ -146,8 +149,7 @@ def test_a_write_beyond_the_store_limit_closes_the_handle_with_nothing_stored(
     with limited_service(tmp_path, ads="127.0.0.1:0", program_max_bytes=100_000) as service:
         connection = RawAds(service)
         try:
-            code, data = _call(connection, FOPEN, MODE_WRITE | PATH_GENERIC, 4, b"huge.nc\x00")
-            handle = struct.unpack("<I", data)[0]
+            handle = _handle(connection, b"huge.nc", MODE_WRITE | PATH_GENERIC)
             chunk = b"G1 X1\n" * 10_000  # 60 000 bytes
             assert _call(connection, FWRITE, handle, 0, chunk) == (0, b"")
             code, message = _call(connection, FWRITE, handle, 0, chunk)
@@ -168,9 +170,7 @@ def test_a_monitor_reads_files_and_may_not_write_or_delete_them(tmp_path: Path) 
         (service.program_dir / "part.nc").write_bytes(b"G1 X1\nM30\n")
         connection = RawAds(service)
         try:
-            code, data = _call(connection, FOPEN, MODE_READ | PATH_GENERIC, 4, b"part.nc\x00")
-            assert code == 0
-            handle = struct.unpack("<I", data)[0]
+            handle = _handle(connection, b"part.nc", MODE_READ | PATH_GENERIC)
             assert _call(connection, FREAD, handle, 64, b"") == (0, b"G1 X1\nM30\n")
             assert _call(connection, FOPEN, MODE_WRITE | PATH_GENERIC, 4, b"new.nc\x00")[0] == 0x704
             assert _call(connection, FDELETE, PATH_GENERIC, 0, b"part.nc\x00")[0] == 0x704
