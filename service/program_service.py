@@ -16,7 +16,13 @@ from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.file_listing import encode_listing
+from cnc_objects.protocol.program_lines import (
+    REPLY_HEADER_BYTES,
+    decode_lines_request,
+    encode_lines_reply,
+)
 
+from .program_line_index import ProgramLines
 from .program_store import ProgramStore, StoreError, StoreFault
 from .program_uploads import ProgramUploads
 
@@ -57,6 +63,7 @@ class ProgramStoreService:
     def __init__(self, store: ProgramStore) -> None:
         self.store = store
         self.uploads = ProgramUploads(store)
+        self.lines = ProgramLines(store)
 
     def read(self, offset: int, length: int) -> Result:
         """ADS Read: the program list."""
@@ -80,7 +87,11 @@ class ProgramStoreService:
                 case Op.DELETE:
                     self.store.delete(request_name(data))
                 case Op.UPLOAD_OPEN:
-                    self.uploads.open(holder, request_name(data))
+                    name, _, announced = data.partition(b"\x00")
+                    if announced and len(announced) != _U64.size:
+                        return _E.DEVICE_INVALIDSIZE, "an open is the name, NUL, [size u64]"
+                    self.uploads.open(holder, request_name(name),
+                                      _U64.unpack(announced)[0] if announced else None)
                 case Op.UPLOAD_CHUNK:
                     if len(data) < _U64.size:
                         return _E.DEVICE_INVALIDSIZE, "a chunk is its position (u64), then bytes"
@@ -98,7 +109,9 @@ class ProgramStoreService:
         return 0, None
 
     def read_write(self, offset: int, data: bytes, read_length: int) -> Result:
-        """ADS ReadWrite: download."""
+        """ADS ReadWrite: download, or a window of a program's lines."""
+        if offset == Op.READ_LINES:
+            return self._read_lines(data, read_length)
         if offset != Op.DOWNLOAD:
             return _unknown(offset, "answer a read-write")
         try:
@@ -111,3 +124,18 @@ class ProgramStoreService:
                 f"the program has {len(content)} bytes; read length was {read_length}",
             )
         return 0, content
+
+    def _read_lines(self, data: bytes, read_length: int) -> Result:
+        """READ_LINES: whole lines from the first asked, as many as the read length holds."""
+        try:
+            request = decode_lines_request(data)
+        except ValueError as exc:
+            return _E.DEVICE_INVALIDDATA, str(exc)
+        if read_length <= REPLY_HEADER_BYTES:
+            return _E.DEVICE_INVALIDSIZE, (f"a lines reply needs more than {REPLY_HEADER_BYTES} "
+                                           f"bytes; read length was {read_length}")
+        try:
+            reply = self.lines.read(request, read_length - REPLY_HEADER_BYTES)
+        except StoreError as exc:
+            return FAULT_CODES[exc.fault], str(exc)
+        return 0, encode_lines_reply(reply)
