@@ -1,12 +1,13 @@
 """Windows of a stored program's lines, read without reading the program (READ_LINES).
 
 A view of a CAM program of hundreds of MB asks for a few hundred lines around the current
-block. Each program gets a line index the first time it is asked: the number of lines
-before each block of ``BLOCK_BYTES`` (one pass over the file, counting newlines; a 200 MB
-program has 200 entries). A window then costs two reads: the block where its first line
-starts (to skip to it), and the window's bytes. An index belongs to one version of the
-file (size, modification time, inode: an upload replaces the file, so a new version gets
-a new index); ``INDEXES_KEPT`` are kept.
+block. Each program has a line index: the number of lines before each block of
+``BLOCK_BYTES`` (a 200 MB program has 200 entries), counted as a chunked upload arrives
+(``LineCounter``), else in one pass over the file the first time the program is asked.
+A window then costs two reads: the block where its first line starts (to skip to it),
+and the window's bytes. An index belongs to one version of the file (size, modification
+time, inode: an upload replaces the file, so a new version gets a new index);
+``INDEXES_KEPT`` are kept.
 """
 
 from __future__ import annotations
@@ -39,18 +40,43 @@ def _version(path: Path) -> tuple[int, int, int]:
     return st.st_size, st.st_mtime_ns, st.st_ino
 
 
+class LineCounter:
+    """Counts the lines of a file fed in pieces of any size, in order (a chunked upload
+    indexes its program as it arrives: the first window needs no pass over the file)."""
+
+    def __init__(self) -> None:
+        self.size_bytes = 0
+        self.newlines = 0
+        self.lines_before: list[int] = []
+        self._last = b"\n"
+
+    def feed(self, data: bytes | memoryview) -> None:
+        """The next ``data`` of the file."""
+        view = memoryview(data)
+        while view:
+            if self.size_bytes % BLOCK_BYTES == 0:
+                self.lines_before.append(self.newlines)
+            room = BLOCK_BYTES - self.size_bytes % BLOCK_BYTES
+            piece = view[:room]
+            self.newlines += bytes(piece).count(b"\n")
+            self.size_bytes += len(piece)
+            self._last = bytes(piece[-1:])
+            view = view[room:]
+
+    def index(self, version: tuple[int, int, int]) -> LineIndex:
+        """The index of the file fed, as version ``version`` of it."""
+        total = self.newlines + (self._last != b"\n")  # a last line without its newline
+        return LineIndex(version, total, tuple(self.lines_before))
+
+
 def build_index(path: Path) -> LineIndex:
     """Count the lines of ``path`` block by block (memory: one block)."""
     version = _version(path)
-    lines_before: list[int] = []
-    newlines, last = 0, b"\n"
+    counter = LineCounter()
     with path.open("rb") as f:
         while block := f.read(BLOCK_BYTES):
-            lines_before.append(newlines)
-            newlines += block.count(b"\n")
-            last = block[-1:]
-    total = newlines + (last != b"\n")  # a last line without its newline counts too
-    return LineIndex(version, total, tuple(lines_before))
+            counter.feed(block)
+    return counter.index(version)
 
 
 def _skip_lines(data: bytes, count: int) -> int:
@@ -83,6 +109,22 @@ class ProgramLines:
         self.store = store
         self._indexes: OrderedDict[str, LineIndex] = OrderedDict()
 
+    def adopt(self, name: str, counter: LineCounter) -> None:
+        """Keep the lines ``counter`` counted as the index of ``name`` as stored now (its
+        upload just committed); nothing when the file is not what was counted."""
+        try:
+            version = _version(self.store.root / check_name(name))
+        except (OSError, StoreError):
+            return
+        if version[0] == counter.size_bytes:
+            self._keep(name, counter.index(version))
+
+    def _keep(self, name: str, index: LineIndex) -> None:
+        self._indexes[name] = index
+        self._indexes.move_to_end(name)
+        while len(self._indexes) > INDEXES_KEPT:
+            self._indexes.popitem(last=False)
+
     def index(self, name: str) -> LineIndex:
         """The line index of the stored program ``name`` as it is now."""
         path = self.store.root / check_name(name)
@@ -91,10 +133,7 @@ class ProgramLines:
             kept = self._indexes.get(name)
             if kept is None or kept.version != version:
                 kept = build_index(path)
-            self._indexes[name] = kept
-            self._indexes.move_to_end(name)
-            while len(self._indexes) > INDEXES_KEPT:
-                self._indexes.popitem(last=False)
+            self._keep(name, kept)
             return kept
         except FileNotFoundError:
             raise StoreError(StoreFault.NOT_FOUND, f"no program {name!r} in the store") from None

@@ -62,8 +62,8 @@ class ProgramStoreService:
 
     def __init__(self, store: ProgramStore) -> None:
         self.store = store
-        self.uploads = ProgramUploads(store)
         self.lines = ProgramLines(store)
+        self.uploads = ProgramUploads(store, self.lines.adopt)
 
     def read(self, offset: int, length: int) -> Result:
         """ADS Read: the program list."""

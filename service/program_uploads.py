@@ -16,11 +16,12 @@ from __future__ import annotations
 import logging
 import os
 import tempfile
-from collections.abc import Hashable
-from dataclasses import dataclass
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO
 
+from .program_line_index import LineCounter
 from .program_store import _TEMP_PREFIX, ProgramStore, StoreError, StoreFault, check_name
 
 log = logging.getLogger(__name__)
@@ -34,13 +35,16 @@ class _Upload:
     temp: Path
     file: BinaryIO
     written_bytes: int = 0
+    lines: LineCounter = field(default_factory=LineCounter)  # the view's index, as it comes
 
 
 class ProgramUploads:
     """The chunked uploads in progress, one per connection (``holder``)."""
 
-    def __init__(self, store: ProgramStore) -> None:
+    def __init__(self, store: ProgramStore,
+                 committed: Callable[[str, LineCounter], None] | None = None) -> None:
         self.store = store
+        self._committed = committed  # told each program committed, with its lines counted
         self._uploads: dict[Hashable, _Upload] = {}
 
     def in_progress_bytes(self) -> int:
@@ -104,6 +108,7 @@ class ProgramUploads:
             try:
                 upload.file.write(data)
                 upload.written_bytes = end
+                upload.lines.feed(data)
                 return
             except OSError as exc:
                 fault = StoreError(StoreFault.IO, f"cannot write {upload.name!r}: {exc.strerror}")
@@ -131,6 +136,8 @@ class ProgramUploads:
             upload.temp.unlink(missing_ok=True)
             raise
         log.info("program %r uploaded in chunks (%d bytes)", upload.name, size_bytes)
+        if self._committed is not None:
+            self._committed(upload.name, upload.lines)
         return upload.name
 
     def abandon(self, holder: Hashable, why: str) -> bool:

@@ -102,3 +102,9 @@ def test_the_index_has_one_entry_per_block(tmp_path: Path) -> None:
     index = program_line_index.build_index(path)
     assert index.total_lines == 1_000_000
     assert index.lines_before == (0, (1 << 20) // 3, (2 << 20) // 3)
+    counter = program_line_index.LineCounter()  # what a chunked upload counts as it comes
+    data = path.read_bytes() + b"M30"  # a last line without its newline
+    for start in range(0, len(data), 262_151):  # pieces across the blocks' bounds
+        counter.feed(data[start:start + 262_151])
+    counted = counter.index(index.version)
+    assert (counted.total_lines, counted.lines_before) == (1_000_001, index.lines_before)
