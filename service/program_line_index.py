@@ -13,6 +13,7 @@ time, inode: an upload replaces the file, so a new version gets a new index);
 from __future__ import annotations
 
 import bisect
+import threading
 from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
@@ -108,6 +109,17 @@ class ProgramLines:
     def __init__(self, store: ProgramStore) -> None:
         self.store = store
         self._indexes: OrderedDict[str, LineIndex] = OrderedDict()
+        self._lock = threading.Lock()  # the loop reads, the indexing thread adds
+
+    def indexed(self, name: str) -> bool:
+        """True when the index of ``name`` as stored now is kept (a window is two reads);
+        False means a pass over the file first (or a request that fails at once)."""
+        with self._lock:
+            kept = self._indexes.get(name)
+        try:
+            return kept is not None and kept.version == _version(self.store.root / name)
+        except OSError:
+            return True  # no such file: answered (refused) at once
 
     def adopt(self, name: str, counter: LineCounter) -> None:
         """Keep the lines ``counter`` counted as the index of ``name`` as stored now (its
@@ -120,17 +132,19 @@ class ProgramLines:
             self._keep(name, counter.index(version))
 
     def _keep(self, name: str, index: LineIndex) -> None:
-        self._indexes[name] = index
-        self._indexes.move_to_end(name)
-        while len(self._indexes) > INDEXES_KEPT:
-            self._indexes.popitem(last=False)
+        with self._lock:
+            self._indexes[name] = index
+            self._indexes.move_to_end(name)
+            while len(self._indexes) > INDEXES_KEPT:
+                self._indexes.popitem(last=False)
 
     def index(self, name: str) -> LineIndex:
         """The line index of the stored program ``name`` as it is now."""
         path = self.store.root / check_name(name)
         try:
             version = _version(path)
-            kept = self._indexes.get(name)
+            with self._lock:
+                kept = self._indexes.get(name)
             if kept is None or kept.version != version:
                 kept = build_index(path)
             self._keep(name, kept)
@@ -158,7 +172,8 @@ class ProgramLines:
                 f.seek(start)
                 data = f.read(room_bytes)
         except (OSError, ValueError) as exc:  # replaced meanwhile: the next request indexes it
-            self._indexes.pop(request.name, None)
+            with self._lock:
+                self._indexes.pop(request.name, None)
             raise StoreError(StoreFault.IO, f"cannot read {request.name!r}: {exc}") from None
         text, count = _whole_lines(data, request.line_count, start + len(data) >= size)
         return LinesReply(index.total_lines, count, text)
