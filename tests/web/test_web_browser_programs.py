@@ -67,3 +67,20 @@ async def test_cancel_leaves_nothing(page: Any, web: WebProcess,
     assert not (realtime_service.program_dir / "long.nc").exists()
     assert await page.is_hidden("#upload")
 
+
+
+async def test_the_window_follows_the_running_program(page: Any, web: WebProcess,
+                                                      tmp_path: Path) -> None:
+    local = tmp_path / "steps.nc"  # 1000 steps of 0.1 mm at 20 mm/s: 5 s, past the window
+    local.write_text("".join(f"N{n} G1 X{n * 0.1:.1f} F1200\n" for n in range(1, 1001)) + "M30\n")
+    await _open(page, web.url, "program")
+    await page.set_input_files("#upload-input", str(local))
+    await page.wait_for_selector("#program-list li.selected[data-name='steps.nc']",
+                                 timeout=WAIT_MS)
+    assert await page.text_content("#lines-shown") == "lines 1–200 of 1001"
+    await page.click("#start-program")
+    # the run leaves lines 1-200: the window moves on and marks the current line in it
+    await page.wait_for_function("""() => {
+        const shown = document.querySelector('#lines-shown').textContent;
+        return !shown.startsWith('lines 1–') && document.querySelector('#program-text li.current');
+    }""", timeout=WAIT_MS)

@@ -31,6 +31,7 @@ const state = {
   programSizes: {},    // program name -> size in bytes (the store's list)
   checkErrors: {},     // line -> error text of the last syntax check of the shown program
   upload: null,        // {id, name, controller, cancelled} of the upload under way
+  followLines: true,   // the window follows the running program's line (until paged by hand)
   planned: null,       // {x: [], y: []} of the planned tool path (machine coordinates)
   planning: null,      // the dry run under way (a Promise), awaited before a start
   live: [],            // [x, y] machine positions of the tool while a program runs
@@ -315,6 +316,7 @@ async function showProgram(name) {
   state.planned = null;
   state.extent = null;
   state.checkErrors = {};
+  state.followLines = true;
   if (!working()) state.live = [];
   $("#program-name").textContent = name;
   for (const item of $("#program-list").children) item.classList.toggle("selected", item.dataset.name === name);
@@ -380,18 +382,22 @@ async function goToLine(first, scrollTo = null) {
   if (scrollTo !== null) $("#program-text").children[scrollTo - state.programWindow.first]?.scrollIntoView({ block: "center" });
 }
 
+// Paging by hand stops the window from following the running program; "current" (or
+// opening a program) makes it follow again.
 const windowFirst = () => (state.programWindow ? state.programWindow.first : 1);
-$("#lines-first").addEventListener("click", () => goToLine(1));
-$("#lines-previous").addEventListener("click", () => goToLine(windowFirst() - WINDOW_LINES));
-$("#lines-next").addEventListener("click", () => goToLine(windowFirst() + WINDOW_LINES));
-$("#lines-last").addEventListener("click", () => goToLine(state.programWindow ? state.programWindow.total : 1));
+const browse = (first, scrollTo = null) => { state.followLines = false; return goToLine(first, scrollTo); };
+$("#lines-first").addEventListener("click", () => browse(1));
+$("#lines-previous").addEventListener("click", () => browse(windowFirst() - WINDOW_LINES));
+$("#lines-next").addEventListener("click", () => browse(windowFirst() + WINDOW_LINES));
+$("#lines-last").addEventListener("click", () => browse(state.programWindow ? state.programWindow.total : 1));
 $("#lines-current").addEventListener("click", () => {
+  state.followLines = true;
   const line = v(`ch${state.channel}.mc_active_line_r`);
   if (line > 0) goToLine(line - WINDOW_LEAD, line);
 });
 $("#lines-goto").addEventListener("change", (event) => {
   const line = Number(event.target.value);
-  if (Number.isInteger(line) && line >= 1) goToLine(line - WINDOW_LEAD, line);
+  if (Number.isInteger(line) && line >= 1) browse(line - WINDOW_LEAD, line);
 });
 // scrolling past either end of the window brings the lines beyond it (half a window on)
 $("#program-text").addEventListener("scroll", (event) => {
@@ -599,7 +605,7 @@ function renderProgramPage() {
     if (item) {
       item.classList.add("current");
       item.scrollIntoView({ block: "nearest" });
-    } else if (line > 0 && working() && !state.windowLoading) {
+    } else if (line > 0 && working() && state.followLines && !state.windowLoading) {
       goToLine(line - WINDOW_LEAD);  // the run left the window: the window follows it
     }
     state.shownLine = item ? line : null;
