@@ -14,7 +14,14 @@ from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.datatypes import DataType
 
 from .alarm_ops import AlarmEvent, AlarmList
-from .channel_ops import ChannelStatus, CheckResult, ContourReply, OnWaitReason, ProgramEntry
+from .channel_ops import (
+    ChannelStatus,
+    CheckResult,
+    ContourReply,
+    OnWaitReason,
+    ProgramEntry,
+    ProgramLines,
+)
 from .client import BlockingClientBase, DeviceInfo, Sample, iterate_blocking, run_blocking
 from .manual_ops import AxisState
 from .object_info import ObjectInfo
@@ -190,6 +197,12 @@ class Client(BlockingClientBase):
         ``errors-ch<c>.log``, ``dec0<c>.sc``, ``prodtime0<c>.csv``, cycle results), sorted
         by name; sizes as they will be once the kernel's queued writes are written."""
         return run_blocking(self._core.outputs())
+
+    def program_lines(self, name: str, first_line: int, line_count: int) -> ProgramLines:
+        """Lines ``first_line``.. (from 1; at most ``line_count``, as many whole lines as
+        ``LINES_READ_BYTES`` hold) of the stored program ``name``, read by the service
+        without reading the whole program (``protocol/program_lines``)."""
+        return run_blocking(self._core.program_lines(name, first_line, line_count))
 
     def programs(self) -> list[ProgramEntry]:
         """Every file in the store, sorted by name."""

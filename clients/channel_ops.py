@@ -44,6 +44,7 @@ from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.file_listing import decode_listing
+from cnc_objects.protocol.program_lines import LinesRequest, decode_lines_reply, encode_lines_request
 from cnc_objects.protocol.values import (
     ChannelMode,
     ChannelState,
@@ -56,6 +57,7 @@ from cnc_objects.protocol.wait_reasons import WaitReason, wait_reason_text
 from .client_core import MixinBase
 from .errors import AdsError, AdsTimeoutError, ChannelError
 from .execution_mode import describe_execution_mode
+from .program_upload import ChunkedUpload
 from .units import engineering
 
 POLL_S = 0.01  # how often waiting re-reads the channel state (wall time)
@@ -250,6 +252,20 @@ def _name_bytes(name: str) -> bytes:
     return name.encode(STRING_ENCODING) + b"\x00"
 
 
+#: Bytes a window of lines may have (``program_lines``): 1000 lines of 250 characters.
+LINES_READ_BYTES = 256 * 1024
+
+
+@dataclass(frozen=True, slots=True)
+class ProgramLines:
+    """A window of a stored program: ``lines`` from ``first_line`` (from 1), without their
+    line ends, and how many lines the program has."""
+
+    first_line: int
+    total_lines: int
+    lines: list[str]
+
+
 class ProgramOps(MixinBase):
     """Upload, list, download and delete programs of the service's store."""
 
@@ -268,16 +284,40 @@ class ProgramOps(MixinBase):
             if progress is not None:
                 progress(len(data), len(data))
             return
-        await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_OPEN, _name_bytes(name))
+        upload = ChunkedUpload(self, name)
+        await upload.open()
         view = memoryview(data)
         for start in range(0, len(data), UPLOAD_CHUNK_BYTES):
-            chunk = view[start:start + UPLOAD_CHUNK_BYTES]
-            await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_CHUNK,
-                                 _U64.pack(start) + chunk)
+            await upload.write(view[start:start + UPLOAD_CHUNK_BYTES])
             if progress is not None:
-                progress(start + len(chunk), len(data))
-        await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_COMMIT,
-                             _U64.pack(len(data)))
+                progress(upload.sent_bytes, len(data))
+        await upload.commit()
+
+    def chunked_upload(self, name: str, size_bytes: int | None = None) -> ChunkedUpload:
+        """An upload of ``name`` to feed piece by piece (``ChunkedUpload``: open, write,
+        commit); ``size_bytes``, when known, lets the service refuse it at the open."""
+        return ChunkedUpload(self, name, size_bytes)
+
+    async def program_lines(self, name: str, first_line: int,
+                            line_count: int) -> ProgramLines:
+        """Lines ``first_line``.. (from 1; at most ``line_count``, as many whole lines as
+        ``LINES_READ_BYTES`` hold) of the stored program ``name``, read by the service
+        without reading the whole program (``protocol/program_lines``)."""
+        raw = await self.read_write_raw(
+            CncPort.COM, PROGRAM_STORE_GROUP, Op.READ_LINES,
+            encode_lines_request(LinesRequest(name, first_line, line_count)), LINES_READ_BYTES)
+        try:
+            reply = decode_lines_reply(raw)
+        except ValueError as exc:
+            raise AdsError(AdsReturnCode.CLIENT_SYNCRESINVALID, str(exc)) from None
+        try:
+            text = reply.data.decode("utf-8")
+        except UnicodeDecodeError:
+            text = reply.data.decode("cp1252", errors="replace")  # ISG's encoding
+        lines = text.split("\n")
+        if lines and lines[-1] == "":
+            lines.pop()  # the newline that ends the last line
+        return ProgramLines(first_line, reply.total_lines, [s.removesuffix("\r") for s in lines])
 
     async def upload_file(
         self, name: str, path: str | Path,
@@ -291,21 +331,17 @@ class ProgramOps(MixinBase):
             if size_bytes <= UPLOAD_CHUNK_BYTES:
                 await self.upload(name, file.read(), progress)
                 return size_bytes
-            await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_OPEN,
-                                 _name_bytes(name))
-            sent = 0
+            upload = ChunkedUpload(self, name, size_bytes)  # refused at once over the limits
+            await upload.open()
             try:
                 while chunk := file.read(UPLOAD_CHUNK_BYTES):
-                    await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_CHUNK,
-                                         _U64.pack(sent) + chunk)
-                    sent += len(chunk)
+                    await upload.write(chunk)
                     if progress is not None:
-                        progress(sent, max(size_bytes, sent))
+                        progress(upload.sent_bytes, max(size_bytes, upload.sent_bytes))
             except OSError:
-                await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_ABANDON, b"")
+                await upload.abandon()
                 raise
-        await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_COMMIT, _U64.pack(sent))
-        return sent
+        return await upload.commit()
 
     async def download(
         self, name: str, progress: Callable[[int, int], None] | None = None,

@@ -191,10 +191,12 @@ class ProgramStoreOffset(IntEnum):
     DELETE = 4  # Write: name
     # A program larger than one frame goes in chunks, one upload per connection at a time
     # (``service/program_uploads``): the store keeps it in a temporary file until the commit.
-    UPLOAD_OPEN = 5  # Write: name (CP1252), NUL; abandons this connection's earlier upload
+    UPLOAD_OPEN = 5  # Write: name (CP1252), NUL[, size u64 LE]; abandons an earlier upload
     UPLOAD_CHUNK = 6  # Write: position (u64 LE, = bytes sent so far), then the bytes
     UPLOAD_COMMIT = 7  # Write: total size (u64 LE); the program replaces the old atomically
     UPLOAD_ABANDON = 8  # Write: nothing; the temporary file is removed
+    # A view of a huge program reads a window of its lines (``protocol/program_lines``).
+    READ_LINES = 9  # ReadWrite: first line, count, name in; total lines, the lines out
 
 
 #: Bytes of one chunk of a chunked upload the client sends (``UPLOAD_CHUNK``).

@@ -306,9 +306,9 @@ class Dispatcher:
             return self._reply(envelope, req, self.files.read_write(
                 envelope[0], req.group, req.offset, req.data, req.read_length, role))
         if (programs := self._store(req.port, req.group)) is not None:
-            return self._reply(
-                envelope, req, programs.read_write(req.offset, req.data, req.read_length)
-            )
+            result = programs.read_write(req.offset, req.data, req.read_length,
+                                         self._answer_later(envelope, req))
+            return None if result is None else self._reply(envelope, req, result)
         if (outputs := self._output_area(req.port, req.group)) is not None:
             return self._output_download(outputs, envelope, req)
         return self._reply(envelope, req, self.backend.read_write_value(
@@ -319,8 +319,14 @@ class Dispatcher:
     ) -> Reply:
         """A download from the output area: now, or once the writer has written what was
         queued for the file (answered then, from the writer thread through the loop)."""
+        result = outputs.read_write(req.offset, req.data, req.read_length,
+                                    self._answer_later(envelope, req))
+        return None if result is None else self._reply(envelope, req, result)
 
-        def answer(result: ValueResult) -> None:  # the writer thread
+    def _answer_later(self, envelope: Envelope, req: Any) -> Callable[[ValueResult], None]:
+        """The callback that answers ``req`` from another thread, through the loop."""
+
+        def answer(result: ValueResult) -> None:  # the writer's or the indexer's thread
             def send() -> None:
                 self._send(envelope, self._reply(envelope, req, result))
             try:
@@ -328,8 +334,7 @@ class Dispatcher:
             except RuntimeError:  # the loop is closed: the service stops
                 pass
 
-        result = outputs.read_write(req.offset, req.data, req.read_length, answer)
-        return None if result is None else self._reply(envelope, req, result)
+        return answer
 
     def _sum_items(
         self, req: ReadWriteRequest, decode: Callable[..., Any]

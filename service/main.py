@@ -252,6 +252,8 @@ async def serve(
         if ads_server is not None:
             ads_server.close()
         server.close()
+        if backend.programs is not None:
+            backend.programs.close()  # an index of a program under way is not waited for
         kernel.on_cycle_end = None
         writer.refuse_new()  # a program in a write loop stops now, its cycle with it
         kernel.close(KERNEL_STOP_S)

@@ -16,11 +16,12 @@ from __future__ import annotations
 import logging
 import os
 import tempfile
-from collections.abc import Hashable
-from dataclasses import dataclass
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO
 
+from .program_line_index import LineCounter
 from .program_store import _TEMP_PREFIX, ProgramStore, StoreError, StoreFault, check_name
 
 log = logging.getLogger(__name__)
@@ -34,28 +35,48 @@ class _Upload:
     temp: Path
     file: BinaryIO
     written_bytes: int = 0
+    lines: LineCounter = field(default_factory=LineCounter)  # the view's index, as it comes
 
 
 class ProgramUploads:
     """The chunked uploads in progress, one per connection (``holder``)."""
 
-    def __init__(self, store: ProgramStore) -> None:
+    def __init__(self, store: ProgramStore,
+                 committed: Callable[[str, LineCounter], None] | None = None) -> None:
         self.store = store
+        self._committed = committed  # told each program committed, with its lines counted
         self._uploads: dict[Hashable, _Upload] = {}
 
     def in_progress_bytes(self) -> int:
         """Bytes the temporary files of all uploads in progress hold."""
         return sum(u.written_bytes for u in self._uploads.values())
 
-    def open(self, holder: Hashable, name: str) -> None:
-        """Start an upload of ``name`` for ``holder`` (an earlier one of it is abandoned)."""
+    def open(self, holder: Hashable, name: str, size_bytes: int | None = None) -> None:
+        """Start an upload of ``name`` for ``holder`` (an earlier one of it is abandoned).
+        ``size_bytes``, when the client says it: a program the limits will not take is
+        refused here, before a byte is sent."""
         check_name(name)
         self.abandon(holder, "a new upload was opened")
+        if size_bytes is not None:
+            self._check_announced(name, size_bytes)
         try:
             fd, temp = tempfile.mkstemp(prefix=_TEMP_PREFIX, dir=self.store.root)
         except OSError as exc:
             raise StoreError(StoreFault.IO, f"cannot start {name!r}: {exc.strerror}") from None
         self._uploads[holder] = _Upload(name, Path(temp), os.fdopen(fd, "wb"))
+
+    def _check_announced(self, name: str, size_bytes: int) -> None:
+        """Refuse an upload of ``size_bytes`` that ``max_bytes`` or the store's room forbid."""
+        if size_bytes > self.store.max_bytes:
+            raise StoreError(StoreFault.TOO_LARGE, (
+                f"program {name!r} has {size_bytes} bytes; the store takes at most "
+                f"{self.store.max_bytes} in one program ([limits] program_max_bytes)"))
+        room = self.store.max_total_bytes - self.store.used_bytes() - self.in_progress_bytes()
+        if size_bytes > room:
+            raise StoreError(StoreFault.FULL, (
+                f"program {name!r} has {size_bytes} bytes; the store has room for {max(room, 0)} "
+                f"more (of {self.store.max_total_bytes}, [limits] store_max_total_bytes); "
+                "delete some programs first"))
 
     def _current(self, holder: Hashable, what: str) -> _Upload:
         upload = self._uploads.get(holder)
@@ -87,6 +108,7 @@ class ProgramUploads:
             try:
                 upload.file.write(data)
                 upload.written_bytes = end
+                upload.lines.feed(data)
                 return
             except OSError as exc:
                 fault = StoreError(StoreFault.IO, f"cannot write {upload.name!r}: {exc.strerror}")
@@ -114,6 +136,8 @@ class ProgramUploads:
             upload.temp.unlink(missing_ok=True)
             raise
         log.info("program %r uploaded in chunks (%d bytes)", upload.name, size_bytes)
+        if self._committed is not None:
+            self._committed(upload.name, upload.lines)
         return upload.name
 
     def abandon(self, holder: Hashable, why: str) -> bool:

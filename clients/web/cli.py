@@ -31,6 +31,7 @@ from .access import Access
 from .connections import HEADER_TIMEOUT_S, MAX_CONNECTIONS, ConnectionLimits, serve
 from .hosts import AllowedHosts
 from .server import ServiceLink, is_loopback, make_app
+from .uploads import IDLE_S
 from .users import DEFAULT_USERS_FILE, UsersFile
 
 EXIT_USAGE = 2
@@ -68,6 +69,9 @@ def run(
     header_timeout: float = typer.Option(
         HEADER_TIMEOUT_S, "--header-timeout", min=0.1, metavar="S", help="Seconds a "
         "connection has to send a request's headers; then it is closed."),
+    upload_idle: float = typer.Option(
+        IDLE_S, "--upload-idle", min=0.1, metavar="S", help="Seconds an upload from a page "
+        "waits for its next slice; then it is abandoned (a tab closed mid-upload)."),
     log_level: str = typer.Option("INFO", "--log-level", help="DEBUG, INFO, WARNING or ERROR."),
     watch_per_page: int = typer.Option(
         watch.NAMES_PER_PAGE, "--watch-per-page", min=1,
@@ -118,8 +122,8 @@ def run(
                if loaded else f"no sign-in (every browser of this machine is {access.open_role.label})")
     print(f"cnc-web: http://{host}:{port} for {endpoint}; {signing}", file=sys.stderr, flush=True)
     link = ServiceLink(endpoint, key_file=key, server_key=server_key)
-    serve(make_app(link, access, AllowedHosts.serving(host, allow_host), budgets), host, port,
-          ConnectionLimits(max_connections, header_timeout))
+    serve(make_app(link, access, AllowedHosts.serving(host, allow_host), budgets, upload_idle),
+          host, port, ConnectionLimits(max_connections, header_timeout))
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -17,13 +17,14 @@ from aiohttp import web
 
 from cnc_objects.clients.client import AsyncClient
 
-from . import api, machine_api
+from . import api, machine_api, program_api
 from .access import ACCESS_KEY, Access, session_middleware, sweep_sessions
 from .budgets import WatchBudgets
 from .connections import connection_middleware
 from .hosts import HOSTS_KEY, AllowedHosts, host_middleware
 from .hub import LiveHub
 from .live import HUB_KEY, SOCKETS_KEY, live
+from .uploads import IDLE_S, WebUploads
 
 STATIC_DIR = Path(__file__).with_name("static")
 
@@ -36,6 +37,11 @@ class ServiceLink:
     timeout_s: float = 2.0
     key_file: str | None = None
     server_key: str | None = None
+
+    def client(self) -> AsyncClient:
+        """A client of the service (not yet connected)."""
+        return AsyncClient(self.endpoint, timeout_s=self.timeout_s, key_file=self.key_file,
+                           server_key=self.server_key)
 
 
 def is_loopback(host: str) -> bool:
@@ -67,9 +73,11 @@ async def stats(request: web.Request) -> web.StreamResponse:
 
 
 def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts,
-             budgets: WatchBudgets | None = None) -> web.Application:
+             budgets: WatchBudgets | None = None,
+             upload_idle_s: float = IDLE_S) -> web.Application:
     """The cnc-web application for the service at ``link``, answering requests addressed
-    to ``hosts`` only (``budgets``: what pages may watch; default ``WatchBudgets()``).
+    to ``hosts`` only (``budgets``: what pages may watch; default ``WatchBudgets()``;
+    ``upload_idle_s``: how long an upload waits for its next slice).
     Each request passes, in order: its connection's guard (the header timer stops), the
     Host/Origin check, the session."""
     app = web.Application(middlewares=[connection_middleware, host_middleware, session_middleware],
@@ -79,15 +87,17 @@ def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts,
     app[SOCKETS_KEY] = [0]
 
     async def service_client(app: web.Application) -> AsyncIterator[None]:
-        client = AsyncClient(link.endpoint, timeout_s=link.timeout_s, key_file=link.key_file,
-                             server_key=link.server_key)
+        client = link.client()
         client.reset_hint = "Reset, beside the MDI line"
         async with client:
             app[api.CLIENT_KEY] = client
             app[HUB_KEY] = LiveHub(client, budgets=budgets)
+            # one service connection per upload: the service takes one upload per connection
+            app[program_api.UPLOADS_KEY] = uploads = WebUploads(link.client, upload_idle_s)
             sweeper = asyncio.create_task(sweep_sessions(access), name="cnc-web session sweep")
             yield
             sweeper.cancel()
+            await uploads.close()
             await app[HUB_KEY].close()
             access.gate.close()
 
@@ -99,4 +109,5 @@ def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts,
     app.router.add_static("/static/", STATIC_DIR)
     api.add_routes(app)
     machine_api.add_routes(app)
+    program_api.add_routes(app)
     return app

@@ -15,6 +15,9 @@ const PAGES = ["machine", "program", "mdi", "tools", "lookahead", "alarms", "obj
 const WORKING_STATES = ["ACTIVE", "HOLD"];
 const MDI_HISTORY_KEY = "cnc-web-mdi-history";
 const MDI_HISTORY_MAX = 30;
+const WINDOW_LINES = 200;           // lines of a program shown at once (fetched by range)
+const WINDOW_LEAD = 50;             // lines shown above the current block when following it
+const PLAN_AUTO_MAX_BYTES = 2 << 20; // larger programs are planned on "Draw path" only
 
 const state = {
   session: null,
@@ -24,7 +27,11 @@ const state = {
   watchErrors: {},     // object name -> why it cannot be watched
   socket: null,
   program: null,       // the program shown on the program page
-  programLines: [],
+  programWindow: null, // {first, lines, total}: the lines shown (a window of the program)
+  programSizes: {},    // program name -> size in bytes (the store's list)
+  checkErrors: {},     // line -> error text of the last syntax check of the shown program
+  upload: null,        // {id, name, controller, cancelled} of the upload under way
+  followLines: true,   // the window follows the running program's line (until paged by hand)
   planned: null,       // {x: [], y: []} of the planned tool path (machine coordinates)
   planning: null,      // the dry run under way (a Promise), awaited before a start
   live: [],            // [x, y] machine positions of the tool while a program runs
@@ -289,8 +296,9 @@ overrideSlider($("#spindle-override"), $("#spindle-override-value"), "mc_spindle
 async function loadPrograms() {
   const data = await api("GET", "/api/programs");
   const list = $("#program-list");
+  state.programSizes = Object.fromEntries(data.programs.map((p) => [p.name, p.size_bytes]));
   list.replaceChildren(...data.programs.map((p) => {
-    const item = el("li", { textContent: `${p.name}  (${p.size_bytes} B)` });
+    const item = el("li", { textContent: `${p.name}  (${sizeText(p.size_bytes)})` });
     item.dataset.name = p.name;
     item.classList.toggle("selected", p.name === state.program);
     item.addEventListener("click", () => showProgram(p.name));
@@ -298,21 +306,111 @@ async function loadPrograms() {
   }));
 }
 
+function sizeText(bytes) {
+  return bytes < 1e6 ? `${bytes} B` : `${(bytes / 1e6).toFixed(1)} MB`;
+}
+
 async function showProgram(name) {
-  const data = await api("GET", `/api/programs/${encodeURIComponent(name)}`);
+  const part = await fetchLines(name, 1);
   state.program = name;
   state.planned = null;
   state.extent = null;
+  state.checkErrors = {};
+  state.followLines = true;
   if (!working()) state.live = [];
   $("#program-name").textContent = name;
   for (const item of $("#program-list").children) item.classList.toggle("selected", item.dataset.name === name);
-  state.programLines = data.text.split("\n");
-  if (state.programLines.length && state.programLines[state.programLines.length - 1] === "") state.programLines.pop();
-  $("#program-text").replaceChildren(...state.programLines.map((text) => el("li", { textContent: text })));
-  state.shownLine = null;
+  showWindow(part);
   drawPath();
+  if ((state.programSizes[name] ?? 0) > PLAN_AUTO_MAX_BYTES) {
+    $("#path-note").textContent = "a large program: Draw path plans it (a dry run)";
+    return;
+  }
   await planShown(name);
 }
+
+// ------------------------------------------------------------------ the program's lines, a window at a time
+// A program of hundreds of MB is never loaded whole: cnc-web reads the lines shown from
+// the service (GET /api/programs/NAME/lines), WINDOW_LINES at a time.
+
+async function fetchLines(name, first) {
+  const data = await api("GET", `/api/programs/${encodeURIComponent(name)}/lines?first=${Math.max(1, first)}&count=${WINDOW_LINES}`);
+  return { first: data.first_line, lines: data.lines, total: data.total_lines };
+}
+
+function showWindow(part) {
+  state.programWindow = part;
+  const list = $("#program-text");
+  list.start = part.first;
+  list.replaceChildren(...part.lines.map((text, k) => {
+    const item = el("li", { textContent: text });
+    const error = state.checkErrors[part.first + k];
+    if (error) {
+      item.classList.add("error");
+      item.append(el("span", { className: "err", textContent: error }));
+    }
+    return item;
+  }));
+  const last = part.first + part.lines.length - 1;
+  $("#lines-shown").textContent = part.lines.length
+    ? `lines ${part.first}–${last} of ${part.total}` : `${part.total} lines`;
+  $("#lines-previous").disabled = $("#lines-first").disabled = part.first <= 1;
+  $("#lines-next").disabled = $("#lines-last").disabled = last >= part.total;
+  state.shownLine = null;
+}
+
+// Show the window that starts at line ``first`` (one request at a time: a newer wish
+// replaces one not yet sent).
+async function goToLine(first, scrollTo = null) {
+  const name = state.program;
+  if (!name || !state.programWindow) return;
+  first = Math.max(1, Math.min(first, state.programWindow.total - WINDOW_LINES + 1));
+  state.wantedFirst = first;
+  if (state.windowLoading) return;
+  state.windowLoading = true;
+  try {
+    while (state.wantedFirst !== null && state.program === name) {
+      const wanted = state.wantedFirst;
+      state.wantedFirst = null;
+      if (wanted === state.programWindow.first) continue;
+      const part = await fetchLines(name, wanted);
+      if (state.program === name) showWindow(part);
+    }
+  } catch (_) { /* shown on the message line */ } finally {
+    state.windowLoading = false;
+  }
+  if (scrollTo !== null) $("#program-text").children[scrollTo - state.programWindow.first]?.scrollIntoView({ block: "center" });
+}
+
+// Paging by hand stops the window from following the running program; "current" (or
+// opening a program) makes it follow again.
+const windowFirst = () => (state.programWindow ? state.programWindow.first : 1);
+const browse = (first, scrollTo = null) => { state.followLines = false; return goToLine(first, scrollTo); };
+$("#lines-first").addEventListener("click", () => browse(1));
+$("#lines-previous").addEventListener("click", () => browse(windowFirst() - WINDOW_LINES));
+$("#lines-next").addEventListener("click", () => browse(windowFirst() + WINDOW_LINES));
+$("#lines-last").addEventListener("click", () => browse(state.programWindow ? state.programWindow.total : 1));
+$("#lines-current").addEventListener("click", () => {
+  state.followLines = true;
+  const line = v(`ch${state.channel}.mc_active_line_r`);
+  if (line > 0) goToLine(line - WINDOW_LEAD, line);
+});
+$("#lines-goto").addEventListener("change", (event) => {
+  const line = Number(event.target.value);
+  if (Number.isInteger(line) && line >= 1) browse(line - WINDOW_LEAD, line);
+});
+// scrolling past either end of the window brings the lines beyond it (half a window on)
+$("#program-text").addEventListener("scroll", (event) => {
+  const list = event.target;
+  const shown = state.programWindow;
+  if (!shown || state.windowLoading) return;
+  const half = WINDOW_LINES / 2;
+  if (list.scrollTop + list.clientHeight >= list.scrollHeight - 2 && shown.first + shown.lines.length - 1 < shown.total) {
+    goToLine(shown.first + half, shown.first + shown.lines.length - 1);
+  } else if (list.scrollTop <= 0 && shown.first > 1) {
+    goToLine(shown.first - half, shown.first);
+  }
+});
 
 // One dry run at a time in the channel: a plan waits for the one before it, and a
 // program no longer shown is not planned at all.
@@ -345,18 +443,64 @@ function setPlanned(trace) {
   drawPath();
 }
 
+// A program goes in slices of the File (never read whole into the page): each slice is
+// one request that cnc-web forwards to the service's chunked upload as it arrives. The
+// bar shows what cnc-web received; Cancel (or a closed tab) abandons the upload.
 async function upload(files) {
   for (const file of files) {
-    const form = new FormData();
-    form.append("file", file, file.name);
     try {
-      const done = await api("POST", "/api/programs", form);
-      say(`uploaded ${done.name} (${done.size_bytes} bytes)`);
-    } catch (_) { return; }
+      await uploadFile(file);
+      say(`uploaded ${file.name} (${sizeText(file.size)})`);
+    } catch (error) {
+      say(state.upload && state.upload.cancelled ? `upload of ${file.name} cancelled` : error.message, true);
+      return;
+    } finally {
+      state.upload = null;
+      $("#upload").hidden = true;
+      $("#upload-input").value = "";
+    }
   }
   await loadPrograms();
   if (files.length) await showProgram(files[files.length - 1].name);
 }
+
+async function uploadFile(file) {
+  if (state.upload) throw new Error(`an upload (${state.upload.name}) is under way: wait for it or cancel it`);
+  state.upload = { id: null, name: file.name, controller: new AbortController(), cancelled: false };
+  const started = performance.now();
+  const progress = (received) => {
+    const s = (performance.now() - started) / 1000;
+    $("#upload-progress").value = file.size ? received / file.size : 1;
+    $("#upload-status").textContent = `${file.name}: ${sizeText(received)} of ${sizeText(file.size)} ` +
+      `(${file.size ? Math.floor(received / file.size * 100) : 100} %)` + (s > 0.5 ? ` · ${(received / 1e6 / s).toFixed(1)} MB/s` : "");
+  };
+  progress(0);
+  $("#upload").hidden = false;
+  const opened = await api("POST", "/api/uploads", { name: file.name, size_bytes: file.size }, true);
+  state.upload.id = opened.upload;
+  let at = 0;
+  while (at < file.size) {
+    const response = await fetch(`/api/uploads/${opened.upload}?at=${at}`, {
+      method: "PUT", body: file.slice(at, at + opened.slice_bytes), credentials: "same-origin",
+      headers: { "X-CSRF-Token": state.session.csrf, "Content-Type": "application/octet-stream" },
+      signal: state.upload.controller.signal,
+    });
+    let data = {};
+    try { data = await response.json(); } catch (_) { data = {}; }
+    if (!response.ok) throw new Error(data.error || `${response.status} ${response.statusText}`);
+    at = data.received_bytes;
+    progress(at);
+  }
+  await api("POST", `/api/uploads/${opened.upload}/commit`, {}, true);
+}
+
+$("#upload-cancel").addEventListener("click", async () => {
+  const running = state.upload;
+  if (!running) return;
+  running.cancelled = true;
+  running.controller.abort();  // a slice on its way is dropped: cnc-web abandons the upload
+  if (running.id) await api("DELETE", `/api/uploads/${running.id}`, undefined, true).catch(() => {});
+});
 
 $("#upload-input").addEventListener("change", (event) => upload([...event.target.files]));
 const drop = $("#drop");
@@ -398,15 +542,12 @@ $("#check-program").addEventListener("click", async () => {
   try {
     say(`checking ${state.program}…`);
     const result = await api("POST", `/api/channel/${state.channel}/check`, { program: state.program });
-    const items = $("#program-text").children;
-    for (const item of items) { item.classList.remove("error"); item.querySelector(".err")?.remove(); }
     const found = result.errors.concat(result.aborted ? [result.aborted] : []);
+    state.checkErrors = {};
     for (const e of found) {
-      const item = e.file === state.program ? items[e.line - 1] : undefined;
-      if (!item) continue;
-      item.classList.add("error");
-      item.append(el("span", { className: "err", textContent: `← error ${e.id} (${e.category}) col ${e.column}: ${e.message}` }));
+      if (e.file === state.program) state.checkErrors[e.line] = `← error ${e.id} (${e.category}) col ${e.column}: ${e.message}`;
     }
+    if (state.programWindow) showWindow(state.programWindow);  // the errors of the lines shown
     say(found.length ? `${state.program}: ${result.error_count} errors in ${result.lines} lines` : `${state.program}: no errors in ${result.lines} lines`, found.length > 0);
   } catch (_) { /* shown */ }
 });
@@ -457,14 +598,17 @@ function renderProgramPage() {
   $("#program-block").textContent = block === undefined || block < 0 ? "-" : `N${block} line ${v(`${c}.mc_active_line_r`)}`;
   const items = $("#program-text").children;
   const line = v(`${c}.mc_active_file_name_r`) === state.program ? v(`${c}.mc_active_line_r`) : null;
+  const first = windowFirst();
   if (line !== state.shownLine) {
-    items[state.shownLine - 1]?.classList.remove("current");
-    const item = items[line - 1];
+    items[state.shownLine - first]?.classList.remove("current");
+    const item = items[line - first];
     if (item) {
       item.classList.add("current");
       item.scrollIntoView({ block: "nearest" });
+    } else if (line > 0 && working() && state.followLines && !state.windowLoading) {
+      goToLine(line - WINDOW_LEAD);  // the run left the window: the window follows it
     }
-    state.shownLine = line;
+    state.shownLine = item ? line : null;
   }
   drawPath();
 }
