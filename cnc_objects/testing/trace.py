@@ -176,12 +176,17 @@ class _Recording:
         self._firsts: list[int] = []
         self._marker_ns = -1  # the newest marker sample's kernel time
         self._marker_seen = asyncio.Event()
+        self.lost = 0  # samples missing between sequence numbers
 
     async def follow(self, client: AsyncClient, index: int, name: str, cycle_ms: int,
                      on_change: bool, first: asyncio.Event, marker: bool) -> None:
         samples = client.subscribe(name, on_change=on_change, cycle_ms=cycle_ms)
+        sequence = 0
         async with contextlib.aclosing(samples):
             async for sample in samples:
+                if sample.sequence != sequence + 1:  # the service drops none: the client did
+                    self.lost += sample.sequence - sequence - 1
+                sequence = sample.sequence
                 kernel_ns = self._kernel_ns(sample.timestamp)
                 if not first.is_set():
                     self._firsts.append(kernel_ns)
@@ -216,6 +221,12 @@ class _Recording:
             await self._marker_seen.wait()
 
     def rows(self, end_ns: int) -> list[TraceRow]:
-        """The rows up to ``end_ns``, by kernel time, then in the order watched."""
+        """The rows up to ``end_ns``, by kernel time, then in the order watched;
+        ``TraceError`` when samples were lost on the way (a gap in a sequence)."""
+        if self.lost:
+            raise TraceError(
+                f"{self.lost} samples did not reach the recorder (gaps in their sequence "
+                "numbers; the client library keeps 1000 per subscription): watch fewer "
+                "objects or with a longer cycle_ms")
         kept = sorted((r for r in self._rows if r[0] <= end_ns), key=lambda r: r[:2])
         return [TraceRow(kernel_ns, name, value) for kernel_ns, _, name, value in kept]
