@@ -10,7 +10,9 @@ dropped because the client did not keep up; ADS frames leave it out) and a times
 The timestamp is wall-clock time as a FILETIME: the instant the kernel cycle that
 produced the value published its snapshot (``Snapshot.wall_ns``). Samples of one cycle
 share it, and it never runs ahead of the wall clock, also not under the virtual clock
-(where kernel time does): kernel time stays readable as ``cnc_kernel_time_r``.
+(where kernel time does): kernel time stays readable as ``cnc_kernel_time_r``. With
+repeatable samples (``[clock] samples = "repeatable"``, docs/kernel.md "Traces that
+repeat") it is the cycle's kernel time instead, and no sample is dropped.
 
 The kernel thread only looks at one number per cycle (when the next sample is due) and
 wakes the event loop when it is; all sampling and sending happens on the loop, in

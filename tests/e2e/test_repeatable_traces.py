@@ -9,6 +9,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import pytest
 import zmq
 
 from cnc_objects.clients import Client
@@ -145,3 +146,26 @@ def _read_until(reader: zmq.Socket[bytes], handle: int, kernel_ns: int) -> list[
             samples.extend(message.samples)
             last = max([last, *(s.timestamp for s in message.samples if s.handle == handle)])
     return samples
+
+
+def test_repeatable_samples_are_refused_on_the_realtime_clock() -> None:
+    """The realtime clock cannot wait for a reader: the service says so and does not
+    start."""
+    with pytest.raises(RuntimeError, match="repeatable samples .* need --clock virtual"):
+        with serving("--clock", "realtime", "--samples", "repeatable"):
+            pass
+
+
+def test_a_bad_samples_key_is_refused_naming_it(tmp_path: Path) -> None:
+    config = tmp_path / "bad.toml"
+    config.write_text('[clock]\nsamples = "every"\n')
+    with pytest.raises(RuntimeError, match=r"clock\.samples"):
+        with serving("--config", str(config)):
+            pass
+
+
+def test_the_configuration_key_selects_repeatable_samples(tmp_path: Path) -> None:
+    config = tmp_path / "repeatable.toml"
+    config.write_text('[clock]\nsamples = "repeatable"\n')
+    with serving("--config", str(config)) as service:
+        assert "repeatable samples" in service.wait_for_log(r"listening on ")
