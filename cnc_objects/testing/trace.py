@@ -35,7 +35,8 @@ from cnc_objects.protocol.values import ChannelState
 #: epoch (``NotificationHub``).
 _KERNEL_EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
 #: The object whose cyclic samples tell the recorder that every sample up to the end has
-#: come: subscribed last, so in a pass it is sampled after every watched object.
+#: come (with a round trip after it): subscribed last, so in a pass it is sampled after
+#: every watched object.
 _MARKER = "cnc_kernel_time_r"
 STEP_CHUNK_CYCLES = 1000  # cycles granted per step on the step clock
 RUN_TIMEOUT_S = 120.0  # wall time for the run and its samples
@@ -113,6 +114,11 @@ class TraceRecorder:
                     end_ns = start_ns + round(program_s * 1e9 / cycle_ns) * cycle_ns
                     await recording.wait_marker(_last_on_grid(end_ns, self._marker_ns(
                         cycle_ns)), start_ns)
+                    # The hub sends a slice's samples in one frame per port: a frame of
+                    # another port with samples up to the marker's may follow its frame.
+                    # A reply goes out after both, and the subscriptions' tasks take what
+                    # came before it before this goes on (their wake-ups are queued first).
+                    await client.read(_MARKER)
                 finally:
                     for task in tasks:
                         task.cancel()
