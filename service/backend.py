@@ -92,6 +92,7 @@ class Backend:
         outputs: OutputService | None = None,
         structs: PlcStructs | None = None,
         jog_hold_timeout_s: float = JOG_HOLD_TIMEOUT_S,
+        repeatable_samples: bool = False,
     ) -> None:
         """``notification_limits``: what notifications may hold (``[limits]``
         notifications_per_client, notifications_total, notification_max_bytes,
@@ -99,7 +100,9 @@ class Backend:
         the hub keeps its counts (the address space serves them); ``outputs``: the
         output area (the files the kernel writes); ``structs``: the HLI's struct and
         array symbols, by name and by handle (none without); ``jog_hold_timeout_s``:
-        a jog key not renewed for this long is released (``jog_holds``)."""
+        a jog key not renewed for this long is released (``jog_holds``);
+        ``repeatable_samples``: the hub samples every due cycle and drops nothing
+        (``[clock] samples = "repeatable"``, ``NotificationHub``)."""
         self.space = space
         self.structs = structs if structs is not None else PlcStructs(AddressSpace())
         self.kernel = kernel
@@ -113,7 +116,7 @@ class Backend:
         self.jog_holds = JogHolds(loop, kernel.submit, jog_hold_timeout_s)
         self.hub = NotificationHub(
             self.read_value, loop, kernel.cycle_ns, kernel.reading,
-            notification_limits, notification_counts,
+            notification_limits, notification_counts, repeatable=repeatable_samples,
         )
 
     # ------------------------------------------------------------ reads

@@ -11,6 +11,7 @@ kernel is handed ``ServiceConfig.machine``, the machine part alone.
 from __future__ import annotations
 
 import tomllib
+from enum import StrEnum
 from pathlib import Path
 from typing import Any
 
@@ -19,8 +20,29 @@ from pydantic import Field, ValidationError
 from .frontend_config import AdsConfig, SecurityConfig
 from .kernel.realtime_priority import DEFAULT_RT_PRIORITY, RT_PRIORITY_MAX
 from .limits import LimitsConfig
-from .machine_config import DEFAULT_MACHINE, MachineConfig
+from .machine_config import DEFAULT_MACHINE, MachineConfig, Strict
 from .param_list import ParamListError, read_axis_list, read_channel_list
+
+
+class SampleMode(StrEnum):
+    """How the notification hub samples subscriptions (``[clock] samples``,
+    ``cnc-service --samples``; docs/kernel.md, "Traces that repeat")."""
+
+    LATEST = "latest"  # the kernel never waits for a reader: a reader far behind misses
+    # the oldest samples (a sequence gap), the newest go out
+    REPEATABLE = "repeatable"  # every due sample goes out: a slow reader slows the kernel;
+    # the virtual clocks stand still while the kernel rests; samples carry kernel time
+
+
+class ClockConfig(Strict):
+    """``[clock]``: how kernel time meets the clients."""
+
+    samples: SampleMode = Field(
+        SampleMode.LATEST, description="latest: the kernel never waits for a reader (a "
+        "reader far behind misses samples); repeatable: every subscription is sampled at "
+        "its due cycles of kernel time and nothing is dropped (a slow reader slows the "
+        "kernel), virtual and step clocks only (docs/kernel.md, Traces that repeat)",
+    )
 
 
 class ServiceConfig(MachineConfig):
@@ -45,6 +67,10 @@ class ServiceConfig(MachineConfig):
         description="realtime clock: SCHED_FIFO priority (1..99) of the cycle thread, with the "
         "service's memory locked, where the process is permitted (root, CAP_SYS_NICE); 0: a "
         "normal thread (docs/kernel.md)",
+    )
+    clock: ClockConfig = Field(
+        default_factory=ClockConfig, description="[clock]: how subscriptions are sampled "
+        "(samples = latest | repeatable)",
     )
     ads: AdsConfig = Field(
         default_factory=AdsConfig, description="the ADS front end ([ads] endpoint, net_id, routes)"

@@ -3,6 +3,7 @@
     cnc-service [--config FILE] [--endpoint URL] [--ads HOST[:PORT]|off] [--ams-net-id ID]
                 [--keys DIR] [--insecure]
                 [--clock realtime|virtual|virtual-step|step] [--speed X] [--cycle-ms MS]
+                [--samples latest|repeatable]
                 [--program-dir DIR | --data-dir DIR] [--output-dir DIR] [--log-level L]
 
 Two front ends over one dispatcher: ZeroMQ (``--endpoint``) and ADS over AMS/TCP
@@ -49,7 +50,7 @@ from .ads_server import AdsTcpServer
 from .ads_symbols import SymbolService
 from .backend import Backend
 from .binding import build_address_space
-from .config import ConfigError, ServiceConfig, load_config
+from .config import ClockConfig, ConfigError, SampleMode, ServiceConfig, load_config
 from .data_location import (
     OPERATOR_DATA_NAME,
     StoreLocation,
@@ -189,11 +190,12 @@ async def serve(
         operator_data = store.root.with_name(f"{store.root.name}-{OPERATOR_DATA_NAME}")
     kept = OperatorDataStore(operator_data, config.machine)
     alarms = AlarmLog(limits.alarm_history_max, limits.alarm_active_max)
+    repeatable = config.clock.samples is SampleMode.REPEATABLE
     kernel = Kernel(
         config.machine, clock, load, exists,
         writer.kernel_file, writer.save, check_max_errors=config.limits.check_max_errors,
         idle_steps_max=limits.decoder_idle_steps_max,
-        alarms=alarms, tables=kept.load(alarms),
+        alarms=alarms, tables=kept.load(alarms), repeatable=repeatable,
     )
     counts = NotificationCounts()  # the hub counts, cnc_notifications_r shows
     space = build_address_space(kernel, counts)
@@ -202,7 +204,8 @@ async def serve(
                       SymbolService(space, structs),
                       notification_limits(limits), counts,
                       outputs=OutputService(writer), structs=structs,
-                      jog_hold_timeout_s=limits.jog_hold_timeout_s)
+                      jog_hold_timeout_s=limits.jog_hold_timeout_s,
+                      repeatable_samples=repeatable)
     kernel.on_cycle_end = _both(backend.hub.kernel_cycle_end,  # one hub serves both front ends
                                 kept.observe)  # the tables, written by a thread of its own
     kernel.next_observed_ns = backend.hub.next_observed_ns  # cycles it must see
@@ -241,9 +244,10 @@ async def serve(
         log.info("CURVE on: server public key %s; allow-list %s (%s)",
                  curve.public_key.decode(), curve.allow_list.origin, curve.allow_list.census())
     log.info(
-        "listening on %s (machine %s, %d channels, %d objects, %s clock, cycle %g ms)",
+        "listening on %s (machine %s, %d channels, %d objects, %s clock, cycle %g ms, "
+        "%s samples)",
         server.endpoint, config.name, len(config.channels), len(space), clock_kind,
-        config.cycle_ms,
+        config.cycle_ms, config.clock.samples,
     )
     try:
         await stop.wait()
@@ -255,6 +259,7 @@ async def serve(
         if backend.programs is not None:
             backend.programs.close()  # an index of a program under way is not waited for
         kernel.on_cycle_end = None
+        backend.hub.close()  # a cycle that waits for a pass (repeatable samples) goes on
         writer.refuse_new()  # a program in a write loop stops now, its cycle with it
         kernel.close(KERNEL_STOP_S)
         writer.close(WRITER_STOP_S)  # what was queued before is written
@@ -315,6 +320,13 @@ def run(
     cycle_ms: float | None = typer.Option(
         None, "--cycle-ms", metavar="MS", help="Cycle time in ms (overrides the configuration).",
     ),
+    samples: SampleMode | None = typer.Option(
+        None, "--samples",
+        help="How subscriptions are sampled: latest (the kernel never waits for a reader) "
+        "or repeatable (every due sample, none dropped: a slow reader slows the kernel; "
+        "virtual and step clocks; default: [clock] samples of the configuration, else "
+        "latest).",
+    ),
     rt_priority: int | None = typer.Option(
         None, "--rt-priority", metavar="N", min=0, max=RT_PRIORITY_MAX,
         help="Realtime clock: SCHED_FIFO priority 1..99 of the cycle thread, with memory "
@@ -371,6 +383,11 @@ def run(
     config = _machine_config(config_file, cycle_ms)
     if rt_priority is not None:  # typer checked the range
         config = config.model_copy(update={"rt_priority": rt_priority})
+    if samples is not None:
+        config = config.model_copy(update={"clock": ClockConfig(samples=samples)})
+    if config.clock.samples is SampleMode.REPEATABLE and clock is ClockKind.REALTIME:
+        _usage("repeatable samples (--samples or [clock] samples) need --clock virtual, "
+               "virtual-step or step: the realtime clock cannot wait for a reader")
     location = program_store_location(
         program_dir, data_dir, config.program_store_dir, config.data_dir
     )

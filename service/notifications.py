@@ -10,7 +10,9 @@ dropped because the client did not keep up; ADS frames leave it out) and a times
 The timestamp is wall-clock time as a FILETIME: the instant the kernel cycle that
 produced the value published its snapshot (``Snapshot.wall_ns``). Samples of one cycle
 share it, and it never runs ahead of the wall clock, also not under the virtual clock
-(where kernel time does): kernel time stays readable as ``cnc_kernel_time_r``.
+(where kernel time does): kernel time stays readable as ``cnc_kernel_time_r``. With
+repeatable samples (``[clock] samples = "repeatable"``, docs/kernel.md "Traces that
+repeat") it is the cycle's kernel time instead, and no sample is dropped.
 
 The kernel thread only looks at one number per cycle (when the next sample is due) and
 wakes the event loop when it is; all sampling and sending happens on the loop, in
@@ -99,8 +101,15 @@ SLICE_CHECK_EVERY = 32  # subscriptions sampled between two looks at the clock
 SLICE_CHECK_BYTES = 2048
 #: Due cycles the kernel keeps for passes not yet begun. While this many wait, the
 #: event-speed clock takes its cycles one by one (the loop is behind); a due cycle beyond
-#: it pushes out the oldest waiting one (the newest values go out, none older).
+#: it pushes out the oldest waiting one (the newest values go out, none older). With
+#: repeatable samples nothing is pushed out: the cycle thread waits for room instead.
 PASSES_PENDING_MAX = 64
+#: Repeatable samples: how often the loop tries again to send the frames a client's
+#: full send queue refused (no front end says per client when it has room again).
+BACKLOG_RETRY_S = 0.001
+#: Repeatable samples: how long the cycle thread waits for room at a time before it
+#: looks again whether the hub was closed.
+ROOM_WAIT_S = 0.1
 
 
 @dataclass(frozen=True, slots=True)
@@ -171,9 +180,16 @@ class NotificationHub:
         pin: PinFn,
         limits: NotificationLimits | None = None,
         counts: NotificationCounts | None = None,
+        repeatable: bool = False,
     ) -> None:
         """``read`` serves an address on the loop, from the snapshot the kernel shows
-        the calling thread; ``pin`` pins a snapshot for a block (``Kernel.reading``)."""
+        the calling thread; ``pin`` pins a snapshot for a block (``Kernel.reading``).
+        ``repeatable`` (``[clock] samples = "repeatable"``): no sample is ever dropped.
+        The cycle thread waits while ``PASSES_PENDING_MAX`` due cycles wait for their
+        passes; a frame a client's send queue refuses is kept and sent again, and no
+        pass begins until it went out (so a slow reader holds the passes, and the
+        passes the kernel); the first sample is taken when the subscription is added;
+        samples carry kernel time, not wall time (docs/kernel.md, Traces that repeat)."""
         self._read = read
         self._pin = pin
         self._loop = loop
@@ -203,9 +219,16 @@ class NotificationHub:
         # Due cycles' snapshots the passes still have to sample, oldest first (the kernel
         # appends, the loop takes), and whether a pass is scheduled or under way: both
         # under ``_handover``.
-        self._due_snapshots: deque[Snapshot] = deque(maxlen=PASSES_PENDING_MAX)
-        self._handover = threading.Lock()
+        self.repeatable = repeatable
+        self._due_snapshots: deque[Snapshot] = deque(
+            maxlen=None if repeatable else PASSES_PENDING_MAX)
+        self._handover = threading.Condition()  # repeatable: the cycle thread waits on it
+        self._closed = False  # ``close``: the cycle thread waits no more
         self._scheduled = False
+        # Repeatable samples: frames a client's send queue refused, in order, with the
+        # timer that tries them again (latest samples: always empty).
+        self._backlog: deque[tuple[Envelope, int, NotifyFn, list[list[Any]]]] = deque()
+        self._retry: asyncio.TimerHandle | None = None
         self._pass: SamplingPass | None = None  # the sampling pass in progress
         self._stamp = 0  # FILETIME of the snapshot pinned while sampling
         self._read_bytes = 0  # bytes the slice under way has read (not shared)
@@ -269,10 +292,13 @@ class NotificationHub:
         held = self._envelopes.get(envelope)
         self._envelopes[envelope] = (notify, 1 if held is None else held[1] + 1)
         self._count()
+        # repeatable: the first sample is the cycle the subscription was added at, not
+        # whatever cycle the kernel has reached when the loop sends it
+        first = self._take_first(sub) if self.repeatable else None
         if first_delay_s > 0:
-            self._loop.call_later(first_delay_s, self._first_sample, sub)
+            self._loop.call_later(first_delay_s, self._first_sample, sub, first)
         else:
-            self._loop.call_soon(self._first_sample, sub)
+            self._loop.call_soon(self._first_sample, sub, first)
         return 0, handle
 
     def _size_refusal(self, envelope: Envelope, length: int) -> tuple[int, str] | None:
@@ -365,6 +391,9 @@ class NotificationHub:
             return
         self._kernel_due_ns = _after(now_ns, self._due_from)
         with self._handover:
+            if self.repeatable:  # nothing is pushed out: wait for the loop to make room
+                while len(self._due_snapshots) >= PASSES_PENDING_MAX and not self._closed:
+                    self._handover.wait(ROOM_WAIT_S)
             self._due_snapshots.append(snapshot)
             if self._scheduled:
                 return
@@ -378,8 +407,9 @@ class NotificationHub:
         subscription's due times lie on the grid of its cycle time, so the next due
         cycle is the grid's next point. Only when ``PASSES_PENDING_MAX`` due cycles wait
         for the loop is it now (0): the kernel takes single cycles until the loop is
-        back."""
-        if len(self._due_snapshots) >= PASSES_PENDING_MAX:
+        back. With repeatable samples the next due cycle is always the event: the cycle
+        thread waits for room in ``kernel_cycle_end`` instead."""
+        if len(self._due_snapshots) >= PASSES_PENDING_MAX and not self.repeatable:
             return 0
         return self._kernel_due()
 
@@ -391,17 +421,27 @@ class NotificationHub:
             self._kernel_due_ns = _after(self._seen_ns, periods)
         return self._kernel_due_ns
 
-    def _first_sample(self, sub: Subscription) -> None:
-        if sub.handle not in self._subs:
-            return
+    def _take_first(self, sub: Subscription) -> list[Any]:
+        """The first sample of ``sub``: its value in the kernel's newest cycle."""
         with self._pinned(None) as now_ns:
             sample = self._take(sub, now_ns, None, force=True)
         assert sample is not None  # forced: a sample whether or not the value changed
+        return sample
+
+    def _first_sample(self, sub: Subscription, sample: list[Any] | None) -> None:
+        if sub.handle not in self._subs:
+            return
+        if sample is None:
+            sample = self._take_first(sub)
         self._emit({(sub.envelope, sub.port): (sub.notify, [sample])})
 
     def _sample(self) -> None:
         """Begin a sampling pass over every subscription for the oldest due cycle the
-        kernel kept; when none is left, the next due cycle schedules the next pass."""
+        kernel kept; when none is left, the next due cycle schedules the next pass.
+        While frames wait in the backlog (repeatable samples) no pass begins: the retry
+        comes back here once they went out."""
+        if self._backlog or self._pass is not None:
+            return
         if self._next_pass():
             self._continue_pass()
 
@@ -413,6 +453,7 @@ class NotificationHub:
                 self._scheduled = False
                 return False
             snapshot = self._due_snapshots.popleft()
+            self._handover.notify()  # repeatable: a cycle thread may wait for the room
         self._pass = SamplingPass(snapshot.time_ns, snapshot, iter(list(self._subs.values())))
         return True
 
@@ -428,7 +469,8 @@ class NotificationHub:
         while True:
             if not self._slice(batches, deadline_s):
                 self._emit(batches)
-                self._loop.call_soon(self._continue_pass)
+                if not self._backlog:  # else the retry goes on once the backlog went out
+                    self._loop.call_soon(self._continue_pass)
                 return
             self._pass = None
             if perf_counter() > deadline_s:
@@ -471,7 +513,8 @@ class NotificationHub:
         every read in it comes from that cycle, and set ``_stamp`` to its FILETIME;
         yields its kernel time."""
         with self._pin(snapshot) as pinned:
-            self._stamp = filetime_from_unix_ns(pinned.wall_ns)
+            self._stamp = filetime_from_unix_ns(
+                pinned.time_ns if self.repeatable else pinned.wall_ns)
             yield pinned.time_ns
 
     def _take(self, sub: Subscription, now_ns: int, reads: _Reads | None,
@@ -506,11 +549,54 @@ class NotificationHub:
         return hit
 
     def _emit(self, batches: dict[tuple[Envelope, int], tuple[NotifyFn, list[list[Any]]]]) -> None:
-        """One frame per client and port with all its samples of this cycle."""
+        """One frame per client and port with all its samples of this cycle. With
+        repeatable samples a frame that is not delivered waits in the backlog, and so do
+        all after it, until the retry sends them."""
+        backlog = self._backlog
         for (envelope, port), (notify, samples) in batches.items():
             samples = [s for s in samples if s is not None]
-            if samples and not notify(envelope, port, samples):
-                self.dropped += len(samples)
+            if not samples:
+                continue
+            if backlog:  # repeatable: behind the frames that wait, in order
+                backlog.append((envelope, port, notify, samples))
+            elif not notify(envelope, port, samples):
+                if self.repeatable:
+                    backlog.append((envelope, port, notify, samples))
+                    self._retry_later()
+                else:
+                    self.dropped += len(samples)
+
+    def _retry_later(self) -> None:
+        if self._retry is None and not self._closed:
+            self._retry = self._loop.call_later(BACKLOG_RETRY_S, self._send_backlog)
+
+    def _send_backlog(self) -> None:
+        """Send the frames that wait, oldest first, until one is refused again (then try
+        later); when all went out, the passes go on where they stopped. Frames of a
+        client that is gone are forgotten."""
+        self._retry = None
+        backlog = self._backlog
+        while backlog:
+            envelope, port, notify, samples = backlog[0]
+            if envelope in self._envelopes and not notify(envelope, port, samples):
+                if envelope in self._envelopes:  # refused, not gone: later
+                    self._retry_later()
+                    return
+            backlog.popleft()
+        if self._pass is not None:
+            self._continue_pass()
+        else:
+            self._sample()
+
+    def close(self) -> None:
+        """The service stops: a cycle thread that waits for room goes on, and nothing is
+        tried again."""
+        with self._handover:
+            self._closed = True
+            self._handover.notify_all()
+        if self._retry is not None:
+            self._retry.cancel()
+            self._retry = None
 
 
 

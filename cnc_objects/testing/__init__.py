@@ -13,6 +13,9 @@ Fixtures:
 - ``cnc_async_client``: an ``AsyncClient`` connected to ``cnc_service`` (pytest-asyncio).
 - ``cnc_alarms``: the alarms ``cnc_service`` raised during the test (``AlarmRecorder``:
   ``raised_ids()``, ``active_ids()``, ``wait_for(id)``, ``clear()``).
+- ``cnc_trace``: a program run's samples as (kernel time ns, object, value) rows, the same
+  in every run (``TraceRecorder``: ``watch([...], cycle_ms, on_change)``, ``run(program)``;
+  ``cnc_service`` then runs with ``--samples repeatable``).
 
 Helpers (imported from here on first use, so that loading the plugin stays cheap):
 ``run_program`` / ``run_program_async`` run a program to its end, ``wait_for`` /
@@ -30,6 +33,7 @@ from .plugin import (
     cnc_client,
     cnc_service,
     cnc_shared_service,
+    cnc_trace,
     pytest_configure,
     pytest_runtest_makereport,
 )
@@ -39,7 +43,7 @@ _HELPERS = frozenset({"run_program", "run_program_async", "wait_for", "wait_for_
 
 __all__ = [
     "ServiceProcess", "cnc_alarms", "cnc_async_client", "cnc_client", "cnc_service", "cnc_shared_service",
-    "pytest_configure", "pytest_runtest_makereport", "run_program", "run_program_async",
+    "cnc_trace", "pytest_configure", "pytest_runtest_makereport", "run_program", "run_program_async",
     "serving", "start_service", "wait_for", "wait_for_async",
 ]
 

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from cnc_objects.clients import AsyncClient, Client
 
     from .alarms import AlarmRecorder
+    from .trace import TraceRecorder
 
 MARKER = "cnc_service"
 MARKER_HELP = (
@@ -62,6 +63,8 @@ def cnc_service(request: pytest.FixtureRequest,
     test starts. At teardown the service is stopped; a service that does not exit with
     code 0 fails the test with its log."""
     config, programs, args = _marker_options(request)
+    if "cnc_trace" in request.fixturenames and "--samples" not in args:
+        args = [*args, "--samples", "repeatable"]  # the trace needs every sample
     marker = request.node.get_closest_marker(MARKER)
     ads = bool(marker.kwargs.get("ads", False)) if marker is not None else False
     service = start_service(*args, *(("--config", str(config)) if config else ()),
@@ -103,6 +106,24 @@ def cnc_alarms(cnc_client: Client) -> AlarmRecorder:
     from .alarms import AlarmRecorder
 
     return AlarmRecorder(cnc_client)
+
+
+@pytest.fixture
+def cnc_trace(cnc_service: ServiceProcess) -> TraceRecorder:
+    """Records a program run's samples as (kernel time ns, object, value) rows:
+    ``watch([...], cycle_ms=10, on_change=False)``, then ``run(program)``
+    (``cnc_objects.testing.trace``). ``cnc_service`` then runs with ``--samples
+    repeatable``; the marker's ``args`` may choose ``--clock virtual-step`` or ``step``."""
+    from .trace import TraceRecorder
+
+    return TraceRecorder(cnc_service.endpoint, stepping=_clock_of(cnc_service) == "step")
+
+
+def _clock_of(service: ServiceProcess) -> str:
+    """The clock a service was started on (the last ``--clock`` of its command line)."""
+    argv = [str(a) for a in service.process.args]  # type: ignore[union-attr]
+    clocks = [argv[k + 1] for k, arg in enumerate(argv[:-1]) if arg == "--clock"]
+    return clocks[-1] if clocks else "realtime"
 
 
 async def _async_client(cnc_service: ServiceProcess) -> AsyncIterator[AsyncClient]:

@@ -112,6 +112,7 @@ class Kernel:
         tables: Sequence[ToolingTables | None] = (),
         idle_steps_max: int | None = None,
         rest_when_idle: bool = True,
+        repeatable: bool = False,
     ) -> None:
         """``loader(name)`` returns a program's text (KeyError when absent) and
         ``exists(name)`` says whether it is there: the program store, seen by the kernel,
@@ -128,7 +129,10 @@ class Kernel:
         ``idle_steps_max``: the decoder's endless-program guard ([limits]
         decoder_idle_steps_max; None: the default). ``rest_when_idle`` False: every cycle
         does its whole work, also at rest (the reference the resting cycles must equal,
-        value for value; see ``_work``).
+        value for value; see ``_work``). ``repeatable`` (``[clock] samples =
+        "repeatable"``, virtual clocks): kernel time stands still while the kernel rests
+        (``_stands_still``), so that what clients send while it rests lands at the same
+        cycle in every run, as between two steps of the step clock.
 
         The kernel owns its threads: the cycle thread and the workers (``workers``: the
         decoders and syntax checks), which run below the cycle's priority and which
@@ -170,6 +174,10 @@ class Kernel:
         # run in bulk.
         self.next_observed_ns: Callable[[], int | None] | None = None
         self._event_speed = isinstance(clock, VirtualClock) and clock.event_speed
+        self._repeatable = repeatable and isinstance(clock, VirtualClock)
+        # no cycle has run since the last command applied between cycles (or since the
+        # start): whether the kernel rests is then the state's alone (``_stands_still``)
+        self._between_cycles = True
         self._queue: queue.SimpleQueue[Queued] = queue.SimpleQueue()
         self._waiting: deque[Queued] = deque()
         self._channel_index = {c.channel_id: k for k, c in enumerate(self.state.channels)}
@@ -296,11 +304,16 @@ class Kernel:
             while True:
                 if not self.stats.running and not self._paused():
                     return
+                if self._stands_still():
+                    if not self._apply_between_cycles():
+                        return
+                    continue
                 started = time.perf_counter()
                 if self._event_speed and self._busy:
                     self._run_in_bulk()
                 if not self._cycle():
                     return
+                self._between_cycles = False
                 exec_us = int((time.perf_counter() - started) * 1e6)
                 if exec_us > self.stats.exec_time_max_us:
                     self.stats.exec_time_max_us = exec_us
@@ -312,6 +325,31 @@ class Kernel:
                 "stopped: restart it (ADS WriteControl RESET)"), 0, AlarmClass.KERNEL)
             self.stats.running = False
             self._publish()
+
+    def _stands_still(self) -> bool:
+        """Repeatable samples on a virtual clock: no cycle runs while the kernel rests
+        (the next cycle would change nothing but the time, ``_rests``), as under the step
+        clock between two steps. Kernel time then does not run with the wall clock while
+        nothing happens, so a subscription added and a program started while the kernel
+        rests meet the same cycles in every run, however late the requests come."""
+        if not self._repeatable or self._busy:
+            return False
+        if self._between_cycles:  # a command applied between cycles: the state decides
+            return self._rests()
+        return self._resting or (self._quiet and self._rests())
+
+    def _apply_between_cycles(self) -> bool:
+        """Wait for the next command and apply it between cycles, published without a
+        cycle passing (as the step clock does between steps); False on shutdown."""
+        command, done = self._next_command(block=True)
+        if isinstance(command, _Shutdown):
+            self._refuse_queued()
+            return False
+        result = self._apply(command)
+        self._between_cycles = True
+        self._publish()
+        done(result)
+        return True
 
     # ------------------------------------------------------------ step clock
 
