@@ -45,7 +45,7 @@ from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, Compensation, StopKind
 from .nc.check import CheckAborted, ErrorCategory, PointBatch
 from .nc.errors import DecodingCancelled
-from .nc.source import SourceText, strip_comments
+from .nc.source import NcText, SourceText, strip_comments
 from .nc.technology import Surroundings
 from .path.endpoints import first_violation
 from .path.errors import PathError
@@ -114,7 +114,7 @@ class CheckRun:
         *,
         channel_id: int,
         name: str,
-        text_of: Callable[[str], str],
+        text_of: Callable[[str], NcText],
         axes: tuple[str, ...],
         axis_numbers: tuple[int, ...],
         tools: Mapping[int, float],
@@ -270,7 +270,7 @@ class CheckRun:
             src = self._sources.get(error.file)
             if src is None and self._decoder is not None:
                 src = self._decoder.source_of(error.file)
-            if src is not None and 0 < error.line <= len(src.lines):  # the decoder is here
+            if src is not None and 0 < error.line <= src.count:  # the decoder is here
                 p.file, p.line, p.offset = error.file, error.line, src.offset(error.line - 1)
             if self._stop_at_total(p):
                 return
@@ -290,12 +290,26 @@ class CheckRun:
         self._lines(src, index, after)
         if self._checkpoint():  # also inside loops that yield nothing: STOP, RESET, budget
             raise CheckAborted
-        if self.line_by_line and strip_comments(src.lines[index]).strip():  # an NC line
+        if self.line_by_line and strip_comments(src.line(index)).strip():  # an NC line
             self._wait(Pause.SINGLE_STEP)
 
     # ------------------------------------------------------------ SDA thread
 
     def _run(self) -> None:
+        try:
+            self._check()
+        finally:
+            if self._decoder is not None:
+                self._decoder.close()  # the program's file (a stream) is read no more
+        if self._cancelled:
+            return
+        self._write_log()
+        with self._cond:
+            self._progress.done = True
+            self._progress.pause = Pause.NONE
+            self._cond.notify_all()
+
+    def _check(self) -> None:
         try:
             text = self._text_of(self.name)
             decoder = Decoder(
@@ -321,22 +335,15 @@ class CheckRun:
             self._flush_prep()
         except (CheckAborted, DecodingCancelled):
             pass
-        except KeyError as exc:
+        except (KeyError, FileNotFoundError):  # gone between select and start
             self._end_with(CheckedError(NcError(
                 NcErrorId.PROGRAM_NOT_FOUND, self.name, 0, 0,
-                f"program {exc.args[0]!r} not found"), None, self.name))
+                f"program {self.name!r} not found"), None, self.name))
         except Exception as exc:  # a fault is the run's error, never a dead thread
             log.exception("syntax check of %s failed", self.name)
             self._end_with(CheckedError(NcError(
                 NcErrorId.INTERNAL_ERROR, self.name, 0, 0, f"check fault: {exc!r}"), None,
                 self.name))
-        if self._cancelled:
-            return
-        self._write_log()
-        with self._cond:
-            self._progress.done = True
-            self._progress.pause = Pause.NONE
-            self._cond.notify_all()
 
     def _checkpoint(self) -> bool:
         """Between two items: honour STOP and the virtual clock's budget; True when
@@ -370,14 +377,14 @@ class CheckRun:
             return
         self._sources[src.name] = src
         last = stop - 1
-        raw = src.lines[last]
+        raw = src.line(last)
         m = _N_WORD.match(raw)
         if self._record and self._log_bytes < PROGRAM_MAX_BYTES:
-            lines = src.lines
+            line = src.line
             name = src.name
             start = len(self._log)
-            self._log.extend(f"{name}:{k + 1}: {lines[k].rstrip()}" for k in range(first, stop)
-                             if strip_comments(lines[k]).strip())  # NC lines, not comments
+            self._log.extend(f"{name}:{k + 1}: {line(k).rstrip()}" for k in range(first, stop)
+                             if strip_comments(line(k)).strip())  # NC lines, not comments
             self._log_bytes += sum(len(entry) + 1 for entry in self._log[start:])
         if self._record:
             self._log.extend(self._pending_log)
