@@ -161,6 +161,7 @@ class CheckRun:
         self._log: list[str] = []
         self._pending_log: list[str] = []  # errors of the line being decoded
         self._log_bytes = 0  # size of the log kept so far (it stops at the store limit)
+        self._error_log_bytes = 0  # the errors' part of it (kept up to the store limit)
         self._errors_not_logged = 0  # errors after the log reached the store limit
         self._decoder: Decoder | None = None
         self._sources: dict[str, SourceText] = {}  # files decoded so far, by name
@@ -258,10 +259,13 @@ class CheckRun:
         error.__traceback__ = error.__context__ = None
         checked = CheckedError(error, category, error.file, error.line, error.column)
         if self._record:  # written after the line it belongs to
-            if self._log_bytes < PROGRAM_MAX_BYTES:
+            # errors have a budget of their own: the checked lines of a big program fill
+            # the log, an error at its end must still be in it
+            if self._error_log_bytes < PROGRAM_MAX_BYTES:
                 entry = _error_line(error, category)
                 self._pending_log.append(entry)
                 self._log_bytes += len(entry) + 1
+                self._error_log_bytes += len(entry) + 1
             else:  # the log is full: counted, not kept (memory stays bounded)
                 self._errors_not_logged += 1
         with self._cond:

@@ -18,6 +18,7 @@ from hypothesis import strategies as st
 
 from cnc_objects.service.kernel.nc import Decoder, NcError, text_pages
 from cnc_objects.service.kernel.nc.text_pages import SourceText
+from tests.support.cam_programs import write_cam_program
 
 from .support import AXES, TOOLS
 
@@ -121,21 +122,6 @@ def test_lines_offsets_and_sections_of_a_file_match_its_text(
         streamed.close()
 
 
-def cam_program(path: Path, size_bytes: int) -> None:
-    """A CAM-like finishing program of about ``size_bytes``: short G1 moves in X Y Z."""
-    with path.open("wb") as f:
-        f.write(b"%cam\nN1 G90 G17 G1 F3000\n")
-        n = total = 0
-        while total < size_bytes:
-            chunk = b"".join(b"N%d X%.3f Y%.3f Z%.3f\n" % (
-                k + 2, (k * 0.05) % 400, (k // 8000) * 0.1, -(k % 97) * 0.01)
-                for k in range(n, n + 10_000))
-            f.write(chunk)
-            n += 10_000
-            total += len(chunk)
-        f.write(b"M30\n")
-
-
 def decoding_peak_bytes(path: Path, blocks_wanted: int) -> int:
     """Peak Python memory of opening ``path`` and decoding ``blocks_wanted`` blocks."""
     tracemalloc.start()
@@ -154,8 +140,8 @@ def decoding_peak_bytes(path: Path, blocks_wanted: int) -> int:
 
 def test_the_memory_of_a_decoder_does_not_grow_with_the_program(tmp_path: Path) -> None:
     small, large = tmp_path / "small.nc", tmp_path / "large.nc"
-    cam_program(small, 4_000_000)
-    cam_program(large, 20_000_000)
+    write_cam_program(small, 4_000_000)
+    write_cam_program(large, 20_000_000)
     # past the first pages of both, so the reading of pages is part of it
     small_peak = decoding_peak_bytes(small, 30_000)
     large_peak = decoding_peak_bytes(large, 30_000)
