@@ -7,7 +7,7 @@ loop, no thread). Async generators (``subscribe``) become plain iterators."""
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator, Mapping
-from typing import Any
+from typing import Any, BinaryIO
 
 from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.datatypes import DataType
@@ -370,7 +370,7 @@ class Client(BlockingClientBase):
     def upload(
         self,
         name: str,
-        data: bytes,
+        data: bytes | BinaryIO,
         progress: Callable[[int, int], None] | None = None,
     ) -> None:
         """Store ``data`` as ``name``, replacing an older version atomically. A program
@@ -378,7 +378,8 @@ class Client(BlockingClientBase):
         so its size is bounded by the store's ``[limits] program_max_bytes`` only, not by
         a frame; ``progress(sent_bytes, total_bytes)`` is called after each chunk. A
         failed chunk abandons the upload on the service (nothing is left behind) and
-        raises its ``AdsError``."""
+        raises its ``AdsError``. ``data`` may be a binary file open for reading, read
+        one chunk at a time (a program of any size costs one chunk of memory)."""
         return run_blocking(self._core.upload(name, data, progress))
 
     def wait_mdi(

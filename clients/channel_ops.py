@@ -16,11 +16,12 @@ RESET clears them (a CNC does not start in ERROR).
 
 from __future__ import annotations
 
+import os
 import struct
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, fields
-from typing import Any
+from typing import Any, BinaryIO
 
 from cnc_objects.protocol import check_log
 from cnc_objects.protocol.check_log import check_log_name
@@ -245,14 +246,20 @@ class ProgramOps(MixinBase):
     """Upload, list, download and delete programs of the service's store."""
 
     async def upload(
-        self, name: str, data: bytes, progress: Callable[[int, int], None] | None = None,
+        self, name: str, data: bytes | BinaryIO,
+        progress: Callable[[int, int], None] | None = None,
     ) -> None:
         """Store ``data`` as ``name``, replacing an older version atomically. A program
         larger than one chunk (``UPLOAD_CHUNK_BYTES``) goes in chunks, one frame each,
         so its size is bounded by the store's ``[limits] program_max_bytes`` only, not by
         a frame; ``progress(sent_bytes, total_bytes)`` is called after each chunk. A
         failed chunk abandons the upload on the service (nothing is left behind) and
-        raises its ``AdsError``."""
+        raises its ``AdsError``. ``data`` may be a binary file open for reading: it is
+        read chunk by chunk from where it stands to its end, so a program of 200 MB
+        costs the client one chunk of memory, not 200 MB."""
+        if not isinstance(data, bytes | bytearray | memoryview):
+            await self._upload_file(name, data, progress)
+            return
         if len(data) <= UPLOAD_CHUNK_BYTES:
             await self.write_raw(
                 CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD, _name_bytes(name) + data)
@@ -269,6 +276,26 @@ class ProgramOps(MixinBase):
                 progress(start + len(chunk), len(data))
         await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_COMMIT,
                              _U64.pack(len(data)))
+
+    async def _upload_file(
+        self, name: str, f: BinaryIO, progress: Callable[[int, int], None] | None,
+    ) -> None:
+        """``upload`` of a file, read one chunk at a time."""
+        start = f.tell()
+        total = f.seek(0, os.SEEK_END) - start
+        f.seek(start)
+        if total <= UPLOAD_CHUNK_BYTES:
+            await self.upload(name, f.read(), progress)
+            return
+        await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_OPEN, _name_bytes(name))
+        sent = 0
+        while chunk := f.read(UPLOAD_CHUNK_BYTES):
+            await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_CHUNK,
+                                 _U64.pack(sent) + chunk)
+            sent += len(chunk)
+            if progress is not None:
+                progress(sent, max(total, sent))
+        await self.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD_COMMIT, _U64.pack(sent))
 
     async def download(self, name: str) -> bytes:
         """The stored content of ``name``."""

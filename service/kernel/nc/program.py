@@ -14,6 +14,10 @@ the first ``$GOTO`` of that section needs them. ``$GOTO`` searches forward from 
 jump to the end of the section, then from the section start (ISG searches both ways;
 with a label defined twice, the next one after the jump wins).
 
+The lines come from a ``SourceText`` (``text_pages``): a stored program is read from its
+file page by page, so nothing here holds the whole text; the label index and the
+structures keep line indices only.
+
 Everything is computed lazily and cached: the statement of a line is parsed when the
 line is first reached, the matching ``$ENDIF`` of an ``$IF`` is searched when needed.
 """
