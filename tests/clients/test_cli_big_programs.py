@@ -49,4 +49,5 @@ def test_cnc_upload_reads_a_big_program_a_chunk_at_a_time(tmp_path: Path) -> Non
         assert [p.size_bytes for p in cnc.programs() if p.name == "large.nc"] == [
             large.stat().st_size]
     # held whole, the 40 MB program would add 40 MB; read a chunk at a time, nothing
+    print(f"\ncnc upload peak RSS: {small_kib} KiB (2 MB), {large_kib} KiB (40 MB)")
     assert large_kib - small_kib < 8_000, (small_kib, large_kib)
