@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import os
 import re
+import weakref
 from bisect import bisect_right
 from collections.abc import Iterable
 from itertools import accumulate
@@ -71,6 +72,7 @@ class SourceText:
     """
 
     _fd = -1  # the open file of a streamed text
+    _closer: weakref.finalize[[int], SourceText] | None = None  # closes it when collected
 
     def __init__(self, text: str, name: str) -> None:
         self.name = name
@@ -101,10 +103,11 @@ class SourceText:
         """The file at ``path``, read as a stream in pages of about ``page_bytes``
         (default ``PAGE_BYTES``); ``OSError`` when it cannot be read."""
         fd = os.open(path, os.O_RDONLY)
+        src = cls.__new__(cls)
+        src.name = name
+        src._fd = fd
+        closer = src._closer = weakref.finalize(src, os.close, fd)
         try:
-            src = cls.__new__(cls)
-            src.name = name
-            src._fd = fd
             scan = _Scan(fd, max(1, PAGE_BYTES if page_bytes is None else page_bytes))
             src._encoding = "utf-8" if scan.utf8 else "cp1252"
             src._page_offsets = scan.page_offsets  # one more: the end of the file
@@ -115,23 +118,16 @@ class SourceText:
             src._pages = {}
             src._window = src._load(0)
         except BaseException:
-            os.close(fd)
+            closer()
             raise
         return src
 
     def close(self) -> None:
-        """Close the file (a streamed text); lines already in memory stay readable."""
-        if self._fd >= 0:
-            os.close(self._fd)
+        """Close the file (a streamed text); lines already in memory stay readable.
+        A text not closed closes its file when it is collected."""
+        if self._closer is not None:
+            self._closer()  # once: a finalizer runs at most one time
             self._fd = -1
-
-    def __del__(self) -> None:
-        self.close()
-
-    @property
-    def streamed(self) -> bool:
-        """True when the text is read from its file page by page."""
-        return bool(self._page_firsts)
 
     def window(self, index: int) -> Window:
         """The page of lines that holds line ``index`` (0-based, < ``count``)."""
