@@ -10,6 +10,10 @@ Targets (issue 22): >= 500x with none, >= 100x with 20 subscriptions.
 Repeatable traces (issue 37, ``repeatable_traces``): the one-hour part on a service with
 ``--samples repeatable``, 20 cyclic subscriptions at 10 ms held by a second connection
 that reads them as they come: the speed, and the samples delivered per wall second.
+
+A 200 MB CAM program (issue 37, ``big_program_row``): the upload's MB/s, the service's
+RSS while the program runs (read as a stream: flat, start / max) and the speed, over 60 s
+of wall time (all of it would take hours at today's block rate), then RESET.
 """
 
 from __future__ import annotations
@@ -21,6 +25,8 @@ import time
 from pathlib import Path
 
 from cnc_objects.clients import AsyncClient
+from tests.support.cam_programs import write_cam_program
+from tests.support.resources import rss_kib
 from tests.support.service import start_service
 
 from .jitter_bench import WATCHED
@@ -78,6 +84,56 @@ async def _run(endpoint: str, name: str, data: bytes, subscriptions: int) -> tup
     return simulated_s, wall_s
 
 
+BIG_PROGRAM_BYTES = 200_000_000  # a CAM finishing program as big as CAM writes them
+BIG_WINDOW_S = 60.0  # wall time the big program runs before RESET (all of it takes hours)
+_RSS_EVERY_S = 0.5
+
+
+async def _run_big(endpoint: str, pid: int, path: Path) -> tuple[float, int, int, int, float]:
+    """Upload ``path``, run it for ``BIG_WINDOW_S`` of wall time, RESET: (upload MB/s,
+    RSS KiB before START, at the first sample, the most while running, speed)."""
+    data = path.read_bytes()
+    async with AsyncClient(endpoint, timeout_s=600) as c:
+        started = time.perf_counter()
+        await c.upload(path.name, data)
+        upload_mb_s = len(data) / 1e6 / (time.perf_counter() - started)
+        del data
+        await c.wait_mdi(await c.mdi("G90 G0 X0 Y0 Z0"))
+        before = rss_kib(pid)
+        started = time.perf_counter()
+        await c.run_program(path.name)
+        samples = []
+        while time.perf_counter() - started < BIG_WINDOW_S:
+            samples.append(rss_kib(pid))
+            await asyncio.sleep(_RSS_EVERY_S)  # a bench samples RSS over time
+        simulated_s = await c.read("ch1.program_time")
+        wall_s = time.perf_counter() - started
+        await c.reset(1)
+        await c.delete_program(path.name)
+    return upload_mb_s, before, samples[0], max(samples), simulated_s / wall_s
+
+
+def big_program_row() -> str:
+    """The row of a 200 MB CAM program, 0 subscriptions: upload MB/s, the service's RSS
+    while it runs (read as a stream: flat) and the speed over ``BIG_WINDOW_S`` of wall
+    time, after which it is RESET."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="cnc-bench-") as tmp:
+        path = Path(tmp) / "cam-200mb.nc"
+        write_cam_program(path, BIG_PROGRAM_BYTES)
+        service = start_service("--clock", "virtual")
+        try:
+            upload, before, first, most, speed = asyncio.run(
+                _run_big(service.endpoint, service.process.pid, path))
+        finally:
+            service.stop()
+    return (f"{'cam-200mb.nc':18} {0:13d} upload {upload:.0f} MB/s, RSS before START "
+            f"{before / 1024:.0f} MiB, running {first / 1024:.0f} / max {most / 1024:.0f} "
+            f"MiB (start / max), {speed:.0f}x over {BIG_WINDOW_S:.0f} s of wall time, "
+            "then RESET")
+
+
 def main(runs: int) -> None:
     """Measure and print the table."""
     parts = programs()
@@ -105,6 +161,7 @@ def main(runs: int) -> None:
               f"{'met' if factor >= target else 'NOT met'}"
               f"{'' if repeats > 1 else ' (one run)'}")
     print(repeatable)
+    print(big_program_row())
 
 
 #: Cycle time of the repeatable-traces row's subscriptions.

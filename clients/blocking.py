@@ -7,8 +7,7 @@ loop, no thread). Async generators (``subscribe``) become plain iterators."""
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator, Mapping
-from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.datatypes import DataType
@@ -387,7 +386,7 @@ class Client(BlockingClientBase):
     def upload(
         self,
         name: str,
-        data: bytes,
+        data: bytes | BinaryIO,
         progress: Callable[[int, int], None] | None = None,
     ) -> None:
         """Store ``data`` as ``name``, replacing an older version atomically. A program
@@ -395,19 +394,10 @@ class Client(BlockingClientBase):
         so its size is bounded by the store's ``[limits] program_max_bytes`` only, not by
         a frame; ``progress(sent_bytes, total_bytes)`` is called after each chunk. A
         failed chunk abandons the upload on the service (nothing is left behind) and
-        raises its ``AdsError``."""
+        raises its ``AdsError``. ``data`` may be a binary file open for reading: it is
+        read chunk by chunk from where it stands to its end, so a program of 200 MB
+        costs the client one chunk of memory, not 200 MB."""
         return run_blocking(self._core.upload(name, data, progress))
-
-    def upload_file(
-        self,
-        name: str,
-        path: str | Path,
-        progress: Callable[[int, int], None] | None = None,
-    ) -> int:
-        """``upload`` of the file at ``path``, read a chunk at a time: a CAM program of
-        hundreds of MB never lies in this process's memory whole. Returns its size in
-        bytes. A read error of the file abandons the upload (``OSError`` raised)."""
-        return run_blocking(self._core.upload_file(name, path, progress))
 
     def wait_mdi(
         self,

@@ -21,8 +21,7 @@ import struct
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, fields
-from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 from cnc_objects.protocol import check_log
 from cnc_objects.protocol.check_log import check_log_name
@@ -270,14 +269,20 @@ class ProgramOps(MixinBase):
     """Upload, list, download and delete programs of the service's store."""
 
     async def upload(
-        self, name: str, data: bytes, progress: Callable[[int, int], None] | None = None,
+        self, name: str, data: bytes | BinaryIO,
+        progress: Callable[[int, int], None] | None = None,
     ) -> None:
         """Store ``data`` as ``name``, replacing an older version atomically. A program
         larger than one chunk (``UPLOAD_CHUNK_BYTES``) goes in chunks, one frame each,
         so its size is bounded by the store's ``[limits] program_max_bytes`` only, not by
         a frame; ``progress(sent_bytes, total_bytes)`` is called after each chunk. A
         failed chunk abandons the upload on the service (nothing is left behind) and
-        raises its ``AdsError``."""
+        raises its ``AdsError``. ``data`` may be a binary file open for reading: it is
+        read chunk by chunk from where it stands to its end, so a program of 200 MB
+        costs the client one chunk of memory, not 200 MB."""
+        if not isinstance(data, bytes | bytearray | memoryview):
+            await self._upload_file(name, data, progress)
+            return
         if len(data) <= UPLOAD_CHUNK_BYTES:
             await self.write_raw(
                 CncPort.COM, PROGRAM_STORE_GROUP, Op.UPLOAD, _name_bytes(name) + data)
@@ -319,29 +324,29 @@ class ProgramOps(MixinBase):
             lines.pop()  # the newline that ends the last line
         return ProgramLines(first_line, reply.total_lines, [s.removesuffix("\r") for s in lines])
 
-    async def upload_file(
-        self, name: str, path: str | Path,
-        progress: Callable[[int, int], None] | None = None,
-    ) -> int:
-        """``upload`` of the file at ``path``, read a chunk at a time: a CAM program of
-        hundreds of MB never lies in this process's memory whole. Returns its size in
-        bytes. A read error of the file abandons the upload (``OSError`` raised)."""
-        with open(path, "rb") as file:
-            size_bytes = os.fstat(file.fileno()).st_size
-            if size_bytes <= UPLOAD_CHUNK_BYTES:
-                await self.upload(name, file.read(), progress)
-                return size_bytes
-            upload = ChunkedUpload(self, name, size_bytes)  # refused at once over the limits
-            await upload.open()
-            try:
-                while chunk := file.read(UPLOAD_CHUNK_BYTES):
-                    await upload.write(chunk)
-                    if progress is not None:
-                        progress(upload.sent_bytes, max(size_bytes, upload.sent_bytes))
-            except OSError:
-                await upload.abandon()
-                raise
-        return await upload.commit()
+    async def _upload_file(
+        self, name: str, f: BinaryIO, progress: Callable[[int, int], None] | None,
+    ) -> None:
+        """``upload`` of a file from where it stands, read one chunk at a time; its size
+        is announced at the open (a program over the limits is refused at once). A read
+        error of the file abandons the upload (``OSError`` raised)."""
+        start = f.tell()
+        total = f.seek(0, os.SEEK_END) - start
+        f.seek(start)
+        if total <= UPLOAD_CHUNK_BYTES:
+            await self.upload(name, f.read(), progress)
+            return
+        upload = ChunkedUpload(self, name, total)
+        await upload.open()
+        try:
+            while chunk := f.read(UPLOAD_CHUNK_BYTES):
+                await upload.write(chunk)
+                if progress is not None:
+                    progress(upload.sent_bytes, max(total, upload.sent_bytes))
+        except OSError:
+            await upload.abandon()
+            raise
+        await upload.commit()
 
     async def download(
         self, name: str, progress: Callable[[int, int], None] | None = None,

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 from collections.abc import Callable
 from dataclasses import asdict
@@ -100,14 +101,18 @@ def finish_wait(exc: Exception) -> None:
     fail(exc)
 
 
-def store_local(c: Client, name: str, data: bytes | None) -> None:
-    """Upload a local program (``data`` from ``local_program``) before it is used. A role
-    that may not upload is refused with the role that may (the service's words) and told
-    how to do without: a program already in the store is run by its name."""
+def store_local(c: Client, name: str, data: Path | None) -> None:
+    """Upload a local program (the file ``data`` from ``local_program``, read a chunk at
+    a time) before it is used. A role that may not upload is refused with the role that
+    may (the service's words) and told how to do without: a program already in the store
+    is run by its name."""
     if data is None:
         return
     try:
-        c.upload(name, data)
+        with data.open("rb") as f:
+            c.upload(name, f)
+    except OSError as exc:
+        raise ClientValueError(f"cannot read {data}: {exc.strerror}") from None
     except AdsError as exc:
         if exc.code != AdsReturnCode.DEVICE_INVALIDACCESS:
             raise
@@ -116,14 +121,16 @@ def store_local(c: Client, name: str, data: bytes | None) -> None:
                        "them)") from None
 
 
-def local_program(program: str) -> tuple[str, bytes | None]:
-    """``FILE|NAME`` of run/check/plot: (store name, bytes to upload) for a local file,
-    (name, None) for a stored program. An unreadable file exits 2 with its reason."""
+def local_program(program: str) -> tuple[str, Path | None]:
+    """``FILE|NAME`` of run/check/plot: (store name, file to upload) for a local file,
+    (name, None) for a stored program. An unreadable file exits 2 with its reason. The
+    file is read when it is uploaded, a chunk at a time (``store_local``)."""
     local = Path(program)
     if not local.is_file():
         return program, None
     try:
-        return local.name, local.read_bytes()
+        with local.open("rb"):
+            return local.name, local
     except OSError as exc:
         say_error(f"cannot read {local}: {exc.strerror}")
         raise typer.Exit(EXIT_USAGE) from None
@@ -137,23 +144,23 @@ def upload(
 ) -> None:
     """Upload a local NC file into the service's program store."""
     settings: Settings = ctx.obj
-    try:  # read a chunk at a time while it goes (a CAM program of hundreds of MB)
-        size_bytes = file.stat().st_size
-        if not file.is_file():
-            raise IsADirectoryError(21, "Is a directory")
+    target = name or file.name
+    try:
+        f = file.open("rb")  # read a chunk at a time: a 200 MB program costs one chunk
     except OSError as exc:
         say_error(f"cannot read {file}: {exc.strerror}")
         raise typer.Exit(EXIT_USAGE) from None
-    target = name or file.name
-    with upload_progress(f"upload {target}", size_bytes, UPLOAD_CHUNK_BYTES) as progress:
-        try:
-            sent = settings.call(lambda c: c.upload_file(target, file, progress),
-                                 f"upload of {target}")
-        except OSError as exc:
-            say_error(f"cannot read {file}: {exc.strerror}")
-            raise typer.Exit(EXIT_USAGE) from None
-    emit(settings, {"name": target, "size_bytes": sent, "ok": True},
-          f"uploaded {target} ({sent} bytes)")
+    with f:
+        size = os.fstat(f.fileno()).st_size
+
+        def send(c: Client) -> None:
+            f.seek(0)  # from the start, also when the call is made again
+            c.upload(target, f, progress)
+
+        with upload_progress(f"upload {target}", size, UPLOAD_CHUNK_BYTES) as progress:
+            settings.call(send, f"upload of {target}")
+    emit(settings, {"name": target, "size_bytes": size, "ok": True},
+          f"uploaded {target} ({size} bytes)")
 
 
 @command()

@@ -62,6 +62,7 @@ from .frontend_config import parse_ads_endpoint
 from .kernel.alarms import AlarmLog
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
 from .kernel.kernel import Kernel
+from .kernel.nc.source import NcText
 from .kernel.realtime_priority import DEFAULT_RT_PRIORITY, RT_PRIORITY_MAX, serve_below
 from .kernel.state import Snapshot
 from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
@@ -131,12 +132,13 @@ def make_clock(kind: ClockKind, cycle_s: float, speed: float | None,
 
 def _kernel_loader(
     store: ProgramStore,
-) -> tuple[Callable[[str], str], Callable[[str], bool]]:
-    """The store as the kernel sees it: text by name, KeyError when absent."""
+) -> tuple[Callable[[str], NcText], Callable[[str], bool]]:
+    """The store as the kernel sees it: a program's file by name (the decoder reads it as
+    a stream, page by page), KeyError when absent."""
 
-    def load(name: str) -> str:
+    def load(name: str) -> NcText:
         try:
-            return store.read_text(name)
+            return store.path_of(name)
         except StoreError:
             raise KeyError(name) from None
 

@@ -184,6 +184,14 @@ class ProgramStore:
         except OSError as exc:
             raise StoreError(StoreFault.IO, f"cannot read {name!r}: {exc.strerror}") from None
 
+    def path_of(self, name: str) -> Path:
+        """The file of program ``name``, for the kernel to read as a stream (a program
+        of 200 MB is never read whole); StoreError when there is none."""
+        path = self._path(name)
+        if not path.is_file():
+            raise StoreError(StoreFault.NOT_FOUND, f"no program {name!r} in the store")
+        return path
+
     def read_text(self, name: str) -> str:
         """The content of ``name`` as text: UTF-8, or CP1252 (ISG's encoding) when not."""
         data = self.read(name)

@@ -175,8 +175,8 @@ def _imports(methods: list[Method], offered: dict[str, dict[str, tuple[str, str]
     standard = {m: wanted.pop(m) for m in list(wanted)
                 if m.split(".")[0] in sys.stdlib_module_names}  # isort's first group
     if abc:
-        standard["collections.abc"] = abc
-    standard["typing"] = typing
+        standard["collections.abc"] = standard.get("collections.abc", set()) | abc
+    standard["typing"] = standard.get("typing", set()) | typing
     lines = [_wrap(f"from {m} import ", sorted(standard[m]), "") for m in sorted(standard)]
     absolute = sorted(m for m in wanted if not m.startswith("."))
     relative = sorted(m for m in wanted if m.startswith("."))

@@ -45,6 +45,7 @@ from .decoder_feed import DecoderFeed, Job
 from .manual_mode import ManualMode
 from .nc import ModalState
 from .nc.blocks import LogArea, LookAheadMark, ManualModeRequest
+from .nc.source import NcText
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
 from .nc.tool_data import ToolingTables
 from .path.executor import AxisDynamics, PathExecutor
@@ -94,7 +95,7 @@ class ChannelRunner:
         channel: Channel,
         config: ChannelConfig,
         machine: MachineConfig,
-        loader: Callable[[str], str],
+        loader: Callable[[str], NcText],
         exists: Callable[[str], bool],
         cycle_s: float,
         deterministic: bool,

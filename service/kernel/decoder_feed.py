@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, Compensation, SourceRef, StopKind
 from .nc.errors import DecodingCancelled
+from .nc.source import NcText
 from .nc.technology import Surroundings
 from .path.errors import PathError
 from .path.section_plan import SectionPlan
@@ -104,7 +105,7 @@ class SectionCollector:
             out.append(plan.error)
         return out
 
-ProgramLoader = Callable[[str], str]
+ProgramLoader = Callable[[str], NcText]  # the text of a program, or its file (a stream)
 
 
 class DecoderFeed:
@@ -236,7 +237,10 @@ class DecoderFeed:
             skip_levels=self._skip_levels,
         )
         decoder.cancelled = self._cancel.is_set
-        yield from decoder.blocks()
+        try:
+            yield from decoder.blocks()
+        finally:
+            decoder.close()  # a program read as a stream: its file is read no more
         self.modal = decoder.modal
 
     def _run(self) -> None:
@@ -280,10 +284,10 @@ class DecoderFeed:
         except NcError as exc:
             if self._flush_section():  # the blocks before the error run to their end
                 self._put(exc)
-        except KeyError as exc:  # loader: the program vanished between select and start
+        except (KeyError, FileNotFoundError):  # the program vanished between select and start
             name = self._job.name
             self._put(NcError(
-                NcErrorId.PROGRAM_NOT_FOUND, name, 0, 0, f"program {exc.args[0]!r} not found"
+                NcErrorId.PROGRAM_NOT_FOUND, name, 0, 0, f"program {name!r} not found"
             ))
         except Exception as exc:  # a decoder fault is the program's error, never a crash
             log.exception("decoder failed on %s", self._job.name)

@@ -26,6 +26,7 @@ from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
 from .commands import Command, Refusal, RefusalReason, ResetChannel
+from .nc.source import NcText
 from .nc.tool_data import ToolingTables
 from .realtime_priority import RealtimeGrant, worker_priority
 from .state import CycleStats, ErrorEntry, KernelState, Snapshot
@@ -37,7 +38,7 @@ from .workers import Workers
 log = logging.getLogger(__name__)
 
 Done = Callable[[Refusal | None], None]
-Loader = Callable[[str], str]
+Loader = Callable[[str], NcText]  # a program's text, or its file read as a stream
 
 
 #: The most cycles the event-speed virtual clock runs in one bulk step: the queue is

@@ -45,7 +45,7 @@ from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, Compensation, StopKind
 from .nc.check import CheckAborted, ErrorCategory, PointBatch
 from .nc.errors import DecodingCancelled
-from .nc.source import SourceText, strip_comments
+from .nc.source import NcText, SourceText, strip_comments
 from .nc.technology import Surroundings
 from .path.endpoints import first_violation
 from .path.errors import PathError
@@ -114,7 +114,7 @@ class CheckRun:
         *,
         channel_id: int,
         name: str,
-        text_of: Callable[[str], str],
+        text_of: Callable[[str], NcText],
         axes: tuple[str, ...],
         axis_numbers: tuple[int, ...],
         tools: Mapping[int, float],
@@ -161,6 +161,7 @@ class CheckRun:
         self._log: list[str] = []
         self._pending_log: list[str] = []  # errors of the line being decoded
         self._log_bytes = 0  # size of the log kept so far (it stops at the store limit)
+        self._error_log_bytes = 0  # the errors' part of it (kept up to the store limit)
         self._errors_not_logged = 0  # errors after the log reached the store limit
         self._decoder: Decoder | None = None
         self._sources: dict[str, SourceText] = {}  # files decoded so far, by name
@@ -258,10 +259,13 @@ class CheckRun:
         error.__traceback__ = error.__context__ = None
         checked = CheckedError(error, category, error.file, error.line, error.column)
         if self._record:  # written after the line it belongs to
-            if self._log_bytes < PROGRAM_MAX_BYTES:
+            # errors have a budget of their own: the checked lines of a big program fill
+            # the log, an error at its end must still be in it
+            if self._error_log_bytes < PROGRAM_MAX_BYTES:
                 entry = _error_line(error, category)
                 self._pending_log.append(entry)
                 self._log_bytes += len(entry) + 1
+                self._error_log_bytes += len(entry) + 1
             else:  # the log is full: counted, not kept (memory stays bounded)
                 self._errors_not_logged += 1
         with self._cond:
@@ -270,7 +274,7 @@ class CheckRun:
             src = self._sources.get(error.file)
             if src is None and self._decoder is not None:
                 src = self._decoder.source_of(error.file)
-            if src is not None and 0 < error.line <= len(src.lines):  # the decoder is here
+            if src is not None and 0 < error.line <= src.count:  # the decoder is here
                 p.file, p.line, p.offset = error.file, error.line, src.offset(error.line - 1)
             if self._stop_at_total(p):
                 return
@@ -290,12 +294,26 @@ class CheckRun:
         self._lines(src, index, after)
         if self._checkpoint():  # also inside loops that yield nothing: STOP, RESET, budget
             raise CheckAborted
-        if self.line_by_line and strip_comments(src.lines[index]).strip():  # an NC line
+        if self.line_by_line and strip_comments(src.line(index)).strip():  # an NC line
             self._wait(Pause.SINGLE_STEP)
 
     # ------------------------------------------------------------ SDA thread
 
     def _run(self) -> None:
+        try:
+            self._check()
+        finally:
+            if self._decoder is not None:
+                self._decoder.close()  # the program's file (a stream) is read no more
+        if self._cancelled:
+            return
+        self._write_log()
+        with self._cond:
+            self._progress.done = True
+            self._progress.pause = Pause.NONE
+            self._cond.notify_all()
+
+    def _check(self) -> None:
         try:
             text = self._text_of(self.name)
             decoder = Decoder(
@@ -321,22 +339,15 @@ class CheckRun:
             self._flush_prep()
         except (CheckAborted, DecodingCancelled):
             pass
-        except KeyError as exc:
+        except (KeyError, FileNotFoundError):  # gone between select and start
             self._end_with(CheckedError(NcError(
                 NcErrorId.PROGRAM_NOT_FOUND, self.name, 0, 0,
-                f"program {exc.args[0]!r} not found"), None, self.name))
+                f"program {self.name!r} not found"), None, self.name))
         except Exception as exc:  # a fault is the run's error, never a dead thread
             log.exception("syntax check of %s failed", self.name)
             self._end_with(CheckedError(NcError(
                 NcErrorId.INTERNAL_ERROR, self.name, 0, 0, f"check fault: {exc!r}"), None,
                 self.name))
-        if self._cancelled:
-            return
-        self._write_log()
-        with self._cond:
-            self._progress.done = True
-            self._progress.pause = Pause.NONE
-            self._cond.notify_all()
 
     def _checkpoint(self) -> bool:
         """Between two items: honour STOP and the virtual clock's budget; True when
@@ -370,14 +381,14 @@ class CheckRun:
             return
         self._sources[src.name] = src
         last = stop - 1
-        raw = src.lines[last]
+        raw = src.line(last)
         m = _N_WORD.match(raw)
         if self._record and self._log_bytes < PROGRAM_MAX_BYTES:
-            lines = src.lines
+            line = src.line
             name = src.name
             start = len(self._log)
-            self._log.extend(f"{name}:{k + 1}: {lines[k].rstrip()}" for k in range(first, stop)
-                             if strip_comments(lines[k]).strip())  # NC lines, not comments
+            self._log.extend(f"{name}:{k + 1}: {line(k).rstrip()}" for k in range(first, stop)
+                             if strip_comments(line(k)).strip())  # NC lines, not comments
             self._log_bytes += sum(len(entry) + 1 for entry in self._log[start:])
         if self._record:
             self._log.extend(self._pending_log)

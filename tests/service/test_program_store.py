@@ -106,5 +106,5 @@ def test_the_store_has_no_path_for_kernel_writes(store):
     output area (service/output_writer.py), so the store offers no append to reach
     (a chunked upload appends to its own temporary file, ``program_uploads``)."""
     assert [name for name in dir(store) if not name.startswith("_")] == [
-        "delete", "exists", "list", "max_bytes", "max_files", "max_total_bytes", "read",
+        "delete", "exists", "list", "max_bytes", "max_files", "max_total_bytes", "path_of", "read",
         "read_text", "replace_with", "root", "used_bytes", "write"]

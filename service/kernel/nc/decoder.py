@@ -47,7 +47,7 @@ from .instructions import Instruction
 from .modal import ModalState
 from .parser import RESERVED_LETTERS, LineParser, word_table
 from .program import Program, Section, Statement
-from .source import LogicalLine, SourceText, strip_comments
+from .source import LogicalLine, NcText, SourceText, strip_comments
 from .statements import (
     CLOSER_OF,
     OPENERS,
@@ -70,8 +70,10 @@ class Decoder:
     """Decodes one NC text (a program, or a manual block) into Blocks.
 
     ``axes``: the channel's axis names in order, one upper-case letter each (I/J/K are
-    the centre offsets of the axes named X/Y/Z). ``loader(name)`` returns the text of a
-    file subprogram and raises KeyError when there is none. ``tools`` maps D numbers to
+    the centre offsets of the axes named X/Y/Z). ``text`` is the program's text or its
+    file (a ``Path``: read as a stream, page by page, ``text_pages``). ``loader(name)``
+    returns the text or the file of a file subprogram and raises KeyError when there is
+    none. ``tools`` maps D numbers to
     tool radii in mm (D0 is radius 0). ``modal`` is continued (and changed) when given;
     otherwise decoding starts from a fresh ``ModalState`` at position 0. Bit n-1 of
     ``skip_levels`` skips the lines marked ``/n``. ``manual`` marks the blocks as
@@ -88,11 +90,11 @@ class Decoder:
 
     def __init__(
         self,
-        text: str,
+        text: NcText,
         file: str,
         *,
         axes: tuple[str, ...],
-        loader: Callable[[str], str],
+        loader: Callable[[str], NcText],
         tools: Mapping[int, float],
         modal: ModalState | None = None,
         skip_levels: int = 1,
@@ -155,6 +157,13 @@ class Decoder:
         limit = self.surroundings.idle_steps_max
         self.idle_steps_max = work_guard.IDLE_STEPS_MAX if limit is None else limit
         self._executed: Block | None = None  # check mode: the Block of the line's words
+
+    def close(self) -> None:
+        """Close the files of the programs read as streams (the main program and the
+        file subprograms loaded); the decoder decodes nothing more after this."""
+        self._main.src.close()
+        for program in self._files.values():
+            program.src.close()
 
     @property
     def source(self) -> SourceText:
@@ -582,8 +591,8 @@ def _first_pos(line: LogicalLine) -> int:
 
 def _last_code_line(program: Program, section: Section) -> int:
     """1-based number of the last line with code in ``section`` (for end errors)."""
-    lines = program.src.lines
+    line = program.src.line
     for k in range(section.end - 1, section.start - 1, -1):
-        if strip_comments(lines[k]).strip():
+        if strip_comments(line(k)).strip():
             return k + 1
     return max(section.start, 1)

@@ -76,11 +76,16 @@ def run(decoder):
         # called, returned, jumped or changed G90/G91, the plane, F, D, ...
         frame = frames[-1]
         program = frame.program
-        lines = program.src.lines
-        starts = program.src.starts
         file = program.name
         end = frame.section.end
         i = frame.index
+        # the page of lines in memory that holds line i (text_pages): the hot path runs
+        # to its end at most, then takes the next one
+        if i < end:
+            window = program.src.window(i)
+            lines, offsets, base, page_end = window.lines, window.offsets, window.first, window.stop
+        else:
+            page_end = i
         pos = modal.position_mm
         {unpack_pos} = pos
         kind = modal.motion
@@ -96,11 +101,11 @@ def run(decoder):
         role_i, role_j, role_k = roles
         # with an axis released (#AX RELEASE) every line takes the general path, which
         # rejects the words of released axes
-        fast_end = {fast_end}
+        fast_end = min({fast_end}, page_end)
 {setup}
         try:
             while i < fast_end:
-                m = match(lines[i])
+                m = match(lines[i - base])
                 if m is None:
                     break
                 ws, number, gcode, {axis_texts}, t_i, t_j, t_k, ftext = m.groups()
@@ -207,6 +212,8 @@ def run(decoder):
             raise decoder.fault(exc, frame, i) from exc
         frame.index = i
 {flush}
+        if i == page_end and i < end:  # the page is done (no line stopped the hot path)
+            continue
         # the line the hot path did not take: the general path
         block = slow_step(frame)
         work += 1
@@ -241,7 +248,7 @@ _BLOCK_FAST = '''\
                 src.file = file
                 src.line = i + 1
                 src.column = len(ws) + 1 if ws else 1
-                src.offset = starts[i] + i
+                src.offset = offsets[i - base]
                 src.__class__ = SOURCE
                 block = new(BLOCK_TWIN)
                 block.source = src
@@ -263,7 +270,7 @@ _BLOCK_FAST = '''\
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\
-                block = MAKE_BLOCK(MAKE_SOURCE(file, i + 1, len(ws) + 1, starts[i] + i),
+                block = MAKE_BLOCK(MAKE_SOURCE(file, i + 1, len(ws) + 1, offsets[i - base]),
                                    None if number is None else int(number), motion, 0.0,
                                    NO_STOP, (), None, None, manual, None, None,
                                    look_ahead)'''

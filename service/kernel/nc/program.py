@@ -14,6 +14,10 @@ the first ``$GOTO`` of that section needs them. ``$GOTO`` searches forward from 
 jump to the end of the section, then from the section start (ISG searches both ways;
 with a label defined twice, the next one after the jump wins).
 
+The lines come from a ``SourceText`` (``text_pages``): a stored program is read from its
+file page by page, so nothing here holds the whole text; the label index and the
+structures keep line indices only.
+
 Everything is computed lazily and cached: the statement of a line is parsed when the
 line is first reached, the matching ``$ENDIF`` of an ``$IF`` is searched when needed.
 """
@@ -28,7 +32,14 @@ from .check import SyntaxCheck, categorize, parse_checked
 from .errors import NcError, NcErrorId
 from .instructions import Instruction
 from .parser import LineParser
-from .source import LogicalLine, SourceText, comment_directive, read_logical, strip_comments
+from .source import (
+    LogicalLine,
+    NcText,
+    SourceText,
+    comment_directive,
+    read_logical,
+    strip_comments,
+)
 from .statements import (
     CLOSER_OF,
     OPENERS,
@@ -107,16 +118,18 @@ class Structure:
 class Program:
     """One NC file prepared for decoding (sections, caches)."""
 
-    def __init__(self, text: str, name: str, parser: LineParser, skip_levels: int,
+    def __init__(self, text: NcText, name: str, parser: LineParser, skip_levels: int,
                  check: SyntaxCheck | None = None) -> None:
-        """With ``check`` (syntax check) an error in a line is reported and the line
-        repositioned after it (``check.parse_checked``), never raised."""
+        """``text``: the program's text, or its file (a ``Path``), read as a stream
+        (``text_pages``; ``OSError`` when it cannot be read). With ``check`` (syntax
+        check) an error in a line is reported and the line repositioned after it
+        (``check.parse_checked``), never raised."""
         self.check = check
-        self.src = SourceText(text, name)
+        self.src = SourceText(text, name) if isinstance(text, str) else SourceText.open(text, name)
         self.name = name
         self.parser = parser
         self.skip_levels = skip_levels
-        self.main, self.locals = _sections(text.removeprefix("\ufeff"), self.src)
+        self.main, self.locals = _sections(self.src)
         self._statements: dict[int, tuple[Statement | None, int]] = {}
         self._logical: dict[int, tuple[LogicalLine | None, int]] = {}
         self._structures: dict[int, Structure] = {}
@@ -271,34 +284,12 @@ def _mismatch(found: StmtKind, open_kind: StmtKind, line: LogicalLine) -> NcErro
     )
 
 
-def _header_lines(text: str) -> list[int]:
-    """Line indices of the lines starting with '%' or '#' (str.find: fast on big files)."""
-    starts = []
-    for mark in "%#":
-        pos = text.find(mark)
-        while pos >= 0:
-            line_start = text.rfind("\n", 0, pos) + 1
-            if not text[line_start:pos].strip(" \t"):
-                starts.append(line_start)
-            pos = text.find(mark, pos + 1)
-    starts.sort()
-    indices = []
-    line_no = 0
-    last = 0
-    for start in starts:
-        line_no += text.count("\n", last, start)
-        last = start
-        indices.append(line_no)
-    return indices
-
-
-def _sections(text: str, src: SourceText) -> tuple[Section, dict[str, list[Section]]]:
+def _sections(src: SourceText) -> tuple[Section, dict[str, list[Section]]]:
     """Main section and local subprograms (by upper-case name) of a file."""
-    count = len(src.lines)
+    count = src.count
     headers: list[tuple[int, SectionKind, str]] = []
     in_comment = False
-    for line_no in _header_lines(text):
-        raw = src.lines[line_no]
+    for line_no, raw in src.marked_lines():
         stripped = raw.lstrip()
         if stripped.startswith("#"):
             directive = comment_directive(raw)
@@ -313,7 +304,7 @@ def _sections(text: str, src: SourceText) -> tuple[Section, dict[str, list[Secti
             headers.append((line_no, SectionKind.LOCAL, local.group(1).upper()))
         else:
             main_header = _MAIN_HEADER.match(code)
-            # _header_lines gives lines whose first non-blank is '%' (not '#', see above),
+            # marked_lines gives lines whose first non-blank is '%' (not '#', see above),
             # and comments start with '(' or ';': the '%' is still there
             assert main_header is not None
             headers.append((line_no, SectionKind.MAIN, main_header.group(1).upper()))

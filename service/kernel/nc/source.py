@@ -1,7 +1,8 @@
 """Physical lines to logical lines, keeping file, line, column and byte offset.
 
-An NC file is split once into physical lines (``SourceText``). The decoder reads it one
-*logical line* at a time (``read_logical``):
+An NC file is a sequence of physical lines (``SourceText``, ``text_pages``: held whole,
+or read from its file page by page). The decoder reads it one *logical line* at a time
+(``read_logical``):
 
 * ``;`` starts a comment to the end of the line; ``( ... )`` is a comment inside the
   line (an unclosed ``(`` runs to the end of the line). Comment characters inside
@@ -21,42 +22,14 @@ came from, so an error in the third continuation line points at that line.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
-from itertools import accumulate
 
 from .errors import NcError, NcErrorId
+from .text_pages import NcText, SourceText, comment_directive
 
-# "#COMMENT BEGIN" / "#COMMENT END" at the start of a line (any case, any spacing)
-_COMMENT_DIRECTIVE = re.compile(r"[ \t]*#[ \t]*COMMENT[ \t]+(BEGIN|END)\b", re.IGNORECASE)
+__all__ = ["LogicalLine", "NcText", "SourceText", "comment_directive", "join_lines",
+           "read_logical", "skip_comment_block", "strip_comments"]
 _SKIP_PREFIX = re.compile(r"[ \t]*/([0-9]*)")
 _MAX_SKIP_LEVEL = 10
-
-
-class SourceText:
-    """One NC file: its name, its physical lines and the byte offset of each line."""
-
-    __slots__ = ("name", "lines", "starts")
-
-    def __init__(self, text: str, name: str) -> None:
-        self.name = name
-        base = 0
-        if text.startswith("\ufeff"):  # a UTF-8 byte order mark is 3 bytes, not code
-            text = text[1:]
-            base = 3
-        raw = text.split("\n")
-        if text.isascii():
-            lengths: Iterable[int] = map(len, raw)
-        else:  # offsets are byte offsets of the UTF-8 file, as the HMI counts them
-            lengths = (len(line.encode("utf-8")) for line in raw)
-        # byte offset of line i = starts[i] + i (the i newlines before it)
-        self.starts: list[int] = list(accumulate(lengths, initial=base))
-        if "\r" in text:
-            raw = [line[:-1] if line.endswith("\r") else line for line in raw]
-        self.lines: list[str] = raw
-
-    def offset(self, index: int) -> int:
-        """Byte offset of the start of line ``index``."""
-        return self.starts[index] + index
 
 
 class LogicalLine:
@@ -133,21 +106,14 @@ def strip_comments(line: str) -> str:
     return "".join(out)
 
 
-def comment_directive(line: str) -> str | None:
-    """"BEGIN" or "END" when ``line`` is ``#COMMENT BEGIN`` / ``#COMMENT END``."""
-    if "#" not in line:
-        return None
-    m = _COMMENT_DIRECTIVE.match(line)
-    return m.group(1).upper() if m else None
-
-
 def skip_comment_block(src: SourceText, index: int, end: int) -> int:
     """Index after the ``#COMMENT END`` that closes the ``#COMMENT BEGIN`` at ``index``."""
-    lines = src.lines
+    line = src.line
     for k in range(index + 1, end):
-        if comment_directive(lines[k]) == "END":
+        if comment_directive(line(k)) == "END":
             return k + 1
-    col = len(lines[index]) - len(lines[index].lstrip()) + 1
+    first = line(index)
+    col = len(first) - len(first.lstrip()) + 1
     raise NcError(
         NcErrorId.COMMENT_BLOCK_NOT_CLOSED, src.name, index + 1, col,
         "#COMMENT BEGIN without #COMMENT END",
@@ -162,8 +128,7 @@ def read_logical(
     Returns ``(None, next)`` for a line without code: blank, comment only, a whole
     ``#COMMENT`` block, or a skipped ``/`` line.
     """
-    lines = src.lines
-    raw = lines[index]
+    raw = src.line(index)
     directive = comment_directive(raw)
     if directive == "BEGIN":
         return None, skip_comment_block(src, index, end)
@@ -197,7 +162,7 @@ def read_logical(
     length = len(parts[0])
     k = index + 1
     while k < end:
-        more = strip_comments(lines[k])
+        more = strip_comments(src.line(k))
         more_stripped = more.rstrip()
         k += 1
         if not more_stripped:

@@ -25,7 +25,7 @@ def check_syntax(text: str, file: str, *, axes: tuple[str, ...],
     """All syntax errors of ``text``, in line order (empty when there is none)."""
     parser = LineParser(word_table(tuple(axes)))
     src = SourceText(text, file)
-    count = len(src.lines)
+    count = src.count
     errors: list[NcError] = []
     in_var_block = False
     k = 0

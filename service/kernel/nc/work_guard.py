@@ -39,9 +39,8 @@ IDLE_STEPS_MAX = 1_000_000
 def endless_program(src: SourceText, file: str, index: int, limit: int) -> NcError:
     """The ENDLESS_PROGRAM error at line ``index`` (0-based) of ``src``: its first
     non-blank character, or the last line when the decoder stands at the text's end."""
-    lines = src.lines
-    index = min(max(index, 0), len(lines) - 1) if lines else 0
-    text = lines[index] if lines else ""
+    index = min(max(index, 0), src.count - 1)
+    text = src.line(index)
     column = len(text) - len(text.lstrip()) + 1
     return NcError(NcErrorId.ENDLESS_LOOP, file, index + 1, column,
                    f"endless program: {limit} steps without a motion or other block "
