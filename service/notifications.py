@@ -58,6 +58,7 @@ from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.filetime import filetime_from_unix_ns
 
 from .kernel.state import Snapshot
+from .sample_reads import FAILED, Probe, Probes, ResolveFn, unchanged
 
 log = logging.getLogger(__name__)
 
@@ -140,6 +141,9 @@ class Subscription:
     next_due_ns: int
     last: bytes | None = None
     sequence: int = 0
+    #: reads the object the short way (``sample_reads``); None: through the dispatcher
+    probe: Probe | None = None
+    last_value: Any = FAILED  # the value ``last`` was encoded from (a probe's)
 
 
 @dataclass(slots=True)
@@ -171,10 +175,15 @@ class NotificationHub:
         pin: PinFn,
         limits: NotificationLimits | None = None,
         counts: NotificationCounts | None = None,
+        resolve: ResolveFn | None = None,
     ) -> None:
         """``read`` serves an address on the loop, from the snapshot the kernel shows
-        the calling thread; ``pin`` pins a snapshot for a block (``Kernel.reading``)."""
+        the calling thread; ``pin`` pins a snapshot for a block (``Kernel.reading``);
+        ``resolve`` gives the getter and encoder of an address that is one object's whole
+        value, which the passes then read the short way (``sample_reads``)."""
         self._read = read
+        self._probes = Probes(resolve)
+        self._read_no = 0  # counts the passes and first samples: a probe reads once in each
         self._pin = pin
         self._loop = loop
         self._kernel_cycle_ns = kernel_cycle_ns
@@ -260,6 +269,7 @@ class NotificationHub:
         sub = Subscription(
             handle, envelope, notify, req.port, req.group, req.offset, length,
             mode in ON_CHANGE_MODES, max(cycle_ns, self._kernel_cycle_ns), FIRST_SAMPLE_PENDING,
+            probe=self._probes.probe(req.port, req.group, req.offset, length),
         )
         self._subs[handle] = sub
         self._count_period(sub.cycle_ns, 1)
@@ -394,6 +404,7 @@ class NotificationHub:
     def _first_sample(self, sub: Subscription) -> None:
         if sub.handle not in self._subs:
             return
+        self._read_no += 1
         with self._pinned(None) as now_ns:
             sample = self._take(sub, now_ns, None, force=True)
         assert sample is not None  # forced: a sample whether or not the value changed
@@ -413,6 +424,7 @@ class NotificationHub:
                 self._scheduled = False
                 return False
             snapshot = self._due_snapshots.popleft()
+        self._read_no += 1
         self._pass = SamplingPass(snapshot.time_ns, snapshot, iter(list(self._subs.values())))
         return True
 
@@ -478,13 +490,25 @@ class NotificationHub:
               force: bool) -> list[Any] | None:
         """Read one subscription in the pinned snapshot of kernel time ``now_ns`` (once
         per address in ``reads``, when given); a sample list or None when on-change saw
-        no change."""
-        code, data = self._read_shared(reads, sub.port, sub.group, sub.offset, sub.length)
+        no change. An on-change subscription with a probe compares the value first and
+        encodes only one that may have changed (``sample_reads.unchanged``)."""
         # Next due time on the subscription's own grid, never in the past.
         sub.next_due_ns = now_ns - now_ns % sub.cycle_ns + sub.cycle_ns
-        if code:
-            return None  # the object went away (cannot happen with a fixed catalog)
-        if sub.on_change and not force and data == sub.last:
+        compare = sub.on_change and not force
+        probe = sub.probe
+        data: bytes | str | None = None
+        if probe is not None:
+            value = probe.value_in(self._read_no)
+            if value is not FAILED:
+                if compare and unchanged(value, sub.last_value):
+                    return None
+                data = probe.encoded()
+                sub.last_value = value if data is not None else FAILED
+        if data is None:  # no probe, or its read failed: the dispatcher reads (and says why)
+            code, data = self._read_shared(reads, sub.port, sub.group, sub.offset, sub.length)
+            if code:
+                return None  # the object went away (cannot happen with a fixed catalog)
+        if compare and data == sub.last:
             return None
         sub.last = data  # type: ignore[assignment]
         sub.sequence += 1
