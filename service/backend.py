@@ -47,7 +47,7 @@ from .kernel.kernel import Kernel
 from .notifications import NotificationCounts, NotificationHub, NotificationLimits
 from .output_service import OutputService
 from .program_service import ProgramStoreService
-from .sample_reads import Encoder, Getter
+from .sample_reads import Encoder, Getter, encoder_of
 
 _E = AdsReturnCode
 _U16 = struct.Struct("<H")
@@ -158,8 +158,7 @@ class Backend:
                 return None  # a cut string or a PLC memory range: read_other_length
         if entry is None or entry.read is None or length < entry.obj.dtype.size:
             return None
-        dtype = entry.obj.dtype
-        return entry.read, (dtype.encode_fitted if dtype.kind == "str" else dtype.encode)
+        return entry.read, encoder_of(entry.obj.dtype)
 
     def read_other_length(
         self, port: int, group: int, offset: int, length: int,

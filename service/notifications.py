@@ -144,6 +144,10 @@ class Subscription:
     #: reads the object the short way (``sample_reads``); None: through the dispatcher
     probe: Probe | None = None
     last_value: Any = FAILED  # the value ``last`` was encoded from (a probe's)
+    batch_key: tuple[Envelope, int] = ()  # (envelope, port): its frame in a slice
+
+    def __post_init__(self) -> None:
+        self.batch_key = (self.envelope, self.port)
 
 
 @dataclass(slots=True)
@@ -465,10 +469,12 @@ class NotificationHub:
                 if subs.get(sub.handle) is not sub:
                     continue  # deleted since the pass began
                 if sub.next_due_ns <= due_ns:
-                    sample = take(sub, now_ns, reads, force=False)
+                    sample = take(sub, now_ns, reads, False)
                     if sample is not None:
-                        batches.setdefault((sub.envelope, sub.port), (sub.notify, []))[
-                            1].append(sample)
+                        batch = batches.get(sub.batch_key)
+                        if batch is None:
+                            batch = batches[sub.batch_key] = (sub.notify, [])
+                        batch[1].append(sample)
                 if k % SLICE_CHECK_EVERY and self._read_bytes < SLICE_CHECK_BYTES:
                     continue
                 self._read_bytes = 0
@@ -493,12 +499,14 @@ class NotificationHub:
         no change. An on-change subscription with a probe compares the value first and
         encodes only one that may have changed (``sample_reads.unchanged``)."""
         # Next due time on the subscription's own grid, never in the past.
-        sub.next_due_ns = now_ns - now_ns % sub.cycle_ns + sub.cycle_ns
+        cycle_ns = sub.cycle_ns
+        sub.next_due_ns = now_ns - now_ns % cycle_ns + cycle_ns
         compare = sub.on_change and not force
         probe = sub.probe
         data: bytes | str | None = None
         if probe is not None:
-            value = probe.value_in(self._read_no)
+            read_no = self._read_no
+            value = probe.value if probe.read_no == read_no else probe.value_in(read_no)
             if value is not FAILED:
                 if compare and unchanged(value, sub.last_value):
                     return None

@@ -15,8 +15,11 @@ subscription still sends exactly when the bytes change.
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Callable
 from typing import Any
+
+from cnc_objects.protocol.datatypes import DataType
 
 Getter = Callable[[], Any]
 Encoder = Callable[[Any], bytes]
@@ -47,6 +50,23 @@ def unchanged(value: Any, last: Any) -> bool:
     if kind in _EQUAL_IS_SAME:
         return bool(value == last)
     return kind is float and value is last
+
+
+def encoder_of(dtype: DataType) -> Encoder:
+    """How a read of ``dtype`` encodes a value the CNC produced: ``encode_fitted`` for a
+    STRING (made to fit), else ``encode``, with a float of a REAL64 packed at once (the
+    most sampled values; ``encode`` checks every other kind and value)."""
+    if dtype.kind == "str":
+        return dtype.encode_fitted
+    encode = dtype.encode
+    if dtype.kind == "float" and dtype.size == 8:
+        pack = struct.Struct("<d").pack
+
+        def encode_real64(value: Any) -> bytes:
+            return pack(value) if type(value) is float else encode(value)
+
+        return encode_real64
+    return encode
 
 
 class Probe:
