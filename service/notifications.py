@@ -48,7 +48,7 @@ import logging
 import threading
 from collections import deque
 from collections.abc import Callable, Iterator
-from contextlib import AbstractContextManager, contextmanager
+from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
 from time import perf_counter
 from typing import Any
@@ -144,7 +144,7 @@ class Subscription:
     #: reads the object the short way (``sample_reads``); None: through the dispatcher
     probe: Probe | None = None
     last_value: Any = FAILED  # the value ``last`` was encoded from (a probe's)
-    batch_key: tuple[Envelope, int] = ()  # (envelope, port): its frame in a slice
+    batch_key: tuple[Envelope, int] = ((), 0)  # (envelope, port): its frame in a slice
 
     def __post_init__(self) -> None:
         self.batch_key = (self.envelope, self.port)
@@ -409,8 +409,9 @@ class NotificationHub:
         if sub.handle not in self._subs:
             return
         self._read_no += 1
-        with self._pinned(None) as now_ns:
-            sample = self._take(sub, now_ns, None, force=True)
+        with self._pin(None) as pinned:
+            self._stamp = filetime_from_unix_ns(pinned.wall_ns)
+            sample = self._take(sub, pinned.time_ns, None, force=True)
         assert sample is not None  # forced: a sample whether or not the value changed
         self._emit({(sub.envelope, sub.port): (sub.notify, [sample])})
 
@@ -464,7 +465,9 @@ class NotificationHub:
         subs, take, due_ns, reads = self._subs, self._take, run.now_ns, run.reads
         finished = True
         self._read_bytes = 0  # read since the last look at the clock
-        with self._pinned(run.snapshot) as now_ns:
+        with self._pin(run.snapshot) as pinned:
+            # every sample of the pass carries its cycle's FILETIME
+            self._stamp, now_ns = filetime_from_unix_ns(pinned.wall_ns), pinned.time_ns
             for k, sub in enumerate(run.todo, 1):
                 if subs.get(sub.handle) is not sub:
                     continue  # deleted since the pass began
@@ -482,15 +485,6 @@ class NotificationHub:
                     finished = False
                     break
         return finished
-
-    @contextmanager
-    def _pinned(self, snapshot: Snapshot | None) -> Iterator[int]:
-        """Pin ``snapshot`` (None: the kernel's newest) while the block lasts, so that
-        every read in it comes from that cycle, and set ``_stamp`` to its FILETIME;
-        yields its kernel time."""
-        with self._pin(snapshot) as pinned:
-            self._stamp = filetime_from_unix_ns(pinned.wall_ns)
-            yield pinned.time_ns
 
     def _take(self, sub: Subscription, now_ns: int, reads: _Reads | None,
               force: bool) -> list[Any] | None:

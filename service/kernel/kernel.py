@@ -15,8 +15,7 @@ import queue
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import Enum
 
@@ -84,6 +83,30 @@ class _Pin(threading.local):
     """The snapshot one thread has pinned (``Kernel.reading``); None: it reads the newest."""
 
     snapshot: Snapshot | None = None
+
+
+class _Reading:
+    """``Kernel.reading``'s block (a class, not a generator: a notification pass pins
+    once per due cycle, issue 37)."""
+
+    __slots__ = ("_kernel", "_snapshot", "_owner")
+
+    def __init__(self, kernel: Kernel, snapshot: Snapshot | None) -> None:
+        self._kernel, self._snapshot, self._owner = kernel, snapshot, False
+
+    def __enter__(self) -> Snapshot:
+        pin = self._kernel._pin
+        held = pin.snapshot
+        if held is not None:
+            return held  # nested: the outer pin holds
+        snapshot = self._snapshot
+        pinned = pin.snapshot = self._kernel._latest if snapshot is None else snapshot
+        self._owner = True
+        return pinned
+
+    def __exit__(self, *exc: object) -> None:
+        if self._owner:
+            self._kernel._pin.snapshot = None
 
 
 def _no_answer(_result: Refusal | None) -> None:
@@ -226,23 +249,13 @@ class Kernel:
         pinned = self._pin.snapshot
         return self._latest if pinned is None else pinned
 
-    @contextmanager
-    def reading(self, snapshot: Snapshot | None = None) -> Iterator[Snapshot]:
+    def reading(self, snapshot: Snapshot | None = None) -> _Reading:
         """Pin ``snapshot`` (None: the newest published one) for the calling thread until
         the block ends: every read of ``snapshot`` on this thread (every object's getter)
         sees that cycle, however many cycles the kernel publishes meanwhile; other
         threads are not affected. Yields the pinned snapshot. A nested block keeps the
         outer pin."""
-        pin = self._pin
-        held = pin.snapshot
-        if held is not None:
-            yield held
-            return
-        pinned = pin.snapshot = self._latest if snapshot is None else snapshot
-        try:
-            yield pinned
-        finally:
-            pin.snapshot = None
+        return _Reading(self, snapshot)
 
     def channel_index(self, channel_id: int) -> int:
         """Position of the channel with logical id ``channel_id`` in the state."""
