@@ -50,7 +50,7 @@ from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
-from time import perf_counter
+from time import perf_counter, sleep
 from typing import Any
 
 from cnc_objects.protocol.constants import TransmissionMode
@@ -392,9 +392,14 @@ class NotificationHub:
         subscription's due times lie on the grid of its cycle time, so the next due
         cycle is the grid's next point. Only when ``PASSES_PENDING_MAX`` due cycles wait
         for the loop is it now (0): the kernel takes single cycles until the loop is
-        back."""
+        back. Before such a cycle the cycle thread gives the interpreter to the loop
+        once (``sleep(0)``): a whole cycle stepped only because the loop is behind costs
+        more than the passes it waits for (issue 37: the kernel thread and the loop share
+        one GIL)."""
         if len(self._due_snapshots) >= PASSES_PENDING_MAX:
-            return 0
+            sleep(0)
+            if len(self._due_snapshots) >= PASSES_PENDING_MAX:
+                return 0
         return self._kernel_due()
 
     def _kernel_due(self) -> int | None:
