@@ -507,8 +507,10 @@ class NotificationHub:
             read_no = self._read_no
             value = probe.value if probe.read_no == read_no else probe.value_in(read_no)
             if value is not FAILED:
-                if compare and unchanged(value, sub.last_value):
-                    return None
+                if compare:
+                    last = sub.last_value
+                    if value is last or unchanged(value, last):  # the same object: unchanged
+                        return None
                 data = probe.encoded()
                 sub.last_value = value if data is not None else FAILED
         if data is None:  # no probe, or its read failed: the dispatcher reads (and says why)

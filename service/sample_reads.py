@@ -40,16 +40,15 @@ FAILED = _Failed()
 
 
 def unchanged(value: Any, last: Any) -> bool:
-    """True when ``value`` surely encodes to the bytes ``last`` did (same type, and equal
-    for ints and texts, the same object for floats); False says nothing (compare the
-    bytes). Snapshots share the values of what a cycle did not change, so an unchanged
-    float is the same object."""
+    """True when ``value`` surely encodes to the bytes ``last`` did: the same object (a
+    getter of a fixed-size type gives an immutable number, flag or text), or equal ints
+    or texts of the same type; False says nothing (compare the bytes). Snapshots share
+    the values of what a cycle did not change, so an unchanged float is the same
+    object."""
+    if value is last:
+        return True
     kind = type(value)
-    if kind is not type(last):
-        return False
-    if kind in _EQUAL_IS_SAME:
-        return bool(value == last)
-    return kind is float and value is last
+    return kind is type(last) and kind in _EQUAL_IS_SAME and bool(value == last)
 
 
 def encoder_of(dtype: DataType) -> Encoder:
