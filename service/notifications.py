@@ -25,6 +25,9 @@ once. A sample's data and timestamp thus come from the same cycle however
 long a read takes and however many cycles the kernel publishes meanwhile; nothing is
 read again. A slice looks at the clock by the bytes it read, not only by the
 subscriptions it took, so a large subscription ends its slice (``SLICE_CHECK_BYTES``).
+A subscription to one object's whole value reads it the short way (``sample_reads``:
+the object's getter and encoder, resolved once; issue 37), every other one through the
+read dispatcher.
 
 What one subscription may cost is bounded by ``NotificationLimits`` (``[limits]``): the
 bytes one notification carries (``notification_max_bytes``) and the bytes of all
