@@ -24,7 +24,8 @@ overruns while the service answers 5 000 reads/s and feeds 20 on-change subscrip
 during a run (``bench/jitter_bench.py``).
 Virtual part (``--part virtual``): simulated seconds per wall second of the whole service
 on the virtual clock for the pocket, a 10 000-block spiral and a one-hour part, with no
-and with 20 on-change subscriptions (``bench/virtual_bench.py``).
+and with 20 on-change subscriptions, and the pocket and the one-hour part with cnc-web
+attached and one browser session (``bench/virtual_bench.py``).
 Fairness part (``--part fairness``): another client's read latency while one client
 holds every notification the service takes (20 000 cyclic, 1 ms), idle and loaded
 (``bench/fairness_bench.py``; target p99 < 10 ms); then beside a monitor's large
@@ -255,6 +256,7 @@ def main(argv: list[str] | None = None) -> int:
         from . import virtual_bench
 
         virtual_bench.main(min(args.runs, 3))
+        virtual_bench.web_rows(min(args.runs, 3))
     if args.part in ("all", "fairness"):
         from . import fairness_bench
 

@@ -14,6 +14,12 @@ that reads them as they come: the speed, and the samples delivered per wall seco
 A 200 MB CAM program (issue 37, ``big_program_row``): the upload's MB/s, the service's
 RSS while the program runs (read as a stream: flat, start / max) and the speed, over 60 s
 of wall time (all of it would take hours at today's block rate), then RESET.
+``web_rows`` (issue 37): the pocket and the one-hour part with cnc-web attached to the
+service as ``make run`` starts it, and one browser-like session on its live WebSocket
+watching what the machine page watches (app.js ``connectLive``: every channel's state
+objects and every axis's positions, links, homing and jog keys, and the alarm counts; a
+WebSocket client from aiohttp speaks the page's protocol, no browser runs). Target
+>= 100x.
 """
 
 from __future__ import annotations
@@ -23,8 +29,12 @@ import statistics
 import sys
 import time
 from pathlib import Path
+from typing import Any
+
+import aiohttp
 
 from cnc_objects.clients import AsyncClient
+from cnc_objects.testing.web import serving_web
 from tests.support.cam_programs import write_cam_program
 from tests.support.resources import rss_kib
 from tests.support.service import start_service
@@ -34,6 +44,8 @@ from .lookahead_programs import spiral
 
 ROOT = Path(__file__).resolve().parents[1]
 SUBSCRIPTIONS = 20
+#: x real time with 20 on-change subscriptions (issue 37; others: issue 22's 100x)
+WATCHED_TARGETS = {"pocket-la-on.nc": 200, "one-hour.nc": 200}
 
 
 def one_hour_part(blocks: int = 7200) -> str:
@@ -156,7 +168,7 @@ def main(runs: int) -> None:
     print("\nvirtual time, whole service (1 ms cycle): simulated s per wall s, START to READY")
     print(f"{'part':18} {'subscriptions':>13} {'machining s':>12} {'speed':>8}  target")
     for name, subscriptions, sim, factor, repeats in rows:
-        target = 500 if subscriptions == 0 else 100
+        target = 500 if subscriptions == 0 else WATCHED_TARGETS.get(name, 100)
         print(f"{name:18} {subscriptions:13d} {sim:12.1f} {factor:7.0f}x  >= {target}: "
               f"{'met' if factor >= target else 'NOT met'}"
               f"{'' if repeats > 1 else ' (one run)'}")
@@ -221,3 +233,100 @@ def repeatable_traces(data: bytes, runs: int = 1) -> str:
     return (f"{'one-hour.nc':18} {SUBSCRIPTIONS:10d} at {TRACE_CYCLE_MS} ms, repeatable: "
             f"{factor:.0f}x, {rate:.0f} samples/s delivered"
             f"{'' if runs > 1 else ' (one run)'}")
+
+
+# ------------------------------------------------------------------ with cnc-web (issue 37)
+
+WEB_TARGET = 100  # x real time with cnc-web and one browser session
+#: What app.js ``channelNames`` watches of a channel and of each of its axes.
+PAGE_CHANNEL_LEAVES = (
+    "mc_active_mode_r", "mc_active_state_r", "mc_active_program_name_r", "actual_block_number",
+    "mc_active_file_name_r", "mc_active_line_r", "mc_active_feedrate_r",
+    "mc_active_feed_override_r", "mc_active_single_block_r", "mc_error_count_r",
+    "mc_spindle_mode_r", "mc_spindle_active_rev_r", "mc_spindle_override_w", "mc_active_tool_r",
+    "mc_active_tool_offset_r", "mc_active_zero_offset_r")
+PAGE_AXIS_LEAVES = ("command_position_acs", "command_position_pcs", "position_offset",
+                    "link_state", "homing_referenced_r", "manual_jog_plus_w",
+                    "manual_jog_minus_w")
+PAGE_POSITION = "ch1.ax1.command_position_acs"  # moves in every part: the page is live
+
+
+def page_names(machine: dict[str, Any]) -> list[str]:
+    """The names the machine page watches when its live WebSocket opens (app.js
+    ``connectLive``), for the machine cnc-web describes (``/api/machine``)."""
+    names = []
+    for ch in machine["channels"]:
+        c = f"ch{ch['id']}"
+        names += [f"{c}.{leaf}" for leaf in PAGE_CHANNEL_LEAVES]
+        names.append(f"gpCh[{ch['plc_index']}].bahn_mc_control.suspend_axis_output.state_r")
+        names += [f"{c}.ax{a['index']}.{leaf}" for a in ch["axes"] for leaf in PAGE_AXIS_LEAVES]
+    return names + ["alarm_active_count_r", "alarm_raised_r"]
+
+
+async def _run_watched_by_web(endpoint: str, url: str, name: str, data: bytes
+                              ) -> tuple[float, float, int]:
+    """(simulated s, wall s, position updates the session got) of one run of ``name``
+    while one browser session of cnc-web at ``url`` watches the machine page."""
+    jar = aiohttp.CookieJar(unsafe=True)  # the session cookie on 127.0.0.1
+    async with aiohttp.ClientSession(cookie_jar=jar) as http, \
+            AsyncClient(endpoint, timeout_s=600) as c:
+        async with http.get(url + "/api/session"):
+            pass
+        async with http.get(url + "/api/machine") as response:
+            names = page_names(await response.json())
+        await c.upload(name, data)
+        await c.wait_mdi(await c.mdi("G90 G0 X0 Y0 Z0"))  # every run from the origin
+        updates = 0
+        first = asyncio.Event()
+        async with http.ws_connect(url + "/ws") as socket:
+            await socket.send_json({"watch": names})
+
+            async def receive() -> None:
+                nonlocal updates
+                async for message in socket:
+                    if message.type != aiohttp.WSMsgType.TEXT:
+                        continue
+                    if PAGE_POSITION in message.json().get("values", {}):
+                        updates += 1
+                        first.set()
+
+            receiver = asyncio.create_task(receive())
+            await asyncio.wait_for(first.wait(), 30)  # the page shows its first values
+            before = updates
+            started = time.perf_counter()
+            await c.run_program(name)
+            await c.wait_program(timeout_s=3600)
+            wall_s = time.perf_counter() - started
+            receiver.cancel()
+        simulated_s = await c.read("ch1.program_time")
+        await c.delete_program(name)
+    return simulated_s, wall_s, updates - before
+
+
+def web_rows(runs: int) -> None:
+    """The pocket and the one-hour part on the virtual clock with cnc-web attached and
+    one browser session watching the machine page: print the rows, target >= 100x."""
+    parts = programs()
+    service = start_service("--clock", "virtual")
+    rows = []
+    try:
+        with serving_web(service.endpoint) as web:
+            for name in ("pocket-la-on.nc", "one-hour.nc"):
+                repeats = 1 if name == "one-hour.nc" else runs
+                factors, sim, updates = [], 0.0, 0
+                for _ in range(repeats):
+                    sim, wall, updates = asyncio.run(
+                        _run_watched_by_web(service.endpoint, web.url, name, parts[name]))
+                    factors.append(sim / wall)
+                    print(f"virtual: {name} with cnc-web and one session: {sim:.1f} s in "
+                          f"{wall:.2f} s ({sim / wall:.0f}x, {updates} position updates)",
+                          file=sys.stderr)
+                rows.append((name, sim, statistics.median(factors), repeats))
+    finally:
+        service.stop()
+    print("\nvirtual time with cnc-web attached, one browser session on the machine page")
+    print(f"{'part':18} {'watching':>13} {'machining s':>12} {'speed':>8}  target")
+    for name, sim, factor, repeats in rows:
+        print(f"{name:18} {'cnc-web':>13} {sim:12.1f} {factor:7.0f}x  >= {WEB_TARGET}: "
+              f"{'met' if factor >= WEB_TARGET else 'NOT met'}"
+              f"{'' if repeats > 1 else ' (one run)'}")

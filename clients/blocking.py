@@ -22,6 +22,7 @@ from .channel_ops import (
     ProgramLines,
 )
 from .client import BlockingClientBase, DeviceInfo, Sample, iterate_blocking, run_blocking
+from .client_core import SAMPLE_BUFFER
 from .manual_ops import AxisState
 from .object_info import ObjectInfo
 from .path_trace import PathTrace
@@ -324,6 +325,7 @@ class Client(BlockingClientBase):
         on_change: bool = True,
         cycle_ms: int | None = None,
         units: bool = False,
+        buffer_samples: int | None = SAMPLE_BUFFER,
     ) -> Iterator[Sample]:
         """Samples of ``name`` as the service sends them (server-side notification).
 
@@ -331,9 +333,18 @@ class Client(BlockingClientBase):
         time (default 10 ms; 0: every kernel cycle, so that a value held for one cycle is
         seen); otherwise one every ``cycle_ms`` (default 100 ms). The first sample is the
         current value. Leaving the loop deletes the subscription. ``units``: the samples'
-        values in engineering units, as for ``read``.
+        values in engineering units, as for ``read``. ``buffer_samples``: how many samples
+        wait for the loop at most (a loop that falls behind loses the oldest; the sample's
+        ``sequence`` shows the gap); None keeps every one (a recorder of a repeatable
+        trace, ``cnc_trace``: memory grows while the loop lags).
         """
-        return iterate_blocking(self._core.subscribe(name, on_change, cycle_ms, units))
+        return iterate_blocking(self._core.subscribe(
+            name,
+            on_change,
+            cycle_ms,
+            units,
+            buffer_samples,
+        ))
 
     def syntax_check(
         self,

@@ -62,6 +62,7 @@ from .channel_ops import (
     CheckResult,
     ProgramEntry,
 )
+from .client_core import SAMPLE_BUFFER
 from .curve import client_curve
 from .endpoint import DEFAULT_ENDPOINT as DEFAULT_ENDPOINT  # re-exported: its old home
 from .errors import AdsConnectionError, AdsError, ClientValueError, NoReplyError
@@ -430,7 +431,7 @@ class AsyncClient(TraceOps, AlarmOps, MachineOps):
 
     async def subscribe(
         self, name: str, on_change: bool = True, cycle_ms: int | None = None,
-        units: bool = False,
+        units: bool = False, buffer_samples: int | None = SAMPLE_BUFFER,
     ) -> AsyncGenerator[Sample, None]:
         """Samples of ``name`` as the service sends them (server-side notification).
 
@@ -438,7 +439,10 @@ class AsyncClient(TraceOps, AlarmOps, MachineOps):
         time (default 10 ms; 0: every kernel cycle, so that a value held for one cycle is
         seen); otherwise one every ``cycle_ms`` (default 100 ms). The first sample is the
         current value. Leaving the loop deletes the subscription. ``units``: the samples'
-        values in engineering units, as for ``read``.
+        values in engineering units, as for ``read``. ``buffer_samples``: how many samples
+        wait for the loop at most (a loop that falls behind loses the oldest; the sample's
+        ``sequence`` shows the gap); None keeps every one (a recorder of a repeatable
+        trace, ``cnc_trace``: memory grows while the loop lags).
         """
         mode = TransmissionMode.SERVER_ON_CHANGE if on_change else TransmissionMode.SERVER_CYCLE
         default = DEFAULT_ON_CHANGE_CYCLE_MS if on_change else DEFAULT_CYCLIC_CYCLE_MS
@@ -452,7 +456,7 @@ class AsyncClient(TraceOps, AlarmOps, MachineOps):
         except NoReplyError as exc:
             raise exc.asking(f"SUBSCRIBE {name}") from None
         handle = self._payload(reply)
-        self._t.open_samples(handle)
+        self._t.open_samples(handle, buffer_samples)
         try:
             while True:
                 raw = await self._t.next_sample(handle)

@@ -11,6 +11,9 @@ from typing import TYPE_CHECKING, Any, Protocol
 if TYPE_CHECKING:
     from .object_info import ObjectInfo
 
+#: Samples a subscription keeps for its reader by default; a full buffer drops the oldest.
+SAMPLE_BUFFER = 1000
+
 
 class Pausing(Protocol):
     """The transport's wall-clock wait (asyncio's sleep, or the blocking driver's)."""
@@ -47,7 +50,7 @@ class ClientCore(Protocol):
 
     def subscribe(
         self, name: str, on_change: bool = True, cycle_ms: int | None = None,
-        units: bool = False,
+        units: bool = False, buffer_samples: int | None = SAMPLE_BUFFER,
     ) -> AsyncIterator[Any]:
         """Samples of ``name`` as the service sends them."""
         ...

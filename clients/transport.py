@@ -24,12 +24,12 @@ from cnc_objects.protocol.errors import ProtocolError
 from cnc_objects.protocol.frames import RawSample, Response, decode_incoming
 
 from .batching import QueuedRequest, ReplyWaiter, SumBatch, batchable, chunks, runs, sum_fields
+from .client_core import SAMPLE_BUFFER as SAMPLE_BUFFER  # re-exported: its old home
 from .curve import ClientCurve, HandshakeWatch
 from .errors import AdsConnectionError, AuthenticationError, ServiceFullError
-from .transport_base import (  # noqa: F401  (EARLY_HANDLES, SAMPLE_BUFFER: their old home)
+from .transport_base import (  # noqa: F401  (EARLY_HANDLES: its old home)
     _NOBLOCK,
     EARLY_HANDLES,
-    SAMPLE_BUFFER,
     _new_socket,
     _Transport,
 )

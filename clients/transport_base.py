@@ -16,11 +16,11 @@ import zmq
 from cnc_objects.protocol.constants import AdsCommand
 from cnc_objects.protocol.frames import Notification, RawSample, encode_request
 
+from .client_core import SAMPLE_BUFFER
 from .curve import ClientCurve, HandshakeWatch
 from .errors import AdsConnectionError, NoReplyError
 
 _NOBLOCK = int(zmq.NOBLOCK)
-SAMPLE_BUFFER = 1000  # samples kept per subscription; a full buffer drops the oldest
 # Samples of handles not yet claimed: they can overtake the reply that names the handle,
 # for as many subscriptions as are opened at once. The oldest unclaimed handle (most
 # likely a deleted subscription's last samples) makes room for a new one.
@@ -66,10 +66,14 @@ class _Transport:
             invoke_id = 1
         return invoke_id, encode_request(invoke_id, command, port, fields)
 
-    def open_samples(self, handle: int) -> None:
-        """Start buffering samples of ``handle`` (claims any that arrived early)."""
+    def open_samples(self, handle: int, buffer_samples: int | None = SAMPLE_BUFFER) -> None:
+        """Start buffering samples of ``handle`` (claims any that arrived early), at most
+        ``buffer_samples`` (None: every sample until it is read)."""
         early = self._early.pop(handle, None)
-        self._samples[handle] = early if early else deque(maxlen=SAMPLE_BUFFER)
+        if early and buffer_samples == SAMPLE_BUFFER:
+            self._samples[handle] = early
+        else:
+            self._samples[handle] = deque(early or (), maxlen=buffer_samples)
 
     def close_samples(self, handle: int) -> None:
         """Stop buffering samples of ``handle``."""

@@ -48,6 +48,7 @@ from .kernel.kernel import Kernel
 from .notifications import NotificationCounts, NotificationHub, NotificationLimits
 from .output_service import OutputService
 from .program_service import ProgramStoreService
+from .sample_reads import Encoder, Getter, encoder_of
 
 _E = AdsReturnCode
 _U16 = struct.Struct("<H")
@@ -117,6 +118,7 @@ class Backend:
         self.hub = NotificationHub(
             self.read_value, loop, kernel.cycle_ns, kernel.reading,
             notification_limits, notification_counts, repeatable=repeatable_samples,
+            resolve=self.direct_read,
         )
 
     # ------------------------------------------------------------ reads
@@ -140,6 +142,30 @@ class Backend:
         if code == _E.DEVICE_INVALIDSIZE:
             return self.read_other_length(port, group, offset, length) or (code, data)
         return code, data
+
+    def direct_read(
+        self, port: int, group: int, offset: int, length: int,
+    ) -> tuple[Getter, Encoder] | None:
+        """The getter and encoder of the object a read of this address answers whole, as
+        ``read_value`` would (by address with the object's size, or by handle with at
+        least its size); None for every other read (symbol services, device data, PLC
+        memory ranges, a string cut to a shorter buffer). The notification hub samples
+        such a subscription without the lookups of ``read_value`` (issue 37)."""
+        entry: Entry | None
+        if group == RIG.SYM_VALUE_BY_HANDLE:
+            entry = self.space.by_handle(offset)
+        elif group == RIG.DEVICE_DATA and port == CncPort.PLC:
+            return None
+        elif self.symbols is not None and self.symbols.handles(group):
+            return None
+        else:
+            found = self.space.find(port, group, offset)
+            entry = None if isinstance(found, tuple) else found
+            if entry is not None and length != entry.obj.dtype.size:
+                return None  # a cut string or a PLC memory range: read_other_length
+        if entry is None or entry.read is None or length < entry.obj.dtype.size:
+            return None
+        return entry.read, encoder_of(entry.obj.dtype)
 
     def read_other_length(
         self, port: int, group: int, offset: int, length: int,

@@ -27,6 +27,9 @@ once. A sample's data and timestamp thus come from the same cycle however
 long a read takes and however many cycles the kernel publishes meanwhile; nothing is
 read again. A slice looks at the clock by the bytes it read, not only by the
 subscriptions it took, so a large subscription ends its slice (``SLICE_CHECK_BYTES``).
+A subscription to one object's whole value reads it the short way (``sample_reads``:
+the object's getter and encoder, resolved once; issue 37), every other one through the
+read dispatcher.
 
 What one subscription may cost is bounded by ``NotificationLimits`` (``[limits]``): the
 bytes one notification carries (``notification_max_bytes``) and the bytes of all
@@ -50,9 +53,9 @@ import logging
 import threading
 from collections import deque
 from collections.abc import Callable, Iterator
-from contextlib import AbstractContextManager, contextmanager
+from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
-from time import perf_counter
+from time import perf_counter, sleep
 from typing import Any
 
 from cnc_objects.protocol.constants import TransmissionMode
@@ -60,6 +63,7 @@ from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.filetime import filetime_from_unix_ns
 
 from .kernel.state import Snapshot
+from .sample_reads import FAILED, Probe, Probes, ResolveFn, unchanged
 
 log = logging.getLogger(__name__)
 
@@ -149,6 +153,13 @@ class Subscription:
     next_due_ns: int
     last: bytes | None = None
     sequence: int = 0
+    #: reads the object the short way (``sample_reads``); None: through the dispatcher
+    probe: Probe | None = None
+    last_value: Any = FAILED  # the value ``last`` was encoded from (a probe's)
+    batch_key: tuple[Envelope, int] = ((), 0)  # (envelope, port): its frame in a slice
+
+    def __post_init__(self) -> None:
+        self.batch_key = (self.envelope, self.port)
 
 
 @dataclass(slots=True)
@@ -181,9 +192,12 @@ class NotificationHub:
         limits: NotificationLimits | None = None,
         counts: NotificationCounts | None = None,
         repeatable: bool = False,
+        resolve: ResolveFn | None = None,
     ) -> None:
         """``read`` serves an address on the loop, from the snapshot the kernel shows
-        the calling thread; ``pin`` pins a snapshot for a block (``Kernel.reading``).
+        the calling thread; ``pin`` pins a snapshot for a block (``Kernel.reading``);
+        ``resolve`` gives the getter and encoder of an address that is one object's whole
+        value, which the passes then read the short way (``sample_reads``).
         ``repeatable`` (``[clock] samples = "repeatable"``): no sample is ever dropped.
         The cycle thread waits while ``PASSES_PENDING_MAX`` due cycles wait for their
         passes; a frame a client's send queue refuses is kept and sent again, and no
@@ -191,6 +205,8 @@ class NotificationHub:
         passes the kernel); the first sample is taken when the subscription is added;
         samples carry kernel time, not wall time (docs/kernel.md, Traces that repeat)."""
         self._read = read
+        self._probes = Probes(resolve)
+        self._read_no = 0  # counts the passes and first samples: a probe reads once in each
         self._pin = pin
         self._loop = loop
         self._kernel_cycle_ns = kernel_cycle_ns
@@ -283,6 +299,7 @@ class NotificationHub:
         sub = Subscription(
             handle, envelope, notify, req.port, req.group, req.offset, length,
             mode in ON_CHANGE_MODES, max(cycle_ns, self._kernel_cycle_ns), FIRST_SAMPLE_PENDING,
+            probe=self._probes.probe(req.port, req.group, req.offset, length),
         )
         self._subs[handle] = sub
         self._count_period(sub.cycle_ns, 1)
@@ -407,10 +424,15 @@ class NotificationHub:
         subscription's due times lie on the grid of its cycle time, so the next due
         cycle is the grid's next point. Only when ``PASSES_PENDING_MAX`` due cycles wait
         for the loop is it now (0): the kernel takes single cycles until the loop is
-        back. With repeatable samples the next due cycle is always the event: the cycle
-        thread waits for room in ``kernel_cycle_end`` instead."""
+        back. Before such a cycle the cycle thread gives the interpreter to the loop
+        once (``sleep(0)``): a whole cycle stepped only because the loop is behind costs
+        more than the passes it waits for (issue 37: the kernel thread and the loop share
+        one GIL). With repeatable samples the next due cycle is always the event: the
+        cycle thread waits for room in ``kernel_cycle_end`` instead."""
         if len(self._due_snapshots) >= PASSES_PENDING_MAX and not self.repeatable:
-            return 0
+            sleep(0)
+            if len(self._due_snapshots) >= PASSES_PENDING_MAX:
+                return 0
         return self._kernel_due()
 
     def _kernel_due(self) -> int | None:
@@ -423,8 +445,10 @@ class NotificationHub:
 
     def _take_first(self, sub: Subscription) -> list[Any]:
         """The first sample of ``sub``: its value in the kernel's newest cycle."""
-        with self._pinned(None) as now_ns:
-            sample = self._take(sub, now_ns, None, force=True)
+        self._read_no += 1
+        with self._pin(None) as pinned:
+            self._stamp = self._filetime(pinned)
+            sample = self._take(sub, pinned.time_ns, None, force=True)
         assert sample is not None  # forced: a sample whether or not the value changed
         return sample
 
@@ -454,6 +478,7 @@ class NotificationHub:
                 return False
             snapshot = self._due_snapshots.popleft()
             self._handover.notify()  # repeatable: a cycle thread may wait for the room
+        self._read_no += 1
         self._pass = SamplingPass(snapshot.time_ns, snapshot, iter(list(self._subs.values())))
         return True
 
@@ -490,15 +515,19 @@ class NotificationHub:
         subs, take, due_ns, reads = self._subs, self._take, run.now_ns, run.reads
         finished = True
         self._read_bytes = 0  # read since the last look at the clock
-        with self._pinned(run.snapshot) as now_ns:
+        with self._pin(run.snapshot) as pinned:
+            # every sample of the pass carries its cycle's FILETIME
+            self._stamp, now_ns = self._filetime(pinned), pinned.time_ns
             for k, sub in enumerate(run.todo, 1):
                 if subs.get(sub.handle) is not sub:
                     continue  # deleted since the pass began
                 if sub.next_due_ns <= due_ns:
-                    sample = take(sub, now_ns, reads, force=False)
+                    sample = take(sub, now_ns, reads, False)
                     if sample is not None:
-                        batches.setdefault((sub.envelope, sub.port), (sub.notify, []))[
-                            1].append(sample)
+                        batch = batches.get(sub.batch_key)
+                        if batch is None:
+                            batch = batches[sub.batch_key] = (sub.notify, [])
+                        batch[1].append(sample)
                 if k % SLICE_CHECK_EVERY and self._read_bytes < SLICE_CHECK_BYTES:
                     continue
                 self._read_bytes = 0
@@ -507,27 +536,38 @@ class NotificationHub:
                     break
         return finished
 
-    @contextmanager
-    def _pinned(self, snapshot: Snapshot | None) -> Iterator[int]:
-        """Pin ``snapshot`` (None: the kernel's newest) while the block lasts, so that
-        every read in it comes from that cycle, and set ``_stamp`` to its FILETIME;
-        yields its kernel time."""
-        with self._pin(snapshot) as pinned:
-            self._stamp = filetime_from_unix_ns(
-                pinned.time_ns if self.repeatable else pinned.wall_ns)
-            yield pinned.time_ns
+    def _filetime(self, pinned: Snapshot) -> int:
+        """The FILETIME the samples of the pinned cycle carry: its wall time, or with
+        repeatable samples its kernel time (so that a trace repeats)."""
+        return filetime_from_unix_ns(pinned.time_ns if self.repeatable else pinned.wall_ns)
 
     def _take(self, sub: Subscription, now_ns: int, reads: _Reads | None,
               force: bool) -> list[Any] | None:
         """Read one subscription in the pinned snapshot of kernel time ``now_ns`` (once
         per address in ``reads``, when given); a sample list or None when on-change saw
-        no change."""
-        code, data = self._read_shared(reads, sub.port, sub.group, sub.offset, sub.length)
+        no change. An on-change subscription with a probe compares the value first and
+        encodes only one that may have changed (``sample_reads.unchanged``)."""
         # Next due time on the subscription's own grid, never in the past.
-        sub.next_due_ns = now_ns - now_ns % sub.cycle_ns + sub.cycle_ns
-        if code:
-            return None  # the object went away (cannot happen with a fixed catalog)
-        if sub.on_change and not force and data == sub.last:
+        cycle_ns = sub.cycle_ns
+        sub.next_due_ns = now_ns - now_ns % cycle_ns + cycle_ns
+        compare = sub.on_change and not force
+        probe = sub.probe
+        data: bytes | str | None = None
+        if probe is not None:
+            read_no = self._read_no
+            value = probe.value if probe.read_no == read_no else probe.value_in(read_no)
+            if value is not FAILED:
+                if compare:
+                    last = sub.last_value
+                    if value is last or unchanged(value, last):  # the same object: unchanged
+                        return None
+                data = probe.encoded()
+                sub.last_value = value if data is not None else FAILED
+        if data is None:  # no probe, or its read failed: the dispatcher reads (and says why)
+            code, data = self._read_shared(reads, sub.port, sub.group, sub.offset, sub.length)
+            if code:
+                return None  # the object went away (cannot happen with a fixed catalog)
+        if compare and data == sub.last:
             return None
         sub.last = data  # type: ignore[assignment]
         sub.sequence += 1

@@ -186,7 +186,8 @@ class _Recording:
 
     async def follow(self, client: AsyncClient, index: int, name: str, cycle_ms: int,
                      on_change: bool, first: asyncio.Event, marker: bool) -> None:
-        samples = client.subscribe(name, on_change=on_change, cycle_ms=cycle_ms)
+        samples = client.subscribe(name, on_change=on_change, cycle_ms=cycle_ms,
+                                   buffer_samples=None)  # the service holds; so does this
         sequence = 0
         async with contextlib.aclosing(samples):
             async for sample in samples:

@@ -15,8 +15,7 @@ import queue
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import Enum
 
@@ -85,6 +84,30 @@ class _Pin(threading.local):
     """The snapshot one thread has pinned (``Kernel.reading``); None: it reads the newest."""
 
     snapshot: Snapshot | None = None
+
+
+class _Reading:
+    """``Kernel.reading``'s block (a class, not a generator: a notification pass pins
+    once per due cycle, issue 37)."""
+
+    __slots__ = ("_kernel", "_snapshot", "_owner")
+
+    def __init__(self, kernel: Kernel, snapshot: Snapshot | None) -> None:
+        self._kernel, self._snapshot, self._owner = kernel, snapshot, False
+
+    def __enter__(self) -> Snapshot:
+        pin = self._kernel._pin
+        held = pin.snapshot
+        if held is not None:
+            return held  # nested: the outer pin holds
+        snapshot = self._snapshot
+        pinned = pin.snapshot = self._kernel._latest if snapshot is None else snapshot
+        self._owner = True
+        return pinned
+
+    def __exit__(self, *exc: object) -> None:
+        if self._owner:
+            self._kernel._pin.snapshot = None
 
 
 def _no_answer(_result: Refusal | None) -> None:
@@ -235,23 +258,13 @@ class Kernel:
         pinned = self._pin.snapshot
         return self._latest if pinned is None else pinned
 
-    @contextmanager
-    def reading(self, snapshot: Snapshot | None = None) -> Iterator[Snapshot]:
+    def reading(self, snapshot: Snapshot | None = None) -> _Reading:
         """Pin ``snapshot`` (None: the newest published one) for the calling thread until
         the block ends: every read of ``snapshot`` on this thread (every object's getter)
         sees that cycle, however many cycles the kernel publishes meanwhile; other
         threads are not affected. Yields the pinned snapshot. A nested block keeps the
         outer pin."""
-        pin = self._pin
-        held = pin.snapshot
-        if held is not None:
-            yield held
-            return
-        pinned = pin.snapshot = self._latest if snapshot is None else snapshot
-        try:
-            yield pinned
-        finally:
-            pin.snapshot = None
+        return _Reading(self, snapshot)
 
     def channel_index(self, channel_id: int) -> int:
         """Position of the channel with logical id ``channel_id`` in the state."""
@@ -310,9 +323,9 @@ class Kernel:
                         return
                     continue
                 started = time.perf_counter()
-                if self._event_speed and self._busy:
-                    self._run_in_bulk()
-                if not self._cycle():
+                if self._event_speed and self._busy and self._run_in_bulk():
+                    pass  # the bulk ran through a cycle an observer must see, published
+                elif not self._cycle():
                     return
                 self._between_cycles = False
                 exec_us = int((time.perf_counter() - started) * 1e6)
@@ -407,42 +420,58 @@ class Kernel:
         done(None)
         return True
 
-    def _run_in_bulk(self) -> None:
-        """Event-speed virtual clock: run the cycles up to the next event in one step,
-        unpublished. An event is anything that can change the course of the run or be
-        seen: a command in the queue, a cycle an observer (the notification hub) must
-        see, and whatever makes a channel's next cycle more than cruising (a block end,
-        a block to feed, a ramp, a link, see ``ChannelRunner.cruise_budget``). The
+    def _run_in_bulk(self) -> bool:
+        """Event-speed virtual clock: run the cycles up to the next event in one step.
+        An event is anything that can change the course of the run: a command in the
+        queue, and whatever makes a channel's next cycle more than cruising (a block
+        end, a block to feed, a ramp, a link, see ``ChannelRunner.cruise_budget``). The
         state after the bulk is the state after stepping the same cycles, bit for bit;
-        the next cycle (the event's) then runs and is published as a cycle."""
+        the next cycle (the event's) then runs and is published as a cycle.
+
+        A cycle an observer (the notification hub) must see is no event when it only
+        cruises: the bulk runs through it and publishes it (issue 37: a due cycle of the
+        subscriptions costs one snapshot, not a whole cycle's work). True when it did;
+        False when the cycle the bulk stopped before still has to run."""
         if self._waiting or not self._queue.empty() or not self.stats.running:
-            return
+            return False
         most = BULK_CYCLES_MAX
+        due_cycle = None
         if self.on_cycle_end is not None:
             if self.next_observed_ns is None:
-                return  # the hook sees every cycle
+                return False  # the hook sees every cycle
             due_ns = self.next_observed_ns()
-            if due_ns is not None:  # the cycles run in bulk lie before the due one
-                most = min(most, -(-due_ns // self.cycle_ns) - 1 - self.stats.cycles)
+            if due_ns is not None:  # the bulk ends at the due cycle, or before it
+                due_cycle = -(-due_ns // self.cycle_ns)
+                most = min(most, due_cycle - self.stats.cycles)
         if most <= 0 or not self.switchover.at_rest():
-            return
+            return False
         runners = self.state.runners
         moving = False
+        changed = []
         for runner in runners:
             budget = runner.cruise_budget(most)
+            changed.append(budget is not None)
             if budget is None:
                 continue  # its cycles change nothing
             if budget <= 0:
-                return
+                return False
             most, moving = budget, True
         if not moving:
-            return
+            return False
         self.stats.cycles += most
         time_s = self.stats.cycles * self.cycle_s
         for runner in runners:
             runner.cruise(most, time_s)
         self.state.drive_axes()
         self.switchover.update_offsets([False] * len(runners))
+        if self.stats.cycles != due_cycle:
+            return False
+        # the due cycle cruised: publish it as stepping would (a channel whose cycles
+        # change nothing keeps its frozen copy, as in a cycle's ``_work``)
+        self.alarms.tick(self.stats.cycles, self.stats.cycles * self.cycle_ns)
+        self._changed = changed
+        self._publish()
+        return True
 
     def _next_command(self, block: bool) -> Queued:
         if self._waiting:
