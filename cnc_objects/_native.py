@@ -12,7 +12,6 @@ same float operations (``tests/service/kernel/test_native_path.py``).
 
 from __future__ import annotations
 
-import hashlib
 import importlib.abc
 import importlib.machinery
 import importlib.util
@@ -59,6 +58,8 @@ class NativeFinder(importlib.abc.MetaPathFinder):
         return self._checked
 
     def _current(self) -> bool:
+        import hashlib  # here: the package's import (every ``cnc`` start) stays light
+
         for module, entry in self.modules.items():
             try:
                 digest = hashlib.sha256(_source_of(module).read_bytes()).hexdigest()

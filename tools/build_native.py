@@ -31,6 +31,9 @@ ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "build" / "native"
 LIB = OUT / "lib"
 MANIFEST = LIB / "manifest.json"
+#: No fused multiply-add: a * b + c stays two roundings as in Python (gcc contracts by
+#: default where the target has FMA, e.g. aarch64), so the results are the same bit for bit.
+CFLAGS = "-ffp-contract=off"
 
 #: The compiled modules (all or none are loaded: compiled modules of one group call each
 #: other natively). Each must pass mypy strict, which mypyc relies on.
@@ -72,6 +75,7 @@ def up_to_date() -> bool:
         return False
     modules = manifest.get("modules", {})
     return (manifest.get("cache_tag") == sys.implementation.cache_tag
+            and manifest.get("cflags") == CFLAGS
             and set(modules) == set(NATIVE_MODULES)
             and all(modules[m]["sha256"] == digest(source_of(m)) for m in NATIVE_MODULES))
 
@@ -113,7 +117,8 @@ def build() -> int:
             f"      script_args=['build_ext', '--build-lib', {str(lib)!r},\n"
             f"                   '--build-temp', {str(Path(scratch) / 'tmp')!r}])\n"
         )
-        done = subprocess.run([sys.executable, "-c", script, *files], cwd=src,
+        env = dict(os.environ, CFLAGS=f"{os.environ.get('CFLAGS', '')} {CFLAGS}".strip())
+        done = subprocess.run([sys.executable, "-c", script, *files], cwd=src, env=env,
                               capture_output=True, text=True)
         if done.returncode != 0:
             tail = (done.stderr or done.stdout).strip().splitlines()[-3:]
@@ -133,6 +138,7 @@ def build() -> int:
         shutil.copytree(lib, LIB)
         MANIFEST.write_text(json.dumps({
             "cache_tag": sys.implementation.cache_tag,
+            "cflags": CFLAGS,
             "group": [p.name.split(".")[0] for p in group],
             "group_files": [p.name for p in group],
             "modules": modules,
