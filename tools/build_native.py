@@ -156,7 +156,10 @@ def main() -> int:
     """Build unless up to date (``--force``: always)."""
     if "--force" not in sys.argv and up_to_date():
         return 0
-    return build()
+    try:
+        return build()
+    except Exception as exc:  # whatever goes wrong, the pure-Python kernel still runs
+        return _warn(f"the build failed: {exc!r}")
 
 
 if __name__ == "__main__":

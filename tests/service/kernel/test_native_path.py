@@ -74,3 +74,27 @@ def test_compiled_path_equals_pure_python(name: str) -> None:
     assert len(pure) > 100  # the run reached its end through many cycles
     for a, b in zip(compiled, pure, strict=True):
         assert a == b, f"compiled: {a}\npure:     {b}"
+
+
+def test_a_changed_source_makes_the_finder_step_aside() -> None:
+    """A manifest whose hash is not the source's: nothing compiled is handed out (the
+    pure module is imported instead), whatever the build left in ``build/native``."""
+    module = "cnc_objects.service.kernel.path.limits"
+    finder = _native.NativeFinder({"modules": {module: {
+        "so": "cnc_objects/service/kernel/path/limits.so", "sha256": "0" * 64}}})
+    assert not finder.active
+    assert finder.find_spec(module) is None
+
+
+def test_without_a_compiler_the_build_warns_and_succeeds(tmp_path: Path) -> None:
+    """No C compiler on the PATH: ``tools/build_native.py`` says so and exits 0 (``make
+    run`` goes on, the kernel runs pure Python); what was built before stays."""
+    manifest = ROOT / "build" / "native" / "lib" / "manifest.json"
+    before = manifest.read_bytes() if manifest.exists() else None
+    env = {k: v for k, v in os.environ.items() if k != "CC"}
+    env["PATH"] = str(tmp_path)  # an empty folder: no gcc, no cc
+    done = subprocess.run([sys.executable, "tools/build_native.py", "--force"], cwd=ROOT,
+                          env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "warning: the kernel's hot path is not compiled (no C compiler" in done.stderr
+    assert (manifest.read_bytes() if manifest.exists() else None) == before
