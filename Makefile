@@ -19,19 +19,30 @@ $(BIN)/python:
 
 # Stamp files record which extras are installed, so a changed pyproject reinstalls.
 $(VENV)/.installed: pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[plot]'
+	$(BIN)/python -m pip install --quiet -e '.[plot,native]'
+	$(BIN)/python tools/build_native.py
 	touch $@
 
 $(VENV)/.installed-test: pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[test,plot]'
+	$(BIN)/python -m pip install --quiet -e '.[test,plot,native]'
+	$(BIN)/python tools/build_native.py
 	touch $@ $(VENV)/.installed
+
+# The kernel's hot path compiled with mypyc (tools/build_native.py; issue 37): again
+# whenever one of its sources changes. Never fails: without a compiler it warns, and the
+# service runs the same code as pure Python.
+NATIVE_SOURCES := $(wildcard service/kernel/path/*.py) service/kernel/contour_lookahead.py \
+	tools/build_native.py
+$(VENV)/.native: $(NATIVE_SOURCES) | $(VENV)/.installed
+	$(BIN)/python tools/build_native.py
+	touch $@
 
 # `make run` starts the web HMI cnc-web beside the service, on http://127.0.0.1:$(WEB_PORT)
 # (loopback only); WEB=0 leaves it out. It ends with the service (Ctrl-C).
 WEB      ?= 1
 WEB_PORT ?= 8080
 
-run: $(VENV)/.installed
+run: $(VENV)/.installed $(VENV)/.native
 ifeq ($(WEB),0)
 	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) \
 		$(if $(DATA_DIR),--data-dir $(DATA_DIR)) $(if $(CONFIG),--config $(CONFIG))
@@ -44,12 +55,12 @@ endif
 
 # The checkers first (ruff: lint and import order; mypy, strict: tools/typecheck.py), then
 # the tests.
-test: $(VENV)/.installed-test
+test: $(VENV)/.installed-test $(VENV)/.native
 	$(BIN)/ruff check .
 	$(BIN)/python tools/typecheck.py
 	$(BIN)/python -m pytest $(PYTEST_ARGS)
 
-bench: $(VENV)/.installed-test
+bench: $(VENV)/.installed-test $(VENV)/.native
 	$(BIN)/python -m bench
 
 # The long form of tests/reliability (100 000 fuzzed frames, 640 NC mutants, 1.5 M load

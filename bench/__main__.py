@@ -23,9 +23,10 @@ Jitter part (``--part jitter``): the realtime cycle's lateness (p50, p99, max) a
 overruns while the service answers 5 000 reads/s and feeds 20 on-change subscriptions
 during a run (``bench/jitter_bench.py``).
 Virtual part (``--part virtual``): simulated seconds per wall second of the whole service
-on the virtual clock for the pocket, a 10 000-block spiral and a one-hour part, with no
-and with 20 on-change subscriptions, and the pocket and the one-hour part with cnc-web
-attached and one browser session (``bench/virtual_bench.py``).
+on the virtual clock for the pocket and a one-hour part, with no and with 20 on-change
+subscriptions, and with cnc-web attached and one browser session (``bench/virtual_bench.py``);
+then the short blocks (also ``--part short-blocks`` alone): a 10 000-block spiral and a
+CAM finishing program of 115 000 blocks (``bench/programs/cam_finish.py``).
 Fairness part (``--part fairness``): another client's read latency while one client
 holds every notification the service takes (20 000 cyclic, 1 ms), idle and loaded
 (``bench/fairness_bench.py``; target p99 < 10 ms); then beside a monitor's large
@@ -220,7 +221,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
     parser.add_argument("--part", choices=("all", "dispatch", "client", "ads", "kernel",
                                            "jitter", "virtual", "lookahead", "fairness", "cli",
-                                           "web", "idle"),
+                                           "web", "idle", "short-blocks"),
                         default="all",
                         help="dispatch: request dispatch (ZeroMQ); client: AsyncClient "
                         "batching against the raw echo, wall and CPU; ads: pyads over AMS/TCP; "
@@ -229,7 +230,8 @@ def main(argv: list[str] | None = None) -> int:
                         "machining time against the optimum; fairness: reads while the "
                         "notification limit is used up; cli: cnc's start to exit; web: "
                         "cnc-web's live values and their cost; idle: an idle service's CPU "
-                        "and its kernel's idle cycle")
+                        "and its kernel's idle cycle; short-blocks: the spiral and the CAM "
+                        "finishing program on the virtual clock (also in virtual)")
     parser.add_argument("--jitter-s", type=float, default=20.0,
                         help="seconds of load per jitter run (issue 22 asks 60)")
     parser.add_argument("--idle-s", type=float, default=15.0,
@@ -257,6 +259,10 @@ def main(argv: list[str] | None = None) -> int:
 
         virtual_bench.main(min(args.runs, 3))
         virtual_bench.web_rows(min(args.runs, 3))
+    if args.part in ("all", "virtual", "short-blocks"):
+        from . import virtual_bench
+
+        virtual_bench.short_blocks(min(args.runs, 3))
     if args.part in ("all", "fairness"):
         from . import fairness_bench
 

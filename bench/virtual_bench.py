@@ -1,11 +1,16 @@
 """Virtual time: simulated seconds per wall second of the whole service (issue 22).
 
 A service on the virtual clock (1 ms cycle, the default machine) runs, through the client
-library as ``cnc run --wait`` does, the pocket example, the look-ahead bench's spiral of
-10 000 blocks and a generated part of one hour of machining; each with no subscription
-and with 20 on-change subscriptions to values that move (held by a second connection).
-The figure is ``ch1.program_time`` divided by the wall time from START to READY.
-Targets (issue 22): >= 500x with none, >= 100x with 20 subscriptions.
+library as ``cnc run --wait`` does, the pocket example and a generated part of one hour of
+machining; each with no subscription and with 20 on-change subscriptions to values that
+move (held by a second connection). The figure is ``ch1.program_time`` divided by the
+wall time from START to READY. Targets (issue 22): >= 500x with none, >= 100x with 20
+subscriptions.
+
+Short blocks (issue 37, ``short_blocks``): the look-ahead bench's spiral of 10 000 blocks
+of 0.05 mm and a CAM finishing program of about 115 000 blocks
+(``bench/programs/cam_finish.py``), the same way, in a table of their own. Targets:
+>= 100x with none, >= 50x with 20 subscriptions.
 
 Repeatable traces (issue 37, ``repeatable_traces``): the one-hour part on a service with
 ``--samples repeatable``, 20 cyclic subscriptions at 10 ms held by a second connection
@@ -41,6 +46,7 @@ from tests.support.service import start_service
 
 from .jitter_bench import WATCHED
 from .lookahead_programs import spiral
+from .programs import cam_finish
 
 ROOT = Path(__file__).resolve().parents[1]
 SUBSCRIPTIONS = 20
@@ -61,7 +67,6 @@ def programs() -> dict[str, bytes]:
     """The three parts, by name."""
     return {
         "pocket-la-on.nc": (ROOT / "docs/examples/pocket-la-on.nc").read_bytes(),
-        "spiral.nc": spiral().text.encode(),
         "one-hour.nc": one_hour_part().encode(),
     }
 
@@ -330,3 +335,43 @@ def web_rows(runs: int) -> None:
         print(f"{name:18} {'cnc-web':>13} {sim:12.1f} {factor:7.0f}x  >= {WEB_TARGET}: "
               f"{'met' if factor >= WEB_TARGET else 'NOT met'}"
               f"{'' if repeats > 1 else ' (one run)'}")
+
+
+SHORT_BLOCK_TARGETS = {0: 100, SUBSCRIPTIONS: 50}  # issue 37: speed by subscriptions
+
+
+def short_block_programs() -> dict[str, bytes]:
+    """The short-block parts, by name: the spiral and the CAM finishing program
+    (generated here: the generator is the source, see its docstring)."""
+    return {
+        "spiral.nc": spiral().text.encode(),
+        "cam-finish.nc": cam_finish.program().encode("ascii"),
+    }
+
+
+def short_blocks(runs: int) -> None:
+    """Measure and print the short-block table (issue 37): each part with no and with 20
+    on-change subscriptions, medians of ``runs``."""
+    parts = short_block_programs()
+    service = start_service("--clock", "virtual")
+    rows = []
+    try:
+        for name, data in parts.items():
+            for subscriptions in (0, SUBSCRIPTIONS):
+                factors, sim = [], 0.0
+                for _ in range(runs):
+                    sim, wall = asyncio.run(_run(service.endpoint, name, data, subscriptions))
+                    factors.append(sim / wall)
+                    print(f"virtual: {name} with {subscriptions} subscriptions: {sim:.1f} s "
+                          f"in {wall:.2f} s ({sim / wall:.1f}x)", file=sys.stderr)
+                rows.append((name, len(data), subscriptions, sim, statistics.median(factors)))
+    finally:
+        service.stop()
+    print("\nshort blocks, virtual time, whole service (1 ms cycle): simulated s per wall s, "
+          f"START to READY, median of {runs}")
+    print(f"{'part':14} {'bytes':>9} {'subscriptions':>13} {'machining s':>12} {'speed':>8}  "
+          "target")
+    for name, size, subscriptions, sim, factor in rows:
+        target = SHORT_BLOCK_TARGETS[subscriptions]
+        print(f"{name:14} {size:9d} {subscriptions:13d} {sim:12.1f} {factor:7.1f}x  "
+              f">= {target}: {'met' if factor >= target else 'NOT met'}")

@@ -9,3 +9,7 @@ repository's top-level folders and are mapped here by setuptools' ``package-dir`
 - ``cnc_objects.clients``: the client library, ``cnc``, ``cnc-hmi``, ``cnc-mqtt``
 - ``cnc_objects.testing``: the pytest plugin for integration tests against a service
 """
+
+from . import _native
+
+_native.install()  # the compiled kernel hot path, when built and current

@@ -150,6 +150,8 @@ class DecoderFeed:
         self.modal = modal
         self.keep_open = keep_open  # extended MDI: wait for more jobs instead of ending
         self._jobs: queue.SimpleQueue[Job | None] = queue.SimpleQueue()
+        # (``_take_queued`` drains it under its own lock: ``mutex``, ``queue`` and
+        # ``not_full`` are the attributes ``queue.Queue``'s methods use)
         self._out: queue.Queue[Item] = queue.Queue(maxsize=capacity)
         self._cancel = threading.Event()
         self._ended = False
@@ -178,6 +180,7 @@ class DecoderFeed:
         """Up to ``limit`` items; with ``wait``, block until ``limit`` items, the end of
         the jobs added so far, or the end of decoding."""
         items: list[Item] = []
+        self._take_queued(limit, items)
         while len(items) < limit and not self._ended:
             try:
                 item = self._out.get_nowait()
@@ -196,6 +199,25 @@ class DecoderFeed:
             elif id(item) in self._markers:
                 self._outstanding -= 1
         return items
+
+    def _take_queued(self, limit: int, items: list[Item]) -> None:
+        """Move what is queued already (up to ``limit`` items in all) into ``items`` under
+        one lock: what ``get_nowait`` one by one would give, without a lock and a wake-up
+        per block (issue 37: a CAM program hands over a block or two in every cycle)."""
+        out = self._out
+        with out.mutex:
+            queued = out.queue
+            taken = 0
+            while queued and len(items) < limit and not self._ended:
+                item = queued.popleft()
+                taken += 1
+                items.append(item)
+                if isinstance(item, DecodeEnd | NcError):
+                    self._ended = True
+                elif id(item) in self._markers:
+                    self._outstanding -= 1
+            if taken:
+                out.not_full.notify(taken)
 
     def ready(self, limit: int) -> bool:
         """``take(limit, wait=True)`` would return at once: ``limit`` items are queued or

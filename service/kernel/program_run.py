@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import replace
 from enum import IntEnum
 from functools import partial
 from typing import Protocol
@@ -47,11 +46,14 @@ from .path.interpolator import StepResult, Waiting
 from .path.segments import Segment
 from .plc_functions import PlcFunctions
 from .prod_time_trace import ProdTimeTrace, trace_file_name
-from .state import BLOCK_START_COLUMN, Channel, ErrorEntry
+from .state import BLOCK_START_COLUMN, Channel, ContourLookaheadUnit, ErrorEntry
 from .tool_life import count_cutting
 from .wait_reason import WaitReason, manual_open, path_wait_reason
 
 _NOT_WAITING, _OVERRIDE_ZERO = int(WaitReason.NONE), int(WaitReason.OVERRIDE_ZERO)
+# an int, not the flag: ``int & IntFlag`` goes through enum's Python-level __rand__,
+# about 2 us, asked in every cycle (issue 37, short blocks)
+_SUPPRESS_TECHNO = int(ExecutionMode.SUPPRESS_TECHNO_OUTPUT)
 _INCR_PER_MM = 10_000  # 0.1 um increments per mm
 PROD_TIME_STEPS_PER_CYCLE = 5_000  # virtual clock: simulated cycles per GEO cycle (PROD_TIME)
 _PROD_TIME_SHARE = 0.4  # realtime clock: share of a GEO cycle the calculation may use
@@ -321,7 +323,7 @@ class ProgramRun:
 
     def _technology(self) -> PlcFunctions | None:
         """The channel's technology output, None while it is suppressed (PROD_TIME)."""
-        if self.channel.execution_mode_active & ExecutionMode.SUPPRESS_TECHNO_OUTPUT:
+        if self.channel.execution_mode_active & _SUPPRESS_TECHNO:
             return None
         return self._host.plc
 
@@ -551,9 +553,16 @@ class ProdTimeRun(ProgramRun):
 def show_contour_state(channel: Channel, contour: ContourLog) -> None:
     """The contour look-ahead unit's state after blocks were prepared, the log cleared
     or ended."""
-    channel.contour = replace(
-        channel.contour, max_dist_prog_start_incr=contour.max_dist_prog_start_incr,
+    unit = channel.contour
+    # built field by field (a new field of the unit must be added here): ``replace``
+    # looks the fields up at each call, and this runs in every cycle that prepared
+    # blocks (issue 37)
+    channel.contour = ContourLookaheadUnit(
+        request_start_position=unit.request_start_position,
+        request_length=unit.request_length, semaphor=unit.semaphor,
+        max_dist_prog_start_incr=contour.max_dist_prog_start_incr,
         count_logged_blocks=len(contour.log), log_active=contour.active,
+        response=unit.response,
     )
 
 

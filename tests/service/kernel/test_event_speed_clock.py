@@ -15,6 +15,7 @@ and the scripts; ``--soak`` (make soak) runs many more examples.
 
 from __future__ import annotations
 
+import math
 import threading
 from dataclasses import dataclass, field
 from typing import Any
@@ -229,3 +230,44 @@ def test_cruising_cycles_run_in_bulk() -> None:
     published = assert_same(text, (100,), {})
     stepped_cycles = run(text, False, (100,), {}).end_cycle
     assert published < stepped_cycles / 10
+
+
+@st.composite
+def short_block_programs(draw: st.DrawFn) -> str:
+    """CAM-like runs of short blocks (issue 37): 20-200 moves of 0.01-0.1 mm in X, Y
+    and Z at a high feed, so that several blocks end in one cycle, with LA_ON or not,
+    and now and then an M function between two runs."""
+    lines = ["G90 G17"]
+    x = y = z = 0.0
+    for _ in range(draw(st.integers(1, 3))):
+        if draw(st.booleans()):
+            lines.append("LA_ON")
+        lines.append(f"G1 F{draw(st.sampled_from([1500, 3000, 6000, 12000]))}")
+        heading = draw(st.integers(0, 359))
+        for _ in range(draw(st.integers(20, 200))):
+            heading += draw(st.integers(-20, 20))
+            step = draw(st.integers(10, 100)) / 1000
+            x += step * math.cos(math.radians(heading))
+            y += step * math.sin(math.radians(heading))
+            z += draw(st.integers(-10, 10)) / 1000
+            lines.append(f"X{x:.4f} Y{y:.4f} Z{z:.4f}")
+        lines.append("LA_OFF")
+        if draw(st.booleans()):
+            lines.append(draw(st.sampled_from(["M8", "M9", "G4 X0.01"])))
+    lines.append("M30")
+    return "\n".join(lines) + "\n"
+
+
+def test_short_blocks_are_cycle_exact_against_stepping() -> None:
+    """Programs of short blocks (several block ends per cycle, issue 37), with the
+    subscription periods and scripts of the test above: 10 generated runs (``--soak``:
+    100 new ones)."""
+    soak = scale.soak()
+
+    @settings(max_examples=100 if soak else 10, deadline=None, derandomize=not soak,
+              suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    @given(text=short_block_programs(), periods=PERIODS, script=scripts())
+    def check(text: str, periods: list[int], script: dict[int, list[Any]]) -> None:
+        assert_same(text, tuple(sorted(set(periods))), script)
+
+    check()
