@@ -254,15 +254,14 @@ def main(argv: list[str] | None = None) -> int:
         from . import jitter_bench
 
         jitter_bench.main(min(args.runs, 3), args.jitter_s)
-    if args.part in ("all", "virtual"):
+    if args.part in ("all", "virtual"):  # issue 37's table, every row in one
         from . import virtual_bench
 
-        virtual_bench.main(min(args.runs, 3))
-        virtual_bench.web_rows(min(args.runs, 3))
-    if args.part in ("all", "virtual", "short-blocks"):
+        virtual_bench.print_table(virtual_bench.all_rows(min(args.runs, 3)))
+    if args.part == "short-blocks":
         from . import virtual_bench
 
-        virtual_bench.short_blocks(min(args.runs, 3))
+        virtual_bench.print_table(virtual_bench.short_blocks(min(args.runs, 3)))
     if args.part in ("all", "fairness"):
         from . import fairness_bench
 
