@@ -45,7 +45,12 @@ import zmq
 
 from cnc_objects.protocol.constants import AdsCommand, CncPort
 from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
-from cnc_objects.protocol.frames import decode_request, encode_error, encode_notification
+from cnc_objects.protocol.frames import (
+    decode_request,
+    encode_error,
+    encode_notification,
+    encode_rows_response,
+)
 from cnc_objects.protocol.roles import Role
 
 from .backend import Backend
@@ -73,6 +78,7 @@ _POLLIN = int(zmq.POLLIN)
 _packb = msgpack.Packer(use_bin_type=True, autoreset=True).pack  # as protocol.frames packs
 _USER_ID = "User-Id"  # message property: the ZAP handler's name for the connection
 _READ_WRITE = AdsCommand.READ_WRITE
+_BROWSE = AdsCommand.BROWSE
 
 
 Envelope = tuple[bytes, ...]
@@ -363,7 +369,11 @@ class ZmqServer:
     @staticmethod
     def ok(envelope: Envelope, req: Any, *fields: Any) -> bytes:
         """``[invoke_id, command, 0, *fields]``: ``frames.encode_response``, packed here
-        without its own call (the dispatch hot path)."""
+        without its own call (the dispatch hot path). A browse's rows (the catalogue) are
+        packed row by row, so that the cycle thread gets the GIL between them
+        (``encode_rows_response``)."""
+        if req.COMMAND == _BROWSE:
+            return encode_rows_response(req.invoke_id, _BROWSE, fields[0])
         frame: bytes = _packb([req.invoke_id, req.COMMAND, 0, *fields])
         return frame
 
