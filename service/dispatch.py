@@ -67,6 +67,8 @@ _ADMIN = Role.ADMIN
 _READ_WRITE = AdsCommand.READ_WRITE
 
 Reply = bytes | None
+#: Browse patterns whose answers are kept (the catalogue described); more start over.
+BROWSE_PATTERNS_KEPT = 16
 
 
 class FrontEnd(Protocol):
@@ -114,6 +116,7 @@ class Dispatcher:
         self._send = front.send
         self._space_read = backend.space.read
         self._read_value = backend.read_value
+        self._browsed: dict[str, list[list[Any]]] = {}  # pattern -> its objects described
         self._handlers: dict[int, Callable[[Envelope, Any], Reply]] = {
             AdsCommand.READ_DEVICE_INFO: self._read_device_info,
             AdsCommand.READ: self._read,
@@ -285,7 +288,16 @@ class Dispatcher:
         return self._ok(envelope, req)
 
     def _browse(self, envelope: Envelope, req: BrowseRequest) -> Reply:
-        found = [obj.describe() for obj in self.space.match(req.pattern)]
+        # The catalogue does not change while the service runs (frozen objects, added at
+        # start-up): describing it once per pattern spares the event loop 10-30 ms of
+        # Python per browse of ``*``, during which the realtime cycle waited for the GIL
+        # up to a switch interval every cycle (issue 37, docs/kernel.md).
+        found = self._browsed.get(req.pattern)
+        if found is None:
+            found = [obj.describe() for obj in self.space.match(req.pattern)]
+            if len(self._browsed) >= BROWSE_PATTERNS_KEPT:
+                self._browsed.clear()  # patterns are the clients' choice: bounded
+            self._browsed[req.pattern] = found
         return self._ok(envelope, req, found)
 
     # ------------------------------------------------------------ read-write
