@@ -52,7 +52,7 @@ def _handoffs(rows: list[list[object]], request: BrowseRequest) -> tuple[int, by
     try:
         for _ in range(40):
             start = time.perf_counter()
-            frame = ZmqServer.ok((), request, rows)
+            frame = ZmqServer.ok((), request, list(rows))  # a new list: packed again
             end = time.perf_counter()
             best = max(best, sum(1 for t in list(handoffs) if start < t < end))
             if best >= HANDOFFS_MIN:
