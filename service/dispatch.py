@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from enum import IntEnum
 from typing import Any, Protocol, cast
 
 from cnc_objects.objects import Entry
@@ -71,6 +72,14 @@ Reply = bytes | None
 BROWSE_PATTERNS_KEPT = 16
 
 
+def _as_tuples(value: Any) -> Any:
+    """``value`` with every list in it a tuple and every int enum an int: msgpack packs
+    them alike, and a tuple of atoms is one the collector stops tracking."""
+    if isinstance(value, list):
+        return tuple(_as_tuples(v) for v in value)
+    return int(value) if isinstance(value, IntEnum) else value
+
+
 class FrontEnd(Protocol):
     """A front end's wire, as the dispatcher needs it."""
 
@@ -116,7 +125,7 @@ class Dispatcher:
         self._send = front.send
         self._space_read = backend.space.read
         self._read_value = backend.read_value
-        self._browsed: dict[str, list[list[Any]]] = {}  # pattern -> its objects described
+        self._browsed: dict[str, list[Any]] = {}  # pattern -> its objects described
         self._handlers: dict[int, Callable[[Envelope, Any], Reply]] = {
             AdsCommand.READ_DEVICE_INFO: self._read_device_info,
             AdsCommand.READ: self._read,
@@ -294,7 +303,9 @@ class Dispatcher:
         # up to a switch interval every cycle (issue 37, docs/kernel.md).
         found = self._browsed.get(req.pattern)
         if found is None:
-            found = [obj.describe() for obj in self.space.match(req.pattern)]
+            # as tuples of atoms (the same msgpack arrays): the collector stops tracking
+            # them, so 50 000 kept objects do not lengthen its full collections
+            found = [_as_tuples(obj.describe()) for obj in self.space.match(req.pattern)]
             if len(self._browsed) >= BROWSE_PATTERNS_KEPT:
                 self._browsed.clear()  # patterns are the clients' choice: bounded
             self._browsed[req.pattern] = found
