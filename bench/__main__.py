@@ -21,7 +21,9 @@ not, against the raw pipelined echo in the same run, in reads/s and in CPU time 
 of each process (``bench/client_bench.py``; issue 30).
 Jitter part (``--part jitter``): the realtime cycle's lateness (p50, p99, max) and
 overruns while the service answers 5 000 reads/s and feeds 20 on-change subscriptions
-during a run (``bench/jitter_bench.py``).
+during a run, and while an idle service answers browses of the whole catalogue
+(``bench/jitter_bench.py``); its rows of the virtual part's table (issue 37) are printed
+there and again under that table when both parts run (``make bench``).
 Virtual part (``--part virtual``): simulated seconds per wall second of the whole service
 on the virtual clock for the pocket and a one-hour part, with no and with 20 on-change
 subscriptions, and with cnc-web attached and one browser session (``bench/virtual_bench.py``);
@@ -250,14 +252,16 @@ def main(argv: list[str] | None = None) -> int:
         ads_clients_bench.main()
     if args.part in ("all", "kernel"):
         kernel(args.runs)
+    realtime_rows: list[str] = []  # the jitter part's rows of the virtual part's table
     if args.part in ("all", "jitter"):
         from . import jitter_bench
 
-        jitter_bench.main(min(args.runs, 3), args.jitter_s)
+        realtime_rows = jitter_bench.main(min(args.runs, 3), args.jitter_s)
     if args.part in ("all", "virtual"):  # issue 37's table, every row in one
         from . import virtual_bench
 
-        virtual_bench.print_table(virtual_bench.all_rows(min(args.runs, 3)))
+        virtual_bench.print_table(virtual_bench.all_rows(min(args.runs, 3)),
+                                  tuple(realtime_rows))
     if args.part == "short-blocks":
         from . import virtual_bench
 

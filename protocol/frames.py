@@ -44,7 +44,9 @@ from .constants import AdsCommand
 from .errors import AdsReturnCode, ProtocolError
 
 U32_MAX = 0xFFFFFFFF
-_packb = msgpack.Packer(use_bin_type=True, autoreset=True).pack
+_packer = msgpack.Packer(use_bin_type=True, autoreset=True)
+_packb = _packer.pack
+_array_header = _packer.pack_array_header
 
 
 def _pack(obj: list[Any]) -> bytes:
@@ -364,6 +366,25 @@ def encode_request(invoke_id: int, command: int, port: int, fields: tuple[Any, .
 def encode_response(invoke_id: int, command: int, *fields: Any) -> bytes:
     """Encode a successful reply without building a ``Response`` (the hot path)."""
     return _pack([invoke_id, command, 0, *fields])
+
+
+def pack_rows(rows: list[Any]) -> bytes:
+    """The rows of a list, packed one at a time, without the list's header (see
+    ``encode_rows_response``)."""
+    return b"".join([_packb(row) for row in rows])
+
+
+def encode_rows_response(invoke_id: int, command: int, rows: list[Any],
+                         packed_rows: bytes | None = None) -> bytes:
+    """``encode_response(invoke_id, command, rows)`` byte for byte, packed one row at a
+    time (or ``packed_rows``: ``pack_rows(rows)`` kept from before). Why: msgpack packs a
+    list in one C call that holds the GIL throughout; the whole catalogue (a browse of
+    ``*``: 4 000 rows, 0.6 MB) held it for 1.5-4 ms, and the realtime cycle waited that
+    long for it (docs/kernel.md, "What delays the realtime cycle"). Between two rows the
+    interpreter hands the GIL to a thread that asks."""
+    head: bytes = (_array_header(4) + _packb(invoke_id) + _packb(command) + _packb(0)
+                   + _array_header(len(rows)))
+    return head + (pack_rows(rows) if packed_rows is None else packed_rows)
 
 
 def encode_error(invoke_id: int, command: int, code: int, message: str) -> bytes:

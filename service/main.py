@@ -89,6 +89,8 @@ DEFAULT_ENDPOINT = "tcp://127.0.0.1:5555"
 EXIT_USAGE = 2
 KERNEL_STOP_S = 2.0  # at SIGTERM: the cycle thread gets this long to end
 WRITER_STOP_S = 2.0  # then the output writer this long to write what is queued
+#: Under SCHED_FIFO the GIL switch interval is the cycle time divided by this (issue 37).
+SWITCH_CYCLE_FRACTION_FIFO = 2
 
 
 class ClockKind(StrEnum):
@@ -175,10 +177,13 @@ async def serve(
         log.info("service threads under %s", f"SCHED_FIFO priority {served.priority}"
                  if served.priority else "SCHED_OTHER")
         if served.priority:
-            # no other process delays a GIL hand-over now: a shorter interval brings the
-            # cycle's wait for the GIL down (p99 430 -> 290 us, make bench part jitter)
-            switch_s = config.cycle_ms / 1000.0 / 10
+            # No other process delays a GIL hand-over now. The interval trades the cycle's
+            # wait for the GIL when it wakes (p99) against the times another thread takes
+            # the GIL from it inside a cycle (overruns): half a cycle, 0.09 % overruns and
+            # p99 510 us against 0.29 % and 440 us at a tenth (issue 37, docs/kernel.md).
+            switch_s = config.cycle_ms / 1000.0 / SWITCH_CYCLE_FRACTION_FIFO
     sys.setswitchinterval(switch_s)
+    log.info("GIL switch interval %g ms", switch_s * 1000.0)
     load, exists = _kernel_loader(store)
     limits = config.limits
     if outputs is None:

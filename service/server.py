@@ -45,7 +45,13 @@ import zmq
 
 from cnc_objects.protocol.constants import AdsCommand, CncPort
 from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
-from cnc_objects.protocol.frames import decode_request, encode_error, encode_notification
+from cnc_objects.protocol.frames import (
+    decode_request,
+    encode_error,
+    encode_notification,
+    encode_rows_response,
+    pack_rows,
+)
 from cnc_objects.protocol.roles import Role
 
 from .backend import Backend
@@ -73,6 +79,20 @@ _POLLIN = int(zmq.POLLIN)
 _packb = msgpack.Packer(use_bin_type=True, autoreset=True).pack  # as protocol.frames packs
 _USER_ID = "User-Id"  # message property: the ZAP handler's name for the connection
 _READ_WRITE = AdsCommand.READ_WRITE
+_BROWSE = AdsCommand.BROWSE
+#: The rows of the last browse answered and their packing: the dispatcher keeps a pattern's
+#: rows (one list, never changed), so a browse of ``*`` after the first packs nothing.
+_browsed: tuple[list[Any], bytes] | None = None
+
+
+def _browse_reply(invoke_id: int, rows: list[Any]) -> bytes:
+    """A browse's reply, its rows packed once per list of rows (the event loop's time, and
+    the cycle's wait for the GIL meanwhile: issue 37)."""
+    global _browsed
+    kept = _browsed
+    if kept is None or kept[0] is not rows:
+        kept = _browsed = (rows, pack_rows(rows))
+    return encode_rows_response(invoke_id, _BROWSE, rows, kept[1])
 
 
 Envelope = tuple[bytes, ...]
@@ -363,7 +383,11 @@ class ZmqServer:
     @staticmethod
     def ok(envelope: Envelope, req: Any, *fields: Any) -> bytes:
         """``[invoke_id, command, 0, *fields]``: ``frames.encode_response``, packed here
-        without its own call (the dispatch hot path)."""
+        without its own call (the dispatch hot path). A browse's rows (the catalogue) are
+        packed row by row, so that the cycle thread gets the GIL between them
+        (``encode_rows_response``)."""
+        if req.COMMAND == _BROWSE:
+            return _browse_reply(req.invoke_id, fields[0])
         frame: bytes = _packb([req.invoke_id, req.COMMAND, 0, *fields])
         return frame
 
