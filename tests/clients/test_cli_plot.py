@@ -5,12 +5,14 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from cnc_objects.clients import AdsError, Client
+from cnc_objects.protocol.wait_reasons import WaitReason
 from tests.clients.test_cli import cnc, json_lines
 from tests.clients.test_path_plot import FEED_RGB, PROGRAM, TOP_SPEED_RGB, png_pixels
 from tests.support.service import RunningService
@@ -75,12 +77,17 @@ def test_a_long_run_is_thinned_to_fit_one_download(service: RunningService) -> N
 
 def test_trace_run_refuses_a_working_channel(service: RunningService) -> None:
     with Client(service.endpoint) as c:
-        c.upload("slow.nc", b"G01 X150 F60\nM30\n")
+        # M0 stops the run until START: it stays, however fast the event-speed clock is
+        c.upload("slow.nc", b"G01 X1 F600\nM0\nG01 X150\nM30\n")
         c.run_program("slow.nc")
+        deadline = time.monotonic() + 30
+        while c.read("ch1.mc_wait_reason_r") != WaitReason.PROGRAMMED_STOP:
+            assert time.monotonic() < deadline, "the run never reached its M0"
         with pytest.raises(AdsError, match="needs a channel that is not working") as caught:
             c.trace_run("slow.nc")
         assert caught.value.code == 0x707  # DEVICE_NOTREADY
-        assert c.read("ch1.mc_active_state_r") == 4  # the real run goes on
+        assert c.read("ch1.mc_active_state_r") == 4  # the real run goes on (at its M0)
+        assert c.read("ch1.mc_active_program_name_r") == "slow.nc"
 
 
 def test_cnc_plot_writes_the_png(endpoint: str, tmp_path: Path) -> None:
