@@ -107,4 +107,5 @@ def test_the_store_has_no_path_for_kernel_writes(store):
     (a chunked upload appends to its own temporary file, ``program_uploads``)."""
     assert [name for name in dir(store) if not name.startswith("_")] == [
         "delete", "exists", "list", "max_bytes", "max_files", "max_total_bytes", "path_of", "read",
-        "read_text", "replace_with", "root", "used_bytes", "write"]
+        "read_text", "remove_unfinished_uploads", "replace_with", "root", "size_bytes",
+        "used_bytes", "write"]
