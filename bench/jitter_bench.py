@@ -27,11 +27,14 @@ import statistics
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 from cnc_objects.clients import AsyncClient
 from cnc_objects.service.kernel.realtime_priority import SchedPolicy
+from cnc_objects.testing import ServiceProcess
 from tests.support.service import start_service
 
 from .common import BENCH_MACHINE
@@ -209,20 +212,27 @@ async def _browsing(endpoint: str) -> Browsing:
     return Browsing(figures["cnc_cycle_overruns_r"], figures["cnc_cycle_jitter_max_r"], elapsed)
 
 
+@contextmanager
+def realtime_bench_service() -> Iterator[ServiceProcess]:
+    """A fresh realtime service of the bench machine (``BENCH_MACHINE``), stopped after."""
+    with tempfile.TemporaryDirectory() as tmp:
+        machine = Path(tmp) / "bench.toml"
+        machine.write_text(BENCH_MACHINE)
+        service = start_service("--clock", "realtime", "--config", str(machine))
+        try:
+            yield service
+        finally:
+            service.stop()
+
+
 def measure_browsing(runs: int) -> list[Browsing]:
     """``runs`` times: a fresh realtime service, idle, answers ``BROWSES`` browses of the
     whole catalogue (issue 37: the reply packed in one call held the GIL 1.5-4 ms, and
     every browse made the cycle overrun)."""
     results = []
     for run in range(runs):
-        with tempfile.TemporaryDirectory() as tmp:
-            machine = Path(tmp) / "bench.toml"
-            machine.write_text(BENCH_MACHINE)
-            service = start_service("--clock", "realtime", "--config", str(machine))
-            try:
-                results.append(asyncio.run(_browsing(service.endpoint)))
-            finally:
-                service.stop()
+        with realtime_bench_service() as service:
+            results.append(asyncio.run(_browsing(service.endpoint)))
         b = results[-1]
         print(f"browse run {run + 1}/{runs}: {BROWSES} browses in {b.seconds:.2f} s, lateness "
               f"max {b.max_us} us, overruns {b.overruns}", file=sys.stderr)

@@ -21,21 +21,17 @@ from __future__ import annotations
 import asyncio
 import statistics
 import sys
-import tempfile
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import aiohttp
 
 from cnc_objects.clients import AsyncClient
 from cnc_objects.testing.web import serving_web
-from tests.support.service import start_service
 
-from .common import BENCH_MACHINE
 from .jitter_bench import CycleFigures as Cycles
-from .jitter_bench import program
+from .jitter_bench import program, realtime_bench_service
 
 SESSIONS = 10
 POSITION = "ch1.ax1.command_position_acs"
@@ -123,14 +119,8 @@ def measure(runs: int, seconds: float) -> list[WebRun]:
     """``runs`` runs, each on a fresh realtime service: alone, then with cnc-web."""
     results = []
     for run in range(runs):
-        with tempfile.TemporaryDirectory() as tmp:
-            machine = Path(tmp) / "bench.toml"
-            machine.write_text(BENCH_MACHINE)
-            service = start_service("--clock", "realtime", "--config", str(machine))
-            try:
-                results.append(_one_run(service.endpoint, seconds))
-            finally:
-                service.stop()
+        with realtime_bench_service() as service:
+            results.append(_one_run(service.endpoint, seconds))
         r = results[-1]
         print(f"web run {run + 1}/{runs}: p99 {r.alone.p99_us} -> {r.with_web.p99_us} us, "
               f"overruns {r.alone.overruns} -> {r.with_web.overruns}, position rate min "

@@ -41,6 +41,19 @@ def leftovers(service_dir: Path) -> list[str]:
     return sorted(p.name for p in service_dir.iterdir() if p.name.startswith("."))
 
 
+def write_big_program(path: Path, megabytes: int = 200) -> bytes:
+    """A CAM-sized program of about ``megabytes`` MB written to ``path`` a block of 1 MB
+    at a time (never whole in memory); its SHA-256."""
+    block = g1_program(1_000_000)
+    digest = hashlib.sha256()
+    with path.open("wb") as f:
+        for k in range(megabytes):
+            part = b"(block %d)\n" % k + block
+            f.write(part)
+            digest.update(part)
+    return digest.digest()
+
+
 def raw(cnc: Client, offset: int, data: bytes) -> None:
     cnc.write_raw(CncPort.COM, PROGRAM_STORE_GROUP, offset, data)
 
@@ -197,14 +210,8 @@ def peak_rss_bytes(pid: int) -> int:
 def test_a_200_mb_cam_program_lands_whole(tmp_path: Path) -> None:
     """The size CAM writes: 200 MB of G1 lines, made on the fly, land byte for byte; the
     service's memory does not grow with the program (chunks go to the file)."""
-    block = g1_program(1_000_000)
     local = tmp_path / "finish.nc"
-    digest = hashlib.sha256()
-    with local.open("wb") as f:
-        for k in range(200):
-            part = b"(block %d)\n" % k + block
-            f.write(part)
-            digest.update(part)
+    digest = write_big_program(local)
     program = local.read_bytes()
     with serving() as service, Client(service.endpoint) as cnc:
         before = peak_rss_bytes(service.process.pid)
@@ -215,7 +222,7 @@ def test_a_200_mb_cam_program_lands_whole(tmp_path: Path) -> None:
         stored = service.program_dir / "finish.nc"
         assert stored.stat().st_size == len(program) > 200_000_000
         with stored.open("rb") as f:
-            assert hashlib.file_digest(f, "sha256").digest() == digest.digest()
+            assert hashlib.file_digest(f, "sha256").digest() == digest
         assert leftovers(service.program_dir) == []
         print(f"\n200 MB upload: {len(program) / elapsed_s / 1e6:.0f} MB/s, service peak RSS "
               f"{before / 1e6:.0f} -> {after / 1e6:.0f} MB")

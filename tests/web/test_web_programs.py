@@ -17,7 +17,12 @@ from cnc_objects.clients.web.users import WebRole
 from cnc_objects.testing import ServiceProcess
 from cnc_objects.testing.web import WebProcess, serving_web
 from tests.limits.wire import limited_service
-from tests.service.test_program_upload_chunks import g1_program, leftovers, peak_rss_bytes
+from tests.service.test_program_upload_chunks import (
+    g1_program,
+    leftovers,
+    peak_rss_bytes,
+    write_big_program,
+)
 
 from .conftest import PASSWORDS
 from .test_web_api import _json, _session
@@ -191,14 +196,8 @@ async def test_a_200_mb_program_through_cnc_web(realtime_service: ServiceProcess
                                                 web: WebProcess, tmp_path: Path) -> None:
     """The size CAM writes: 200 MB through cnc-web, slice by slice; cnc-web's memory does
     not grow with the program, and its view opens on a window of lines."""
-    block = g1_program(1_000_000)
     local = tmp_path / "finish.nc"
-    digest = hashlib.sha256()
-    with local.open("wb") as f:
-        for k in range(200):
-            part = b"(block %d)\n" % k + block
-            f.write(part)
-            digest.update(part)
+    digest = write_big_program(local)
     size = local.stat().st_size
     pid = web.process.pid
     async with _session() as http:
@@ -210,7 +209,7 @@ async def test_a_200_mb_program_through_cnc_web(realtime_service: ServiceProcess
         after = peak_rss_bytes(pid)
         stored = realtime_service.program_dir / "finish.nc"
         with stored.open("rb") as f:
-            assert hashlib.file_digest(f, "sha256").digest() == digest.digest()
+            assert hashlib.file_digest(f, "sha256").digest() == digest
         open_ms = []
         for first in (3_000_000, 1, 5_000_000):
             opened = time.perf_counter()
