@@ -605,8 +605,10 @@ function renderProgramPage() {
     if (item) {
       item.classList.add("current");
       item.scrollIntoView({ block: "nearest" });
-    } else if (line > 0 && working() && state.followLines && !state.windowLoading) {
-      goToLine(line - WINDOW_LEAD);  // the run left the window: the window follows it
+    } else if (line > 0 && working() && state.followLines && !state.windowLoading && !state.planning) {
+      // the run left the window: the window follows it (not the page's own dry run that
+      // plans the path: that one runs through the program while nobody started it)
+      goToLine(line - WINDOW_LEAD);
     }
     state.shownLine = item ? line : null;
   }
