@@ -55,7 +55,7 @@ from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
-from time import perf_counter, sleep
+from time import perf_counter
 from typing import Any
 
 from cnc_objects.protocol.constants import TransmissionMode
@@ -104,10 +104,16 @@ SLICE_CHECK_EVERY = 32  # subscriptions sampled between two looks at the clock
 #: end a slice as many small ones do.
 SLICE_CHECK_BYTES = 2048
 #: Due cycles the kernel keeps for passes not yet begun. While this many wait, the
-#: event-speed clock takes its cycles one by one (the loop is behind); a due cycle beyond
-#: it pushes out the oldest waiting one (the newest values go out, none older). With
-#: repeatable samples nothing is pushed out: the cycle thread waits for room instead.
+#: event-speed clock and, with repeatable samples, every clock's cycle thread wait until
+#: the loop has sampled all but ``PASSES_PENDING_LOW`` of them (the loop is behind: a
+#: pass costs more than the cruising cycles between two due ones). Under the other clocks
+#: with latest samples (the realtime clock never waits) a due cycle beyond it pushes out
+#: the oldest waiting one (the newest values go out, none older).
 PASSES_PENDING_MAX = 64
+#: Due cycles left waiting when the loop wakes a cycle thread that waits for room: it then
+#: runs several due cycles before it waits again, instead of one per pass the loop ends
+#: (each wake-up hands the GIL over twice; issue 37, docs/kernel.md "Watched at 200x").
+PASSES_PENDING_LOW = 16
 #: Repeatable samples: how often the loop tries again to send the frames a client's
 #: full send queue refused (no front end says per client when it has room again).
 BACKLOG_RETRY_S = 0.001
@@ -238,7 +244,8 @@ class NotificationHub:
         self.repeatable = repeatable
         self._due_snapshots: deque[Snapshot] = deque(
             maxlen=None if repeatable else PASSES_PENDING_MAX)
-        self._handover = threading.Condition()  # repeatable: the cycle thread waits on it
+        self._handover = threading.Condition()  # a cycle thread that waits for room waits on it
+        self._room_wanted = False  # (under ``_handover``) a cycle thread waits for room
         self._closed = False  # ``close``: the cycle thread waits no more
         self._scheduled = False
         # Repeatable samples: frames a client's send queue refused, in order, with the
@@ -409,8 +416,7 @@ class NotificationHub:
         self._kernel_due_ns = _after(now_ns, self._due_from)
         with self._handover:
             if self.repeatable:  # nothing is pushed out: wait for the loop to make room
-                while len(self._due_snapshots) >= PASSES_PENDING_MAX and not self._closed:
-                    self._handover.wait(ROOM_WAIT_S)
+                self._wait_for_room()
             self._due_snapshots.append(snapshot)
             if self._scheduled:
                 return
@@ -422,18 +428,32 @@ class NotificationHub:
         event-speed virtual clock runs the cycles before it in bulk, unpublished, also
         while passes are pending (each reads the snapshot of its own due cycle). Every
         subscription's due times lie on the grid of its cycle time, so the next due
-        cycle is the grid's next point. Only when ``PASSES_PENDING_MAX`` due cycles wait
-        for the loop is it now (0): the kernel takes single cycles until the loop is
-        back. Before such a cycle the cycle thread gives the interpreter to the loop
-        once (``sleep(0)``): a whole cycle stepped only because the loop is behind costs
-        more than the passes it waits for (issue 37: the kernel thread and the loop share
-        one GIL). With repeatable samples the next due cycle is always the event: the
-        cycle thread waits for room in ``kernel_cycle_end`` instead."""
+        cycle is the grid's next point. Only the event-speed clock asks (before each
+        bulk): when ``PASSES_PENDING_MAX`` due cycles wait for the loop, the cycle thread
+        waits here until the loop has sampled all but ``PASSES_PENDING_LOW`` of them.
+        Stepping single cycles meanwhile (as before issue 37's "Watched at 200x") cost
+        more than the passes it waited for (the kernel thread and the loop share one
+        GIL) and pushed the oldest kept due cycles out: samples were lost for nothing
+        but CPU. A client does not hold the kernel by this (with latest samples the
+        passes never wait for a client's socket). With repeatable samples the cycle
+        thread waits for room in ``kernel_cycle_end``."""
         if len(self._due_snapshots) >= PASSES_PENDING_MAX and not self.repeatable:
-            sleep(0)
-            if len(self._due_snapshots) >= PASSES_PENDING_MAX:
-                return 0
+            with self._handover:
+                self._wait_for_room()
         return self._kernel_due()
+
+    def _wait_for_room(self) -> None:
+        """(cycle thread, under ``_handover``) When ``PASSES_PENDING_MAX`` due cycles
+        wait, wait until the loop has taken all but ``PASSES_PENDING_LOW`` of them (or
+        the hub is closed)."""
+        if len(self._due_snapshots) < PASSES_PENDING_MAX:
+            return
+        self._room_wanted = True
+        try:
+            while len(self._due_snapshots) > PASSES_PENDING_LOW and not self._closed:
+                self._handover.wait(ROOM_WAIT_S)
+        finally:
+            self._room_wanted = False
 
     def _kernel_due(self) -> int | None:
         """(cycle thread) The next due kernel time on the current grid."""
@@ -477,7 +497,8 @@ class NotificationHub:
                 self._scheduled = False
                 return False
             snapshot = self._due_snapshots.popleft()
-            self._handover.notify()  # repeatable: a cycle thread may wait for the room
+            if self._room_wanted and len(self._due_snapshots) <= PASSES_PENDING_LOW:
+                self._handover.notify()  # the cycle thread that waits for room goes on
         self._read_no += 1
         self._pass = SamplingPass(snapshot.time_ns, snapshot, iter(list(self._subs.values())))
         return True
