@@ -15,7 +15,9 @@ repeatable samples (``[clock] samples = "repeatable"``, docs/kernel.md "Traces t
 repeat") it is the cycle's kernel time instead, and no sample is dropped.
 
 The kernel thread only looks at one number per cycle (when the next sample is due) and
-wakes the event loop when it is; all sampling and sending happens on the loop, in
+wakes the event loop when it is (the event-speed clock's bulk: once per ``WAKE_BATCH``
+due cycles; a loop ``PASSES_PENDING_MAX`` due cycles behind holds it, issue 37
+"Watched at 200x"); all sampling and sending happens on the loop, in
 slices of at most ``SAMPLE_SLICE_S`` of loop time (``SamplingPass``): with the
 notification limit used up by one client, another client's request waits one slice, not
 a pass over every subscription.
@@ -114,6 +116,11 @@ PASSES_PENDING_MAX = 64
 #: runs several due cycles before it waits again, instead of one per pass the loop ends
 #: (each wake-up hands the GIL over twice; issue 37, docs/kernel.md "Watched at 200x").
 PASSES_PENDING_LOW = 16
+#: Due cycles the event-speed bulk keeps before it wakes the loop (latest samples): one
+#: wake-up, and its two hand-overs of the GIL, for a batch of passes instead of one each
+#: (issue 37, docs/kernel.md "Watched at 200x"). A batch is a few bulk steps: well under
+#: a millisecond of wall time.
+WAKE_BATCH = 16
 #: Repeatable samples: how often the loop tries again to send the frames a client's
 #: full send queue refused (no front end says per client when it has room again).
 BACKLOG_RETRY_S = 0.001
@@ -236,6 +243,10 @@ class NotificationHub:
         # cycle thread only: the kernel time of the next due cycle, the grid it was taken
         # from, and the last cycle seen
         self._kernel_due_ns: int | None = None
+        # the due time the event-speed bulk runs to (``next_observed_ns``), and whether
+        # due cycles it ran to wait without the loop woken (``kernel_cycle_end``)
+        self._bulk_due_ns: int | None = None
+        self._deferred = False
         self._due_from: tuple[int, ...] = ()
         self._seen_ns = 0
         # Due cycles' snapshots the passes still have to sample, oldest first (the kernel
@@ -408,10 +419,22 @@ class NotificationHub:
         """Called by the cycle thread after each published cycle: keep a due cycle's
         snapshot for its pass and wake the loop (once, while no pass is scheduled). The
         kernel goes on at once: the pass reads the snapshot kept, whatever the kernel
-        has run meanwhile."""
+        has run meanwhile.
+
+        A due cycle the event-speed clock's bulk ran to (the one ``next_observed_ns``
+        named) wakes the loop only when ``WAKE_BATCH`` due cycles wait (latest samples):
+        the bulk goes on to the next one at once, and the loop then samples the batch in
+        one go. Any other published cycle (an event's, a cycle at rest, every cycle of
+        the other clocks) wakes it for what waits, so a kept due cycle waits for its
+        pass only while the kernel runs in bulk (issue 37, docs/kernel.md "Watched at
+        200x")."""
         now_ns = self._seen_ns = snapshot.time_ns
+        in_bulk = now_ns == self._bulk_due_ns
+        self._bulk_due_ns = None
         due = self._kernel_due()
         if due is None or now_ns < due:
+            if self._deferred:
+                self._wake()
             return
         self._kernel_due_ns = _after(now_ns, self._due_from)
         with self._handover:
@@ -419,6 +442,20 @@ class NotificationHub:
                 self._wait_for_room()
             self._due_snapshots.append(snapshot)
             if self._scheduled:
+                return
+            if (in_bulk and not self.repeatable and snapshot.stats.running
+                    and len(self._due_snapshots) < WAKE_BATCH):
+                self._deferred = True
+                return
+            self._scheduled = True
+            self._deferred = False
+        self._loop.call_soon_threadsafe(self._sample)
+
+    def _wake(self) -> None:
+        """(cycle thread) Wake the loop for the due cycles a bulk kept without waking it."""
+        with self._handover:
+            self._deferred = False
+            if self._scheduled or not self._due_snapshots:
                 return
             self._scheduled = True
         self._loop.call_soon_threadsafe(self._sample)
@@ -440,7 +477,8 @@ class NotificationHub:
         if len(self._due_snapshots) >= PASSES_PENDING_MAX and not self.repeatable:
             with self._handover:
                 self._wait_for_room()
-        return self._kernel_due()
+        due = self._bulk_due_ns = self._kernel_due()  # ``kernel_cycle_end``: in bulk
+        return due
 
     def _wait_for_room(self) -> None:
         """(cycle thread, under ``_handover``) When ``PASSES_PENDING_MAX`` due cycles
