@@ -572,6 +572,7 @@ class NotificationHub:
         run = self._pass
         assert run is not None
         subs, take, due_ns, reads = self._subs, self._take, run.now_ns, run.reads
+        read_no = self._read_no
         finished = True
         self._read_bytes = 0  # read since the last look at the clock
         with self._pin(run.snapshot) as pinned:
@@ -581,7 +582,26 @@ class NotificationHub:
                 if subs.get(sub.handle) is not sub:
                     continue  # deleted since the pass began
                 if sub.next_due_ns <= due_ns:
-                    sample = take(sub, now_ns, reads, False)
+                    probe = sub.probe
+                    if probe is None or not sub.on_change:
+                        sample = take(sub, now_ns, reads, False)
+                    else:
+                        # The common case of a page that watches many values, without
+                        # a call: an on-change value that stands still (as ``_take``
+                        # and ``Probe.value_in`` would find it).
+                        if probe.read_no != read_no:
+                            probe.read_no, probe.data = read_no, None
+                            try:
+                                probe.value = probe.getter()
+                            except Exception:  # the dispatcher's read says why
+                                probe.value = FAILED
+                        value, last = probe.value, sub.last_value
+                        if value is not FAILED and (value is last or unchanged(value, last)):
+                            sample = None
+                            cycle_ns = sub.cycle_ns  # the next due time, as ``_take`` sets it
+                            sub.next_due_ns = now_ns - now_ns % cycle_ns + cycle_ns
+                        else:
+                            sample = take(sub, now_ns, reads, False)
                     if sample is not None:
                         batch = batches.get(sub.batch_key)
                         if batch is None:
