@@ -106,11 +106,13 @@ SLICE_CHECK_EVERY = 32  # subscriptions sampled between two looks at the clock
 #: end a slice as many small ones do.
 SLICE_CHECK_BYTES = 2048
 #: Due cycles the kernel keeps for passes not yet begun. While this many wait, the
-#: event-speed clock and, with repeatable samples, every clock's cycle thread wait until
-#: the loop has sampled all but ``PASSES_PENDING_LOW`` of them (the loop is behind: a
-#: pass costs more than the cruising cycles between two due ones). Under the other clocks
-#: with latest samples (the realtime clock never waits) a due cycle beyond it pushes out
-#: the oldest waiting one (the newest values go out, none older).
+#: event-speed clock waits until the loop has sampled all but ``PASSES_PENDING_LOW`` of
+#: them (the loop is behind: a pass costs more than the cruising cycles between two due
+#: ones); with repeatable samples every clock's cycle thread waits until there is room
+#: for one (the loop may wait for a slow reader: the kernel goes on as soon as it can).
+#: Under the other clocks with latest samples (the realtime clock never waits) a due
+#: cycle beyond it pushes out the oldest waiting one (the newest values go out, none
+#: older).
 PASSES_PENDING_MAX = 64
 #: Due cycles left waiting when the loop wakes a cycle thread that waits for room: it then
 #: runs several due cycles before it waits again, instead of one per pass the loop ends
@@ -256,7 +258,9 @@ class NotificationHub:
         self._due_snapshots: deque[Snapshot] = deque(
             maxlen=None if repeatable else PASSES_PENDING_MAX)
         self._handover = threading.Condition()  # a cycle thread that waits for room waits on it
-        self._room_wanted = False  # (under ``_handover``) a cycle thread waits for room
+        # (under ``_handover``) the due cycles a cycle thread that waits for room waits
+        # for the loop to get down to; -1: none waits
+        self._room_left = -1
         self._closed = False  # ``close``: the cycle thread waits no more
         self._scheduled = False
         # Repeatable samples: frames a client's send queue refused, in order, with the
@@ -439,7 +443,7 @@ class NotificationHub:
         self._kernel_due_ns = _after(now_ns, self._due_from)
         with self._handover:
             if self.repeatable:  # nothing is pushed out: wait for the loop to make room
-                self._wait_for_room()
+                self._wait_for_room(PASSES_PENDING_MAX - 1)
             self._due_snapshots.append(snapshot)
             if self._scheduled:
                 return
@@ -476,22 +480,22 @@ class NotificationHub:
         thread waits for room in ``kernel_cycle_end``."""
         if len(self._due_snapshots) >= PASSES_PENDING_MAX and not self.repeatable:
             with self._handover:
-                self._wait_for_room()
+                self._wait_for_room(PASSES_PENDING_LOW)
         due = self._bulk_due_ns = self._kernel_due()  # ``kernel_cycle_end``: in bulk
         return due
 
-    def _wait_for_room(self) -> None:
+    def _wait_for_room(self, left: int) -> None:
         """(cycle thread, under ``_handover``) When ``PASSES_PENDING_MAX`` due cycles
-        wait, wait until the loop has taken all but ``PASSES_PENDING_LOW`` of them (or
-        the hub is closed)."""
+        wait, wait until the loop has taken all but ``left`` of them (or the hub is
+        closed)."""
         if len(self._due_snapshots) < PASSES_PENDING_MAX:
             return
-        self._room_wanted = True
+        self._room_left = left
         try:
-            while len(self._due_snapshots) > PASSES_PENDING_LOW and not self._closed:
+            while len(self._due_snapshots) > left and not self._closed:
                 self._handover.wait(ROOM_WAIT_S)
         finally:
-            self._room_wanted = False
+            self._room_left = -1
 
     def _kernel_due(self) -> int | None:
         """(cycle thread) The next due kernel time on the current grid."""
@@ -535,7 +539,7 @@ class NotificationHub:
                 self._scheduled = False
                 return False
             snapshot = self._due_snapshots.popleft()
-            if self._room_wanted and len(self._due_snapshots) <= PASSES_PENDING_LOW:
+            if len(self._due_snapshots) == self._room_left:
                 self._handover.notify()  # the cycle thread that waits for room goes on
         self._read_no += 1
         self._pass = SamplingPass(snapshot.time_ns, snapshot, iter(list(self._subs.values())))
