@@ -16,6 +16,10 @@ Repeatable traces (issue 37, ``repeatable_traces``): the one-hour part on a serv
 ``--samples repeatable``, 20 cyclic subscriptions at 10 ms held by a second connection
 that reads them as they come: the speed, and the samples delivered per wall second.
 
+Before and after (issue 37, ``side_by_side``; ``python -m bench.virtual_bench --against
+COMMIT``): a part on the service of an older commit and on this checkout's at once, the
+runs alternating, so that a loaded machine's swings fall on both alike.
+
 A 200 MB CAM program (issue 37, ``big_program_row``): the upload's MB/s, the service's
 RSS while the program runs (read as a stream: flat, start / max) and the speed, over 60 s
 of wall time (all of it would take hours at today's block rate), then RESET.
@@ -30,8 +34,11 @@ WebSocket client from aiohttp speaks the page's protocol, no browser runs). Targ
 from __future__ import annotations
 
 import asyncio
+import io
 import statistics
+import subprocess
 import sys
+import tarfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -407,3 +414,83 @@ def short_blocks(runs: int) -> list[Row]:
     finally:
         service.stop()
     return rows
+
+
+# ------------------------------------------------------- before and after, side by side
+
+def export_tree(commit: str, into: Path) -> Path:
+    """The repository at ``commit`` as a tree a service runs from (its working directory:
+    ``python -m`` puts it first on the path): ``git archive``, the package's folders
+    linked under ``cnc_objects`` as pyproject's ``package-dir`` maps them, and this
+    checkout's compiled path (``build``; it loads only where the sources match)."""
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", commit],
+                             capture_output=True, check=True).stdout
+    with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
+        tar.extractall(into, filter="data")
+    for folder in ("service", "protocol", "objects", "clients"):
+        (into / "cnc_objects" / folder).symlink_to(Path("..") / folder)
+    if (ROOT / "build").exists():
+        (into / "build").symlink_to(ROOT / "build")
+    return into
+
+
+def side_by_side(commit: str, runs: int, name: str = "pocket-la-on.nc",
+                 subscriptions: tuple[int, ...] = (0, SUBSCRIPTIONS)) -> list[str]:
+    """``name`` on two services at once, the one of ``commit`` and this checkout's, the
+    runs alternating between them (``runs`` each per count of subscriptions): on a
+    machine others load, one service's runs swing by 2x from minute to minute, and only
+    runs taken turn about compare two versions (issue 37, docs/kernel.md "Watched at
+    200x"). One line per count: the medians, and the service's CPU per run."""
+    import tempfile
+
+    data = (programs() | short_block_programs())[name]
+    lines = []
+    with tempfile.TemporaryDirectory(prefix="cnc-before-") as tmp:
+        trees = {commit: export_tree(commit, Path(tmp)), "this checkout": None}
+        services = {label: start_service("--clock", "virtual", cwd=tree)
+                    for label, tree in trees.items()}
+        try:
+            for subs in subscriptions:
+                speeds: dict[str, list[float]] = {label: [] for label in services}
+                cpu_ms: dict[str, list[float]] = {label: [] for label in services}
+                for k in range(runs):
+                    turn = list(services.items())
+                    for label, service in turn if k % 2 == 0 else reversed(turn):
+                        before = _cpu_ms(service.process.pid)
+                        sim, wall = asyncio.run(_run(service.endpoint, name, data, subs))
+                        cpu_ms[label].append(_cpu_ms(service.process.pid) - before)
+                        speeds[label].append(sim / wall)
+                lines.append(f"{name}, {subs} on change: " + "; ".join(
+                    f"{label} {statistics.median(speeds[label]):.0f}x (service CPU "
+                    f"{statistics.median(cpu_ms[label]):.0f} ms a run)" for label in services)
+                    + f"; medians of {runs}, alternating")
+        finally:
+            for service in services.values():
+                service.stop()
+    return lines
+
+
+def _cpu_ms(pid: int) -> float:
+    """CPU time of all threads of process ``pid`` so far (ms; Linux schedstat)."""
+    total_ns = 0
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        try:
+            total_ns += int((task / "schedstat").read_text().split()[0])
+        except OSError:  # a thread that ended meanwhile
+            pass
+    return total_ns / 1e6
+
+
+if __name__ == "__main__":
+    import argparse
+
+    parser = argparse.ArgumentParser(
+        description="A part on the service of an older commit and on this checkout's, "
+                    "side by side (python -m bench.virtual_bench --against 56a115f)")
+    parser.add_argument("--against", required=True, help="the commit to compare with")
+    parser.add_argument("--runs", type=int, default=7)
+    parser.add_argument("--part", default="pocket-la-on.nc")
+    parser.add_argument("--subscriptions", default=f"0,{SUBSCRIPTIONS}")
+    args = parser.parse_args()
+    counts = tuple(int(n) for n in args.subscriptions.split(","))
+    print("\n".join(side_by_side(args.against, args.runs, args.part, counts)))

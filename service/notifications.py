@@ -15,7 +15,9 @@ repeatable samples (``[clock] samples = "repeatable"``, docs/kernel.md "Traces t
 repeat") it is the cycle's kernel time instead, and no sample is dropped.
 
 The kernel thread only looks at one number per cycle (when the next sample is due) and
-wakes the event loop when it is; all sampling and sending happens on the loop, in
+wakes the event loop when it is (the event-speed clock's bulk: once per ``WAKE_BATCH``
+due cycles; a loop ``PASSES_PENDING_MAX`` due cycles behind holds it, issue 37
+"Watched at 200x"); all sampling and sending happens on the loop, in
 slices of at most ``SAMPLE_SLICE_S`` of loop time (``SamplingPass``): with the
 notification limit used up by one client, another client's request waits one slice, not
 a pass over every subscription.
@@ -55,7 +57,7 @@ from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
-from time import perf_counter, sleep
+from time import perf_counter
 from typing import Any
 
 from cnc_objects.protocol.constants import TransmissionMode
@@ -104,10 +106,23 @@ SLICE_CHECK_EVERY = 32  # subscriptions sampled between two looks at the clock
 #: end a slice as many small ones do.
 SLICE_CHECK_BYTES = 2048
 #: Due cycles the kernel keeps for passes not yet begun. While this many wait, the
-#: event-speed clock takes its cycles one by one (the loop is behind); a due cycle beyond
-#: it pushes out the oldest waiting one (the newest values go out, none older). With
-#: repeatable samples nothing is pushed out: the cycle thread waits for room instead.
+#: event-speed clock waits until the loop has sampled all but ``PASSES_PENDING_LOW`` of
+#: them (the loop is behind: a pass costs more than the cruising cycles between two due
+#: ones); with repeatable samples every clock's cycle thread waits until there is room
+#: for one (the loop may wait for a slow reader: the kernel goes on as soon as it can).
+#: Under the other clocks with latest samples (the realtime clock never waits) a due
+#: cycle beyond it pushes out the oldest waiting one (the newest values go out, none
+#: older).
 PASSES_PENDING_MAX = 64
+#: Due cycles left waiting when the loop wakes a cycle thread that waits for room: it then
+#: runs several due cycles before it waits again, instead of one per pass the loop ends
+#: (each wake-up hands the GIL over twice; issue 37, docs/kernel.md "Watched at 200x").
+PASSES_PENDING_LOW = 16
+#: Due cycles the event-speed bulk keeps before it wakes the loop (latest samples): one
+#: wake-up, and its two hand-overs of the GIL, for a batch of passes instead of one each
+#: (issue 37, docs/kernel.md "Watched at 200x"). A batch is a few bulk steps: well under
+#: a millisecond of wall time.
+WAKE_BATCH = 16
 #: Repeatable samples: how often the loop tries again to send the frames a client's
 #: full send queue refused (no front end says per client when it has room again).
 BACKLOG_RETRY_S = 0.001
@@ -230,6 +245,10 @@ class NotificationHub:
         # cycle thread only: the kernel time of the next due cycle, the grid it was taken
         # from, and the last cycle seen
         self._kernel_due_ns: int | None = None
+        # the due time the event-speed bulk runs to (``next_observed_ns``), and whether
+        # due cycles it ran to wait without the loop woken (``kernel_cycle_end``)
+        self._bulk_due_ns: int | None = None
+        self._deferred = False
         self._due_from: tuple[int, ...] = ()
         self._seen_ns = 0
         # Due cycles' snapshots the passes still have to sample, oldest first (the kernel
@@ -238,7 +257,10 @@ class NotificationHub:
         self.repeatable = repeatable
         self._due_snapshots: deque[Snapshot] = deque(
             maxlen=None if repeatable else PASSES_PENDING_MAX)
-        self._handover = threading.Condition()  # repeatable: the cycle thread waits on it
+        self._handover = threading.Condition()  # a cycle thread that waits for room waits on it
+        # (under ``_handover``) the due cycles a cycle thread that waits for room waits
+        # for the loop to get down to; -1: none waits
+        self._room_left = -1
         self._closed = False  # ``close``: the cycle thread waits no more
         self._scheduled = False
         # Repeatable samples: frames a client's send queue refused, in order, with the
@@ -401,18 +423,43 @@ class NotificationHub:
         """Called by the cycle thread after each published cycle: keep a due cycle's
         snapshot for its pass and wake the loop (once, while no pass is scheduled). The
         kernel goes on at once: the pass reads the snapshot kept, whatever the kernel
-        has run meanwhile."""
+        has run meanwhile.
+
+        A due cycle the event-speed clock's bulk ran to (the one ``next_observed_ns``
+        named) wakes the loop only when ``WAKE_BATCH`` due cycles wait (latest samples):
+        the bulk goes on to the next one at once, and the loop then samples the batch in
+        one go. Any other published cycle (an event's, a cycle at rest, every cycle of
+        the other clocks) wakes it for what waits, so a kept due cycle waits for its
+        pass only while the kernel runs in bulk (issue 37, docs/kernel.md "Watched at
+        200x")."""
         now_ns = self._seen_ns = snapshot.time_ns
+        in_bulk = now_ns == self._bulk_due_ns
+        self._bulk_due_ns = None
         due = self._kernel_due()
         if due is None or now_ns < due:
+            if self._deferred:
+                self._wake()
             return
         self._kernel_due_ns = _after(now_ns, self._due_from)
         with self._handover:
             if self.repeatable:  # nothing is pushed out: wait for the loop to make room
-                while len(self._due_snapshots) >= PASSES_PENDING_MAX and not self._closed:
-                    self._handover.wait(ROOM_WAIT_S)
+                self._wait_for_room(PASSES_PENDING_MAX - 1)
             self._due_snapshots.append(snapshot)
             if self._scheduled:
+                return
+            if (in_bulk and not self.repeatable and snapshot.stats.running
+                    and len(self._due_snapshots) < WAKE_BATCH):
+                self._deferred = True
+                return
+            self._scheduled = True
+            self._deferred = False
+        self._loop.call_soon_threadsafe(self._sample)
+
+    def _wake(self) -> None:
+        """(cycle thread) Wake the loop for the due cycles a bulk kept without waking it."""
+        with self._handover:
+            self._deferred = False
+            if self._scheduled or not self._due_snapshots:
                 return
             self._scheduled = True
         self._loop.call_soon_threadsafe(self._sample)
@@ -422,18 +469,33 @@ class NotificationHub:
         event-speed virtual clock runs the cycles before it in bulk, unpublished, also
         while passes are pending (each reads the snapshot of its own due cycle). Every
         subscription's due times lie on the grid of its cycle time, so the next due
-        cycle is the grid's next point. Only when ``PASSES_PENDING_MAX`` due cycles wait
-        for the loop is it now (0): the kernel takes single cycles until the loop is
-        back. Before such a cycle the cycle thread gives the interpreter to the loop
-        once (``sleep(0)``): a whole cycle stepped only because the loop is behind costs
-        more than the passes it waits for (issue 37: the kernel thread and the loop share
-        one GIL). With repeatable samples the next due cycle is always the event: the
-        cycle thread waits for room in ``kernel_cycle_end`` instead."""
+        cycle is the grid's next point. Only the event-speed clock asks (before each
+        bulk): when ``PASSES_PENDING_MAX`` due cycles wait for the loop, the cycle thread
+        waits here until the loop has sampled all but ``PASSES_PENDING_LOW`` of them.
+        Stepping single cycles meanwhile (as before issue 37's "Watched at 200x") cost
+        more than the passes it waited for (the kernel thread and the loop share one
+        GIL) and pushed the oldest kept due cycles out: samples were lost for nothing
+        but CPU. A client does not hold the kernel by this (with latest samples the
+        passes never wait for a client's socket). With repeatable samples the cycle
+        thread waits for room in ``kernel_cycle_end``."""
         if len(self._due_snapshots) >= PASSES_PENDING_MAX and not self.repeatable:
-            sleep(0)
-            if len(self._due_snapshots) >= PASSES_PENDING_MAX:
-                return 0
-        return self._kernel_due()
+            with self._handover:
+                self._wait_for_room(PASSES_PENDING_LOW)
+        due = self._bulk_due_ns = self._kernel_due()  # ``kernel_cycle_end``: in bulk
+        return due
+
+    def _wait_for_room(self, left: int) -> None:
+        """(cycle thread, under ``_handover``) When ``PASSES_PENDING_MAX`` due cycles
+        wait, wait until the loop has taken all but ``left`` of them (or the hub is
+        closed)."""
+        if len(self._due_snapshots) < PASSES_PENDING_MAX:
+            return
+        self._room_left = left
+        try:
+            while len(self._due_snapshots) > left and not self._closed:
+                self._handover.wait(ROOM_WAIT_S)
+        finally:
+            self._room_left = -1
 
     def _kernel_due(self) -> int | None:
         """(cycle thread) The next due kernel time on the current grid."""
@@ -477,7 +539,8 @@ class NotificationHub:
                 self._scheduled = False
                 return False
             snapshot = self._due_snapshots.popleft()
-            self._handover.notify()  # repeatable: a cycle thread may wait for the room
+            if len(self._due_snapshots) == self._room_left:
+                self._handover.notify()  # the cycle thread that waits for room goes on
         self._read_no += 1
         self._pass = SamplingPass(snapshot.time_ns, snapshot, iter(list(self._subs.values())))
         return True
@@ -513,6 +576,7 @@ class NotificationHub:
         run = self._pass
         assert run is not None
         subs, take, due_ns, reads = self._subs, self._take, run.now_ns, run.reads
+        read_no = self._read_no
         finished = True
         self._read_bytes = 0  # read since the last look at the clock
         with self._pin(run.snapshot) as pinned:
@@ -522,7 +586,26 @@ class NotificationHub:
                 if subs.get(sub.handle) is not sub:
                     continue  # deleted since the pass began
                 if sub.next_due_ns <= due_ns:
-                    sample = take(sub, now_ns, reads, False)
+                    probe = sub.probe
+                    if probe is None or not sub.on_change:
+                        sample = take(sub, now_ns, reads, False)
+                    else:
+                        # The common case of a page that watches many values, without
+                        # a call: an on-change value that stands still (as ``_take``
+                        # and ``Probe.value_in`` would find it).
+                        if probe.read_no != read_no:
+                            probe.read_no, probe.data = read_no, None
+                            try:
+                                probe.value = probe.getter()
+                            except Exception:  # the dispatcher's read says why
+                                probe.value = FAILED
+                        value, last = probe.value, sub.last_value
+                        if value is not FAILED and (value is last or unchanged(value, last)):
+                            sample = None
+                            cycle_ns = sub.cycle_ns  # the next due time, as ``_take`` sets it
+                            sub.next_due_ns = now_ns - now_ns % cycle_ns + cycle_ns
+                        else:
+                            sample = take(sub, now_ns, reads, False)
                     if sample is not None:
                         batch = batches.get(sub.batch_key)
                         if batch is None:
