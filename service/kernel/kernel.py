@@ -415,7 +415,7 @@ class Kernel:
         last = first + step.cycles
         while self.stats.cycles < last:
             started = time.perf_counter()
-            if self._busy and self._run_in_bulk(last):
+            if self._run_in_bulk(last):
                 pass  # the bulk ran through a cycle that had to be published
             elif not self._cycle():
                 done(Refusal(RefusalReason.NOT_READY, "the kernel is shutting down"))
@@ -461,13 +461,19 @@ class Kernel:
             most = min(most, due_cycle - self.stats.cycles)
         if most <= 1:
             return False  # one cycle: stepped (``_cycle``), through the same cruise
-        allowed = self._cruise_budget(most)
-        if allowed is None:
-            return False
-        cycles, changed = allowed
-        self._count_cycles(cycles)
-        self.stats.bulk_cycles += cycles
-        self._cruise(cycles, changed)
+        if last is not None and (self._resting or (self._quiet and self._rests())):
+            # the step clock's cycles of a machine at rest: all up to the due one
+            self._count_cycles(most)
+            self.stats.bulk_cycles += most
+            self._rest(most)
+        else:
+            allowed = self._cruise_budget(most)
+            if allowed is None:
+                return False
+            cycles, changed = allowed
+            self._count_cycles(cycles)
+            self.stats.bulk_cycles += cycles
+            self._cruise(cycles, changed)
         if self.stats.cycles != due_cycle:
             return False
         # the due cycle cruised: publish it as stepping would (a channel whose cycles
@@ -481,7 +487,7 @@ class Kernel:
         no link or suspend handshake, every channel's ``cruise_budget``), with the
         channels they change; None when the next cycle must be a whole one (or no
         channel moves)."""
-        if self._commanded or not self.switchover.at_rest():
+        if self._commanded:
             return None
         moving = False
         changed = []
@@ -493,7 +499,9 @@ class Kernel:
             if budget <= 0:
                 return None
             most, moving = budget, True
-        return (most, changed) if moving else None
+        if not moving or not self.switchover.at_rest():
+            return None
+        return most, changed
 
     def _cruise(self, cycles: int, changed: list[bool]) -> None:
         """Run ``cycles`` cycles that ``_cruise_budget`` allowed, counted already (the
@@ -668,17 +676,11 @@ class Kernel:
 
         A resting cycle (``_rests``) only takes the time: the idle machine's cycles cost
         next to nothing, as the realtime clock runs them a thousand times a second."""
+        if self._resting or (self._quiet and self._rests()):
+            self._rest(1)
+            return
         time_s = self.stats.cycles * self.cycle_s
         runners = self.state.runners
-        if self._resting or (self._quiet and self._rests()):
-            # Nothing but a command changes a machine at rest (``_rests``): once one cycle
-            # rested, the next ones do too, without asking again (``_apply`` ends the rest).
-            self._resting = True
-            for runner in runners:
-                runner.cruise(1, time_s)  # a channel whose cycles change nothing: the time
-            self._changed = [False] * len(runners)
-            self._drives_changed = False
-            return
         allowed = self._cruise_budget(1)
         if allowed is not None:  # the cycle only cruises: as one cycle of a bulk
             self._cruise(1, allowed[1])
@@ -698,6 +700,19 @@ class Kernel:
             self._changed = [a or b for a, b in zip(changed, switched, strict=True)]
         self._quiet = self._rest_when_idle and not (
             applied_commands or self._busy or any(changed) or any(switched))
+
+    def _rest(self, cycles: int) -> None:
+        """Run ``cycles`` resting cycles, counted already (one stepped, or the step
+        clock's bulk): nothing but a command changes a machine at rest (``_rests``), so
+        once one cycle rested the next ones do too, without asking again (``_apply``
+        ends the rest); each channel only takes the time."""
+        self._resting = True
+        runners = self.state.runners
+        time_s = self.stats.cycles * self.cycle_s
+        for runner in runners:
+            runner.cruise(cycles, time_s)  # a channel whose cycles change nothing: the time
+        self._changed = [False] * len(runners)
+        self._drives_changed = False
 
     def _rests(self) -> bool:
         """The next cycle's work would change nothing: the last cycle's changed nothing
