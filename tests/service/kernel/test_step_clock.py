@@ -140,3 +140,17 @@ def test_granted_cycles_nobody_watches_run_in_bulk_equal_to_single_steps() -> No
     assert bulk_end == one_end
     assert one_bulk == 0  # one cycle per grant: every cycle stepped and published
     assert bulk_cycles > 1500  # most of the 2 244 granted cycles only cruise
+
+
+def test_granted_cycles_of_a_machine_at_rest_run_in_bulk(kernel: Kernel) -> None:
+    """An idle machine's granted cycles only take the time: after the first (a whole
+    cycle, as a command came before it) they run in bulk, and the reply shows the
+    granted cycle with its kernel time and the channels as they were."""
+    assert submit(kernel, SetFeedOverride(0, 500)) is None
+    before = kernel.snapshot.channels[0]
+    assert submit(kernel, StepCycles(1000)) is None
+    assert kernel.snapshot.cycle == 1000
+    assert kernel.snapshot.time_ns == 1000 * kernel.cycle_ns
+    assert kernel.stats.bulk_cycles >= 998
+    after = kernel.snapshot.channels[0]
+    assert (after.state, after.feed_override_command) == (before.state, 500)
