@@ -475,6 +475,9 @@ class Kernel:
             self.stats.bulk_cycles += cycles
             self._cruise(cycles, changed)
         if self.stats.cycles != due_cycle:
+            # unpublished: the next cycle notes what it changes itself (a cycle that
+            # applies commands copies every channel, as after any publication)
+            self._changed, self._drives_changed = None, True
             return False
         # the due cycle cruised: publish it as stepping would (a channel whose cycles
         # change nothing keeps its frozen copy, as in a cycle's ``_work``)
