@@ -102,8 +102,10 @@ _GRANTS = (1, 1, 400, 1, 1234, 7, 600)
 _OVERRIDE_AT = sum(_GRANTS[:3])  # cycles granted before the feed override is written
 
 
-def _stepped_run(grants: tuple[int, ...]) -> tuple[list[tuple[Any, ...]], int, int]:
-    """Run the zigzag under the step clock, granting ``grants`` one after another, then
+def _stepped_run(grants: tuple[int, ...], override_at: int | None = _OVERRIDE_AT
+                 ) -> tuple[list[tuple[Any, ...]], int, int]:
+    """Run the zigzag under the step clock, granting ``grants`` one after another (the
+    feed override written before the grant that starts at cycle ``override_at``), then
     the rest one cycle at a time: what each grant's reply showed, the cycle the program
     ended at, and the cycles the kernel ran in bulk."""
     k = Kernel(build_config(), StepClock(0.001), {"p.nc": _ZIGZAG}.__getitem__,
@@ -114,7 +116,7 @@ def _stepped_run(grants: tuple[int, ...]) -> tuple[list[tuple[Any, ...]], int, i
         assert submit(k, SelectProgram(0, "p.nc")) is None
         assert submit(k, StartProgram(0, True)) is None  # applied between cycles
         for cycles in grants:
-            if k.snapshot.cycle == _OVERRIDE_AT:
+            if k.snapshot.cycle == override_at:
                 assert submit(k, SetFeedOverride(0, 700)) is None
             assert submit(k, StepCycles(cycles)) is None
             seen.append(_observed(k.snapshot))
@@ -154,3 +156,28 @@ def test_granted_cycles_of_a_machine_at_rest_run_in_bulk(kernel: Kernel) -> None
     assert kernel.stats.bulk_cycles >= 998
     after = kernel.snapshot.channels[0]
     assert (after.state, after.feed_override_command) == (before.state, 500)
+
+
+def test_a_step_publishes_the_cycles_an_observer_is_due_at_and_its_last() -> None:
+    """With an observer (the notification hub's hooks) due every 100 cycles, a grant
+    runs in bulk between the due cycles: each due cycle and the step's last one are
+    published, with the values single steps show there; the others are not."""
+    k = Kernel(build_config(), StepClock(0.001), {"p.nc": _ZIGZAG}.__getitem__,
+               lambda name: name == "p.nc")
+    published: dict[int, tuple[Any, ...]] = {}
+    k.on_cycle_end = lambda snap: published.__setitem__(snap.cycle, _observed(snap))
+    k.next_observed_ns = lambda: -(-(k.stats.cycles + 1) // 100) * 100 * k.cycle_ns
+    k.start()
+    try:
+        assert submit(k, SelectProgram(0, "p.nc")) is None
+        assert submit(k, StartProgram(0, True)) is None
+        published.clear()
+        assert submit(k, StepCycles(1050)) is None
+    finally:
+        k.close()
+    due = set(range(100, 1051, 100)) | {1050}
+    assert due <= set(published)
+    assert len(published) < 100  # the cruising cycles in between ran unpublished
+    one_seen, _end, _bulk = _stepped_run((1,) * 1050, override_at=None)
+    for cycle in due:
+        assert published[cycle] == one_seen[cycle - 1], cycle
