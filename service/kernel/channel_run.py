@@ -634,10 +634,10 @@ class ChannelRunner:
             axes_missing=self._waits_for_axes, internal_hold=self._internal_hold)
 
     def cruise_budget(self, most: int) -> int | None:
-        """How many of the next cycles (at most ``most``) of this channel may be run in
-        bulk (event-speed virtual clock): None when its cycles change nothing (no run,
-        the technology at rest), else what its program run's cruise allows (0: the
-        next cycle must be run as a cycle)."""
+        """How many of the next cycles (at most ``most``) of this channel may be run
+        through ``cruise`` (one stepped cycle, or a bulk): None when its cycles change
+        nothing (no run, the technology at rest), else what its program run's cruise
+        allows (0: the next cycle must be run as a cycle, ``cycle``)."""
         plc, ch = self.plc, self.channel
         if (not plc.spindle.reached or ch.spindle is not plc.spindle.state
                 or ch.plc_functions is not plc.unit
@@ -647,13 +647,16 @@ class ChannelRunner:
             return None
         run = self._run
         if (self.manual.engaged or self.manual.in_program or self._pending_start is not None
-                or not self.axes_ready or not isinstance(run, ProgramRun)):
-            return 0
+                or self._waits_for_axes or not self.axes_ready
+                or not isinstance(run, ProgramRun)):
+            return 0  # (the last cycle waited for the axes: this one's wait reason changes)
         return run.cruise_budget(most)
 
     def cruise(self, cycles: int, time_s: float) -> None:
         """Run ``cycles`` cycles that ``cruise_budget`` allowed, the last at ``time_s``
-        (a channel whose cycles change nothing only takes the time)."""
+        (a channel whose cycles change nothing only takes the time): what ``cycle``
+        would do in each, as the budget's conditions hold (technology at rest, wait
+        reason unchanged)."""
         self.time_s = time_s
         run = self._run
         if self.channel.state in (ChannelState.ACTIVE, ChannelState.HOLD):

@@ -180,6 +180,9 @@ class Kernel:
         # commands may be a resting one (``_rests``); its drives stay as published.
         self._quiet = False
         self._resting = False  # the last cycle rested: so do the next ones, until a command
+        # a command was applied since the last whole cycle: the next cycle is a whole one
+        # (a command is an event; ``_cruise_budget``)
+        self._commanded = True
         self._rest_when_idle = rest_when_idle
         self._drives_changed = True
         self.state = self._initial_state()
@@ -397,36 +400,47 @@ class Kernel:
             self._publish()
 
     def _step(self, step: StepCycles, done: Done) -> bool:
-        """Run the granted cycles one by one (commands that arrive meanwhile are applied
-        at the start of the next, as under the other clocks); answer after the last one
-        is published. False when the kernel shuts down meanwhile."""
+        """Run the granted cycles (commands that arrive meanwhile are applied at the
+        start of the next, as under the other clocks); answer after the last one is
+        published. Cycles that no observer needs (no notification due, no command
+        queued) and that only move inside their segments run in bulk, as at event
+        speed (``_run_in_bulk``: the queue is looked at between two bulks); the last
+        granted cycle is always published. False when the kernel shuts down meanwhile."""
         assert isinstance(self._clock, StepClock)
         refusal = self._clock.check(step)
         if refusal is not None:
             done(refusal)
             return True
-        for ran in range(1, step.cycles + 1):
+        first = self.stats.cycles
+        last = first + step.cycles
+        while self.stats.cycles < last:
             started = time.perf_counter()
-            if not self._cycle():
+            if self._run_in_bulk(last):
+                pass  # the bulk ran through a cycle that had to be published
+            elif not self._cycle():
                 done(Refusal(RefusalReason.NOT_READY, "the kernel is shutting down"))
                 return False
             exec_us = int((time.perf_counter() - started) * 1e6)
             if exec_us > self.stats.exec_time_max_us:
                 self.stats.exec_time_max_us = exec_us
             if not self.stats.running:  # a STOP applied in the step's cycle ends it
+                ran = self.stats.cycles - first
                 done(Refusal(RefusalReason.NOT_READY,
                              f"the kernel stopped after {ran} of {step.cycles} cycles"))
                 return True
         done(None)
         return True
 
-    def _run_in_bulk(self) -> bool:
-        """Event-speed virtual clock: run the cycles up to the next event in one step.
-        An event is anything that can change the course of the run: a command in the
-        queue, and whatever makes a channel's next cycle more than cruising (a block
-        end, a block to feed, a ramp, a link, see ``ChannelRunner.cruise_budget``). The
-        state after the bulk is the state after stepping the same cycles, bit for bit;
-        the next cycle (the event's) then runs and is published as a cycle.
+    def _run_in_bulk(self, last: int | None = None) -> bool:
+        """Run the cycles up to the next event in one step (event-speed virtual clock;
+        the step clock's granted cycles up to ``last``, the step's last cycle, which is
+        always published). An event is anything that can change the course of the run:
+        a command in the queue or applied since the last whole cycle, and whatever makes
+        a channel's next cycle more than cruising (a block end, a block to feed, a ramp,
+        a link, see ``_cruise_budget``). The cycles run through ``_cruise``, the code
+        every stepped cycle that only cruises runs too (``_work``), so the state after
+        the bulk is the state after stepping the same cycles, bit for bit; the next
+        cycle (the event's) then runs and is published as a cycle.
 
         A cycle an observer (the notification hub) must see is no event when it only
         cruises: the bulk runs through it and publishes it (issue 37: a due cycle of the
@@ -435,43 +449,82 @@ class Kernel:
         if self._waiting or not self._queue.empty() or not self.stats.running:
             return False
         most = BULK_CYCLES_MAX
-        due_cycle = None
+        due_cycle = last
         if self.on_cycle_end is not None:
             if self.next_observed_ns is None:
                 return False  # the hook sees every cycle
             due_ns = self.next_observed_ns()
             if due_ns is not None:  # the bulk ends at the due cycle, or before it
-                due_cycle = -(-due_ns // self.cycle_ns)
-                most = min(most, due_cycle - self.stats.cycles)
-        if most <= 0 or not self.switchover.at_rest():
+                due = -(-due_ns // self.cycle_ns)
+                due_cycle = due if last is None else min(due, last)
+        if due_cycle is not None:
+            most = min(most, due_cycle - self.stats.cycles)
+        if most <= 1:
+            return False  # one cycle: stepped (``_cycle``), through the same cruise
+        if last is not None and (self._resting or (self._quiet and self._rests())):
+            # the step clock's cycles of a machine at rest: all up to the due one
+            self._count_cycles(most)
+            self.stats.bulk_cycles += most
+            self._rest(most)
+        else:
+            allowed = self._cruise_budget(most)
+            if allowed is None:
+                return False
+            cycles, changed = allowed
+            self._count_cycles(cycles)
+            self.stats.bulk_cycles += cycles
+            self._cruise(cycles, changed)
+        if self.stats.cycles != due_cycle:
+            # unpublished: the next cycle notes what it changes itself (a cycle that
+            # applies commands copies every channel, as after any publication)
+            self._changed, self._drives_changed = None, True
             return False
-        runners = self.state.runners
+        # the due cycle cruised: publish it as stepping would (a channel whose cycles
+        # change nothing keeps its frozen copy, as in a cycle's ``_work``)
+        self._publish()
+        return True
+
+    def _cruise_budget(self, most: int) -> tuple[int, list[bool]] | None:
+        """The gate of a bulk and of every stepped cycle: how many of the next cycles
+        (at most ``most``) only cruise (no command applied since the last whole cycle,
+        no link or suspend handshake, every channel's ``cruise_budget``), with the
+        channels they change; None when the next cycle must be a whole one (or no
+        channel moves)."""
+        if self._commanded:
+            return None
         moving = False
         changed = []
-        for runner in runners:
+        for runner in self.state.runners:
             budget = runner.cruise_budget(most)
             changed.append(budget is not None)
             if budget is None:
                 continue  # its cycles change nothing
             if budget <= 0:
-                return False
+                return None
             most, moving = budget, True
-        if not moving:
-            return False
-        self.stats.cycles += most
+        if not moving or not self.switchover.at_rest():
+            return None
+        return most, changed
+
+    def _cruise(self, cycles: int, changed: list[bool]) -> None:
+        """Run ``cycles`` cycles that ``_cruise_budget`` allowed, counted already (the
+        last is the current cycle): the channels cruise, the drives follow. One cycle
+        of it is a stepped cycle (``_work``), more a bulk."""
+        runners = self.state.runners
         time_s = self.stats.cycles * self.cycle_s
         for runner in runners:
-            runner.cruise(most, time_s)
+            runner.cruise(cycles, time_s)
         self.state.drive_axes()
-        self.switchover.update_offsets([False] * len(runners))
-        if self.stats.cycles != due_cycle:
-            return False
-        # the due cycle cruised: publish it as stepping would (a channel whose cycles
-        # change nothing keeps its frozen copy, as in a cycle's ``_work``)
-        self.alarms.tick(self.stats.cycles, self.stats.cycles * self.cycle_ns)
-        self._changed = changed
-        self._publish()
-        return True
+        switched = [False] * len(runners)
+        self.switchover.update_offsets(switched)
+        self._changed = [a or b for a, b in zip(changed, switched, strict=True)]
+        self._busy, self._quiet = True, False
+
+    def _count_cycles(self, cycles: int) -> None:
+        """``cycles`` more cycles ran (or start): the counter, and the time stamp of what
+        the current one raises."""
+        cycles = self.stats.cycles = self.stats.cycles + cycles
+        self.alarms.tick(cycles, cycles * self.cycle_ns)
 
     def _next_command(self, block: bool) -> Queued:
         if self._waiting:
@@ -499,8 +552,7 @@ class Kernel:
                 shutting_down = True
                 break
             applied.append((done, self._apply(command)))
-        self.stats.cycles += 1
-        self.alarms.tick(self.stats.cycles, self.stats.cycles * self.cycle_ns)
+        self._count_cycles(1)
         had_commands = bool(applied)
         if had_commands and self._deterministic and self.stats.running:
             self._held = applied  # answered at once should the work wait
@@ -538,6 +590,7 @@ class Kernel:
         # A command may change anything: the cycles after it do their whole work again
         # (the step clock applies commands between cycles, not in ``_cycle``).
         self._resting = self._quiet = False
+        self._commanded = True
         try:
             if isinstance(command, ControlCommand):
                 self._control(command.control)
@@ -626,17 +679,16 @@ class Kernel:
 
         A resting cycle (``_rests``) only takes the time: the idle machine's cycles cost
         next to nothing, as the realtime clock runs them a thousand times a second."""
+        if self._resting or (self._quiet and self._rests()):
+            self._rest(1)
+            return
         time_s = self.stats.cycles * self.cycle_s
         runners = self.state.runners
-        if self._resting or (self._quiet and self._rests()):
-            # Nothing but a command changes a machine at rest (``_rests``): once one cycle
-            # rested, the next ones do too, without asking again (``_apply`` ends the rest).
-            self._resting = True
-            for runner in runners:
-                runner.cruise(1, time_s)  # a channel whose cycles change nothing: the time
-            self._changed = [False] * len(runners)
-            self._drives_changed = False
+        allowed = self._cruise_budget(1)
+        if allowed is not None:  # the cycle only cruises: as one cycle of a bulk
+            self._cruise(1, allowed[1])
             return
+        self._commanded = False
         busy = False
         switched = [False] * len(runners)
         self.switchover.step(switched)
@@ -651,6 +703,19 @@ class Kernel:
             self._changed = [a or b for a, b in zip(changed, switched, strict=True)]
         self._quiet = self._rest_when_idle and not (
             applied_commands or self._busy or any(changed) or any(switched))
+
+    def _rest(self, cycles: int) -> None:
+        """Run ``cycles`` resting cycles, counted already (one stepped, or the step
+        clock's bulk): nothing but a command changes a machine at rest (``_rests``), so
+        once one cycle rested the next ones do too, without asking again (``_apply``
+        ends the rest); each channel only takes the time."""
+        self._resting = True
+        runners = self.state.runners
+        time_s = self.stats.cycles * self.cycle_s
+        for runner in runners:
+            runner.cruise(cycles, time_s)  # a channel whose cycles change nothing: the time
+        self._changed = [False] * len(runners)
+        self._drives_changed = False
 
     def _rests(self) -> bool:
         """The next cycle's work would change nothing: the last cycle's changed nothing

@@ -235,10 +235,7 @@ class ProgramRun:
         step = executor.step(override)
         if full and executor.buffer_limits_speed():
             self._warn_buffer_limits()
-        if output:
-            self._output(step)
-            count_cutting(ch, step.current, 1)  # tool life (a dry run cuts nothing)
-        ch.program_time_s = time_s - self.started_at_s
+        self._show_cycles(step, time_s, 1, output)
         self._stepped(step)
         for block in step.finished:
             if plc is not None and plc.block_finished(block, time_s):
@@ -278,6 +275,15 @@ class ProgramRun:
                 return Step.WAITING  # extended MDI: waiting for the next manual block
         return Step.BUSY
 
+    def _show_cycles(self, step: StepResult, time_s: float, cycles: int, output: bool) -> None:
+        """What every cycle shows, stepped or the last of a bulk (``cruise``): the path's
+        values and the axes (``output`` False: they stay, PROD_TIME), the tool life of
+        ``cycles`` cycles (a dry run cuts nothing), the program time at ``time_s``."""
+        if output:
+            self._output(step)
+            count_cutting(self.channel, step.current, cycles)
+        self.channel.program_time_s = time_s - self.started_at_s
+
     def _output(self, step: StepResult) -> None:
         """The cycle's path values shown in the channel, its axes' command positions."""
         ch = self.channel
@@ -301,7 +307,8 @@ class ProgramRun:
         """How many of the next cycles (at most ``most``) would do nothing but move
         inside the current segment: no block to feed (the buffer is full or the program
         read to its end), nothing waited for, no re-planning, single block and override
-        as the path has them (event-speed virtual clock, ``Kernel``)."""
+        as the path has them. The gate of every cycle (``Kernel._cruise_budget``): a
+        cycle it allows runs as ``cruise(1)``, more as a bulk; else ``cycle`` runs."""
         ch, executor = self.channel, self.executor
         if (not self._skips_cycles or self._sync is not None or self._contour_changed
                 or self._pending_error is not None or executor.single_block != ch.single_block
@@ -316,10 +323,7 @@ class ProgramRun:
     def cruise(self, cycles: int, time_s: float) -> None:
         """Run ``cycles`` cycles that ``cruise_budget`` allowed at once, the last at
         kernel time ``time_s``: the channel shows what stepping them one by one shows."""
-        step = self.executor.cruise(cycles)
-        self._output(step)
-        count_cutting(self.channel, step.current, cycles)
-        self.channel.program_time_s = time_s - self.started_at_s
+        self._show_cycles(self.executor.cruise(cycles), time_s, cycles, True)
 
     def _technology(self) -> PlcFunctions | None:
         """The channel's technology output, None while it is suppressed (PROD_TIME)."""

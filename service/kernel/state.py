@@ -278,6 +278,9 @@ class CycleStats:
     jitter_max_us: int = 0
     exec_time_max_us: int = 0
     running: bool = True
+    # of ``cycles``: those run in bulk steps (``Kernel._run_in_bulk``: the event-speed
+    # virtual clock, the step clock's unwatched granted cycles)
+    bulk_cycles: int = 0
 
     def frozen(self) -> CycleStats:
         """A copy for the snapshot."""
@@ -288,6 +291,7 @@ class CycleStats:
             self.jitter_max_us,
             self.exec_time_max_us,
             self.running,
+            self.bulk_cycles,
         )
 
 

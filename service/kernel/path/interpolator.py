@@ -155,25 +155,44 @@ class Interpolator:
         if self.planner.dirty:
             self.planner.update()
         seg = self.seg
-        if seg is not None and not self.hold and self.waiting == 0 and not self.events:
-            v = self.v_mm_s
-            if v == seg.cap_mm_s:  # cruising: the common case, kept short
-                ex = seg.exit_mm_s
-                s = self.s_mm + v * self.cycle_s
-                if s < seg.length_mm - (v * v - ex * ex) * seg.inv_2acc:
-                    self.s_mm = s
-                    pos = self.position_mm = seg.point_at(s)
-                    return StepResult(pos, v, seg.programmed_mm_s, [], seg.block,
-                                      seg.length_mm - s + seg.block_rest_mm,
-                                      self.distance_base_mm + s, None)
-        return self._step()
+        if seg is None or self.waiting or self.events:
+            return self._step(None)
+        moved = self._in_segment(seg, self.s_mm, self.v_mm_s)
+        if not moved[0] < seg.length_mm:  # the segment ends in this cycle
+            return self._step(moved)
+        self.s_mm, self.v_mm_s = moved[0], moved[1]
+        return self._inside(seg)
+
+    def _in_segment(self, seg: Segment, s: float, v: float) -> tuple[float, float, float]:
+        """The in-segment cycle, the one function ``step`` and ``cruise`` both run: from
+        ``s`` at speed ``v``, one cycle on ``seg`` (cruising at its cap while the
+        braking point is ahead, else ``advance``'s closed form: accelerate, brake, stand
+        in feedhold). Returns (s, v, time left): inside the segment while s < its length;
+        else ``_step`` goes on from there with the time left, through the segment end."""
+        t = self.cycle_s
+        hold = self.hold
+        if not hold and v == seg.cap_mm_s:  # cruising: the common case, kept short
+            ex = seg.exit_mm_s
+            s_next = s + v * t
+            if s_next < seg.length_mm - (v * v - ex * ex) * seg.inv_2acc:
+                return s_next, v, 0.0
+        return advance(seg.length_mm, seg.acc_mm_s2, 0.0 if hold else seg.cap_mm_s,
+                       seg.exit_mm_s, s, v, t)
+
+    def _inside(self, seg: Segment) -> StepResult:
+        """The report of a cycle that ended inside ``seg`` (no block end passed)."""
+        s = self.s_mm
+        pos = self.position_mm = seg.point_at(s)
+        return StepResult(pos, self.v_mm_s, seg.programmed_mm_s, [], seg.block,
+                          seg.length_mm - s + seg.block_rest_mm, self.distance_base_mm + s,
+                          None)
 
     def cruise_budget(self, override: float, most: int,
                       accept: Callable[[float, float], bool] | None = None) -> int:
         """How many of the next cycles (at most ``most``) ``step(override)`` would end
         inside the current segment with no block end due: cruising, accelerating,
         braking or standing in feedhold. ``accept(s_mm, v_mm_s)``, when given, is asked
-        after each cycle that does not cruise at the cap; the first cycle it refuses is
+        after each cycle that ends below the segment's cap; the first cycle it refuses is
         not counted (the caller has work to do there). 0 when the next cycle is anything
         else."""
         seg = self.seg
@@ -196,29 +215,20 @@ class Interpolator:
         else:
             assert self._cruise(seg, cycles, None, apply=True) == cycles
         self._counted = None
-        v, s = self.v_mm_s, self.s_mm
-        pos = self.position_mm = seg.point_at(s)
-        return StepResult(pos, v, seg.programmed_mm_s, [], seg.block,
-                          seg.length_mm - s + seg.block_rest_mm, self.distance_base_mm + s,
-                          None)
+        return self._inside(seg)
 
     def _cruise(self, seg: Segment, most: int, accept: Callable[[float, float], bool] | None,
                 apply: bool) -> int:
-        """``step`` reduced to its motion inside ``seg``, for up to ``most`` cycles."""
+        """Up to ``most`` in-segment cycles (``_in_segment``, as ``step`` runs them) from
+        the current state; stops before the first that would reach the segment end or
+        that ``accept`` refuses."""
         s, v = self.s_mm, self.v_mm_s
-        hold, t = self.hold, self.cycle_s
-        length, acc, cap_mm_s, ex = seg.length_mm, seg.acc_mm_s2, seg.cap_mm_s, seg.exit_mm_s
-        cap = 0.0 if hold else cap_mm_s
+        length, cap_mm_s = seg.length_mm, seg.cap_mm_s
         n = 0
         while n < most:
-            if not hold and v == cap_mm_s:  # the fast path of ``step``
-                s_next = s + v * t
-                if s_next < length - (v * v - ex * ex) * seg.inv_2acc:
-                    s = s_next
-                    n += 1
-                    continue
-            s_next, v_next, _left = advance(length, acc, cap, ex, s, v, t)  # as ``_step``
-            if not s_next < length or (accept is not None and not accept(s_next, v_next)):
+            s_next, v_next, _left = self._in_segment(seg, s, v)
+            if not s_next < length or (accept is not None and v_next < cap_mm_s
+                                       and not accept(s_next, v_next)):
                 break
             s, v = s_next, v_next
             n += 1
@@ -228,7 +238,10 @@ class Interpolator:
             self._counted = (n, seg, self.s_mm, self.v_mm_s, s, v)
         return n
 
-    def _step(self) -> StepResult:
+    def _step(self, moved: tuple[float, float, float] | None) -> StepResult:
+        """A cycle that passes block ends (or waits, or stands without a segment);
+        ``moved``: its first piece in the current segment, already computed by
+        ``_in_segment`` (None: none yet)."""
         finished: list[Block] = []
         t = self.cycle_s
         while True:
@@ -239,9 +252,13 @@ class Interpolator:
             seg = self.seg
             if seg is None or t <= 0.0:
                 break
-            cap = 0.0 if self.hold else seg.cap_mm_s
-            s, v, t = advance(seg.length_mm, seg.acc_mm_s2, cap, seg.exit_mm_s,
-                              self.s_mm, self.v_mm_s, t)
+            if moved is not None:
+                s, v, t = moved
+                moved = None
+            else:
+                cap = 0.0 if self.hold else seg.cap_mm_s
+                s, v, t = advance(seg.length_mm, seg.acc_mm_s2, cap, seg.exit_mm_s,
+                                  self.s_mm, self.v_mm_s, t)
             self.s_mm, self.v_mm_s = s, v
             if s < seg.length_mm:
                 break
