@@ -183,6 +183,9 @@ class Kernel:
         # a command was applied since the last whole cycle: the next cycle is a whole one
         # (a command is an event; ``_cruise_budget``)
         self._commanded = True
+        # False: every stepped cycle that is not a resting one runs whole, never through
+        # the cruise gate (the reference the equality tests compare the gate against)
+        self.gate_stepped_cycles = True
         self._rest_when_idle = rest_when_idle
         self._drives_changed = True
         self.state = self._initial_state()
@@ -684,7 +687,7 @@ class Kernel:
             return
         time_s = self.stats.cycles * self.cycle_s
         runners = self.state.runners
-        allowed = self._cruise_budget(1)
+        allowed = self._cruise_budget(1) if self.gate_stepped_cycles else None
         if allowed is not None:  # the cycle only cruises: as one cycle of a bulk
             self._cruise(1, allowed[1])
             return

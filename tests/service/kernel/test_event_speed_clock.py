@@ -1,7 +1,7 @@
 """The event-speed virtual clock is cycle-exact against stepping (issue 30).
 
 The same program runs on a real kernel twice: on ``--clock virtual-step`` (every cycle
-run and published) and on ``--clock virtual`` (the cycles between two events run in
+run whole and published, the cruise gate off) and on ``--clock virtual`` (the cycles between two events run in
 bulk, unpublished). An observer stands for the notification hub: it asks for the cycles
 of subscriptions at several cycle times, and client commands (feed override, feedhold,
 START after it) are written at fixed cycles. Every value observed under the event clock
@@ -76,6 +76,9 @@ def run(text: str, event_speed: bool, periods: tuple[int, ...],
     config = build_config()
     kernel = Kernel(config, VirtualClock(config.cycle_ms / 1000.0, event_speed=event_speed),
                     {"p.nc": text}.__getitem__, lambda name: name == "p.nc")
+    # the reference steps every cycle whole: the cruise gate (``_cruise_budget``, which
+    # every other clock's stepped cycles pass through too) is what is proved here
+    kernel.gate_stepped_cycles = event_speed
     recording = Recording()
     done = threading.Event()
     refusals: list[Any] = []
