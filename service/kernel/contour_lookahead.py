@@ -46,7 +46,7 @@ from collections.abc import Iterable, Sequence
 from cnc_objects.protocol.values import ContourBlockType
 
 from .nc.blocks import Block, ContourCommand, ContourKind, LogArea, MotionKind, next_log_area
-from .path.geometry import Arc
+from .path.geometry import Arc, Element
 from .path.segments import Segment
 from .state import ContourElement
 
@@ -72,10 +72,10 @@ def tangent_angle_rad(a: Sequence[float], b: Sequence[float]) -> float:
     return 2.0 * math.atan2(diff, total)
 
 
-def _programmed_radius_mm(segment: Segment) -> float:
+def _programmed_radius_mm(element: Element, block: Block) -> float:
     """Radius of the programmed arc this element is the (offset) image of; 0 for a line
     and for the pieces compensation adds (connecting arcs, approach lines)."""
-    element, motion = segment.element, segment.block.motion
+    motion = block.motion
     if not isinstance(element, Arc) or motion is None or motion.center_mm is None:
         return 0.0
     if motion.kind not in (MotionKind.ARC_CW, MotionKind.ARC_CCW):
@@ -85,6 +85,40 @@ def _programmed_radius_mm(segment: Segment) -> float:
         return 0.0  # a connecting arc around a corner of the programmed contour
     p, q = motion.plane
     return math.hypot(motion.start_mm[p] - cp, motion.start_mm[q] - cq)
+
+
+class _Prepared:
+    """An element of the prepared path as mode 2 keeps it: what its ``ContourElement``
+    is made of, made only when a request reads it (``entry``). Most elements are never
+    asked for, and building each one cost a block of a CAM program about a tenth of
+    its preparation (issue 37, short blocks)."""
+
+    __slots__ = ("element", "number", "ordinal", "start_position", "previous")
+
+    def __init__(self, element: Element, number: int, ordinal: int, start_position: float,
+                 previous: tuple[float, ...] | None) -> None:
+        self.element = element
+        self.number = number
+        self.ordinal = ordinal
+        self.start_position = start_position  # 0.1 um
+        self.previous = previous  # the end tangent of the element before (None: none)
+
+    def entry(self, block: Block) -> ContourElement:
+        """The element as the PLC reads it (``block``: the block it belongs to)."""
+        element, previous = self.element, self.previous
+        variation = 0.0 if previous is None else tangent_angle_rad(previous,
+                                                                   element.tangent_start)
+        length = element.length_mm * _INCR_PER_MM
+        if isinstance(element, Arc):
+            return ContourElement(
+                CIRCULAR, self.number, self.ordinal, self.start_position, length,
+                _programmed_radius_mm(element, block) * _INCR_PER_MM,
+                element.radius_mm * _INCR_PER_MM, element.sweep_rad, 0.0, variation,
+            )
+        return ContourElement(
+            LINEAR, self.number, self.ordinal, self.start_position, length, 0.0, 0.0, 0.0,
+            0.0, variation,
+        )
 
 
 class ContourLog:
@@ -99,7 +133,8 @@ class ContourLog:
         self.log_max = log_max
         self.log: list[ContourElement] = []
         # mode 2: (distance epoch, element); nothing when P-CHAN-00658 is 0
-        self.recent: deque[tuple[int, ContourElement]] = deque(
+        # (an element is made into its ``ContourElement`` only when a request reads it)
+        self.recent: deque[tuple[int, _Prepared, Block]] = deque(
             maxlen=log_max + 3 * buffer_blocks if log_max else 0)
         self.area = LogArea.NONE
         self.distance_incr = 0.0  # start of the next element (0.1 um, summed as the PLC does)
@@ -201,25 +236,13 @@ class ContourLog:
         element = segment.element
         block = segment.block
         start = self.distance_incr
-        length = element.length_mm * _INCR_PER_MM
-        self.distance_incr = start + length
+        self.distance_incr = start + element.length_mm * _INCR_PER_MM
         previous, self._tangent = self._tangent, element.tangent_end
-        variation = 0.0 if previous is None else tangent_angle_rad(previous, element.tangent_start)
-        if isinstance(element, Arc):
-            entry = ContourElement(
-                CIRCULAR, self._number(block), self._ordinal, start, length,
-                _programmed_radius_mm(segment) * _INCR_PER_MM,
-                element.radius_mm * _INCR_PER_MM, element.sweep_rad, 0.0, variation,
-            )
-        else:
-            entry = ContourElement(
-                LINEAR, self._number(block), self._ordinal, start, length, 0.0, 0.0, 0.0,
-                0.0, variation,
-            )
+        prepared = _Prepared(element, self._number(block), self._ordinal, start, previous)
         if self.log_max:
-            self.recent.append((self.epoch, entry))
+            self.recent.append((self.epoch, prepared, block))
         if self.area == LogArea.OPEN:
-            return self._log(entry, block)
+            return self._log(prepared.entry(block), block)
         return False
 
     def _command(self, block: Block, kind: ContourKind, param: float | None) -> bool:
@@ -298,8 +321,9 @@ class ContourLog:
         low = start_position - _WINDOW_TOLERANCE_INCR
         high = start_position + length + _WINDOW_TOLERANCE_INCR
         epoch = self.executed_epoch
-        found = [e for k, e in self.recent if k == epoch and low <= e.start_position <= high]
-        return tuple(found[:RESPONSE_BLOCKS])
+        found = [(e, block) for k, e, block in self.recent
+                 if k == epoch and low <= e.start_position <= high]
+        return tuple(e.entry(block) for e, block in found[:RESPONSE_BLOCKS])
 
 
 def check_request(start_position: float, length: float) -> None:

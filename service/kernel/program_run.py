@@ -379,26 +379,27 @@ class ProgramRun:
         items, self._backlog = self._backlog or feed.take(free, wait=wait), []
         if items:
             self._host.show_decoder_state()
-        contour = self.contour
+        contour, channel = self.contour, self.channel
+        plc = self._technology()  # (looked up once per cycle, not per block: issue 37)
         for k, item in enumerate(items):
-            if isinstance(item, Block) and item.contour is not None and (
-                    item.contour.kind in LOOP_MARKERS):
-                # a real-time loop pass: for the contour log only, never a block of the path
-                if contour is not None:
-                    contour.mark(item.contour)
-                continue
-            if isinstance(item, Block) and _waits_for_standstill(item):
-                # axes change hands, or the log is cleared, at standstill: flush, feed
-                # the rest after it
-                self._backlog = items[k + 1:]
-                if self._close(item):
-                    self._sync = item
-                return
             if isinstance(item, Block):
-                item = with_optional_stop(item, self.channel)  # M1 and its switch
+                marks = item.contour
+                if marks is not None and marks.kind in LOOP_MARKERS:
+                    # a real-time loop pass: for the contour log only, never a block of
+                    # the path
+                    if contour is not None:
+                        contour.mark(marks)
+                    continue
+                if _waits_for_standstill(item):
+                    # axes change hands, or the log is cleared, at standstill: flush,
+                    # feed the rest after it
+                    self._backlog = items[k + 1:]
+                    if self._close(item):
+                        self._sync = item
+                    return
+                item = with_optional_stop(item, channel)  # M1 and its switch
                 if contour is not None:
                     contour.expect(item)
-                plc = self._technology()
                 try:
                     for part in ([item] if plc is None else plc.split(item)):
                         executor.push(part)

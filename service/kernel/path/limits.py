@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 from .errors import PathError, PathErrorId
-from .geometry import Arc, Element
+from .geometry import Arc, Element, Line
 
 SQRT2 = math.sqrt(2.0)
 SW_LIMIT_TOLERANCE_MM = 1e-9  # rounding allowance at a software limit
@@ -95,6 +95,15 @@ def check_software_limits(element: Element,
     leaves the range [min, max] of an axis."""
     if sw_limits_mm is None:
         return
+    if isinstance(element, Line):
+        # a line lies between its end points: both within the limits, so is the line
+        # (the common case, without building the extent; issue 37, short blocks)
+        tol = SW_LIMIT_TOLERANCE_MM
+        for (lo, hi), s, e in zip(sw_limits_mm, element.start_mm, element.end_mm):
+            if not (lo - tol <= s <= hi + tol and lo - tol <= e <= hi + tol):
+                break
+        else:
+            return
     lows, highs = element.extent_mm()
     for axis, ((lo, hi), low, high) in enumerate(zip(sw_limits_mm, lows, highs), start=1):
         if low < lo - SW_LIMIT_TOLERANCE_MM:

@@ -496,3 +496,15 @@ def test_each_manual_block_start_begins_a_new_marked_area(kernel):
         assert kernel.mdi(loop).channel.state == ChannelState.READY
         counts.append(kernel.kernel.snapshot.channels[0].contour.count_logged_blocks)
     assert counts == [2 + 3 * 4, 2 + 3 * 4]  # ON, three transitions of four lines, OFF
+
+
+def test_mode_2_answers_the_elements_of_the_log_field_for_field(kernel):
+    """Mode 2 makes its elements only when asked (issue 37, short blocks): each is the
+    same, to the last bit, as the log's entry of that element (arcs of compensation,
+    programmed radii and tangent variations included)."""
+    kernel.run(G41_PROGRAM)
+    logged = [e for e in request(kernel, 0) if e.block_type in (LINEAR, CIRCULAR)]
+    assert len(logged) > 5
+    for entry in logged:  # a window at the element's start: that element comes first
+        reply = request(kernel, entry.start_position, 0.5)
+        assert reply and reply[0] == entry
