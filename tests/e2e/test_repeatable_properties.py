@@ -95,7 +95,8 @@ def test_repeatable_traces_of_generated_programs_are_the_same_on_every_clock(
         program.write_text(text)
         traces = {clock: repeatable_trace(clock, program, watches) for clock in CLOCKS}
         reference = traces["virtual-step"]
-        assert reference[-1].kernel_ns > reference[0].kernel_ns  # the run is in it
+        if not all(on_change for _, _, on_change in watches):  # the run is in it
+            assert reference[-1].kernel_ns > reference[0].kernel_ns
         for clock in ("virtual", "step"):
             _assert_same_rows(traces[clock], reference, clock)
 
@@ -181,8 +182,11 @@ def test_latest_samples_during_bulk_are_values_of_their_cycles(tmp_path: Path) -
             asyncio.run(_upload(service.endpoint, program))
             samples, cycle_ns = asyncio.run(latest_samples(
                 service.endpoint, program.name, cycle_ms, watched))
-        compared = _compare(samples, _by_cycle(reference, cycle_ns), cycle_ns, cycle_ms)
-        assert compared > 0, "no sample fell into the run"
+        by_cycle = _by_cycle(reference, cycle_ns)
+        compared = _compare(samples, by_cycle, cycle_ns, cycle_ms)
+        if not all(on_change for _, on_change in watched) and max(by_cycle) * cycle_ns > (
+                2 * cycle_ms * 1_000_000):  # a cyclic sample of a run of two cycle times
+            assert compared > 0, "no sample fell into the run"
 
     check()
 
