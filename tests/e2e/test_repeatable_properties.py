@@ -86,10 +86,10 @@ def repeatable_trace(clock: str, program: Path, watches: list[WatchSpec]) -> lis
 def test_repeatable_traces_of_generated_programs_are_the_same_on_every_clock(
         tmp_path: Path) -> None:
     """Generated programs and subscriptions: ``virtual``, ``virtual-step`` and ``step``
-    give the same rows (4 examples, 12 services; soak: 40)."""
+    give the same rows (6 examples, 18 services; soak: 40)."""
     program = tmp_path / "generated.nc"
 
-    @_settings(quick=4, soak=40)
+    @_settings(quick=6, soak=40)
     @given(text=mixed_programs(max_pieces=4), watches=watch_specs())
     def check(text: str, watches: list[WatchSpec]) -> None:
         program.write_text(text)
