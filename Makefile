@@ -65,9 +65,12 @@ bench: $(VENV)/.installed-test $(VENV)/.native
 
 # The long form of tests/reliability (100 000 fuzzed frames, 640 NC mutants, 1.5 M load
 # requests, 20 restarts of each kind): bounded, about 16 minutes on a 2-core machine; and
-# 300 programs run under both virtual clocks (event speed against stepping).
+# 300 programs run under both virtual clocks (event speed against stepping), and the
+# equality properties of issue 37 with many new examples (docs/testing.md).
 soak: $(VENV)/.installed-test
-	$(BIN)/python -m pytest tests/reliability tests/service/kernel/test_event_speed_clock.py -q --soak $(PYTEST_ARGS)
+	$(BIN)/python -m pytest tests/reliability tests/service/kernel/test_event_speed_clock.py \
+		tests/service/kernel/test_equality_properties.py tests/e2e/test_repeatable_properties.py \
+		-q --soak $(PYTEST_ARGS)
 
 # Code made from other code: the blocking Client from AsyncClient's methods.
 generate: | $(BIN)/python
