@@ -124,11 +124,16 @@ def test_wrong_program_stops_with_a_precise_error(kernel, case):
 def test_same_program_twice_gives_the_same_cycles(kernel):
     text = "G1 X20 Y10 F3000\nG2 X40 Y10 I10 J0\nG1 Y-10\nG3 X20 Y-10 R10\nG0 X0 Y0\nM30\n"
     def moving(samples: list) -> list:
-        """The positions from the first cycle that moves: the decoder thread hands the
-        first block over after a cycle or two more or less (1 run in 4 under load)."""
+        """The positions from the cycle before the first that moves to the first that
+        stands at the end: the decoder thread hands the first block over after a cycle
+        or two more or less (1 run in 4 under load), and the recording ends a cycle or
+        two after READY (the harness's wait), so the standing cycles around the motion
+        are not the program's."""
         positions = [s.positions_mm for s in samples]
         start = next(k for k, p in enumerate(positions) if p != positions[0])
-        return positions[start - 1:]
+        end = next(k for k in range(len(positions) - 1, 0, -1)
+                   if positions[k - 1] != positions[-1])
+        return positions[start - 1:end + 1]
 
     first = kernel.run(text, record=True).samples
     kernel.mdi("G90 G0 X0 Y0 Z0")
