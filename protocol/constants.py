@@ -107,7 +107,7 @@ class SystemServiceGroup(IntEnum):
     """The TwinCAT system service's file functions (index groups at ``AmsPort.SYSTEM_SERVICE``,
     each an ADS ReadWrite; the index offset is the file handle, or the open flags): what
     Tc2_System's FB_FileOpen / FB_FileRead / FB_FileWrite / FB_FileClose / FB_FileDelete and
-    AdsLib's ``AdsFile`` send. Served on the program store (``service/ads_file_service``)."""
+    AdsLib's ``AdsFile`` send. Served on the program store (``service/ads/file_service``)."""
 
     FOPEN = 120  # offset: mode | path << 16; write: the file name; read: the handle (u32)
     FCLOSE = 121  # offset: the handle

@@ -40,7 +40,7 @@ from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
 from cnc_objects.protocol.datatypes import STRING_ENCODING
 from cnc_objects.protocol.errors import AdsReturnCode
 
-from .ads_file_service import FileService
+from .ads.file_service import FileService
 from .binding import refusal_code
 from .jog_holds import JOG_HOLD_TIMEOUT_S, JogHolds
 from .kernel.commands import Refusal

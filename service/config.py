@@ -51,7 +51,7 @@ class ServiceConfig(MachineConfig):
 
     program_store_dir: str | None = Field(
         None, description="directory of the program store; default: programs/ in the data "
-        "directory (service/data_location.py)"
+        "directory (service/storage/data_location.py)"
     )
     data_dir: str | None = Field(
         None, description="the service's data directory (the program store is its programs/, "
@@ -60,7 +60,7 @@ class ServiceConfig(MachineConfig):
     output_dir: str | None = Field(
         None, description="directory of the output area (the files the kernel writes); "
         "default: output/ in the data directory, else <program store>-output beside the "
-        "store (service/data_location.py)"
+        "store (service/storage/data_location.py)"
     )
     rt_priority: int = Field(
         DEFAULT_RT_PRIORITY, ge=0, le=RT_PRIORITY_MAX,

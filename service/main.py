@@ -45,19 +45,12 @@ from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.protocol.ams import parse_net_id
 from cnc_objects.protocol.roles import LOOPBACK_ROLE, Role
 
-from .ads_routes import Route, RouteTable
-from .ads_server import AdsTcpServer
-from .ads_symbols import SymbolService
+from .ads.routes import Route, RouteTable
+from .ads.server import AdsTcpServer
+from .ads.symbols import SymbolService
 from .backend import Backend
 from .binding import build_address_space
 from .config import ClockConfig, ConfigError, SampleMode, ServiceConfig, load_config
-from .data_location import (
-    OPERATOR_DATA_NAME,
-    StoreLocation,
-    operator_data_location,
-    output_area_location,
-    program_store_location,
-)
 from .frontend_config import parse_ads_endpoint
 from .kernel.alarms import AlarmLog
 from .kernel.clock import Clock, RealtimeClock, VirtualClock
@@ -68,12 +61,8 @@ from .kernel.state import Snapshot
 from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
 from .limits import notification_limits, rate_limiter
 from .notifications import NotificationCounts
-from .operator_data_store import OperatorDataStore
-from .output_area import OutputArea
 from .output_service import OutputService
-from .output_writer import OutputLimits, OutputWriter
 from .program_service import ProgramStoreService
-from .program_store import ProgramStore, StoreError
 from .security import (
     SecurityError,
     ServerCurve,
@@ -82,6 +71,17 @@ from .security import (
     load_server_curve,
 )
 from .server import ZmqServer
+from .storage.data_location import (
+    OPERATOR_DATA_NAME,
+    StoreLocation,
+    operator_data_location,
+    output_area_location,
+    program_store_location,
+)
+from .storage.operator_data_store import OperatorDataStore
+from .storage.output_area import OutputArea
+from .storage.output_writer import OutputLimits, OutputWriter
+from .storage.program_store import ProgramStore, StoreError
 
 log = logging.getLogger("cnc-service")
 

@@ -17,10 +17,10 @@ from cnc_objects.protocol.constants import OutputAreaOffset as Op
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.file_listing import encode_listing
 
-from .output_area import WHAT
-from .output_writer import OutputWriter
 from .program_service import FAULT_CODES, Result, request_name
-from .program_store import StoreError, StoreFault
+from .storage.output_area import WHAT
+from .storage.output_writer import OutputWriter
+from .storage.program_store import StoreError, StoreFault
 
 _E = AdsReturnCode
 Answer = Callable[[Result], None]  # a result delivered later, from any thread

@@ -23,9 +23,9 @@ from cnc_objects.protocol.program_lines import (
     encode_lines_reply,
 )
 
-from .program_line_index import ProgramLines
-from .program_store import ProgramStore, StoreError, StoreFault, check_name
-from .program_uploads import ProgramUploads
+from .storage.program_line_index import ProgramLines
+from .storage.program_store import ProgramStore, StoreError, StoreFault, check_name
+from .storage.program_uploads import ProgramUploads
 
 log = logging.getLogger(__name__)
 

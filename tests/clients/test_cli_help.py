@@ -71,7 +71,7 @@ def test_a_command_registered_anyhow_names_its_arguments_in_capitals() -> None:
     usage line (``use_usage_command``)."""
     from typer.testing import CliRunner
 
-    from cnc_objects.clients.cli_app import use_usage_command
+    from cnc_objects.clients.cli.app import use_usage_command
 
     demo, sub = typer.Typer(), typer.Typer()
     demo.add_typer(sub, name="sub")
@@ -148,7 +148,7 @@ def _modules_of(*argv: str) -> set[str]:
 
 
 def test_web_users_help_names_the_default_file() -> None:
-    from cnc_objects.clients.cli_web_users import DEFAULT_FILE_TEXT
+    from cnc_objects.clients.cli.web_users import DEFAULT_FILE_TEXT
     from cnc_objects.clients.web.users import DEFAULT_USERS_FILE
 
     assert DEFAULT_FILE_TEXT == str(DEFAULT_USERS_FILE)  # the help says the file used

@@ -12,7 +12,7 @@ import threading
 from pathlib import Path
 
 from cnc_objects.clients import Client
-from cnc_objects.clients.cli_machine import EXIT_WAIT_TIMEOUT
+from cnc_objects.clients.cli.machine import EXIT_WAIT_TIMEOUT
 from cnc_objects.protocol.wait_reasons import WaitReason
 from cnc_objects.testing import ServiceProcess, wait_for
 from tests.clients.test_cli import ROOT, cnc, json_lines

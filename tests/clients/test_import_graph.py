@@ -1,5 +1,5 @@
-"""The ``cnc`` modules read top-down: the command modules import the shared ``cli_app``,
-the entry module ``cli`` imports the command modules, and nothing imports ``cli``.
+"""The ``cnc`` modules read top-down: the command modules import the shared ``cli.app``,
+the entry package ``cli`` imports the command modules, and only its ``__main__`` imports it.
 (The graph comes from ``tests/test_import_graph.py``: ``ast``, nothing is executed.)"""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from __future__ import annotations
 from tests.test_import_graph import import_cycles, internal_graph
 
 CLIENTS = "cnc_objects.clients"
-COMMAND_MODULES = {f"{CLIENTS}.cli_objects", f"{CLIENTS}.cli_machine", f"{CLIENTS}.cli_plot"}
+COMMAND_MODULES = {f"{CLIENTS}.cli.objects", f"{CLIENTS}.cli.machine", f"{CLIENTS}.cli.plot"}
 
 
 def clients_graph() -> dict[str, dict[str, int]]:
@@ -26,6 +26,7 @@ def test_the_clients_modules_have_no_import_circle() -> None:
 def test_the_entry_module_imports_the_commands_and_nothing_imports_it() -> None:
     graph = clients_graph()
     assert COMMAND_MODULES <= set(graph[f"{CLIENTS}.cli"])
-    assert [name for name, imports in graph.items() if f"{CLIENTS}.cli" in imports] == []
+    importers = [name for name, imports in graph.items() if f"{CLIENTS}.cli" in imports]
+    assert importers == [f"{CLIENTS}.cli.__main__"]  # python -m cnc_objects.clients.cli
     for module in COMMAND_MODULES:  # each takes what it shares from below, not from cli
-        assert f"{CLIENTS}.cli_app" in graph[module], module
+        assert f"{CLIENTS}.cli.app" in graph[module], module

@@ -26,7 +26,7 @@ from pathlib import Path
 import pytest
 
 from cnc_objects.clients import Client
-from cnc_objects.service.ads_routes import Route, RouteTable
+from cnc_objects.service.ads.routes import Route, RouteTable
 from cnc_objects.testing import ServiceProcess, start_service
 
 READ_DEVICE_INFO, READ, WRITE, READ_STATE, WRITE_CONTROL = 1, 2, 3, 4, 5

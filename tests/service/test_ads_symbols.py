@@ -1,4 +1,4 @@
-"""The symbol information services (service/ads_symbols.py) over the default machine.
+"""The symbol information services (service/ads/symbols.py) over the default machine.
 
 The address space is the one the service builds (service/binding.py over the default
 configuration's kernel, not started); every answer is parsed with the protocol decoders
@@ -33,7 +33,7 @@ from cnc_objects.protocol.ads_symbols import (
 )
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
-from cnc_objects.service.ads_symbols import SymbolService
+from cnc_objects.service.ads.symbols import SymbolService
 from cnc_objects.service.binding import build_address_space
 from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.clock import VirtualClock

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from cnc_objects.service.data_location import output_area_location, program_store_location
+from cnc_objects.service.storage.data_location import output_area_location, program_store_location
 
 
 @pytest.mark.parametrize(

@@ -299,7 +299,7 @@ def test_both_front_ends_serve_and_say_where(tmp_path: Path) -> None:
 
 
 def test_the_default_net_id_is_the_ads_address_and_1_1() -> None:
-    from cnc_objects.service.ads_server import default_net_id
+    from cnc_objects.service.ads.server import default_net_id
 
     assert default_net_id("127.0.0.5") == "127.0.0.5.1.1"
     assert default_net_id("192.0.2.7") == "192.0.2.7.1.1"

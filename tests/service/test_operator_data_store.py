@@ -11,7 +11,7 @@ from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.alarms import AlarmLog
 from cnc_objects.service.kernel.nc.tool_data import ToolField
 from cnc_objects.service.kernel.tooling import SetToolData, SetZeroOffset
-from cnc_objects.service.operator_data_store import UNREADABLE_ID, OperatorDataStore
+from cnc_objects.service.storage.operator_data_store import UNREADABLE_ID, OperatorDataStore
 from tests.support.kernel import KernelHarness
 
 INCR = 10_000

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from cnc_objects.service.kernel.nc.technology import OutputLimitReached
-from cnc_objects.service.output_area import OutputArea
-from cnc_objects.service.output_writer import OutputLimits, OutputWriter
+from cnc_objects.service.storage.output_area import OutputArea
+from cnc_objects.service.storage.output_writer import OutputLimits, OutputWriter
 
 LIMITS = OutputLimits(max_files=3, max_file_bytes=4096, max_total_bytes=10_000,
                       queue_max_bytes=1 << 20)

@@ -6,7 +6,7 @@ import threading
 
 import pytest
 
-from cnc_objects.service.program_store import ProgramStore, StoreError, StoreFault, check_name
+from cnc_objects.service.storage.program_store import ProgramStore, StoreError, StoreFault, check_name
 
 
 @pytest.fixture
@@ -103,7 +103,7 @@ def test_a_reader_never_sees_half_a_file(store):
 
 def test_the_store_has_no_path_for_kernel_writes(store):
     """Only upload and delete change the store: the files the kernel writes go to the
-    output area (service/output_writer.py), so the store offers no append to reach
+    output area (service/storage/output_writer.py), so the store offers no append to reach
     (a chunked upload appends to its own temporary file, ``program_uploads``)."""
     assert [name for name in dir(store) if not name.startswith("_")] == [
         "delete", "exists", "list", "max_bytes", "max_files", "max_total_bytes", "path_of", "read",

@@ -22,7 +22,7 @@ from cnc_objects.objects.plc_structs import PlcStructs
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
 from cnc_objects.protocol.datatypes import REAL64, SGN32
-from cnc_objects.service.ads_symbols import SymbolService
+from cnc_objects.service.ads.symbols import SymbolService
 from cnc_objects.service.backend import Backend
 from cnc_objects.service.binding import build_address_space
 from cnc_objects.service.config import build_config

@@ -12,11 +12,11 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from .cli_app import EXIT_USAGE, Settings, command, emit, err
-from .cli_machine import ChannelOption
+from .app import EXIT_USAGE, Settings, command, emit, err
+from .machine import ChannelOption
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
-    from .blocking import Client
+    from ..blocking import Client
 
 
 @command()

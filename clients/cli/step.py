@@ -10,10 +10,10 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from .cli_app import Settings, command, emit
+from .app import Settings, command, emit
 
 if TYPE_CHECKING:  # the client library is imported when a command connects (a quick --help)
-    from .blocking import Client
+    from ..blocking import Client
 
 STEP_OBJECT = "cnc_cycle_step_w"
 

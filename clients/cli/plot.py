@@ -14,19 +14,19 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from .cli_app import EXIT_USAGE, Settings, command, emit, err
-from .cli_machine import (
+from ..errors import AdsError, ChannelError, ClientValueError
+from ..figure_png import PlotExtraMissing, require_matplotlib
+from .app import EXIT_USAGE, Settings, command, emit, err
+from .machine import (
     EXIT_CHANNEL_ERROR,
     ChannelOption,
     finish_wait,
     local_program,
     store_local,
 )
-from .errors import AdsError, ChannelError, ClientValueError
-from .figure_png import PlotExtraMissing, require_matplotlib
 
 if TYPE_CHECKING:
-    from .path_trace import PathTrace
+    from ..path_trace import PathTrace
 
 
 @command()
@@ -65,7 +65,7 @@ def plot(
             trace: PathTrace = c.trace_run(name, channel, timeout_s)
     except (AdsError, ChannelError, ClientValueError) as exc:
         finish_wait(exc)
-    from .path_plot import plot_trace  # numpy and matplotlib: only for the drawing
+    from ..path_plot import plot_trace  # numpy and matplotlib: only for the drawing
 
     try:
         png = plot_trace(trace, width_px=width_px, x_axis=axes[0], y_axis=axes[1])

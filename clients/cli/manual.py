@@ -20,12 +20,12 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from .cli_app import EXIT_USAGE, Settings, command, emit, err, fail, say_error
-from .errors import AdsError, AdsTimeoutError, ClientValueError, NoReplyError
+from ..errors import AdsError, AdsTimeoutError, ClientValueError, NoReplyError
+from .app import EXIT_USAGE, Settings, command, emit, err, fail, say_error
 
 if TYPE_CHECKING:  # the client library is imported when a command connects
-    from .blocking import Client
-    from .manual_ops import AxisState
+    from ..blocking import Client
+    from ..manual_ops import AxisState
 
 EXIT_WAIT_TIMEOUT = 5
 AxesArgument = typer.Argument(..., metavar="AXIS...", help="Axis names (X Y Z) or indices, homed together.")
@@ -38,7 +38,7 @@ def _hold(c: Client, axis: str, direction: str, channel: int,
     the axis stands (its software limit), Ctrl-C or ``timeout_s``; then release it."""
     import time
 
-    from .jog_hold import RENEW_S  # here: ``cnc --help`` imports no asyncio
+    from ..jog_hold import RENEW_S  # here: ``cnc --help`` imports no asyncio
 
     deadline = None if timeout_s is None else time.monotonic() + timeout_s
     try:

@@ -21,8 +21,8 @@ import typer
 
 from cnc_objects.protocol.roles import ROLE_NAMES, Role
 
-from .cli_app import EXIT_USAGE, Settings, app, emit, say_error
-from .key_files import PUBLIC_SUFFIX, SECRET_SUFFIX, SERVER_KEY_FILE
+from ..key_files import PUBLIC_SUFFIX, SECRET_SUFFIX, SERVER_KEY_FILE
+from .app import EXIT_USAGE, Settings, app, emit, say_error
 
 CLIENTS_DIR = "clients"  # DIR/clients/<role>/<name>.key: the service's allow-list
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,62}")

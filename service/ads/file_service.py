@@ -42,9 +42,9 @@ from cnc_objects.protocol.constants import (
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.roles import Role, roles_that_may
 
-from .program_service import FAULT_CODES, Result, request_name
-from .program_store import StoreError, StoreFault, check_name
-from .program_uploads import ProgramUploads
+from ..program_service import FAULT_CODES, Result, request_name
+from ..storage.program_store import StoreError, StoreFault, check_name
+from ..storage.program_uploads import ProgramUploads
 
 log = logging.getLogger(__name__)
 

@@ -20,12 +20,12 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from .cli_app import Settings, app, emit
-from .errors import ClientValueError
+from ..errors import ClientValueError
+from .app import Settings, app, emit
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
-    from .blocking import Client
-    from .tooling_ops import ActiveTool, ToolRow, ZeroOffsets
+    from ..blocking import Client
+    from ..tooling_ops import ActiveTool, ToolRow, ZeroOffsets
 
 ChannelOption = typer.Option(1, "--channel", "-c", min=1, metavar="N", help="Channel id (default 1).")
 
@@ -40,7 +40,7 @@ _ASSIGNMENT = re.compile(r"^([A-Za-z])=([-+]?[0-9.]+(?:[eE][-+]?\d+)?)$")
 
 
 def _group_name(group: int) -> str:
-    from .tooling_ops import group_name  # the client library, once a command runs
+    from ..tooling_ops import group_name  # the client library, once a command runs
 
     return group_name(group)
 

@@ -26,14 +26,14 @@ import typer
 
 from cnc_objects.protocol.datatypes import DataType, parse_type, parse_value
 
-from .cli_app import EXIT_USAGE, Settings, command, emit, fail, out, say_error
-from .errors import AdsError, ClientValueError, NoReplyError
-from .object_info import ObjectInfo
-from .units import parse_engineering, record, show
+from ..errors import AdsError, ClientValueError, NoReplyError
+from ..object_info import ObjectInfo
+from ..units import parse_engineering, record, show
+from .app import EXIT_USAGE, Settings, command, emit, fail, out, say_error
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
-    from .blocking import Client
-    from .client import AsyncClient
+    from ..blocking import Client
+    from ..client import AsyncClient
 
 EXIT_WATCH_TIMEOUT = 5  # watch --count N --wait-timeout S: a name got fewer than N samples
 

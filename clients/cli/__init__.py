@@ -2,12 +2,12 @@
 
     cnc [--endpoint URL] [--key FILE [--server-key FILE]] [--json] [--timeout S] COMMAND ...
 
-The entry module: the global options and ``main``. The commands live in ``cli_objects``
-(info, browse, read, write, watch), ``cli_machine`` (program store, run, MDI, hold,
-resume, reset, status, lookahead, check), ``cli_plot`` (plot), ``cli_keys`` (keys new) and
-``cli_tools`` (tool, offsets), ``cli_tools_files`` (their export/import), ``cli_step``
-(step), ``cli_alarms`` (alarms);
-what they share is in ``cli_app``. Importing them here registers them on the app, in this order.
+The package's ``__init__`` holds the global options and ``main``. The commands live in its
+modules ``objects`` (info, browse, read, write, watch), ``machine`` (program store, run,
+MDI, hold, resume, reset, status, lookahead, check), ``plot`` (plot), ``keys`` (keys new),
+``tools`` (tool, offsets), ``tools_files`` (their export/import), ``step`` (step),
+``spindle``, ``manual`` (jog, home), ``alarms`` and ``web_users``; what they share is in
+``app``. Importing them here registers them on the app, in this order.
 
 A service started with ``--keys`` needs this client's key (``--key FILE`` or
 ``CNC_KEY``) and its own public key (``--server-key FILE`` or ``CNC_SERVER_KEY``, by
@@ -30,22 +30,23 @@ import sys
 
 import typer
 
+from ..endpoint import DEFAULT_ENDPOINT
+
 # Importing a command module registers its commands; help lists them in this order.
 from . import (
-    cli_alarms,  # noqa: F401  (alarms, alarms ack)
-    cli_keys,  # noqa: F401  (keys new)
-    cli_machine,  # noqa: F401  (programs, channel commands, check)
-    cli_manual,  # noqa: F401  (jog, home)
-    cli_objects,  # noqa: F401  (info, browse, read, write, watch)
-    cli_plot,  # noqa: F401  (plot)
-    cli_spindle,  # noqa: F401  (spindle)
-    cli_step,  # noqa: F401  (step: the step clock)
-    cli_tools,  # noqa: F401  (tool, offsets)
-    cli_tools_files,  # noqa: F401  (tool export/import, offsets export/import)
-    cli_web_users,  # noqa: F401  (web-users set, remove, list)
+    alarms,  # noqa: F401  (alarms, alarms ack)
+    keys,  # noqa: F401  (keys new)
+    machine,  # noqa: F401  (programs, channel commands, check)
+    manual,  # noqa: F401  (jog, home)
+    objects,  # noqa: F401  (info, browse, read, write, watch)
+    plot,  # noqa: F401  (plot)
+    spindle,  # noqa: F401  (spindle)
+    step,  # noqa: F401  (step: the step clock)
+    tools,  # noqa: F401  (tool, offsets)
+    tools_files,  # noqa: F401  (tool export/import, offsets export/import)
+    web_users,  # noqa: F401  (web-users set, remove, list)
 )
-from .cli_app import Settings, app, use_usage_command
-from .endpoint import DEFAULT_ENDPOINT
+from .app import Settings, app, use_usage_command
 
 __all__ = ["app", "main"]
 
@@ -85,6 +86,3 @@ def main() -> None:
     except KeyboardInterrupt:
         sys.exit(130)
 
-
-if __name__ == "__main__":  # python -m cnc_objects.clients.cli, as the cnc script
-    main()

@@ -39,8 +39,8 @@ from enum import IntEnum
 
 from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES
 
-from .kernel.nc.technology import OutputLimitReached
-from .log_throttle import ThrottledWarning
+from ..kernel.nc.technology import OutputLimitReached
+from ..log_throttle import ThrottledWarning
 from .output_area import WHAT, OutputArea
 from .program_store import ProgramInfo, StoreError, check_name
 

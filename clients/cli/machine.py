@@ -42,7 +42,7 @@ import typer
 from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES, UPLOAD_CHUNK_BYTES
 from cnc_objects.protocol.errors import AdsReturnCode
 
-from .channel_ops import (
+from ..channel_ops import (
     CONTOUR_BLOCK_TYPES,
     ChannelStatus,
     CheckError,
@@ -51,13 +51,13 @@ from .channel_ops import (
     OnWaitReason,
     ProgramEntry,
 )
-from .cli_app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
-from .cli_progress import download_progress, upload_progress
-from .errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
-from .units import tidy
+from ..errors import AdsError, AdsTimeoutError, ChannelError, ClientValueError, NoReplyError
+from ..units import tidy
+from .app import EXIT_USAGE, Settings, app, command, emit, err, fail, out, say_error
+from .progress import download_progress, upload_progress
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
-    from .blocking import Client
+    from ..blocking import Client
 
 EXIT_CHANNEL_ERROR = 4
 EXIT_WAIT_TIMEOUT = 5

@@ -59,12 +59,12 @@ from cnc_objects.protocol.constants import AdsCommand, AmsStateFlag
 from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
 from cnc_objects.protocol.roles import Role
 
-from .ads_routes import Admission, RouteTable
-from .connection_limits import ConnectionLimits, Seat
-from .dispatch import Dispatcher
-from .log_throttle import ThrottledWarning
-from .notifications import NotificationHub
-from .rate_limit import BYTES_PER_TOKEN, RateLimiter, extra_tokens
+from ..connection_limits import ConnectionLimits, Seat
+from ..dispatch import Dispatcher
+from ..log_throttle import ThrottledWarning
+from ..notifications import NotificationHub
+from ..rate_limit import BYTES_PER_TOKEN, RateLimiter, extra_tokens
+from .routes import Admission, RouteTable
 
 log = logging.getLogger(__name__)
 

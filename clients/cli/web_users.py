@@ -17,10 +17,10 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from .cli_app import EXIT_USAGE, app, say_error
+from .app import EXIT_USAGE, app, say_error
 
 if TYPE_CHECKING:  # imported by the commands that use them (argon2: not on every start)
-    from .web.users import WebRole, WebUsers
+    from ..web.users import WebRole, WebUsers
 
 DEFAULT_FILE_TEXT = "cnc-data/web-users.json"  # shown in --help; users.DEFAULT_USERS_FILE
 
@@ -36,13 +36,13 @@ FileOption = typer.Option(None, "--file", metavar="FILE", show_default=False,
 
 def _file(path: Path | None) -> Path:
     """The file given, else the users' default file."""
-    from .web.users import DEFAULT_USERS_FILE
+    from ..web.users import DEFAULT_USERS_FILE
 
     return DEFAULT_USERS_FILE if path is None else path
 
 
 def _role(name: str) -> WebRole:
-    from .web.users import WebRole
+    from ..web.users import WebRole
 
     try:
         return WebRole.parse(name)
@@ -52,7 +52,7 @@ def _role(name: str) -> WebRole:
 
 
 def _load(path: Path) -> WebUsers:
-    from .web.users import WebUsers, load_users
+    from ..web.users import WebUsers, load_users
 
     if not path.exists():
         return WebUsers()
@@ -64,7 +64,7 @@ def _load(path: Path) -> WebUsers:
 
 
 def _save(path: Path, users: WebUsers) -> None:
-    from .web.users import save_users
+    from ..web.users import save_users
 
     save_users(path, users)
 

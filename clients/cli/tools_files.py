@@ -29,13 +29,13 @@ from cnc_objects.objects.operator_data import (
     loads,
 )
 
-from .cli_app import Settings, emit, fail
-from .cli_tools import ChannelOption, offsets_app, tool_app
-from .errors import ClientValueError
-from .units import engineering, raw_value
+from ..errors import ClientValueError
+from ..units import engineering, raw_value
+from .app import Settings, emit, fail
+from .tools import ChannelOption, offsets_app, tool_app
 
 if TYPE_CHECKING:  # a client is made by Settings, when a command connects
-    from .blocking import Client
+    from ..blocking import Client
 
 def in_mm(c: Client, name: str, raw: float) -> float:
     """The value ``raw`` of the object ``name`` (0.1 um) in mm, by the object's scale."""

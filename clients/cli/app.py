@@ -22,8 +22,7 @@ from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 import typer
 import typer.core
 
-from .cli_terminal import Terminal
-from .errors import (
+from ..errors import (
     AdsError,
     AdsTimeoutError,
     AuthenticationError,
@@ -31,11 +30,12 @@ from .errors import (
     NoReplyError,
     ServiceFullError,
 )
-from .units import tidy
+from ..units import tidy
+from .terminal import Terminal
 
 if TYPE_CHECKING:  # imported where a command connects: cnc --help needs no zmq
-    from .blocking import Client
-    from .client import AsyncClient
+    from ..blocking import Client
+    from ..client import AsyncClient
 
 T = TypeVar("T")
 
@@ -119,14 +119,14 @@ class Settings:
 
     def client(self) -> Client:
         """A blocking client for one command (``ClientValueError`` for a bad key file)."""
-        from .blocking import Client
+        from ..blocking import Client
 
         return Client(self.endpoint, timeout_s=self.timeout_s, key_file=self.key_file,
                       server_key=self.server_key)
 
     def async_client(self) -> AsyncClient:
         """An asyncio client for one command (``ClientValueError`` for a bad key file)."""
-        from .client import AsyncClient
+        from ..client import AsyncClient
 
         return AsyncClient(self.endpoint, timeout_s=self.timeout_s, key_file=self.key_file,
                            server_key=self.server_key)

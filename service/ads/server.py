@@ -39,13 +39,13 @@ from cnc_objects.protocol.constants import (
 )
 from cnc_objects.protocol.errors import AdsReturnCode, describe_code
 
-from .ads_connection import AmsConnection
-from .ads_routes import RouteTable
-from .backend import Backend
-from .connection_limits import ConnectionLimits
-from .dispatch import Dispatcher
-from .limits import LimitsConfig
-from .rate_limit import RateLimiter
+from ..backend import Backend
+from ..connection_limits import ConnectionLimits
+from ..dispatch import Dispatcher
+from ..limits import LimitsConfig
+from ..rate_limit import RateLimiter
+from .connection import AmsConnection
+from .routes import RouteTable
 
 log = logging.getLogger(__name__)
 

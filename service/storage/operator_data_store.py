@@ -35,18 +35,18 @@ from cnc_objects.objects.operator_data import (
     loads,
 )
 
-from .kernel.alarms import AlarmLog
-from .kernel.nc.tool_data import (
+from ..kernel.alarms import AlarmLog
+from ..kernel.nc.tool_data import (
     UM01_PER_MM,
     ToolData,
     ToolingTables,
     ToolTable,
     ZeroOffsetTable,
 )
-from .kernel.state import ErrorEntry, Snapshot
-from .kernel.tooling import tables_from_config
-from .log_throttle import ThrottledWarning
-from .machine_config import MachineConfig
+from ..kernel.state import ErrorEntry, Snapshot
+from ..kernel.tooling import tables_from_config
+from ..log_throttle import ThrottledWarning
+from ..machine_config import MachineConfig
 
 log = logging.getLogger(__name__)
 

@@ -16,12 +16,12 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from .cli_app import EXIT_USAGE, Settings, app, emit, fail, say_error
-from .errors import AdsError, ClientValueError
+from ..errors import AdsError, ClientValueError
+from .app import EXIT_USAGE, Settings, app, emit, fail, say_error
 
 if TYPE_CHECKING:  # the client library is imported when a command connects (a quick --help)
-    from .alarm_ops import AlarmInfo
-    from .blocking import Client
+    from ..alarm_ops import AlarmInfo
+    from ..blocking import Client
 
 alarms_app = typer.Typer(
     no_args_is_help=False,

@@ -1,0 +1,5 @@
+"""``python -m cnc_objects.clients.cli`` is ``cnc``."""
+
+from . import main
+
+main()
