@@ -1,4 +1,4 @@
-"""The import graph of our four packages: no circles, and the layers of DESIGN.md.
+"""The import graph of our four packages: no circles, and the layers of docs/architecture.md.
 
 The graph is built from the source with the stdlib ``ast``, never by importing, so a
 circle is found even where it is dodged at run time by an import inside a function
@@ -46,8 +46,16 @@ KERNEL = f"{SERVICE}.kernel"
 # configuration (not the front ends', the keys' or the limits', nor the loading). The
 # server, dispatcher, bindings, notifications and entry point are above the kernel.
 KERNEL_MAY_IMPORT_FROM_SERVICE = (KERNEL, f"{SERVICE}.machine_config")
-# Wire libraries the kernel must not know (DESIGN.md: "knows nothing of sockets, msgpack").
+# Wire libraries the kernel must not know (docs/architecture.md: "knows nothing of sockets,
+# msgpack").
 KERNEL_FORBIDDEN_LIBRARIES = ("zmq", "msgpack")
+ADS_FRONT_END = f"{SERVICE}.ads"
+ZMQ_FRONT_END = (f"{SERVICE}.server", f"{SERVICE}.zmq_connections")
+STORAGE = f"{SERVICE}.storage"
+# What the service keeps on disk knows the kernel's types it stores and the machine's
+# configuration, never a front end, the dispatcher or the bindings.
+STORAGE_MAY_IMPORT = (STORAGE, KERNEL, f"{SERVICE}.machine_config", f"{SERVICE}.log_throttle",
+                      OBJECTS, PROTOCOL)
 
 
 @dataclass(frozen=True)
@@ -285,10 +293,12 @@ def _violations(importers: str, allowed: tuple[str, ...]) -> list[str]:
         pytest.param(CLIENTS, (CLIENTS, OBJECTS, PROTOCOL), id="clients-never-import-service"),
         pytest.param(KERNEL, (*KERNEL_MAY_IMPORT_FROM_SERVICE, PROTOCOL),
                      id="kernel-below-server"),
+        pytest.param(STORAGE, STORAGE_MAY_IMPORT, id="storage-knows-no-front-end"),
     ],
 )
 def test_layers_import_only_downward(layer: str, allowed: tuple[str, ...]) -> None:
-    """The dependency direction of DESIGN.md: protocol <- objects <- service, clients."""
+    """The dependency direction of docs/architecture.md: protocol <- objects <- service,
+    clients; the kernel and the storage below the front ends."""
     violations = _violations(layer, allowed)
     assert not violations, f"{layer} may import only {allowed}:\n" + "\n".join(violations)
 
@@ -300,5 +310,18 @@ def test_kernel_knows_no_wire_library() -> None:
         for edge in import_edges()
         if _within(edge.importer, KERNEL)
         and any(_within(edge.imported, library) for library in KERNEL_FORBIDDEN_LIBRARIES)
+    )
+    assert not violations, "\n".join(violations)
+
+
+def test_the_two_front_ends_do_not_know_each_other() -> None:
+    """ZeroMQ and ADS are two front ends over one dispatcher: neither imports the other."""
+    pairs = [(ADS_FRONT_END, zmq) for zmq in ZMQ_FRONT_END]
+    pairs += [(zmq, ADS_FRONT_END) for zmq in ZMQ_FRONT_END]
+    violations = sorted(
+        f"{edge.importer} (line {edge.line}) imports {edge.imported}"
+        for edge in import_edges()
+        for importer, imported in pairs
+        if _within(edge.importer, importer) and _within(edge.imported, imported)
     )
     assert not violations, "\n".join(violations)
