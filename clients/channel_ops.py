@@ -45,6 +45,7 @@ from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.file_listing import decode_listing
 from cnc_objects.protocol.program_lines import LinesRequest, decode_lines_reply, encode_lines_request
 from cnc_objects.protocol.values import (
+    WORKING_STATES,
     ChannelMode,
     ChannelState,
     ContourBlockType,
@@ -63,7 +64,7 @@ POLL_S = 0.01  # how often waiting re-reads the channel state (wall time)
 
 MODES = value_names(ChannelMode)
 STATES = value_names(ChannelState)
-_ACTIVE, _HOLD, _ERROR = ChannelState.ACTIVE, ChannelState.HOLD, ChannelState.ERROR
+_ERROR = ChannelState.ERROR
 _ERROR_SLOTS = 8
 SYNCHK, MACHINE_LOCK = int(ExecutionMode.SYNCHK), int(ExecutionMode.MACHINE_LOCK)
 WAIT_REASONS = value_names(WaitReason)
@@ -612,7 +613,7 @@ class ChannelOps(ProgramOps):
         (name, sentence) once it has held for ``reason_settle_s`` of wall time (so that
         reasons of a moment, such as the first blocks' decoding, can be left out), and
         with ("NONE", "") at once when a reason it was told of has gone."""
-        await self._wait(channel, lambda state, _: state not in (_ACTIVE, _HOLD), timeout_s,
+        await self._wait(channel, lambda state, _: state not in WORKING_STATES, timeout_s,
                          on_wait_reason, reason_settle_s)
 
     async def wait_mdi(self, before: int, channel: int = 1, timeout_s: float | None = None,
@@ -623,7 +624,7 @@ class ChannelOps(ProgramOps):
         ``wait_program``)."""
         await self._wait(
             channel,
-            lambda state, count: count > before or state not in (_ACTIVE, _HOLD),
+            lambda state, count: count > before or state not in WORKING_STATES,
             timeout_s, on_wait_reason, reason_settle_s,
         )
 
@@ -698,7 +699,7 @@ class ChannelOps(ProgramOps):
         mode, state = (before[n] for n in state_names)
         if state == _ERROR:  # before anything changes (the last log)
             raise AdsError(AdsReturnCode.DEVICE_NOTREADY, await self._in_error(channel, what))
-        if state in (_ACTIVE, _HOLD):
+        if state in WORKING_STATES:
             raise AdsError(
                 AdsReturnCode.DEVICE_NOTREADY,
                 f"channel {channel} is {MODES.get(mode, mode)}/{STATES.get(state, state)}: "
@@ -791,7 +792,7 @@ class ChannelOps(ProgramOps):
         if cancel:
             try:
                 state = await self.read(f"ch{channel}.mc_active_state_r")
-                if state in (_ACTIVE, _HOLD):
+                if state in WORKING_STATES:
                     await self.reset(channel)
             except AdsError as exc:
                 first = exc

@@ -17,7 +17,14 @@ from enum import Enum, IntEnum
 
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16, UNS32, DataType
-from cnc_objects.protocol.values import ChannelMode, ChannelState, ContourBlockType, LinkState
+from cnc_objects.protocol.values import (
+    ERRORS_LISTED,
+    MESSAGES_LISTED,
+    ChannelMode,
+    ChannelState,
+    ContourBlockType,
+    LinkState,
+)
 from cnc_objects.protocol.wait_reasons import WAIT_REASON_TEXT_CHARS, WaitReason
 
 from .addressing import GroupBase, axis_offset, channel_group
@@ -329,7 +336,7 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
             f"mc_error_{k}_{field}_r", Scope.CHANNEL, COM, COM_CH, 0x3020 + 0x10 * k + n,
             dtype, R, "-", f"Error {k} of the list: {meaning} (project)",
         )
-        for k in range(1, 9)
+        for k in range(1, ERRORS_LISTED + 1)
         for n, (field, dtype, meaning) in enumerate((
             ("id", UNS32, "ISG-style error id; 0 = no error"),
             ("text", STRING(256), "message"),
@@ -462,7 +469,7 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
             f"mc_message_{k}_text_r", Scope.CHANNEL, COM, COM_CH, 0x3200 + k, STRING(256), R,
             "-", f"#MSG text {k} of the message list, 1 = newest; empty = none (project)",
         )
-        for k in range(1, 9)
+        for k in range(1, MESSAGES_LISTED + 1)
     ),
     *(
         ObjectTemplate(f"{name}_r", Scope.CHANNEL, COM, COM_CH, 0x3210 + n, dtype, R, unit,

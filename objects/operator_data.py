@@ -29,11 +29,12 @@ from typing import Any
 
 from cnc_objects.protocol.constants import TOOL_LIFE_MAX_S as LIFE_MAX_S
 from cnc_objects.protocol.constants import TOOL_NAME_CHARS
+from cnc_objects.protocol.units import UM01_PER_MM
 
 FORMAT_NAME = "cnc-objects operator data"
 FORMAT_VERSION = 1
 #: the largest |value| a table takes, in mm (the SGN32 position objects' 214748.3647 mm)
-VALUE_MAX_MM = (2**31 - 1) / 10_000
+VALUE_MAX_MM = (2**31 - 1) / UM01_PER_MM
 
 
 class OperatorDataError(ValueError):

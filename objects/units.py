@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from cnc_objects.protocol.units import UM01_PER_MM
+
 
 @dataclass(frozen=True, slots=True)
 class EngineeringScale:
@@ -30,7 +32,7 @@ class EngineeringScale:
 # catalog unit -> scale. A unit not listed ("-", "byte", enumerations) has no scale: its
 # value is shown as it is.
 SCALES: dict[str, EngineeringScale] = {
-    "0.1 um": EngineeringScale("mm", 1e-4, 4),  # positions, lengths, offsets, tool data
+    "0.1 um": EngineeringScale("mm", 1 / UM01_PER_MM, 4),  # positions, lengths, offsets, tool data
     "um/s": EngineeringScale("mm/min", 0.06, 3),  # path and jog speeds, as F is programmed
     "0.1 %": EngineeringScale("%", 0.1, 1),  # overrides
     "0.001 deg/s": EngineeringScale("rpm", 1 / 6000, 3),  # spindle speeds: 360 000 per rpm

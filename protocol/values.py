@@ -36,6 +36,21 @@ class ChannelState(IntEnum):
     ERROR = 6  # an error stopped the channel; RESET clears it
 
 
+WORKING_STATES: frozenset[ChannelState] = frozenset({ChannelState.ACTIVE, ChannelState.HOLD})
+"""The channel is working its program or manual block: running, or stopped in a feedhold
+that START resumes. READY, SELECTED, ERROR and DESELECTED are not."""
+
+ERRORS_LISTED = 8
+"""Errors a channel lists (``ch<c>.mc_error_<k>_*_r``, k = 1..8): the first of a run, whose
+first entry is the cause."""
+MESSAGES_LISTED = 8
+"""``#MSG`` texts a channel shows (``ch<c>.mc_message_<k>_text_r``, k = 1..8, 1 = newest)."""
+
+IDLE_STATES: frozenset[ChannelState] = frozenset(
+    {ChannelState.DESELECTED, ChannelState.SELECTED, ChannelState.READY})
+"""The channel has nothing in hand: a mode may be selected, a program started."""
+
+
 class LinkState(IntEnum):
     """State of a logical axis's link to its physical axis (FCT-C15 ``link_state``)."""
 

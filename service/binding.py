@@ -19,6 +19,8 @@ from cnc_objects.objects.catalog_tools import build_tool_objects
 from cnc_objects.objects.directory import ObjectDirectory
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.units import UM01_PER_MM
+from cnc_objects.protocol.values import ERRORS_LISTED, MESSAGES_LISTED
 from cnc_objects.protocol.wait_reasons import wait_reason_text
 
 from . import __version__
@@ -311,7 +313,7 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "requested_link_to_physical_axis": _channel_axis("requested_link"),
     "actual_link_to_physical_axis": _channel_axis("actual_link"),
     "link_state": _channel_axis("link_state"),
-    "dist_prog_start": _channel("dist_prog_start_incr"),
+    "dist_prog_start": _channel("dist_prog_start_01um"),
     "mc_command_feed_override_r": _channel("feed_override_command"),
     "mc_active_feed_override_r": _channel("feed_override_per_mille"),
     "mc_command_execution_mode_r": _channel("execution_mode_command"),
@@ -346,13 +348,13 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "cnc_cycle_sched_priority_r": _realtime_grant("priority"),
     "cnc_memory_locked_r": _realtime_grant("memory_locked"),
     "command_position_acs": _per_scope(
-        _physical_axis("command_position_incr"), _channel_axis("command_position_incr")
+        _physical_axis("command_position_01um"), _channel_axis("command_position_01um")
     ),
-    "actual_position_acs": _physical_axis("actual_position_incr"),
+    "actual_position_acs": _physical_axis("actual_position_01um"),
     "link_to_logical_axis": _physical_axis("linked_logical_axis"),
     "axis_name": _per_scope(_physical_axis("name"), _channel_axis("name")),
     "logical_axis_number": _channel_axis("logical_number"),
-    "remaining_path_in_block": _scaled("remaining_in_block_mm", 1e4),
+    "remaining_path_in_block": _scaled("remaining_in_block_mm", UM01_PER_MM),
     "actual_path_velocity": _scaled("path_velocity_mm_s", 1e3),
     "programmed_path_velocity": _scaled("programmed_velocity_mm_s", 1e3),
     "actual_block_number": _channel("block_number"),
@@ -373,7 +375,7 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "mc_wait_reason_text_r": _wait_reason_text,
     "mc_manual_blocks_done_r": _channel("manual_blocks_done"),
     "mc_error_count_r": _channel("error_count"),
-    "position_offset": _channel_axis("position_offset_incr"),
+    "position_offset": _channel_axis("position_offset_01um"),
     "vel_max": _axis_param("vel_max_mm_s"),
     "acc_max": _axis_param("acc_max_mm_s2"),
     "vel_jump_max": _axis_param("vel_jump_mm_s"),
@@ -382,11 +384,11 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "bahn_mc_control.suspend_axis_output.enable_w": _channel("suspend_enable_w"),
     "bahn_mc_control.suspend_axis_output.request_r": _channel("suspend_request_r"),
     "bahn_mc_control.suspend_axis_output.state_r": _channel("output_suspended"),
-    "bahn_state.dist_prog_start": _channel("dist_prog_start_incr"),
+    "bahn_state.dist_prog_start": _channel("dist_prog_start_01um"),
     "contour_lookahead.request.start_position": _contour("request_start_position"),
     "contour_lookahead.request.length": _contour("request_length"),
     "contour_lookahead.semaphor_rw": _contour("semaphor"),
-    "contour_lookahead.state.max_dist_prog_start": _contour("max_dist_prog_start_incr"),
+    "contour_lookahead.state.max_dist_prog_start": _contour("max_dist_prog_start_01um"),
     "contour_lookahead.state.count_logged_blocks": _contour("count_logged_blocks"),
     "contour_lookahead.state.f_log_is_active": _contour("log_active"),
     **{
@@ -395,16 +397,16 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
         for name, *_ in CONTOUR_BLOCK_FIELDS
     },
     "head.log_ax_n_r": _constant_per_object(lambda kernel, obj: obj.axis),
-    "lr_state.position_offset_r": _hli_physical("position_offset_incr"),
+    "lr_state.position_offset_r": _hli_physical("position_offset_01um"),
     "lr_state.link_to_ipo_r": _hli_physical("linked_logical_axis"),
     "ipo_state.link_to_lr": _hli_logical("actual_link"),
     **{
         f"mc_error_{k}_{field}_r": _channel_error(k, field)
-        for k in range(1, 9)
+        for k in range(1, ERRORS_LISTED + 1)
         for field in ("id", "text", "file", "line", "column", "warning")
     },
     "mc_message_count_r": _channel("message_count"),
-    **{f"mc_message_{k}_text_r": _channel_message(k) for k in range(1, 9)},
+    **{f"mc_message_{k}_text_r": _channel_message(k) for k in range(1, MESSAGES_LISTED + 1)},
     **{f"{name}_r": _machining(attr) for name, attr, *_ in MACHINING_FIELDS},
     **MANUAL_READERS,
 }

@@ -50,7 +50,7 @@ MANUAL_READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "manual_jog_plus_w": _view("jog_plus"),
     "manual_jog_minus_w": _view("jog_minus"),
     "manual_rapid_w": _view("rapid"),
-    "manual_increment_w": _view("increment_incr"),
+    "manual_increment_w": _view("increment_01um"),
     "manual_handwheel_counter_w": _view("handwheel_counter"),
     "manual_hr_aufloesung_w": _view("hr_aufloesung"),
     "manual_velocity_r": _view("velocity_um_s"),
@@ -58,7 +58,7 @@ MANUAL_READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "manual_limit_warning_r": _view("limit_warning"),
     "homing_referenced_r": _view("referenced"),
     "homing_active_r": _view("homing_active"),
-    "manual_offset_r": _view("offset_incr", _int32),
+    "manual_offset_r": _view("offset_01um", _int32),
 }
 
 MANUAL_WRITERS: dict[str, Callable[[Kernel, CncObject], Callable[[Any], ManualAxisCommand]]] = {

@@ -44,7 +44,7 @@ def _referencing_required(kernel: Kernel, obj: CncObject) -> Getter:
 
 def _distance_to_go(kernel: Kernel, obj: CncObject) -> Getter:
     ci, ai = kernel.channel_index(obj.channel), obj.axis - 1
-    return lambda: kernel.snapshot.channels[ci].axes[ai].distance_to_go_incr
+    return lambda: kernel.snapshot.channels[ci].axes[ai].distance_to_go_01um
 
 
 def _configured(value: Callable[[Kernel, CncObject], Any]) -> Binder:

@@ -18,11 +18,12 @@ from cnc_objects.objects.catalog_tools import (
     zero_offset_element,
 )
 
+from ..protocol.units import UM01_PER_MM
 from .binding_tool_life import tool_extra_reader, tool_extra_writer
 from .kernel.commands import Command
 from .kernel.kernel import Kernel
 from .kernel.nc.tool_data import ToolField
-from .kernel.tooling import INCR_PER_MM, SetToolData, SetZeroOffset
+from .kernel.tooling import SetToolData, SetZeroOffset
 from .kernel.tooling_view import ChannelTooling
 
 Getter = Callable[[], Any]
@@ -48,8 +49,8 @@ def _position_pcs(kernel: Kernel, obj: CncObject) -> Getter:
     def get() -> int:
         channel = kernel.snapshot.channels[ci]
         shift = channel.tooling.shift_mm
-        shift_incr = round(shift[ai] * INCR_PER_MM) if ai < len(shift) else 0
-        return channel.axes[ai].command_position_incr - shift_incr
+        shift_01um = round(shift[ai] * UM01_PER_MM) if ai < len(shift) else 0
+        return channel.axes[ai].command_position_01um - shift_01um
 
     return get
 

@@ -32,6 +32,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from cnc_objects.protocol.units import UM01_PER_MM
+
 __all__ = [
     "ParamListError",
     "Problem",
@@ -250,9 +252,9 @@ _AXIS_PARAMS = {
                ("auto_release_of_axis_link",)),
         _Param("kenngr.achs_typ", "P-AXIS-00018", _axis_type, ("axis_type",)),
         # 0.1 um in the list, mm in the configuration.
-        _Param("kenngr.swe_neg", "P-AXIS-00177", lambda t: _SGN32(t) / 10_000,
+        _Param("kenngr.swe_neg", "P-AXIS-00177", lambda t: _SGN32(t) / UM01_PER_MM,
                ("limits", "sw_limit_min_mm")),
-        _Param("kenngr.swe_pos", "P-AXIS-00178", lambda t: _SGN32(t) / 10_000,
+        _Param("kenngr.swe_pos", "P-AXIS-00178", lambda t: _SGN32(t) / UM01_PER_MM,
                ("limits", "sw_limit_max_mm")),
         # um/s in the list, mm/s in the configuration.
         _Param("getriebe[0].dynamik.vb_max", "P-AXIS-00212", lambda t: _UNS32(t) / 1_000,

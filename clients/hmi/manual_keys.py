@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from cnc_objects.clients.client import AsyncClient
 from cnc_objects.clients.errors import AdsError
 from cnc_objects.clients.jog_hold import RENEW_S
+from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import ChannelMode, ManualOperationMode
 
 from .machine import AxisView, ChannelView
@@ -38,8 +39,8 @@ log = logging.getLogger(__name__)
 
 #: The increments ``i`` steps through (0.1 um units): 1 um, 10 um, 0.1 mm, 1 mm, 10 mm;
 #: the step after the last is continuous jog.
-INCREMENTS_INCR = (10, 100, 1_000, 10_000, 100_000)
-CONTINUOUS = len(INCREMENTS_INCR)  # the JogChoice.increment index of continuous jog
+INCREMENTS_01UM = (10, 100, 1_000, 10_000, 100_000)
+CONTINUOUS = len(INCREMENTS_01UM)  # the JogChoice.increment index of continuous jog
 FIRST_REPEAT_S = 0.7  # wall time a key may wait for its first auto-repeat (X11: 660 ms)
 REPEAT_GAP_S = 0.2  # wall time between two repeats (auto-repeat is 10..30 per second)
 
@@ -49,7 +50,7 @@ class JogChoice:
     """The HMI's jog selection: axis index in the channel (from 0) and the jog step."""
 
     axis: int = 0
-    increment: int = 3  # index into INCREMENTS_INCR (1 mm); CONTINUOUS: continuous jog
+    increment: int = 3  # index into INCREMENTS_01UM (1 mm); CONTINUOUS: continuous jog
 
     @property
     def continuous(self) -> bool:
@@ -57,13 +58,13 @@ class JogChoice:
         return self.increment == CONTINUOUS
 
     @property
-    def increment_incr(self) -> int:
+    def increment_01um(self) -> int:
         """The chosen increment in 0.1 um (continuous: the largest)."""
-        return INCREMENTS_INCR[min(self.increment, CONTINUOUS - 1)]
+        return INCREMENTS_01UM[min(self.increment, CONTINUOUS - 1)]
 
     def step_text(self) -> str:
         """``1 mm`` or ``continuous``."""
-        return "continuous" if self.continuous else f"{self.increment_incr / 10_000:g} mm"
+        return "continuous" if self.continuous else f"{self.increment_01um / UM01_PER_MM:g} mm"
 
     def axis_of(self, channel: ChannelView) -> AxisView:
         """The chosen axis of ``channel``."""
@@ -83,7 +84,7 @@ class JogChoice:
         """Choose the next step; the line the message bar shows."""
         self.increment = (self.increment + 1) % (CONTINUOUS + 1)
         return ("jog continuous (while the key is held)" if self.continuous
-                else f"jog increment {self.increment_incr / 10_000:g} mm")
+                else f"jog increment {self.increment_01um / UM01_PER_MM:g} mm")
 
 
 async def _prepare(client: AsyncClient, channel: ChannelView, axis: AxisView,
@@ -104,12 +105,12 @@ async def jog(client: AsyncClient, channel: ChannelView, choice: JogChoice,
     """One increment of the chosen axis in ``direction`` (+1 / -1), in MANUAL."""
     axis = choice.axis_of(channel)
     await _prepare(client, channel, axis, ManualOperationMode.INCREMENTAL)
-    await client.write(axis.obj("manual_increment_w"), choice.increment_incr)
+    await client.write(axis.obj("manual_increment_w"), choice.increment_01um)
     key = _key(axis, direction)
     await client.write(key, True)
     await client.write(key, False)
     sign = "+" if direction > 0 else "-"
-    return f"ch{channel.id}: jog {axis.name}{sign}{choice.increment_incr / 10_000:g} mm"
+    return f"ch{channel.id}: jog {axis.name}{sign}{choice.increment_01um / UM01_PER_MM:g} mm"
 
 
 @dataclass(slots=True)

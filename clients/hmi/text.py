@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from cnc_objects.clients.channel_ops import CONTOUR_BLOCK_TYPES, MODES, STATES
 from cnc_objects.clients.errors import AdsConnectionError, AdsError, AdsTimeoutError
+from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import LinkState
 
-UM01_PER_MM = 10_000  # positions and distances travel in 0.1 um
 PERMILLE_PER_PERCENT = 10  # override travels in 0.1 %
 # ch<c>.ax<a>.link_state; 1 is also what a suspended channel's axes read
 LINK_STATES = {int(s): s.name.lower().replace("_", " ") for s in LinkState}

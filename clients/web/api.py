@@ -20,6 +20,8 @@ from cnc_objects.clients.client import AsyncClient
 from cnc_objects.clients.errors import AdsError, AdsTimeoutError, ClientValueError
 from cnc_objects.clients.hmi.machine import discover
 from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.units import UM01_PER_MM
+from cnc_objects.protocol.values import ChannelMode, ManualOperationMode
 
 from . import alarms
 from .access import ACCESS_KEY, STORE_ROLE, WRITE_ROLE, refusal, require_write, set_session_cookie
@@ -30,9 +32,6 @@ from .users import WebRole
 CLIENT_KEY: web.AppKey[AsyncClient] = web.AppKey("client")
 MAX_UPLOAD_BYTES = 4 * 1024 * 1024  # a program larger than this is refused before it is read
 TRACE_TIMEOUT_S = 60.0  # wall time for the dry run that draws a program's tool path
-MANUAL_MODE = 4  # ChannelMode.MANUAL
-JOG_INCREMENTAL = 3  # ManualOperationMode: jog by increments
-UM01_PER_MM = 10_000
 MAX_COUNT_DIGITS = 9  # a count in a query (``limit``): more digits than any catalogue needs
 
 Handler = Callable[[web.Request], Awaitable[web.StreamResponse]]
@@ -298,17 +297,17 @@ async def jog(request: web.Request) -> web.StreamResponse:
     increment = await c.find(f"{prefix}.manual_increment_w")
     if increment is None:
         raise refusal(400, f"no axis {axis} in channel {channel}")
-    increment_um01 = round(increment_mm * UM01_PER_MM)
+    increment_01um = round(increment_mm * UM01_PER_MM)
     low, high = increment.dtype.minimum, increment.dtype.maximum
-    if low is not None and high is not None and not low <= increment_um01 <= high:
+    if low is not None and high is not None and not low <= increment_01um <= high:
         raise refusal(400, f"'increment_mm' {increment_mm} is out of range "
                            f"({low / UM01_PER_MM}..{high / UM01_PER_MM} mm)")
     if direction not in (1, -1):
         raise refusal(400, f"'direction' is +1 or -1, not {direction}")
-    if await c.read(f"ch{channel}.mc_active_mode_r") != MANUAL_MODE:
-        await c.write(f"ch{channel}.mc_command_mode_w", MANUAL_MODE)
-    await c.write(f"{prefix}.manual_operation_mode_w", JOG_INCREMENTAL)
-    await c.write(f"{prefix}.manual_increment_w", increment_um01)
+    if await c.read(f"ch{channel}.mc_active_mode_r") != ChannelMode.MANUAL:
+        await c.write(f"ch{channel}.mc_command_mode_w", ChannelMode.MANUAL)
+    await c.write(f"{prefix}.manual_operation_mode_w", ManualOperationMode.INCREMENTAL)
+    await c.write(f"{prefix}.manual_increment_w", increment_01um)
     key = f"{prefix}.manual_jog_{'plus' if direction > 0 else 'minus'}_w"
     await c.write(key, True)
     await c.write(key, False)

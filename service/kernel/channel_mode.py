@@ -23,13 +23,10 @@ docs/kernel.md ("Channel mode and state"); in short:
 from __future__ import annotations
 
 # The value sets are part of the wire contract: defined in protocol, used here.
-from cnc_objects.protocol.values import ChannelMode, ChannelState
+from cnc_objects.protocol.values import IDLE_STATES, ChannelMode, ChannelState
 
 __all__ = ["IDLE_STATES", "SELECTABLE_MODES", "ChannelMode", "ChannelState", "describe"]
 
-
-#: States in which the channel is not working: a mode or program may be chosen.
-IDLE_STATES = frozenset({ChannelState.DESELECTED, ChannelState.SELECTED, ChannelState.READY})
 
 #: Modes a client may select with ``mc_command_mode_w``.
 SELECTABLE_MODES = frozenset(

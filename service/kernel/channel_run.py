@@ -31,7 +31,8 @@ from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
 
-from cnc_objects.protocol.values import ExecutionMode
+from cnc_objects.protocol.units import UM01_PER_MM
+from cnc_objects.protocol.values import ERRORS_LISTED, MESSAGES_LISTED, WORKING_STATES, ExecutionMode
 
 from ..machine_config import ChannelConfig, MachineConfig
 from .alarms import AlarmClass, AlarmLog
@@ -61,7 +62,7 @@ from .program_run import (
     show_contour_state,
 )
 from .spindle import Spindle
-from .state import MESSAGES_KEPT, Channel, DecoderFlag, ErrorEntry
+from .state import Channel, DecoderFlag, ErrorEntry
 from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
 from .tooling import seed_modal, tables_from_config, tooling_of
@@ -73,7 +74,6 @@ log = logging.getLogger(__name__)
 
 _ACTIVE = int(ChannelState.ACTIVE)
 _NOT_WAITING = int(WaitReason.NONE)
-MAX_ERRORS_KEPT = 8  # the error list keeps the first errors of a run (the first is the cause)
 _FEED_MARGIN_BLOCKS = 256  # the decoder may run this far ahead of the look-ahead buffer
 _MDI_NAME = "MDI"  # file name of manual blocks in errors and objects
 _CHECK_MODES = ExecutionMode.SYNCHK | ExecutionMode.MACHINE_LOCK
@@ -169,11 +169,11 @@ class ChannelRunner:
         channel.spindle, channel.plc_functions = self.plc.spindle.state, self.plc.unit
         self.touched = False  # the last cycle changed the channel's state
         # #MSG texts from the decoder thread (deque appends are thread-safe)
-        self._messages: deque[str] = deque(maxlen=MESSAGES_KEPT)
+        self._messages: deque[str] = deque(maxlen=MESSAGES_LISTED)
         self._surroundings = Surroundings(
             write_file=lambda name, text, replace: save(name, text.encode(), replace),
             show_message=self._messages.append,
-            hscs={mode.upper(): HscProgram(c.prog, c.tolerance * 1e-4)  # 0.1 um -> mm
+            hscs={mode.upper(): HscProgram(c.prog, c.tolerance / UM01_PER_MM)
                   for mode, c in config.hscs},
             kinematics=False,  # this kernel configures no kinematic transformation
             idle_steps_max=idle_steps_max,
@@ -318,7 +318,7 @@ class ChannelRunner:
         ch.waiting_for_start = False
         ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
         for axis in ch.axes:
-            axis.distance_to_go_incr = 0  # no block in the interpolator
+            axis.distance_to_go_01um = 0  # no block in the interpolator
         self._move(ChannelEvent.RESET)
         self._modal = None
         ch.tooling = after_reset(ch.tooling)
@@ -545,7 +545,7 @@ class ChannelRunner:
         program also starts with no messages and default high-speed settings."""
         ch = self.channel
         ch.block_count = 0
-        ch.dist_prog_start_incr = 0.0
+        ch.dist_prog_start_01um = 0.0
         ch.program_time_s = 0.0
         ch.file_name, ch.line, ch.file_offset, ch.block_number = job.name, 0, 0, -1
         if not job.manual:
@@ -560,7 +560,7 @@ class ChannelRunner:
         while self._messages:
             new.append(self._messages.popleft())
         if new:
-            ch.messages = (tuple(reversed(new)) + ch.messages)[:MESSAGES_KEPT]
+            ch.messages = (tuple(reversed(new)) + ch.messages)[:MESSAGES_LISTED]
             ch.message_count += len(new)
         if self._modal is not None and self._modal.settings != ch.machining:
             ch.machining = replace(self._modal.settings)
@@ -643,7 +643,7 @@ class ChannelRunner:
                 or ch.plc_functions is not plc.unit
                 or any(u.pending and u.ack_due_s is not None for u in plc.unit.units)):
             return 0  # a ramp or an acknowledge runs in time
-        if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
+        if ch.state not in WORKING_STATES:
             return None
         run = self._run
         if (self.manual.engaged or self.manual.in_program or self._pending_start is not None
@@ -659,7 +659,7 @@ class ChannelRunner:
         reason unchanged)."""
         self.time_s = time_s
         run = self._run
-        if self.channel.state in (ChannelState.ACTIVE, ChannelState.HOLD):
+        if self.channel.state in WORKING_STATES:
             assert isinstance(run, ProgramRun)
             run.cruise(cycles, time_s)
             self.touched = True
@@ -668,7 +668,7 @@ class ChannelRunner:
         self.time_s = time_s
         ch = self.channel
         self._waits_for_axes = False
-        if ch.state not in (ChannelState.ACTIVE, ChannelState.HOLD):
+        if ch.state not in WORKING_STATES:
             self.touched = False
             return False
         if self.manual.engaged and self._run is None:  # jog, handwheel, homing (MANUAL)
@@ -770,7 +770,7 @@ class ChannelRunner:
             log.info("channel %d: %s", ch.channel_id, error)
             self._files(self.error_log_name, f"{self.time_s:.3f} s {error}\n".encode())
         ch.error_count += 1
-        if len(ch.errors) < MAX_ERRORS_KEPT - keep_last:
+        if len(ch.errors) < ERRORS_LISTED - keep_last:
             ch.errors = (*ch.errors, error)
 
     # ------------------------------------------------------------ contour look-ahead

@@ -43,6 +43,7 @@ import math
 from collections import deque
 from collections.abc import Iterable, Sequence
 
+from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import ContourBlockType
 
 from .nc.blocks import Block, ContourCommand, ContourKind, LogArea, MotionKind, next_log_area
@@ -54,7 +55,6 @@ RESPONSE_BLOCKS = 32  # entries of gpCh[i].contour_lookahead.response.block[0..3
 LOG_FULL_WARNING = 22074  # warning id: the marked area has more entries than the log keeps
 
 LINEAR, CIRCULAR = ContourBlockType.LINEAR, ContourBlockType.CIRCULAR  # motion elements
-_INCR_PER_MM = 10_000.0  # 0.1 um per mm
 _SAME_CENTRE_MM = 1e-6  # an offset arc keeps the centre of its programmed arc
 # mode 2 window edges: start positions are exact sums of the lengths in 0.1 um, as a
 # PLC adds them; this only absorbs a client's own rounding
@@ -108,12 +108,12 @@ class _Prepared:
         element, previous = self.element, self.previous
         variation = 0.0 if previous is None else tangent_angle_rad(previous,
                                                                    element.tangent_start)
-        length = element.length_mm * _INCR_PER_MM
+        length = element.length_mm * UM01_PER_MM
         if isinstance(element, Arc):
             return ContourElement(
                 CIRCULAR, self.number, self.ordinal, self.start_position, length,
-                _programmed_radius_mm(element, block) * _INCR_PER_MM,
-                element.radius_mm * _INCR_PER_MM, element.sweep_rad, 0.0, variation,
+                _programmed_radius_mm(element, block) * UM01_PER_MM,
+                element.radius_mm * UM01_PER_MM, element.sweep_rad, 0.0, variation,
             )
         return ContourElement(
             LINEAR, self.number, self.ordinal, self.start_position, length, 0.0, 0.0, 0.0,
@@ -137,7 +137,7 @@ class ContourLog:
         self.recent: deque[tuple[int, _Prepared, Block]] = deque(
             maxlen=log_max + 3 * buffer_blocks if log_max else 0)
         self.area = LogArea.NONE
-        self.distance_incr = 0.0  # start of the next element (0.1 um, summed as the PLC does)
+        self.distance_01um = 0.0  # start of the next element (0.1 um, summed as the PLC does)
         self.epoch = 0  # #DISTANCE PROG START CLEAR prepared so far
         self.executed_epoch = 0  # ... and executed: the distances dist_prog_start counts in
         self.complete = False  # the end of data was prepared: everything is read in
@@ -154,9 +154,9 @@ class ContourLog:
     # ------------------------------------------------------------ state
 
     @property
-    def max_dist_prog_start_incr(self) -> float:
+    def max_dist_prog_start_01um(self) -> float:
         """Maximum look-ahead distance: the end of the path prepared so far (0.1 um)."""
-        return self.distance_incr
+        return self.distance_01um
 
     @property
     def active(self) -> bool:
@@ -235,8 +235,8 @@ class ContourLog:
     def _element(self, segment: Segment) -> bool:
         element = segment.element
         block = segment.block
-        start = self.distance_incr
-        self.distance_incr = start + element.length_mm * _INCR_PER_MM
+        start = self.distance_01um
+        self.distance_01um = start + element.length_mm * UM01_PER_MM
         previous, self._tangent = self._tangent, element.tangent_end
         prepared = _Prepared(element, self._number(block), self._ordinal, start, previous)
         if self.log_max:
@@ -247,7 +247,7 @@ class ContourLog:
 
     def _command(self, block: Block, kind: ContourKind, param: float | None) -> bool:
         if kind == ContourKind.DISTANCE_CLEAR:
-            self.distance_incr = 0.0
+            self.distance_01um = 0.0
             self.epoch += 1
             return False
         if kind == ContourKind.LOG_CLEAR:  # normally applied at standstill by the channel
@@ -256,7 +256,7 @@ class ContourLog:
         before = self.area
         self.area = next_log_area(before, kind)
         entry = ContourElement(
-            int(kind), self._number(block), self._ordinal, self.distance_incr,
+            int(kind), self._number(block), self._ordinal, self.distance_01um,
             0.0 if param is None else param, 0.0, 0.0, 0.0, 0.0, 0.0,
         )
         if kind == ContourKind.LOG_ON:

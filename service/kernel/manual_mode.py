@@ -33,7 +33,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from enum import IntEnum
 
-from cnc_objects.protocol.values import ManualOperationMode
+from cnc_objects.protocol.units import UM01_PER_MM
+from cnc_objects.protocol.values import WORKING_STATES, ManualOperationMode
 
 from ..machine_config import MachineConfig, ManualAxisConfig
 from .axis_params import AxisParameters
@@ -46,10 +47,9 @@ from .manual_view import DisplayState, ManualAxisView
 from .nc.blocks import ManualModeKind, ManualModeRequest
 from .state import Channel, ErrorEntry
 
-INCREMENT_MIN_INCR = 1  # 0.1 um: the smallest jog increment
-INCREMENT_MAX_INCR = 100_000  # 10 mm: the largest jog increment
-RESOLUTION_MIN_INCR, RESOLUTION_MAX_INCR = 1, 100_000  # handwheel path per pulse, 0.1 um
-_INCR_PER_MM = 10_000
+INCREMENT_MIN_01UM = 1  # 0.1 um: the smallest jog increment
+INCREMENT_MAX_01UM = 100_000  # 10 mm: the largest jog increment
+RESOLUTION_MIN_01UM, RESOLUTION_MAX_01UM = 1, 100_000  # handwheel path per pulse, 0.1 um
 
 
 class ManualErrorId(IntEnum):
@@ -66,7 +66,7 @@ class _Axis:
     config: ManualAxisConfig
     operation_mode: int = ManualOperationMode.NONE
     hr_aufloesung: int = 10
-    increment_incr: int = 10_000
+    increment_01um: int = UM01_PER_MM
     rapid: bool = False
     handwheel_counter: int = 0
     jog_plus: bool = False
@@ -113,8 +113,7 @@ class ManualMode:
     def engaged(self) -> bool:
         """Manual mode works the channel now (MANUAL, ACTIVE or HOLD)."""
         ch = self._channel
-        return ch.mode == ChannelMode.MANUAL and ch.state in (ChannelState.ACTIVE,
-                                                               ChannelState.HOLD)
+        return ch.mode == ChannelMode.MANUAL and ch.state in WORKING_STATES
 
     @property
     def in_program(self) -> bool:
@@ -158,18 +157,18 @@ class ManualMode:
 
     def set_increment(self, axis_index: int, value: int) -> Refusal | None:
         """``manual_increment_w``: the jog increment in 0.1 um (0.1 um .. 10 mm)."""
-        if not INCREMENT_MIN_INCR <= value <= INCREMENT_MAX_INCR:
-            return _invalid(f"jog increment {value} (0.1 um) is outside {INCREMENT_MIN_INCR}.."
-                            f"{INCREMENT_MAX_INCR} (0.1 um .. 10 mm)")
-        self._axes[axis_index].increment_incr = value
+        if not INCREMENT_MIN_01UM <= value <= INCREMENT_MAX_01UM:
+            return _invalid(f"jog increment {value} (0.1 um) is outside {INCREMENT_MIN_01UM}.."
+                            f"{INCREMENT_MAX_01UM} (0.1 um .. 10 mm)")
+        self._axes[axis_index].increment_01um = value
         self.publish()
         return None
 
     def set_resolution(self, axis_index: int, value: int) -> Refusal | None:
         """``manual_hr_aufloesung_w``: handwheel path per pulse in 0.1 um."""
-        if not RESOLUTION_MIN_INCR <= value <= RESOLUTION_MAX_INCR:
+        if not RESOLUTION_MIN_01UM <= value <= RESOLUTION_MAX_01UM:
             return _invalid(f"handwheel resolution {value} (0.1 um per pulse) is outside "
-                            f"{RESOLUTION_MIN_INCR}..{RESOLUTION_MAX_INCR}")
+                            f"{RESOLUTION_MIN_01UM}..{RESOLUTION_MAX_01UM}")
         self._axes[axis_index].hr_aufloesung = value
         self.publish()
         return None
@@ -213,7 +212,7 @@ class ManualMode:
         if mode == ManualOperationMode.CONTINUOUS:
             motion.run(direction)
         else:
-            motion.move_by(direction * axis.increment_incr / _INCR_PER_MM)
+            motion.move_by(direction * axis.increment_01um / UM01_PER_MM)
         self._started(axis_index)
         return None
 
@@ -232,7 +231,7 @@ class ManualMode:
             self.publish()
             return refused
         motion = self._motion(axis_index, self._jog_vel(axis))
-        motion.move_by(pulses * axis.hr_aufloesung / _INCR_PER_MM)
+        motion.move_by(pulses * axis.hr_aufloesung / UM01_PER_MM)
         self._started(axis_index)
         return None
 
@@ -346,8 +345,8 @@ class ManualMode:
                 continue
             position = motion.step(self._cycle_s)
             # the drive follows the step (KernelState.drive_axes)
-            logical.command_position_incr = round(position * _INCR_PER_MM)
-            logical.position_mm = logical.command_position_incr / _INCR_PER_MM
+            logical.command_position_01um = round(position * UM01_PER_MM)
+            logical.position_mm = logical.command_position_01um / UM01_PER_MM
             if motion.hit_limit and not axis.limit_warning:
                 axis.limit_warning = True
                 self._warn_limit(k, position)
@@ -380,14 +379,14 @@ class ManualMode:
             control_element=1 if state == DisplayState.ASSIGNED else 0,
             hr_aufloesung=axis.hr_aufloesung,
             tipp_geschw_um_s=round(self._jog_vel(axis) * 1000),
-            increment_incr=axis.increment_incr, rapid=axis.rapid,
+            increment_01um=axis.increment_01um, rapid=axis.rapid,
             handwheel_counter=axis.handwheel_counter,
             jog_plus=axis.jog_plus, jog_minus=axis.jog_minus,
             velocity_um_s=0.0 if motion is None else motion.velocity_mm_s * 1000,
             moving=motion is not None, limit_warning=axis.limit_warning,
             referenced=homing is not None and homing.referenced,
             homing_active=homing is not None and homing.active,
-            offset_incr=round(axis.offset_mm * _INCR_PER_MM),
+            offset_01um=round(axis.offset_mm * UM01_PER_MM),
         )
 
     def _jog_vel(self, axis: _Axis) -> float:

@@ -7,6 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 
+from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import ManualOperationMode
 
 
@@ -27,7 +28,7 @@ class ManualAxisView:
     control_element: int = 0  # hb_display_r.control_element: 1 while assigned (one per axis)
     hr_aufloesung: int = 10  # handwheel path per pulse (0.1 um)
     tipp_geschw_um_s: int = 0  # continuous jog speed in effect (um/s)
-    increment_incr: int = 10_000  # jog increment (0.1 um)
+    increment_01um: int = UM01_PER_MM  # jog increment: 1 mm
     rapid: bool = False  # the rapid key: jog at the rapid jog speed
     handwheel_counter: int = 0  # the counter as the PLC/HMI wrote it last
     jog_plus: bool = False  # the + key as written last
@@ -37,4 +38,4 @@ class ManualAxisView:
     limit_warning: bool = False  # the last manual motion stopped at a software limit
     referenced: bool = False  # the axis has been homed
     homing_active: bool = False  # the homing run of the axis is under way
-    offset_incr: int = 0  # manual offset summed by G200/G201 in the running program (0.1 um)
+    offset_01um: int = 0  # manual offset summed by G200/G201 in the running program (0.1 um)

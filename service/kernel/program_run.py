@@ -22,6 +22,7 @@ from enum import IntEnum
 from functools import partial
 from typing import Protocol
 
+from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import ExecutionMode
 
 from .alarms import AlarmClass
@@ -54,7 +55,6 @@ _NOT_WAITING, _OVERRIDE_ZERO = int(WaitReason.NONE), int(WaitReason.OVERRIDE_ZER
 # an int, not the flag: ``int & IntFlag`` goes through enum's Python-level __rand__,
 # about 2 us, asked in every cycle (issue 37, short blocks)
 _SUPPRESS_TECHNO = int(ExecutionMode.SUPPRESS_TECHNO_OUTPUT)
-_INCR_PER_MM = 10_000  # 0.1 um increments per mm
 PROD_TIME_STEPS_PER_CYCLE = 5_000  # virtual clock: simulated cycles per GEO cycle (PROD_TIME)
 _PROD_TIME_SHARE = 0.4  # realtime clock: share of a GEO cycle the calculation may use
 
@@ -292,16 +292,16 @@ class ProgramRun:
             p + o for p, o in zip(step.position_mm, offsets, strict=True))
         for axis, pos in zip(ch.axes, positions, strict=True):
             axis.position_mm = pos
-            axis.command_position_incr = round(pos * _INCR_PER_MM)
+            axis.command_position_01um = round(pos * UM01_PER_MM)
         motion = step.current.motion if step.current is not None else None
         ends = () if motion is None else motion.end_mm
         for k, axis in enumerate(ch.axes):  # distance to go: to the block's end point
-            axis.distance_to_go_incr = round(
-                (ends[k] - step.position_mm[k]) * _INCR_PER_MM) if k < len(ends) else 0
+            axis.distance_to_go_01um = round(
+                (ends[k] - step.position_mm[k]) * UM01_PER_MM) if k < len(ends) else 0
         ch.path_velocity_mm_s = step.path_velocity_mm_s
         ch.programmed_velocity_mm_s = step.programmed_velocity_mm_s
         ch.remaining_in_block_mm = step.remaining_in_block_mm
-        ch.dist_prog_start_incr = step.distance_mm * _INCR_PER_MM
+        ch.dist_prog_start_01um = step.distance_mm * UM01_PER_MM
 
     def cruise_budget(self, most: int) -> int:
         """How many of the next cycles (at most ``most``) would do nothing but move
@@ -565,7 +565,7 @@ def show_contour_state(channel: Channel, contour: ContourLog) -> None:
     channel.contour = ContourLookaheadUnit(
         request_start_position=unit.request_start_position,
         request_length=unit.request_length, semaphor=unit.semaphor,
-        max_dist_prog_start_incr=contour.max_dist_prog_start_incr,
+        max_dist_prog_start_01um=contour.max_dist_prog_start_01um,
         count_logged_blocks=len(contour.log), log_active=contour.active,
         response=unit.response,
     )

@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 from enum import IntFlag
 from typing import Any, NamedTuple, Protocol
 
+from cnc_objects.protocol.units import UM01_PER_MM
+
 # Defined with the wire's value sets; the kernel's modules import them from here.
 from cnc_objects.protocol.values import ExecutionMode as ExecutionMode
 from cnc_objects.protocol.values import LinkState as LinkState
@@ -26,8 +28,6 @@ from .plc_functions import PlcFunctions, PlcFunctionsUnit
 from .refusal import Refusal
 from .spindle import SpindleState
 from .tooling_view import ChannelTooling
-
-MESSAGES_KEPT = 8  # #MSG texts a channel shows (ch<c>.mc_message_<k>_text_r)
 
 
 class DecoderFlag(IntFlag):
@@ -46,22 +46,22 @@ class PhysicalAxis:
 
     number: int
     name: str
-    command_position_incr: int = 0  # 0.1 um
-    actual_position_incr: int = 0  # 0.1 um
+    command_position_01um: int = 0  # 0.1 um
+    actual_position_01um: int = 0  # 0.1 um
     linked_logical_axis: int = 0  # logical axis number driving it; 0 = none
     last_logical_axis: int = 0  # the logical axis that was linked last (survives unlinking)
-    position_offset_incr: int = 0  # offset of the link: command of the linked axis - position
+    position_offset_01um: int = 0  # offset of the link: command of the linked axis - position
 
     def frozen(self) -> PhysicalAxis:
         """A copy for the snapshot."""
         return PhysicalAxis(
             self.number,
             self.name,
-            self.command_position_incr,
-            self.actual_position_incr,
+            self.command_position_01um,
+            self.actual_position_01um,
             self.linked_logical_axis,
             self.last_logical_axis,
-            self.position_offset_incr,
+            self.position_offset_01um,
         )
 
 
@@ -75,27 +75,27 @@ class LogicalAxis:
     actual_link: int = 0  # physical axis number linked now; 0 = none
     link_state: LinkState = LinkState.LINKED
     position_mm: float = 0.0  # command position of the channel axis
-    command_position_incr: int = 0  # the same in 0.1 um, as the objects show it
-    output_incr: int = 0  # command position last handed to the physical axis
-    position_offset_incr: int = 0  # command position - physical position (jog of path)
+    command_position_01um: int = 0  # the same in 0.1 um, as the objects show it
+    output_01um: int = 0  # command position last handed to the physical axis
+    position_offset_01um: int = 0  # command position - physical position (jog of path)
     offset_live: bool = False  # the axis took its drive over from another logical axis
     released: bool = False  # left the channel by #AX RELEASE
-    distance_to_go_incr: int = 0  # to the end of the block in the interpolator (0.1 um)
+    distance_to_go_01um: int = 0  # to the end of the block in the interpolator (0.1 um)
 
     def frozen(self) -> LogicalAxis:
         """A copy for the snapshot."""
         return LogicalAxis(
             self.name, self.logical_number, self.requested_link, self.actual_link,
-            self.link_state, self.position_mm, self.command_position_incr, self.output_incr,
-            self.position_offset_incr, self.offset_live, self.released,
-            self.distance_to_go_incr,
+            self.link_state, self.position_mm, self.command_position_01um, self.output_01um,
+            self.position_offset_01um, self.offset_live, self.released,
+            self.distance_to_go_01um,
         )
 
-    def set_position_incr(self, incr: int) -> None:
+    def set_position_01um(self, incr: int) -> None:
         """Move the command position to ``incr`` without handing a step to the drive
         (a position adjustment: the channel takes the drive's position)."""
-        self.command_position_incr = self.output_incr = incr
-        self.position_mm = incr / 10_000
+        self.command_position_01um = self.output_01um = incr
+        self.position_mm = incr / UM01_PER_MM
 
 
 BLOCK_START_COLUMN = 1  # the column of an error about a whole block: the block's start
@@ -150,7 +150,7 @@ class ContourLookaheadUnit:
     request_start_position: float = 0.0  # mode 1: index; mode 2: distance (0.1 um)
     request_length: float = 0.0  # 0: mode 1 (by index); else mode 2 (by distance)
     semaphor: bool = False  # TRUE: a request waits; the CNC answers and resets it
-    max_dist_prog_start_incr: float = 0.0  # end of the path prepared so far (0.1 um)
+    max_dist_prog_start_01um: float = 0.0  # end of the path prepared so far (0.1 um)
     count_logged_blocks: int = 0  # entries in the log of the marked area
     log_active: bool = False  # the marked area is open and not all of it was read in
     response: tuple[ContourElement, ...] = ()  # the last reply (at most N entries)
@@ -168,7 +168,7 @@ class Channel:
     feed_override_per_mille: int = 1000  # 0.1 %
     execution_mode_command: int = 0
     execution_mode_active: int = 0
-    dist_prog_start_incr: float = 0.0  # 0.1 um
+    dist_prog_start_01um: float = 0.0  # 0.1 um
     output_suspended: bool = False  # suspend_axis_output.state_r: the axes are given up
     mode: int = 1  # ChannelMode
     state: int = 1  # ChannelState
@@ -198,7 +198,7 @@ class Channel:
     execution_mode_plc_enable: bool = False
     syn_chk: Any = None  # SyntaxCheckConfig for the next check (ch<c>.syn_chk.*)
     decoder_flags: int = 0  # DecoderFlag bits (pMC[i].StateDecoder_Data)
-    # #MSG texts of the program, newest first (at most MESSAGES_KEPT), and their count
+    # #MSG texts of the program, newest first (at most MESSAGES_LISTED), and their count
     messages: tuple[str, ...] = ()
     message_count: int = 0
     # #TRAFO/#HSC/#SLOPE/#FILTER/G133/G134 as decoded so far (nc.technology)
@@ -252,7 +252,7 @@ class Channel:
             self.channel_id, self.name, [a.frozen() for a in self.axes],
             self.feed_override_max, self.feed_override_command, self.feed_override_per_mille,
             self.execution_mode_command, self.execution_mode_active,
-            self.dist_prog_start_incr, self.output_suspended, self.mode, self.state,
+            self.dist_prog_start_01um, self.output_suspended, self.mode, self.state,
             self.program_name, self.single_block, self.waiting_for_start, self.block_number,
             self.line, self.file_name, self.file_offset, self.block_count,
             self.manual_blocks_done, self.path_velocity_mm_s, self.programmed_velocity_mm_s,
@@ -418,15 +418,15 @@ class KernelState:
         drives = self.physical_axes
         for channel in self.channels:
             for axis in channel.axes:
-                delta = axis.command_position_incr - axis.output_incr
+                delta = axis.command_position_01um - axis.output_01um
                 if not delta or not axis.actual_link:
                     continue
                 for drive in drives:
                     if drive.number == axis.actual_link:
-                        drive.command_position_incr += delta
-                        drive.actual_position_incr = drive.command_position_incr
+                        drive.command_position_01um += delta
+                        drive.actual_position_01um = drive.command_position_01um
                         break
-                axis.output_incr = axis.command_position_incr
+                axis.output_01um = axis.command_position_01um
 
     def snapshot(
         self,

@@ -98,7 +98,7 @@ class Switchover:
         drive.linked_logical_axis = drive.last_logical_axis = axis.logical_number
         axis.actual_link = drive.number
         axis.link_state = LinkState.LINKED
-        axis.output_incr = axis.command_position_incr
+        axis.output_01um = axis.command_position_01um
 
     @staticmethod
     def _unlink(axis: LogicalAxis, drive: PhysicalAxis) -> None:
@@ -135,21 +135,21 @@ class Switchover:
         """Position offset of every logical axis and of every physical axis's link."""
         for ci, axis, drive in self._axes:
             if axis.actual_link or axis.offset_live:
-                offset = axis.command_position_incr - drive.command_position_incr
+                offset = axis.command_position_01um - drive.command_position_01um
             else:
                 offset = 0
-            if offset != axis.position_offset_incr:
-                axis.position_offset_incr = offset
+            if offset != axis.position_offset_01um:
+                axis.position_offset_01um = offset
                 changed[ci] = True
             if drive.linked_logical_axis == axis.logical_number:
-                drive.position_offset_incr = offset
+                drive.position_offset_01um = offset
         for drive in self._state.physical_axes:
             if not drive.linked_logical_axis:
-                drive.position_offset_incr = 0
+                drive.position_offset_01um = 0
 
     def adjust_to_drives(self, channel: Channel) -> None:
         """Position adjustment: the channel's command positions take the positions of
         the physical axes (program start, channel init); the offsets become 0."""
         for axis in channel.axes:
-            axis.set_position_incr(self._drives[axis.requested_link].command_position_incr)
-            axis.position_offset_incr = 0
+            axis.set_position_01um(self._drives[axis.requested_link].command_position_01um)
+            axis.position_offset_01um = 0

@@ -30,7 +30,6 @@ from .nc.tool_data import (
 from .state import Channel, KernelState
 from .tooling_view import ChannelTooling
 
-INCR_PER_MM = 10_000  # the objects carry lengths in 0.1 um
 # |tool length|, radius and zero offsets the tables take (0.1 um): the largest position
 # the SGN32 position objects carry, 214748.3647 mm
 TABLE_VALUE_MAX_01UM = float(2**31 - 1)
@@ -138,7 +137,7 @@ class SetZeroOffset:
     channel_index: int
     group: int
     axis_index: int
-    value_incr: float
+    value_01um: float
 
     def apply(self, state: KernelState) -> Refusal | None:
         runner = state.runners[self.channel_index]
@@ -150,7 +149,7 @@ class SetZeroOffset:
                            "(group 0 is G53: no offset)")
         channel = runner.channel
         axis = channel.axes[self.axis_index].name
-        value = float(self.value_incr)
+        value = float(self.value_01um)
         refused = _value_refused(f"np_grp[{self.group}] {axis}", value, -TABLE_VALUE_MAX_01UM)
         if refused is not None:
             return refused

@@ -10,6 +10,7 @@ attribute reads), so the reason costs next to nothing per cycle.
 
 from __future__ import annotations
 
+from cnc_objects.protocol.values import WORKING_STATES
 from cnc_objects.protocol.wait_reasons import WaitReason as WaitReason  # re-exported for the runs
 
 from .channel_mode import ChannelMode, ChannelState
@@ -19,7 +20,6 @@ from .plc_functions import PlcFunctions
 from .state import Channel, DecoderFlag
 
 _CHECK_PAUSED = DecoderFlag.WAIT_CONTINUE | DecoderFlag.WAIT_AFTER_ERROR
-_WORKING = (ChannelState.ACTIVE, ChannelState.HOLD)
 
 
 def channel_wait_reason(
@@ -30,7 +30,7 @@ def channel_wait_reason(
     run). ``axes_missing``: the run (or the start) needs axes that are not linked;
     ``internal_hold``: a suspend request brakes the path."""
     state = channel.state
-    if state not in _WORKING:
+    if state not in WORKING_STATES:
         return WaitReason.ERROR if state == ChannelState.ERROR else WaitReason.NONE
     if state == ChannelState.HOLD:
         if channel.decoder_flags & _CHECK_PAUSED:

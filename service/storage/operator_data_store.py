@@ -35,9 +35,9 @@ from cnc_objects.objects.operator_data import (
     loads,
 )
 
+from ...protocol.units import UM01_PER_MM
 from ..kernel.alarms import AlarmLog
 from ..kernel.nc.tool_data import (
-    UM01_PER_MM,
     ToolData,
     ToolingTables,
     ToolTable,

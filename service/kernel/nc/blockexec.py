@@ -27,6 +27,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from enum import IntEnum
 
+from cnc_objects.protocol.units import UM01_PER_MM
+
 from .blocks import (
     AxisExchange,
     AxisExchangeKind,
@@ -77,7 +79,7 @@ ItemFailed = Callable[[NcError, int], None]
 
 # The largest feed: the path velocity is carried in 0.1 um/s as SGN32 (as the ISG
 # interface objects carry it), 2**31 - 1 increments = 12,884,901.88 mm/min.
-FEED_MAX_MM_MIN = (2**31 - 1) * 1e-4 * 60.0
+FEED_MAX_MM_MIN = (2**31 - 1) / UM01_PER_MM * 60.0
 
 # plane -> (p, q, normal) as indices into (X, Y, Z); and the plane of each normal
 _CS_PLANE = {Plane.XY: (0, 1, 2), Plane.ZX: (2, 0, 1), Plane.YZ: (1, 2, 0)}

@@ -21,6 +21,8 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
+from cnc_objects.protocol.units import UM01_PER_MM
+
 # the tool axis of each working plane (G17, G18, G19): the tool length acts along it
 TOOL_AXIS_OF_PLANE = {17: "Z", 18: "Y", 19: "X"}
 
@@ -36,7 +38,6 @@ class ToolField(IntEnum):
     LIFE_MAX = 5  # wz[i].life_max: cutting time the tool may run, s; 0 = no limit (project)
 
 
-UM01_PER_MM = 10_000  # the tables keep what the objects wrote: 0.1 um
 
 
 @dataclass(frozen=True, slots=True)

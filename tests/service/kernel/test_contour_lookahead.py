@@ -177,8 +177,8 @@ def test_every_field_of_a_g41_contour(kernel):
     assert unit.count_logged_blocks == len(expected)
     assert unit.log_active is False
     end_mm = expected[-1][1]  # LOG OFF sits at the end of the path
-    assert unit.max_dist_prog_start_incr == pytest.approx(end_mm * INCR, abs=1e-3)
-    assert run.channel.dist_prog_start_incr == pytest.approx(end_mm * INCR, abs=1e-3)
+    assert unit.max_dist_prog_start_01um == pytest.approx(end_mm * INCR, abs=1e-3)
+    assert run.channel.dist_prog_start_01um == pytest.approx(end_mm * INCR, abs=1e-3)
 
 
 def test_every_field_of_a_g42_contour(kernel):
@@ -309,7 +309,7 @@ def test_only_the_first_area_until_clear_which_flushes_and_waits(kernel):
     def watch(snap) -> bool:
         ch = snap.channels[0]
         if ch.state == ChannelState.ACTIVE:
-            seen.append((ch.dist_prog_start_incr / INCR, ch.contour.count_logged_blocks,
+            seen.append((ch.dist_prog_start_01um / INCR, ch.contour.count_logged_blocks,
                          ch.path_velocity_mm_s))
         return False
 
@@ -343,7 +343,7 @@ def test_distance_prog_start_clear_restarts_the_distance(kernel):
     run = kernel.run("N10 #CONTOUR LOOKAHEAD LOG ON\nN20 G1 X10 F600\n"
                      "N30 #DISTANCE PROG START CLEAR\nN40 G1 X15\n"
                      "N50 #CONTOUR LOOKAHEAD LOG OFF\nM30\n")
-    assert run.channel.dist_prog_start_incr == pytest.approx(5.0 * INCR)
+    assert run.channel.dist_prog_start_01um == pytest.approx(5.0 * INCR)
     reply = request(kernel, 0)
     assert [(e.block_number, e.start_position / INCR) for e in reply] == [
         (10, 0.0), (20, 0.0), (40, 0.0), (50, 5.0)]
@@ -385,17 +385,17 @@ def test_the_marked_area_is_there_before_it_runs_and_through_feedhold(kernel):
                + "".join(f"N{20 + k} G1 X{10 * (k + 1)} F600\n" for k in range(8))
                + "N90 #CONTOUR LOOKAHEAD LOG OFF\nM30\n")
     kernel.start(program)
-    snap = kernel.wait_for(lambda s: s.channels[0].dist_prog_start_incr > 0.0)
-    assert snap.channels[0].dist_prog_start_incr < 10 * INCR  # still in the first element
+    snap = kernel.wait_for(lambda s: s.channels[0].dist_prog_start_01um > 0.0)
+    assert snap.channels[0].dist_prog_start_01um < 10 * INCR  # still in the first element
     assert snap.channels[0].contour.count_logged_blocks == 10
     reply = request(kernel, 0)
     assert [e.block_type for e in reply] == [LOG_ON] + [LINEAR] * 8 + [LOG_OFF]
-    max_before = kernel.kernel.snapshot.channels[0].contour.max_dist_prog_start_incr
+    max_before = kernel.kernel.snapshot.channels[0].contour.max_dist_prog_start_01um
     assert max_before == pytest.approx(80 * INCR)
     assert kernel.command(Feedhold(0, True)) is None
     held = kernel.wait_for(lambda s: s.channels[0].path_velocity_mm_s == 0.0)
     assert held.channels[0].state == ChannelState.HOLD
-    assert held.channels[0].contour.max_dist_prog_start_incr == max_before  # feedhold: same
+    assert held.channels[0].contour.max_dist_prog_start_01um == max_before  # feedhold: same
     assert [e.block_type for e in request(kernel, 0)] == [e.block_type for e in reply]
     assert kernel.command(StartProgram(0, True)) is None
     run = kernel.wait()
@@ -429,8 +429,8 @@ def test_clear_with_radius_compensation_is_error_22072_and_nothing_jumps(kernel)
 def test_mode_2_sees_every_element_still_in_the_look_ahead_buffer(kernel):
     squares = "".join("G1 Y10\nX10\nY0\nX0\n" for _ in range(40))  # 2 elements per corner
     kernel.start(f"N2 G41 D1 G1 X0 Y0.5 F600\n{squares}G40 G1 X-5 Y-5\nM30\n")
-    snap = kernel.wait_for(lambda s: s.channels[0].dist_prog_start_incr > 0.0)
-    ahead = snap.channels[0].contour.max_dist_prog_start_incr
+    snap = kernel.wait_for(lambda s: s.channels[0].dist_prog_start_01um > 0.0)
+    ahead = snap.channels[0].contour.max_dist_prog_start_01um
     assert ahead > 1000 * INCR  # the buffer holds 120 blocks, far more elements than 128
     reply = request(kernel, 0.0, 12 * INCR)  # the first elements are still to come
     # the approach line (r = 1 mm), N2's offset line (0.5 mm), then the first square
@@ -478,11 +478,11 @@ def test_mode_2_answers_in_the_distances_dist_prog_start_counts(kernel):
     lines = "".join(f"N{100 + k} X{k + 1}\n" for k in range(40))
     more = "".join(f"N{600 + k} X{41 + k}\n" for k in range(40))
     kernel.start(f"G90 G1 F600\n{lines}N500 #DISTANCE PROG START CLEAR\n{more}M30\n")
-    kernel.wait_for(lambda s: s.channels[0].dist_prog_start_incr > 0.0)
+    kernel.wait_for(lambda s: s.channels[0].dist_prog_start_01um > 0.0)
     # before the path reaches the CLEAR: the elements of the first 40 mm
     assert [e.block_number for e in request(kernel, 0, 2.5 * INCR)] == [100, 101, 102]
     run = kernel.wait()
-    assert run.channel.dist_prog_start_incr == pytest.approx(40 * INCR)
+    assert run.channel.dist_prog_start_01um == pytest.approx(40 * INCR)
     # after it: the same window holds the elements after the CLEAR only
     assert [e.block_number for e in request(kernel, 0, 2.5 * INCR)] == [600, 601, 602]
 

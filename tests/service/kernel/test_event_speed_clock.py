@@ -44,11 +44,11 @@ def _observed(snap: Snapshot) -> tuple[Any, ...]:
     """What a client can see of channel 1 and the drives at the end of a cycle."""
     ch = snap.channels[0]
     return (
-        tuple(a.position_mm for a in ch.axes), tuple(a.command_position_incr for a in ch.axes),
+        tuple(a.position_mm for a in ch.axes), tuple(a.command_position_01um for a in ch.axes),
         ch.path_velocity_mm_s, ch.programmed_velocity_mm_s, ch.remaining_in_block_mm,
-        ch.dist_prog_start_incr, ch.program_time_s, ch.block_count, ch.line, int(ch.state),
+        ch.dist_prog_start_01um, ch.program_time_s, ch.block_count, ch.line, int(ch.state),
         ch.feed_override_per_mille, ch.spindle, ch.plc_functions,
-        tuple((p.command_position_incr, p.actual_position_incr) for p in snap.physical_axes),
+        tuple((p.command_position_01um, p.actual_position_01um) for p in snap.physical_axes),
     )
 
 

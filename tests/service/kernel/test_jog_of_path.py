@@ -63,9 +63,9 @@ class Machine:
         x1, x2 = s.channels[0].axes[0], s.channels[1].axes[0]
         drive = s.physical_axes[0]
         return (
-            x1.command_position_incr / INCR, x2.command_position_incr / INCR,
-            drive.command_position_incr / INCR,
-            x1.position_offset_incr / INCR, x2.position_offset_incr / INCR,
+            x1.command_position_01um / INCR, x2.command_position_01um / INCR,
+            drive.command_position_01um / INCR,
+            x1.position_offset_01um / INCR, x2.position_offset_01um / INCR,
         )
 
 
@@ -102,7 +102,7 @@ def test_the_function_description_table_step_by_step(machine: Machine) -> None:
     # The PLC side shows the offset of the link that drives the physical axis.
     s = m.snap()
     assert s.physical_axes[0].linked_logical_axis == 11
-    assert s.physical_axes[0].position_offset_incr == -30 * INCR
+    assert s.physical_axes[0].position_offset_01um == -30 * INCR
 
 
 def test_a_second_sequence_with_three_handovers(machine: Machine) -> None:
@@ -112,23 +112,23 @@ def test_a_second_sequence_with_three_handovers(machine: Machine) -> None:
     switch_to(m, 1)
     m.mdi(1, "G01 G91 Y10 F6000")  # 20 -> 30 on the drive, as the example of section 2.4
     s = m.snap()
-    assert s.physical_axes[1].command_position_incr == 30 * INCR
-    assert s.channels[1].axes[1].command_position_incr == 30 * INCR
-    assert s.channels[0].axes[1].position_offset_incr == 0  # not taken back yet
+    assert s.physical_axes[1].command_position_01um == 30 * INCR
+    assert s.channels[1].axes[1].command_position_01um == 30 * INCR
+    assert s.channels[0].axes[1].position_offset_01um == 0  # not taken back yet
     switch_to(m, 0)
     m.mdi(0, "G91 Y-5 X5")  # channel 1 continues from its own 20: drive Y 30 -> 25
     s = m.snap()
     ch1_y, ch2_y = s.channels[0].axes[1], s.channels[1].axes[1]
-    assert s.physical_axes[1].command_position_incr == 25 * INCR
-    assert ch1_y.command_position_incr == 15 * INCR
-    assert ch1_y.position_offset_incr == -10 * INCR  # 15 - 25
-    assert ch2_y.position_offset_incr == 5 * INCR  # 30 - 25
-    assert s.channels[0].axes[0].position_offset_incr == 0  # X: 15 on both
+    assert s.physical_axes[1].command_position_01um == 25 * INCR
+    assert ch1_y.command_position_01um == 15 * INCR
+    assert ch1_y.position_offset_01um == -10 * INCR  # 15 - 25
+    assert ch2_y.position_offset_01um == 5 * INCR  # 30 - 25
+    assert s.channels[0].axes[0].position_offset_01um == 0  # X: 15 on both
     # RESET is channel init: command positions take the drives', offsets cleared.
     assert m.h.command(ResetChannel(0, True)) is None
     s = m.h.wait_for(lambda s: s.channels[0].state != ChannelState.ACTIVE)
-    assert s.channels[0].axes[1].command_position_incr == 25 * INCR
-    assert s.channels[0].axes[1].position_offset_incr == 0
+    assert s.channels[0].axes[1].command_position_01um == 25 * INCR
+    assert s.channels[0].axes[1].position_offset_01um == 0
 
 
 def test_handshake_states_in_order_cycle_by_cycle(machine: Machine) -> None:
@@ -168,14 +168,14 @@ def test_request_waits_while_the_other_channel_holds_the_axis(machine: Machine) 
     assert m.h.command(ManualBlock(1, "G01 G90 X1 F6000")) is None
     s = m.snap()
     assert s.channels[1].state == ChannelState.ACTIVE
-    assert s.physical_axes[0].command_position_incr == 5 * INCR
+    assert s.physical_axes[0].command_position_01um == 5 * INCR
     m.suspend(0, True)
     s = m.linked(1)
     m.done[1] += 1
     s = m.h.wait_for(lambda s: s.channels[1].manual_blocks_done >= 1
                      and s.channels[1].path_velocity_mm_s == 0)
-    assert s.channels[1].axes[0].command_position_incr == 1 * INCR  # started at 5 (adjusted)
-    assert s.physical_axes[0].command_position_incr == 1 * INCR
+    assert s.channels[1].axes[0].command_position_01um == 1 * INCR  # started at 5 (adjusted)
+    assert s.physical_axes[0].command_position_01um == 1 * INCR
 
 
 def test_suspending_a_moving_channel_brakes_it_first_then_it_continues(machine: Machine) -> None:
@@ -187,15 +187,15 @@ def test_suspending_a_moving_channel_brakes_it_first_then_it_continues(machine: 
     s = h.wait_for(lambda s: s.channels[0].output_suspended)
     ch = s.channels[0]
     assert ch.path_velocity_mm_s == 0.0 and ch.state == ChannelState.ACTIVE
-    stopped_at = ch.axes[0].command_position_incr
+    stopped_at = ch.axes[0].command_position_01um
     assert 0 < stopped_at < 200 * INCR
     assert s.physical_axes[0].linked_logical_axis == 0
     m.suspend(0, False)
     m.linked(0)
     s = h.wait_for(lambda s: s.channels[0].manual_blocks_done >= 1
                    and s.channels[0].path_velocity_mm_s == 0)
-    assert s.channels[0].axes[0].command_position_incr == 200 * INCR
-    assert s.physical_axes[0].command_position_incr == 200 * INCR
+    assert s.channels[0].axes[0].command_position_01um == 200 * INCR
+    assert s.physical_axes[0].command_position_01um == 200 * INCR
 
 
 def test_suspending_is_refused_in_error_state_and_works_after_reset(machine: Machine) -> None:
@@ -336,4 +336,4 @@ def test_program_start_brings_released_axes_back() -> None:
         run = h.run("G01 X1 Y7 F6000\nM30\n", name="again.nc")
         assert run.channel.state == ChannelState.READY
         assert not run.channel.axes[1].released and run.channel.axes[1].actual_link == 2
-        assert run.final.physical_axes[1].command_position_incr == 7 * INCR
+        assert run.final.physical_axes[1].command_position_01um == 7 * INCR

@@ -24,7 +24,7 @@ from tests.service.kernel.test_manual_mode import LIMIT_MAX_MM, machine
 from tests.service.kernel.test_plc_functions import Recorder
 from tests.support.kernel import KernelHarness
 
-INCREMENT_INCR = 20_000  # 2 mm
+INCREMENT_01UM = 20_000  # 2 mm
 
 
 @pytest.fixture
@@ -51,7 +51,7 @@ def _view(s: Snapshot, axis: int = 0) -> Any:
 
 def _incremental(k: KernelHarness, axis: int = 0) -> None:
     assert write(k, "operation_mode", ManualOperationMode.INCREMENTAL, axis) is None
-    assert write(k, "increment", INCREMENT_INCR, axis) is None
+    assert write(k, "increment", INCREMENT_01UM, axis) is None
 
 
 def test_g200_stops_the_program_jogs_the_axis_and_start_goes_on_with_the_offset(k: Any) -> None:
@@ -63,7 +63,7 @@ def test_g200_stops_the_program_jogs_the_axis_and_start_goes_on_with_the_offset(
     _incremental(k)
     assert write(k, "jog_plus", True) is None
     jogged = k.wait_for(lambda s: _x(s) == 3.0 and not _view(s).moving)
-    assert _view(jogged).offset_incr == INCREMENT_INCR
+    assert _view(jogged).offset_01um == INCREMENT_01UM
     assert jogged.channels[0].state == ChannelState.ACTIVE  # the program still runs
     _incremental(k, axis=1)
     refused = write(k, "jog_plus", True, axis=1)
@@ -73,7 +73,7 @@ def test_g200_stops_the_program_jogs_the_axis_and_start_goes_on_with_the_offset(
     assert run.channel.state == ChannelState.READY
     assert (_x(run.final), _y(run.final)) == (6.0, 1.0)  # X4 + 2 mm offset, Y as programmed
     assert _view(run.final).state == DisplayState.DEACTIVATED
-    assert _view(run.final).offset_incr == 0  # the offset ends with the program
+    assert _view(run.final).offset_01um == 0  # the offset ends with the program
 
 
 def test_start_is_refused_while_a_g200_jog_still_moves(k: Any) -> None:
@@ -98,7 +98,7 @@ def test_a_g200_jog_stops_at_the_software_limit_of_path_plus_offset(k: Any) -> N
     assert write(k, "jog_plus", True) is None
     s = k.wait_for(lambda s: _view(s).limit_warning and not _view(s).moving)
     assert _x(s) == LIMIT_MAX_MM
-    assert _view(s).offset_incr == 10_000
+    assert _view(s).offset_01um == 10_000
 
 
 def test_g201_jogs_in_parallel_to_the_path_until_g202(k: Any) -> None:

@@ -62,8 +62,8 @@ def manual(k: KernelHarness) -> None:
     assert k.command(SelectMode(0, ChannelMode.MANUAL)) is None
 
 
-def x_incr(k: KernelHarness) -> int:
-    return k.kernel.snapshot.channels[0].axes[0].command_position_incr
+def x_01um(k: KernelHarness) -> int:
+    return k.kernel.snapshot.channels[0].axes[0].command_position_01um
 
 
 def view(k: KernelHarness, axis: int = 0):
@@ -116,21 +116,21 @@ def test_incremental_jog_from_0_1_um_to_10_mm_and_refuses_outside(k) -> None:
     assert write(k, "operation_mode", ManualOperationMode.INCREMENTAL) is None
     assert write(k, "increment", 1) is None  # 0.1 um
     record_until_rest(k, ("jog_plus", True))
-    assert x_incr(k) == 1
+    assert x_01um(k) == 1
     assert write(k, "jog_plus", False) is None
     assert write(k, "increment", 50_000) is None  # 5 mm
     samples = record_until_rest(k, ("jog_minus", True))
     assert abs(samples[0][1]) <= ACC_MM_S2 * CYCLE_S  # from standstill
-    assert x_incr(k) == 1 - 50_000
+    assert x_01um(k) == 1 - 50_000
     assert_ramps(samples, ACC_MM_S2)
     assert max(abs(v) for _, v in samples) <= JOG_MM_S + 1e-9
     drive = k.kernel.snapshot.physical_axes[0]
-    assert drive.actual_position_incr == x_incr(k)  # the drive followed
+    assert drive.actual_position_01um == x_01um(k)  # the drive followed
     for bad in (0, 100_001):
         refusal = write(k, "increment", bad)
         assert refusal is not None and refusal.reason == RefusalReason.INVALID_VALUE
         assert "0.1 um .. 10 mm" in refusal.message
-    assert view(k).increment_incr == 50_000
+    assert view(k).increment_01um == 50_000
     assert k.kernel.snapshot.channels[0].state == ChannelState.READY  # manual mode done
 
 
@@ -167,7 +167,7 @@ def test_continuous_jog_stops_exactly_at_the_software_limit_with_a_warning(k) ->
     write(k, "operation_mode", ManualOperationMode.CONTINUOUS)
     samples = record_until_rest(k, ("jog_plus", True))
     assert_ramps(samples, ACC_MM_S2)
-    assert x_incr(k) == LIMIT_MAX_MM * 10_000
+    assert x_01um(k) == LIMIT_MAX_MM * 10_000
     assert max(p for p, _ in samples) <= LIMIT_MAX_MM
     assert view(k).limit_warning
     ch = k.kernel.snapshot.channels[0]
@@ -182,7 +182,7 @@ def test_continuous_jog_stops_exactly_at_the_software_limit_with_a_warning(k) ->
     write(k, "operation_mode", ManualOperationMode.INCREMENTAL)
     write(k, "increment", 20_000)
     record_until_rest(k, ("jog_minus", True))
-    assert x_incr(k) == (LIMIT_MAX_MM - 2) * 10_000 and not view(k).limit_warning
+    assert x_01um(k) == (LIMIT_MAX_MM - 2) * 10_000 and not view(k).limit_warning
 
 
 def test_an_increment_beyond_the_limit_stops_at_it(k) -> None:
@@ -192,21 +192,21 @@ def test_an_increment_beyond_the_limit_stops_at_it(k) -> None:
     assert write(k, "jog_minus", True) is None
     assert view(k).limit_warning  # known when the goal is cut
     record_until_rest(k)
-    assert x_incr(k) == LIMIT_MIN_MM * 10_000
+    assert x_01um(k) == LIMIT_MIN_MM * 10_000
 
 
 def test_handwheel_moves_by_pulses_times_resolution_and_survives_wrap_around(k) -> None:
     manual(k)
     write(k, "handwheel", 0x7FFF_FFFE)  # outside handwheel mode: only taken
-    assert x_incr(k) == 0 and view(k).handwheel_counter == 0x7FFF_FFFE
+    assert x_01um(k) == 0 and view(k).handwheel_counter == 0x7FFF_FFFE
     write(k, "operation_mode", ManualOperationMode.HANDWHEEL)
     write(k, "resolution", 25)  # 2.5 um per pulse
     record_until_rest(k, ("handwheel", 0x7FFF_FFFF),  # +1
                       ("handwheel", -0x8000_0000 + 2))  # +3 across the wrap
-    assert x_incr(k) == 4 * 25
+    assert x_01um(k) == 4 * 25
     assert k.kernel.snapshot.channels[0].manual[0].hr_aufloesung == 25
     record_until_rest(k, ("handwheel", -0x8000_0000 - 8 + 0x1_0000_0000))  # -10 back
-    assert x_incr(k) == 4 * 25 - 10 * 25
+    assert x_01um(k) == 4 * 25 - 10 * 25
     refusal = write(k, "resolution", 0)
     assert refusal is not None and refusal.reason == RefusalReason.INVALID_VALUE
     refusal = write(k, "jog_plus", True)  # keys do nothing in handwheel mode
@@ -246,7 +246,7 @@ def test_homing_by_object_moves_to_pos_refpkt_at_homing_speed(k) -> None:
     samples = record_until_rest(k, ("homing_start", True))
     assert_ramps(samples, ACC_MM_S2)
     assert max(abs(v) for _, v in samples) == pytest.approx(HOMING_MM_S)
-    assert x_incr(k) == REF_MM * 10_000
+    assert x_01um(k) == REF_MM * 10_000
     assert view(k).referenced and not view(k).homing_active
     assert not view(k, 1).referenced  # Y was not homed
 
@@ -342,16 +342,16 @@ def test_true_on_a_pressed_key_renews_it_and_is_no_new_press(k) -> None:
     write(k, "operation_mode", ManualOperationMode.INCREMENTAL)
     write(k, "increment", 10_000)  # 1 mm
     record_until_rest(k, ("jog_plus", True))
-    assert x_incr(k) == 10_000
+    assert x_01um(k) == 10_000
     record_until_rest(k, ("jog_plus", True))  # a renewal: no second increment
-    assert x_incr(k) == 10_000 and view(k).jog_plus
+    assert x_01um(k) == 10_000 and view(k).jog_plus
     assert write(k, "jog_plus", False) is None
     record_until_rest(k, ("jog_plus", True))  # a new press after the release
-    assert x_incr(k) == 20_000
+    assert x_01um(k) == 20_000
     assert write(k, "jog_plus", False) is None
     write(k, "operation_mode", ManualOperationMode.CONTINUOUS)
     record_until_rest(k, ("jog_plus", True))  # runs to the software limit
-    assert x_incr(k) == LIMIT_MAX_MM * 10_000 and view(k).limit_warning
+    assert x_01um(k) == LIMIT_MAX_MM * 10_000 and view(k).limit_warning
     state = k.kernel.snapshot.channels[0].state
     assert write(k, "jog_plus", True) is None  # renewed at the limit: nothing starts
     assert not view(k).moving and k.kernel.snapshot.channels[0].state == state

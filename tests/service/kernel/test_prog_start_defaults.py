@@ -54,8 +54,8 @@ def test_the_example_runs_as_printed() -> None:
         s = _run_example(h)
         ch2 = s.channels[1]
         assert ch2.state != ChannelState.ERROR, ch2.errors
-        assert s.physical_axes[1].command_position_incr == 30 * INCR  # Y 20 -> 30
-        assert ch2.axes[1].command_position_incr == 30 * INCR
+        assert s.physical_axes[1].command_position_01um == 30 * INCR  # Y 20 -> 30
+        assert ch2.axes[1].command_position_01um == 30 * INCR
         _suspend(h, 0, False)  # 5.
         _suspend(h, 1, True)  # 6.
         h.wait_for(lambda s: all(a.link_state == LinkState.LINKED for a in s.channels[0].axes))

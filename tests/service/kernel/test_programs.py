@@ -77,7 +77,7 @@ def test_program_finishes_where_and_when_expected(kernel, case):
     ch = run.channel
     assert ch.state == ChannelState.READY and ch.mode == ChannelMode.AUTOMATIC, ch.errors
     assert run.positions_mm == pytest.approx(final, abs=1e-9)
-    drives = [p.command_position_incr for p in run.final.physical_axes]
+    drives = [p.command_position_01um for p in run.final.physical_axes]
     assert drives == [round(x * 10_000) for x in final]  # physical axes followed
     if time_s is not None:
         assert abs(ch.program_time_s - time_s) <= (stops + 1) * CYCLE_S, (ch.program_time_s, time_s)
