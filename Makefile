@@ -72,9 +72,11 @@ soak: $(VENV)/.installed-test
 		tests/service/kernel/test_equality_properties.py tests/e2e/test_repeatable_properties.py \
 		-q --soak $(PYTEST_ARGS)
 
-# Code made from other code: the blocking Client from AsyncClient's methods.
-generate: | $(BIN)/python
+# Code made from other code: the blocking Client from AsyncClient's methods, and the typed
+# object names (clients/names.py) from the catalog. A test fails when either is stale.
+generate: $(VENV)/.installed
 	$(BIN)/python tools/gen_blocking_client.py
+	$(BIN)/python tools/gen_names.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

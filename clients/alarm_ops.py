@@ -21,6 +21,7 @@ from typing import Any
 
 from cnc_objects.protocol.alarm_values import AlarmClass, AlarmState, Severity, describe_alarm
 
+from . import names
 from .client_core import MixinBase
 
 ACTIVE_SLOTS = 16  # alarm_active[1..16] (objects.catalog_alarms.ACTIVE_SLOTS)
@@ -139,13 +140,13 @@ class AlarmOps(MixinBase):
 
     async def _alarms_once(self, history: bool) -> tuple[AlarmList, bool]:
         counts = await self.read_many(
-            ["alarm_changes_r", "alarm_active_count_r", "alarm_history_count_r"])
-        active_n = min(counts["alarm_active_count_r"], ACTIVE_SLOTS)
-        history_n = counts["alarm_history_count_r"] if history else 0
-        names = [f"alarm_active[{k}].{f}" for k in range(1, active_n + 1) for f in _FIELDS]
-        names += [f"alarm_history[{k}].{f}" for k in range(1, history_n + 1) for f in _FIELDS]
-        values = await self.read_many([*names, "alarm_changes_r"]) if names else counts
-        consistent = values["alarm_changes_r"] == counts["alarm_changes_r"]
+            [names.alarm_changes_r, names.alarm_active_count_r, names.alarm_history_count_r])
+        active_n = min(counts[names.alarm_active_count_r], ACTIVE_SLOTS)
+        history_n = counts[names.alarm_history_count_r] if history else 0
+        wanted = [f"alarm_active[{k}].{f}" for k in range(1, active_n + 1) for f in _FIELDS]
+        wanted += [f"alarm_history[{k}].{f}" for k in range(1, history_n + 1) for f in _FIELDS]
+        values = await self.read_many([*wanted, names.alarm_changes_r]) if wanted else counts
+        consistent = values[names.alarm_changes_r] == counts[names.alarm_changes_r]
 
         def slots(element: str, n: int) -> tuple[AlarmInfo, ...]:
             rows = ({f: values[f"{element}[{k}].{f}"] for f in _FIELDS} for k in range(1, n + 1))
@@ -154,18 +155,18 @@ class AlarmOps(MixinBase):
                          if v["sequence"] and v["class"] in _CLASS_VALUES
                          and v["state"] in _STATE_VALUES)
 
-        return AlarmList(counts["alarm_changes_r"], counts["alarm_active_count_r"],
+        return AlarmList(counts[names.alarm_changes_r], counts[names.alarm_active_count_r],
                          slots("alarm_active", active_n),
                          slots("alarm_history", history_n)), consistent
 
     async def acknowledge_alarm(self, sequence: int) -> None:
         """Acknowledge the alarm numbered ``sequence`` (an error stays active until
         RESET, a warning is cleared); an unknown number raises ``AdsError`` 0x70C."""
-        await self.write("alarm_acknowledge_w", sequence)
+        await self.write(names.alarm_acknowledge_w, sequence)
 
     async def acknowledge_all_alarms(self) -> None:
         """Acknowledge every active alarm."""
-        await self.write("alarm_acknowledge_all_w", True)
+        await self.write(names.alarm_acknowledge_all_w, True)
 
     async def alarm_events(self) -> AsyncGenerator[AlarmEvent, None]:
         """The alarms' events from now on, in the order they happened per alarm:
@@ -174,7 +175,7 @@ class AlarmOps(MixinBase):
         # what is there already, read before the subscription: an alarm raised while it
         # opens is then told at its first sample, not taken for an old one
         seen = seen_states(await self.alarms(history=True))
-        async for _sample in self.subscribe("alarm_changes_r"):
+        async for _sample in self.subscribe(names.alarm_changes_r):
             for event in events_since(seen, await self.alarms(history=True)):
                 yield event
 

@@ -54,6 +54,7 @@ from cnc_objects.protocol.values import (
 )
 from cnc_objects.protocol.wait_reasons import WaitReason, wait_reason_text
 
+from . import names
 from .client_core import MixinBase
 from .errors import AdsError, AdsTimeoutError, ChannelError
 from .execution_mode import describe_execution_mode
@@ -436,12 +437,12 @@ class ChannelOps(ProgramOps):
         """Select ``name`` (AUTOMATIC) and START it; returns once the channel is ACTIVE.
         A channel in ERROR refuses (ADS 0x707, naming its errors) until RESET."""
         what = f"start {name!r}"
-        await self._command(channel, what, f"ch{channel}.mc_command_program_name_w", name)
-        await self._command(channel, what, f"ch{channel}.mc_command_start_w", True)
+        await self._command(channel, what, names.ch(channel).mc_command_program_name_w, name)
+        await self._command(channel, what, names.ch(channel).mc_command_start_w, True)
 
     async def start(self, channel: int = 1) -> None:
         """START: run the selected program, or resume after feedhold, M0 or single block."""
-        await self._command(channel, "START", f"ch{channel}.mc_command_start_w", True)
+        await self._command(channel, "START", names.ch(channel).mc_command_start_w, True)
 
     async def _command(self, channel: int, what: str, name: str, value: Any) -> None:
         """Write a channel command. The service refuses a channel in ERROR as not ready
@@ -452,7 +453,7 @@ class ChannelOps(ProgramOps):
         except AdsError as exc:
             if exc.code != AdsReturnCode.DEVICE_NOTREADY:
                 raise
-            if await self.read(f"ch{channel}.mc_active_state_r") != _ERROR:
+            if await self.read(names.ch(channel).mc_active_state_r) != _ERROR:
                 raise
             message = await self._in_error(channel, what)
             raise AdsError(exc.code, message) from None
@@ -466,11 +467,11 @@ class ChannelOps(ProgramOps):
 
     async def hold(self, channel: int = 1) -> None:
         """Feedhold: the path decelerates and stops (HOLD)."""
-        await self.write(f"ch{channel}.mc_command_hold_w", True)
+        await self.write(names.ch(channel).mc_command_hold_w, True)
 
     async def reset(self, channel: int = 1) -> None:
         """RESET the channel from any state."""
-        await self.write(f"ch{channel}.mc_command_reset_w", True)
+        await self.write(names.ch(channel).mc_command_reset_w, True)
 
     async def reset_to_standard(self, channel: int = 1) -> None:
         """RESET the channel and command standard execution: execution mode ISG_STANDARD
@@ -487,23 +488,23 @@ class ChannelOps(ProgramOps):
     async def mdi(self, blocks: str, channel: int = 1) -> int:
         """Run ``blocks`` as manual blocks; returns the count of finished manual blocks
         before this one (``wait_mdi`` waits until it has grown)."""
-        before = await self.read(f"ch{channel}.mc_manual_blocks_done_r")
-        await self._command(channel, "a manual block", f"ch{channel}.mc_command_manual_block_w",
+        before = await self.read(names.ch(channel).mc_manual_blocks_done_r)
+        await self._command(channel, "a manual block", names.ch(channel).mc_command_manual_block_w,
                             blocks)
         return int(before)
 
     async def channel_errors(self, channel: int = 1) -> list[str]:
         """The channel's error list as readable lines."""
-        count = await self.read(f"ch{channel}.mc_error_count_r")
+        count = await self.read(names.ch(channel).mc_error_count_r)
         fields = ("id", "file", "line", "column", "text", "warning")
-        names = [
+        wanted = [
             f"ch{channel}.mc_error_{k}_{f}_r"
             for k in range(1, min(count, _ERROR_SLOTS) + 1)
             for f in fields
         ]
-        if not names:
+        if not wanted:
             return []
-        values = await self.read_many(names)
+        values = await self.read_many(wanted)
         lines = []
         for k in range(1, min(count, _ERROR_SLOTS) + 1):
             v = [values[f"ch{channel}.mc_error_{k}_{f}_r"] for f in fields]
@@ -514,7 +515,7 @@ class ChannelOps(ProgramOps):
     async def status(self, channel: int = 1) -> ChannelStatus:
         """Mode, state, program, block and axis positions of a channel."""
         axes = list(await self.browse(f"ch{channel}.ax*.command_position_acs"))
-        names = [
+        wanted = [
             f"ch{channel}.{n}"
             for n in (
                 "mc_active_mode_r", "mc_active_state_r", "mc_active_program_name_r",
@@ -524,8 +525,8 @@ class ChannelOps(ProgramOps):
             )
         ]
         axis_names = [o.name.replace("command_position_acs", "axis_name") for o in axes]
-        values = await self.read_many([*names, *axis_names, *(o.name for o in axes)])
-        v: list[Any] = [values[n] for n in names]
+        values = await self.read_many([*wanted, *axis_names, *(o.name for o in axes)])
+        v: list[Any] = [values[n] for n in wanted]
         positions = {
             # 0.1 um -> mm by the scale the service gives, rounded to 0.1 um: no float noise
             values[an]: engineering(o, values[o.name])
@@ -556,12 +557,12 @@ class ChannelOps(ProgramOps):
         await self.write(f"{unit}.semaphor_rw", True)
         state = [f"{unit}.semaphor_rw", f"{unit}.state.max_dist_prog_start",
                  f"{unit}.state.count_logged_blocks", f"{unit}.state.f_log_is_active"]
-        names = [
+        wanted = [
             f"{unit}.response.block[{k}].{field}"
             for k in range(CONTOUR_RESPONSE_BLOCKS)
             for field in CONTOUR_BLOCK_FIELDS
         ]
-        values = await self.read_many([*state, *names])
+        values = await self.read_many([*state, *wanted])
         if values[state[0]]:
             raise AdsTimeoutError(f"{unit}: the CNC has not answered (semaphor_rw still TRUE)")
         blocks = []
@@ -575,13 +576,13 @@ class ChannelOps(ProgramOps):
     async def _wait(self, channel: int, done: Any, timeout_s: float | None,
                     on_wait_reason: OnWaitReason | None, settle_s: float) -> None:
         deadline = None if timeout_s is None else time.monotonic() + timeout_s
-        names = [f"ch{channel}.mc_active_state_r", f"ch{channel}.mc_manual_blocks_done_r",
-                 f"ch{channel}.mc_wait_reason_r"]
+        wanted = [names.ch(channel).mc_active_state_r, names.ch(channel).mc_manual_blocks_done_r,
+                  names.ch(channel).mc_wait_reason_r]
         reported = current = WaitReason.NONE
         since = time.monotonic()  # when ``current`` was first seen
         while True:
-            values = await self.read_many(names)
-            state, done_count, reason = values[names[0]], values[names[1]], values[names[2]]
+            values = await self.read_many(wanted)
+            state, done_count, reason = values[wanted[0]], values[wanted[1]], values[wanted[2]]
             if state == _ERROR:
                 raise ChannelError(channel, await self.channel_errors(channel))
             if done(state, done_count):
@@ -732,7 +733,7 @@ class ChannelOps(ProgramOps):
         the PLC's ``command_w`` (which must hold ``mode_bit``) instead of
         ``mc_command_execution_mode_w``."""
         order = [o.name.lower() for o in await self.browse("ch*.mc_active_state_r")]
-        index = order.index(f"ch{channel}.mc_active_state_r")  # gpCh[i]: layout position
+        index = order.index(names.ch(channel).mc_active_state_r)  # gpCh[i]: layout position
         unit = f"gpCh[{index}].decoder_mc_control.execution_mode"
         values = await self.read_many([f"{unit}.enable_w", f"{unit}.command_w"])
         command = values[f"{unit}.command_w"]
@@ -791,7 +792,7 @@ class ChannelOps(ProgramOps):
         first: AdsError | None = None
         if cancel:
             try:
-                state = await self.read(f"ch{channel}.mc_active_state_r")
+                state = await self.read(names.ch(channel).mc_active_state_r)
                 if state in WORKING_STATES:
                     await self.reset(channel)
             except AdsError as exc:

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 
 from cnc_objects.protocol.values import ChannelMode, ManualOperationMode
 
+from . import names
 from .client_core import MixinBase
 from .errors import AdsTimeoutError, ClientValueError
 from .units import engineering
@@ -191,15 +192,15 @@ class ManualOps(MixinBase):
         indices = [await self.axis_index(a, channel) for a in chosen]
         await self._manual_mode(channel)
         for k in indices:
-            await self.write(f"ch{channel}.ax{k}.homing_start_w", True)
+            await self.write(names.ch(channel).ax(k).homing_start_w, True)
         for k in indices:
             await self._wait_standstill(channel, k, timeout_s, homing=True)
         return [await self.axis_state(k, channel) for k in indices]
 
     async def _manual_mode(self, channel: int) -> None:
         """Select MANUAL unless the channel is in it (the kernel refuses while it works)."""
-        if await self.read(f"ch{channel}.mc_active_mode_r") != ChannelMode.MANUAL:
-            await self.write(f"ch{channel}.mc_command_mode_w", int(ChannelMode.MANUAL))
+        if await self.read(names.ch(channel).mc_active_mode_r) != ChannelMode.MANUAL:
+            await self.write(names.ch(channel).mc_command_mode_w, int(ChannelMode.MANUAL))
 
     async def _wait_standstill(self, channel: int, k: int, timeout_s: float | None,
                                homing: bool = False) -> None:

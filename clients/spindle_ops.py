@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from . import names
 from .channel_ops import ChannelOps
 from .errors import ClientValueError
 from .units import engineering
@@ -73,7 +74,7 @@ class SpindleOps(ChannelOps):
 
     async def set_spindle_override(self, percent: float, channel: int = 1) -> None:
         """Set the spindle override (%, 0..150)."""
-        await self.write(f"ch{channel}.mc_spindle_override_w", percent, units=True)
+        await self.write(names.ch(channel).mc_spindle_override_w, percent, units=True)
 
     async def start_spindle(self, rpm: float, ccw: bool = False, channel: int = 1,
                             timeout_s: float | None = None) -> None:

@@ -20,6 +20,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from . import names
 from .errors import ClientValueError
 from .manual_ops import ManualOps
 from .units import engineering
@@ -94,7 +95,7 @@ class ToolingOps(ManualOps):
 
     async def tools(self, channel: int = 1) -> list[ToolRow]:
         """Every row of the channel's tool list, empty ones included."""
-        size = await self.read(f"ch{channel}.mc_tool_list_size_r")
+        size = await self.read(names.ch(channel).mc_tool_list_size_r)
         rows = [f"ch{channel}.wz[{i}]." for i in range(1, size + 1)]
         valid = await self.read_many(r + "valid" for r in rows)
         mm = await self._mm([r + f for r in rows for f in ("radius", "laenge")])
@@ -115,8 +116,8 @@ class ToolingOps(ManualOps):
 
     async def zero_offsets(self, channel: int = 1) -> ZeroOffsets:
         """The zero offset table, the active group and the positions (mm)."""
-        groups = await self.read(f"ch{channel}.mc_zero_offset_groups_r")
-        active = await self.read(f"ch{channel}.mc_active_zero_offset_r")
+        groups = await self.read(names.ch(channel).mc_zero_offset_groups_r)
+        active = await self.read(names.ch(channel).mc_active_zero_offset_r)
         axes = await self.axis_names(channel)
         n = range(1, len(axes) + 1)
         offsets = [f"ch{channel}.ax{a}.np_grp[{g}].v" for g in range(1, groups) for a in n]

@@ -10,12 +10,13 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from .. import names
 from .app import Settings, command, emit
 
 if TYPE_CHECKING:  # the client library is imported when a command connects (a quick --help)
     from ..blocking import Client
 
-STEP_OBJECT = "cnc_cycle_step_w"
+STEP_OBJECT = names.cnc_cycle_step_w
 
 
 @command()
@@ -33,8 +34,8 @@ def step(
 
     def act(c: Client) -> dict[str, Any]:
         c.write(STEP_OBJECT, cycles)
-        return {"cycles": cycles, "cycle": c.read("cnc_tick_counter_r"),
-                "kernel_time_s": c.read("cnc_kernel_time_r")}
+        return {"cycles": cycles, "cycle": c.read(names.cnc_tick_counter_r),
+                "kernel_time_s": c.read(names.cnc_kernel_time_r)}
 
     r = settings.call(act, f"step {cycles} cycles")
     emit(settings, r, f"cycle {r['cycle']}  kernel time {r['kernel_time_s']:.6f} s")

@@ -29,6 +29,7 @@ from cnc_objects.objects.operator_data import (
     loads,
 )
 
+from .. import names
 from ..errors import ClientValueError
 from ..units import engineering, raw_value
 from .app import Settings, emit, fail
@@ -80,9 +81,9 @@ def _channel_entry(path: str, channel: int, section: str) -> ChannelData:
 
 
 def _tool_rows(c: Client, channel: int) -> tuple[int, dict[int, ToolRow]]:
-    size: int = c.read(f"ch{channel}.mc_tool_list_size_r")
-    names = [f"ch{channel}.wz[{i}].{f}" for i in range(1, size + 1) for f in _TOOL_FIELDS]
-    v = c.read_many(names)
+    size: int = c.read(names.ch(channel).mc_tool_list_size_r)
+    wanted = [f"ch{channel}.wz[{i}].{f}" for i in range(1, size + 1) for f in _TOOL_FIELDS]
+    v = c.read_many(wanted)
     rows = {}
     for i in range(1, size + 1):
         p = f"ch{channel}.wz[{i}]."
@@ -151,11 +152,11 @@ def tool_import(ctx: typer.Context, file: str = FileArgument,
 
 
 def _groups(c: Client, channel: int) -> tuple[list[str], dict[int, OffsetGroup]]:
-    count: int = c.read(f"ch{channel}.mc_zero_offset_groups_r")
+    count: int = c.read(names.ch(channel).mc_zero_offset_groups_r)
     axes = [a.upper() for a in c.axis_names(channel)]
-    names = [f"ch{channel}.ax{a}.np_grp[{g}].v" for g in range(1, count)
-             for a in range(1, len(axes) + 1)]
-    v = c.read_many(names)
+    wanted = [f"ch{channel}.ax{a}.np_grp[{g}].v" for g in range(1, count)
+              for a in range(1, len(axes) + 1)]
+    v = c.read_many(wanted)
     groups = {}
     for g in range(1, count):
         values: dict[str, float] = {}

@@ -20,6 +20,7 @@ from cnc_objects.clients.client import AsyncClient
 from cnc_objects.clients.errors import AdsError
 from cnc_objects.protocol.alarm_values import AlarmState
 
+from .. import names
 from .session import Feed
 
 COLUMNS = ("#", "state", "severity", "id", "ch", "time", "where", "text")
@@ -58,7 +59,7 @@ class AlarmLine(Static):
                 self.text = f"alarms not available: {exc}"
                 self.update(self.text)
 
-        return [Feed("alarm_changes_r", apply)]
+        return [Feed(names.alarm_changes_r, apply)]
 
     def show(self, listed: AlarmList) -> None:
         """Show ``listed``'s newest active alarm; refresh an open page."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from cnc_objects.clients import names
 from cnc_objects.clients.client import AsyncClient
 
 _CHANNEL = re.compile(r"ch(\d+)\.mc_active_state_r", re.IGNORECASE)
@@ -92,12 +93,12 @@ async def discover(client: AsyncClient) -> Machine:
             for info in await client.browse(f"ch{channel}.ax*.axis_name")
             if (m := _AXIS.fullmatch(info.name)) and int(m.group(1)) == channel
         )
-        names = [f"ch{channel}.ax{a}.{leaf}" for a in found
-                 for leaf in ("axis_name", "requested_link_to_physical_axis")]
-        values = await client.read_many(names) if names else {}
+        wanted = [f"ch{channel}.ax{a}.{leaf}" for a in found
+                  for leaf in ("axis_name", "requested_link_to_physical_axis")]
+        values = await client.read_many(wanted) if wanted else {}
         axes = tuple(
-            AxisView(channel, a, values[f"ch{channel}.ax{a}.axis_name"] or f"ax{a}",
-                     values[f"ch{channel}.ax{a}.requested_link_to_physical_axis"])
+            AxisView(channel, a, values[names.ch(channel).ax(a).axis_name] or f"ax{a}",
+                     values[names.ch(channel).ax(a).requested_link_to_physical_axis])
             for a in found
         )
         channels.append(ChannelView(channel, position, axes))

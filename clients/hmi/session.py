@@ -25,6 +25,7 @@ from cnc_objects.clients.errors import (
 )
 from cnc_objects.clients.units import engineering
 
+from .. import names
 from . import text
 from .machine import Machine, discover
 
@@ -32,7 +33,7 @@ log = logging.getLogger(__name__)
 
 RETRY_S = 1.0  # wall time between two connection attempts
 HEARTBEAT_S = 1.0  # wall time between two liveness reads while connected
-HEARTBEAT_OBJECT = "cnc_tick_counter_r"  # any readable object will do; this one is tiny
+HEARTBEAT_OBJECT = names.cnc_tick_counter_r  # any readable object will do; this one is tiny
 
 _LOST = (AdsTimeoutError, AdsConnectionError)  # the service does not answer
 

@@ -19,6 +19,7 @@ from collections import deque
 
 import aiomqtt
 
+from .. import names
 from ..alarm_ops import AlarmEvent, AlarmList, events_since, seen_states
 from ..client import AsyncClient
 from .topics import Topics
@@ -27,7 +28,7 @@ log = logging.getLogger(__name__)
 
 QOS = 1
 EVENTS_KEPT = 1000  # events waiting for the broker; older ones are dropped (logged)
-CHANGES_OBJECT = "alarm_changes_r"
+CHANGES_OBJECT = names.alarm_changes_r
 
 
 def list_payload(listed: AlarmList) -> bytes:

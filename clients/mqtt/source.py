@@ -20,6 +20,7 @@ import logging
 import math
 from collections.abc import Callable
 
+from .. import names
 from ..client import AsyncClient
 from ..errors import AdsConnectionError, AdsError, AdsTimeoutError
 from ..object_info import ObjectInfo
@@ -30,7 +31,7 @@ from .retry import Backoff, session
 
 log = logging.getLogger(__name__)
 
-PROBE_OBJECT = "cnc_kernel_time_r"  # REAL64 s, never decreases while a service runs
+PROBE_OBJECT = names.cnc_kernel_time_r  # REAL64 s, never decreases while a service runs
 # Subscriptions waiting for their first sample at once. The client's transport keeps the
 # samples that overtake their AddNotification reply for at most 64 handles and drops the
 # rest, so a larger burst would lose first samples (and those objects' values).

@@ -23,6 +23,7 @@ from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import ChannelMode, ManualOperationMode
 
+from .. import names
 from . import alarms
 from .access import ACCESS_KEY, STORE_ROLE, WRITE_ROLE, refusal, require_write, set_session_cookie
 from .hub import json_value
@@ -252,7 +253,7 @@ async def select(request: web.Request) -> web.StreamResponse:
     channel = _channel(request)
     program = _field(await _body(request), "program", str)
     require_write(request, f"select {program}")
-    await _client(request).write(f"ch{channel}.mc_command_program_name_w", program)
+    await _client(request).write(names.ch(channel).mc_command_program_name_w, program)
     return web.json_response({"ok": True})
 
 
@@ -304,8 +305,8 @@ async def jog(request: web.Request) -> web.StreamResponse:
                            f"({low / UM01_PER_MM}..{high / UM01_PER_MM} mm)")
     if direction not in (1, -1):
         raise refusal(400, f"'direction' is +1 or -1, not {direction}")
-    if await c.read(f"ch{channel}.mc_active_mode_r") != ChannelMode.MANUAL:
-        await c.write(f"ch{channel}.mc_command_mode_w", ChannelMode.MANUAL)
+    if await c.read(names.ch(channel).mc_active_mode_r) != ChannelMode.MANUAL:
+        await c.write(names.ch(channel).mc_command_mode_w, ChannelMode.MANUAL)
     await c.write(f"{prefix}.manual_operation_mode_w", ManualOperationMode.INCREMENTAL)
     await c.write(f"{prefix}.manual_increment_w", increment_01um)
     key = f"{prefix}.manual_jog_{'plus' if direction > 0 else 'minus'}_w"

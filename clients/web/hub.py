@@ -28,6 +28,7 @@ from cnc_objects.clients.client import AsyncClient, Sample
 from cnc_objects.clients.errors import AdsConnectionError, AdsError, AdsTimeoutError
 from cnc_objects.protocol.errors import AdsReturnCode
 
+from .. import names
 from .budgets import WatchBudgets
 
 log = logging.getLogger(__name__)
@@ -37,7 +38,7 @@ FLUSH_S = 0.015  # at most ~66 messages a second to one browser
 SUBSCRIPTION_CYCLE_MS = 20  # the service checks a watched object every 20 ms of kernel time (50 Hz)
 RESUBSCRIBE_S = 1.0  # wall time before a subscription lost with the service is tried again
 HEARTBEAT_S = 1.0  # wall time between two checks that the subscriptions are alive
-HEARTBEAT_OBJECT = "cnc_tick_counter_r"  # changes every cycle: a sure beat
+HEARTBEAT_OBJECT = names.cnc_tick_counter_r  # changes every cycle: a sure beat
 BEAT_CYCLE_MS = 500  # one beat per 0.5 s of kernel time
 STALE_S = 3.0  # wall time without a beat after which the subscriptions count as gone
 

@@ -30,6 +30,7 @@ from aiohttp import WSMsgType, web
 from cnc_objects.clients.client import AsyncClient
 from cnc_objects.clients.errors import AdsError, ClientValueError
 
+from .. import names
 from .access import require_write
 
 log = logging.getLogger(__name__)
@@ -70,8 +71,8 @@ class Key:
 
 async def press(client: AsyncClient, key: Key, rapid: bool) -> None:
     """Press ``key`` in continuous jog (MANUAL selected first, as ``cnc jog`` does)."""
-    if await client.read(f"ch{key.channel}.mc_active_mode_r") != MANUAL_MODE:
-        await client.write(f"ch{key.channel}.mc_command_mode_w", MANUAL_MODE)
+    if await client.read(names.ch(key.channel).mc_active_mode_r) != MANUAL_MODE:
+        await client.write(names.ch(key.channel).mc_command_mode_w, MANUAL_MODE)
     prefix = f"ch{key.channel}.ax{key.axis}"
     await client.write(f"{prefix}.manual_operation_mode_w", JOG_CONTINUOUS)
     await client.write(f"{prefix}.manual_rapid_w", rapid)

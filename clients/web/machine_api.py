@@ -20,6 +20,7 @@ from aiohttp import web
 from cnc_objects.clients.client import AsyncClient
 from cnc_objects.clients.units import raw_value
 
+from .. import names
 from . import alarms, jog_hold
 from .access import refusal, require_write
 from .api import CLIENT_KEY, _body, _channel, _service_call
@@ -59,8 +60,8 @@ def _index(request: web.Request, part: str) -> int:
 
 async def _manual(client: AsyncClient, channel: int) -> None:
     """Select MANUAL unless the channel is in it (the kernel refuses while it works)."""
-    if await client.read(f"ch{channel}.mc_active_mode_r") != jog_hold.MANUAL_MODE:
-        await client.write(f"ch{channel}.mc_command_mode_w", jog_hold.MANUAL_MODE)
+    if await client.read(names.ch(channel).mc_active_mode_r) != jog_hold.MANUAL_MODE:
+        await client.write(names.ch(channel).mc_command_mode_w, jog_hold.MANUAL_MODE)
 
 
 async def _mm_per_raw(client: AsyncClient, name: str) -> float:
@@ -115,7 +116,7 @@ async def home(request: web.Request) -> web.StreamResponse:
     c = _client(request)
     await _manual(c, channel)
     for axis in axes:
-        await c.write(f"ch{channel}.ax{axis}.homing_start_w", True)
+        await c.write(names.ch(channel).ax(axis).homing_start_w, True)
     return web.json_response({"ok": True})
 
 
