@@ -32,6 +32,7 @@ from cnc_objects.clients.errors import AdsError, ClientValueError
 
 from .. import names
 from .access import require_write
+from .closing import registered
 
 log = logging.getLogger(__name__)
 
@@ -133,8 +134,9 @@ async def jog_socket(request: web.Request, client: AsyncClient) -> web.StreamRes
     await socket.prepare(request)
     holder = Holder(client)
     try:
-        await socket.send_json({"held": [], "renew_s": RENEW_S})
-        await _serve(socket, holder)
+        with registered(request, socket):  # cnc-web's shutdown closes it (closing.py)
+            await socket.send_json({"held": [], "renew_s": RENEW_S})
+            await _serve(socket, holder)
     except ConnectionError:
         pass  # the page went: its keys are released below
     finally:

@@ -18,6 +18,7 @@ from aiohttp import WSMsgType, web
 
 from .access import current_session
 from .budgets import NameRate
+from .closing import OPEN_SOCKETS_KEY
 from .hub import FLUSH_S, LiveHub, Outbox
 
 HUB_KEY: web.AppKey[LiveHub] = web.AppKey("hub")
@@ -42,6 +43,7 @@ async def live(request: web.Request) -> web.StreamResponse:
     await socket.prepare(request)
     outbox = Outbox(current_session(request).csrf)  # the csrf token names the session
     request.app[SOCKETS_KEY][0] += 1
+    request.app[OPEN_SOCKETS_KEY].add(socket)  # closed by cnc-web's shutdown (closing.py)
     sender = asyncio.create_task(_send(socket, outbox), name="web socket sender")
     rate = NameRate(hub.budgets.names_per_s)
     try:
@@ -60,6 +62,7 @@ async def live(request: web.Request) -> web.StreamResponse:
             await hub.watch(outbox, names)
     finally:
         request.app[SOCKETS_KEY][0] -= 1
+        request.app[OPEN_SOCKETS_KEY].discard(socket)
         hub.unwatch(outbox)
         sender.cancel()
         with contextlib.suppress(asyncio.CancelledError):

@@ -20,6 +20,7 @@ from cnc_objects.clients.client import AsyncClient
 from . import api, machine_api, program_api
 from .access import ACCESS_KEY, Access, session_middleware, sweep_sessions
 from .budgets import WatchBudgets
+from .closing import OPEN_SOCKETS_KEY, close_open_sockets
 from .connections import connection_middleware
 from .hosts import HOSTS_KEY, AllowedHosts, host_middleware
 from .hub import LiveHub
@@ -85,6 +86,8 @@ def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts,
     app[ACCESS_KEY] = access
     app[HOSTS_KEY] = hosts
     app[SOCKETS_KEY] = [0]
+    app[OPEN_SOCKETS_KEY] = set()
+    app.on_shutdown.append(close_open_sockets)
 
     async def service_client(app: web.Application) -> AsyncIterator[None]:
         client = link.client()

@@ -11,7 +11,7 @@ import pytest
 from cnc_objects.clients import AdsError, Client
 from cnc_objects.protocol.constants import PROGRAM_STORE_GROUP, CncPort
 from cnc_objects.protocol.constants import ProgramStoreOffset as Op
-from cnc_objects.service import program_line_index
+from cnc_objects.service.storage import program_line_index
 from cnc_objects.testing import serving
 from tests.limits.wire import limited_service
 

@@ -7,6 +7,7 @@ acknowledge-all, and RESET after a manual block in ERROR.
 
 from __future__ import annotations
 
+import asyncio
 import time
 from collections.abc import Callable
 from typing import Any
@@ -14,7 +15,8 @@ from typing import Any
 import aiohttp
 
 from cnc_objects.clients.web.users import WebRole
-from cnc_objects.testing.web import WebProcess
+from cnc_objects.testing import ServiceProcess
+from cnc_objects.testing.web import STOP_TIMEOUT_S, WebProcess, start_web
 
 from .conftest import PASSWORDS
 from .test_web_api import _json, _session
@@ -244,3 +246,32 @@ async def test_alarm_history_with_times_acknowledge_all_and_reset(web: WebProces
         assert newest["state"] == "cleared" and newest["time"].endswith("Z")
         async with http.post(web.url + "/api/alarms/acknowledge-all") as response:
             assert response.status == 403  # no CSRF token
+
+
+async def test_cnc_web_stops_at_once_with_pages_open_and_releases_a_held_jog(
+        realtime_service: ServiceProcess) -> None:
+    """Ctrl-C on cnc-web with a browser open: it closes the pages' WebSockets (1001) instead
+    of waiting for them, and a jog key held through one is released on the way out."""
+    from cnc_objects.clients import Client
+
+    web = start_web(realtime_service.endpoint)
+    try:
+        async with _session() as http:
+            csrf = await _open_session(http, web.url)
+            live = await _live(http, web.url, [f"{AX1}.manual_jog_minus_w"])
+            socket = await _jog_socket(http, web.url, csrf)
+            await socket.send_json({"press": {"channel": 1, "axis": 1, "direction": -1}})
+            await live.until(f"{AX1}.manual_jog_minus_w", lambda held: held is True)
+            asked = time.monotonic()
+            exit_code = await asyncio.to_thread(web.stop)
+            took_s = time.monotonic() - asked
+            closed = await socket.receive(timeout=WAIT_S)
+            while closed.type == aiohttp.WSMsgType.TEXT:  # what it said before it closed
+                closed = await socket.receive(timeout=WAIT_S)
+    finally:
+        web.stop()
+    assert exit_code == 0 and took_s < STOP_TIMEOUT_S / 2, (exit_code, took_s)
+    assert (closed.type, closed.data, closed.extra) == (
+        aiohttp.WSMsgType.CLOSE, aiohttp.WSCloseCode.GOING_AWAY, "cnc-web is stopping")
+    with Client(realtime_service.endpoint) as client:
+        assert client.read(f"{AX1}.manual_jog_minus_w") is False
