@@ -54,11 +54,14 @@ else
 endif
 
 # The checkers first (ruff: lint and import order; mypy, strict: tools/typecheck.py), then
-# the tests.
+# the tests in TEST_WORKERS processes (pytest-xdist; most tests wait on a service, a
+# browser or a subprocess, so 4 workers keep 2 cores busy), without the slow reruns that
+# `make soak` runs (marker soak). TEST_WORKERS=0 runs them in this process, in order.
+TEST_WORKERS ?= 4
 test: $(VENV)/.installed-test $(VENV)/.native
 	$(BIN)/ruff check .
 	$(BIN)/python tools/typecheck.py
-	$(BIN)/python -m pytest $(PYTEST_ARGS)
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) -m "not soak" $(PYTEST_ARGS)
 
 bench: $(VENV)/.installed-test $(VENV)/.native
 	$(BIN)/python -m bench
@@ -66,11 +69,13 @@ bench: $(VENV)/.installed-test $(VENV)/.native
 # The long form of tests/reliability (100 000 fuzzed frames, 640 NC mutants, 1.5 M load
 # requests, 20 restarts of each kind): bounded, about 16 minutes on a 2-core machine; and
 # 300 programs run under both virtual clocks (event speed against stepping), and the
-# equality properties of issue 37 with many new examples (docs/testing.md).
+# equality properties of issue 37 with many new examples (docs/testing.md); then the slow
+# reruns marked soak (the decoder's tests again with its plain constructors).
 soak: $(VENV)/.installed-test
 	$(BIN)/python -m pytest tests/reliability tests/service/kernel/test_event_speed_clock.py \
 		tests/service/kernel/test_equality_properties.py tests/e2e/test_repeatable_properties.py \
 		-q --soak $(PYTEST_ARGS)
+	$(BIN)/python -m pytest -q -m soak $(PYTEST_ARGS)
 
 # Code made from other code: the blocking Client from AsyncClient's methods, and the typed
 # object names (clients/names.py) from the catalog. A test fails when either is stale.

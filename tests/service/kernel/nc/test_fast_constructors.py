@@ -11,6 +11,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from cnc_objects.service.kernel.nc.construct import FAST, PLAIN_CONSTRUCTORS_ENV
 
 REPO = Path(__file__).resolve().parents[4]
@@ -80,6 +82,7 @@ def test_example_programs_decode_to_the_same_blocks_with_and_without_the_twins()
     assert fast == plain
 
 
+@pytest.mark.soak  # the whole decoder suite again (about 90 s): `make soak`
 def test_the_decoder_tests_pass_with_the_plain_constructors() -> None:
     done = subprocess.run(
         [sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider", str(NC_TESTS),
