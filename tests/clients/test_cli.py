@@ -3,34 +3,15 @@
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import pty
 import re
 import socket
 import subprocess
 import sys
-from pathlib import Path
 
+from tests.support.cli import cnc, json_lines
 from tests.support.service import ROOT, RunningService
-
-
-def cnc(
-    *args: str, endpoint: str | None = None, env: dict | None = None, cwd: Path | None = None
-) -> subprocess.CompletedProcess:
-    """Run ``cnc`` as a user would (module entry point of the installed script), in
-    ``cwd`` (default: the project root)."""
-    argv = [sys.executable, "-c", "from cnc_objects.clients.cli import main; main()"]
-    if endpoint is not None:
-        argv += ["--endpoint", endpoint]
-    return subprocess.run(
-        [*argv, *args], cwd=cwd or ROOT, capture_output=True, text=True, timeout=60,
-        env={**os.environ, **(env or {})},
-    )
-
-
-def json_lines(result: subprocess.CompletedProcess) -> list[dict]:
-    return [json.loads(line) for line in result.stdout.splitlines() if line.strip()]
 
 
 def test_info(endpoint: str) -> None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from cnc_objects.clients import Client
-from tests.clients.test_cli import cnc, json_lines
+from tests.support.cli import cnc, json_lines
 from tests.support.service import RunningService
 
 CLEAN = "N10 G1 X10 Y5 F6000\nN20 M30\n"

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from cnc_objects.clients import Client
 from cnc_objects.clients.channel_ops import CheckError, CheckResult, parse_check_log
-from tests.clients.test_cli import cnc, json_lines
+from tests.support.cli import cnc, json_lines
 from tests.support.service import RunningService
 
 EXAMPLE_PATH = Path(__file__).resolve().parents[2] / "docs" / "examples" / "check-syntax.nc"

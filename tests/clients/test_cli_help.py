@@ -15,7 +15,7 @@ import typer.main
 
 from cnc_objects.clients.cli import app
 from cnc_objects.clients.mqtt.cli import app as mqtt_app
-from tests.clients.test_cli import cnc
+from tests.support.cli import cnc
 
 # Heavy modules a command needs only where it uses them (plot: numpy, matplotlib; the
 # HMI: textual; service configuration: pydantic; fancy output: rich).

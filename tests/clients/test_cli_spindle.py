@@ -3,7 +3,7 @@ a manual block (S.. M3 waits for the speed: MVS_SVS), stop."""
 
 from __future__ import annotations
 
-from tests.clients.test_cli import cnc, json_lines
+from tests.support.cli import cnc, json_lines
 from tests.support.service import RunningService
 
 

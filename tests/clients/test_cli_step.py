@@ -7,7 +7,7 @@ from collections.abc import Iterator
 import pytest
 
 from cnc_objects.testing import ServiceProcess, serving
-from tests.clients.test_cli import cnc, json_lines
+from tests.support.cli import cnc, json_lines
 from tests.support.service import RunningService
 
 

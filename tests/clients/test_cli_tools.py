@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from cnc_objects.clients import Client
 from cnc_objects.testing import ServiceProcess, run_program
-from tests.clients.test_cli import cnc, json_lines
+from tests.support.cli import cnc, json_lines
 
 
 def test_tool_set_and_show(service: ServiceProcess) -> None:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from cnc_objects.clients import Client
 from cnc_objects.testing import ServiceProcess
-from tests.clients.test_cli import cnc
+from tests.support.cli import cnc
 
 INCR = 10_000  # 0.1 um per mm
 

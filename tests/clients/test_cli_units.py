@@ -9,7 +9,7 @@ import re
 from cnc_objects.clients import Client
 from cnc_objects.clients.units import noise_free, round_to, tidy
 from cnc_objects.testing import ServiceProcess
-from tests.clients.test_cli import cnc, json_lines
+from tests.support.cli import cnc, json_lines
 
 LONG_DECIMALS = re.compile(r"\d\.\d{7,}")  # float noise: 0.18900000000007822
 

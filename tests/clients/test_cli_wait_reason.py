@@ -15,7 +15,7 @@ from cnc_objects.clients import Client
 from cnc_objects.clients.cli.machine import EXIT_WAIT_TIMEOUT
 from cnc_objects.protocol.wait_reasons import WaitReason
 from cnc_objects.testing import ServiceProcess, wait_for
-from tests.clients.test_cli import ROOT, cnc, json_lines
+from tests.support.cli import ROOT, cnc, json_lines
 
 M0_PROGRAM = "G1 X1 F6000\nM0\nG1 X2\nM30\n"
 M0_LINE = "channel 1 waits: M0 programmed stop: waiting for START (PROGRAMMED_STOP)"

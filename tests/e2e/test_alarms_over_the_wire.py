@@ -22,8 +22,8 @@ from cnc_objects.clients import (
 )
 from cnc_objects.protocol.alarm_values import AlarmClass, AlarmState, Severity
 from cnc_objects.testing import ServiceProcess, serving
-from tests.clients.test_cli import cnc, json_lines
 from tests.e2e.test_ads_pyads import Ads, ads  # noqa: F401  (the pyads fixture)
+from tests.support.cli import cnc, json_lines
 from tests.support.service import reset_client, serving_config
 
 BAD = "G0 X1\nG1 X10\nM30\n"  # line 2: G1 without F, NC error 20008

@@ -11,7 +11,7 @@ import pytest
 from cnc_objects.clients import AdsError, Client
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.testing import ServiceProcess, wait_for
-from tests.clients.test_cli import cnc, json_lines
+from tests.support.cli import cnc, json_lines
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "examples" / "contour-lookahead.nc"
 UNIT = "gpCh[0].contour_lookahead"

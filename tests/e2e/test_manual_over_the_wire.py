@@ -10,7 +10,7 @@ import pytest
 from cnc_objects.clients import AdsError, Client
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.testing import ServiceProcess, serving
-from tests.clients.test_cli import cnc, json_lines
+from tests.support.cli import cnc, json_lines
 
 HB = "gpCh[0].bahn_state.coord_r[{}].hb_display_r.{}"
 

@@ -9,7 +9,7 @@ import pytest
 from cnc_objects.clients import AdsError, ChannelError, Client
 from cnc_objects.protocol.constants import PROGRAM_MAX_BYTES, PROGRAM_STORE_GROUP, CncPort
 from cnc_objects.testing import ServiceProcess, run_program, serving, wait_for
-from tests.clients.test_cli import cnc, json_lines
+from tests.support.cli import cnc, json_lines
 
 SQUARE = "N10 G1 X10 F6000\nN20 Y10\nN30 X0\nN40 Y0\nN50 M30\n"
 
