@@ -11,7 +11,7 @@ DATA_DIR ?=
 # docs/configuration.md); empty: the embedded default machine.
 CONFIG   ?=
 
-.PHONY: run test bench soak clean generate
+.PHONY: run test bench soak clean generate coverage
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -62,6 +62,14 @@ test: $(VENV)/.installed-test $(VENV)/.native
 	$(BIN)/ruff check .
 	$(BIN)/python tools/typecheck.py
 	$(BIN)/python -m pytest -n $(TEST_WORKERS) -m "not soak" $(PYTEST_ARGS)
+
+# The tests of `make test` with line coverage of the package (services, cnc-web and cnc
+# subprocesses included): a table of what is missed, and build/coverage.json, which
+# tools/coverage_diff.py compares with the report of an earlier commit.
+coverage: $(VENV)/.installed-test $(VENV)/.native
+	rm -f .coverage .coverage.*
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) -m "not soak" --cov --cov-report=term:skip-covered \
+		--cov-report=json:build/coverage.json $(PYTEST_ARGS)
 
 bench: $(VENV)/.installed-test $(VENV)/.native
 	$(BIN)/python -m bench
