@@ -38,7 +38,7 @@ def errors(c: Client) -> list[str]:
     return c.channel_errors(1)
 
 
-def test_the_configured_tool_list_is_readable_by_objects(c):
+def test_the_configured_tool_list_is_readable_by_objects(c) -> None:
     values = c.read_many(["ch1.mc_tool_list_size_r", "ch1.wz[2].valid", "ch1.wz[2].radius",
                           "ch1.wz[2].laenge", "ch1.wz[4].valid"])
     assert values == {"ch1.mc_tool_list_size_r": 32, "ch1.wz[2].valid": True,
@@ -46,7 +46,7 @@ def test_the_configured_tool_list_is_readable_by_objects(c):
                       "ch1.wz[4].valid": False}
 
 
-def test_tool_select_change_and_length_compensation(c):
+def test_tool_select_change_and_length_compensation(c) -> None:
     c.write("ch1.wz[5].radius", 3.0 * INCR)
     c.write("ch1.wz[5].laenge", 100.0 * INCR)
     assert c.read("ch1.wz[5].valid") is False  # data alone does not make a tool
@@ -70,7 +70,7 @@ def test_tool_select_change_and_length_compensation(c):
     assert values["ch1.program_time"] >= 2.5
 
 
-def test_the_tool_change_time_is_the_parameter(c):
+def test_the_tool_change_time_is_the_parameter(c) -> None:
     assert run(c, "G0 X0 Y0 Z0\nM30\n").state == "READY"  # both runs start here
     without = run(c, "T1\nG0 X1\nM30\n")
     assert without.state == "READY"
@@ -82,7 +82,7 @@ def test_the_tool_change_time_is_the_parameter(c):
     assert c.read("ch1.mc_active_tool_r") == 1
 
 
-def test_work_offsets_g54_to_g59_and_g53(c):
+def test_work_offsets_g54_to_g59_and_g53(c) -> None:
     for group in range(1, 7):  # G54..G59: X offset = 10 * group mm
         c.write(f"ch1.ax1.np_grp[{group}].v", 10.0 * group * INCR)
     c.write("ch1.ax2.np_grp[2].v", -5.0 * INCR)
@@ -106,7 +106,7 @@ def test_work_offsets_g54_to_g59_and_g53(c):
     assert c.read("ch1.ax1.command_position_pcs") == 0
 
 
-def test_g159_selects_the_further_groups(c):
+def test_g159_selects_the_further_groups(c) -> None:
     c.write("ch1.ax1.np_grp[9].v", 7.5 * INCR)
     assert c.read("ch1.mc_zero_offset_groups_r") == 10
     status = run(c, "G0 X0 Y0 Z0\nG159=9\nG0 X1\nM30\n")
@@ -115,7 +115,7 @@ def test_g159_selects_the_further_groups(c):
     assert c.read("ch1.ax1.command_position_acs") == 8.5 * INCR
 
 
-def test_incremental_moves_ignore_a_new_offset(c):
+def test_incremental_moves_ignore_a_new_offset(c) -> None:
     """ISG: a new zero offset acts at the next absolute position only (G91 X0 stays)."""
     c.write("ch1.ax1.np_grp[1].v", 10.0 * INCR)
     status = run(c, "G0 X0 Y0 Z0\nG54 G91 X0\nG90\nM30\n")
@@ -123,7 +123,7 @@ def test_incremental_moves_ignore_a_new_offset(c):
     assert c.read("ch1.ax1.command_position_acs") == 0
 
 
-def test_radius_compensation_keeps_taking_the_radius_from_d(c):
+def test_radius_compensation_keeps_taking_the_radius_from_d(c) -> None:
     c.write("ch1.wz[6].radius", 2.0 * INCR)
     c.write("ch1.wz[6].valid", True)
     status = run(c, "G0 X0 Y-10 Z0\nD6\nG41 G1 X0 Y0 F1000\nG1 X20\nG40 G1 X20 Y-10\nM30\n")
@@ -131,7 +131,7 @@ def test_radius_compensation_keeps_taking_the_radius_from_d(c):
     assert c.read("ch1.mc_active_tool_radius_r") == 2.0 * INCR
 
 
-def test_a_written_offset_is_read_back_and_reset_keeps_the_tool(c):
+def test_a_written_offset_is_read_back_and_reset_keeps_the_tool(c) -> None:
     c.write("ch1.ax3.np_grp[4].v", -123.4567 * INCR)
     assert c.read("ch1.ax3.np_grp[4].v") == pytest.approx(-123.4567 * INCR)
     run(c, "T2 M6\nD2\nG57\nM30\n")
@@ -156,7 +156,7 @@ def test_a_written_offset_is_read_back_and_reset_keeps_the_tool(c):
         ("G54 G55\nM30\n", 20116, 1, 5),  # two zero offsets in one block
     ],
 )
-def test_bad_nc_input_gives_isg_error_ids_with_place(c, program, error_id, line, column):
+def test_bad_nc_input_gives_isg_error_ids_with_place(c, program, error_id, line, column) -> None:
     with pytest.raises(ChannelError) as info:
         run(c, program, "bad-tools.nc")
     assert f"error {error_id}: bad-tools.nc:{line}:{column}:" in str(info.value)
@@ -175,7 +175,7 @@ def test_bad_nc_input_gives_isg_error_ids_with_place(c, program, error_id, line,
         ("ch1.ax1.np_grp[1].v", float("nan"), "np_grp[1] X"),
     ],
 )
-def test_writes_out_of_range_are_refused_with_0x706(c, name, value, words):
+def test_writes_out_of_range_are_refused_with_0x706(c, name, value, words) -> None:
     before = c.read(name)
     with pytest.raises(AdsError) as info:
         c.write(name, value)
@@ -184,7 +184,7 @@ def test_writes_out_of_range_are_refused_with_0x706(c, name, value, words):
     assert c.read(name) == before
 
 
-def test_objects_beyond_the_tables_do_not_exist(c):
+def test_objects_beyond_the_tables_do_not_exist(c) -> None:
     for name in ("ch1.wz[33].radius", "ch1.ax1.np_grp[10].v", "ch1.ax1.np_grp[0].v"):
         with pytest.raises(AdsError) as info:
             c.read(name)

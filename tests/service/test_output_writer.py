@@ -46,7 +46,7 @@ def hold_the_writer(w: OutputWriter) -> threading.Event:
     return gate
 
 
-def test_appends_append_and_exclusive_replaces_once(writer):
+def test_appends_append_and_exclusive_replaces_once(writer) -> None:
     writer.save("m.txt", b"one\n")
     writer.save("m.txt", b"two\n")
     assert written(writer, "m.txt") == b"one\ntwo\n"
@@ -63,7 +63,7 @@ def test_appends_append_and_exclusive_replaces_once(writer):
     ([("a", 10), ("b", 10), ("c", 10), ("d", 10)], "output_max_files"),
     ([("a", 4000), ("b", 4000), ("c", 2100)], "output_max_total_bytes"),
 ])
-def test_a_write_over_a_limit_is_refused_naming_the_key(writer, writes, limit):
+def test_a_write_over_a_limit_is_refused_naming_the_key(writer, writes, limit) -> None:
     *fine, (name, size) = writes
     for n, s in fine:
         writer.save(n, b"x" * s)
@@ -74,7 +74,7 @@ def test_a_write_over_a_limit_is_refused_naming_the_key(writer, writes, limit):
     assert [(p.name, p.size_bytes) for p in writer.listing()] == before
 
 
-def test_a_full_queue_refuses_an_nc_write_and_drops_a_log_line(tmp_path):
+def test_a_full_queue_refuses_an_nc_write_and_drops_a_log_line(tmp_path) -> None:
     w = OutputWriter(OutputArea(tmp_path), OutputLimits(queue_max_bytes=1 << 20))
     gate = hold_the_writer(w)
     w.kernel_file("prodtime01.csv", lambda: b"made\n", replace=True)  # counts as 1 MB queued
@@ -89,7 +89,7 @@ def test_a_full_queue_refuses_an_nc_write_and_drops_a_log_line(tmp_path):
     assert [p.name for p in w.area.list()] == ["first.csv", "prodtime01.csv"]
 
 
-def test_a_log_keeps_its_newest_lines_cut_once_per_half_limit(writer):
+def test_a_log_keeps_its_newest_lines_cut_once_per_half_limit(writer) -> None:
     line = b"%04d" + b"-" * 95 + b"\n"  # 100 bytes
     inodes = set()
     for k in range(200):
@@ -103,7 +103,7 @@ def test_a_log_keeps_its_newest_lines_cut_once_per_half_limit(writer):
     assert len(inodes) <= 200 * 100 // (LIMITS.max_file_bytes // 2) + 1  # few rewrites
 
 
-def test_a_newer_report_supersedes_one_still_queued(tmp_path):
+def test_a_newer_report_supersedes_one_still_queued(tmp_path) -> None:
     w = OutputWriter(OutputArea(tmp_path))
     gate = hold_the_writer(w)
     w.kernel_file("dec01.sc", b"old", replace=True)
@@ -113,7 +113,7 @@ def test_a_newer_report_supersedes_one_still_queued(tmp_path):
     assert w.area.read("dec01.sc") == b"new"
 
 
-def test_delete_is_ordered_after_queued_writes_and_frees_room(writer):
+def test_delete_is_ordered_after_queued_writes_and_frees_room(writer) -> None:
     writer.save("a", b"x" * 4000)
     assert writer.delete("a")
     assert not writer.delete("a")
@@ -123,7 +123,7 @@ def test_delete_is_ordered_after_queued_writes_and_frees_room(writer):
     assert not (writer.area.root / "a").exists()
 
 
-def test_close_writes_everything_queued_and_refuses_more(tmp_path):
+def test_close_writes_everything_queued_and_refuses_more(tmp_path) -> None:
     w = OutputWriter(OutputArea(tmp_path))
     for k in range(1000):
         w.save("m.txt", b"%d padding-padding\n" % k)
@@ -134,7 +134,7 @@ def test_close_writes_everything_queued_and_refuses_more(tmp_path):
         w.save("m.txt", b"late\n")
 
 
-def test_bad_names_are_refused(writer):
+def test_bad_names_are_refused(writer) -> None:
     for name in ("../x", "a/b", ".hidden", ""):
         with pytest.raises(ValueError, match="output file name"):
             writer.save(name, b"x")

@@ -168,7 +168,7 @@ def g42_expected() -> list[tuple[Expected, float]]:
     return with_starts(0.0, entries)
 
 
-def test_every_field_of_a_g41_contour(kernel):
+def test_every_field_of_a_g41_contour(kernel) -> None:
     run = kernel.run(G41_PROGRAM)
     assert run.channel.state == ChannelState.READY, run.channel.errors
     expected = g41_expected()
@@ -181,13 +181,13 @@ def test_every_field_of_a_g41_contour(kernel):
     assert run.channel.dist_prog_start_01um == pytest.approx(end_mm * INCR, abs=1e-3)
 
 
-def test_every_field_of_a_g42_contour(kernel):
+def test_every_field_of_a_g42_contour(kernel) -> None:
     run = kernel.run(G42_PROGRAM)
     assert run.channel.state == ChannelState.READY, run.channel.errors
     assert_entries(request(kernel, 0), g42_expected())
 
 
-def test_mode_1_from_the_middle_and_past_the_end(kernel):
+def test_mode_1_from_the_middle_and_past_the_end(kernel) -> None:
     kernel.run(G41_PROGRAM)
     expected = g41_expected()
     assert_entries(request(kernel, 5), expected[5:])
@@ -201,7 +201,7 @@ def test_mode_1_from_the_middle_and_past_the_end(kernel):
     ((21.5, 19.5), 4, 4),  # cuts N30 (started before): only the arc starting at 41
     ((0.0, 10.5), None, None),  # N05 and the approach line start at 0 and 10
 ])
-def test_mode_2_windows_by_path_distance(kernel, window_mm, first, last):
+def test_mode_2_windows_by_path_distance(kernel, window_mm, first, last) -> None:
     kernel.run(G41_PROGRAM)
     expected = g41_expected()
     start, length = window_mm
@@ -215,7 +215,7 @@ def test_mode_2_windows_by_path_distance(kernel, window_mm, first, last):
     assert_entries(reply, wanted)
 
 
-def test_requests_that_cannot_be_answered_are_refused(kernel):
+def test_requests_that_cannot_be_answered_are_refused(kernel) -> None:
     kernel.command(SetContourRequest(0, "start_position", 1.5))
     kernel.command(SetContourRequest(0, "length", 0.0))
     refusal = kernel.command(SetContourSemaphore(0, True))
@@ -258,7 +258,7 @@ def body(first_variation: float, start_count: int) -> list[Expected]:
     ]
 
 
-def test_log_inside_a_real_time_loop_gives_the_body_once_with_the_entry(kernel):
+def test_log_inside_a_real_time_loop_gives_the_body_once_with_the_entry(kernel) -> None:
     run = kernel.run(rt_program(inside=True))
     assert run.channel.state == ChannelState.READY, run.channel.errors
     entry = angle((1, 0), (1, 1))  # from N10 (+X) into N80
@@ -268,7 +268,7 @@ def test_log_inside_a_real_time_loop_gives_the_body_once_with_the_entry(kernel):
     assert_entries(request(kernel, 0), expected)
 
 
-def test_log_around_a_real_time_loop_gives_three_transitions(kernel):
+def test_log_around_a_real_time_loop_gives_three_transitions(kernel) -> None:
     run = kernel.run(rt_program(inside=False, passes=5))
     assert run.channel.state == ChannelState.READY, run.channel.errors
     entry = angle((1, 0), (1, 1))  # start of loop: from N10 into N80
@@ -281,7 +281,7 @@ def test_log_around_a_real_time_loop_gives_three_transitions(kernel):
     assert_entries(request(kernel, 0), first + second + last + off)
 
 
-def test_a_loop_of_two_passes_has_two_transitions(kernel):
+def test_a_loop_of_two_passes_has_two_transitions(kernel) -> None:
     kernel.run(rt_program(inside=False, passes=2))
     reply = request(kernel, 0)
     assert [e.block_type for e in reply] == [LOG_ON] + [LINEAR] * 6 + [LOG_OFF]
@@ -303,7 +303,7 @@ M30
 """
 
 
-def test_only_the_first_area_until_clear_which_flushes_and_waits(kernel):
+def test_only_the_first_area_until_clear_which_flushes_and_waits(kernel) -> None:
     seen: list[tuple[float, int, float]] = []
 
     def watch(snap) -> bool:
@@ -330,7 +330,7 @@ def test_only_the_first_area_until_clear_which_flushes_and_waits(kernel):
     assert_entries(request(kernel, 0), expected)
 
 
-def test_clear_inside_a_real_time_loop_is_error_22073(kernel):
+def test_clear_inside_a_real_time_loop_is_error_22073(kernel) -> None:
     run = kernel.run("N10 G1 X10 F600\nN20 #RT WHILE [TRUE]\n"
                      "N30   #CONTOUR LOOKAHEAD LOG CLEAR\nN40 #RT ENDWHILE\nM30\n")
     assert run.channel.state == ChannelState.ERROR
@@ -339,7 +339,7 @@ def test_clear_inside_a_real_time_loop_is_error_22073(kernel):
     assert run.positions_mm[0] == pytest.approx(10.0)  # the block before it ran
 
 
-def test_distance_prog_start_clear_restarts_the_distance(kernel):
+def test_distance_prog_start_clear_restarts_the_distance(kernel) -> None:
     run = kernel.run("N10 #CONTOUR LOOKAHEAD LOG ON\nN20 G1 X10 F600\n"
                      "N30 #DISTANCE PROG START CLEAR\nN40 G1 X15\n"
                      "N50 #CONTOUR LOOKAHEAD LOG OFF\nM30\n")
@@ -350,7 +350,7 @@ def test_distance_prog_start_clear_restarts_the_distance(kernel):
 
 
 # --- limits, enabling, reading while running ----------------------------------------------
-def test_the_log_keeps_contour_lookahead_log_max_entries_and_warns():
+def test_the_log_keeps_contour_lookahead_log_max_entries_and_warns() -> None:
     config = build_config({"channels": [
         {**build_config().model_dump()["channels"][0], "contour_lookahead_log_max": 4}]})
     program = ("N10 #CONTOUR LOOKAHEAD LOG ON\n"
@@ -367,7 +367,7 @@ def test_the_log_keeps_contour_lookahead_log_max_entries_and_warns():
         assert harness.kernel.snapshot.channels[0].contour.count_logged_blocks == 4
 
 
-def test_contour_commands_need_fct_contour_lah():
+def test_contour_commands_need_fct_contour_lah() -> None:
     base = build_config().model_dump()["channels"][0]
     config = build_config({"channels": [{**base, "interpolator_function": "FCT_IPO_DEFAULT"}]})
     with KernelHarness(config=config) as harness:
@@ -380,7 +380,7 @@ def test_contour_commands_need_fct_contour_lah():
         assert run.channel.state == ChannelState.READY  # needs no function
 
 
-def test_the_marked_area_is_there_before_it_runs_and_through_feedhold(kernel):
+def test_the_marked_area_is_there_before_it_runs_and_through_feedhold(kernel) -> None:
     program = ("N10 #CONTOUR LOOKAHEAD LOG ON\n"
                + "".join(f"N{20 + k} G1 X{10 * (k + 1)} F600\n" for k in range(8))
                + "N90 #CONTOUR LOOKAHEAD LOG OFF\nM30\n")
@@ -402,7 +402,7 @@ def test_the_marked_area_is_there_before_it_runs_and_through_feedhold(kernel):
     assert run.channel.state == ChannelState.READY
 
 
-def test_response_size_and_fields_match_the_catalog_and_the_client():
+def test_response_size_and_fields_match_the_catalog_and_the_client() -> None:
     from cnc_objects.clients.channel_ops import CONTOUR_BLOCK_FIELDS as CLIENT_FIELDS
     from cnc_objects.clients.channel_ops import CONTOUR_RESPONSE_BLOCKS as CLIENT_BLOCKS
     from cnc_objects.objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS
@@ -413,7 +413,7 @@ def test_response_size_and_fields_match_the_catalog_and_the_client():
 
 
 # --- found in review: compensation, buffer-sized mode 2, markers, distance epochs ------
-def test_clear_with_radius_compensation_is_error_22072_and_nothing_jumps(kernel):
+def test_clear_with_radius_compensation_is_error_22072_and_nothing_jumps(kernel) -> None:
     run = kernel.run("N10 G41 D1 G1 X10 Y0 F600\nN20 X20\n"
                      "N25 #CONTOUR LOOKAHEAD LOG CLEAR\nN30 X30\nN40 G40 X40\nM30\n",
                      record=True)
@@ -426,7 +426,7 @@ def test_clear_with_radius_compensation_is_error_22072_and_nothing_jumps(kernel)
     assert max(steps) <= 10.0 * 0.001 + 1e-9  # F600 = 10 mm/s in 1 ms cycles
 
 
-def test_mode_2_sees_every_element_still_in_the_look_ahead_buffer(kernel):
+def test_mode_2_sees_every_element_still_in_the_look_ahead_buffer(kernel) -> None:
     squares = "".join("G1 Y10\nX10\nY0\nX0\n" for _ in range(40))  # 2 elements per corner
     kernel.start(f"N2 G41 D1 G1 X0 Y0.5 F600\n{squares}G40 G1 X-5 Y-5\nM30\n")
     snap = kernel.wait_for(lambda s: s.channels[0].dist_prog_start_01um > 0.0)
@@ -438,14 +438,14 @@ def test_mode_2_sees_every_element_still_in_the_look_ahead_buffer(kernel):
     kernel.command(ResetChannel(0, True))
 
 
-def test_start_positions_are_exact_sums_of_the_lengths(kernel):
+def test_start_positions_are_exact_sums_of_the_lengths(kernel) -> None:
     kernel.run(G41_PROGRAM)
     motion = [e for e in request(kernel, 0) if e.block_type in (LINEAR, CIRCULAR)]
     for before, after in zip(motion, motion[1:]):
         assert after.start_position == before.start_position + before.length  # exactly
 
 
-def test_loop_markers_are_no_blocks_of_the_path(kernel):
+def test_loop_markers_are_no_blocks_of_the_path(kernel) -> None:
     """Single block stops at the same places with and without logging the loop."""
     def stops(log: bool) -> list[tuple[float, float, int]]:
         on, off = (("#CONTOUR LOOKAHEAD LOG ON\n", "#CONTOUR LOOKAHEAD LOG OFF\n") if log
@@ -474,7 +474,7 @@ def test_loop_markers_are_no_blocks_of_the_path(kernel):
     assert len(request(kernel, 0)) == 2 + 3 * 2  # ON, three passes of two lines, OFF
 
 
-def test_mode_2_answers_in_the_distances_dist_prog_start_counts(kernel):
+def test_mode_2_answers_in_the_distances_dist_prog_start_counts(kernel) -> None:
     lines = "".join(f"N{100 + k} X{k + 1}\n" for k in range(40))
     more = "".join(f"N{600 + k} X{41 + k}\n" for k in range(40))
     kernel.start(f"G90 G1 F600\n{lines}N500 #DISTANCE PROG START CLEAR\n{more}M30\n")
@@ -487,7 +487,7 @@ def test_mode_2_answers_in_the_distances_dist_prog_start_counts(kernel):
     assert [e.block_number for e in request(kernel, 0, 2.5 * INCR)] == [600, 601, 602]
 
 
-def test_each_manual_block_start_begins_a_new_marked_area(kernel):
+def test_each_manual_block_start_begins_a_new_marked_area(kernel) -> None:
     loop = ("#VAR\nV.L.I = 0\n#ENDVAR\n#CONTOUR LOOKAHEAD LOG ON\n#RT WHILE [V.L.I < 5]\n"
             "V.L.I = V.L.I + 1\nG91 G1 X1 F6000\nY1\nX-1\nY-1\n#RT ENDWHILE\n"
             "#CONTOUR LOOKAHEAD LOG OFF\nG90\n")
@@ -498,7 +498,7 @@ def test_each_manual_block_start_begins_a_new_marked_area(kernel):
     assert counts == [2 + 3 * 4, 2 + 3 * 4]  # ON, three transitions of four lines, OFF
 
 
-def test_mode_2_answers_the_elements_of_the_log_field_for_field(kernel):
+def test_mode_2_answers_the_elements_of_the_log_field_for_field(kernel) -> None:
     """Mode 2 makes its elements only when asked (issue 37, short blocks): each is the
     same, to the last bit, as the log's entry of that element (arcs of compensation,
     programmed radii and tangent variations included)."""

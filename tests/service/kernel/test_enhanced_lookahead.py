@@ -127,7 +127,7 @@ def machine_with_buffer(function: str):
     return CONFIG.model_copy(update={"channels": tuple(channels)})
 
 
-def test_the_default_machine_is_the_model_of_these_tests():
+def test_the_default_machine_is_the_model_of_these_tests() -> None:
     assert CYCLE_S == 0.001 and BUFFER == 120
     assert all((d.vel_max_mm_s, d.acc_max_mm_s2, d.vel_jump_mm_s) == (V, A, DV)
                for d in DYNAMICS)
@@ -140,7 +140,7 @@ def test_the_default_machine_is_the_model_of_these_tests():
 
 # ---------------------------------------------------- 1. micro chords reach the optimum
 
-def test_la_on_runs_1um_chords_of_a_small_circle_at_the_optimum(kernel):
+def test_la_on_runs_1um_chords_of_a_small_circle_at_the_optimum(kernel) -> None:
     program = circle_chords(1.0)  # 2 x 6283 chords of 1 um, F6000
     optimum = optimum_time_s(program.elements, axis_limits(CONFIG))
     end = program.elements[-1].end
@@ -166,7 +166,7 @@ def test_la_on_runs_1um_chords_of_a_small_circle_at_the_optimum(kernel):
 LONG_LINE = "LA_ON\nMETB={metb}\nN10 G1 X200 F12000\nLA_OFF\nN20 M30\n"
 
 
-def test_metb_splits_a_long_line_without_changing_its_time(kernel):
+def test_metb_splits_a_long_line_without_changing_its_time(kernel) -> None:
     # 200 mm at 200 mm/s: ramps of 200/5000 = 40 ms each side
     expected_s = trapezoid_s(200.0, 200.0, A)
     off = run_from_origin(kernel, "N10 G1 X200 F12000\nN20 M30\n")
@@ -190,7 +190,7 @@ def test_metb_splits_a_long_line_without_changing_its_time(kernel):
 
 
 @pytest.mark.parametrize("metb", [0.005, 0.01, 0.015])
-def test_metb_sub_blocks_lie_on_the_line_in_order(metb):
+def test_metb_sub_blocks_lie_on_the_line_in_order(metb) -> None:
     start, end = (0.0, 0.0, 0.0), (120.0, -90.0, 40.0)
     text = f"LA_ON\nMETB={metb}\nN10 G1 X120 Y-90 Z40 F12000\nLA_OFF\nM30\n"
     original = section_of(text)[0]
@@ -230,7 +230,7 @@ def test_metb_sub_blocks_lie_on_the_line_in_order(metb):
     assert [b.look_ahead.blocks_after for b in blocks] == list(range(len(blocks) - 1, -1, -1))
 
 
-def test_larger_metb_gives_fewer_sub_blocks():
+def test_larger_metb_gives_fewer_sub_blocks() -> None:
     counts = [len(plan(LONG_LINE.format(metb=metb)).blocks)
               for metb in (0.002, 0.005, 0.01, 0.02, 0.05)]
     assert counts == sorted(counts, reverse=True) and counts[0] > counts[-1] == 1
@@ -249,7 +249,7 @@ ARCS = {
 
 
 @pytest.mark.parametrize("case", ARCS, ids=list(ARCS))
-def test_arc_sub_blocks_lie_on_the_circle(kernel, case):
+def test_arc_sub_blocks_lie_on_the_circle(kernel, case) -> None:
     text, plane, center, radius, kind = ARCS[case]
     original = section_of(text)[0]
     assert original.motion.center_mm == pytest.approx(center)
@@ -288,19 +288,19 @@ def test_arc_sub_blocks_lie_on_the_circle(kernel, case):
     ("G1 X10 F600\nLA_ON\nG1 X20 METB=0.0005\nLA_OFF\nM30\n", 3, 8),  # inside a block
     ("LA_ON\nMETB=-0.5\nM30\n", 2, 1),
 ])
-def test_metb_not_above_the_cycle_time_is_an_error(text, line, column):
+def test_metb_not_above_the_cycle_time_is_an_error(text, line, column) -> None:
     with pytest.raises(NcError) as info:
         decode(text)
     e = info.value
     assert (e.id, e.line, e.column) == (NcErrorId.VALUE_OUT_OF_RANGE, line, column), str(e)
 
 
-def test_metb_just_above_the_cycle_time_is_accepted():
+def test_metb_just_above_the_cycle_time_is_accepted() -> None:
     mark = section_of("LA_ON\nMETB=0.0011\nG1 X10 F600\nLA_OFF\nM30\n")[0].look_ahead
     assert mark.metb_s == 0.0011
 
 
-def test_metb_error_stops_the_kernel_run_at_its_line(kernel):
+def test_metb_error_stops_the_kernel_run_at_its_line(kernel) -> None:
     run = run_from_origin(kernel, "G1 X10 F600\nLA_ON\nG1 X20 METB=0.001\nLA_OFF\nM30\n",
                           name="metb.nc")
     ch = run.channel
@@ -312,7 +312,7 @@ def test_metb_error_stops_the_kernel_run_at_its_line(kernel):
     assert run.positions_mm == pytest.approx((10.0, 0.0, 0.0), abs=EPS)  # N1 ran, N3 not
 
 
-def test_configured_metb_must_exceed_the_cycle_time():
+def test_configured_metb_must_exceed_the_cycle_time() -> None:
     raw = CONFIG.model_dump()
     raw["channels"][0]["la"]["metb_s"] = CONFIG.cycle_ms / 1000.0
     with pytest.raises(ValueError, match="METB"):
@@ -341,7 +341,7 @@ def corner_minima(run, corners) -> list[float]:
             for c in corners]
 
 
-def test_vfbt_lowers_the_speed_at_corners_of_the_section(kernel):
+def test_vfbt_lowers_the_speed_at_corners_of_the_section(kernel) -> None:
     body, corners = zigzag()
     limit = corner_limit((1, 0, 0), (0, 1, 0))  # every corner turns one axis fully
     assert limit == pytest.approx(20.0)
@@ -359,7 +359,7 @@ def test_vfbt_lowers_the_speed_at_corners_of_the_section(kernel):
     assert 0.4 <= results[0.5][1] / results[1.0][1] <= 0.65
 
 
-def test_vfbt_has_no_effect_outside_la_on(kernel):
+def test_vfbt_has_no_effect_outside_la_on(kernel) -> None:
     body, _ = zigzag()
     plain = run_from_origin(kernel, body + "M30\n")
     with_vfbt = run_from_origin(kernel, "VFBT=0.5\n" + body + "M30\n")
@@ -407,7 +407,7 @@ def _circle_crossings(c1, c2, r):
     return [(mx - h * uy, my + h * ux), (mx + h * uy, my - h * ux)]
 
 
-def test_keyhole_geometry_has_two_bottlenecks_the_ordinary_compensation_misses(kernel):
+def test_keyhole_geometry_has_two_bottlenecks_the_ordinary_compensation_misses(kernel) -> None:
     assert TOOLS[2] == R_TOOL
     assert 23 - 20 < 2 * R_TOOL < 33 - 10  # the neck is too narrow, the chamber is not
     # outside corners get an arc of r about the corner, clockwise (right turns, G41);
@@ -438,7 +438,7 @@ def test_keyhole_geometry_has_two_bottlenecks_the_ordinary_compensation_misses(k
     (5, 30, "(21.5000, -7.0000)", "N80"),
 ])
 def test_bbtrc_finds_the_bottleneck_and_stops_before_it(kernel, bbtrc, named, crossing,
-                                                        with_block):
+                                                        with_block) -> None:
     head = "LA_ON\n" + (f"BBTRC={bbtrc}\n" if bbtrc else "")
     text = head + KEYHOLE + "LA_OFF\nM30\n"
     result = plan(text)
@@ -468,7 +468,7 @@ def test_bbtrc_finds_the_bottleneck_and_stops_before_it(kernel, bbtrc, named, cr
 
 
 @pytest.mark.parametrize("bbtrc", [1, 4])
-def test_bbtrc_too_short_to_reach_the_crossing_runs_the_program(kernel, bbtrc):
+def test_bbtrc_too_short_to_reach_the_crossing_runs_the_program(kernel, bbtrc) -> None:
     text = f"LA_ON\nBBTRC={bbtrc}\n" + KEYHOLE + "LA_OFF\nM30\n"
     assert plan(text).error is None
     run = run_from_origin(kernel, text)
@@ -476,7 +476,7 @@ def test_bbtrc_too_short_to_reach_the_crossing_runs_the_program(kernel, bbtrc):
     assert run.channel.block_count == 11  # compensated blocks are never split
 
 
-def test_bbtrc_ignores_moves_without_compensation():
+def test_bbtrc_ignores_moves_without_compensation() -> None:
     # after G40 the rapid at Z10 crosses the contour's offset line x = 17.5 (N20) in the
     # plane: not the compensated path, no bottleneck
     text = ("LA_ON\nN10 G41 D2 G1 X20 Y0 F3000\nN20 Y20\nN30 X0\nN40 G40 X-5 Y10\n"
@@ -490,7 +490,7 @@ def test_bbtrc_ignores_moves_without_compensation():
     assert plan(text).error is None
 
 
-def test_rapid_over_a_compensated_contour_runs_in_the_kernel(kernel):
+def test_rapid_over_a_compensated_contour_runs_in_the_kernel(kernel) -> None:
     text = ("LA_ON\nN10 G41 D2 G1 X20 Y0 F3000\nN20 Y20\nN30 X0\nN40 G40 X-5 Y10\n"
             "N50 G0 Z10\nN60 X30 Y10\nLA_OFF\nM30\n")
     assert_finished_at(run_from_origin(kernel, text), (30.0, 10.0, 10.0))
@@ -498,7 +498,7 @@ def test_rapid_over_a_compensated_contour_runs_in_the_kernel(kernel):
 
 # ------------------------------------------------------------ 7. a stop ends the section
 
-def test_dwell_ends_the_section_and_the_path_stops_there(kernel):
+def test_dwell_ends_the_section_and_the_path_stops_there(kernel) -> None:
     text = "LA_ON\nN10 G1 X50 F6000\nN20 G4 X0.1\nN30 G1 X100\nLA_OFF\nN40 M30\n"
     # the SDA hands over the section when the dwell block arrives, the rest after it
     planned = []
@@ -521,7 +521,7 @@ def test_dwell_ends_the_section_and_the_path_stops_there(kernel):
     assert abs(run.channel.program_time_s - expected) <= 4 * CYCLE_S
 
 
-def test_m0_inside_a_section_stops_and_start_continues(kernel):
+def test_m0_inside_a_section_stops_and_start_continues(kernel) -> None:
     kernel.command(ResetChannel(0, True))
     kernel.mdi("G90 G40 G0 X0 Y0 Z0")
     kernel.start("LA_ON\nG1 X50 F12000\nM0\nX100\nLA_OFF\nM30\n", record=True)
@@ -556,7 +556,7 @@ def assert_within_limits(run, speed_limit: float) -> None:
     assert float(np.max(np.abs(np.diff(v)))) <= A * CYCLE_S * (1 + 1e-6)
 
 
-def test_feed_override_halves_the_speed_of_a_section(kernel):
+def test_feed_override_halves_the_speed_of_a_section(kernel) -> None:
     text = fine_line()
     full = run_from_origin(kernel, text)
     assert_finished_at(full, (100.0, 0.0, 0.0))
@@ -572,7 +572,7 @@ def test_feed_override_halves_the_speed_of_a_section(kernel):
     assert 1.9 <= ratio <= 2.05, ratio
 
 
-def test_feed_override_changed_at_full_speed_stays_within_limits(kernel):
+def test_feed_override_changed_at_full_speed_stays_within_limits(kernel) -> None:
     kernel.command(ResetChannel(0, True))
     kernel.mdi("G90 G40 G0 X0 Y0 Z0")
     kernel.start(fine_line(), record=True)
@@ -585,7 +585,7 @@ def test_feed_override_changed_at_full_speed_stays_within_limits(kernel):
     assert_within_limits(run, 200.0)
 
 
-def test_single_block_stops_at_every_sub_block_end(kernel):
+def test_single_block_stops_at_every_sub_block_end(kernel) -> None:
     text = LONG_LINE.format(metb=0.01)
     ends = [b.motion.end_mm[0] for b in plan(text).blocks]
     assert ends == pytest.approx([0.25, 1.0, 2.25, 197.75, 199.0, 199.75, 200.0])
@@ -614,7 +614,7 @@ G41_THEN_LA_ON = ("N10 G41 D2 G1 X100 Y0 F12000\nLA_ON\nN20 X150\nN30 Y100\nN40 
                   "LA_OFF\nN50 G40 Y0\nN60 M30\n")
 
 
-def test_la_on_while_compensation_holds_a_block_passes_unplanned(kernel):
+def test_la_on_while_compensation_holds_a_block_passes_unplanned(kernel) -> None:
     calls = []
     collector = SectionCollector(lambda blocks: calls.append(blocks) or plan_section(
         blocks, DYNAMICS, buffer_blocks=BUFFER, cycle_s=CYCLE_S))
@@ -652,7 +652,7 @@ def duplicated_chords(count: int = 3000) -> str:
     return "\n".join(lines) + "\n"
 
 
-def test_zero_length_blocks_in_a_section_keep_the_path_within_its_limits(kernel):
+def test_zero_length_blocks_in_a_section_keep_the_path_within_its_limits(kernel) -> None:
     body = duplicated_chords()
     on = run_from_origin(kernel, "LA_ON\n" + body + "LA_OFF\nM30\n")
     off = run_from_origin(kernel, body + "M30\n")
@@ -665,7 +665,7 @@ def test_zero_length_blocks_in_a_section_keep_the_path_within_its_limits(kernel)
     assert float(np.max(speeds(on))) <= 0.001 * (BUFFER - 1) / 3 / CYCLE_S * (1 + EPS)
 
 
-def test_bare_blocks_filling_the_buffer_make_the_section_stop():
+def test_bare_blocks_filling_the_buffer_make_the_section_stop() -> None:
     # a 30-block buffer: 40 zero-length blocks after N10 leave nothing to move behind it
     text = "LA_ON\nN10 G1 X50 F6000\n" + "X50\n" * 40 + "N20 X100\nLA_OFF\nM30\n"
 
@@ -683,7 +683,7 @@ def test_bare_blocks_filling_the_buffer_make_the_section_stop():
     assert np.any(pos == 50.0) and np.all(v[pos == 50.0] <= 1e-9)  # stopped at N10's end
 
 
-def test_compensated_chords_keep_the_path_within_its_limits(kernel):
+def test_compensated_chords_keep_the_path_within_its_limits(kernel) -> None:
     # G41 holds the last compensated block back: one buffer slot has no segment yet
     lines = [f"X{k * 0.001:.3f}" for k in range(1, 3001)]
     lines[0] = f"G41 D1 G1 {lines[0]} F12000"

@@ -71,7 +71,7 @@ FINISHING = {
 
 
 @pytest.mark.parametrize("case", FINISHING, ids=list(FINISHING))
-def test_program_finishes_where_and_when_expected(kernel, case):
+def test_program_finishes_where_and_when_expected(kernel, case) -> None:
     text, final, time_s, stops = FINISHING[case]
     run = kernel.run(text)
     ch = run.channel
@@ -102,7 +102,7 @@ FAILING = {
 
 
 @pytest.mark.parametrize("case", FAILING, ids=list(FAILING))
-def test_wrong_program_stops_with_a_precise_error(kernel, case):
+def test_wrong_program_stops_with_a_precise_error(kernel, case) -> None:
     text, line, column, final_x = FAILING[case]
     run = kernel.run(text, name="bad.nc")
     ch = run.channel
@@ -121,7 +121,7 @@ def test_wrong_program_stops_with_a_precise_error(kernel, case):
     assert kernel.kernel.snapshot.channels[0].errors == ()
 
 
-def test_same_program_twice_gives_the_same_cycles(kernel):
+def test_same_program_twice_gives_the_same_cycles(kernel) -> None:
     text = "G1 X20 Y10 F3000\nG2 X40 Y10 I10 J0\nG1 Y-10\nG3 X20 Y-10 R10\nG0 X0 Y0\nM30\n"
     def moving(samples: list) -> list:
         """The positions from the cycle before the first that moves to the first that
@@ -142,7 +142,7 @@ def test_same_program_twice_gives_the_same_cycles(kernel):
     assert moving(first) == moving(second)
 
 
-def test_axis_speed_and_acceleration_stay_within_limits_inside_blocks(kernel):
+def test_axis_speed_and_acceleration_stay_within_limits_inside_blocks(kernel) -> None:
     text = (
         "G1 X30 Y10 F12000\nG2 X50 Y30 I0 J20\nG1 X50 Y60\nG3 X30 Y80 I-20 J0\n"
         "G1 X-20 Y40 Z5\nG0 X0 Y0 Z0\nM30\n"
@@ -160,7 +160,7 @@ def test_axis_speed_and_acceleration_stay_within_limits_inside_blocks(kernel):
             assert abs(v2 - v1) / CYCLE_S <= A * (1 + 1e-6) + 1e-6, (k, axis, v1, v2)
 
 
-def test_arc_samples_lie_on_the_circle(kernel):
+def test_arc_samples_lie_on_the_circle(kernel) -> None:
     run = kernel.run("G0 X20 Y0\nG3 X-20 Y0 I-20 J0 F6000\nG3 X20 Y0 R20\nM30\n", record=True)
     on_arc = [s.positions_mm for s in run.samples if s.block_count >= 1 and s.state == 4]
     assert len(on_arc) > 50
@@ -170,7 +170,7 @@ def test_arc_samples_lie_on_the_circle(kernel):
         assert math.hypot(x, y) == pytest.approx(20.0, abs=1e-6)
 
 
-def test_feedhold_stops_within_limits_and_resume_finishes(kernel):
+def test_feedhold_stops_within_limits_and_resume_finishes(kernel) -> None:
     kernel.start("G1 X200 F12000\nM30\n", record=True)
     kernel.wait_for(lambda s: s.channels[0].path_velocity_mm_s >= 199.0)
     assert kernel.command(Feedhold(0, True)) is None
@@ -185,7 +185,7 @@ def test_feedhold_stops_within_limits_and_resume_finishes(kernel):
     assert all(abs(b - a) <= A * CYCLE_S * (1 + 1e-6) for a, b in zip(v, v[1:]))
 
 
-def test_single_block_stops_after_each_block(kernel):
+def test_single_block_stops_after_each_block(kernel) -> None:
     assert kernel.command(SetSingleBlock(0, True)) is None
     try:
         kernel.start("G1 X10 F6000\nX20\nX30\nM30\n")
@@ -203,7 +203,7 @@ def test_single_block_stops_after_each_block(kernel):
         kernel.command(SetSingleBlock(0, False))
 
 
-def test_m0_waits_for_start(kernel):
+def test_m0_waits_for_start(kernel) -> None:
     kernel.start("G1 X10 F6000\nM0\nG1 X20\nM30\n")
     snap = kernel.wait_for(lambda s: s.channels[0].waiting_for_start)
     assert snap.channels[0].axes[0].position_mm == pytest.approx(10.0, abs=1e-9)
@@ -211,14 +211,14 @@ def test_m0_waits_for_start(kernel):
     assert kernel.wait().positions_mm[0] == pytest.approx(20.0, abs=1e-9)
 
 
-def test_manual_block_runs_in_mdi(kernel):
+def test_manual_block_runs_in_mdi(kernel) -> None:
     run = kernel.mdi("G1 X5 Y5 F600")
     assert run.channel.mode == ChannelMode.MDI
     assert run.channel.state == ChannelState.READY
     assert run.positions_mm[:2] == pytest.approx((5, 5), abs=1e-9)
 
 
-def test_extended_manual_blocks_continue_one_program(kernel):
+def test_extended_manual_blocks_continue_one_program(kernel) -> None:
     assert kernel.command(SetExecutionMode(0, 0x80)) is None
     try:
         done = kernel.kernel.snapshot.channels[0].manual_blocks_done
@@ -239,7 +239,7 @@ def test_extended_manual_blocks_continue_one_program(kernel):
         kernel.command(SetExecutionMode(0, 0))
 
 
-def test_commands_not_allowed_in_the_state_are_refused(kernel):
+def test_commands_not_allowed_in_the_state_are_refused(kernel) -> None:
     refusal = kernel.command(StartProgram(0, True))  # MDI/READY after the fixture: nothing selected
     assert refusal is not None and refusal.reason == RefusalReason.NOT_READY
     assert "AUTOMATIC/READY" in refusal.message
@@ -255,7 +255,7 @@ def test_commands_not_allowed_in_the_state_are_refused(kernel):
     assert kernel.kernel.snapshot.channels[0].state == ChannelState.READY
 
 
-def test_tool_radius_compensation_offsets_the_square(kernel):
+def test_tool_radius_compensation_offsets_the_square(kernel) -> None:
     """G41 with D3 (r = 5 mm) around a 40 mm square, clockwise: the tool runs 5 mm outside."""
     text = (
         "G0 X-20 Y-20\nG41 D3 G1 X0 Y0 F3000\nG1 Y40\nX40\nY0\nX0\nG40 G1 X-20 Y-20\nM30\n"

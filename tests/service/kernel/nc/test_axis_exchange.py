@@ -33,7 +33,7 @@ def exchanges(text: str, **kw) -> list[AxisExchange]:
 # ---------------------------------------------------------------- release
 
 
-def test_release_by_name_gives_a_stopping_block_without_motion():
+def test_release_by_name_gives_a_stopping_block_without_motion() -> None:
     program = "G1 X1 Y2 Z3 F600\nN20 #AX RELEASE [Y]\nX5 Z4\nM30"
     for text in (program, slow(program)):
         d = decoder(text)
@@ -52,39 +52,39 @@ def test_release_by_name_gives_a_stopping_block_without_motion():
         assert d.modal.released_axes == frozenset({1})
 
 
-def test_needs_stop_for_an_axis_exchange():
+def test_needs_stop_for_an_axis_exchange() -> None:
     src = SourceRef("f.nc", 1)
     assert Block(src, axis_exchange=AxisExchange(REQUEST, (0,))).needs_stop
     assert not Block(src).needs_stop
 
 
-def test_keywords_and_names_are_case_insensitive_and_keep_the_programmed_order():
+def test_keywords_and_names_are_case_insensitive_and_keep_the_programmed_order() -> None:
     assert exchanges("#ax Release [ z , x ]\nM30") == [AxisExchange(RELEASE, (2, 0))]
 
 
-def test_release_by_number_with_expressions():
+def test_release_by_number_with_expressions() -> None:
     program = "#VAR\nV.L.N = 1\n#ENDVAR\n#AX RELEASE NBR [V.L.N + 2, V.L.N]\nM30"
     assert exchanges(program) == [AxisExchange(RELEASE, (2, 0))]
 
 
-def test_release_by_configured_axis_numbers():
+def test_release_by_configured_axis_numbers() -> None:
     d = decoder("#AX RELEASE NBR [2 * 3]\nM30", axis_numbers=(5, 6, 7))
     blocks = list(d.blocks())
     assert blocks[0].axis_exchange == AxisExchange(RELEASE, (1,))
     assert d.modal.released_axes == frozenset({1})
 
 
-def test_release_all_moves_the_axes_still_in_the_channel():
+def test_release_all_moves_the_axes_still_in_the_channel() -> None:
     program = "#AX RELEASE [Y]\n#AX RELEASE ALL\nM30"
     assert exchanges(program) == [AxisExchange(RELEASE, (1,)), AxisExchange(RELEASE, (0, 2))]
 
 
-def test_duplicates_are_dropped():
+def test_duplicates_are_dropped() -> None:
     assert exchanges("#AX RELEASE [X, Y, X]\nM30") == [AxisExchange(RELEASE, (0, 1))]
     assert exchanges("#AX RELEASE NBR [3, 3]\nM30") == [AxisExchange(RELEASE, (2,))]
 
 
-def test_release_of_an_axis_not_in_the_channel_gives_nothing():
+def test_release_of_an_axis_not_in_the_channel_gives_nothing() -> None:
     d = decoder("#AX RELEASE [Y]\nN10 #AX RELEASE [Y]\n#AX RELEASE [W, Y]\n"
                 "#AX RELEASE NBR [9]\nG1 X1 F100\nM30")
     blocks = list(d.blocks())
@@ -109,13 +109,13 @@ def test_release_of_an_axis_not_in_the_channel_gives_nothing():
         ("#AX RELEASE [X]\nG19 G0 Y1\nG18 G2 Z2 K1 F100", 3, 5, "X"),  # G18 needs X
     ],
 )
-def test_programming_a_released_axis_is_an_error(program, line, column, axis):
+def test_programming_a_released_axis_is_an_error(program, line, column, axis) -> None:
     e = error_of(program + "\nM30")
     assert (e.id, e.line, e.column) == (NcErrorId.AXIS_RELEASED, line, column)
     assert e.message.startswith(f"axis {axis} is not in the channel (released by #AX RELEASE)")
 
 
-def test_the_other_axes_work_while_one_is_released():
+def test_the_other_axes_work_while_one_is_released() -> None:
     program = "G1 X1 Y2 F600\n#AX RELEASE [Y]\nG18 G2 X3 I1\nG0 Z5\nM30"
     for text in (program, slow(program)):
         blocks = decode(text)
@@ -125,12 +125,12 @@ def test_the_other_axes_work_while_one_is_released():
         assert blocks[3].motion.end_mm == (3.0, 2.0, 5.0)
 
 
-def test_the_time_of_g4_is_no_axis_word():
+def test_the_time_of_g4_is_no_axis_word() -> None:
     blocks = decode("#AX RELEASE [X]\nG4 X2\nM30")
     assert blocks[1].dwell_s == 2.0 and blocks[1].motion is None
 
 
-def test_a_release_in_a_subprogram_stays_after_it():
+def test_a_release_in_a_subprogram_stays_after_it() -> None:
     files = {"rel.nc": "#AX RELEASE [Y]\nM17\n"}
     e = error_of("L rel.nc\nG1 Y1 F100\nM30", files=files)
     assert (e.id, e.file, e.line, e.column, e.message) == (
@@ -140,7 +140,7 @@ def test_a_release_in_a_subprogram_stays_after_it():
 # ---------------------------------------------------------------- request
 
 
-def test_request_brings_the_axis_back():
+def test_request_brings_the_axis_back() -> None:
     program = "G1 X1 Y2 F600\n#AX RELEASE [Y]\nX3\nN40 #AX REQUEST [Y, 2, 1]\nY5\nM30"
     for text in (program, slow(program)):
         d = decoder(text)
@@ -154,14 +154,14 @@ def test_request_brings_the_axis_back():
         assert d.modal.released_axes == frozenset()
 
 
-def test_request_with_expressions_and_several_axes():
+def test_request_with_expressions_and_several_axes() -> None:
     d = decoder("#AX RELEASE ALL\n#AX REQUEST [z, 1 + 2, 4 / 2] [X, 1, 0] [X, 1, 0]\nM30")
     blocks = list(d.blocks())
     assert blocks[1].axis_exchange == AxisExchange(REQUEST, (2, 0))
     assert d.modal.released_axes == frozenset({1})
 
 
-def test_request_by_configured_axis_numbers():
+def test_request_by_configured_axis_numbers() -> None:
     program = "#AX RELEASE NBR [12]\n#AX REQUEST [Y, 12, 1]\nG0 Y1\nM30"
     blocks = decode(program, axis_numbers=(11, 12, 13))
     assert [b.axis_exchange for b in blocks[:2]] == [AxisExchange(RELEASE, (1,)),
@@ -169,7 +169,7 @@ def test_request_by_configured_axis_numbers():
     assert blocks[2].motion.end_mm == (0.0, 1.0, 0.0)
 
 
-def test_request_of_an_axis_in_the_channel_gives_nothing():
+def test_request_of_an_axis_in_the_channel_gives_nothing() -> None:
     blocks = decode("#AX REQUEST [X, 1, 0]\nG0 X1\nM30")
     assert [b.axis_exchange for b in blocks] == [None, None]
     assert blocks[0].motion.end_mm == (1.0, 0.0, 0.0)
@@ -195,13 +195,13 @@ def test_request_of_an_axis_in_the_channel_gives_nothing():
         ('#AX RELEASE NBR ["X"]', NcErrorId.TYPE_MISMATCH, 18, "string"),
     ],
 )
-def test_request_errors(program, err, column, text):
+def test_request_errors(program, err, column, text) -> None:
     e = error_of("#AX RELEASE [Y]\n" + program + "\nM30")
     assert (e.id, e.line, e.column) == (err, 2, column)
     assert text in e.message
 
 
-def test_a_failed_request_changes_nothing():
+def test_a_failed_request_changes_nothing() -> None:
     d = decoder("#AX RELEASE [X, Y]\n#AX REQUEST [X, 1, 0] [Y, 9, 1]\nM30")
     with pytest.raises(NcError) as info:
         list(d.blocks())
@@ -230,18 +230,18 @@ def test_a_failed_request_changes_nothing():
         ("#AX REQUEST X, 1, 0", NcErrorId.EXPRESSION_SYNTAX, 13),
     ],
 )
-def test_syntax_errors(program, err, column):
+def test_syntax_errors(program, err, column) -> None:
     e = error_of("G0 X0\n" + program + "\nM30")
     assert (e.id, e.line, e.column) == (err, 2, column)
 
 
-def test_number_and_label_may_precede_the_command():
+def test_number_and_label_may_precede_the_command() -> None:
     blocks = decode("N10 [START] #AX RELEASE [X]\nM30")
     assert blocks[0].axis_exchange == AxisExchange(RELEASE, (0,))
     assert blocks[0].number == 10
 
 
-def test_check_syntax_reports_misplaced_commands():
+def test_check_syntax_reports_misplaced_commands() -> None:
     errors = check_syntax("#AX RELEASE [X]\nG1 X1 #AX REQUEST [X, 1, 0]\n#AX RELEASE [Y] Y1\n",
                           "p.nc", axes=AXES)
     assert [(e.id, e.line, e.column) for e in errors] == [
@@ -251,7 +251,7 @@ def test_check_syntax_reports_misplaced_commands():
 # ---------------------------------------------------------------- program start, MDI
 
 
-def test_manual_blocks_keep_the_released_axes():
+def test_manual_blocks_keep_the_released_axes() -> None:
     modal = ModalState()
     first = decode("#AX RELEASE [Y]", modal=modal, manual=True)
     assert first[0].axis_exchange == AxisExchange(RELEASE, (1,)) and first[0].manual
@@ -264,7 +264,7 @@ def test_manual_blocks_keep_the_released_axes():
     assert blocks[1].motion.end_mm == (4.0, 1.0, 0.0)
 
 
-def test_a_program_start_gives_all_axes_back():
+def test_a_program_start_gives_all_axes_back() -> None:
     modal = ModalState()
     decode("#AX RELEASE ALL", modal=modal, manual=True)
     assert modal.released_axes == frozenset({0, 1, 2})
@@ -273,7 +273,7 @@ def test_a_program_start_gives_all_axes_back():
     assert modal.released_axes == frozenset()
 
 
-def test_a_fresh_decoder_has_all_axes():
+def test_a_fresh_decoder_has_all_axes() -> None:
     d = decoder("#AX RELEASE [Z]\nM30")
     list(d.blocks())
     assert d.modal.released_axes == frozenset({2})
@@ -282,17 +282,17 @@ def test_a_fresh_decoder_has_all_axes():
 
 
 @pytest.mark.parametrize("numbers", [(1, 2), (1, 2, 2), (0, 1, 2), (1, 2, 3.0)])
-def test_invalid_axis_numbers(numbers):
+def test_invalid_axis_numbers(numbers) -> None:
     with pytest.raises(ValueError):
         decoder("M30", axis_numbers=numbers)
 
 
-def test_released_axes_must_belong_to_the_channel():
+def test_released_axes_must_belong_to_the_channel() -> None:
     with pytest.raises(ValueError):
         decoder("G0 X1", modal=ModalState(released_axes=frozenset({3})), manual=True)
 
 
-def test_hot_and_general_path_agree_around_an_exchange():
+def test_hot_and_general_path_agree_around_an_exchange() -> None:
     lines = ["G1 X0 Y0 Z0 F1200"]
     lines += [f"N{k} X{k} Y{k % 7} Z{k % 3}" for k in range(1, 30)]
     lines += ["#AX RELEASE [Z]"] + [f"X{k} Y{k % 5}" for k in range(30, 60)]

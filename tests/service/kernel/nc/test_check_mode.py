@@ -128,7 +128,7 @@ def without_offset(block: Block) -> Block:
 # ------------------------------------------------------------ the example program
 
 
-def test_example_program_of_the_function_description():
+def test_example_program_of_the_function_description() -> None:
     run = check_run(SEED_EXAMPLE)
     assert run.check.found == [
         (20113, 5, C.LIMIT),  # N40 F1111111111111111 overflows
@@ -154,7 +154,7 @@ def test_example_program_of_the_function_description():
     assert run.ends() == [(10.0, 0.0, 0.0), (100.0, 0.0, 0.0)]
 
 
-def test_error_limit_of_the_caller_ends_decoding():
+def test_error_limit_of_the_caller_ends_decoding() -> None:
     check = Recorder(errors_total=3)
     decoder = Decoder(SEED_EXAMPLE, "prog.nc", axes=AXES, loader=loader_of(None),
                       tools=TOOLS, check=check)
@@ -170,7 +170,7 @@ def test_error_limit_of_the_caller_ends_decoding():
     assert not any(isinstance(b, Block) and b.source.line > 11 for b in items)
 
 
-def test_example_program_step_by_step_gives_the_same_errors():
+def test_example_program_step_by_step_gives_the_same_errors() -> None:
     run = check_run(SEED_EXAMPLE, line_by_line=True)
     assert [f[0] for f in run.check.found] == [20113, 20500, 20310, 20151, 20121]
     assert run.batches == [] and run.ended()
@@ -179,7 +179,7 @@ def test_example_program_step_by_step_gives_the_same_errors():
 # ------------------------------------------------------------ the responses per category
 
 
-def test_term_is_dropped_and_the_rest_of_the_line_used():
+def test_term_is_dropped_and_the_rest_of_the_line_used() -> None:
     run = check_run("G1 X10 Q5 Y3 F100\nG1 X20\nM30")
     assert run.check.found == [(int(E.UNKNOWN_WORD), 1, C.TERM)]
     assert run.check.errors[0][0].column == 8
@@ -190,14 +190,14 @@ def test_term_is_dropped_and_the_rest_of_the_line_used():
     assert run.ended()
 
 
-def test_unknown_g_and_missing_value_are_terms():
+def test_unknown_g_and_missing_value_are_terms() -> None:
     run = check_run("G0 X1 G99 Y2\nG0 X3 Y\nM30")
     assert run.check.found == [(int(E.UNSUPPORTED_G_CODE), 1, C.TERM),
                                (int(E.MISSING_VALUE), 2, C.TERM)]
     assert run.ends() == [(1.0, 2.0, 0.0), (3.0, 2.0, 0.0)]
 
 
-def test_error_inside_brackets_drops_the_whole_word():
+def test_error_inside_brackets_drops_the_whole_word() -> None:
     # the word X[...] is the term: Y5 and F100 behind it are used, no error cascade
     run = check_run("G1 X[1 +] Y5 F100\nG1 X[FOO[4]] Z2\nG1 X2\nM30")
     assert run.check.found == [(int(E.EXPRESSION_SYNTAX), 1, C.TERM),
@@ -206,13 +206,13 @@ def test_error_inside_brackets_drops_the_whole_word():
     assert run.blocks[0].motion.feed_mm_s * 60 == 100.0
 
 
-def test_unclosed_bracket_at_the_end_of_the_line_drops_only_its_word():
+def test_unclosed_bracket_at_the_end_of_the_line_drops_only_its_word() -> None:
     run = check_run("G1 X5 F100 Y[2*[3+1]\nM30")
     assert run.check.found == [(int(E.EXPRESSION_SYNTAX), 1, C.TERM)]
     assert run.ends() == [(5.0, 0.0, 0.0)]
 
 
-def test_assignment_with_bad_left_side_is_dropped_and_the_rest_runs():
+def test_assignment_with_bad_left_side_is_dropped_and_the_rest_runs() -> None:
     run = check_run("V.E.NOPE = 1 G0 X5\nV.L.NOPE = 2 G0 Y7\nM30")
     assert run.check.found == [(int(E.UNKNOWN_VARIABLE), 1, C.ASSIGNMENT),
                                (int(E.UNDECLARED_VARIABLE), 2, C.ASSIGNMENT)]
@@ -220,7 +220,7 @@ def test_assignment_with_bad_left_side_is_dropped_and_the_rest_runs():
     assert run.ends() == [(5.0, 0.0, 0.0), (5.0, 7.0, 0.0)]
 
 
-def test_assignment_with_bad_index_is_dropped_and_the_next_one_runs():
+def test_assignment_with_bad_index_is_dropped_and_the_next_one_runs() -> None:
     text = ("#VAR\nV.L.A[2] = [0, 0]\nV.L.B = 0\n#ENDVAR\n"
             "V.L.A[5] = 3 V.L.B = 4 G0 X1\nG0 X[V.L.B]\nM30")
     run = check_run(text)
@@ -228,14 +228,14 @@ def test_assignment_with_bad_index_is_dropped_and_the_next_one_runs():
     assert run.ends() == [(1.0, 0.0, 0.0), (4.0, 0.0, 0.0)]
 
 
-def test_error_in_the_right_side_of_an_assignment_drops_only_the_assignment():
+def test_error_in_the_right_side_of_an_assignment_drops_only_the_assignment() -> None:
     text = "#VAR\nV.L.A = 7\n#ENDVAR\nV.L.A = 1/0 G0 X[V.L.A]\nM30"
     run = check_run(text)
     assert run.check.found == [(int(E.DIVISION_BY_ZERO), 4, C.VALUE)]
     assert run.ends() == [(7.0, 0.0, 0.0)]
 
 
-def test_junk_after_an_axis_command_uses_the_command():
+def test_junk_after_an_axis_command_uses_the_command() -> None:
     run = check_run("G0 X1 Y1\n#AX RELEASE [Y] X10\nG0 X2\nM30")
     assert run.check.found == [(int(E.AXIS_COMMAND_NOT_ALONE), 2, C.AFTER_COMMAND)]
     assert run.check.errors[0][0].column == 17
@@ -246,7 +246,7 @@ def test_junk_after_an_axis_command_uses_the_command():
     assert run.ended()
 
 
-def test_junk_after_a_control_statement_uses_the_statement():
+def test_junk_after_a_control_statement_uses_the_statement() -> None:
     run = check_run("$IF 1 junk\nG0 X1\n$ENDIF junk\nG0 X2\n$IF 0 junk\nG0 X3\n$ENDIF\nM30")
     assert run.check.found == [(int(E.UNKNOWN_WORD), 1, C.AFTER_COMMAND),
                                (int(E.UNKNOWN_WORD), 3, C.AFTER_COMMAND),
@@ -255,7 +255,7 @@ def test_junk_after_a_control_statement_uses_the_statement():
     assert run.ended()
 
 
-def test_error_in_a_command_drops_the_line():
+def test_error_in_a_command_drops_the_line() -> None:
     run = check_run("N50 #COMMAND UNKNOWN [...] X5\nG0 X1\n#AX REQUEST [Y\nG0 Y2\nM30")
     assert run.check.found == [(int(E.INSTRUCTION_NOT_SUPPORTED), 1, C.COMMAND),
                                (int(E.EXPRESSION_SYNTAX), 3, C.COMMAND)]
@@ -263,7 +263,7 @@ def test_error_in_a_command_drops_the_line():
     assert all(b.axis_exchange is None for b in run.blocks)
 
 
-def test_combination_drops_the_second_word():
+def test_combination_drops_the_second_word() -> None:
     run = check_run("G0 X1 X2 Y3\nG1 G2 X4 F100\nM0 M30 X5\nG0 X6\nM30")
     assert run.check.found == [(int(E.WORD_REPEATED), 1, C.COMBINATION),
                                (int(E.CONFLICTING_G_CODES), 2, C.COMBINATION),
@@ -275,7 +275,7 @@ def test_combination_drops_the_second_word():
     assert run.ended()
 
 
-def test_value_errors_drop_the_word():
+def test_value_errors_drop_the_word() -> None:
     run = check_run("G1 X5 F-5 Y2\nG1 X7\nG0 X8 S-5 D9 Z1\nM30")
     assert sorted(run.check.found) == [(int(E.INVALID_FEED), 1, C.VALUE),
                                        (int(E.INVALID_SPINDLE_SPEED), 3, C.VALUE),
@@ -284,7 +284,7 @@ def test_value_errors_drop_the_word():
     assert run.ends() == [(5.0, 2.0, 0.0), (7.0, 2.0, 0.0), (8.0, 2.0, 1.0)]
 
 
-def test_value_error_inside_a_word_drops_that_word():
+def test_value_error_inside_a_word_drops_that_word() -> None:
     run = check_run("G1 X[1/0] Y5 F100\nG1 X2\nG1 X3 F[1/0]\nG1 X4\nM30")
     assert run.check.found == [(int(E.DIVISION_BY_ZERO), 1, C.VALUE),
                                (int(E.DIVISION_BY_ZERO), 3, C.VALUE)]
@@ -292,7 +292,7 @@ def test_value_error_inside_a_word_drops_that_word():
     assert run.blocks[0].motion.feed_mm_s * 60 == 100.0
 
 
-def test_limit_errors_drop_the_word():
+def test_limit_errors_drop_the_word() -> None:
     run = check_run("G1 X10 F1111111111111111 Y2\nG1 X3\n/12 G0 X9\nG0 Z4\nM30")
     assert run.check.found == [(int(E.VALUE_OUT_OF_RANGE), 1, C.LIMIT),
                                (int(E.INVALID_SKIP_LEVEL), 3, C.LIMIT)]
@@ -301,14 +301,14 @@ def test_limit_errors_drop_the_word():
     assert run.ended()
 
 
-def test_missing_feed_is_reported_once():
+def test_missing_feed_is_reported_once() -> None:
     run = check_run("G1 X1\nG1 X2\nG1 X3 Y1\nG2 X5 Y3 I2\nM30")
     assert run.check.found == [(int(E.NO_FEED), 1, C.INCOMPLETE)]
     assert run.ends() == [(1.0, 0.0, 0.0), (2.0, 0.0, 0.0), (3.0, 1.0, 0.0), (5.0, 3.0, 0.0)]
     assert run.ended()
 
 
-def test_missing_file_drops_the_call_and_decoding_goes_on():
+def test_missing_file_drops_the_call_and_decoding_goes_on() -> None:
     run = check_run("L nofile\nG0 X4\nLL nosub\nG0 X5\nM30")
     assert run.check.found == [(int(E.FILE_NOT_FOUND), 1, C.RESOURCE),
                                (int(E.SUBPROGRAM_NOT_FOUND), 3, C.RESOURCE)]
@@ -316,7 +316,7 @@ def test_missing_file_drops_the_call_and_decoding_goes_on():
     assert len(run.decoder.frames) == 1 and run.ended()
 
 
-def test_failing_call_keeps_the_motion_of_its_line():
+def test_failing_call_keeps_the_motion_of_its_line() -> None:
     # the words ran (the position moved to X3): their Block is not lost
     run = check_run("G0 X3 L nofile\nG1 Y4 F100\nG0 X6 $GOTO N99\nM30")
     assert run.check.found == [(int(E.FILE_NOT_FOUND), 1, C.RESOURCE),
@@ -324,21 +324,21 @@ def test_failing_call_keeps_the_motion_of_its_line():
     assert run.ends() == [(3.0, 0.0, 0.0), (3.0, 4.0, 0.0), (6.0, 4.0, 0.0)]
 
 
-def test_errors_in_a_subprogram_name_the_subprogram():
+def test_errors_in_a_subprogram_name_the_subprogram() -> None:
     files = {"sub.nc": "G0 X1 Q2\nG0 X2 Y3\nM17"}
     run = check_run("L sub.nc\nG0 X9\nM30", files=files)
     assert [(e.file, e.line, cat) for e, cat in run.check.errors] == [("sub.nc", 1, C.TERM)]
     assert run.ends() == [(1.0, 0.0, 0.0), (2.0, 3.0, 0.0), (9.0, 3.0, 0.0)]
 
 
-def test_subprogram_end_in_the_main_program_keeps_the_block():
+def test_subprogram_end_in_the_main_program_keeps_the_block() -> None:
     run = check_run("G0 X1 M17\nG0 X9\nM30")
     assert run.check.found == [(int(E.SUBPROGRAM_END_IN_MAIN), 1, C.COMBINATION)]
     assert run.ends() == [(1.0, 0.0, 0.0), (9.0, 0.0, 0.0)]
     assert run.ended()
 
 
-def test_arc_error_stays_in_its_line():
+def test_arc_error_stays_in_its_line() -> None:
     run = check_run("G1 X10 F100\nG2 X20 Y0 I3 J4\nG1 Y5\nM30")
     assert run.check.found[0] == (int(E.ARC_RADIUS_DIFFERENCE), 2, C.VALUE)
     assert {line for _, line, _ in run.check.found} == {2}  # nothing after line 2
@@ -349,7 +349,7 @@ def test_arc_error_stays_in_its_line():
 # ------------------------------------------------------------ errors per block
 
 
-def test_errors_per_block_limits_the_errors_of_a_line():
+def test_errors_per_block_limits_the_errors_of_a_line() -> None:
     text = "G0 X1 Q1 Q2 Q3 Y4\nG0 X2\nM30"
     limited = check_run(text, errors_per_block=2)
     assert limited.check.found == [(int(E.UNKNOWN_WORD), 1, C.TERM)] * 2
@@ -363,7 +363,7 @@ def test_errors_per_block_limits_the_errors_of_a_line():
     assert unlimited.ends() == [(1.0, 4.0, 0.0), (2.0, 4.0, 0.0)]
 
 
-def test_errors_per_block_counts_parse_and_execution_errors_together():
+def test_errors_per_block_counts_parse_and_execution_errors_together() -> None:
     text = "G0 Q1 X1 G1 Y3 S-5\nG0 X2\nM30"
     limited = check_run(text, errors_per_block=2)
     assert limited.check.found == [(int(E.UNKNOWN_WORD), 1, C.TERM),
@@ -378,20 +378,20 @@ def test_errors_per_block_counts_parse_and_execution_errors_together():
     assert four.ends() == [(1.0, 3.0, 0.0), (2.0, 3.0, 0.0)]
 
 
-def test_one_error_per_block_drops_the_line_at_the_first_error():
+def test_one_error_per_block_drops_the_line_at_the_first_error() -> None:
     run = check_run("G0 X1 G1 Y2\nG0 X3\nM30", errors_per_block=1)
     assert run.check.found == [(int(E.CONFLICTING_G_CODES), 1, C.COMBINATION)]
     assert run.ends() == [(3.0, 0.0, 0.0)]
 
 
-def test_one_error_per_block_drops_a_command_with_junk_after_it():
+def test_one_error_per_block_drops_a_command_with_junk_after_it() -> None:
     run = check_run("#AX RELEASE [Y] X10\nG0 Y2\nM30", errors_per_block=1)
     assert run.check.found == [(int(E.AXIS_COMMAND_NOT_ALONE), 1, C.AFTER_COMMAND)]
     assert run.decoder.modal.released_axes == frozenset()
     assert run.ends() == [(0.0, 2.0, 0.0)]
 
 
-def test_one_error_per_block_drops_the_call_of_the_line():
+def test_one_error_per_block_drops_the_call_of_the_line() -> None:
     files = {"sub.nc": "G0 Z7\nM17"}
     run = check_run("G0 G1 X1 L sub.nc\nG0 X3\nM30", errors_per_block=1, files=files)
     assert run.check.found == [(int(E.CONFLICTING_G_CODES), 1, C.COMBINATION)]
@@ -401,7 +401,7 @@ def test_one_error_per_block_drops_the_call_of_the_line():
 # ------------------------------------------------------------ control statements
 
 
-def test_failing_if_condition_skips_the_whole_if_block():
+def test_failing_if_condition_skips_the_whole_if_block() -> None:
     text = ("$IF V.L.NOPE == 1\nG0 X1\n$ELSE\nG0 X2\n$ENDIF\nG0 X5\n"
             "$IF [1 +] == 2\nG0 Y1\n$ENDIF\nG0 Y5\nM30")
     run = check_run(text)
@@ -411,7 +411,7 @@ def test_failing_if_condition_skips_the_whole_if_block():
     assert run.ended()
 
 
-def test_failing_loop_and_switch_heads_skip_their_blocks():
+def test_failing_loop_and_switch_heads_skip_their_blocks() -> None:
     text = ("$WHILE V.L.NOPE < 3\nG0 X1\n$ENDWHILE\n"
             "$WHILE FOO[1]\nG0 X2\n$ENDWHILE\n"
             "$FOR V.L.NOPE = 0, 3, 1\nG0 X3\n$ENDFOR\n"
@@ -425,7 +425,7 @@ def test_failing_loop_and_switch_heads_skip_their_blocks():
     assert run.ended()
 
 
-def test_broken_elseif_or_case_skips_the_block_without_a_decoder_fault():
+def test_broken_elseif_or_case_skips_the_block_without_a_decoder_fault() -> None:
     text = ("$IF 0\nG0 X1\n$ELSEIF [1 +\nG0 X2\n$ELSE\nG0 X3\n$ENDIF\n"
             "$IF 1\nG0 Y1\n$ELSEIF [1 +\nG0 Y2\n$ENDIF\n"
             "$SWITCH 2\n$CASE [1 +\nG0 Z1\n$BREAK\n$CASE 2\nG0 Z2\n$BREAK\n$ENDSWITCH\n"
@@ -439,7 +439,7 @@ def test_broken_elseif_or_case_skips_the_block_without_a_decoder_fault():
     assert run.ended()
 
 
-def test_failing_until_ends_its_loop():
+def test_failing_until_ends_its_loop() -> None:
     text = "$IF 1\n$REPEAT\nG0 X1\n$UNTIL V.L.NOPE == 1\n$ENDIF\nG0 X5\nM30"
     run = check_run(text)
     assert run.check.found == [(int(E.UNDECLARED_VARIABLE), 4, C.COMMAND)]
@@ -447,7 +447,7 @@ def test_failing_until_ends_its_loop():
     assert run.ended()
 
 
-def test_endif_without_if_is_reported_once():
+def test_endif_without_if_is_reported_once() -> None:
     run = check_run("G0 X1\n$ENDIF\nG0 X2\n$ENDFOR\nG0 X3\nM30")
     assert run.check.found == [(int(E.ENDIF_WITHOUT_IF), 2, C.COMMAND),
                                (int(E.LOOP_END_WITHOUT_BEGIN), 4, C.COMMAND)]
@@ -455,21 +455,21 @@ def test_endif_without_if_is_reported_once():
     assert run.ended()
 
 
-def test_missing_program_end_is_reported_and_decoding_ends():
+def test_missing_program_end_is_reported_and_decoding_ends() -> None:
     run = check_run("G0 X1\nG0 X2\n")
     assert run.check.found == [(int(E.MISSING_PROGRAM_END), 2, C.INCOMPLETE)]
     assert run.ends() == [(1.0, 0.0, 0.0), (2.0, 0.0, 0.0)]
     assert not run.ended() and run.decoder.finished
 
 
-def test_unclosed_if_and_missing_end_are_both_reported():
+def test_unclosed_if_and_missing_end_are_both_reported() -> None:
     run = check_run("$IF 1\nG0 X1")
     assert run.check.found == [(int(E.BLOCK_NOT_CLOSED), 1, C.INCOMPLETE),
                                (int(E.MISSING_PROGRAM_END), 2, C.INCOMPLETE)]
     assert run.decoder.finished
 
 
-def test_endless_loop_is_reported_not_hung(monkeypatch):
+def test_endless_loop_is_reported_not_hung(monkeypatch) -> None:
     monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 1000)
     run = check_run("$WHILE 1\n; only a comment\n$ENDWHILE\nG0 X1\nM30", limit=20_000)
     # reported once, at the loop's line the decoder stands at; the check ends there
@@ -482,7 +482,7 @@ def test_endless_loop_is_reported_not_hung(monkeypatch):
 # ------------------------------------------------------------ assignments run once
 
 
-def test_assignments_before_an_error_run_once():
+def test_assignments_before_an_error_run_once() -> None:
     text = ("#VAR\nV.L.A = 0\n#ENDVAR\n"
             "V.L.A = V.L.A + 1 G0 G1 X1\n"
             "G0 X[V.L.A * 10]\nM30")
@@ -491,7 +491,7 @@ def test_assignments_before_an_error_run_once():
     assert run.ends() == [(1.0, 0.0, 0.0), (10.0, 0.0, 0.0)]
 
 
-def test_assignments_around_several_errors_run_once():
+def test_assignments_around_several_errors_run_once() -> None:
     text = ("#VAR\nV.L.A = 0\n#ENDVAR\n"
             "V.L.A = V.L.A + 1 G0 X1 Q1 V.L.A = V.L.A + 10 Y2 G1 S-1 V.L.A = V.L.A + 100\n"
             "G0 X[V.L.A]\nM30")
@@ -501,7 +501,7 @@ def test_assignments_around_several_errors_run_once():
     assert run.ends() == [(1.0, 2.0, 0.0), (111.0, 2.0, 0.0)]
 
 
-def test_assignment_in_a_loop_with_an_error_runs_once_per_pass():
+def test_assignment_in_a_loop_with_an_error_runs_once_per_pass() -> None:
     text = ("#VAR\nV.L.A = 0\nV.L.I = 0\n#ENDVAR\n"
             "$WHILE V.L.I < 3\n"
             "V.L.I = V.L.I + 1 V.L.A = V.L.A + 2 G0 G1 X[V.L.A]\n"
@@ -525,7 +525,7 @@ def _normal_points(text: str) -> list:
             for b in normal_blocks(text) if b.motion is not None]
 
 
-def test_point_batches_give_the_motions_of_a_normal_run():
+def test_point_batches_give_the_motions_of_a_normal_run() -> None:
     text = _bench_program()
     expected = _normal_points(text)
     run = check_run(text)
@@ -539,7 +539,7 @@ def test_point_batches_give_the_motions_of_a_normal_run():
     assert any(r[3] is None for r in records)  # straight lines without one
 
 
-def test_point_batches_chain_their_start_points():
+def test_point_batches_chain_their_start_points() -> None:
     text = _bench_program()
     run = check_run(text)
     position = (0.0, 0.0, 0.0)
@@ -557,7 +557,7 @@ def test_point_batches_chain_their_start_points():
             position = item.motion.end_mm
 
 
-def test_every_line_is_decoded_once_by_a_batch_or_by_line():
+def test_every_line_is_decoded_once_by_a_batch_or_by_line() -> None:
     text = _bench_program()
     run = check_run(text)
     spans = sorted([(b.first, b.stop) for b in run.batches]
@@ -569,7 +569,7 @@ def test_every_line_is_decoded_once_by_a_batch_or_by_line():
     assert {file for file, _, _ in run.check.lines} == {"prog.nc"}
 
 
-def test_line_by_line_sends_every_line_through_line():
+def test_line_by_line_sends_every_line_through_line() -> None:
     text = _bench_program(600)
     run = check_run(text, line_by_line=True)
     assert run.batches == []
@@ -580,7 +580,7 @@ def test_line_by_line_sends_every_line_through_line():
     assert run.check.errors == []
 
 
-def test_batches_are_bounded():
+def test_batches_are_bounded() -> None:
     from cnc_objects.service.kernel.nc.check import BATCH_LINES
 
     text = "G1 F100\n" + "\n".join(f"G1 X{k % 97}.5 Y{k % 13}" for k in range(5000)) + "\nM30"
@@ -590,7 +590,7 @@ def test_batches_are_bounded():
     assert len(run.ends()) == 5000
 
 
-def test_tool_radius_compensation_takes_the_general_path():
+def test_tool_radius_compensation_takes_the_general_path() -> None:
     text = "G1 X0 Y0 F100\nG41 D1\nG1 X10\nG1 Y10\nG40\nG1 X0\nG1 Y0\nM30"
     run = check_run(text)
     assert run.check.errors == []
@@ -635,7 +635,7 @@ M17
 """
 
 
-def test_clean_program_reports_no_errors():
+def test_clean_program_reports_no_errors() -> None:
     files = {"sub.nc": "G91 G1 X1 Y1\nG90\nM17\n"}
     run = check_run(CLEAN_PROGRAM, files=files)
     assert run.check.errors == []
@@ -645,7 +645,7 @@ def test_clean_program_reports_no_errors():
     assert run.ends()[-1] == (41.0, -9.0, -1.0)
 
 
-def test_clean_bench_program_reports_no_errors_line_by_line():
+def test_clean_bench_program_reports_no_errors_line_by_line() -> None:
     run = check_run(_bench_program(1000), line_by_line=True, errors_per_block=1)
     assert run.check.errors == [] and run.ended()
 
@@ -691,7 +691,7 @@ _CLEAN_ENDS = {b.source.line: b.motion.end_mm
 @given(program=junk_programs(), errors_per_block=st.integers(0, 3),
        line_by_line=st.booleans())
 def test_junk_in_one_line_is_reported_in_that_line_only(program, errors_per_block,
-                                                       line_by_line):
+                                                       line_by_line) -> None:
     text, junk_line = program
     run = check_run(text, errors_per_block=errors_per_block, line_by_line=line_by_line)
     lines = text.split("\n")
@@ -722,7 +722,7 @@ def _normal_outcome(text: str, files, limit: int = 300):
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(text=st.one_of(
     nc_text, plain_programs().map(lambda lines: "\n".join(["F1000", *lines, "M30"]))))
-def test_check_reports_first_what_a_normal_run_stops_at(monkeypatch, text):
+def test_check_reports_first_what_a_normal_run_stops_at(monkeypatch, text) -> None:
     """Up to the first error the check decodes what a normal run does; its first report
     is the error the normal run raises; a program without error reports nothing."""
     monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 200)
@@ -751,7 +751,7 @@ def test_check_reports_first_what_a_normal_run_stops_at(monkeypatch, text):
         assert check.errors == []
 
 
-def test_comment_end_without_begin_is_a_command_error():
+def test_comment_end_without_begin_is_a_command_error() -> None:
     run = check_run("G1 X1 F100\n#COMMENT END\nG1 X2\nM30\n")
     assert [(e.id, e.line, c) for e, c in run.check.errors] == [
         (NcErrorId.COMMENT_END_WITHOUT_BEGIN, 2, ErrorCategory.COMMAND)]

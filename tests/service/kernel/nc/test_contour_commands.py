@@ -92,11 +92,11 @@ def program(*parts: str) -> str:
         ("#distance program start clear", DISTANCE, None),
     ],
 )
-def test_syntax_forms(line, kind, param):
+def test_syntax_forms(line, kind, param) -> None:
     assert commands(VARS + line + "\nM30") == [ContourCommand(kind, param)]
 
 
-def test_the_command_block_has_the_number_and_the_place_of_the_hash():
+def test_the_command_block_has_the_number_and_the_place_of_the_hash() -> None:
     blocks = run("G1 X1 F100\nN20 [MARK] #CONTOUR LOOKAHEAD LOG ON [PARAM=1]\n"
                  "  #DISTANCE PROG START CLEAR\nM30")
     on, distance = blocks[1], blocks[2]
@@ -107,29 +107,29 @@ def test_the_command_block_has_the_number_and_the_place_of_the_hash():
         assert not block.needs_stop  # the path runs through; only CLEAR stops it
 
 
-def test_the_hash_on_a_continuation_line():
+def test_the_hash_on_a_continuation_line() -> None:
     blocks = run("N7 \\\n#CONTOUR LOOKAHEAD LOG ON\nM30")
     assert (blocks[0].number, blocks[0].source.line, blocks[0].source.column) == (7, 2, 1)
 
 
-def test_clear_stops_the_path():
+def test_clear_stops_the_path() -> None:
     blocks = run("#CONTOUR LOOKAHEAD LOG CLEAR\nM30")
     assert blocks[0].contour == ContourCommand(CLEAR) and blocks[0].needs_stop
 
 
-def test_manual_blocks_are_marked_manual():
+def test_manual_blocks_are_marked_manual() -> None:
     block = run("#CONTOUR LOOKAHEAD LOG ON", manual=True)[0]
     assert block.manual and block.contour == ContourCommand(ON)
 
 
-def test_a_block_is_produced_even_when_the_area_does_not_change():
+def test_a_block_is_produced_even_when_the_area_does_not_change() -> None:
     text = "\n".join(["#CONTOUR LOOKAHEAD LOG OFF", "#CONTOUR LOOKAHEAD LOG ON",
                       "#CONTOUR LOOKAHEAD LOG ON", "#CONTOUR LOOKAHEAD LOG [PARAM=2]",
                       "#CONTOUR LOOKAHEAD LOG OFF", "#CONTOUR LOOKAHEAD LOG OFF", "M30"])
     assert [c.kind for c in commands(text)] == [OFF, ON, ON, PARAM, OFF, OFF]
 
 
-def test_distance_clear_works_without_the_contour_lookahead_function():
+def test_distance_clear_works_without_the_contour_lookahead_function() -> None:
     blocks = decode("#DISTANCE PROG START CLEAR\nM30")
     assert blocks[0].contour == ContourCommand(DISTANCE)
 
@@ -142,7 +142,7 @@ def test_distance_clear_works_without_the_contour_lookahead_function():
     ["#CONTOUR LOOKAHEAD LOG ON", "#CONTOUR LOOKAHEAD LOG OFF [PARAM=1]",
      "#CONTOUR LOOKAHEAD LOG [PARAM=1]", "#CONTOUR LOOKAHEAD LOG CLEAR"],
 )
-def test_contour_lookahead_needs_the_function(line):
+def test_contour_lookahead_needs_the_function(line) -> None:
     e = error_of(f"G1 X1 F100\nN10 {line}\nM30")
     assert (e.id, e.file, e.line, e.column, e.message) == (
         NcErrorId.CONTOUR_LOOKAHEAD_NOT_ENABLED, "prog.nc", 2, 5, NOT_ENABLED)
@@ -182,7 +182,7 @@ def test_contour_lookahead_needs_the_function(line):
         ("M3 # distance PROG START CLEAR", 4, "#DISTANCE must stand alone in its NC line"),
     ],
 )
-def test_syntax_errors(line, column, text):
+def test_syntax_errors(line, column, text) -> None:
     for enabled in (True, False):  # a syntax error is found before the function is missed
         e = error_of("G1 X0 F100\n" + line + "\nM30", contour_lookahead=enabled)
         assert (e.id, e.line, e.column) == (NcErrorId.CONTOUR_COMMAND_SYNTAX, 2, column), str(e)
@@ -200,7 +200,7 @@ def test_syntax_errors(line, column, text):
         ("#CONTOUR MODE [DEV PATH_DEV=0.1]", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1),
     ],
 )
-def test_param_errors(line, err, column):
+def test_param_errors(line, err, column) -> None:
     modal = ModalState()
     e = error_of(line + "\nM30", contour_lookahead=True, modal=modal)
     assert (e.id, e.line, e.column) == (err, 1, column), str(e)
@@ -224,13 +224,13 @@ def test_param_errors(line, err, column):
          ("outer.nc", 4, 1)),
     ],
 )
-def test_clear_inside_a_real_time_loop_is_an_error(text, files, where):
+def test_clear_inside_a_real_time_loop_is_an_error(text, files, where) -> None:
     e = error_of(text, files=files, contour_lookahead=True)
     assert (e.id, e.file, e.line, e.column, e.message) == (
         NcErrorId.CONTOUR_CLEAR_IN_RT_LOOP, *where, CLEAR_IN_LOOP)
 
 
-def test_clear_outside_a_real_time_loop_is_fine():
+def test_clear_outside_a_real_time_loop_is_fine() -> None:
     text = program(
         "#CONTOUR LOOKAHEAD LOG ON\n", loop(2),
         "#CONTOUR LOOKAHEAD LOG CLEAR\n",  # after the loop
@@ -245,7 +245,7 @@ def test_clear_outside_a_real_time_loop_is_fine():
 # ---------------------------------------------------------------- the log area
 
 
-def test_log_area_after_sequences():
+def test_log_area_after_sequences() -> None:
     modal = ModalState()
     steps = [
         ("#CONTOUR LOOKAHEAD LOG ON", LogArea.OPEN),
@@ -266,7 +266,7 @@ def test_log_area_after_sequences():
         assert modal.contour_log_area == area, line
 
 
-def test_a_program_start_clears_the_area_and_a_manual_decoder_keeps_it():
+def test_a_program_start_clears_the_area_and_a_manual_decoder_keeps_it() -> None:
     modal = ModalState()
     d = decoder("#CONTOUR LOOKAHEAD LOG ON\nM30", modal=modal, contour_lookahead=True)
     list(d.blocks())
@@ -286,7 +286,7 @@ def test_a_program_start_clears_the_area_and_a_manual_decoder_keeps_it():
 # ---------------------------------------------------------------- real-time loop markers
 
 
-def test_a_loop_entered_in_an_open_area_gets_a_marker_per_pass():
+def test_a_loop_entered_in_an_open_area_gets_a_marker_per_pass() -> None:
     text = program("N10 #CONTOUR LOOKAHEAD LOG ON [PARAM=1]\n", loop(3),
                    "#CONTOUR LOOKAHEAD LOG ON [PARAM=8]\n")
     blocks = run(text)
@@ -300,7 +300,7 @@ def test_a_loop_entered_in_an_open_area_gets_a_marker_per_pass():
     assert all(not b.needs_stop for b in markers)
 
 
-def test_a_marker_has_the_number_and_the_hash_of_its_rt_while():
+def test_a_marker_has_the_number_and_the_hash_of_its_rt_while() -> None:
     text = program("#CONTOUR LOOKAHEAD LOG ON\nV.L.I = 0\n",
                    "  N60 #RT WHILE [V.L.I < 1]\nV.L.I = 1\nG1 X2\n#RT ENDWHILE\n")
     markers = [b for b in run(text) if b.contour is not None and b.contour.kind in (PASS, END)]
@@ -309,7 +309,7 @@ def test_a_marker_has_the_number_and_the_hash_of_its_rt_while():
         (ContourCommand(END, loop=1), 60, 8, 7)]
 
 
-def test_log_on_inside_the_loop_gives_no_markers():
+def test_log_on_inside_the_loop_gives_no_markers() -> None:
     # ISG's example: the area is opened inside the loop, its elements are logged once
     body = "#CONTOUR LOOKAHEAD LOG ON [PARAM=1]\nG1 X[V.L.I]\n#CONTOUR LOOKAHEAD LOG ON [PARAM=8]"
     assert trace(run(program(loop(2, body)))) == [
@@ -322,25 +322,25 @@ def test_log_on_inside_the_loop_gives_no_markers():
     ["", "#CONTOUR LOOKAHEAD LOG ON\n#CONTOUR LOOKAHEAD LOG OFF\n",
      "#CONTOUR LOOKAHEAD LOG ON\n#CONTOUR LOOKAHEAD LOG CLEAR\n"],
 )
-def test_a_loop_outside_an_open_area_gets_no_markers(before):
+def test_a_loop_outside_an_open_area_gets_no_markers(before) -> None:
     blocks = run(program(before, loop(3)))
     assert [e for e in trace(blocks) if e[0] == "X"] == [("X", 1.0), ("X", 2.0), ("X", 3.0)]
     assert all(b.contour.kind not in (PASS, END) for b in blocks if b.contour is not None)
 
 
-def test_a_loop_false_at_entry_gets_no_markers():
+def test_a_loop_false_at_entry_gets_no_markers() -> None:
     text = program("#CONTOUR LOOKAHEAD LOG ON\nG1 X7\n", loop(0), "G1 X8\n")
     assert trace(run(text)) == [("LOG_ON", None), ("X", 7.0), ("X", 8.0)]
 
 
-def test_log_off_inside_the_tracked_loop_keeps_its_markers():
+def test_log_off_inside_the_tracked_loop_keeps_its_markers() -> None:
     body = "G1 X[V.L.I]\n#CONTOUR LOOKAHEAD LOG OFF"
     assert trace(run(program("#CONTOUR LOOKAHEAD LOG ON\n", loop(2, body)))) == [
         ("LOG_ON", None), ("PASS", 1, 1), ("X", 1.0), ("LOG_OFF", None),
         ("PASS", 1, 2), ("X", 2.0), ("LOG_OFF", None), ("END", 1)]
 
 
-def test_break_out_of_the_tracked_loop_ends_it():
+def test_break_out_of_the_tracked_loop_ends_it() -> None:
     body = "G1 X[V.L.I]\n$IF V.L.I == 2\n$BREAK\n$ENDIF\nG1 Y[V.L.I]"
     text = program("#CONTOUR LOOKAHEAD LOG ON\n", loop(5, body), "G1 X9\n")
     assert trace(run(text)) == [
@@ -348,7 +348,7 @@ def test_break_out_of_the_tracked_loop_ends_it():
         ("END", 1), ("X", 9.0)]
 
 
-def test_break_out_of_an_inner_loop_does_not_end_the_tracked_one():
+def test_break_out_of_an_inner_loop_does_not_end_the_tracked_one() -> None:
     inner = "$WHILE TRUE\nG1 Y[V.L.I]\n$BREAK\n$ENDWHILE\nG1 X[V.L.I]"
     text = program("#CONTOUR LOOKAHEAD LOG ON\n", loop(2, inner))
     assert trace(run(text)) == [
@@ -356,7 +356,7 @@ def test_break_out_of_an_inner_loop_does_not_end_the_tracked_one():
         ("X", 1.0), ("X", 2.0), ("END", 1)]
 
 
-def test_continue_starts_the_next_pass():
+def test_continue_starts_the_next_pass() -> None:
     body = "$IF V.L.I == 1\n$CONTINUE\n$ENDIF\nG1 X[V.L.I]"
     text = program("#CONTOUR LOOKAHEAD LOG ON\n", loop(3, body))
     assert trace(run(text)) == [
@@ -364,7 +364,7 @@ def test_continue_starts_the_next_pass():
         ("X", 3.0), ("END", 1)]
 
 
-def test_nested_loops_give_markers_of_the_outer_loop_only():
+def test_nested_loops_give_markers_of_the_outer_loop_only() -> None:
     inner = loop(2, "G1 X[V.L.I * 10 + V.L.J]", name="J")
     text = program("#CONTOUR LOOKAHEAD LOG ON\n", loop(2, inner.rstrip("\n")), "G1 X0\n")
     assert trace(run(text)) == [
@@ -372,7 +372,7 @@ def test_nested_loops_give_markers_of_the_outer_loop_only():
         ("PASS", 1, 2), ("X", 21.0), ("X", 22.0), ("END", 1), ("X", 0.0)]
 
 
-def test_an_inner_loop_entered_after_log_on_inside_an_outer_loop_is_tracked():
+def test_an_inner_loop_entered_after_log_on_inside_an_outer_loop_is_tracked() -> None:
     inner = loop(1, "G1 X[V.L.I]", name="J")
     body = "#CONTOUR LOOKAHEAD LOG ON\n" + inner.rstrip("\n")
     assert trace(run(program(loop(2, body)))) == [
@@ -380,7 +380,7 @@ def test_an_inner_loop_entered_after_log_on_inside_an_outer_loop_is_tracked():
         ("LOG_ON", None), ("PASS", 2, 1), ("X", 2.0), ("END", 2)]
 
 
-def test_loops_are_numbered_per_decoder():
+def test_loops_are_numbered_per_decoder() -> None:
     files = {"sub.nc": "#VAR\nV.L.K = 0\n#ENDVAR\n" + loop(1, "G1 X5\nX6", name="K") + "M17"}
     text = program("#CONTOUR LOOKAHEAD LOG ON\n", loop(1), "L sub.nc\nL sub.nc\n")
     assert trace(run(text, files=files)) == [
@@ -390,14 +390,14 @@ def test_loops_are_numbered_per_decoder():
     assert trace(run(text, files=files)) == trace(run(text, files=files))  # starts at 1
 
 
-def test_a_subprogram_inside_the_tracked_loop_adds_no_markers():
+def test_a_subprogram_inside_the_tracked_loop_adds_no_markers() -> None:
     files = {"sub.nc": "#VAR\nV.L.K = 0\n#ENDVAR\n" + loop(2, "G1 Y[V.L.K]", name="K") + "M17"}
     text = program("#CONTOUR LOOKAHEAD LOG ON\n", loop(2, "L sub.nc"))
     assert [e for e in trace(run(text, files=files)) if e[0] != "X"] == [
         ("LOG_ON", None), ("PASS", 1, 1), ("PASS", 1, 2), ("END", 1)]
 
 
-def test_goto_out_of_the_tracked_loop_ends_the_tracking_without_a_marker():
+def test_goto_out_of_the_tracked_loop_ends_the_tracking_without_a_marker() -> None:
     body = "G1 X[V.L.I]\n$IF V.L.I == 2\n$GOTO [OUT]\n$ENDIF"
     text = program("#CONTOUR LOOKAHEAD LOG ON\n", loop(5, body), "[OUT] G1 X9\n",
                    loop(1, "G1 X[20]", name="J"))
@@ -406,7 +406,7 @@ def test_goto_out_of_the_tracked_loop_ends_the_tracking_without_a_marker():
         ("PASS", 2, 1), ("X", 20.0), ("END", 2)]
 
 
-def test_an_endless_real_time_loop_gives_markers_as_long_as_pulled():
+def test_an_endless_real_time_loop_gives_markers_as_long_as_pulled() -> None:
     d = decoder("#CONTOUR LOOKAHEAD LOG ON\nG1 F100\n#RT WHILE\nG1 X1\nG1 X2\n#RT ENDWHILE\nM30",
                 contour_lookahead=True)
     assert trace(list(islice(d.blocks(), 8))) == [
@@ -414,7 +414,7 @@ def test_an_endless_real_time_loop_gives_markers_as_long_as_pulled():
         ("X", 2.0), ("PASS", 1, 3)]
 
 
-def test_markers_do_not_count_for_the_endless_loop_guard(monkeypatch):
+def test_markers_do_not_count_for_the_endless_loop_guard(monkeypatch) -> None:
     monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 50)
     d = decoder("#CONTOUR LOOKAHEAD LOG ON\nG0 X1\n#RT WHILE\n#RT ENDWHILE\nM30",
                 contour_lookahead=True)
@@ -431,7 +431,7 @@ def test_markers_do_not_count_for_the_endless_loop_guard(monkeypatch):
 # ---------------------------------------------------------------- paths, syntax check
 
 
-def test_hot_and_general_path_agree():
+def test_hot_and_general_path_agree() -> None:
     lines = ["G1 X0 Y0 Z0 F1200", "#VAR", "V.L.I = 0", "#ENDVAR"]
     lines += [f"N{k} X{k} Y{k % 7} Z{k % 3}" for k in range(1, 20)]
     lines += ["N100 #CONTOUR LOOKAHEAD LOG ON [PARAM=1]", "X20 Y1", "G2 X22 I1",
@@ -450,7 +450,7 @@ def test_hot_and_general_path_agree():
     assert len(fast) == 1 + 19 + 1 + 2 + 4 + 6 + 1 + 10 + 2 + 1 + 1 + 1
 
 
-def test_check_syntax_reports_malformed_commands_only():
+def test_check_syntax_reports_malformed_commands_only() -> None:
     text = "\n".join([
         "#CONTOUR LOOKAHEAD LOG ON [PARAM=1]",
         "#CONTOUR LOOKAHEAD LOG",

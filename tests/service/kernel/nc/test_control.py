@@ -32,7 +32,7 @@ def xs(program: str, **kw) -> list[float]:
         ("N10 $IF 1\nG0 X1\nN20 $ENDIF\nM30", [1]),
     ],
 )
-def test_if(program, expected):
+def test_if(program, expected) -> None:
     assert xs(program) == expected
 
 
@@ -58,7 +58,7 @@ def test_if(program, expected):
         (DECL + "#RT WHILE [V.L.I < 2]\nG0 X[V.L.I]\nV.L.I = V.L.I + 1\n#RT ENDWHILE\nM30", [0, 1]),
     ],
 )
-def test_loops(program, expected):
+def test_loops(program, expected) -> None:
     decl = "#VAR\nV.P.K\nV.P.M\n#ENDVAR\n"
     assert xs(decl + program) == expected
 
@@ -67,7 +67,7 @@ def test_loops(program, expected):
     ("value", "expected"),
     [(0, [10, 11]), (1, [11]), (2, [20]), (3, [20]), (7, [99]), ('"s"', [30])],
 )
-def test_switch(value, expected):
+def test_switch(value, expected) -> None:
     program = f"""$SWITCH {value}
 $CASE 0
   G0 X10
@@ -87,7 +87,7 @@ M30"""
     assert xs(program) == expected
 
 
-def test_switch_without_match_and_default():
+def test_switch_without_match_and_default() -> None:
     assert xs("$SWITCH 5\n$CASE 1\nG0 X1\n$ENDSWITCH\nG0 X2\nM30") == [2]
 
 
@@ -107,22 +107,22 @@ def test_switch_without_match_and_default():
         ("N20: G0 X1\n$IF 0 $GOTO N20\n$GOTO N20\nG0 X5\nN20: G0 X2\nM30", [1, 2]),
     ],
 )
-def test_goto(program, expected):
+def test_goto(program, expected) -> None:
     assert xs(program) == expected
 
 
-def test_while_with_motion_is_lazy():
+def test_while_with_motion_is_lazy() -> None:
     blocks = decoder("G1 F100\n$WHILE 1\nG1 X1\nG1 X0\n$ENDWHILE\nM30").blocks()
     taken = list(islice(blocks, 1001))
     assert len(taken) == 1001
 
 
-def test_rt_while_without_condition_runs_as_long_as_pulled():
+def test_rt_while_without_condition_runs_as_long_as_pulled() -> None:
     blocks = decoder("G1 F100\n#RT WHILE\nG1 X1\nG1 X0\n#RT ENDWHILE\nM30").blocks()
     assert [b.motion.end_mm[0] for b in islice(blocks, 4)] == [1, 0, 1, 0]
 
 
-def test_endless_loop_without_blocks_is_an_error(monkeypatch):
+def test_endless_loop_without_blocks_is_an_error(monkeypatch) -> None:
     monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 1000)
     # the error is at the line the decoder stands at when the guard's limit is passed
     e = error_of("G0 X1\n$WHILE TRUE\n$ENDWHILE\nM30")
@@ -131,7 +131,7 @@ def test_endless_loop_without_blocks_is_an_error(monkeypatch):
     assert (e.id, e.line) == (NcErrorId.ENDLESS_LOOP, 1)
 
 
-def test_loop_guard_counts_passes_without_blocks_only(monkeypatch):
+def test_loop_guard_counts_passes_without_blocks_only(monkeypatch) -> None:
     monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 10)
     program = "#VAR\nV.L.I = 0\n#ENDVAR\nG1 F100\n$WHILE V.L.I < 100\n" \
               "V.L.I = V.L.I + 1\nG1 X[V.L.I]\n$ENDWHILE\nM30"
@@ -178,12 +178,12 @@ def test_loop_guard_counts_passes_without_blocks_only(monkeypatch):
         ("#RT CLEAR\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 1),
     ],
 )
-def test_control_errors(program, err, line, column):
+def test_control_errors(program, err, line, column) -> None:
     e = error_of(program)
     assert (e.id, e.line, e.column) == (err, line, column), str(e)
 
 
-def test_control_error_messages():
+def test_control_error_messages() -> None:
     assert error_of("$ENDIF\nM30").message == "$ENDIF without $IF"
     assert error_of("$IF 0\nM30").message == "$IF without $ENDIF"
     assert error_of("$GOTO [FOO]\nM30").message == "label [FOO] not found"
@@ -191,7 +191,7 @@ def test_control_error_messages():
     assert error_of("#WAIT\nM30").message == "#WAIT is not supported yet"
 
 
-def test_error_comes_after_the_blocks_before_it():
+def test_error_comes_after_the_blocks_before_it() -> None:
     d = decoder("G0 X1\nG0 X2\nQ5\nM30")
     blocks = d.blocks()
     assert next(blocks).motion.end_mm[0] == 1

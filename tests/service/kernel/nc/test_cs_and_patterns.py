@@ -33,7 +33,7 @@ def cs_matrix(a: float, b: float, c: float) -> np.ndarray:
 
 # ---------------------------------------------------------------- 8. #CS
 
-def test_cs_rotated_90_degrees_about_z():
+def test_cs_rotated_90_degrees_about_z() -> None:
     text = ("G01 F100\n#CS ON [10, 20, 30, 0, 0, 90]\nX1 Y2 Z3\nX5\nG91 X1 Y1\nG90\n"
             "#CS OFF\nX7 Y8 Z9\nM30\n")
     d, moves = Channel().moves(text)
@@ -47,7 +47,7 @@ def test_cs_rotated_90_degrees_about_z():
     assert d.modal.cs_placement is None and d.modal.cs == ()
 
 
-def test_cs_with_general_angles():
+def test_cs_with_general_angles() -> None:
     text = "G01 F100\n#CS ON [1, 2, 3, 10, 20, 30]\nX4 Y5 Z6\nG91 Z2\nM30\n"
     _, moves = Channel().moves(text)
     r = cs_matrix(10, 20, 30)
@@ -57,12 +57,12 @@ def test_cs_with_general_angles():
     assert moves[1].motion.end_mm == pytest.approx(tuple(second), abs=1e-9)
 
 
-def test_cs_offset_only():
+def test_cs_offset_only() -> None:
     _, moves = Channel().moves("G01 F100\n#CS ON [5, -5, 1]\nX1 Y1 Z1\nM30\n")
     assert moves[0].motion.end_mm == (6.0, -4.0, 2.0)
 
 
-def test_word_for_one_axis_keeps_the_others_in_a_rotated_cs():
+def test_word_for_one_axis_keeps_the_others_in_a_rotated_cs() -> None:
     # the machine starts at (3, 4, 5); in the CS the point has some Y and Z that stay
     text = "G00 X3 Y4 Z5\n#CS ON [0, 0, 0, 0, 0, 30]\nG01 F100 X10\nM30\n"
     _, moves = Channel().moves(text)
@@ -73,13 +73,13 @@ def test_word_for_one_axis_keeps_the_others_in_a_rotated_cs():
     assert moves[1].motion.end_mm[2] == 5.0
 
 
-def test_a_cs_without_a_move_leaves_the_machine_position():
+def test_a_cs_without_a_move_leaves_the_machine_position() -> None:
     d, moves = Channel().moves("G00 X3 Y4 Z5\n#CS ON [1, 1, 1, 0, 0, 37]\nG01 F100\n#CS OFF\n"
                                "X3\nM30\n")
     assert [m.motion.end_mm for m in moves] == [(3.0, 4.0, 5.0)]  # X3 is where it is
 
 
-def test_nested_cs_is_relative_to_the_first():
+def test_nested_cs_is_relative_to_the_first() -> None:
     text = ("G01 F100\n#CS ON [10, 0, 0, 0, 0, 90]\n#CS ON [5, 0, 0, 0, 0, 90]\nX1 Y0 Z0\n"
             "#CS OFF\nX1 Y0 Z0\n#CS ON [0, 0, 2]\n#CS ON [1, 1, 1]\n#CS OFF ALL\nX1 Y0 Z0\nM30\n")
     _, moves = Channel().moves(text)
@@ -90,7 +90,7 @@ def test_nested_cs_is_relative_to_the_first():
     ]
 
 
-def test_nested_cs_with_general_angles():
+def test_nested_cs_with_general_angles() -> None:
     text = ("G01 F100\n#CS ON [10, -3, 4, 15, 0, 40]\n#CS ON [2, 5, -1, 0, 25, -70]\n"
             "X3 Y-2 Z7\nM30\n")
     _, moves = Channel().moves(text)
@@ -99,7 +99,7 @@ def test_nested_cs_with_general_angles():
     assert moves[0].motion.end_mm == pytest.approx(tuple(expected), abs=1e-9)
 
 
-def test_cs_def_then_on_by_name():
+def test_cs_def_then_on_by_name() -> None:
     text = ("G01 F100\n#CS DEF [Tilt] [1, 2, 3, 0, 0, 30]\nX1 Y0 Z0\n#CS ON [Tilt]\n"
             "X1 Y0 Z0\n#CS OFF\n#CS ON [Tilt]\nX0 Y0 Z0\nM30\n")
     d, moves = Channel().moves(text)
@@ -110,7 +110,7 @@ def test_cs_def_then_on_by_name():
     assert len(d.modal.cs) == 1
 
 
-def test_cs_on_with_an_undefined_name():
+def test_cs_on_with_an_undefined_name() -> None:
     text = "#CS ON [Nope]\nM30\n"
     error = Channel().error(text)
     assert_at(error, E.INSTRUCTION_SYNTAX, text, "#CS")
@@ -119,12 +119,12 @@ def test_cs_on_with_an_undefined_name():
 
 @pytest.mark.parametrize("line", ["#CS ON [1, 2]", "#CS ON [1, 2, 3, 4]", "#CS DEF [1, 2, 3]",
                                   "#CS ON", "#CS FOO [1, 2, 3]", "#CS ON [1, 2, 3] X1"])
-def test_malformed_cs(line):
+def test_malformed_cs(line) -> None:
     error = Channel().error(f"{line}\nM30\n")
     assert error.id == E.INSTRUCTION_SYNTAX and error.line == 1
 
 
-def test_arc_in_a_cs_rotated_about_z():
+def test_arc_in_a_cs_rotated_about_z() -> None:
     text = "G01 F100\n#CS ON [10, 20, 0, 0, 0, 90]\nX0 Y0\nG02 X10 Y0 I5 J0\nG03 X0 Y0 R5\nM30\n"
     _, moves = Channel().moves(text)
     cw, ccw = moves[1].motion, moves[2].motion
@@ -134,7 +134,7 @@ def test_arc_in_a_cs_rotated_about_z():
         (MotionKind.ARC_CCW, (10.0, 20.0, 0.0), (10.0, 25.0))
 
 
-def test_arc_in_a_cs_rotated_by_an_odd_angle_about_z():
+def test_arc_in_a_cs_rotated_by_an_odd_angle_about_z() -> None:
     text = "G01 F100\n#CS ON [3, 4, 5, 0, 0, 33]\nX2 Y1 Z0\nG03 X-1 Y4 I-3 J0\nM30\n"
     _, moves = Channel().moves(text)
     r = cs_matrix(0, 0, 33)
@@ -145,7 +145,7 @@ def test_arc_in_a_cs_rotated_by_an_odd_angle_about_z():
     assert arc.center_mm == pytest.approx(tuple((o + r @ np.array([-1, 1, 0]))[:2]), abs=1e-9)
 
 
-def test_cs_turned_over_about_x_flips_the_arc_direction():
+def test_cs_turned_over_about_x_flips_the_arc_direction() -> None:
     text = "G01 F100\n#CS ON [0, 0, 0, 180, 0, 0]\nX0 Y1\nG02 X10 Y1 I5 J0\nM30\n"
     _, moves = Channel().moves(text)
     arc = moves[-1].motion
@@ -154,7 +154,7 @@ def test_cs_turned_over_about_x_flips_the_arc_direction():
     assert arc.center_mm == (5.0, -1.0) and arc.plane == (0, 1)
 
 
-def test_g18_arc_in_a_cs_rotated_about_z_runs_in_the_machine_yz_plane():
+def test_g18_arc_in_a_cs_rotated_about_z_runs_in_the_machine_yz_plane() -> None:
     # the CS ZX plane is the machine YZ plane, its normal CS +Y is machine -X
     text = "G01 F100\n#CS ON [0, 0, 0, 0, 0, 90]\nG18 G02 X10 Z0 I5 K0\nM30\n"
     _, moves = Channel().moves(text)
@@ -164,7 +164,7 @@ def test_g18_arc_in_a_cs_rotated_about_z_runs_in_the_machine_yz_plane():
     assert arc.kind == MotionKind.ARC_CCW
 
 
-def test_arc_in_a_tilted_cs():
+def test_arc_in_a_tilted_cs() -> None:
     text = "G01 F100\n#CS ON [0, 0, 0, 30, 0, 0]\nX0 Y0\nG02 X10 Y0 I5 J0\nM30\n"
     error = Channel().error(text)
     assert int(E.ARC_PLANE_TILTED) == 20148
@@ -174,7 +174,7 @@ def test_arc_in_a_tilted_cs():
     assert moves[-1].motion.end_mm == pytest.approx((10.0, 0.0, 0.0), abs=1e-12)
 
 
-def test_program_start_resets_the_cs():
+def test_program_start_resets_the_cs() -> None:
     channel = Channel()
     first, _ = channel.run("G01 F100\n#CS DEF [A] [0, 0, 0, 0, 0, 45]\n#CS ON [100, 0, 0, 0, 0, 90]\n"
                            "X1\nM30\n")
@@ -255,7 +255,7 @@ def processing(example: str, lines: str) -> str:
     return example.replace("@P1 = 1", "@P1 = 3").replace(PROCESSING, PROCESSING + "\n" + lines)
 
 
-def test_example_1_as_documented_needs_a_kinematic_transformation():
+def test_example_1_as_documented_needs_a_kinematic_transformation() -> None:
     text = "G00 X1 Y2 Z3\n" + EXAMPLE_1 + "M30\n"
     error = Channel().error(text)
     assert int(E.TRAFO_NOT_CONFIGURED) == 20519
@@ -263,12 +263,12 @@ def test_example_1_as_documented_needs_a_kinematic_transformation():
     assert "kinematic transformation" in error.message
 
 
-def test_example_2_as_documented_needs_a_kinematic_transformation():
+def test_example_2_as_documented_needs_a_kinematic_transformation() -> None:
     error = Channel().error(EXAMPLE_2)
     assert_at(error, E.TRAFO_NOT_CONFIGURED, EXAMPLE_2, "@P1")
 
 
-def test_example_1_rotates_the_mcs_onto_the_plane_of_the_points():
+def test_example_1_rotates_the_mcs_onto_the_plane_of_the_points() -> None:
     text = "G00 X1 Y2 Z3\n" + processing(EXAMPLE_1, "G01 F100 X0 Y0 Z0\nX10\nY10\nZ10\nM0") \
         + "G01 X1 Y2 Z3\nM30\n"
     d = Channel().decoder(text)
@@ -303,7 +303,7 @@ def test_example_1_rotates_the_mcs_onto_the_plane_of_the_points():
     assert ends[3] == pytest.approx(tuple(origin + 10 * x + 10 * y + 10 * z), abs=1e-9)
 
 
-def test_example_1_points_lie_in_a_plane_parallel_to_the_new_xy_plane():
+def test_example_1_points_lie_in_a_plane_parallel_to_the_new_xy_plane() -> None:
     text = "G00 Z0\n" + processing(EXAMPLE_1, "M30")
     d, _ = Channel().run(text)
     placement = d.modal.cs_placement
@@ -314,7 +314,7 @@ def test_example_1_points_lie_in_a_plane_parallel_to_the_new_xy_plane():
     assert x_new[1] - x_new[0] == pytest.approx(40.0, abs=1e-9)  # X along point 1 -> 2
 
 
-def test_example_1_runs_with_a_kinematic_transformation():
+def test_example_1_runs_with_a_kinematic_transformation() -> None:
     channel = Channel(kinematics=True)
     d, blocks = channel.run("G00 X1 Y2 Z3\n" + EXAMPLE_1 + "M30\n")
     moves = [b for b in blocks if b.motion is not None]
@@ -323,7 +323,7 @@ def test_example_1_runs_with_a_kinematic_transformation():
     assert d.modal.settings.trafo is False
 
 
-def test_example_2_by_angles():
+def test_example_2_by_angles() -> None:
     text = "G00 X1 Y2 Z3\n" + processing(EXAMPLE_2, "G01 F100 X10 Y0 Z0\nX0 Y10 Z0\nX0 Y0 Z10")
     text = text.replace("#TRAFO OFF", "X0 Y0 Z10\n#TRAFO OFF")
     _, moves = Channel().moves(text)
@@ -345,7 +345,7 @@ ORDERS = {1: "XYZ", 2: "XZY", 3: "YXZ", 4: "YZX", 5: "ZXY", 6: "ZYX"}
 
 @pytest.mark.parametrize("order", sorted(ORDERS))
 @pytest.mark.parametrize("mode", [1, 2])
-def test_rotation_orders(order, mode):
+def test_rotation_orders(order, mode) -> None:
     a, b, c = 17.0, -29.0, 41.0
     text = (f"L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=3 @P3=1 @P4=-2 @P5=3 @P15={a} "
             f"@P16={b} @P17={c} @P18={mode} @P19={order}]\nG01 F100 X4 Y5 Z6\nM30\n")
@@ -361,7 +361,7 @@ def test_rotation_orders(order, mode):
     assert moves[-1].motion.end_mm == pytest.approx(tuple(end), abs=1e-9)
 
 
-def test_default_order_is_zyx_intrinsic_like_cs_on():
+def test_default_order_is_zyx_intrinsic_like_cs_on() -> None:
     a, b, c = 12.0, 34.0, -56.0
     text = (f"L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=3 @P15={a} @P16={b} @P17={c}]\n"
             "M30\n")
@@ -369,7 +369,7 @@ def test_default_order_is_zyx_intrinsic_like_cs_on():
     assert np.array(d.modal.cs_placement.rotation) == pytest.approx(cs_matrix(a, b, c), abs=1e-9)
 
 
-def test_rotation_refers_to_the_active_cs():
+def test_rotation_refers_to_the_active_cs() -> None:
     text = ("#CS ON [10, 0, 0, 0, 0, 90]\n"
             "L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=3 @P3=5 @P17=90]\n"
             "G01 F100 X1 Y0 Z0\n#CS OFF\nX1 Y0 Z0\n#CS OFF\nX1 Y0 Z0\nM30\n")
@@ -379,7 +379,7 @@ def test_rotation_refers_to_the_active_cs():
     assert moves[2].motion.end_mm == (1.0, 0.0, 0.0)
 
 
-def test_retraction_is_along_machine_z_in_a_rotated_cs():
+def test_retraction_is_along_machine_z_in_a_rotated_cs() -> None:
     text = ("G00 X1 Y2 Z3\n#CS ON [4, 5, 6, 20, 70, 10]\n"
             "L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=3 @P2=10 @P15=5]\nM30\n")
     _, moves = Channel().moves(text)
@@ -388,7 +388,7 @@ def test_retraction_is_along_machine_z_in_a_rotated_cs():
     assert retract.motion.end_mm == pytest.approx((1.0, 2.0, 13.0), abs=1e-9)
 
 
-def test_callers_modal_functions_survive_the_retraction():
+def test_callers_modal_functions_survive_the_retraction() -> None:
     text = ("G91 G01 F100 X1\nL CYCLE [NAME=SysPosRotationToPlane.ecy @P1=3 @P2=5 @P15=0]\n"
             "X1\nM30\n")
     _, moves = Channel().moves(text)
@@ -408,7 +408,7 @@ RESULT_1 = [
 ]
 
 
-def test_result_file_of_example_1():
+def test_result_file_of_example_1() -> None:
     channel = Channel({"SysPosRotationToPlaneResult.txt": "old\n"})
     text = processing(EXAMPLE_1, "M30").replace("@P14 = -50       \\", "@P14 = -50 @P20 = 1 \\")
     d, _ = channel.run(text)
@@ -423,7 +423,7 @@ def test_result_file_of_example_1():
     assert check.modal.cs_placement.origin_mm == pytest.approx((140.0, 0.0, -80.0), abs=1e-6)
 
 
-def test_mode_4_only_writes_the_result():
+def test_mode_4_only_writes_the_result() -> None:
     channel = Channel()
     text = ("G00 X1 Y2 Z3\nL CYCLE [NAME=SysPosRotationToPlane.ecy @P1=4 @P2=50 @P3=140 @P5=-80 "
             "@P6=100 @P7=30 @P8=-25 @P9=100 @P10=70 @P11=-25 @P12=115 @P13=70 @P14=-50 "
@@ -436,13 +436,13 @@ def test_mode_4_only_writes_the_result():
     assert lines[2:6] == RESULT_1[2:6]
 
 
-def test_no_result_file_without_p20():
+def test_no_result_file_without_p20() -> None:
     channel = Channel()
     channel.run("L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=4 @P15=10]\nM30\n")
     assert channel.files == {}
 
 
-def test_mode_2_with_kinematics_rotates_no_mcs():
+def test_mode_2_with_kinematics_rotates_no_mcs() -> None:
     # @P1=2: only the tool is rotated (was: the MCS was rotated too)
     text = ("G00 X1 Y2 Z3\nL CYCLE [NAME=SysPosRotationToPlane.ecy @P1=2 @P2=5 @P3=10 @P15=30]\n"
             "G01 F100 X0 Y0 Z0\nM30\n")
@@ -461,13 +461,13 @@ POINTS = "@P6={} @P7={} @P8={} @P9={} @P10={} @P11={} @P12={} @P13={} @P14={}"
     ((0, 0, 0, 1, 1, 1, 3, 3, 3), E.CYCLE_POINTS_COLLINEAR),
     ((0, 0, 0, 1, 0, 0, 0, 0, 0), E.CYCLE_POINTS_COLLINEAR),  # point 3 on point 1
 ])
-def test_degenerate_reference_points(coords, err_id):
+def test_degenerate_reference_points(coords, err_id) -> None:
     text = f"L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=3 {POINTS.format(*coords)}]\nM30\n"
     error = Channel().error(text)
     assert_at(error, err_id, text, "@P6")
 
 
-def test_points_and_angles_together():
+def test_points_and_angles_together() -> None:
     text = (f"L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=3 {POINTS.format(0, 0, 0, 1, 0, 0, 0, 1, 0)}"
             " @P16=10]\nM30\n")
     error = Channel().error(text)
@@ -475,20 +475,20 @@ def test_points_and_angles_together():
     assert "@P16" in error.message
 
 
-def test_partial_reference_points():
+def test_partial_reference_points() -> None:
     text = "L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=3 @P6=0 @P7=0 @P8=0 @P9=1 @P10=0]\nM30\n"
     error = Channel().error(text)
     assert error.id == E.CYCLE_PARAMETER_MISSING and "@P11" in error.message
 
 
-def test_no_plane_at_all():
+def test_no_plane_at_all() -> None:
     error = Channel().error("L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=3 @P2=5]\nM30\n")
     assert error.id == E.CYCLE_PARAMETER_MISSING
 
 
 @pytest.mark.parametrize("param", ["@P1=5", "@P1=0", "@P2=-1", "@P18=3", "@P19=7", "@P20=2",
                                    "@P19=1.5"])
-def test_rotation_parameters_out_of_range(param):
+def test_rotation_parameters_out_of_range(param) -> None:
     text = f"L CYCLE [NAME=SysPosRotationToPlane.ecy @P15=10 {param}]\nM30\n"
     error = Channel().error(text)
     assert_at(error, E.CYCLE_PARAMETER_RANGE, text, param)
@@ -525,7 +525,7 @@ M30
 """
 
 
-def test_cycle_runs_at_every_pattern_position():
+def test_cycle_runs_at_every_pattern_position() -> None:
     d, moves = Channel({"pocket.ecy": PATTERN_CYCLE}).moves(PATTERN_PROGRAM)
     positions = [((100.0, 0.0, 0.0), 0.0), ((100.0, 100.0, 5.0), 60.0),
                  ((0.0, 100.0, 10.0), 0.0)]
@@ -553,7 +553,7 @@ def test_cycle_runs_at_every_pattern_position():
     assert d.modal.cs == () and d.modal.cs_placement is None
 
 
-def test_pattern_call_passes_the_cycle_parameters_each_time():
+def test_pattern_call_passes_the_cycle_parameters_each_time() -> None:
     files = {"p.ecy": '#MSG SAVE ["%g", @P1]\nM17\n'}
     text = ("#PATTERN BEGIN [ID7]\n#AT [1, 2, 3]\n#AT [4, 5, 6]\n#PATTERN END\n"
             "L CYCLE [NAME=p.ecy @P1=42 PATTERN_ID=7 PATTERN_RETRACT=20]\nM30\n")
@@ -562,7 +562,7 @@ def test_pattern_call_passes_the_cycle_parameters_each_time():
     assert channel.files["msg_save.txt"] == "42\n42\n"
 
 
-def test_pattern_with_a_builtin_cycle():
+def test_pattern_with_a_builtin_cycle() -> None:
     text = ("#VAR\nV.CYC.SysRetRadius\n#ENDVAR\n#PATTERN BEGIN [ID=1]\n#AT [1, 2, 3]\n#AT [4, 5, 6]\n"
             "#PATTERN END\nL CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=-1 @P51=0 @P61=1 @P52=1 "
             "@P62=0 PATTERN_ID=1 PATTERN_RETRACT=5]\nM30\n")
@@ -575,7 +575,7 @@ def test_pattern_with_a_builtin_cycle():
     assert channel.messages == ["1"]
 
 
-def test_pattern_redefinition_replaces_the_positions():
+def test_pattern_redefinition_replaces_the_positions() -> None:
     text = ("#PATTERN BEGIN [ID=1]\n#AT [1, 2, 3]\n#PATTERN END\n#PATTERN BEGIN [ID=1]\n"
             "#AT [7, 8, 9]\n#PATTERN END\nL CYCLE [NAME=c.ecy PATTERN_ID=1 PATTERN_RETRACT=50]\n"
             "M30\n")
@@ -584,7 +584,7 @@ def test_pattern_redefinition_replaces_the_positions():
         (0.0, 0.0, 50.0), (7.0, 8.0, 50.0), (17.0, 8.0, 7.0), (17.0, 8.0, 50.0)]
 
 
-def test_pattern_keeps_the_callers_modal_state():
+def test_pattern_keeps_the_callers_modal_state() -> None:
     text = ("G91 G00 X1\n#PATTERN BEGIN [ID=1]\n#AT [10, 20, 3]\n#PATTERN END\n"
             "L CYCLE [NAME=c.ecy PATTERN_ID=1 PATTERN_RETRACT=5]\nX1\nM30\n")
     _, moves = Channel({"c.ecy": PATTERN_CYCLE}).moves(text)
@@ -593,52 +593,52 @@ def test_pattern_keeps_the_callers_modal_state():
         (MotionKind.RAPID, (20.0, 20.0, 5.0), (21.0, 20.0, 5.0))
 
 
-def test_undefined_pattern():
+def test_undefined_pattern() -> None:
     text = "L CYCLE [NAME=c.ecy PATTERN_ID=3 PATTERN_RETRACT=5]\nM30\n"
     error = Channel({"c.ecy": PATTERN_CYCLE}).error(text)
     assert_at(error, E.PATTERN_NOT_DEFINED, text, "PATTERN_ID")
 
 
-def test_pattern_id_without_retract():
+def test_pattern_id_without_retract() -> None:
     text = "#PATTERN BEGIN [ID=1]\n#AT [1,2,3]\n#PATTERN END\nL CYCLE [NAME=c.ecy PATTERN_ID=1]\nM30\n"
     error = Channel({"c.ecy": PATTERN_CYCLE}).error(text)
     assert error.id == E.CYCLE_PARAMETER_MISSING and error.line == 4
     assert "PATTERN_RETRACT" in error.message
 
 
-def test_retract_without_pattern_id():
+def test_retract_without_pattern_id() -> None:
     text = "L CYCLE [NAME=c.ecy PATTERN_RETRACT=5]\nM30\n"
     error = Channel({"c.ecy": PATTERN_CYCLE}).error(text)
     assert_at(error, E.CYCLE_PARAMETER_UNKNOWN, text, "PATTERN_RETRACT")
 
 
-def test_nested_pattern_begin():
+def test_nested_pattern_begin() -> None:
     text = "#PATTERN BEGIN [ID=1]\n#AT [1, 2, 3]\n#PATTERN BEGIN [ID=2]\n#PATTERN END\nM30\n"
     assert_at(Channel().error(text), E.PATTERN_NESTED, text, "#PATTERN BEGIN", 1)
 
 
 @pytest.mark.parametrize("line", ["G01 F100 X1", "#CS ON [1, 2, 3]", "#MSG [\"x\"]",
                                   "V.P.NOPE = 1", "L CYCLE [NAME=c.ecy]"])
-def test_commands_inside_a_definition(line):
+def test_commands_inside_a_definition(line) -> None:
     text = f"#PATTERN BEGIN [ID=1]\n#AT [1, 2, 3]\n{line}\n#PATTERN END\nM30\n"
     error = Channel({"c.ecy": PATTERN_CYCLE}).error(text)
     assert error.id == E.PATTERN_COMMAND_INSIDE and error.line == 3
 
 
 @pytest.mark.parametrize("values, needle", [("1, 2, 3, 5, 0, 0", "5"), ("1, 2, 3, 0, -5, 0", "-5")])
-def test_pattern_rotation_about_x_or_y(values, needle):
+def test_pattern_rotation_about_x_or_y(values, needle) -> None:
     text = f"#PATTERN BEGIN [ID=1]\n#AT [{values}]\n#PATTERN END\nM30\n"
     error = Channel().error(text)
     assert_at(error, E.PATTERN_ROTATION_NOT_SUPPORTED, text, needle)
 
 
-def test_at_outside_a_definition():
+def test_at_outside_a_definition() -> None:
     text = "G01 F100 X1\n#AT [1, 2, 3]\nM30\n"
     assert_at(Channel().error(text), E.PATTERN_SYNTAX, text, "#AT")
 
 
 @pytest.mark.parametrize("line", ["#AT [1, 2]", "#AT [1, 2, 3, 4]", "#AT 1, 2, 3"])
-def test_malformed_at(line):
+def test_malformed_at(line) -> None:
     # (was INSTRUCTION_SYNTAX; errors.py gives malformed #AT its own id)
     text = f"#PATTERN BEGIN [ID=1]\n{line}\n#PATTERN END\nM30\n"
     error = Channel().error(text)
@@ -649,24 +649,24 @@ def test_malformed_at(line):
                                   "#PATTERN BEGIN [ID=1.5]\nM30\n", "#PATTERN END\nM30\n",
                                   "#PATTERN BEGIN [ID=1]\n#PATTERN END\nM30\n",
                                   "#PATTERN END X\nM30\n"])
-def test_malformed_pattern(text):
+def test_malformed_pattern(text) -> None:
     assert Channel().error(text).id == E.PATTERN_SYNTAX
 
 
-def test_missing_pattern_end_at_program_end():
+def test_missing_pattern_end_at_program_end() -> None:
     text = "G01 F100 X1\n#PATTERN BEGIN [ID=4]\n#AT [1, 2, 3]\n"
     error = Channel().error(text)
     assert_at(error, E.PATTERN_NOT_CLOSED, text, "#PATTERN")
 
 
-def test_deleted_pattern_is_not_defined():
+def test_deleted_pattern_is_not_defined() -> None:
     text = ("#PATTERN BEGIN [ID=1]\n#AT [1, 2, 3]\n#PATTERN END\n#PATTERN DELETE [ID=1]\n"
             "L CYCLE [NAME=c.ecy PATTERN_ID=1 PATTERN_RETRACT=5]\nM30\n")
     error = Channel({"c.ecy": PATTERN_CYCLE}).error(text)
     assert (error.id, error.line) == (E.PATTERN_NOT_DEFINED, 5)
 
 
-def test_delete_all():
+def test_delete_all() -> None:
     text = ("#PATTERN BEGIN [ID=1]\n#AT [1, 2, 3]\n#PATTERN END\n#PATTERN BEGIN [ID=2]\n"
             "#AT [4, 5, 6]\n#PATTERN END\n#PATTERN DELETE ALL\n"
             "L CYCLE [NAME=c.ecy PATTERN_ID=2 PATTERN_RETRACT=5]\nM30\n")
@@ -677,7 +677,7 @@ def test_delete_all():
     assert d.modal.patterns == {}
 
 
-def test_delete_spelled_as_in_the_documentation():
+def test_delete_spelled_as_in_the_documentation() -> None:
     text = ("#PATTERN BEGIN [ID=3]\n#AT [1, 2, 3]\n#PATTERN END\n"
             "#PATTERN BEGIN [ID=4]\n#AT [4, 5, 6]\n#PATTERN END\n"
             "# PATTERN DELETE [ID3] ( Delete specific call pattern with ID3)\n")
@@ -690,12 +690,12 @@ def test_delete_spelled_as_in_the_documentation():
     assert d.modal.patterns == {}
 
 
-def test_delete_of_an_undefined_pattern():
+def test_delete_of_an_undefined_pattern() -> None:
     text = "#PATTERN DELETE [ID=4]\nM30\n"
     assert_at(Channel().error(text), E.PATTERN_NOT_DEFINED, text, "4")
 
 
-def test_patterns_end_with_the_program():
+def test_patterns_end_with_the_program() -> None:
     channel = Channel({"c.ecy": PATTERN_CYCLE})
     first, _ = channel.run("#PATTERN BEGIN [ID=1]\n#AT [1, 2, 3]\n#PATTERN END\nM30\n")
     assert list(first.modal.patterns) == [1]
@@ -706,7 +706,7 @@ def test_patterns_end_with_the_program():
 
 # ---------------------------------------------------------------- 11. #MSG
 
-def test_msg_goes_to_the_message_list():
+def test_msg_goes_to_the_message_list() -> None:
     channel = Channel()
     channel.run('#MSG ["text %d", 3]\n#VAR\nV.L.A = 2.5\n#ENDVAR\n'
                 '#MSG ["%5.2f|%-4d|%s|%%|%x|%e", V.L.A * 2, 7.9, "abc", 255, 12345.678]\nM30\n')
@@ -717,7 +717,7 @@ def test_msg_goes_to_the_message_list():
 @pytest.mark.parametrize("line", ['#MSG ["text %d"]', '#MSG ["text", 3]', '#MSG ["%d", "a"]',
                                   '#MSG ["%q", 1]', '#MSG ["%200f", 1]',
                                   '#MSG SAVE ["%d %d", 1]'])
-def test_msg_format_errors(line):
+def test_msg_format_errors(line) -> None:
     channel = Channel()
     text = f"G01 F100 X1\n{line}\nM30\n"
     error = channel.error(text)

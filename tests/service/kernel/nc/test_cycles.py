@@ -62,7 +62,7 @@ OLD = "old content of the file\n"
     (CIRCLE_EXAMPLE, "SysCalcCircleResult.txt", CIRCLE_RESULT),
     (SPHERE_EXAMPLE, "SysCalcSphereResult.txt", SPHERE_RESULT),
 ], ids=["SysCalcCircle", "SysCalcSphere"])
-def test_exclusive_examples_replace_the_old_file(program, file, result):
+def test_exclusive_examples_replace_the_old_file(program, file, result) -> None:
     channel = Channel({file: OLD})
     d, blocks = channel.run(program)
     assert channel.files[file] == result  # the old content is gone
@@ -81,7 +81,7 @@ def test_exclusive_examples_replace_the_old_file(program, file, result):
     (LINE_EXAMPLE, "SysCalcLineResult.txt", LINE_RESULT),
     (PLANE_CIRCLE_EXAMPLE, "SysCalcPlaneCircleResult.txt", PLANE_CIRCLE_RESULT),
 ], ids=["SysCalcPlane", "SysCalcLine", "SysCalcPlaneCircle"])
-def test_examples_without_exclusive_append_to_the_file(program, file, result):
+def test_examples_without_exclusive_append_to_the_file(program, file, result) -> None:
     channel = Channel({file: OLD})
     channel.run(program)
     assert channel.files[file] == OLD + result
@@ -90,7 +90,7 @@ def test_examples_without_exclusive_append_to_the_file(program, file, result):
     assert channel.files[file] == OLD + result + result
 
 
-def test_examples_write_a_new_file_when_there_is_none():
+def test_examples_write_a_new_file_when_there_is_none() -> None:
     channel = Channel()
     for program in (CIRCLE_EXAMPLE, PLANE_EXAMPLE, LINE_EXAMPLE, SPHERE_EXAMPLE,
                     PLANE_CIRCLE_EXAMPLE):
@@ -102,7 +102,7 @@ def test_examples_write_a_new_file_when_there_is_none():
     }
 
 
-def test_exclusive_replaces_once_per_file_and_run():
+def test_exclusive_replaces_once_per_file_and_run() -> None:
     channel = Channel({"a.txt": "old a\n", "b.txt": "old b\n"})
     channel.run('#FILE NAME [MSG="a.txt"]\n#MSG SAVE EXCLUSIVE ["a1"]\n'
                 '#FILE NAME [MSG="b.txt"]\n#MSG SAVE EXCLUSIVE ["b1"]\n'
@@ -110,7 +110,7 @@ def test_exclusive_replaces_once_per_file_and_run():
     assert channel.files == {"a.txt": "a1\na2\na3\n", "b.txt": "b1\n"}
 
 
-def test_outputs_of_the_example_are_in_the_callers_variables():
+def test_outputs_of_the_example_are_in_the_callers_variables() -> None:
     # the documentation example, checked in the program itself: an error if wrong
     text = CIRCLE_EXAMPLE.replace(
         "M30\n", "$IF V.CYC.SysRetRadius <> 1 OR V.CYC.SysRetCenterX <> 0 OR "
@@ -121,7 +121,7 @@ def test_outputs_of_the_example_are_in_the_callers_variables():
     assert move.motion.end_mm == pytest.approx((7.0, 0.0, 0.0), abs=1e-12)
 
 
-def test_outputs_not_declared_are_no_error():
+def test_outputs_not_declared_are_no_error() -> None:
     text = "L CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=-1 @P51=0 @P61=1 @P52=1 @P62=0]\nM30\n"
     _, blocks = Channel().run(text)
     assert len(blocks) == 1
@@ -147,7 +147,7 @@ def fitted(cycle: str, points, outputs) -> dict[str, float]:
     return {name: float(v) for name, v in values.items()}
 
 
-def test_circle_on_a_partial_arc():
+def test_circle_on_a_partial_arc() -> None:
     cx, cy, r = 12.5, -7.25, 37.5
     points = [(cx + r * math.cos(math.radians(a)), cy + r * math.sin(math.radians(a)))
               for a in (10, 35, 60, 85, 110)]
@@ -159,7 +159,7 @@ def test_circle_on_a_partial_arc():
     assert 0.0 <= out["SysRetVariance"] < 1e-9
 
 
-def test_circle_variance_of_points_off_the_circle():
+def test_circle_variance_of_points_off_the_circle() -> None:
     # four points at radius 9 and 11 alternating: centre 0, radius 10, variance 1
     points = [(9.0, 0.0), (0.0, 11.0), (-9.0, 0.0), (0.0, -11.0)]
     out = fitted("SysCalcCircle.ecy", points,
@@ -169,7 +169,7 @@ def test_circle_variance_of_points_off_the_circle():
     assert out["SysRetVariance"] == pytest.approx(1.0, abs=1e-9)
 
 
-def test_tilted_plane():
+def test_tilted_plane() -> None:
     normal = np.array([1.0, 2.0, 2.0]) / 3.0
     u = np.array([2.0, -1.0, 0.0]) / math.sqrt(5.0)
     v = np.cross(normal, u)
@@ -186,7 +186,7 @@ def test_tilted_plane():
     assert support == pytest.approx(np.mean(points, axis=0), abs=1e-9)  # the centroid
 
 
-def test_plane_normal_points_to_positive_z_whatever_the_point_order():
+def test_plane_normal_points_to_positive_z_whatever_the_point_order() -> None:
     points = [(0.0, 0.0, 0.0), (0.0, 1.0, 1.0), (1.0, 0.0, 0.0)]  # clockwise seen from +Z
     out = fitted("SysCalcPlane.ecy", points, ("SysRetNormalX", "SysRetNormalY", "SysRetNormalZ"))
     s = math.sqrt(0.5)
@@ -194,7 +194,7 @@ def test_plane_normal_points_to_positive_z_whatever_the_point_order():
         pytest.approx((0.0, -s, s), abs=1e-9)
 
 
-def test_line_in_space():
+def test_line_in_space() -> None:
     direction = np.array([3.0, -4.0, 12.0]) / 13.0
     base = np.array([1.0, 2.0, 3.0])
     points = [tuple(float(c) for c in base + t * direction) for t in (-2.0, 0.5, 3.0, 7.0)]
@@ -213,7 +213,7 @@ def test_line_in_space():
         pytest.approx(-direction, abs=1e-9)
 
 
-def test_line_through_two_points():
+def test_line_through_two_points() -> None:
     out = fitted("SysCalcLine.ecy", [(1.0, 1.0, 1.0), (1.0, 1.0, -4.0)],
                  ("SysRetDirVectorX", "SysRetDirVectorY", "SysRetDirVectorZ", "SysRetSupVectorZ"))
     assert (out["SysRetDirVectorX"], out["SysRetDirVectorY"], out["SysRetDirVectorZ"]) == \
@@ -221,7 +221,7 @@ def test_line_through_two_points():
     assert out["SysRetSupVectorZ"] == pytest.approx(-1.5, abs=1e-12)
 
 
-def test_sphere():
+def test_sphere() -> None:
     centre = np.array([3.0, -4.0, 5.5])
     r = 7.25
     dirs = [(1, 0.2, 0.1), (-0.3, 1, 0.5), (0.2, -0.4, 1), (-1, -0.5, 0.3), (0.6, 0.7, -0.9),
@@ -236,7 +236,7 @@ def test_sphere():
     assert 0.0 <= out["SysRetVariance"] < 1e-9
 
 
-def test_circle_in_space_on_a_partial_arc():
+def test_circle_in_space_on_a_partial_arc() -> None:
     centre = np.array([10.0, 20.0, 30.0])
     normal = np.array([0.0, 0.6, 0.8])
     e1 = np.array([1.0, 0.0, 0.0])
@@ -254,7 +254,7 @@ def test_circle_in_space_on_a_partial_arc():
     assert 0.0 <= out["SysRetRadVariance"] < 1e-9
 
 
-def test_ten_points_are_accepted():
+def test_ten_points_are_accepted() -> None:
     points = [(5 + 2 * math.cos(k * 0.6), -1 + 2 * math.sin(k * 0.6)) for k in range(10)]
     out = fitted("SysCalcCircle.ecy", points, ("SysRetCenterX", "SysRetCenterY", "SysRetRadius"))
     assert (out["SysRetCenterX"], out["SysRetCenterY"], out["SysRetRadius"]) == \
@@ -273,7 +273,7 @@ def test_ten_points_are_accepted():
     ("SysCalcSphere.ecy", [(1, 0, 0), (2, 0, 0), (3, 0, 0), (4, 0, 0)], E.CYCLE_POINTS_COLLINEAR),
     ("SysCalcPlaneCircle.ecy", [(0, 0, 1), (1, 1, 1), (2, 2, 1)], E.CYCLE_POINTS_COLLINEAR),
 ])
-def test_degenerate_points(cycle, points, err_id):
+def test_degenerate_points(cycle, points, err_id) -> None:
     text = "G01 F100 X1\n" + fit_program(cycle, points, ("SysRetRadius",))
     error = Channel().error(text)
     assert int(err_id) in (20516, 20517, 20518)
@@ -281,7 +281,7 @@ def test_degenerate_points(cycle, points, err_id):
     assert cycle in error.message
 
 
-def test_degenerate_points_error_stops_before_the_rest():
+def test_degenerate_points_error_stops_before_the_rest() -> None:
     text = ('#FILE NAME [MSG="r.txt"]\n#MSG SAVE ["before"]\n'
             "L CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=0 @P51=1 @P61=1 @P52=2 @P62=2]\n"
             '#MSG SAVE ["after"]\nM30\n')
@@ -291,20 +291,20 @@ def test_degenerate_points_error_stops_before_the_rest():
     assert channel.files == {"r.txt": "before\n"}
 
 
-def test_two_points_are_too_few_for_a_circle():
+def test_two_points_are_too_few_for_a_circle() -> None:
     text = "L CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=0 @P51=1 @P61=1]\nM30\n"
     error = Channel().error(text)
     assert_at(error, E.CYCLE_PARAMETER_MISSING, text, "SysCalcCircle.ecy")
     assert "@P52" in error.message and "point 3" in error.message
 
 
-def test_one_point_is_too_few_for_a_line():
+def test_one_point_is_too_few_for_a_line() -> None:
     text = "L CYCLE [NAME=SysCalcLine.ecy @P50=0 @P60=0 @P70=0]\nM30\n"
     error = Channel().error(text)
     assert error.id == E.CYCLE_PARAMETER_MISSING and "@P51" in error.message
 
 
-def test_point_without_one_of_its_coordinates():
+def test_point_without_one_of_its_coordinates() -> None:
     text = "L CYCLE [NAME=SysCalcPlane.ecy @P50=0 @P60=0 @P70=0 @P51=1 @P61=0 @P71=0 " \
            "@P52=0 @P72=1]\nM30\n"
     error = Channel().error(text)
@@ -312,21 +312,21 @@ def test_point_without_one_of_its_coordinates():
     assert "@P62" in error.message and "point 3" in error.message
 
 
-def test_unknown_parameter_of_the_2d_circle():
+def test_unknown_parameter_of_the_2d_circle() -> None:
     text = "L CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=0 @P51=1 @P61=1 @P52=2 @P62=1 @P70=1]\nM30\n"
     error = Channel().error(text)
     assert_at(error, E.CYCLE_PARAMETER_UNKNOWN, text, "@P70")
     assert "@P70" in error.message
 
 
-def test_string_value_is_out_of_range():
+def test_string_value_is_out_of_range() -> None:
     text = 'L CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=0 @P51=1 @P61=1 @P52="two" @P62=1]\nM30\n'
     error = Channel().error(text)
     assert_at(error, E.CYCLE_PARAMETER_RANGE, text, "@P52")
     assert "@P52" in error.message and "string" in error.message
 
 
-def test_point_five_without_point_four():
+def test_point_five_without_point_four() -> None:
     text = ("L CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=0 @P51=1 @P61=1 @P52=2 @P62=1 "
             "@P54=3 @P64=3]\nM30\n")
     error = Channel().error(text)
@@ -335,21 +335,21 @@ def test_point_five_without_point_four():
     assert (error.file, error.line) == ("prog.nc", 1)
 
 
-def test_unknown_cycle_name():
+def test_unknown_cycle_name() -> None:
     text = "G01 F100 X1\nL CYCLE [NAME=SysCalcEllipse.ecy @P50=0]\nM30\n"
     error = Channel().error(text)
     assert_at(error, E.CYCLE_NOT_FOUND, text, "SysCalcEllipse.ecy")
     assert "SysCalcEllipse.ecy" in error.message
 
 
-def test_parameter_given_twice():
+def test_parameter_given_twice() -> None:
     text = "L CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=0 @P50=1]\nM30\n"
     error = Channel().error(text)
     assert_at(error, E.CYCLE_PARAMETER_TWICE, text, "@P50", occurrence=1)
     assert "@P50" in error.message
 
 
-def test_name_given_twice():
+def test_name_given_twice() -> None:
     text = "L CYCLE [NAME=a.ecy NAME=b.ecy]\nM30\n"
     error = Channel({"a.ecy": "M17\n", "b.ecy": "M17\n"}).error(text)
     assert_at(error, E.CYCLE_PARAMETER_TWICE, text, "NAME", occurrence=1)
@@ -362,19 +362,19 @@ def test_name_given_twice():
     ("L CYCLE [NAME=SysCalcCircle.ecy @P50 0]", "0]"),  # no '='
     ("L CYCLE [NAME=SysCalcCircle.ecy FOO=1]", "FOO"),  # unknown keyword
 ])
-def test_malformed_call(call, needle):
+def test_malformed_call(call, needle) -> None:
     text = f"G01 F100 X1\n{call}\nM30\n"
     error = Channel().error(text)
     assert_at(error, E.CYCLE_SYNTAX, text, needle)
 
 
-def test_missing_bracket_of_a_continued_call_points_at_the_open_bracket():
+def test_missing_bracket_of_a_continued_call_points_at_the_open_bracket() -> None:
     text = "L CYCLE [NAME=SysCalcCircle.ecy \\\n @P50=0 @P60=0 \\\n @P51=1 @P61=1\nM30\n"
     error = Channel().error(text)
     assert_at(error, E.CYCLE_SYNTAX, text, "[")
 
 
-def test_error_in_a_continuation_line_points_at_its_physical_line():
+def test_error_in_a_continuation_line_points_at_its_physical_line() -> None:
     text = ("G01 F100\nL CYCLE [NAME=SysCalcCircle.ecy \\\n  ; first point\n"
             "  @P50=0 @P60=0 \\\n\n  ( second ) @P51=1 @P61=1 \\\n  @P52=2 @P62=\"s\" \\\n]\nM30\n")
     error = Channel().error(text)
@@ -382,7 +382,7 @@ def test_error_in_a_continuation_line_points_at_its_physical_line():
     assert error.line == 7
 
 
-def test_output_variable_of_a_wrong_type_is_the_programs_error():
+def test_output_variable_of_a_wrong_type_is_the_programs_error() -> None:
     # (was a decoder fault, INTERNAL_ERROR, at the line after the call)
     text = ("#VAR\nV.CYC.SysRetCenterX : UNS08\n#ENDVAR\n"
             "L CYCLE [NAME=SysCalcCircle.ecy @P50=-5 @P60=0 @P51=-3 @P61=2 @P52=-1 @P62=0]\nM30\n")
@@ -394,7 +394,7 @@ def test_output_variable_of_a_wrong_type_is_the_programs_error():
     assert_at(Channel().error(text), E.TYPE_MISMATCH, text, "SysCalcCircle.ecy")
 
 
-def test_integer_output_variable_gets_the_rounded_result():
+def test_integer_output_variable_gets_the_rounded_result() -> None:
     text = ("#VAR\nV.CYC.SysRetRadius : UNS08\n#ENDVAR\n"
             "L CYCLE [NAME=SysCalcCircle.ecy @P50=-5 @P60=0 @P51=-3 @P61=2 @P52=-1 @P62=0]\n"
             '#FILE NAME [MSG="r.txt"]\n#MSG SAVE ["%f", V.CYC.SysRetRadius]\nM30\n')
@@ -405,7 +405,7 @@ def test_integer_output_variable_gets_the_rounded_result():
 
 # ---------------------------------------------------------------- 4. how parameters are written
 
-def test_parameters_as_expressions_and_variables():
+def test_parameters_as_expressions_and_variables() -> None:
     text = """#VAR
   V.L.R = 5
   V.L.CX = 2
@@ -430,7 +430,7 @@ M30
     assert channel.files["r.txt"] == "2.000000000 3.000000000 5.000000000\n"
 
 
-def test_cycle_names_are_case_insensitive_and_spaced():
+def test_cycle_names_are_case_insensitive_and_spaced() -> None:
     for name in ("syscalccircle.ecy", " SYSCALCCIRCLE.ECY", '"SysCalcCircle.ecy"'):
         text = (f"#VAR\nV.CYC.SysRetRadius\n#ENDVAR\nL CYCLE [NAME ={name} @P50 = 0 @P60 = -2 "
                 "@P51 = 0 @P61 = 2 @P52 = 2 @P62 = 0]\n"
@@ -440,7 +440,7 @@ def test_cycle_names_are_case_insensitive_and_spaced():
         assert channel.files["r.txt"] == "2\n", name
 
 
-def test_parameter_values_are_evaluated_in_the_caller():
+def test_parameter_values_are_evaluated_in_the_caller() -> None:
     files = {"show.ecy": '#MSG SAVE ["%g %s", @P1, @P2]\nM17\n'}
     text = ('#VAR\nV.L.A = 21\nV.L.S : STRING = "text"\n#ENDVAR\n#FILE NAME [MSG="r.txt"]\n'
             "L CYCLE [NAME=show.ecy @P1 = V.L.A * 2 @P2 = V.L.S]\nV.L.A = 0\nM30\n")
@@ -449,7 +449,7 @@ def test_parameter_values_are_evaluated_in_the_caller():
     assert channel.files["r.txt"] == "42 text\n"
 
 
-def test_undeclared_variable_in_a_parameter():
+def test_undeclared_variable_in_a_parameter() -> None:
     text = "L CYCLE [NAME=SysCalcCircle.ecy @P50 = V.L.NOPE]\nM30\n"
     error = Channel().error(text)
     assert error.id == E.UNDECLARED_VARIABLE and error.line == 1
@@ -464,7 +464,7 @@ M17
 """
 
 
-def test_user_cycle_file_reads_its_parameters_and_writes_outputs():
+def test_user_cycle_file_reads_its_parameters_and_writes_outputs() -> None:
     text = """#VAR
   V.CYC.Done = 0
 #ENDVAR
@@ -486,7 +486,7 @@ M30
     assert moves[2].motion.feed_mm_s == pytest.approx(10.0)  # F is not restored
 
 
-def test_output_declared_in_a_calling_subprogram():
+def test_output_declared_in_a_calling_subprogram() -> None:
     files = {"sub.nc": ("#VAR\nV.CYC.SysRetRadius\n#ENDVAR\n"
                         "L CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=-3 @P51=0 @P61=3 @P52=3 @P62=0]\n"
                         '#FILE NAME [MSG="r.txt"]\n#MSG SAVE ["r=%g", V.CYC.SysRetRadius]\nM17\n')}
@@ -495,21 +495,21 @@ def test_output_declared_in_a_calling_subprogram():
     assert channel.files["r.txt"] == "r=3\n"
 
 
-def test_user_cycle_reading_a_parameter_not_given():
+def test_user_cycle_reading_a_parameter_not_given() -> None:
     channel = Channel({"mill.ecy": USER_CYCLE})
     error = channel.error("L CYCLE [NAME=mill.ecy @P1=3 @P3=100]\nM30\n")
     assert_at(error, E.CYCLE_PARAMETER_UNDEFINED, USER_CYCLE, "@P2", file="mill.ecy")
     assert "@P2" in error.message
 
 
-def test_parameter_outside_a_cycle():
+def test_parameter_outside_a_cycle() -> None:
     text = "G01 F100\nX[@P7 + 1]\nM30\n"
     error = Channel().error(text)
     assert_at(error, E.CYCLE_PARAMETER_UNDEFINED, text, "@P7")
     assert "@P7" in error.message
 
 
-def test_parameters_belong_to_their_call():
+def test_parameters_belong_to_their_call() -> None:
     # after the cycle returns, its @P are gone
     text = "L CYCLE [NAME=c.ecy @P1=5]\nG01 F100 X[@P1]\nM30\n"
     channel = Channel({"c.ecy": "G01 X[@P1] F100\nM17\n"})
@@ -517,7 +517,7 @@ def test_parameters_belong_to_their_call():
     assert_at(error, E.CYCLE_PARAMETER_UNDEFINED, text, "@P1", occurrence=1)
 
 
-def test_nested_user_cycles_see_their_own_parameters():
+def test_nested_user_cycles_see_their_own_parameters() -> None:
     files = {"outer.ecy": "G01 X[@P1] F100\nL CYCLE [NAME=inner.ecy @P1 = @P1 + 10]\nY[@P1]\nM17\n",
              "inner.ecy": "G01 X[@P1]\nM17\n"}
     _, blocks = Channel(files).run("L CYCLE [NAME=outer.ecy @P1=2]\nM30\n")
@@ -525,12 +525,12 @@ def test_nested_user_cycles_see_their_own_parameters():
         [(2.0, 0.0, 0.0), (12.0, 0.0, 0.0), (12.0, 2.0, 0.0)]
 
 
-def test_user_cycle_missing_in_the_store():
+def test_user_cycle_missing_in_the_store() -> None:
     text = "L CYCLE [NAME=mill.ecy @P1=1]\nM30\n"
     assert_at(Channel().error(text), E.CYCLE_NOT_FOUND, text, "mill.ecy")
 
 
-def test_local_cycle_runs_a_percent_l_section():
+def test_local_cycle_runs_a_percent_l_section() -> None:
     text = """G01 F100 X1
 LL CYCLE [NAME=SUB @P1 = 2 @P2 = 5]
 X9
@@ -548,12 +548,12 @@ M17
     ]
 
 
-def test_local_cycle_without_its_section():
+def test_local_cycle_without_its_section() -> None:
     text = "LL CYCLE [NAME=SUB @P1=2]\nM30\n%L OTHER\nM17\n"
     assert_at(Channel().error(text), E.CYCLE_NOT_FOUND, text, "SUB")
 
 
-def test_callers_modal_functions_are_restored_after_a_cycle():
+def test_callers_modal_functions_are_restored_after_a_cycle() -> None:
     files = {"modal.ecy": "G91 G00 X1\nG18\nM17\n"}
     text = "G90 G01 F100 X5\nL CYCLE [NAME=modal.ecy]\nX7\nG02 X9 Y2 I1 J1\nM30\n"
     d, blocks = Channel(files).run(text)
@@ -568,7 +568,7 @@ def test_callers_modal_functions_are_restored_after_a_cycle():
     assert d.modal.plane == Plane.XY and d.modal.distance == DistanceMode.ABSOLUTE
 
 
-def test_incremental_rapid_caller_is_restored_too():
+def test_incremental_rapid_caller_is_restored_too() -> None:
     files = {"modal.ecy": "G90 G01 X50 F100\nM17\n"}
     text = "G91 G00 X1\nL CYCLE [NAME=modal.ecy]\nX1\nM30\n"
     d, blocks = Channel(files).run(text)
@@ -622,7 +622,7 @@ def hsc_channel() -> Channel:
     return Channel(files, hscs=hscs)
 
 
-def test_hsc_example_switches_the_finish_settings():
+def test_hsc_example_switches_the_finish_settings() -> None:
     d, blocks = hsc_channel().run(HSC_EXAMPLE)
     s = d.modal.settings
     assert (s.hsc, s.hsc_surface) == (True, True)
@@ -636,7 +636,7 @@ def test_hsc_example_switches_the_finish_settings():
     assert moves[-1].motion.end_mm == (0.0, 0.0, 150.0)  # the cycle moves nothing
 
 
-def test_hsc_deselect_program_of_the_documentation():
+def test_hsc_deselect_program_of_the_documentation() -> None:
     channel = hsc_channel()
     text = ("L CYCLE [NAME=SysHscSettings.ecy @P1=4]\nL CYCLE [NAME=SysHscSettings.ecy @P1 = 1]\n"
             "M30\n")
@@ -646,14 +646,14 @@ def test_hsc_deselect_program_of_the_documentation():
     assert s.slope == "HSC"  # the deselect program leaves #SLOPE as it is
 
 
-def test_hsc_mode_defaults_to_deselect():
+def test_hsc_mode_defaults_to_deselect() -> None:
     d, _ = hsc_channel().run("L CYCLE [NAME=SysHscSettings.ecy @P1=4]\n"
                              "L CYCLE [NAME=SysHscSettings.ecy]\nM30\n")
     assert d.modal.settings.hsc is False and d.modal.settings.acc_weight_pct == 100.0
 
 
 @pytest.mark.parametrize("mode", [1, 2, 3, 4])
-def test_each_hsc_mode_calls_its_own_program(mode):
+def test_each_hsc_mode_calls_its_own_program(mode) -> None:
     tolerances = {"DESELECT": 0.125, "ROUGH": 0.0625, "PREFINISH": 0.03125, "FINISH": 0.015625}
     files = {f"{m.lower()}.nc": f'#MSG SAVE ["{m} %g", V.G.HSCS.{m}.TOLERANCE]\nG01 X{k + 1}\nM17\n'
              for k, m in enumerate(MODES)}
@@ -667,7 +667,7 @@ def test_each_hsc_mode_calls_its_own_program(mode):
     assert move.motion.end_mm == (float(mode), 0.0, 0.0)
 
 
-def test_hsc_tolerances_are_readable_anywhere():
+def test_hsc_tolerances_are_readable_anywhere() -> None:
     channel = hsc_channel()
     channel.run('#MSG ["%g %g %g %g", V.G.HSCS.DESELECT.TOLERANCE, V.G.HSCS.ROUGH.TOLERANCE, '
                 'V.G.HSCS.PREFINISH.TOLERANCE, V.G.HSCS.FINISH.TOLERANCE]\nM30\n')
@@ -675,17 +675,17 @@ def test_hsc_tolerances_are_readable_anywhere():
 
 
 @pytest.mark.parametrize("value", ["5", "0", "2.5", '"FINISH"'])
-def test_hsc_mode_out_of_range(value):
+def test_hsc_mode_out_of_range(value) -> None:
     text = f"L CYCLE [NAME=SysHscSettings.ecy @P1={value}]\nM30\n"
     assert_at(hsc_channel().error(text), E.CYCLE_PARAMETER_RANGE, text, "@P1")
 
 
-def test_hsc_unknown_parameter():
+def test_hsc_unknown_parameter() -> None:
     text = "L CYCLE [NAME=SysHscSettings.ecy @P1=4 @P2=1]\nM30\n"
     assert_at(hsc_channel().error(text), E.CYCLE_PARAMETER_UNKNOWN, text, "@P2")
 
 
-def test_hsc_mode_without_a_program():
+def test_hsc_mode_without_a_program() -> None:
     channel = hsc_channel()
     channel.hscs["ROUGH"] = HscProgram("", 0.05)
     text = "L CYCLE [NAME=SysHscSettings.ecy @P1=2]\nM30\n"
@@ -696,14 +696,14 @@ def test_hsc_mode_without_a_program():
     assert channel.error(text).id == E.CYCLE_NOT_FOUND
 
 
-def test_hsc_program_missing_in_the_store():
+def test_hsc_program_missing_in_the_store() -> None:
     text = "L CYCLE [NAME=SysHscSettings.ecy @P1=3]\nM30\n"
     error = hsc_channel().error(text)  # prefinish.nc is not in the store
     assert_at(error, E.CYCLE_NOT_FOUND, text, "@P1")
     assert "prefinish.nc" in error.message
 
 
-def test_hsc_program_is_read_as_a_subprogram():
+def test_hsc_program_is_read_as_a_subprogram() -> None:
     channel = hsc_channel()
     channel.files["rough.nc"] = "G133 = 180\n"  # no M17
     error = channel.error("L CYCLE [NAME=SysHscSettings.ecy @P1=2]\nM30\n")
@@ -737,7 +737,7 @@ M30
 """
 
 
-def test_check_reports_every_bad_parameter_of_a_call_and_goes_on():
+def test_check_reports_every_bad_parameter_of_a_call_and_goes_on() -> None:
     channel = Channel({"out.txt": "keep\n"})
     run = check(CHECKED, channel)
     found = [(e.id, e.file, e.line, e.column) for e, _ in run.check.errors]
@@ -755,7 +755,7 @@ def test_check_reports_every_bad_parameter_of_a_call_and_goes_on():
     assert run.ended()
 
 
-def test_check_reports_missing_points_with_unknown_parameters():
+def test_check_reports_missing_points_with_unknown_parameters() -> None:
     text = "L CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=0 @P51=1 @P70=1]\nG01 F100 X4\nM30\n"
     run = check(text, Channel())
     errors = [e for e, _ in run.check.errors]
@@ -766,7 +766,7 @@ def test_check_reports_missing_points_with_unknown_parameters():
     assert run.ends() == [(4.0, 0.0, 0.0)] and run.ended()
 
 
-def test_check_of_user_cycles_and_unknown_cycles():
+def test_check_of_user_cycles_and_unknown_cycles() -> None:
     channel = Channel({"c.ecy": "G01 X[@P1] F100\nM17\n"})
     text = "L CYCLE [NAME=Nope.ecy]\nL CYCLE [NAME=c.ecy @P2=4]\nL CYCLE [NAME=c.ecy @P1=4]\nM30\n"
     run = check(text, channel)
@@ -775,7 +775,7 @@ def test_check_of_user_cycles_and_unknown_cycles():
     assert run.ends()[-1] == (4.0, 0.0, 0.0) and run.ended()
 
 
-def test_check_without_errors_runs_the_cycle():
+def test_check_without_errors_runs_the_cycle() -> None:
     channel = Channel()
     text = ("#VAR\nV.CYC.SysRetRadius\n#ENDVAR\n"
             "L CYCLE [NAME=SysCalcCircle.ecy @P50=0 @P60=-2 @P51=0 @P61=2 @P52=2 @P62=0]\n"

@@ -36,11 +36,11 @@ def value(expr: str) -> float:
         ('"ab" == "ab"', 1), ('"ab" != "ac"', 1),
     ],
 )
-def test_values(expr, expected):
+def test_values(expr, expected) -> None:
     assert value(expr) == pytest.approx(expected, abs=1e-12)
 
 
-def test_short_circuit_skips_errors():
+def test_short_circuit_skips_errors() -> None:
     assert value("0 AND 1/0") == 0
     assert value("1 OR 1/0") == 1
 
@@ -72,16 +72,16 @@ def test_short_circuit_skips_errors():
         ("1e10 ** 40", NcErrorId.EXPRESSION_SYNTAX, 10),
     ],
 )
-def test_expression_errors(expr, err, column):
+def test_expression_errors(expr, err, column) -> None:
     e = error_of(f"G0 Y1 X[{expr}]\nM30")
     assert (e.id, e.line, e.column) == (err, 1, column), str(e)
 
 
-def test_division_by_zero_message():
+def test_division_by_zero_message() -> None:
     assert error_of("G0 X[1/0]\nM30").message == "division by zero"
 
 
-def test_infinite_result_is_out_of_range():
+def test_infinite_result_is_out_of_range() -> None:
     e = error_of("G0 X[1E300]\nM30")
     assert e.id == NcErrorId.EXPRESSION_SYNTAX
     e = error_of("G0 X[10**300 * 10**300]\nM30")
@@ -97,10 +97,10 @@ def test_infinite_result_is_out_of_range():
         ("ROUND[[10**300 * 10**300] - [10**300 * 10**300]]", NcErrorId.MATH_DOMAIN),
     ],
 )
-def test_infinite_intermediate_values(expr, err):
+def test_infinite_intermediate_values(expr, err) -> None:
     assert error_of(f"G0 X[{expr}]\nM30").id == err
 
 
-def test_infinite_array_index():
+def test_infinite_array_index() -> None:
     e = error_of("#VAR\nV.L.A[2]\n#ENDVAR\nG0 X[V.L.A[10**300 * 10**300]]\nM30")
     assert e.id == NcErrorId.ARRAY_INDEX_MISMATCH

@@ -134,34 +134,34 @@ def radially_noisy_2d(centre, radius, degrees, sigma, seed):
 # --- documentation examples --------------------------------------------------------------
 
 
-def test_doc_example_circle():
+def test_doc_example_circle() -> None:
     fit = fit_circle_2d([(0, -1), (0, 1), (1, 0), (-1, 0)])
     assert close((fit.center_x, fit.center_y), (0, 0))
     assert close(fit.radius, 1)
     assert close(fit.variance, 0, 1e-20)
 
 
-def test_doc_example_plane():
+def test_doc_example_plane() -> None:
     fit = fit_plane([(1, 0, 0), (0, 1, 0), (1, 1, 0)])
     assert close(fit.normal, (0, 0, 1))
     assert close(fit.support, (2 / 3, 2 / 3, 0))
 
 
-def test_doc_example_line():
+def test_doc_example_line() -> None:
     fit = fit_line([(0, 0, 0), (1, 0, 0), (2, 0, 0)])
     assert close(fit.direction, (1, 0, 0))
     assert close(fit.support, (1, 0, 0))
     assert close(fit.variance, 0, 1e-20)
 
 
-def test_doc_example_sphere():
+def test_doc_example_sphere() -> None:
     fit = fit_sphere([(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1)])
     assert close(fit.center, (0, 0, 0))
     assert close(fit.radius, 1)
     assert close(fit.variance, 0, 1e-20)
 
 
-def test_doc_example_circle_3d():
+def test_doc_example_circle_3d() -> None:
     fit = fit_circle_3d([(1, 0, 1), (0, 1, 1), (-1, 0, 1), (0, -1, 1)])
     assert close(fit.center, (0, 0, 1))
     assert close(fit.radius, 1)
@@ -172,7 +172,7 @@ def test_doc_example_circle_3d():
 # --- result types ------------------------------------------------------------------------
 
 
-def test_results_are_plain_python_floats_and_frozen():
+def test_results_are_plain_python_floats_and_frozen() -> None:
     results = [
         fit_circle_2d(arc_2d(CENTRE_2D, RADIUS, [0, 100, 200])),
         fit_plane([(1, 0, 0), (0, 1, 0), (1, 1, 0.5)]),
@@ -203,14 +203,14 @@ def test_results_are_plain_python_floats_and_frozen():
     [0, 36, 72, 108, 144, 180, 216, 252, 288, 324],  # 10 points, full circle
     [200, 201, 203, 207],              # 7 degree arc
 ])
-def test_circle_2d_exact(degrees):
+def test_circle_2d_exact(degrees) -> None:
     fit = fit_circle_2d(arc_2d(CENTRE_2D, RADIUS, degrees))
     assert close((fit.center_x, fit.center_y), CENTRE_2D)
     assert close(fit.radius, RADIUS)
     assert 0.0 <= fit.variance <= 1e-20
 
 
-def test_circle_2d_exact_far_from_origin_and_tiny():
+def test_circle_2d_exact_far_from_origin_and_tiny() -> None:
     fit = fit_circle_2d(arc_2d((1.0e4, -2.5e4), 0.5, [0, 50, 100, 150]))
     assert close((fit.center_x, fit.center_y), (1.0e4, -2.5e4))
     assert close(fit.radius, 0.5)
@@ -218,7 +218,7 @@ def test_circle_2d_exact_far_from_origin_and_tiny():
     assert close(tiny.radius, 1e-6, 1e-15)
 
 
-def test_circle_2d_large_radius_through_nearly_straight_points():
+def test_circle_2d_large_radius_through_nearly_straight_points() -> None:
     # Sagitta 1e-3 on a chord of 2: radius (1 + 1e-6) / 2e-3, clearly not collinear.
     fit = fit_circle_2d([(0, 0), (1, 1e-3), (2, 0)])
     radius = (1 + 1e-6) / 2e-3
@@ -228,7 +228,7 @@ def test_circle_2d_large_radius_through_nearly_straight_points():
 
 @pytest.mark.parametrize("normal", [(0, 0, 1), (1, 2, 3), (-3, 1, 0.5), (1, 0, 0)])
 @pytest.mark.parametrize("degrees", [[10, 40, 70], [0, 36, 72, 108, 144, 180, 216, 252, 288, 324]])
-def test_circle_3d_exact(normal, degrees):
+def test_circle_3d_exact(normal, degrees) -> None:
     fit = fit_circle_3d(arc_3d(CENTRE_3D, RADIUS, normal, degrees))
     assert close(fit.center, CENTRE_3D)
     assert close(fit.radius, RADIUS)
@@ -238,7 +238,7 @@ def test_circle_3d_exact(normal, degrees):
 
 @pytest.mark.parametrize("normal", [(1, 2, 3), (-3, 1, 0.5), (0.2, -0.1, -1)])
 @pytest.mark.parametrize("count", [3, 10])
-def test_plane_exact_tilted(normal, count):
+def test_plane_exact_tilted(normal, count) -> None:
     u, v = plane_basis(normal)
     rng = np.random.default_rng(count)
     support = np.array(CENTRE_3D)
@@ -251,7 +251,7 @@ def test_plane_exact_tilted(normal, count):
 
 
 @pytest.mark.parametrize("count", [2, 3, 10])
-def test_line_exact_with_negative_direction(count):
+def test_line_exact_with_negative_direction(count) -> None:
     direction = unit((-1, 2, -2))
     start = np.array([5.0, 3.0, -2.0])
     points = [tuple(float(x) for x in start + t * direction)
@@ -268,7 +268,7 @@ def test_line_exact_with_negative_direction(count):
     [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1),
      (1, 1, 1), (-1, 1, -1), (1, -1, 0.5), (-0.3, -1, 1)],                     # 10 points
 ])
-def test_sphere_exact(directions):
+def test_sphere_exact(directions) -> None:
     fit = fit_sphere(sphere_points(CENTRE_3D, RADIUS, directions))
     assert close(fit.center, CENTRE_3D)
     assert close(fit.radius, RADIUS)
@@ -279,7 +279,7 @@ def test_sphere_exact(directions):
 
 
 @pytest.mark.parametrize("degrees", [list(range(0, 360, 36)), list(range(0, 60, 6))])
-def test_circle_2d_noisy_matches_newton(degrees):
+def test_circle_2d_noisy_matches_newton(degrees) -> None:
     centre = (3.0, -4.0)
     points = radially_noisy_2d(centre, 50.0, degrees, 0.01, seed=7)
     fit = fit_circle_2d(points)
@@ -292,7 +292,7 @@ def test_circle_2d_noisy_matches_newton(degrees):
     assert fit.variance > 1e-6
 
 
-def test_geometric_circle_beats_kasa_on_a_partial_arc():
+def test_geometric_circle_beats_kasa_on_a_partial_arc() -> None:
     centre = (3.0, -4.0)
     points = radially_noisy_2d(centre, 50.0, list(range(0, 46, 5)), 0.05, seed=3)
     fit = fit_circle_2d(points)
@@ -306,7 +306,7 @@ def test_geometric_circle_beats_kasa_on_a_partial_arc():
         assert radial_ssr(points, np.asarray(geometric) + step) > best
 
 
-def test_sphere_noisy_matches_newton():
+def test_sphere_noisy_matches_newton() -> None:
     directions = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (1, 1, 1),
                   (-1, 1, 0.5), (1, -1, 0.3), (-0.3, -1, 1), (0.5, 0.5, -1)]
     centre = (1.0, 2.0, -3.0)
@@ -319,7 +319,7 @@ def test_sphere_noisy_matches_newton():
     assert math.isclose(fit.variance, float(np.mean((d - d.mean()) ** 2)), rel_tol=1e-6)
 
 
-def test_plane_and_line_noisy_match_covariance_eigenvectors():
+def test_plane_and_line_noisy_match_covariance_eigenvectors() -> None:
     normal = unit((1, -2, 4))
     u, v = plane_basis(normal)
     rng = np.random.default_rng(5)
@@ -347,7 +347,7 @@ def test_plane_and_line_noisy_match_covariance_eigenvectors():
     assert line.variance > 1e-5
 
 
-def test_circle_3d_noisy_matches_plane_then_newton():
+def test_circle_3d_noisy_matches_plane_then_newton() -> None:
     normal = (1, 2, 3)
     points = noisy(arc_3d(CENTRE_3D, 50.0, normal, range(0, 91, 10)), 0.01, seed=9)
     fit = fit_circle_3d(points)
@@ -399,7 +399,7 @@ INF = float("inf")
     (fit_sphere, [(1, 0, 0), (0, 1, 0), (0, 0, 1), (0, 0, -INF)], Degeneracy.NOT_FINITE),
     (fit_circle_3d, [(1, 0, 0), (0, 1, NAN), (0, 0, 1)], Degeneracy.NOT_FINITE),
 ], ids=lambda x: getattr(x, "__name__", None) or getattr(x, "name", None) or "")
-def test_degenerate_input_raises(fit, points, degeneracy):
+def test_degenerate_input_raises(fit, points, degeneracy) -> None:
     with pytest.raises(FitError) as info:
         fit(points)
     assert info.value.degeneracy is degeneracy
@@ -410,7 +410,7 @@ def test_degenerate_input_raises(fit, points, degeneracy):
 @pytest.mark.parametrize(("fit", "dim"), [
     (fit_circle_2d, 2), (fit_plane, 3), (fit_line, 3), (fit_sphere, 3), (fit_circle_3d, 3),
 ])
-def test_too_many_points(fit, dim):
+def test_too_many_points(fit, dim) -> None:
     rng = np.random.default_rng(1)
     points = [tuple(float(x) for x in row) for row in rng.uniform(-1, 1, (MAX_POINTS + 1, dim))]
     with pytest.raises(FitError) as info:
@@ -420,7 +420,7 @@ def test_too_many_points(fit, dim):
     fit(points[:MAX_POINTS])  # ten are fine
 
 
-def test_messages_say_what_is_wrong():
+def test_messages_say_what_is_wrong() -> None:
     with pytest.raises(FitError) as info:
         fit_circle_2d([(0, 0), (1, 1), (2, 2)])
     assert info.value.message == "the 3 points are collinear: no circle passes through them"
@@ -435,7 +435,7 @@ def test_messages_say_what_is_wrong():
     assert "point 2 of 2" in info.value.message and "not finite" in info.value.message
 
 
-def test_wrong_dimension_is_a_value_error():
+def test_wrong_dimension_is_a_value_error() -> None:
     with pytest.raises(ValueError):
         fit_plane([(0, 0), (1, 0), (0, 1)])
     with pytest.raises(ValueError):
@@ -445,7 +445,7 @@ def test_wrong_dimension_is_a_value_error():
 # --- sign conventions --------------------------------------------------------------------
 
 
-def test_plane_normal_is_plus_z_whatever_the_order():
+def test_plane_normal_is_plus_z_whatever_the_order() -> None:
     points = [(1, 0, 0), (0, 1, 0), (1, 1, 0)]
     assert close(fit_plane(points).normal, (0, 0, 1))
     assert close(fit_plane(points[::-1]).normal, (0, 0, 1))
@@ -462,11 +462,11 @@ def test_plane_normal_is_plus_z_whatever_the_order():
     ([(-3, 0, 1), (-3, 1, 0), (-3, 0, 0)], (1, 0, 0)),
     ([(0, 0, 0), (1, 1, 0), (0, 0, 1)], tuple(unit((-1, 1, 0)))),       # vertical, diagonal
 ])
-def test_vertical_plane_normal_plus_y_then_plus_x(points, normal):
+def test_vertical_plane_normal_plus_y_then_plus_x(points, normal) -> None:
     assert close(fit_plane(points).normal, normal)
 
 
-def test_circle_3d_normal_independent_of_turning_direction():
+def test_circle_3d_normal_independent_of_turning_direction() -> None:
     points = arc_3d((0, 0, 5), 2.0, (0, 0, 1), [0, 90, 180])
     assert close(fit_circle_3d(points).normal, (0, 0, 1))
     assert close(fit_circle_3d(points[::-1]).normal, (0, 0, 1))
@@ -474,7 +474,7 @@ def test_circle_3d_normal_independent_of_turning_direction():
     assert close(fit_circle_3d(vertical).normal, (1, 0, 0))
 
 
-def test_line_direction_follows_point_order():
+def test_line_direction_follows_point_order() -> None:
     points = [(0, 0, 0), (1, 0, 0), (2, 0, 0)]
     assert close(fit_line(points).direction, (1, 0, 0))
     assert close(fit_line(points[::-1]).direction, (-1, 0, 0))
@@ -483,7 +483,7 @@ def test_line_direction_follows_point_order():
     assert close(fit_line(points[::-1]).direction, unit((-1, 1, 0)))
 
 
-def test_line_direction_when_first_and_last_coincide_follows_normal_convention():
+def test_line_direction_when_first_and_last_coincide_follows_normal_convention() -> None:
     points = [(0, 0, 0), (1, 1, 0), (0, 0, 0)]
     assert close(fit_line(points).direction, unit((1, 1, 0)))
     points = [(0, 0, 0), (-1, -1, -2), (0, 0, 0)]
@@ -510,7 +510,7 @@ def circles(draw):
 
 @settings(max_examples=200, deadline=None)
 @given(circles())
-def test_points_on_a_circle_give_it_back(case):
+def test_points_on_a_circle_give_it_back(case) -> None:
     (cx, cy), radius, points = case
     fit = fit_circle_2d(points)
     assert abs(fit.center_x - cx) <= 1e-7 * radius
@@ -519,7 +519,7 @@ def test_points_on_a_circle_give_it_back(case):
     assert fit.variance <= (1e-7 * radius) ** 2
 
 
-def test_each_fit_of_ten_points_is_well_under_a_millisecond():
+def test_each_fit_of_ten_points_is_well_under_a_millisecond() -> None:
     circle = radially_noisy_2d((3.0, -4.0), 50.0, list(range(0, 60, 6)), 0.01, seed=2)
     space = [(x, y, 0.1 * x) for x, y in circle]
     directions = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (1, 1, 1),

@@ -32,7 +32,7 @@ INF = math.inf
         ("F100\nX1\nM30", [(MotionKind.LINEAR, (0, 0, 0), (1, 0, 0), 100 / 60)]),  # G1 default
     ],
 )
-def test_linear_and_rapid(program, expected):
+def test_linear_and_rapid(program, expected) -> None:
     for text in (program, slow(program)):
         got = [(m.kind, m.start_mm, m.end_mm, m.feed_mm_s) for m in motions(text)]
         assert got == [(k, tuple(map(float, s)), tuple(map(float, e)), f)
@@ -61,7 +61,7 @@ def test_linear_and_rapid(program, expected):
         ("G1 X10 F100\nG3 X0 Y10.0009 I-10\nM30", MotionKind.ARC_CCW, (0, 0), (0, 10.0009, 0)),
     ],
 )
-def test_arcs_in_g17(program, kind, centre, end):
+def test_arcs_in_g17(program, kind, centre, end) -> None:
     for text in (program, slow(program)):
         arc = motions(text)[-1]
         assert arc.kind == kind
@@ -81,14 +81,14 @@ def test_arcs_in_g17(program, kind, centre, end):
         ("G19 G1 Y10 F100\nG3 Y0 Z10 J-10 K0\nM30", (1, 2), (0, 0)),
     ],
 )
-def test_planes(program, plane, centre):
+def test_planes(program, plane, centre) -> None:
     for text in (program, slow(program)):
         arc = motions(text)[-1]
         assert arc.plane == plane
         assert arc.center_mm == pytest.approx(centre)
 
 
-def test_plane_indices_follow_the_channel_axis_order():
+def test_plane_indices_follow_the_channel_axis_order() -> None:
     arc = motions("G1 X10 F100\nG2 X0 Y-10 I-10\nM30", axes=("Y", "X", "Z"))[-1]
     assert arc.plane == (1, 0)  # X is channel axis 1, Y axis 0
     assert arc.end_mm == (-10, 0, 0)
@@ -122,22 +122,22 @@ def test_plane_indices_follow_the_channel_axis_order():
         ("G1 X" + "9" * 400 + " F100\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 4),
     ],
 )
-def test_motion_errors(program, err, line, column):
+def test_motion_errors(program, err, line, column) -> None:
     e = error_of(program)
     assert (e.id, e.line, e.column) == (err, line, column), str(e)
 
 
-def test_arc_error_message_names_both_radii():
+def test_arc_error_message_names_both_radii() -> None:
     e = error_of("G1 X10 F100\nG3 X0 Y10.25 I-10\nM30")
     assert e.message == "arc end point is not on the circle (radius 10.000 vs 10.250)"
 
 
-def test_error_in_an_arc_block_with_plane_axis_missing():
+def test_error_in_an_arc_block_with_plane_axis_missing() -> None:
     e = error_of("G18 G1 X1 F100\nG2 X2 I1\nM30", axes=("X", "Y"))
     assert e.id == NcErrorId.PLANE_AXIS_MISSING
 
 
-def test_compensation_and_tool_radius():
+def test_compensation_and_tool_radius() -> None:
     blocks = decode("G1 X1 F100\nG41 D1 X2\nG42 D2 X3\nG40 X4\nD0 X5\nM30")
     got = [(b.motion.compensation, b.motion.tool_radius_mm) for b in blocks if b.motion]
     assert got == [
@@ -146,14 +146,14 @@ def test_compensation_and_tool_radius():
     ]
 
 
-def test_zero_length_move_gives_a_block_without_motion():
+def test_zero_length_move_gives_a_block_without_motion() -> None:
     for text in ("G1 X0 F100\nN5 G0 X0\nM30", slow("G1 X0 F100\nN5 G0 X0\nM30")):
         blocks = decode(text)
         assert [b.motion for b in blocks[:2]] == [None, None]
         assert blocks[1].number == 5
 
 
-def test_modal_only_blocks_give_no_block():
+def test_modal_only_blocks_give_no_block() -> None:
     blocks = decode("G90\nF100\nG17 G40\nD1\nN10\nG1 X1\nM30")
     assert len(blocks) == 2
     assert blocks[0].source.line == 6

@@ -51,7 +51,7 @@ def _outcome(text: str, limit: int = MAX_BLOCKS, **kw):
 @settings(max_examples=300, deadline=None,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(text=nc_text, manual=st.booleans())
-def test_garbage_raises_only_nc_errors(monkeypatch, text, manual):
+def test_garbage_raises_only_nc_errors(monkeypatch, text, manual) -> None:
     monkeypatch.setattr(work_guard, "IDLE_STEPS_MAX", 200)
     files = {"s.nc": text}
     _outcome(text, manual=manual, files=files)
@@ -59,7 +59,7 @@ def test_garbage_raises_only_nc_errors(monkeypatch, text, manual):
 
 @settings(max_examples=200, deadline=None)
 @given(st.text(max_size=60))
-def test_random_text_raises_only_nc_errors(text):
+def test_random_text_raises_only_nc_errors(text) -> None:
     _outcome(text)
 
 
@@ -114,12 +114,12 @@ def plain_programs(draw):
 
 @settings(max_examples=300, deadline=None)
 @given(plain_programs())
-def test_hot_path_gives_the_same_result_as_the_general_path(lines):
+def test_hot_path_gives_the_same_result_as_the_general_path(lines) -> None:
     text = "\n".join(["F1000"] + lines + ["M30"])
     assert _outcome(text) == _outcome(slow(text))
 
 
-def test_hot_path_equivalence_on_a_generated_program():
+def test_hot_path_equivalence_on_a_generated_program() -> None:
     from bench.decoder_bench import generate_program
 
     text = generate_program(3000)
@@ -130,12 +130,12 @@ def test_hot_path_equivalence_on_a_generated_program():
 
 @settings(max_examples=30, deadline=None)
 @given(valid_arcs())
-def test_valid_arcs_of_the_strategy_decode(lines):
+def test_valid_arcs_of_the_strategy_decode(lines) -> None:
     blocks, error = _outcome("\n".join(["F100"] + lines + ["M30"]))
     assert error is None and blocks[0].motion.center_mm is not None
 
 
-def test_loop_without_fast_constructors_gives_the_same_blocks(monkeypatch):
+def test_loop_without_fast_constructors_gives_the_same_blocks(monkeypatch) -> None:
     """The generated loop also works with the ordinary dataclass constructors (used
     on interpreters where the construct twins are not available)."""
     from cnc_objects.service.kernel.nc import fastpath

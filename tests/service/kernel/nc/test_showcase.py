@@ -24,7 +24,7 @@ TEXT = SHOWCASE.read_text(encoding="utf-8")
 
 
 @pytest.mark.parametrize("files", [{}, {"subPrograms.nc": "G0 X1\nM17\n"}])
-def test_first_real_error(files):
+def test_first_real_error(files) -> None:
     d = decoder(TEXT, files=files, file="isg-syntax-showcase.nc")
     with pytest.raises(NcError) as info:
         list(d.blocks())
@@ -36,7 +36,7 @@ def test_first_real_error(files):
 
 @pytest.mark.parametrize("skip_levels", [0, 1])
 @pytest.mark.parametrize("manual", [False, True])
-def test_every_line_alone_gives_blocks_or_an_nc_error(skip_levels, manual):
+def test_every_line_alone_gives_blocks_or_an_nc_error(skip_levels, manual) -> None:
     lines = TEXT.split("\n")
     for number, line in enumerate(lines, start=1):
         for text in (line, "\n".join(lines[number - 1:])):
@@ -47,7 +47,7 @@ def test_every_line_alone_gives_blocks_or_an_nc_error(skip_levels, manual):
                 assert e.id != NcErrorId.INTERNAL_ERROR, str(e)
 
 
-def test_syntax_check_reports_every_parse_error_and_goes_through():
+def test_syntax_check_reports_every_parse_error_and_goes_through() -> None:
     from cnc_objects.service.kernel.nc import check_syntax
 
     errors = check_syntax(TEXT, "s.nc", axes=("X", "Y", "Z"))
@@ -64,7 +64,7 @@ def test_syntax_check_reports_every_parse_error_and_goes_through():
     assert not [e for e in errors if 49 <= e.line <= 64]
 
 
-def test_syntax_check_of_a_clean_program():
+def test_syntax_check_of_a_clean_program() -> None:
     from cnc_objects.service.kernel.nc import check_syntax
 
     program = "%P\n#VAR\nV.L.A[2] = [1,\n 2]\n#ENDVAR\nG1 X[V.L.A[0]] F100\nLL S\nM30\n%L S\nM17\n"

@@ -21,11 +21,11 @@ from .support import decode, ends, error_of
         "G0 X1 ; (\nM30",
     ],
 )
-def test_comments(program):
+def test_comments(program) -> None:
     assert ends(program) == [(1.0, 0.0, 0.0)]
 
 
-def test_comment_characters_inside_strings_are_text():
+def test_comment_characters_inside_strings_are_text() -> None:
     blocks = decode('#VAR\nV.L.S : STRING = "a;b(c)"\n#ENDVAR\n'
                     '$IF V.L.S == "a;b(c)"\nG0 X1\n$ENDIF\nM30')
     assert len(blocks) == 2
@@ -39,7 +39,7 @@ def test_comment_characters_inside_strings_are_text():
         ("/11 G0 X1\nM30", NcErrorId.INVALID_SKIP_LEVEL, 1, 2),
     ],
 )
-def test_comment_and_skip_errors(program, err, line, column):
+def test_comment_and_skip_errors(program, err, line, column) -> None:
     e = error_of(program)
     assert (e.id, e.line, e.column) == (err, line, column), str(e)
 
@@ -53,21 +53,21 @@ def test_comment_and_skip_errors(program, err, line, column):
         (0b11, [1.0]),
     ],
 )
-def test_skip_levels(skip_levels, expected):
+def test_skip_levels(skip_levels, expected) -> None:
     program = "G0 X1\n/ G0 X2\n/1 G0 X3\n/2 G0 X4\nM30"
     assert [e[0] for e in ends(program, skip_levels=skip_levels)] == expected
 
 
-def test_skipped_line_is_not_decoded():
+def test_skipped_line_is_not_decoded() -> None:
     assert ends("/ this line is not decoded at all\nG0 X1\nM30") == [(1.0, 0.0, 0.0)]
 
 
-def test_not_skipped_line_is_checked():
+def test_not_skipped_line_is_checked() -> None:
     e = error_of("/ ausgeblendete Zeile\nM30", skip_levels=0)
     assert (e.id, e.line, e.column) == (NcErrorId.UNKNOWN_WORD, 1, 3)
 
 
-def test_continuation_lines():
+def test_continuation_lines() -> None:
     blocks = decode("N10 G1 \\\n  X1 \\\n\n  ; a comment inside\n  Y2 F60\nM30")
     assert len(blocks) == 2
     assert blocks[0].number == 10
@@ -75,11 +75,11 @@ def test_continuation_lines():
     assert (blocks[0].source.line, blocks[1].source.line) == (1, 6)
 
 
-def test_error_in_a_continuation_line_points_at_its_physical_line():
+def test_error_in_a_continuation_line_points_at_its_physical_line() -> None:
     e = error_of("G1 X1 \\\n  F100 \\\n    Q7\nM30")
     assert (e.id, e.line, e.column) == (NcErrorId.UNKNOWN_WORD, 3, 5)
 
 
-def test_backslash_inside_a_line_is_text():
+def test_backslash_inside_a_line_is_text() -> None:
     e = error_of("L C:\\ISG\\x.nc\nM30")
     assert e.id == NcErrorId.FILE_NOT_FOUND and "C:\\ISG\\x.nc" in e.message

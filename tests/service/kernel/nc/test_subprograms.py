@@ -25,17 +25,17 @@ M29
 """
 
 
-def test_local_subprograms_before_and_after_the_main_program():
+def test_local_subprograms_before_and_after_the_main_program() -> None:
     blocks = decode(LOCALS)
     assert [b.motion.end_mm[0] for b in blocks if b.motion] == [1.0, 2.0, 3.0]
     assert [b.source.line for b in blocks] == [3, 6, 13, 11]
 
 
-def test_file_without_header_runs_to_its_first_local_subprogram():
+def test_file_without_header_runs_to_its_first_local_subprogram() -> None:
     assert ends("G0 X5\nLL A\nM30\n%L A\nG0 Y5\n") == [(5, 0, 0), (5, 5, 0)]
 
 
-def test_file_subprogram_from_the_loader():
+def test_file_subprogram_from_the_loader() -> None:
     files = {"sub.nc": "%SUB\nG0 Z9\nLL INNER\nM17\n%L INNER\nG0 Y7\nM17\n"}
     blocks = decode("G0 X1\nL sub.nc\nG0 X2\nM30", files=files)
     assert [b.motion.end_mm for b in blocks if b.motion] == [
@@ -45,7 +45,7 @@ def test_file_subprogram_from_the_loader():
         ("prog.nc", 1), ("sub.nc", 2), ("sub.nc", 6), ("prog.nc", 3), ("prog.nc", 4)]
 
 
-def test_file_subprogram_is_loaded_once():
+def test_file_subprogram_is_loaded_once() -> None:
     calls = []
     files = {"s.nc": "G91 G0 X1\nG90\nM17"}
 
@@ -61,23 +61,23 @@ def test_file_subprogram_is_loaded_once():
     assert calls == ["s.nc"]
 
 
-def test_error_inside_a_file_subprogram_names_that_file():
+def test_error_inside_a_file_subprogram_names_that_file() -> None:
     e = error_of("G0 X1\nL sub.nc\nM30", files={"sub.nc": "G0 X2\n  Q1\nM17"})
     assert (e.id, e.file, e.line, e.column) == (NcErrorId.UNKNOWN_WORD, "sub.nc", 2, 3)
 
 
-def test_call_and_motion_in_one_block():
+def test_call_and_motion_in_one_block() -> None:
     blocks = decode("G0 X1 LL A\nM30\n%L A\nG0 Y1\n")
     assert [b.motion.end_mm for b in blocks if b.motion] == [(1, 0, 0), (1, 1, 0)]
 
 
-def test_program_end_inside_a_subprogram_ends_everything():
+def test_program_end_inside_a_subprogram_ends_everything() -> None:
     blocks = decode("LL A\nG0 X9\nM30\n%L A\nG0 Y1\nM30\n")
     assert blocks[-1].stop == StopKind.PROGRAM_END
     assert [b.motion.end_mm for b in blocks if b.motion] == [(0, 1, 0)]
 
 
-def test_recursion_with_an_exit_condition():
+def test_recursion_with_an_exit_condition() -> None:
     program = """#VAR
 V.P.DEPTH = 0
 #ENDVAR
@@ -114,15 +114,15 @@ M17
         ("$GOTO [X]\nM30\n%L A\n[X] G0 X1\nM17", {}, NcErrorId.LABEL_NOT_FOUND, "prog.nc", 1, 1),
     ],
 )
-def test_structure_errors(program, files, err, file, line, column):
+def test_structure_errors(program, files, err, file, line, column) -> None:
     e = error_of(program, files=files)
     assert (e.id, e.file, e.line, e.column) == (err, file, line, column), str(e)
 
 
-def test_m17_inside_an_if_block_ends_the_subprogram():
+def test_m17_inside_an_if_block_ends_the_subprogram() -> None:
     assert ends("LL A\nM30\n%L A\n$IF 1\nG0 X1\nM17\n$ENDIF\n") == [(1, 0, 0)]
 
 
-def test_recursion_never_overflows_pythons_stack():
+def test_recursion_never_overflows_pythons_stack() -> None:
     e = error_of("LL R\nM30\n%L R\nG0 X1\nLL R\n")
     assert e.id == NcErrorId.CALL_DEPTH_EXCEEDED

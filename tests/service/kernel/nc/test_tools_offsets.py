@@ -28,7 +28,7 @@ LENGTH = {1: ToolData.of_mm(2.5), 4: ToolData.of_mm(3.0, 100.0)}
 
 
 @pytest.mark.parametrize("as_text", [lambda t: t, slow], ids=["hot path", "general path"])
-def test_zero_offset_and_tool_length_shift_absolute_positions(as_text):
+def test_zero_offset_and_tool_length_shift_absolute_positions(as_text) -> None:
     program = "G54\nD4\nG0 X1 Y2 Z3\nG1 X5 F100\nG91 X1\nG90 G53 D0 X0 Y0 Z0\nM30"
     got = ends(as_text(program), modal=modal_with({1: (10.0, 20.0, 30.0)}, LENGTH))
     assert got == [(11.0, 22.0, 133.0), (15.0, 22.0, 133.0), (16.0, 22.0, 133.0),
@@ -36,31 +36,31 @@ def test_zero_offset_and_tool_length_shift_absolute_positions(as_text):
 
 
 @pytest.mark.parametrize(("plane", "axis"), [(17, 2), (18, 1), (19, 0)])
-def test_the_tool_length_acts_along_the_tool_axis_of_the_plane(plane, axis):
+def test_the_tool_length_acts_along_the_tool_axis_of_the_plane(plane, axis) -> None:
     [end] = ends(f"G{plane} D4 G0 X0 Y0 Z0\nM30", modal=modal_with(tools=LENGTH))
     expected = [0.0, 0.0, 0.0]
     expected[axis] = 100.0
     assert end == tuple(expected)
 
 
-def test_unprogrammed_axes_keep_their_machine_position():
+def test_unprogrammed_axes_keep_their_machine_position() -> None:
     got = ends("G0 X1 Y1 Z1\nG54\nG0 X2\nM30", modal=modal_with({1: (10.0, 20.0, 30.0)}))
     assert got == [(1.0, 1.0, 1.0), (12.0, 1.0, 1.0)]
 
 
-def test_a_machining_coordinate_system_lies_on_the_zero_offset():
+def test_a_machining_coordinate_system_lies_on_the_zero_offset() -> None:
     program = "G54\n#CS ON [1, 0, 0, 0, 0, 90]\nG0 X1 Y0 Z0\n#CS OFF\nM30"
     [end] = ends(program, modal=modal_with({1: (10.0, 0.0, 0.0)}))
     assert end == pytest.approx((11.0, 1.0, 0.0))
 
 
-def test_g159_selects_further_groups():
+def test_g159_selects_further_groups() -> None:
     modal = modal_with({8: (0.0, -4.0, 0.0)})
     assert ends("G159=8 G0 Y1\nM30", modal=modal) == [(0.0, -3.0, 0.0)]
     assert modal.zero_offset_group == 8
 
 
-def test_m6_takes_the_tool_and_waits_the_change_time():
+def test_m6_takes_the_tool_and_waits_the_change_time() -> None:
     modal = modal_with(change_s=1.5)
     blocks = decode("T1\nM6\nM30", modal=modal)
     assert [(b.tool, b.m_functions, b.dwell_s) for b in blocks[:2]] == [
@@ -75,18 +75,18 @@ def test_m6_takes_the_tool_and_waits_the_change_time():
      ("G159=-1", NcErrorId.ZERO_OFFSET_INDEX_FORMAT, 1),
      ("G159=2 G54", NcErrorId.ZERO_OFFSETS_TWICE, 8)],
 )
-def test_bad_words(program, error_id, column):
+def test_bad_words(program, error_id, column) -> None:
     error = error_of(program + "\nM30", modal=modal_with())
     assert (error.id, error.line, error.column) == (error_id, 1, column)
 
 
-def test_a_failing_block_leaves_the_tool_and_the_offset_as_they_were():
+def test_a_failing_block_leaves_the_tool_and_the_offset_as_they_were() -> None:
     modal = modal_with()
     error_of("T1 M6\nG55\nG54 G159=20\nM30", modal=modal)
     assert (modal.spindle_tool, modal.zero_offset_group) == (1, 2)
 
 
-def test_a_table_from_radii_accepts_every_tool():
+def test_a_table_from_radii_accepts_every_tool() -> None:
     """Decoders given plain radii (syntax tools, tests) do not check T numbers."""
     blocks = decode("T23 M6\nM30")
     assert blocks[0].tool == 23

@@ -14,7 +14,7 @@ def xs(program: str, **kw) -> list[float]:
     return [e[0] for e in ends(program, **kw)]
 
 
-def test_declarations_types_and_initial_values():
+def test_declarations_types_and_initial_values() -> None:
     program = """
 #VAR
   V.L.A                     ; REAL64, 0.0
@@ -39,7 +39,7 @@ M30
     assert xs(program) == [0.0, 200.0, 11.34, 0.0, 10.0, -3.0, 77.0]
 
 
-def test_arrays_and_initializer_lists():
+def test_arrays_and_initializer_lists() -> None:
     program = """
 #VAR
   V.L.A[3] = [1, 2, 3]
@@ -59,17 +59,17 @@ M30
     assert xs(program) == [4.0, 6.0, 3.0, 212.0, 40.0]
 
 
-def test_axis_word_with_a_variable_directly_after_the_letter():
+def test_axis_word_with_a_variable_directly_after_the_letter() -> None:
     program = "#VAR\nV.L.P = 10\n#ENDVAR\nG0 XV.L.P Y-V.L.P Z-[V.L.P * 2]\nM30"
     assert ends(program) == [(10.0, -10.0, -20.0)]
 
 
-def test_assignments_run_left_to_right_in_a_block():
+def test_assignments_run_left_to_right_in_a_block() -> None:
     program = "#VAR\nV.L.P = 1\n#ENDVAR\nV.L.P = 5 G0 X[V.L.P] V.L.P = 7 Y[V.L.P]\nM30"
     assert ends(program) == [(5.0, 7.0, 0.0)]
 
 
-def test_local_variables_belong_to_their_program():
+def test_local_variables_belong_to_their_program() -> None:
     program = """%MAIN
 #VAR
 V.L.A = 1
@@ -87,19 +87,19 @@ M17
     assert ends(program) == [(0.0, 50.0, 0.0), (1.0, 50.0, 0.0)]
 
 
-def test_program_globals_are_visible_in_subprograms():
+def test_program_globals_are_visible_in_subprograms() -> None:
     program = "#VAR\nV.P.COUNT = 0\n#ENDVAR\nLL INC\nLL INC\nG0 X[V.P.COUNT]\nM30\n" \
               "%L INC\nV.P.COUNT = V.P.COUNT + 1\nM17"
     assert xs(program) == [2.0]
 
 
-def test_cycle_variables_are_visible_in_called_programs():
+def test_cycle_variables_are_visible_in_called_programs() -> None:
     files = {"calc.nc": "V.CYC.RESULT = 42\nM17\n"}
     program = "#VAR\nV.CYC.RESULT\n#ENDVAR\nL calc.nc\nG0 X[V.CYC.RESULT]\nM30"
     assert xs(program, files=files) == [42.0]
 
 
-def test_globals_live_in_the_modal_state():
+def test_globals_live_in_the_modal_state() -> None:
     modal = ModalState()
     decode("#VAR\nV.G.TOTAL = 3\n#ENDVAR\nV.G.TOTAL = V.G.TOTAL + 1\nM30", modal=modal)
     # a second program: declaring it again keeps the value
@@ -107,7 +107,7 @@ def test_globals_live_in_the_modal_state():
     assert blocks[0].motion.end_mm[0] == 4.0
 
 
-def test_program_variables_continue_in_manual_blocks():
+def test_program_variables_continue_in_manual_blocks() -> None:
     modal = ModalState()
     decode("#VAR\nV.P.N = 1\n#ENDVAR", modal=modal, manual=True)
     decode("V.P.N = V.P.N + 1", modal=modal, manual=True)
@@ -118,7 +118,7 @@ def test_program_variables_continue_in_manual_blocks():
     assert blocks[0].motion.end_mm[0] == 9
 
 
-def test_declaration_in_a_loop_reinitialises():
+def test_declaration_in_a_loop_reinitialises() -> None:
     program = "$FOR V.P.I = 1, 3\n#VAR\nV.L.X = 0\n#ENDVAR\nV.L.X = V.L.X + V.P.I\n" \
               "G0 X[V.L.X] Y[V.P.I]\n$ENDFOR\nM30"
     d = decoder(program)
@@ -157,10 +157,10 @@ def test_declaration_in_a_loop_reinitialises():
         ("LL S\nM30\n%L S\n#VAR\nV.P.X\n#ENDVAR\nM17", NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED, 5, 1),
     ],
 )
-def test_variable_errors(program, err, line, column):
+def test_variable_errors(program, err, line, column) -> None:
     e = error_of(program)
     assert (e.id, e.line, e.column) == (err, line, column), str(e)
 
 
-def test_undeclared_variable_message():
+def test_undeclared_variable_message() -> None:
     assert error_of("G0 X[V.L.X]\nM30").message == "undeclared variable V.L.X"

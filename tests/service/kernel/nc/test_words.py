@@ -9,7 +9,7 @@ from cnc_objects.service.kernel.nc import NcErrorId, SourceRef, StopKind
 from .support import decode, error_of, slow
 
 
-def test_block_numbers_and_labels():
+def test_block_numbers_and_labels() -> None:
     blocks = decode("N10 G0 X1\nN20: G0 X2\nG0 X3\nN0030 G0 X4\nM30")
     assert [b.number for b in blocks] == [10, 20, None, 30, None]
 
@@ -29,18 +29,18 @@ def test_block_numbers_and_labels():
                           (StopKind.PROGRAM_END, (), None, None)]),
     ],
 )
-def test_technology_and_stops(program, expected):
+def test_technology_and_stops(program, expected) -> None:
     got = [(b.stop, b.m_functions, b.spindle_speed_rpm, b.tool) for b in decode(program)]
     assert got == expected
 
 
-def test_nothing_after_m30_is_decoded():
+def test_nothing_after_m30_is_decoded() -> None:
     blocks = decode("G0 X1\nM30\nthis is not NC at all\n")
     assert blocks[-1].stop == StopKind.PROGRAM_END
     assert len(blocks) == 2
 
 
-def test_motion_and_m30_in_one_block():
+def test_motion_and_m30_in_one_block() -> None:
     (block,) = decode("G0 X5 M30")
     assert block.motion is not None and block.stop == StopKind.PROGRAM_END
 
@@ -49,17 +49,17 @@ def test_motion_and_m30_in_one_block():
     ("program", "dwell"),
     [("G4 X2\nM30", 2.0), ("G4 F1.5\nM30", 1.5), ("G04 X0.25\nM30", 0.25)],
 )
-def test_dwell(program, dwell):
+def test_dwell(program, dwell) -> None:
     block = decode(program)[0]
     assert block.dwell_s == dwell and block.motion is None and block.needs_stop
 
 
-def test_dwell_does_not_change_the_feed():
+def test_dwell_does_not_change_the_feed() -> None:
     blocks = decode("G1 F600 X1\nG4 F2\nX2\nM30")
     assert blocks[2].motion.feed_mm_s == 10.0
 
 
-def test_dwell_x_word_without_an_x_axis():
+def test_dwell_x_word_without_an_x_axis() -> None:
     assert decode("G4 X3\nM30", axes=("Y", "Z"))[0].dwell_s == 3.0
 
 
@@ -99,17 +99,17 @@ def test_dwell_x_word_without_an_x_axis():
         ("M" + "9" * 400 + "\nM30", NcErrorId.VALUE_OUT_OF_RANGE, 1, 1),
     ],
 )
-def test_word_errors(program, err, line, column):
+def test_word_errors(program, err, line, column) -> None:
     e = error_of(program)
     assert (e.id, e.line, e.column) == (err, line, column), str(e)
 
 
-def test_unknown_word_message():
+def test_unknown_word_message() -> None:
     assert error_of("G0 X1 Q5\nM30").message == "unknown word 'Q5'"
     assert str(error_of("G0 X1 Q5\nM30")) == "error 21220: prog.nc:1:7: unknown word 'Q5'"
 
 
-def test_source_reference_of_blocks():
+def test_source_reference_of_blocks() -> None:
     text = "%P\n  N1 G0 X1\n\tG0 X2 ; tab\nG0 X3 (c)\nM30\n"
     sources = [b.source for b in decode(text, file="a.nc")]
     assert sources == [
@@ -122,23 +122,23 @@ def test_source_reference_of_blocks():
     ]
 
 
-def test_byte_offsets_count_utf8_bytes_and_crlf():
+def test_byte_offsets_count_utf8_bytes_and_crlf() -> None:
     text = "; Grüße\r\nG0 X1\r\nM30\r\n"
     blocks = decode(text)
     assert [(b.source.line, b.source.offset) for b in blocks] == [(2, 11), (3, 18)]
 
 
-def test_byte_order_mark_counts_in_offsets():
+def test_byte_order_mark_counts_in_offsets() -> None:
     blocks = decode("\ufeffG0 X1\nM30")
     assert [b.source.offset for b in blocks] == [3, 9]  # 3 bytes of BOM + 'G0 X1\n'
 
 
-def test_lower_case_is_accepted():
+def test_lower_case_is_accepted() -> None:
     blocks = decode("n5 g1 x10 f600\nm30")
     assert blocks[0].number == 5 and blocks[0].motion.end_mm == (10.0, 0.0, 0.0)
 
 
-def test_manual_flag():
+def test_manual_flag() -> None:
     blocks = decode("G0 X1", manual=True)
     assert [b.manual for b in blocks] == [True]
     assert not decode("G0 X1\nM30")[0].manual

@@ -70,7 +70,7 @@ def assert_offset(elements, contour, r=R):
     (G41, False, True),   # tool left of a cw square: outside contour, arcs at corners
     (G42, False, False),
 ])
-def test_square_gives_the_offset_square(comp, ccw, outside):
+def test_square_gives_the_offset_square(comp, ccw, outside) -> None:
     blocks, contour = square_program(comp, ccw)
     elements = compensated_elements(blocks)
     arcs = [e for e in elements if isinstance(e, Arc)]
@@ -90,7 +90,7 @@ def test_square_gives_the_offset_square(comp, ccw, outside):
     assert_offset(elements, contour)
 
 
-def test_approach_and_departure_are_perpendicular():
+def test_approach_and_departure_are_perpendicular() -> None:
     blocks, _ = square_program(G42)
     segs = prepare(blocks)
     approach = segs[1].element
@@ -101,7 +101,7 @@ def test_approach_and_departure_are_perpendicular():
     assert departure.end_mm == START
 
 
-def test_executed_path_keeps_the_tool_radius_from_the_contour():
+def test_executed_path_keeps_the_tool_radius_from_the_contour() -> None:
     blocks, contour = square_program(G42)
     segs = prepare(blocks)
     lead_in = segs[0].length_mm + segs[1].length_mm
@@ -134,7 +134,7 @@ def rounded_contour(comp, r=R):
 
 
 @pytest.mark.parametrize("comp", [G41, G42])
-def test_contour_with_arcs_gives_the_offset_contour(comp):
+def test_contour_with_arcs_gives_the_offset_contour(comp) -> None:
     blocks, contour = rounded_contour(comp)
     elements = compensated_elements(blocks)
     arcs = [e for e in elements if isinstance(e, Arc) and e.center != (0.0, 30.0)
@@ -150,7 +150,7 @@ def test_contour_with_arcs_gives_the_offset_contour(comp):
     assert_offset(elements, contour)
 
 
-def test_arc_smaller_than_the_tool_on_the_inside_is_an_error():
+def test_arc_smaller_than_the_tool_on_the_inside_is_an_error() -> None:
     blocks = [line(START, (0, 0, 0)), line((0, 0, 0), (10, 0, 0), comp=G41, r=R),
               arc((10, 0, 0), (10, 6, 0), (10, 3), ccw=True, comp=G41, r=R)]
     prep = PathPreparation(DYN, START)
@@ -165,7 +165,7 @@ def test_arc_smaller_than_the_tool_on_the_inside_is_an_error():
     assert prep.prepare(outside)
 
 
-def test_element_too_short_at_an_inside_corner_is_an_error():
+def test_element_too_short_at_an_inside_corner_is_an_error() -> None:
     # ccw contour with a 2 mm step; G41 keeps the tool inside: r = 5 cannot follow it
     pts = [(0, 0, 0), (50, 0, 0), (50, 2, 0), (60, 2, 0)]
     blocks = [line(START, pts[0])] + [line(a, b, comp=G41, r=R) for a, b in zip(pts, pts[1:])]
@@ -176,7 +176,7 @@ def test_element_too_short_at_an_inside_corner_is_an_error():
     assert err.value.id == PathErrorId.COMP_CONTOUR_VIOLATION
 
 
-def test_deselection_in_an_arc_is_an_error():
+def test_deselection_in_an_arc_is_an_error() -> None:
     blocks = [line(START, (0, 0, 0)), line((0, 0, 0), (10, 0, 0), comp=G41, r=R),
               arc((10, 0, 0), (20, 0, 0), (15, 0), ccw=True)]
     prep = PathPreparation(DYN, START)
@@ -187,14 +187,14 @@ def test_deselection_in_an_arc_is_an_error():
     assert err.value.id == PathErrorId.COMP_DESELECT_ON_ARC
 
 
-def test_infeed_without_plane_motion_is_an_error():
+def test_infeed_without_plane_motion_is_an_error() -> None:
     prep = PathPreparation(DYN, (0, 0, 0))
     with pytest.raises(PathError) as err:
         prep.prepare(line((0, 0, 0), (0, 0, -5), comp=G41, r=R))
     assert err.value.id == PathErrorId.COMP_NO_PLANE_MOTION
 
 
-def test_streaming_holds_one_block_and_close_releases_it():
+def test_streaming_holds_one_block_and_close_releases_it() -> None:
     blocks, _ = square_program(G41)
     tech = technology(8)
     ex = PathExecutor(DYN, START, cycle_s=DT, buffer_blocks=10)
@@ -215,7 +215,7 @@ def test_streaming_holds_one_block_and_close_releases_it():
     assert ex.position_mm == pytest.approx((50.0, R, 0.0))  # ends perpendicular
 
 
-def test_software_limit_of_a_held_block_names_that_block():
+def test_software_limit_of_a_held_block_names_that_block() -> None:
     ex = PathExecutor(DYN, START, cycle_s=DT, sw_limits_mm=[(-30, 52), (-30, 100), (-10, 10)])
     blocks, _ = square_program(G42)  # outside offset reaches x = 55
     ex.push(blocks[0])
@@ -227,7 +227,7 @@ def test_software_limit_of_a_held_block_names_that_block():
     assert max(p[0] for p in run(ex, []).positions) <= 52.0
 
 
-def test_compensation_with_different_axis_order():
+def test_compensation_with_different_axis_order() -> None:
     """G18-like plane (Z, X): offsets happen in the plane, Y stays."""
     dyn = (AxisDynamics(500, 5000, 50),) * 3
     plane = (2, 0)
@@ -244,7 +244,7 @@ def test_compensation_with_different_axis_order():
 
 
 @pytest.mark.parametrize("comp, radius", [(G41, 20.0 - 3.0), (G42, 20.0 + 3.0)])
-def test_full_circle_is_offset_to_a_full_circle(comp, radius):
+def test_full_circle_is_offset_to_a_full_circle(comp, radius) -> None:
     blocks = [line((0, -30, 0), (20, 0, 0)),
               arc((20, 0, 0), (20, 0, 0), (0, 0), ccw=True, comp=comp, r=3.0),
               line((20, 0, 0), (0, -30, 0))]

@@ -52,7 +52,7 @@ def finish_cycle(trace, block) -> int:
 
 
 @pytest.mark.parametrize("length, feed", [(100.0, 100.0), (0.3, 100.0), (250.0, 400.0)])
-def test_single_line_time_is_the_trapezoid(length, feed):
+def test_single_line_time_is_the_trapezoid(length, feed) -> None:
     blk = line(ORIGIN, (length, 0, 0), feed)
     trace = run(executor(), [blk])
     expected = trapezoid_time(length, 5000.0, feed, 0.0, 0.0)
@@ -61,7 +61,7 @@ def test_single_line_time_is_the_trapezoid(length, feed):
     assert trace.positions[-1] == (length, 0.0, 0.0)
 
 
-def test_collinear_lines_are_one_trapezoid():
+def test_collinear_lines_are_one_trapezoid() -> None:
     xs = [0.0, 3.0, 10.0, 10.5, 40.0, 41.0, 100.0]
     blocks = polyline([(x, 0, 0) for x in xs], 120.0)
     trace = run(executor(), blocks)
@@ -71,7 +71,7 @@ def test_collinear_lines_are_one_trapezoid():
     assert [r.path_velocity_mm_s for r in trace.results].count(0.0) == 1  # no stop on the way
 
 
-def test_diagonal_line_uses_the_axis_derived_acceleration():
+def test_diagonal_line_uses_the_axis_derived_acceleration() -> None:
     # direction (0.6, 0.8, 0) with DYN_MIXED: a = min(4000/0.6, 2500/0.8) = 3125,
     # speed cap min(300/0.6, 200/0.8) = 250 < F
     blk = line(ORIGIN, (60, 80, 0), 1000.0)
@@ -80,7 +80,7 @@ def test_diagonal_line_uses_the_axis_derived_acceleration():
     assert expected - 1e-9 <= finish_cycle(trace, blk) * DT < expected + DT
 
 
-def test_square_corner_speed_from_the_velocity_jump():
+def test_square_corner_speed_from_the_velocity_jump() -> None:
     pts = [ORIGIN, (50, 0, 0), (50, 50, 0), (0, 50, 0), ORIGIN]
     blocks = polyline(pts, 100.0)
     trace = run(executor(), blocks)
@@ -95,7 +95,7 @@ def test_square_corner_speed_from_the_velocity_jump():
         assert min(speeds) <= 50.0 + 5000 * DT and max(speeds) >= 50.0 - 5000 * DT
 
 
-def test_time_matches_the_whole_program_plan_with_dwell_and_stops():
+def test_time_matches_the_whole_program_plan_with_dwell_and_stops() -> None:
     blocks = [line(ORIGIN, (30, 0, 0)), line((30, 0, 0), (30, 20, 0)), dwell(0.1234),
               line((30, 20, 0), (0, 20, 5)), stop(StopKind.PROGRAMMED),
               line((0, 20, 5), ORIGIN, 50.0)]
@@ -105,7 +105,7 @@ def test_time_matches_the_whole_program_plan_with_dwell_and_stops():
     assert optimal - 1e-9 <= trace.cycles * DT <= optimal + (stops + 1) * DT
 
 
-def test_unbounded_buffer_reaches_the_optimal_time_on_short_segments():
+def test_unbounded_buffer_reaches_the_optimal_time_on_short_segments() -> None:
     pts = [(20 * math.cos(k * 0.01), 20 * math.sin(k * 0.01), 0.0) for k in range(400)]
     blocks = polyline(pts, 150.0)
     trace = run(executor(pts[0], buffer_blocks=1000), blocks)
@@ -143,7 +143,7 @@ PROGRAMS = {
 
 @pytest.mark.parametrize("override", [0.5, 1.0, 1.5])
 @pytest.mark.parametrize("name", sorted(PROGRAMS))
-def test_axis_limits_hold_inside_blocks(name, override):
+def test_axis_limits_hold_inside_blocks(name, override) -> None:
     blocks = PROGRAMS[name]()
     trace = run(executor(blocks[0].motion.start_mm, DYN_MIXED), blocks, override=override)
     max_v, max_a = check_axis_limits(trace, DYN_MIXED)
@@ -151,7 +151,7 @@ def test_axis_limits_hold_inside_blocks(name, override):
     assert trace.positions[-1] == pytest.approx(blocks[-1].motion.end_mm, abs=1e-12)
 
 
-def test_axis_limits_hold_with_override_changes_and_feedhold():
+def test_axis_limits_hold_with_override_changes_and_feedhold() -> None:
     blocks = _mixed_program()
     holds = {}
 
@@ -176,7 +176,7 @@ def test_axis_limits_hold_with_override_changes_and_feedhold():
 @given(st.lists(st.tuples(st.floats(-20, 20), st.floats(-20, 20), st.floats(-3, 3)),
                 min_size=2, max_size=8),
        st.floats(20, 400), st.sampled_from([0.5, 1.0, 1.3]))
-def test_random_polylines_respect_the_limits(points, feed, override):
+def test_random_polylines_respect_the_limits(points, feed, override) -> None:
     pts = [ORIGIN] + [tuple(p) for p in points]
     pts = [p for k, p in enumerate(pts) if k == 0 or math.dist(p, pts[k - 1]) > 1e-3]
     if len(pts) < 2:
@@ -191,7 +191,7 @@ def test_random_polylines_respect_the_limits(points, feed, override):
         assert optimal - 1e-9 <= trace.cycles * DT < optimal + DT
 
 
-def test_override_above_100_percent_never_exceeds_axis_limits():
+def test_override_above_100_percent_never_exceeds_axis_limits() -> None:
     blk = line(ORIGIN, (0, 0, 50), 90.0)  # Z: V = 100 mm/s in DYN_MIXED
     trace = run(executor(dynamics=DYN_MIXED), [blk], override=2.0)
     assert max(r.path_velocity_mm_s for r in trace.results) == pytest.approx(100.0)
@@ -200,7 +200,7 @@ def test_override_above_100_percent_never_exceeds_axis_limits():
 
 # -- block ends -----------------------------------------------------------------------
 
-def test_several_block_ends_per_cycle():
+def test_several_block_ends_per_cycle() -> None:
     pts = [(0.01 * k, 0.0, 0.0) for k in range(1001)]  # 0.01 mm blocks at 200 mm/s
     blocks = polyline(pts, 200.0)
     blocks.insert(500, technology(8))
@@ -210,13 +210,13 @@ def test_several_block_ends_per_cycle():
     assert trace.results[-1].distance_mm == pytest.approx(10.0)
 
 
-def test_same_program_gives_identical_cycles():
+def test_same_program_gives_identical_cycles() -> None:
     def once():
         return run(executor(dynamics=DYN_MIXED), _mixed_program(), override=0.9).positions
     assert once() == once()
 
 
-def test_step_result_fields_during_a_block():
+def test_step_result_fields_during_a_block() -> None:
     blocks = [line(ORIGIN, (10, 0, 0), 100.0, number=10), line((10, 0, 0), (10, 5, 0), 50.0)]
     ex = executor()
     for b in blocks:
@@ -234,7 +234,7 @@ def test_step_result_fields_during_a_block():
 
 # -- feedhold, single block, dwell, stops ---------------------------------------------
 
-def test_feedhold_decelerates_within_limits_and_resume_reaches_the_end():
+def test_feedhold_decelerates_within_limits_and_resume_reaches_the_end() -> None:
     blk = line(ORIGIN, (100, 0, 0), 200.0)
     positions_at_hold = []
 
@@ -257,7 +257,7 @@ def test_feedhold_decelerates_within_limits_and_resume_reaches_the_end():
     assert trace.cycles * DT > trapezoid_time(100, 5000, 200, 0, 0) + 0.05
 
 
-def test_single_block_stops_at_each_block_end():
+def test_single_block_stops_at_each_block_end() -> None:
     pts = [ORIGIN, (10, 0, 0), (10, 10, 0), (0, 10, 0)]
     blocks = polyline(pts, 100.0)
     ex = executor()
@@ -280,7 +280,7 @@ def test_single_block_stops_at_each_block_end():
     assert done == blocks
 
 
-def test_single_block_switched_on_while_moving_stops_where_it_still_can():
+def test_single_block_switched_on_while_moving_stops_where_it_still_can() -> None:
     # 0.5 mm blocks at 200 mm/s: braking takes 4 mm, so the stop lands several blocks later
     pts = [(0.5 * k, 0, 0) for k in range(61)]
     blocks = polyline(pts, 200.0)
@@ -308,7 +308,7 @@ def test_single_block_switched_on_while_moving_stops_where_it_still_can():
         assert abs(b - a) <= 5000 * DT * (1 + 1e-9)
 
 
-def test_dwell_stands_for_its_time_and_finishes_afterwards():
+def test_dwell_stands_for_its_time_and_finishes_afterwards() -> None:
     d = dwell(0.05)
     blocks = [line(ORIGIN, (5, 0, 0)), d, line((5, 0, 0), (10, 0, 0))]
     trace = run(executor(), blocks)
@@ -320,7 +320,7 @@ def test_dwell_stands_for_its_time_and_finishes_afterwards():
     assert trace.finished == blocks
 
 
-def test_programmed_stop_waits_and_is_reported_every_cycle():
+def test_programmed_stop_waits_and_is_reported_every_cycle() -> None:
     m0 = line((10, 0, 0), (20, 0, 0), stop=StopKind.PROGRAMMED)
     m30 = stop(StopKind.PROGRAM_END)
     blocks = [line(ORIGIN, (10, 0, 0)), m0, technology(3), line((20, 0, 0), (25, 0, 0)), m30]
@@ -343,7 +343,7 @@ def test_programmed_stop_waits_and_is_reported_every_cycle():
     assert ex.idle
 
 
-def test_override_zero_stands_and_continues():
+def test_override_zero_stands_and_continues() -> None:
     ex = executor()
     ex.push(line(ORIGIN, (50, 0, 0)))
     ex.close()
@@ -358,7 +358,7 @@ def test_override_zero_stands_and_continues():
     assert res.position_mm == (50.0, 0.0, 0.0) and ex.idle
 
 
-def test_stop_now_drops_everything():
+def test_stop_now_drops_everything() -> None:
     ex = executor(buffer_blocks=5)
     for b in polyline([ORIGIN, (10, 0, 0), (10, 10, 0), (0, 10, 0)], 100.0):
         ex.push(b)
@@ -378,7 +378,7 @@ def test_stop_now_drops_everything():
 
 # -- buffer and errors ----------------------------------------------------------------
 
-def test_buffer_full():
+def test_buffer_full() -> None:
     ex = executor(buffer_blocks=3)
     blocks = polyline([(k, 0, 0) for k in range(6)], 100.0)
     for b in blocks[:3]:
@@ -389,7 +389,7 @@ def test_buffer_full():
     assert err.value.id == PathErrorId.BUFFER_FULL and err.value.block is blocks[3]
 
 
-def test_software_limit_refuses_the_block_before_any_motion():
+def test_software_limit_refuses_the_block_before_any_motion() -> None:
     limits = [(-1.0, 100.0), (-50.0, 50.0), (-20.0, 20.0)]
     ex = executor(sw_limits_mm=limits)
     bad = line(ORIGIN, (150, 0, 0))
@@ -402,7 +402,7 @@ def test_software_limit_refuses_the_block_before_any_motion():
     assert ex.idle
 
 
-def test_software_limit_checks_the_extreme_points_of_arcs():
+def test_software_limit_checks_the_extreme_points_of_arcs() -> None:
     limits = [(-100.0, 100.0), (-100.0, 30.0), (-20.0, 20.0)]
     ex = executor(sw_limits_mm=limits)
     good = line(ORIGIN, (20, 0, 0))
@@ -428,7 +428,7 @@ def test_software_limit_checks_the_extreme_points_of_arcs():
     (arc(ORIGIN, (0, 0, 5), (5, 0), ccw=True), PathErrorId.ARC_HELIX),
     (arc(ORIGIN, (10, 0, 0), (5, 0), ccw=True, plane=(0, 0)), PathErrorId.PLANE_INVALID),
 ])
-def test_invalid_blocks(block, error):
+def test_invalid_blocks(block, error) -> None:
     ex = executor()
     with pytest.raises(PathError) as err:
         ex.push(block)
@@ -436,7 +436,7 @@ def test_invalid_blocks(block, error):
     assert ex.free_slots() == 120
 
 
-def test_constructor_validates():
+def test_constructor_validates() -> None:
     with pytest.raises(ValueError):
         PathExecutor(DYN, (0, 0), cycle_s=DT)
     with pytest.raises(ValueError):
@@ -445,7 +445,7 @@ def test_constructor_validates():
         AxisDynamics(0.0, 1.0, 1.0)
 
 
-def test_feedhold_over_many_short_blocks_and_override_steps():
+def test_feedhold_over_many_short_blocks_and_override_steps() -> None:
     pts = [(8 * math.cos(k * 0.02), 8 * math.sin(k * 0.02), 0.001 * k) for k in range(600)]
     blocks = polyline(pts, 250.0)
     held_at = []

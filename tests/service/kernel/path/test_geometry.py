@@ -14,7 +14,7 @@ from cnc_objects.service.kernel.path.geometry import Arc, Line
 PLANES = [(0, 1), (2, 0), (1, 2)]  # G17, G18, G19
 
 
-def test_line_length_points_and_tangent():
+def test_line_length_points_and_tangent() -> None:
     ln = Line((1.0, 2.0, 3.0), (4.0, 6.0, 3.0))
     assert ln.length_mm == 5.0
     assert ln.point_at(0.0) == (1.0, 2.0, 3.0)
@@ -29,7 +29,7 @@ def test_line_length_points_and_tangent():
     radius=st.floats(0.01, 1000), a0=st.floats(-math.pi, math.pi),
     sweep=st.floats(0.001, 2 * math.pi - 0.001), ccw=st.booleans(), plane=st.sampled_from(PLANES),
 )
-def test_arc_samples_lie_on_the_circle(cx, cy, z, radius, a0, sweep, ccw, plane):
+def test_arc_samples_lie_on_the_circle(cx, cy, z, radius, a0, sweep, ccw, plane) -> None:
     p, q = plane
     other = 3 - p - q
     a1 = a0 + (sweep if ccw else -sweep)
@@ -51,7 +51,7 @@ def test_arc_samples_lie_on_the_circle(cx, cy, z, radius, a0, sweep, ccw, plane)
 
 
 @pytest.mark.parametrize("ccw", [True, False])
-def test_full_circle(ccw):
+def test_full_circle(ccw) -> None:
     start = (15.0, 5.0, 1.0)
     arc = Arc.from_points(start, start, (10.0, 5.0), (0, 1), ccw)
     assert arc.sweep_rad == pytest.approx(2 * math.pi if ccw else -2 * math.pi)
@@ -62,7 +62,7 @@ def test_full_circle(ccw):
     assert arc.point_at(arc.length_mm) == start
 
 
-def test_arc_tangents_follow_the_direction_of_motion():
+def test_arc_tangents_follow_the_direction_of_motion() -> None:
     ccw = Arc.from_points((10.0, 0.0, 0.0), (0.0, 10.0, 0.0), (0.0, 0.0), (0, 1), True)
     assert ccw.tangent_start == pytest.approx((0.0, 1.0, 0.0), abs=1e-12)
     assert ccw.tangent_end == pytest.approx((-1.0, 0.0, 0.0), abs=1e-12)
@@ -71,7 +71,7 @@ def test_arc_tangents_follow_the_direction_of_motion():
     assert cw.length_mm == pytest.approx(math.pi * 5.0)
 
 
-def test_arc_extent_includes_extreme_points():
+def test_arc_extent_includes_extreme_points() -> None:
     # from 45 deg to 135 deg ccw passes the top of the circle
     r = 10.0
     s = (r * math.cos(math.pi / 4), r * math.sin(math.pi / 4), 0.0)
@@ -85,7 +85,7 @@ def test_arc_extent_includes_extreme_points():
     assert highs[0] == pytest.approx(10.0)
 
 
-def test_arc_errors():
+def test_arc_errors() -> None:
     with pytest.raises(PathError) as err:
         Arc.from_points((0.0, 0.0, 0.0), (1.0, 1.0, 0.0), (0.0, 0.0), (0, 1), True)
     assert err.value.id == PathErrorId.ARC_CENTER
@@ -95,7 +95,7 @@ def test_arc_errors():
     assert "50011" in str(err.value)
 
 
-def test_arc_end_slightly_off_the_circle_ends_exactly_at_the_programmed_end():
+def test_arc_end_slightly_off_the_circle_ends_exactly_at_the_programmed_end() -> None:
     end = (0.0, 10.004, 0.0)  # 4 um off, within tolerance
     arc = Arc.from_points((10.0, 0.0, 0.0), end, (0.0, 0.0), (0, 1), True)
     assert arc.point_at(arc.length_mm) == end

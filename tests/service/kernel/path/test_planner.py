@@ -16,7 +16,7 @@ from cnc_objects.service.kernel.path.segments import PathPreparation, Segment
 from .programs import DYN, DYN_MIXED, dwell, line, polyline, trapezoid_time
 
 
-def test_line_limits_per_axis():
+def test_line_limits_per_axis() -> None:
     lim = element_limits(Line((0, 0, 0), (3, 4, 0)), 1000.0, DYN_MIXED)
     assert lim.axis_speed_mm_s == pytest.approx(min(300 / 0.6, 200 / 0.8))  # 250
     assert lim.speed_mm_s == pytest.approx(250.0)
@@ -26,7 +26,7 @@ def test_line_limits_per_axis():
     assert rapid.speed_mm_s == rapid.axis_speed_mm_s == 100.0  # Z alone
 
 
-def test_arc_limits():
+def test_arc_limits() -> None:
     arc = Arc.from_points((10, 0, 0), (-10, 0, 0), (0, 0), (0, 1), True)
     lim = element_limits(arc, 1000.0, DYN_MIXED)
     acc = min(4000, 2500) / math.sqrt(2)
@@ -36,7 +36,7 @@ def test_arc_limits():
     assert element_limits(big, 1000.0, DYN_MIXED).speed_mm_s == pytest.approx(200.0)
 
 
-def test_corner_limit():
+def test_corner_limit() -> None:
     jumps = [30.0, 20.0, 10.0]
     assert corner_limit_mm_s((1, 0, 0), (0, 1, 0), jumps) == pytest.approx(20.0)
     assert corner_limit_mm_s((1, 0, 0), (1, 0, 0), jumps) == math.inf
@@ -67,7 +67,7 @@ def _reference_exits(segs, jumps):
     return exits
 
 
-def test_incremental_backward_pass_equals_full_pass():
+def test_incremental_backward_pass_equals_full_pass() -> None:
     rng = random.Random(7)
     pts = [(0.0, 0.0, 0.0)]
     for _ in range(150):
@@ -84,7 +84,7 @@ def test_incremental_backward_pass_equals_full_pass():
             assert [s.exit_mm_s for s in la] == _reference_exits(segs[:k], jumps)
 
 
-def test_pass_stops_early_on_a_long_program():
+def test_pass_stops_early_on_a_long_program() -> None:
     """Appending to a long buffer of short segments touches only the stopping distance."""
     pts = [(0.05 * k, 0.0, 0.0) for k in range(2001)]
     segs = _segments(polyline(pts, 100.0))
@@ -100,14 +100,14 @@ def test_pass_stops_early_on_a_long_program():
     assert 0 < changed <= stop_distance / 0.05 + 2
 
 
-def test_time_of_one_line_is_the_trapezoid():
+def test_time_of_one_line_is_the_trapezoid() -> None:
     blocks = [line((0, 0, 0), (100, 0, 0), 100.0)]
     assert plan_time_optimal(blocks, DYN) == pytest.approx(trapezoid_time(100, 5000, 100, 0, 0))
     short = [line((0, 0, 0), (0.5, 0, 0), 100.0)]  # triangle
     assert plan_time_optimal(short, DYN) == pytest.approx(2 * math.sqrt(0.5 / 5000))
 
 
-def test_square_plan_uses_the_velocity_jump_at_corners():
+def test_square_plan_uses_the_velocity_jump_at_corners() -> None:
     pts = [(0, 0, 0), (50, 0, 0), (50, 50, 0), (0, 50, 0), (0, 0, 0)]
     plan = plan_profile(polyline(pts, 100.0), DYN)
     assert [p.exit_mm_s for p in plan] == pytest.approx([50.0, 50.0, 50.0, 0.0])
@@ -116,7 +116,7 @@ def test_square_plan_uses_the_velocity_jump_at_corners():
     assert plan_time_optimal(polyline(pts, 100.0), DYN) == pytest.approx(expected)
 
 
-def test_plan_is_consistent():
+def test_plan_is_consistent() -> None:
     """Every element's entry and exit are mutually reachable and below its limits."""
     rng = random.Random(3)
     pts = [(0.0, 0.0, 0.0)]
@@ -137,7 +137,7 @@ def test_plan_is_consistent():
     assert plan[-1].exit_mm_s == 0.0
 
 
-def test_dwell_and_stops_in_the_plan():
+def test_dwell_and_stops_in_the_plan() -> None:
     blocks = [line((0, 0, 0), (10, 0, 0)), dwell(0.5), line((10, 0, 0), (20, 0, 0))]
     plan = plan_profile(blocks, DYN)
     assert plan[0].exit_mm_s == 0.0  # the dwell needs a stop
@@ -145,7 +145,7 @@ def test_dwell_and_stops_in_the_plan():
         2 * trapezoid_time(10, 5000, 100, 0, 0) + 0.5)
 
 
-def test_streamed_buffer_plans_like_the_whole_program():
+def test_streamed_buffer_plans_like_the_whole_program() -> None:
     """Backward pass incrementally, forward pass on demand: equal to ``plan_profile``."""
     rng = random.Random(11)
     pts = [(0.0, 0.0, 0.0)]

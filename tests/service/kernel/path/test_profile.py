@@ -30,7 +30,7 @@ def _walk(length, acc, cap, v0, v1, dt):
 @settings(max_examples=80, deadline=None)
 @given(length=st.floats(0.01, 50), acc=st.floats(100, 20000), cap=st.floats(20, 500),
        f0=st.floats(0, 1), f1=st.floats(0, 1), dt=st.sampled_from([0.001, 0.002]))
-def test_time_equals_closed_form_and_limits_hold(length, acc, cap, f0, f1, dt):
+def test_time_equals_closed_form_and_limits_hold(length, acc, cap, f0, f1, dt) -> None:
     # entry and exit speeds reachable from each other, below the cap
     v1 = f1 * min(cap, math.sqrt(2 * acc * length))
     v0 = f0 * min(cap, math.sqrt(v1 * v1 + 2 * acc * length))
@@ -45,7 +45,7 @@ def test_time_equals_closed_form_and_limits_hold(length, acc, cap, f0, f1, dt):
     assert all(b >= a for a, b in zip(positions, positions[1:]))
 
 
-def test_stop_lands_exactly_on_the_end_without_creeping():
+def test_stop_lands_exactly_on_the_end_without_creeping() -> None:
     used, speeds, positions = _walk(10.0, 5000.0, 100.0, 0.0, 0.0, 0.001)
     assert positions[-1] == 10.0 and speeds[-1] == 0.0
     # from cruise to standing takes (100 / 5000) s = 20 cycles, +1 partial at most
@@ -53,17 +53,17 @@ def test_stop_lands_exactly_on_the_end_without_creeping():
     assert len(braking) <= 21
 
 
-def test_decelerates_at_the_limit_when_the_cap_drops():
+def test_decelerates_at_the_limit_when_the_cap_drops() -> None:
     s, v, left = advance(1000.0, 5000.0, 20.0, 0.0, 0.0, 100.0, 0.001)
     assert v == pytest.approx(95.0) and left == 0.0
     assert s == pytest.approx(0.001 * (100 + 95) / 2)
 
 
-def test_standing_with_cap_zero_consumes_the_cycle():
+def test_standing_with_cap_zero_consumes_the_cycle() -> None:
     assert advance(10.0, 5000.0, 0.0, 0.0, 3.0, 0.0, 0.001) == (3.0, 0.0, 0.0)
 
 
-def test_passing_the_end_returns_the_time_left():
+def test_passing_the_end_returns_the_time_left() -> None:
     # 0.05 mm at 100 mm/s, exit 100: end after 0.5 ms
     s, v, left = advance(0.05, 5000.0, 100.0, 100.0, 0.0, 100.0, 0.001)
     assert (s, v) == (0.05, 100.0) and left == pytest.approx(0.0005)
