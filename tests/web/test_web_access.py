@@ -20,6 +20,7 @@ import pytest
 from cnc_objects.clients.web.users import WebRole, WebUsers, save_users
 from cnc_objects.testing import ServiceProcess
 from cnc_objects.testing.web import WebProcess, serving_web
+from tests.support.web_http import browser_session
 
 from .conftest import PASSWORDS
 
@@ -27,11 +28,6 @@ WAIT_S = 20.0
 COOKIE = "cnc_web_session"
 READ = {"name": "ch1.mc_active_feed_override_r"}
 OVERRIDE_WRITE = {"name": "ch1.mc_command_feed_override_w", "value": 500}
-
-
-def _session() -> aiohttp.ClientSession:
-    # unsafe: accept the session cookie of an IP address host (127.0.0.1)
-    return aiohttp.ClientSession(cookie_jar=aiohttp.CookieJar(unsafe=True))
 
 
 async def _json(http: aiohttp.ClientSession, method: str, url: str,
@@ -76,7 +72,7 @@ async def test_an_upload_needs_admin_as_on_the_service(
     stored = realtime_service.program_dir / "busy.nc"
     stored.write_bytes(b"N10 G1 X100 F60\nN20 M30\n")
     with serving_web(realtime_service.endpoint, users_file=tmp_path / "users.json") as web:
-        async with _session() as operator, _session() as admin:
+        async with browser_session() as operator, browser_session() as admin:
             op_csrf, _ = await _sign_in(operator, web.url, WebRole.OPERATOR,
                                         passwords[WebRole.OPERATOR])
             status, body = await _json(operator, "POST", web.url + "/api/programs",
@@ -105,7 +101,7 @@ async def test_an_upload_needs_admin_as_on_the_service(
 async def test_a_foreign_host_or_origin_is_refused_and_this_servers_names_work(
         web: WebProcess) -> None:
     port = web.url.rsplit(":", 1)[1]
-    async with _session() as http:
+    async with browser_session() as http:
         status, body = await _json(http, "GET", web.url + "/api/session",
                                    {"Host": f"evil.example:{port}"})
         assert status == 421 and "Host 'evil.example:" in body["error"]
@@ -147,7 +143,7 @@ async def test_sign_in_hashing_does_not_stall_other_sessions(signed_web: WebProc
     """4 wrong passwords at once (the address's attempts but one) while a monitor reads:
     its reads go on while the hashes are checked (on the event loop they waited for all)."""
     url = signed_web.url
-    async with _session() as reader, aiohttp.ClientSession() as attacker:
+    async with browser_session() as reader, aiohttp.ClientSession() as attacker:
         await _sign_in(reader, url, WebRole.MONITOR, PASSWORDS[WebRole.MONITOR])
         latencies_s: list[float] = []
         attempts = [asyncio.create_task(_json(attacker, "POST", url + "/api/login",
@@ -228,7 +224,7 @@ async def _ends(page: aiohttp.ClientWebSocketResponse) -> None:
 async def test_sign_out_a_new_password_and_a_removed_role_end_sessions_at_once(
         signed_web: WebProcess, users_file: Path) -> None:
     url = signed_web.url
-    async with _session() as a, _session() as b, _session() as c, _session() as d:
+    async with browser_session() as a, browser_session() as b, browser_session() as c, browser_session() as d:
         _, signed_out = await _sign_in(a, signed_web.url, WebRole.OPERATOR,
                                        PASSWORDS[WebRole.OPERATOR])
         _, operator = await _sign_in(b, url, WebRole.OPERATOR, PASSWORDS[WebRole.OPERATOR])
@@ -266,7 +262,7 @@ async def _half_sent(url: str) -> tuple[asyncio.StreamReader, asyncio.StreamWrit
 async def test_a_half_sent_request_is_closed_after_the_header_timeout(
         realtime_service: ServiceProcess) -> None:
     with serving_web(realtime_service.endpoint, options=["--header-timeout", "1"]) as web:
-        async with _session() as http:
+        async with browser_session() as http:
             await _json(http, "GET", web.url + "/api/session")
             async with http.ws_connect(web.url + "/ws") as socket:
                 reader, writer = await _half_sent(web.url)

@@ -18,77 +18,64 @@ import aiohttp
 from cnc_objects.clients.web.users import WebRole
 from cnc_objects.testing import ServiceProcess
 from cnc_objects.testing.web import WebProcess
+from tests.support.web_http import WAIT_S, browser_session, json_request
 
 from .conftest import PASSWORDS
-
-WAIT_S = 20.0
-
-
-def _session() -> aiohttp.ClientSession:
-    # unsafe: accept the session cookie of an IP address host (127.0.0.1)
-    return aiohttp.ClientSession(cookie_jar=aiohttp.CookieJar(unsafe=True))
-
-
-async def _json(http: aiohttp.ClientSession, method: str, url: str, csrf: str | None = None,
-                **kwargs: Any) -> tuple[int, dict[str, Any]]:
-    headers = {"X-CSRF-Token": csrf} if csrf else {}
-    async with http.request(method, url, headers=headers, **kwargs) as response:
-        return response.status, await response.json()
 
 
 async def test_open_server_gives_an_admin_session_and_checks_csrf(web: WebProcess) -> None:
     """Without a users file every browser of this machine has the role the service gives
     loopback peers without keys: admin."""
-    async with _session() as http:
-        status, session = await _json(http, "GET", web.url + "/api/session")
+    async with browser_session() as http:
+        status, session = await json_request(http, "GET", web.url + "/api/session")
         assert status == 200
         assert session["role"] == "admin" and session["may_write"] is True
         assert session["sign_in_required"] is False
         write = {"name": "ch1.mc_command_feed_override_w", "value": 500}
-        status, body = await _json(http, "POST", web.url + "/api/write", json=write)
+        status, body = await json_request(http, "POST", web.url + "/api/write", json=write)
         assert status == 403 and "CSRF" in body["error"]
-        status, body = await _json(http, "POST", web.url + "/api/write", session["csrf"], json=write)
+        status, body = await json_request(http, "POST", web.url + "/api/write", session["csrf"], json=write)
         assert (status, body) == (200, {"ok": True})
-        status, body = await _json(http, "GET", web.url + "/api/read",
+        status, body = await json_request(http, "GET", web.url + "/api/read",
                                    params={"name": "ch1.mc_active_feed_override_r"})
         assert body["value"] == 500
 
 
 async def test_a_refusal_of_the_service_comes_back_in_its_words(web: WebProcess) -> None:
-    async with _session() as http:
-        _, session = await _json(http, "GET", web.url + "/api/session")
-        status, body = await _json(http, "POST", web.url + "/api/write", session["csrf"],
+    async with browser_session() as http:
+        _, session = await json_request(http, "GET", web.url + "/api/session")
+        status, body = await json_request(http, "POST", web.url + "/api/write", session["csrf"],
                                    json={"name": "ch1.mc_command_feed_override_w", "value": 2000})
         assert status == 400
         assert body["error"] == "ADS 0x706 INVALIDDATA: feed override 200 % is outside 0..100 %"
-        status, body = await _json(http, "GET", web.url + "/api/read", params={"name": "ch1.nope"})
+        status, body = await json_request(http, "GET", web.url + "/api/read", params={"name": "ch1.nope"})
         assert status == 400 and body["error"].startswith("ADS 0x710 SYMBOLNOTFOUND")
 
 
 async def test_without_a_session_cookie_the_api_is_refused(signed_web: WebProcess) -> None:
-    async with _session() as http:
-        status, session = await _json(http, "GET", signed_web.url + "/api/session")
+    async with browser_session() as http:
+        status, session = await json_request(http, "GET", signed_web.url + "/api/session")
         assert session["role"] is None and session["sign_in_required"] is True
         assert session["roles"] == ["monitor", "operator"]
-        status, body = await _json(http, "GET", signed_web.url + "/api/machine")
+        status, body = await json_request(http, "GET", signed_web.url + "/api/machine")
         assert status == 401 and "not signed in" in body["error"]
         async with http.get(signed_web.url + "/ws") as response:
             assert response.status == 401
         http.cookie_jar.update_cookies({"cnc_web_session": "forged.value.sig"})
-        status, _ = await _json(http, "GET", signed_web.url + "/api/machine")
+        status, _ = await json_request(http, "GET", signed_web.url + "/api/machine")
         assert status == 401
 
 
 async def test_sign_in_per_role_and_the_monitor_is_refused_every_write(
         signed_web: WebProcess) -> None:
-    async with _session() as http:
-        status, body = await _json(http, "POST", signed_web.url + "/api/login",
+    async with browser_session() as http:
+        status, body = await json_request(http, "POST", signed_web.url + "/api/login",
                                    json={"role": "monitor", "password": "wrong"})
         assert status == 401 and body["error"] == "wrong password for role monitor"
-        status, _ = await _json(http, "POST", signed_web.url + "/api/login",
+        status, _ = await json_request(http, "POST", signed_web.url + "/api/login",
                                 json={"role": "monitor", "password": PASSWORDS[WebRole.MONITOR]})
         assert status == 200
-        _, session = await _json(http, "GET", signed_web.url + "/api/session")
+        _, session = await json_request(http, "GET", signed_web.url + "/api/session")
         assert session["role"] == "monitor" and session["may_write"] is False
         csrf = session["csrf"]
         writes = [
@@ -100,50 +87,50 @@ async def test_sign_in_per_role_and_the_monitor_is_refused_every_write(
             ("/api/alarms/1/acknowledge", {}),
         ]
         for path, payload in writes:
-            status, body = await _json(http, "POST", signed_web.url + path, csrf, json=payload)
+            status, body = await json_request(http, "POST", signed_web.url + path, csrf, json=payload)
             assert status == 403, path
             assert body["error"].startswith("ADS 0x704 INVALIDACCESS: role monitor may not "), path
         form = aiohttp.FormData()
         form.add_field("file", b"N10 G1 X1 F600\n", filename="p.nc")
-        status, body = await _json(http, "POST", signed_web.url + "/api/programs", csrf, data=form)
+        status, body = await json_request(http, "POST", signed_web.url + "/api/programs", csrf, data=form)
         assert status == 403 and "role monitor may not upload programs" in body["error"]
-        status, body = await _json(http, "GET", signed_web.url + "/api/read",
+        status, body = await json_request(http, "GET", signed_web.url + "/api/read",
                                    params={"name": "ch1.mc_active_feed_override_r"})
         assert (status, body["value"]) == (200, 1000)  # reads are allowed; nothing was written
 
-        status, _ = await _json(http, "POST", signed_web.url + "/api/login",
+        status, _ = await json_request(http, "POST", signed_web.url + "/api/login",
                                 json={"role": "operator", "password": PASSWORDS[WebRole.OPERATOR]})
-        _, session = await _json(http, "GET", signed_web.url + "/api/session")
-        status, body = await _json(http, "POST", signed_web.url + "/api/write", session["csrf"],
+        _, session = await json_request(http, "GET", signed_web.url + "/api/session")
+        status, body = await json_request(http, "POST", signed_web.url + "/api/write", session["csrf"],
                                    json={"name": "ch1.mc_command_feed_override_w", "value": 500})
         assert (status, body) == (200, {"ok": True})
 
 
 async def test_upload_list_and_read_a_program(web: WebProcess,
                                               realtime_service: ServiceProcess) -> None:
-    async with _session() as http:
-        _, session = await _json(http, "GET", web.url + "/api/session")
+    async with browser_session() as http:
+        _, session = await json_request(http, "GET", web.url + "/api/session")
         form = aiohttp.FormData()
         form.add_field("file", b"N10 G1 X1 F600\nN20 M30\n", filename="up.nc")
-        status, body = await _json(http, "POST", web.url + "/api/programs", session["csrf"],
+        status, body = await json_request(http, "POST", web.url + "/api/programs", session["csrf"],
                                    data=form)
         assert (status, body) == (200, {"name": "up.nc", "size_bytes": 23})
         assert (realtime_service.program_dir / "up.nc").read_bytes() == b"N10 G1 X1 F600\nN20 M30\n"
-        _, listing = await _json(http, "GET", web.url + "/api/programs")
+        _, listing = await json_request(http, "GET", web.url + "/api/programs")
         assert [p["name"] for p in listing["programs"]] == ["up.nc"]
-        _, text = await _json(http, "GET", web.url + "/api/programs/up.nc")
+        _, text = await json_request(http, "GET", web.url + "/api/programs/up.nc")
         assert text["text"] == "N10 G1 X1 F600\nN20 M30\n"
 
 
 async def test_syntax_check_returns_errors_with_their_lines(
         web: WebProcess, realtime_service: ServiceProcess) -> None:
     source = Path(__file__).resolve().parents[2] / "docs" / "examples" / "check-syntax.nc"
-    async with _session() as http:
-        _, session = await _json(http, "GET", web.url + "/api/session")
+    async with browser_session() as http:
+        _, session = await json_request(http, "GET", web.url + "/api/session")
         form = aiohttp.FormData()
         form.add_field("file", source.read_bytes(), filename="check-syntax.nc")
-        await _json(http, "POST", web.url + "/api/programs", session["csrf"], data=form)
-        status, result = await _json(http, "POST", web.url + "/api/channel/1/check",
+        await json_request(http, "POST", web.url + "/api/programs", session["csrf"], data=form)
+        status, result = await json_request(http, "POST", web.url + "/api/channel/1/check",
                                      session["csrf"], json={"program": "check-syntax.nc"})
         assert status == 200
         assert [(e["line"], e["id"]) for e in result["errors"]] == [
@@ -152,8 +139,8 @@ async def test_syntax_check_returns_errors_with_their_lines(
 
 async def test_every_websocket_shares_one_subscription_per_object(web: WebProcess) -> None:
     names = ["ch1.ax1.command_position_acs", "ch1.mc_active_state_r"]
-    async with _session() as http:
-        await _json(http, "GET", web.url + "/api/session")
+    async with browser_session() as http:
+        await json_request(http, "GET", web.url + "/api/session")
         sockets = [await http.ws_connect(web.url + "/ws") for _ in range(5)]
         try:
             for socket in sockets:
@@ -164,7 +151,7 @@ async def test_every_websocket_shares_one_subscription_per_object(web: WebProces
                     message = await asyncio.wait_for(socket.receive_json(), WAIT_S)
                     seen.update(message.get("values", {}))
                 assert seen["ch1.mc_active_state_r"] == 1  # DESELECTED: a fresh service
-            _, stats = await _json(http, "GET", web.url + "/api/stats")
+            _, stats = await json_request(http, "GET", web.url + "/api/stats")
             assert stats["subscriptions"] == len(names) and stats["sockets"] == 5
             await sockets[0].send_json({"watch": ["ch1.no_such_object"]})
             message = await asyncio.wait_for(sockets[0].receive_json(), WAIT_S)
@@ -173,7 +160,7 @@ async def test_every_websocket_shares_one_subscription_per_object(web: WebProces
             for socket in sockets:
                 await socket.close()
         async def all_gone() -> None:
-            while (await _json(http, "GET", web.url + "/api/stats"))[1]["subscriptions"]:
+            while (await json_request(http, "GET", web.url + "/api/stats"))[1]["subscriptions"]:
                 await asyncio.sleep(0.05)
         await asyncio.wait_for(all_gone(), WAIT_S)  # nobody watches: unsubscribed
 
@@ -220,16 +207,16 @@ async def test_the_web_servers_key_bounds_every_page(tmp_path: Path) -> None:
         assert service.keys is not None
         with serving_web(service.endpoint, key=service.keys.client("monitor"),
                          server_key=service.keys.server_key) as web:
-            async with _session() as http:
-                _, session = await _json(http, "GET", web.url + "/api/session")
+            async with browser_session() as http:
+                _, session = await json_request(http, "GET", web.url + "/api/session")
                 assert session["role"] == "admin"  # no users file: this machine's browsers
-                status, body = await _json(
+                status, body = await json_request(
                     http, "POST", web.url + "/api/write", session["csrf"],
                     json={"name": "ch1.mc_command_feed_override_w", "value": 500})
                 assert status == 400
                 assert body["error"].startswith("ADS 0x704 INVALIDACCESS: role monitor may not "
                                                 "write ch1.mc_command_feed_override_w")
-                status, body = await _json(http, "GET", web.url + "/api/read",
+                status, body = await json_request(http, "GET", web.url + "/api/read",
                                            params={"name": "ch1.mc_active_feed_override_r"})
                 assert (status, body["value"]) == (200, 1000)
     finally:
@@ -246,8 +233,8 @@ async def test_live_values_come_back_after_the_service_restarts(tmp_path: Path) 
     name = "ch1.mc_active_feed_override_r"
     try:
         with serving_web(endpoint) as web:
-            async with _session() as http:
-                await _json(http, "GET", web.url + "/api/session")
+            async with browser_session() as http:
+                await json_request(http, "GET", web.url + "/api/session")
                 async with http.ws_connect(web.url + "/ws") as socket:
                     await socket.send_json({"watch": [name]})
                     first = await asyncio.wait_for(socket.receive_json(), WAIT_S)
@@ -269,17 +256,17 @@ async def test_live_values_come_back_after_the_service_restarts(tmp_path: Path) 
 async def test_an_alarm_is_listed_with_its_place_and_acknowledged_by_its_number(
     web: WebProcess,
 ) -> None:
-    async with _session() as http:
-        _, session = await _json(http, "GET", web.url + "/api/session")
+    async with browser_session() as http:
+        _, session = await json_request(http, "GET", web.url + "/api/session")
         csrf = session["csrf"]
-        status, _ = await _json(http, "POST", web.url + "/api/channel/1/reset", csrf, json={})
+        status, _ = await json_request(http, "POST", web.url + "/api/channel/1/reset", csrf, json={})
         assert status == 200
-        status, _ = await _json(http, "POST", web.url + "/api/channel/1/mdi", csrf,
+        status, _ = await json_request(http, "POST", web.url + "/api/channel/1/mdi", csrf,
                                 json={"blocks": "G1 X1"})  # no feed: ISG 20008
         assert status == 200
         deadline = asyncio.get_running_loop().time() + WAIT_S
         while True:
-            _, listed = await _json(http, "GET", web.url + "/api/alarms")
+            _, listed = await json_request(http, "GET", web.url + "/api/alarms")
             raised = [a for a in listed["alarms"] if a["id"] == 20008]
             if raised:
                 break
@@ -289,12 +276,12 @@ async def test_an_alarm_is_listed_with_its_place_and_acknowledged_by_its_number(
         assert (alarm["channel"], alarm["severity"], alarm["state"]) == (1, "error", "active")
         assert (alarm["file"], alarm["line"]) == ("MDI", 1) and alarm["column"] >= 1
         path = f"/api/alarms/{alarm['sequence']}/acknowledge"
-        status, body = await _json(http, "POST", web.url + path, csrf, json={})
+        status, body = await json_request(http, "POST", web.url + path, csrf, json={})
         assert (status, body) == (200, {"ok": True})
-        _, listed = await _json(http, "GET", web.url + "/api/alarms")
+        _, listed = await json_request(http, "GET", web.url + "/api/alarms")
         again = next(a for a in listed["alarms"] if a["sequence"] == alarm["sequence"])
         assert again["state"] == "acknowledged"  # an error stays active until RESET
-        status, body = await _json(http, "POST", web.url + "/api/alarms/999999/acknowledge",
+        status, body = await json_request(http, "POST", web.url + "/api/alarms/999999/acknowledge",
                                    csrf, json={})
         assert status == 400 and body["error"].startswith("ADS 0x70c NOTFOUND: no alarm has")
-        await _json(http, "POST", web.url + "/api/channel/1/reset", csrf, json={})
+        await json_request(http, "POST", web.url + "/api/channel/1/reset", csrf, json={})

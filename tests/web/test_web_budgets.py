@@ -19,8 +19,7 @@ import pytest
 
 from cnc_objects.testing import ServiceProcess
 from cnc_objects.testing.web import WebProcess, serving_web
-
-from .test_web_api import WAIT_S, _json, _session
+from tests.support.web_http import WAIT_S, browser_session, json_request
 
 UNKNOWN_NAMES = 200
 STALL_BOUND_S = 2.0  # another session's slowest read; it was 2.7 s per 200 unknown names
@@ -39,8 +38,8 @@ def tight_web(realtime_service: ServiceProcess) -> Iterator[WebProcess]:
 async def _page(url: str, timeout: aiohttp.ClientWSTimeout | None = None,
                 ) -> AsyncIterator[aiohttp.ClientWebSocketResponse]:
     """A WebSocket of a session of its own."""
-    async with _session() as http:
-        await _json(http, "GET", url + "/api/session")
+    async with browser_session() as http:
+        await json_request(http, "GET", url + "/api/session")
         async with http.ws_connect(url + "/ws", timeout=timeout or aiohttp.ClientWSTimeout(
                 ws_close=10.0)) as socket:
             yield socket
@@ -59,21 +58,21 @@ async def _answers(socket: aiohttp.ClientWebSocketResponse,
 
 
 async def _readable_names(url: str) -> list[str]:
-    async with _session() as http:
-        await _json(http, "GET", url + "/api/session")
-        _, listed = await _json(http, "GET", url + "/api/objects", params={"limit": "5000"})
+    async with browser_session() as http:
+        await json_request(http, "GET", url + "/api/session")
+        _, listed = await json_request(http, "GET", url + "/api/objects", params={"limit": "5000"})
     return [o["name"] for o in listed["objects"] if "r" in o["access"]]
 
 
 async def test_unknown_names_do_not_stall_another_sessions_reads(web: WebProcess) -> None:
-    async with _session() as other, _page(web.url) as monitor:
-        await _json(other, "GET", web.url + "/api/session")
+    async with browser_session() as other, _page(web.url) as monitor:
+        await json_request(other, "GET", web.url + "/api/session")
         slowest_s = 0.0
         unknown = [f"ch1.no_such_object_{k}" for k in range(5 * UNKNOWN_NAMES)]
         for start in range(0, len(unknown), UNKNOWN_NAMES):
             await monitor.send_json({"watch": unknown[start:start + UNKNOWN_NAMES]})
             started_s = time.perf_counter()
-            status, body = await _json(other, "GET", web.url + "/api/read",
+            status, body = await json_request(other, "GET", web.url + "/api/read",
                                        params={"name": "cnc_tick_counter_r"})
             slowest_s = max(slowest_s, time.perf_counter() - started_s)
             assert status == 200, body
@@ -99,8 +98,8 @@ async def test_a_greedy_page_is_refused_over_its_budget_and_others_keep_their_va
 async def test_a_session_over_its_budget_is_refused_and_another_still_gets_values(
         tight_web: WebProcess) -> None:
     names = await _readable_names(tight_web.url)
-    async with _session() as http:
-        await _json(http, "GET", tight_web.url + "/api/session")
+    async with browser_session() as http:
+        await json_request(http, "GET", tight_web.url + "/api/session")
         async with http.ws_connect(tight_web.url + "/ws") as first, \
                 http.ws_connect(tight_web.url + "/ws") as second:
             await first.send_json({"watch": names[:5]})
@@ -137,12 +136,12 @@ async def test_watch_churn_does_not_slow_an_operators_reset(web: WebProcess) -> 
 
     churners = [asyncio.create_task(churning(k)) for k in range(4)]
     try:
-        async with _session() as operator:
-            _, session = await _json(operator, "GET", web.url + "/api/session")
+        async with browser_session() as operator:
+            _, session = await json_request(operator, "GET", web.url + "/api/session")
             times_s = []
             for _ in range(20):
                 started_s = time.perf_counter()
-                status, body = await _json(operator, "POST", web.url + "/api/channel/1/reset",
+                status, body = await json_request(operator, "POST", web.url + "/api/channel/1/reset",
                                            session["csrf"])
                 times_s.append(time.perf_counter() - started_s)
                 assert status == 200, body
@@ -153,30 +152,30 @@ async def test_watch_churn_does_not_slow_an_operators_reset(web: WebProcess) -> 
 
 
 async def test_a_jog_by_nan_or_infinity_is_refused_and_the_mode_stays(web: WebProcess) -> None:
-    async with _session() as http:
-        _, session = await _json(http, "GET", web.url + "/api/session")
+    async with browser_session() as http:
+        _, session = await json_request(http, "GET", web.url + "/api/session")
         for increment in ("nan", "inf", "-inf", None, "1", 10 ** 400):
-            status, body = await _json(
+            status, body = await json_request(
                 http, "POST", web.url + "/api/channel/1/jog", session["csrf"],
                 json={"axis": 1, "direction": 1, "increment_mm": increment})
             assert status == 400 and "increment_mm" in body["error"], (increment, body)
-        status, body = await _json(http, "POST", web.url + "/api/channel/1/jog", session["csrf"],
+        status, body = await json_request(http, "POST", web.url + "/api/channel/1/jog", session["csrf"],
                                    json={"axis": 1, "direction": 1, "increment_mm": -1})
         assert status == 400 and "out of range" in body["error"]
-        status, body = await _json(http, "POST", web.url + "/api/channel/1/jog", session["csrf"],
+        status, body = await json_request(http, "POST", web.url + "/api/channel/1/jog", session["csrf"],
                                    json={"axis": 99, "direction": 1})
         assert (status, body["error"]) == (400, "no axis 99 in channel 1")
-        _, mode = await _json(http, "GET", web.url + "/api/read",
+        _, mode = await json_request(http, "GET", web.url + "/api/read",
                               params={"name": "ch1.mc_active_mode_r"})
         assert mode["value"] != 4  # not MANUAL: nothing was switched
 
 
 async def test_an_objects_limit_that_is_not_a_number_is_refused(web: WebProcess) -> None:
-    async with _session() as http:
-        await _json(http, "GET", web.url + "/api/session")
+    async with browser_session() as http:
+        await json_request(http, "GET", web.url + "/api/session")
         for limit in ("abc", "-1", "1e3", "²", "9" * 5000):
-            status, body = await _json(http, "GET", web.url + "/api/objects",
+            status, body = await json_request(http, "GET", web.url + "/api/objects",
                                        params={"limit": limit})
             assert status == 400 and "'limit'" in body["error"], (limit, body)
-        status, body = await _json(http, "GET", web.url + "/api/objects", params={"limit": "2"})
+        status, body = await json_request(http, "GET", web.url + "/api/objects", params={"limit": "2"})
         assert status == 200 and len(body["objects"]) == 2

@@ -17,9 +17,9 @@ import aiohttp
 from cnc_objects.clients.web.users import WebRole
 from cnc_objects.testing import ServiceProcess
 from cnc_objects.testing.web import STOP_TIMEOUT_S, WebProcess, start_web
+from tests.support.web_http import browser_session, json_request
 
 from .conftest import PASSWORDS
-from .test_web_api import _json, _session
 
 WAIT_S = 20.0
 AX1 = "ch1.ax1"
@@ -29,10 +29,10 @@ async def _open_session(http: aiohttp.ClientSession, url: str,
                         role: WebRole | None = None) -> str:
     """Sign in as ``role`` (None: the open server's session); the CSRF token."""
     if role is not None:
-        status, _ = await _json(http, "POST", url + "/api/login",
+        status, _ = await json_request(http, "POST", url + "/api/login",
                                 json={"role": role.label, "password": PASSWORDS[role]})
         assert status == 200
-    _, session = await _json(http, "GET", url + "/api/session")
+    _, session = await json_request(http, "GET", url + "/api/session")
     return str(session["csrf"])
 
 
@@ -73,7 +73,7 @@ PRESS_X_PLUS = {"press": {"channel": 1, "axis": 1, "direction": 1, "rapid": Fals
 
 
 async def test_continuous_jog_is_released_when_its_socket_closes(web: WebProcess) -> None:
-    async with _session() as http, _session() as jog_http:
+    async with browser_session() as http, browser_session() as jog_http:
         csrf = await _open_session(http, web.url)
         jog_http.cookie_jar.update_cookies({c.key: c.value for c in http.cookie_jar})
         live = await _live(http, web.url, [f"{AX1}.manual_jog_plus_w", f"{AX1}.manual_moving_r",
@@ -95,7 +95,7 @@ async def test_continuous_jog_is_released_when_its_socket_closes(web: WebProcess
 
 async def test_continuous_jog_is_released_without_renewal_and_on_release(
         web: WebProcess) -> None:
-    async with _session() as http:
+    async with browser_session() as http:
         csrf = await _open_session(http, web.url)
         live = await _live(http, web.url, [f"{AX1}.manual_jog_plus_w"])
         socket = await _jog_socket(http, web.url, csrf)
@@ -123,17 +123,17 @@ async def test_continuous_jog_is_released_without_renewal_and_on_release(
 async def test_a_jog_ends_with_its_session_and_a_monitor_cannot_jog(
         signed_web: WebProcess) -> None:
     url = signed_web.url
-    async with _session() as http, _session() as monitor:
+    async with browser_session() as http, browser_session() as monitor:
         csrf = await _open_session(http, url, WebRole.OPERATOR)
         live = await _live(http, url, [f"{AX1}.manual_jog_minus_w"])
         socket = await _jog_socket(http, url, csrf)
         await socket.send_json({"press": {"channel": 1, "axis": 1, "direction": -1}})
         await live.until(f"{AX1}.manual_jog_minus_w", lambda held: held is True)
-        async with _session() as watcher:  # the operator's live socket ends with the session
+        async with browser_session() as watcher:  # the operator's live socket ends with the session
             await _open_session(watcher, url, WebRole.OPERATOR)
             watching = await _live(watcher, url, [f"{AX1}.manual_jog_minus_w"])
             await watching.until(f"{AX1}.manual_jog_minus_w", lambda held: held is True)
-            await _json(http, "POST", url + "/api/logout", csrf, json={})
+            await json_request(http, "POST", url + "/api/logout", csrf, json={})
             await watching.until(f"{AX1}.manual_jog_minus_w", lambda held: held is False)
 
         monitor_csrf = await _open_session(monitor, url, WebRole.MONITOR)
@@ -143,24 +143,24 @@ async def test_a_jog_ends_with_its_session_and_a_monitor_cannot_jog(
 
 
 async def test_handwheel_and_homing(web: WebProcess) -> None:
-    async with _session() as http:
+    async with browser_session() as http:
         csrf = await _open_session(http, web.url)
         live = await _live(http, web.url, [f"{AX1}.command_position_acs",
                                            f"{AX1}.homing_referenced_r", "ch1.ax2.homing_referenced_r"])
         await live.until(f"{AX1}.homing_referenced_r", lambda r: r is False)
-        status, body = await _json(http, "POST", web.url + "/api/channel/1/handwheel", csrf,
+        status, body = await json_request(http, "POST", web.url + "/api/channel/1/handwheel", csrf,
                                    json={"axis": 1, "pulses": 25, "resolution_mm": 0.01})
         assert (status, body) == (200, {"ok": True})
         await live.until(f"{AX1}.command_position_acs", lambda p: p == 2_500)  # 0.25 mm
-        status, body = await _json(http, "POST", web.url + "/api/channel/1/handwheel", csrf,
+        status, body = await json_request(http, "POST", web.url + "/api/channel/1/handwheel", csrf,
                                    json={"axis": 1, "pulses": 5, "resolution_mm": float("nan")})
         assert status == 400 and "finite" in body["error"]
-        status, body = await _json(http, "POST", web.url + "/api/channel/1/home", csrf,
+        status, body = await json_request(http, "POST", web.url + "/api/channel/1/home", csrf,
                                    json={"axes": [1, 2]})
         assert (status, body) == (200, {"ok": True})
         await live.until(f"{AX1}.homing_referenced_r", bool)
         await live.until("ch1.ax2.homing_referenced_r", bool)
-        status, body = await _json(http, "POST", web.url + "/api/channel/1/home", csrf,
+        status, body = await json_request(http, "POST", web.url + "/api/channel/1/home", csrf,
                                    json={"axes": ["X"]})
         assert status == 400
 
@@ -168,79 +168,79 @@ async def test_handwheel_and_homing(web: WebProcess) -> None:
 async def test_tool_list_read_and_written_with_the_services_roles(
         signed_web: WebProcess) -> None:
     url = signed_web.url
-    async with _session() as operator, _session() as monitor:
+    async with browser_session() as operator, browser_session() as monitor:
         csrf = await _open_session(operator, url, WebRole.OPERATOR)
         monitor_csrf = await _open_session(monitor, url, WebRole.MONITOR)
-        status, listed = await _json(monitor, "GET", url + "/api/channel/1/tools")
+        status, listed = await json_request(monitor, "GET", url + "/api/channel/1/tools")
         assert status == 200 and len(listed["rows"]) >= 8
         row = {"radius_mm": 2.5, "length_mm": 42.125}
-        status, body = await _json(monitor, "POST", url + "/api/channel/1/tools/7",
+        status, body = await json_request(monitor, "POST", url + "/api/channel/1/tools/7",
                                    monitor_csrf, json=row)
         assert status == 403 and body["error"] == (
             "ADS 0x704 INVALIDACCESS: role monitor may not write the tool list row wz[7] of "
             "channel 1; operator or admin may")
-        status, body = await _json(operator, "POST", url + "/api/channel/1/tools/7", csrf, json=row)
+        status, body = await json_request(operator, "POST", url + "/api/channel/1/tools/7", csrf, json=row)
         assert (status, body) == (200, {"ok": True})
-        _, listed = await _json(monitor, "GET", url + "/api/channel/1/tools")
+        _, listed = await json_request(monitor, "GET", url + "/api/channel/1/tools")
         assert listed["rows"][6] == {"d": 7, "valid": True, "radius_mm": 2.5, "length_mm": 42.125}
         # refused values change nothing: the service's words for a negative radius
-        status, body = await _json(operator, "POST", url + "/api/channel/1/tools/7", csrf,
+        status, body = await json_request(operator, "POST", url + "/api/channel/1/tools/7", csrf,
                                    json={"radius_mm": -1.0})
         assert status == 400 and body["error"].startswith("ADS 0x706")
-        status, body = await _json(operator, "POST", url + "/api/channel/1/tools/7", csrf,
+        status, body = await json_request(operator, "POST", url + "/api/channel/1/tools/7", csrf,
                                    json={"radius_mm": float("inf")})  # sent as Infinity
         assert status == 400 and "finite" in body["error"]
-        _, listed = await _json(monitor, "GET", url + "/api/channel/1/tools")
+        _, listed = await json_request(monitor, "GET", url + "/api/channel/1/tools")
         assert listed["rows"][6]["radius_mm"] == 2.5
 
 
 async def test_zero_offsets_read_and_written(signed_web: WebProcess) -> None:
     url = signed_web.url
-    async with _session() as operator, _session() as monitor:
+    async with browser_session() as operator, browser_session() as monitor:
         csrf = await _open_session(operator, url, WebRole.OPERATOR)
         monitor_csrf = await _open_session(monitor, url, WebRole.MONITOR)
-        status, table = await _json(monitor, "GET", url + "/api/channel/1/offsets")
+        status, table = await json_request(monitor, "GET", url + "/api/channel/1/offsets")
         assert status == 200 and table["axes"] == ["X", "Y", "Z"] and table["active"] == 0
         assert table["rows"][0]["name"] == "G54" and table["rows"][0]["offsets_mm"] == [0, 0, 0]
         change = {"offsets_mm": {"1": 12.5, "3": -3.25}}
-        status, body = await _json(monitor, "POST", url + "/api/channel/1/offsets/1",
+        status, body = await json_request(monitor, "POST", url + "/api/channel/1/offsets/1",
                                    monitor_csrf, json=change)
         assert status == 403 and "role monitor may not write zero offset group 1" in body["error"]
-        status, body = await _json(operator, "POST", url + "/api/channel/1/offsets/1", csrf,
+        status, body = await json_request(operator, "POST", url + "/api/channel/1/offsets/1", csrf,
                                    json=change)
         assert (status, body) == (200, {"ok": True})
-        _, table = await _json(monitor, "GET", url + "/api/channel/1/offsets")
+        _, table = await json_request(monitor, "GET", url + "/api/channel/1/offsets")
         assert table["rows"][0]["offsets_mm"] == [12.5, 0, -3.25]
-        status, body = await _json(operator, "POST", url + "/api/channel/1/offsets/1", csrf,
+        status, body = await json_request(operator, "POST", url + "/api/channel/1/offsets/1", csrf,
                                    json={"offsets_mm": {"X": 1}})
         assert status == 400 and "axis index" in body["error"]
 
 
 async def test_alarm_history_with_times_acknowledge_all_and_reset(web: WebProcess) -> None:
-    async with _session() as http:
+    async with browser_session() as http:
         csrf = await _open_session(http, web.url)
-        status, _ = await _json(http, "POST", web.url + "/api/channel/1/mdi", csrf,
+        status, _ = await json_request(http, "POST", web.url + "/api/channel/1/mdi", csrf,
                                 json={"blocks": "G1 X1 F"})
         live = await _live(http, web.url, ["ch1.mc_active_state_r"])
         await live.until("ch1.mc_active_state_r", lambda s: s == 6)  # ERROR
-        _, active = await _json(http, "GET", web.url + "/api/alarms")
+        _, active = await json_request(http, "GET", web.url + "/api/alarms")
         assert active["alarms"] and active["alarms"][-1]["state"] == "active"
         assert active["alarms"][-1]["time"].endswith("Z")
         # a manual block now: refused, naming the page's Reset, not the command line's
-        status, body = await _json(http, "POST", web.url + "/api/channel/1/mdi", csrf,
+        status, body = await json_request(http, "POST", web.url + "/api/channel/1/mdi", csrf,
                                    json={"blocks": "G1 X1 F100"})
         assert status == 409 and "(Reset, beside the MDI line)" in body["error"]
         assert "cnc reset" not in body["error"]
-        status, body = await _json(http, "POST", web.url + "/api/alarms/acknowledge-all", csrf,
+        status, body = await json_request(http, "POST", web.url + "/api/alarms/acknowledge-all", csrf,
                                    json={})
         assert (status, body) == (200, {"ok": True})
-        _, active = await _json(http, "GET", web.url + "/api/alarms")
+        _, active = await json_request(http, "GET", web.url + "/api/alarms")
         assert {a["state"] for a in active["alarms"]} == {"acknowledged"}
-        status, _ = await _json(http, "POST", web.url + "/api/channel/1/reset", csrf, json={})
+        status, _ = await json_request(http, "POST", web.url + "/api/channel/1/reset", csrf, json={})
         assert status == 200
         await live.until("ch1.mc_active_state_r", lambda s: s != 6)
-        _, active = await _json(http, "GET", web.url + "/api/alarms")
-        _, history = await _json(http, "GET", web.url + "/api/alarms/history")
+        _, active = await json_request(http, "GET", web.url + "/api/alarms")
+        _, history = await json_request(http, "GET", web.url + "/api/alarms/history")
         assert active["alarms"] == []
         newest = history["alarms"][0]
         assert newest["state"] == "cleared" and newest["time"].endswith("Z")
@@ -256,7 +256,7 @@ async def test_cnc_web_stops_at_once_with_pages_open_and_releases_a_held_jog(
 
     web = start_web(realtime_service.endpoint)
     try:
-        async with _session() as http:
+        async with browser_session() as http:
             csrf = await _open_session(http, web.url)
             live = await _live(http, web.url, [f"{AX1}.manual_jog_minus_w"])
             socket = await _jog_socket(http, web.url, csrf)

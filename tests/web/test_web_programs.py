@@ -23,9 +23,9 @@ from tests.service.test_program_upload_chunks import (
     peak_rss_bytes,
     write_big_program,
 )
+from tests.support.web_http import browser_session, json_request
 
 from .conftest import PASSWORDS
-from .test_web_api import _json, _session
 
 SLICE_BYTES = 4 << 20  # what the page sends per request
 ABANDONED_S = 20.0  # wall time for an abandon to reach the service's log on a busy machine
@@ -33,20 +33,20 @@ ABANDONED_S = 20.0  # wall time for an abandon to reach the service's log on a b
 
 async def _admin(http: aiohttp.ClientSession, web: WebProcess) -> str:
     """The CSRF token of the open server's session (admin on loopback)."""
-    _, session = await _json(http, "GET", web.url + "/api/session")
+    _, session = await json_request(http, "GET", web.url + "/api/session")
     assert session["role"] == "admin"
     return str(session["csrf"])
 
 
 async def _open(http: aiohttp.ClientSession, web: WebProcess, csrf: str, name: str,
                 size_bytes: int) -> tuple[int, dict[str, Any]]:
-    return await _json(http, "POST", web.url + "/api/uploads", csrf,
+    return await json_request(http, "POST", web.url + "/api/uploads", csrf,
                        json={"name": name, "size_bytes": size_bytes})
 
 
 async def _slice(http: aiohttp.ClientSession, web: WebProcess, csrf: str, upload: str,
                  at: int, data: bytes) -> tuple[int, dict[str, Any]]:
-    return await _json(http, "PUT", f"{web.url}/api/uploads/{upload}?at={at}", csrf, data=data)
+    return await json_request(http, "PUT", f"{web.url}/api/uploads/{upload}?at={at}", csrf, data=data)
 
 
 async def _upload_file(http: aiohttp.ClientSession, web: WebProcess, csrf: str, name: str,
@@ -62,7 +62,7 @@ async def _upload_file(http: aiohttp.ClientSession, web: WebProcess, csrf: str, 
                                         if received else 0, data)
             assert status == 200, body
             received.append(body["received_bytes"])
-    status, body = await _json(http, "POST", f"{web.url}/api/uploads/{opened['upload']}/commit",
+    status, body = await json_request(http, "POST", f"{web.url}/api/uploads/{opened['upload']}/commit",
                                csrf)
     assert (status, body) == (200, {"name": name, "size_bytes": size})
     return received
@@ -74,30 +74,30 @@ async def test_a_program_over_the_old_4_mb_lands_whole_and_its_view_is_a_window(
     local = tmp_path / "cam.nc"
     local.write_bytes(program)
     lines = program.decode().splitlines()
-    async with _session() as http:
+    async with browser_session() as http:
         csrf = await _admin(http, web)
         received = await _upload_file(http, web, csrf, "cam.nc", local)
         assert received == [SLICE_BYTES, 2 * SLICE_BYTES, len(program)]
         stored = realtime_service.program_dir / "cam.nc"
         assert hashlib.sha256(stored.read_bytes()).digest() == hashlib.sha256(program).digest()
         assert leftovers(realtime_service.program_dir) == []
-        _, listing = await _json(http, "GET", web.url + "/api/programs")
+        _, listing = await json_request(http, "GET", web.url + "/api/programs")
         assert [(p["name"], p["size_bytes"]) for p in listing["programs"]] == \
             [("cam.nc", len(program))]
 
         for first in (1, 200_000, len(lines) - 99):
-            status, window = await _json(http, "GET", web.url + "/api/programs/cam.nc/lines",
+            status, window = await json_request(http, "GET", web.url + "/api/programs/cam.nc/lines",
                                          params={"first": first, "count": 100})
             assert status == 200
             assert window["total_lines"] == len(lines)
             assert window["lines"] == lines[first - 1:first + 99], first
-        status, window = await _json(http, "GET", web.url + "/api/programs/cam.nc/lines",
+        status, window = await json_request(http, "GET", web.url + "/api/programs/cam.nc/lines",
                                      params={"first": len(lines) + 1, "count": 100})
         assert (status, window["lines"], window["total_lines"]) == (200, [], len(lines))
-        status, body = await _json(http, "GET", web.url + "/api/programs/cam.nc/lines",
+        status, body = await json_request(http, "GET", web.url + "/api/programs/cam.nc/lines",
                                    params={"first": 1, "count": 1001})
         assert status == 400 and "'count' 1..1000" in body["error"]
-        status, body = await _json(http, "GET", web.url + "/api/programs/none.nc/lines")
+        status, body = await json_request(http, "GET", web.url + "/api/programs/none.nc/lines")
         assert status == 400 and "no program 'none.nc'" in body["error"]
 
 
@@ -121,7 +121,7 @@ async def test_a_dropped_or_forgotten_upload_leaves_nothing(
         realtime_service: ServiceProcess) -> None:
     service = realtime_service
     with serving_web(service.endpoint, options=["--upload-idle", "1"]) as web:
-        async with _session() as http:
+        async with browser_session() as http:
             csrf = await _admin(http, web)
             # the connection drops mid-slice: abandoned at once
             _, opened = await _open(http, web, csrf, "dropped.nc", 3 * SLICE_BYTES)
@@ -140,31 +140,31 @@ async def test_a_dropped_or_forgotten_upload_leaves_nothing(
             # cancelled on the page
             _, opened = await _open(http, web, csrf, "cancelled.nc", 2 * SLICE_BYTES)
             await _slice(http, web, csrf, opened["upload"], 0, b"N1\n" * 1000)
-            status, body = await _json(http, "DELETE", f"{web.url}/api/uploads/{opened['upload']}",
+            status, body = await json_request(http, "DELETE", f"{web.url}/api/uploads/{opened['upload']}",
                                        csrf)
             assert (status, body) == (200, {"ok": True})
             await asyncio.to_thread(service.wait_for_log,
                                     r"upload of 'cancelled.nc' abandoned after 3000 bytes",
                                     ABANDONED_S)
             assert leftovers(service.program_dir) == []
-            _, listing = await _json(http, "GET", web.url + "/api/programs")
+            _, listing = await json_request(http, "GET", web.url + "/api/programs")
             assert listing["programs"] == []
 
 
 async def test_only_admin_uploads_with_its_csrf_token(signed_web: WebProcess,
                                                       web: WebProcess) -> None:
-    async with _session() as http:
-        status, _ = await _json(http, "POST", signed_web.url + "/api/login",
+    async with browser_session() as http:
+        status, _ = await json_request(http, "POST", signed_web.url + "/api/login",
                                 json={"role": "operator",
                                       "password": PASSWORDS[WebRole.OPERATOR]})
-        _, session = await _json(http, "GET", signed_web.url + "/api/session")
+        _, session = await json_request(http, "GET", signed_web.url + "/api/session")
         status, body = await _open(http, signed_web, session["csrf"], "p.nc", 100)
         assert status == 403
         assert body["error"] == ("ADS 0x704 INVALIDACCESS: role operator may not upload "
                                  "programs; admin may")
         status, body = await _slice(http, signed_web, session["csrf"], "any", 0, b"N1\n")
         assert status == 403 and "role operator may not upload programs" in body["error"]
-    async with _session() as http:
+    async with browser_session() as http:
         await _admin(http, web)
         status, body = await _open(http, web, "", "p.nc", 100)  # no CSRF token
         assert status == 403 and "CSRF" in body["error"]
@@ -173,7 +173,7 @@ async def test_only_admin_uploads_with_its_csrf_token(signed_web: WebProcess,
 async def test_over_the_limit_is_refused_in_the_services_words(tmp_path: Path) -> None:
     with limited_service(tmp_path, program_max_bytes=2_000_000) as service, \
             serving_web(service.endpoint) as web:
-        async with _session() as http:
+        async with browser_session() as http:
             csrf = await _admin(http, web)
             status, body = await _open(http, web, csrf, "big.nc", 2_000_001)
             assert status == 400
@@ -188,7 +188,7 @@ async def test_over_the_limit_is_refused_in_the_services_words(tmp_path: Path) -
             assert status == 400 and "beyond the 10 bytes announced" in body["error"]
             await asyncio.to_thread(service.wait_for_log, r"upload of 'lies.nc' abandoned")
             assert leftovers(service.program_dir) == []
-            _, listing = await _json(http, "GET", web.url + "/api/programs")
+            _, listing = await json_request(http, "GET", web.url + "/api/programs")
             assert listing["programs"] == []
 
 
@@ -200,7 +200,7 @@ async def test_a_200_mb_program_through_cnc_web(realtime_service: ServiceProcess
     digest = write_big_program(local)
     size = local.stat().st_size
     pid = web.process.pid
-    async with _session() as http:
+    async with browser_session() as http:
         csrf = await _admin(http, web)
         before = peak_rss_bytes(pid)
         started = time.perf_counter()
@@ -213,7 +213,7 @@ async def test_a_200_mb_program_through_cnc_web(realtime_service: ServiceProcess
         open_ms = []
         for first in (3_000_000, 1, 5_000_000):
             opened = time.perf_counter()
-            status, window = await _json(http, "GET", web.url + "/api/programs/finish.nc/lines",
+            status, window = await json_request(http, "GET", web.url + "/api/programs/finish.nc/lines",
                                          params={"first": first, "count": 200})
             open_ms.append(round((time.perf_counter() - opened) * 1000))
             assert status == 200 and len(window["lines"]) == 200
