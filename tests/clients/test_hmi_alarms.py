@@ -7,7 +7,7 @@ from __future__ import annotations
 from cnc_objects.clients.client import AsyncClient
 from cnc_objects.clients.hmi.alarms import AlarmPage
 from cnc_objects.clients.hmi.app import HmiApp
-from tests.clients.test_hmi import SIZE, started, wait_until
+from tests.support.hmi import SIZE, started, wait_until
 from tests.support.service import RunningService
 
 

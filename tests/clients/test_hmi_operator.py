@@ -16,8 +16,8 @@ from cnc_objects.clients.client import AsyncClient
 from cnc_objects.clients.hmi import manual_keys, text
 from cnc_objects.clients.hmi.app import HmiApp
 from cnc_objects.clients.hmi.mdi import MdiHistory
-from tests.clients.test_hmi import SIZE, WAIT_S, shown, started, wait_until
 from tests.support.broker import free_port
+from tests.support.hmi import SIZE, WAIT_S, shown, started, wait_until
 from tests.support.service import RunningService, start_service
 
 NO_REPLY = re.compile(r"no reply from \S+ since (\d\d:\d\d:\d\d) \((\d+) s\)")

@@ -7,8 +7,8 @@ from __future__ import annotations
 import json
 
 from cnc_objects.clients import AsyncClient, ChannelError
-from tests.clients.test_mqtt_bridge import bridge_config, bridging
 from tests.support.broker import ONLINE, Broker, Watcher
+from tests.support.mqtt_bridge import bridge_config, bridging
 from tests.support.service import RunningService
 
 BAD = b"G0 X1\nG1 X10\nM30\n"  # line 2: G1 without F, NC error 20008

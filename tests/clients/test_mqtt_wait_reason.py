@@ -11,8 +11,8 @@ import json
 
 from cnc_objects.clients import AsyncClient
 from cnc_objects.protocol.wait_reasons import WAIT_REASON_TEXTS, WaitReason
-from tests.clients.test_mqtt_bridge import bridge_config, bridging
 from tests.support.broker import ONLINE, Broker, Watcher
+from tests.support.mqtt_bridge import bridge_config, bridging
 from tests.support.service import RunningService
 
 REASON, TEXT = "cnc/m1/ch1.mc_wait_reason_r", "cnc/m1/ch1.mc_wait_reason_text_r"

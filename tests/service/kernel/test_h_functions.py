@@ -19,8 +19,8 @@ from cnc_objects.service.kernel.nc.errors import NcErrorId
 from cnc_objects.service.kernel.plc_functions import TechnoType
 from cnc_objects.service.kernel.state import Snapshot
 from cnc_objects.service.machine_config import DEFAULT_MACHINE, SyncKind
-from tests.service.kernel.test_plc_functions import Recorder
 from tests.support.kernel import KernelHarness
+from tests.support.plc_recorder import Recorder
 
 H_KINDS = {"20": "MOS", "21": "MVS_SVS", "23": "MNS_SNS", "24": "NO_SYNCH"}
 

@@ -22,8 +22,7 @@ from cnc_objects.service.kernel.commands_technology import AcknowledgeTechnoUnit
 from cnc_objects.service.kernel.state import Snapshot
 from cnc_objects.service.machine_config import DEFAULT_MACHINE, SyncKind
 from tests.support.kernel import KernelHarness
-
-KINDS = {"10": "MOS", "11": "MVS_SVS", "12": "MVS_SNS", "13": "MNS_SNS", "14": "NO_SYNCH"}
+from tests.support.plc_recorder import KINDS, Recorder
 
 
 def _config(auto: bool = False, time_us: int = 0) -> Any:
@@ -33,21 +32,6 @@ def _config(auto: bool = False, time_us: int = 0) -> Any:
     return build_config({"channels": channels})
 
 
-class Recorder:
-    """Every published snapshot, in order (the kernel's cycle-end hook)."""
-
-    def __init__(self, h: KernelHarness) -> None:
-        self.rows: list[Snapshot] = []
-        self._next = h.kernel.on_cycle_end  # the harness's own hook keeps working
-        h.kernel.on_cycle_end = self._add
-
-    def _add(self, s: Snapshot) -> None:
-        self.rows.append(s)
-        if self._next is not None:
-            self._next(s)
-
-    def first(self, predicate: Any) -> Snapshot:
-        return next(s for s in list(self.rows) if predicate(s))
 
 
 def _x(s: Snapshot) -> float:

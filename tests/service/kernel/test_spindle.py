@@ -14,8 +14,8 @@ from cnc_objects.service.kernel.commands_technology import SetSpindleOverride
 from cnc_objects.service.kernel.spindle import DEG_S2_PER_RPM_S, SpindleMode, SpindleState
 from cnc_objects.service.kernel.state import Snapshot
 from cnc_objects.service.machine_config import DEFAULT_MACHINE
-from tests.service.kernel.test_plc_functions import Recorder
 from tests.support.kernel import KernelHarness
+from tests.support.plc_recorder import Recorder
 
 
 def _spindle(s: Snapshot) -> SpindleState:
