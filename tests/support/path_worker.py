@@ -24,7 +24,7 @@ def main() -> None:
     """Serve runs until stdin ends."""
     from cnc_objects import _native
     from cnc_objects.service.kernel.path import interpolator, segments
-    from tests.service.kernel.test_event_speed_clock import run
+    from tests.support.event_speed import run
     from tests.support.nc_strategies import to_commands
 
     compiled = _native.compiled(segments) and _native.compiled(interpolator)

@@ -34,7 +34,7 @@ from hypothesis import strategies as st
 from cnc_objects import _native
 from cnc_objects.service.kernel.channel_mode import ChannelState
 from tests.reliability import scale
-from tests.service.kernel.test_event_speed_clock import assert_same
+from tests.support.event_speed import assert_same
 from tests.support.nc_strategies import PERIODS, Write, mixed_programs, scripts, to_commands
 
 ROOT = Path(__file__).resolve().parents[3]

@@ -27,7 +27,7 @@ _CHILD = """
 import sys
 from cnc_objects import _native
 from cnc_objects.service.kernel.path import interpolator, segments
-from tests.service.kernel.test_event_speed_clock import run
+from tests.support.event_speed import run
 text = sys.stdin.read()
 print("compiled" if _native.compiled(segments) and _native.compiled(interpolator)
       else "pure")

@@ -19,8 +19,8 @@ from cnc_objects.service.kernel.commands import (
 )
 from cnc_objects.service.kernel.kernel import Control, ControlCommand, Kernel
 from cnc_objects.service.kernel.step_clock import StepClock, StepCycles
-from tests.service.kernel.test_event_speed_clock import _observed
 from tests.service.test_kernel import Applied, submit
+from tests.support.event_speed import observed_values
 
 
 @pytest.fixture
@@ -119,7 +119,7 @@ def _stepped_run(grants: tuple[int, ...], override_at: int | None = _OVERRIDE_AT
             if k.snapshot.cycle == override_at:
                 assert submit(k, SetFeedOverride(0, 700)) is None
             assert submit(k, StepCycles(cycles)) is None
-            seen.append(_observed(k.snapshot))
+            seen.append(observed_values(k.snapshot))
         while k.snapshot.channels[0].state != ChannelState.READY:
             assert k.snapshot.cycle < 10_000, "the program did not end"
             assert submit(k, StepCycles(1)) is None
@@ -165,7 +165,7 @@ def test_a_step_publishes_the_cycles_an_observer_is_due_at_and_its_last() -> Non
     k = Kernel(build_config(), StepClock(0.001), {"p.nc": _ZIGZAG}.__getitem__,
                lambda name: name == "p.nc")
     published: dict[int, tuple[Any, ...]] = {}
-    k.on_cycle_end = lambda snap: published.__setitem__(snap.cycle, _observed(snap))
+    k.on_cycle_end = lambda snap: published.__setitem__(snap.cycle, observed_values(snap))
     k.next_observed_ns = lambda: -(-(k.stats.cycles + 1) // 100) * 100 * k.cycle_ns
     k.start()
     try:

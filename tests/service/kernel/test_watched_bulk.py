@@ -14,8 +14,7 @@ from __future__ import annotations
 import pytest
 
 from cnc_objects.service.kernel.channel_run import ChannelRunner
-
-from .test_event_speed_clock import assert_same, run
+from tests.support.event_speed import assert_same, run
 
 #: long blocks at F600: 30 s of cruising, a handful of block ends
 LONG_BLOCKS = "G90 G1 F600\n" + "".join(
