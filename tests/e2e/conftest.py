@@ -9,8 +9,7 @@ from collections.abc import Iterator
 import pytest
 
 from cnc_objects.testing import ServiceProcess, start_service
-
-from .test_ads_raw import RawAds
+from tests.support.ads_raw import RawAds
 
 
 @pytest.fixture(scope="module")

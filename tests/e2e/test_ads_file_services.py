@@ -15,8 +15,8 @@ import pyads
 import pytest
 
 from cnc_objects.testing import ServiceProcess, serving
-from tests.e2e.test_ads_raw import READ_WRITE, SYSTEM, RawAds, read_write
 from tests.limits.wire import limited_service
+from tests.support.ads_raw import READ_WRITE, SYSTEM, RawAds, read_write
 from tests.support.pyads_plc import pyads_service
 
 FOPEN, FCLOSE, FREAD, FWRITE, FDELETE = 120, 121, 122, 123, 131

@@ -13,7 +13,7 @@ import struct
 
 import pytest
 
-from .test_ads_raw import (
+from tests.support.ads_raw import (
     ADD_NOTIFICATION,
     CH1_COM,
     COM,

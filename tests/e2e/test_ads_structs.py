@@ -12,7 +12,7 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass
 
-from .test_ads_raw import (
+from tests.support.ads_raw import (
     ADD_NOTIFICATION,
     DELETE_NOTIFICATION,
     READ,
@@ -24,6 +24,7 @@ from .test_ads_raw import (
     read_write,
     write,
 )
+
 from .test_ads_read_length import ANY, INVALIDSIZE, OK, answer
 from .test_ads_symbols_raw import BIGTYPE, cstrings, parse_symbol, parse_symbols
 

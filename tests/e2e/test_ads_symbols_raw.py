@@ -18,8 +18,8 @@ import pytest
 
 from cnc_objects.clients import Client, ObjectInfo
 from cnc_objects.testing import ServiceProcess, start_service
-from tests.e2e.test_ads_raw import READ, READ_WRITE, RawAds, read, read_write
 from tests.service.test_ads_symbols import DEFAULT_MACHINE_OBJECTS
+from tests.support.ads_raw import READ, READ_WRITE, RawAds, read, read_write
 
 pyads = pytest.importorskip("pyads")
 

@@ -7,7 +7,7 @@ import hashlib
 import struct
 
 from cnc_objects.testing import ServiceProcess
-from tests.e2e.test_ads_raw import COM, WRITE, RawAds, write
+from tests.support.ads_raw import COM, WRITE, RawAds, write
 
 STORE = 0x150000
 OPEN, CHUNK, COMMIT = 5, 6, 7

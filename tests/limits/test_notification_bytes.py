@@ -14,8 +14,8 @@ from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.frames import DeleteNotificationRequest
 from cnc_objects.service.limits import LimitsConfig
 from cnc_objects.testing import ServiceProcess
-from tests.e2e.test_ads_raw import ADD_NOTIFICATION, RawAds, add_notification
 from tests.limits.wire import NOTIFICATIONS, Raw, limited_service, next_id
+from tests.support.ads_raw import ADD_NOTIFICATION, RawAds, add_notification
 from tests.support.large_notifications import DEFAULTS_LARGEST
 
 INVALIDWATCHSIZE = 0x717

@@ -16,7 +16,6 @@ import pytest
 from cnc_objects.protocol.constants import AdsCommand, TransmissionMode
 from cnc_objects.protocol.frames import AddNotificationRequest, DeleteNotificationRequest
 from cnc_objects.testing import ServiceProcess
-from tests.e2e.test_ads_raw import ADD_NOTIFICATION, COM, RawAds, add_notification
 from tests.limits.wire import (
     CHANNELS,
     NOTIFICATION_CLIENTS,
@@ -26,6 +25,7 @@ from tests.limits.wire import (
     next_id,
     wait_until,
 )
+from tests.support.ads_raw import ADD_NOTIFICATION, COM, RawAds, add_notification
 
 PER_CLIENT, TOTAL = 5, 8
 NOMOREHDLS = 0x716

@@ -14,8 +14,6 @@ from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.constants import ReservedIndexGroup as RIG
 from cnc_objects.protocol.frames import ReadWriteRequest
 from cnc_objects.service.limits import LimitsConfig
-from tests.e2e.test_ads_raw import READ, RawAds
-from tests.e2e.test_ads_raw import read as ads_read
 from tests.limits.wire import (
     CHANNELS,
     TICK,
@@ -26,6 +24,8 @@ from tests.limits.wire import (
     read_frame,
     read_many_frame,
 )
+from tests.support.ads_raw import READ, RawAds
+from tests.support.ads_raw import read as ads_read
 
 MAILBOXFULL = 0x502
 RATE_PER_S, BURST = 200, 20

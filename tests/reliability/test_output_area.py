@@ -28,9 +28,9 @@ import pytest
 
 from cnc_objects.clients import AdsError, Client
 from cnc_objects.testing import ServiceProcess, start_service
-from tests.e2e.test_ads_raw import CH1_COM, COM, READ, RawAds
 from tests.reliability import figures
 from tests.reliability.scale import Scale
+from tests.support.ads_raw import CH1_COM, COM, READ, RawAds
 from tests.support.resources import rss_kib
 
 VICTIM = b"G01 X1 F100\nM30\n"

@@ -14,7 +14,7 @@ import struct
 from pathlib import Path
 
 from cnc_objects.testing import ServiceProcess, serving
-from tests.e2e.test_ads_raw import COM, READ, READ_WRITE, WRITE, RawAds, read, read_write, write
+from tests.support.ads_raw import COM, READ, READ_WRITE, WRITE, RawAds, read, read_write, write
 
 CH1_COM = 0x120101
 FEED_W, FEED_R = 0x09, 0x0C  # ch1 feed override, commanded and active (UNS16)

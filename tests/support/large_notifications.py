@@ -17,8 +17,8 @@ from cnc_objects.objects.catalog import PLC_GROUP
 from cnc_objects.protocol.constants import CncPort, TransmissionMode
 from cnc_objects.protocol.frames import AddNotificationRequest
 from cnc_objects.testing import ServiceProcess
-from tests.e2e.test_ads_raw import ADD_NOTIFICATION, RawAds, add_notification
 from tests.limits.wire import Raw, next_id
+from tests.support.ads_raw import ADD_NOTIFICATION, RawAds, add_notification
 from tests.support.notification_load import ads_read_latencies_s, read_latencies_s
 
 GPCH_OFFSET = 0x10100  # gpCh, the first symbol of the PLC memory area
