@@ -13,9 +13,8 @@ import struct
 
 import pytest
 
+from tests.support.ads_answers import ANY, INVALIDSIZE, OK, PER_ITEM, SYMBOLNOTFOUND, answer
 from tests.support.ads_raw import READ, READ_WRITE, RawAds, read, read_write
-
-from .test_ads_read_length import ANY, INVALIDSIZE, OK, PER_ITEM, SYMBOLNOTFOUND, answer
 
 LENGTH = b"gpCh[0].contour_lookahead.request.length"  # LREAL, read-write
 LENGTH_DEREF = b"gpCh[0]^.contour_lookahead.request.length"

@@ -13,12 +13,12 @@ import struct
 
 import pytest
 
+from tests.support.ads_answers import ANY, INVALIDSIZE, OK, PER_ITEM, SYMBOLNOTFOUND, answer
 from tests.support.ads_raw import (
     ADD_NOTIFICATION,
     CH1_COM,
     COM,
     DELETE_NOTIFICATION,
-    PLC,
     READ,
     READ_WRITE,
     RawAds,
@@ -27,21 +27,12 @@ from tests.support.ads_raw import (
     read_write,
 )
 
-ANY = 0xFFFF_FFFF  # "I do not know the size"
-PER_ITEM = 0xFFFF  # what ads-client sends per item of a sum command
 UINT_NAME = b"ch1.mc_command_feed_override_r\x00"  # UINT, 1000 at start
 LREAL_NAME = b"gpCh[0].contour_lookahead.request.length\x00"  # LREAL, 0.0 at start
 STRING_NAME = b"ch1.mc_active_program_name_r\x00"  # STRING(84)
 UNKNOWN = b"gpCh[0].no_such_member\x00"
-OK, INVALIDSIZE, SYMBOLNOTFOUND = 0, 0x705, 0x710
 
 
-def answer(ads: RawAds, command: int, data: bytes, port: int = PLC) -> tuple[int, bytes]:
-    """(result, data) of a Read or ReadWrite; the announced length matches the data."""
-    got = ads.call(command, data, port=port)
-    result, length = struct.unpack_from("<II", got.data)
-    assert len(got.data) == 8 + length
-    return result, got.data[8:]
 
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass
 
+from tests.support.ads_answers import ANY, INVALIDSIZE, OK, answer
 from tests.support.ads_raw import (
     ADD_NOTIFICATION,
     DELETE_NOTIFICATION,
@@ -24,9 +25,7 @@ from tests.support.ads_raw import (
     read_write,
     write,
 )
-
-from .test_ads_read_length import ANY, INVALIDSIZE, OK, answer
-from .test_ads_symbols_raw import BIGTYPE, cstrings, parse_symbol, parse_symbols
+from tests.support.ads_symbols_raw import BIGTYPE, cstrings, parse_symbol, parse_symbols
 
 REQUEST = "gpCh[0].contour_lookahead.request"  # start_position, length: LREAL, writable
 STATE = "gpCh[0].contour_lookahead.state"  # read-only members

@@ -15,38 +15,29 @@ from typing import Any
 
 from cnc_objects.clients.web.users import WebRole
 from cnc_objects.testing.web import WebProcess
+from tests.support.browser import WAIT_MS, open_page, page_message
 
 from .conftest import PASSWORDS
 
 PAGES = ("machine", "program", "mdi", "tools", "lookahead", "alarms", "objects")
-WAIT_MS = 30_000
 # 30 mm at F1200 (20 mm/s): 1.5 s of motion, long enough to be seen moving.
 MOVING_PROGRAM = "N10 G1 X30 Y10 F1200\nN20 G1 X0 Y0\nN30 M30\n"
 
 
-async def _open(page: Any, url: str, hash_: str = "machine") -> None:
-    await page.goto(f"{url}/#{hash_}")
-    await page.wait_for_selector("body[data-ready='1']", timeout=WAIT_MS)
 
 
-async def _message(page: Any, pattern: str) -> str:
-    """Wait until the message line matches ``pattern``; return its text."""
-    await page.wait_for_function(
-        "p => new RegExp(p).test(document.querySelector('#message').textContent)",
-        arg=pattern, timeout=WAIT_MS)
-    return str(await page.text_content("#message"))
 
 
 async def test_each_page_loads(page: Any, web: WebProcess) -> None:
     for name in PAGES:
-        await _open(page, web.url, name)
+        await open_page(page, web.url, name)
         assert await page.is_visible(f"#page-{name}")
         for other in PAGES:
             if other != name:
                 assert await page.is_hidden(f"#page-{other}")
         assert await page.get_attribute(f"#nav a[href='#{name}']", "class") == "active"
         await page.wait_for_function("() => window.cncStats.messages > 0", timeout=WAIT_MS)
-    await _open(page, web.url, "machine")
+    await open_page(page, web.url, "machine")
     await page.wait_for_function(
         "() => /DESELECTED/.test(document.querySelector('#channels tbody tr').textContent)",
         timeout=WAIT_MS)
@@ -54,7 +45,7 @@ async def test_each_page_loads(page: Any, web: WebProcess) -> None:
     await page.wait_for_function(
         "() => document.querySelector('#axes tbody tr td:nth-child(2)').textContent === '0.0000'",
         timeout=WAIT_MS)
-    await _open(page, web.url, "mdi")
+    await open_page(page, web.url, "mdi")
     assert await page.locator("#jog tbody button.jog").count() == 6  # X Y Z, minus and plus
 
 
@@ -62,11 +53,11 @@ async def test_run_a_program_uploaded_by_the_file_input_and_drop(page: Any, web:
                                                         tmp_path: Path) -> None:
     program = tmp_path / "move.nc"
     program.write_text(MOVING_PROGRAM)
-    await _open(page, web.url, "program")
+    await open_page(page, web.url, "program")
     await page.set_input_files("#upload-input", str(program))
     await page.wait_for_selector("#program-list li.selected[data-name='move.nc']", timeout=WAIT_MS)
     assert await page.locator("#program-text li").count() == 3
-    await _message(page, "uploaded move.nc")
+    await page_message(page, "uploaded move.nc")
 
     # a second program by drag and drop onto the drop box
     await page.evaluate("""() => {
@@ -99,7 +90,7 @@ async def test_positions_update_at_20_hz_while_a_program_runs(page: Any, web: We
                                                               tmp_path: Path) -> None:
     program = tmp_path / "rate.nc"
     program.write_text("N10 G1 X100 F1200\nN20 M30\n")  # 5 s of motion
-    await _open(page, web.url, "program")
+    await open_page(page, web.url, "program")
     await page.set_input_files("#upload-input", str(program))
     await page.wait_for_selector("#program-list li.selected[data-name='rate.nc']", timeout=WAIT_MS)
     await page.click("#start-program")
@@ -116,14 +107,14 @@ async def test_positions_update_at_20_hz_while_a_program_runs(page: Any, web: We
 
 
 async def test_a_refusal_is_shown_in_the_services_words(page: Any, web: WebProcess) -> None:
-    await _open(page, web.url, "objects")
+    await open_page(page, web.url, "objects")
     await page.fill("#object-pattern", "ch1.mc_command_feed_override_w")
     await page.click("#object-search button")
     await page.click("#object-table tbody tr button")
     row = page.locator("#watch-table tbody tr")
     await row.locator("input").fill("200")  # in %, the object's engineering unit
     await row.locator("button", has_text="Write").click()
-    text = await _message(page, "INVALIDDATA")
+    text = await page_message(page, "INVALIDDATA")
     assert text == "ADS 0x706 INVALIDDATA: feed override 200 % is outside 0..100 %"
     assert await page.get_attribute("#message", "class") == "error"
     # nothing was written
@@ -136,7 +127,7 @@ async def test_the_objects_page_shows_and_writes_engineering_units(page: Any,
                                                                    web: WebProcess) -> None:
     """Values in mm, %, rpm as the catalog's scale says (issue 36), the raw value in the
     cell's title; a write in % is the object's 0.1 %."""
-    await _open(page, web.url, "objects")
+    await open_page(page, web.url, "objects")
     await page.fill("#object-pattern", "ch1.mc_command_feed_override_w")
     await page.click("#object-search button")
     assert "%" in await page.locator("#object-table tbody tr td").nth(4).inner_text()
@@ -198,5 +189,5 @@ async def test_a_monitor_finds_every_write_disabled_and_refused(page: Any,
     await page.wait_for_selector("body[data-ready='1']", timeout=WAIT_MS)
     await page.evaluate("() => { const b = document.querySelector(\"[data-command='reset']\");"
                         " b.disabled = false; b.click(); }")
-    text = await _message(page, "INVALIDACCESS")
+    text = await page_message(page, "INVALIDACCESS")
     assert text == "ADS 0x704 INVALIDACCESS: role monitor may not RESET channel 1; operator or admin may"

@@ -9,8 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from cnc_objects.testing.web import WebProcess
-
-from .test_web_browser import WAIT_MS, _open
+from tests.support.browser import WAIT_MS, open_page
 
 JOG_KEY = "ch1.ax1.manual_jog_plus_w"
 # ten 6 mm moves at F600 (10 mm/s): 6 s of motion, line by line
@@ -50,7 +49,7 @@ async def _held(page: Any, held: bool) -> None:
 
 async def test_continuous_jog_is_released_on_key_up_and_on_blur(page: Any,
                                                                 web: WebProcess) -> None:
-    await _open(page, web.url, "mdi")
+    await open_page(page, web.url, "mdi")
     await page.select_option("#jog-mode", "continuous")
     plus = page.locator(f"#jog button[data-key='{JOG_KEY}']")
     # held by the keyboard: moves while the key is down, stops at key-up
@@ -75,7 +74,7 @@ async def test_continuous_jog_is_released_on_key_up_and_on_blur(page: Any,
 
 async def test_the_program_page_opened_while_a_program_runs_shows_it(
         page: Any, web: WebProcess) -> None:
-    await _open(page, web.url, "machine")
+    await open_page(page, web.url, "machine")
     await _upload(page, "long.nc", LONG_PROGRAM)
     status, _ = await _api(page, "POST", "/api/channel/1/select", {"program": "long.nc"})
     assert status == 200
@@ -108,7 +107,7 @@ async def test_the_program_page_opened_while_a_program_runs_shows_it(
 
 async def test_tool_path_has_axes_scale_and_the_planned_path_in_workpiece_coordinates(
         page: Any, web: WebProcess, tmp_path: Path) -> None:
-    await _open(page, web.url, "program")
+    await open_page(page, web.url, "program")
     status, _ = await _api(page, "POST", "/api/channel/1/offsets/1",
                            {"offsets_mm": {"1": 10, "2": 5}})
     assert status == 200

@@ -10,8 +10,7 @@ from typing import Any
 from cnc_objects.testing import ServiceProcess
 from cnc_objects.testing.web import WebProcess
 from tests.service.test_program_upload_chunks import g1_program, leftovers
-
-from .test_web_browser import WAIT_MS, _message, _open
+from tests.support.browser import WAIT_MS, open_page, page_message
 
 WATCH_PROGRESS = """() => {
     window.progressSeen = [];
@@ -28,10 +27,10 @@ async def test_a_big_program_uploads_with_progress_and_shows_a_window(
     lines = program.decode().splitlines()
     local = tmp_path / "cam.nc"
     local.write_bytes(program)
-    await _open(page, web.url, "program")
+    await open_page(page, web.url, "program")
     await page.evaluate(WATCH_PROGRESS)
     await page.set_input_files("#upload-input", str(local))
-    await _message(page, r"uploaded cam\.nc \(12\.0 MB\)")
+    await page_message(page, r"uploaded cam\.nc \(12\.0 MB\)")
     seen = await page.evaluate("window.progressSeen")
     assert any(0 < value < 1 for value in seen), seen  # the bar moved on before the end
     assert (realtime_service.program_dir / "cam.nc").read_bytes() == program
@@ -55,12 +54,12 @@ async def test_cancel_leaves_nothing(page: Any, web: WebProcess,
                                      realtime_service: ServiceProcess, tmp_path: Path) -> None:
     local = tmp_path / "long.nc"
     local.write_bytes(g1_program(60_000_000))  # fifteen slices: time to cancel after one
-    await _open(page, web.url, "program")
+    await open_page(page, web.url, "program")
     await page.set_input_files("#upload-input", str(local))
     await page.wait_for_function("() => document.querySelector('#upload-progress').value > 0",
                                  timeout=WAIT_MS)
     await page.click("#upload-cancel")
-    await _message(page, r"upload of long\.nc cancelled")
+    await page_message(page, r"upload of long\.nc cancelled")
     await asyncio.to_thread(realtime_service.wait_for_log, r"upload of 'long\.nc' abandoned",
                             20.0)
     assert leftovers(realtime_service.program_dir) == []
@@ -73,7 +72,7 @@ async def test_the_window_follows_the_running_program(page: Any, web: WebProcess
                                                       tmp_path: Path) -> None:
     local = tmp_path / "steps.nc"  # 1000 steps of 0.1 mm at 20 mm/s: 5 s, past the window
     local.write_text("".join(f"N{n} G1 X{n * 0.1:.1f} F1200\n" for n in range(1, 1001)) + "M30\n")
-    await _open(page, web.url, "program")
+    await open_page(page, web.url, "program")
     await page.set_input_files("#upload-input", str(local))
     await page.wait_for_selector("#program-list li.selected[data-name='steps.nc']",
                                  timeout=WAIT_MS)

@@ -17,9 +17,9 @@ from cnc_objects.service.kernel.nc import MotionKind, NcErrorId
 from cnc_objects.service.kernel.nc.check import ErrorCategory
 from cnc_objects.service.kernel.nc.modal import DistanceMode, Plane
 from cnc_objects.service.kernel.nc.technology import HscProgram
+from tests.support.check_mode import Recorder, Run
 
 from .cycle_support import Channel, assert_at, where
-from .test_check_mode import Recorder, Run
 
 E = NcErrorId
 def lit(value: float) -> str:

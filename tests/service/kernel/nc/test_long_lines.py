@@ -27,9 +27,9 @@ from cnc_objects.service.kernel.nc.check import (
 )
 from cnc_objects.service.kernel.nc.parser import LineParser, word_table
 from cnc_objects.service.kernel.nc.source import LogicalLine
+from tests.support.check_mode import Recorder
 
 from .support import AXES, TOOLS, loader_of
-from .test_check_mode import Recorder
 
 RATIO_MAX = 8.0
 
