@@ -15,8 +15,8 @@ import pytest
 
 from cnc_objects.clients import Client
 from cnc_objects.testing import serving
-from tests.clients.test_path_plot import PROGRAM
 from tests.support.cli import cnc, json_lines
+from tests.support.path_plot import PROGRAM
 from tests.support.service import ROOT, RunningService
 
 ADD_MDI_BLOCK = 0x80  # an execution mode bit that changes nothing of a program's path

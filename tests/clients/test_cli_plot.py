@@ -13,8 +13,8 @@ import pytest
 
 from cnc_objects.clients import AdsError, Client
 from cnc_objects.protocol.wait_reasons import WaitReason
-from tests.clients.test_path_plot import FEED_RGB, PROGRAM, TOP_SPEED_RGB, png_pixels
 from tests.support.cli import cnc, json_lines
+from tests.support.path_plot import FEED_RGB, PROGRAM, TOP_SPEED_RGB, png_pixels
 from tests.support.service import RunningService
 
 # PROGRAM: a line, a half circle (G2, r 10) and a line at a lower feed: 20 + 10*pi + 20 mm

@@ -9,9 +9,9 @@ from collections.abc import AsyncIterator
 
 import pytest
 
-from tests.clients.test_mqtt_cli import kill_and_see_the_last_will
 from tests.support.broker import OFFLINE, ONLINE, Broker, Watcher, running_broker
 from tests.support.mqtt_bridge import bridge_config, bridging, values_of
+from tests.support.mqtt_cli import kill_and_see_the_last_will
 from tests.support.service import RunningService
 
 

@@ -7,23 +7,15 @@ figure's own data-to-pixel transform: the path's colour must sit where the path 
 
 from __future__ import annotations
 
-import io
-
 import numpy as np
 import pytest
-from matplotlib import colormaps
-from PIL import Image
 
 from cnc_objects.clients import Client
 from cnc_objects.clients.figure_png import png_bytes
 from cnc_objects.clients.path_plot import plot_trace, trace_figure
 from cnc_objects.clients.path_trace import PathTrace
+from tests.support.path_plot import FEED_RGB, PROGRAM, TOP_SPEED_RGB, png_pixels
 from tests.support.service import RunningService
-
-# a line at F6000 (100 mm/s), a half circle (G2, r 10, centre (20, 10)) and a line at F3000
-PROGRAM = b"G01 X0 Y0 F6000\nG01 X20 Y0\nG02 X20 Y20 I0 J10\nG01 X0 Y20 F3000\nM30\n"
-TOP_SPEED_RGB = tuple(round(255 * c) for c in colormaps["viridis"](1.0)[:3])
-FEED_RGB = (214, 39, 40)  # tab:red
 
 
 @pytest.fixture(scope="module")
@@ -34,11 +26,6 @@ def trace(shared_service: RunningService) -> PathTrace:
         return c.trace_run("plot-part.nc")
 
 
-def png_pixels(png: bytes) -> np.ndarray:
-    """The (H, W, 3) 8-bit RGB pixels of a PNG."""
-    with Image.open(io.BytesIO(png)) as image:
-        assert image.format == "PNG"
-        return np.asarray(image.convert("RGB"))
 
 
 def colour_near(img: np.ndarray, row: int, col: int, rgb: tuple[int, ...], tol: int = 4) -> bool:

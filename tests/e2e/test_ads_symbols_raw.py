@@ -18,8 +18,8 @@ import pytest
 
 from cnc_objects.clients import Client, ObjectInfo
 from cnc_objects.testing import ServiceProcess, start_service
-from tests.service.test_ads_symbols import DEFAULT_MACHINE_OBJECTS
 from tests.support.ads_raw import READ, READ_WRITE, RawAds, read, read_write
+from tests.support.ads_symbols import DEFAULT_MACHINE_OBJECTS
 from tests.support.ads_symbols_raw import BIGTYPE, cstrings, parse_symbol, parse_symbols
 
 pyads = pytest.importorskip("pyads")

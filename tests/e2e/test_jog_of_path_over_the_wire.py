@@ -11,8 +11,8 @@ import pytest
 from cnc_objects.clients import AdsError, ChannelError, Client
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.testing import ServiceProcess, serving
-from tests.service.test_entry_point import run_service
 from tests.support.cli import cnc, json_lines
+from tests.support.entry_point import run_service
 
 PARAMS = Path(__file__).parent.parent / "data" / "params"
 SUSPEND = "gpCh[{}].bahn_mc_control.suspend_axis_output.command_w"

@@ -38,21 +38,13 @@ from cnc_objects.service.binding import build_address_space
 from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.clock import VirtualClock
 from cnc_objects.service.kernel.kernel import Kernel
+from tests.support.ads_symbols import DEFAULT_MACHINE_OBJECTS
 
 E = AdsReturnCode
 PYADS_SYMBOL_ENTRY_BYTES = 30 + 3 * 256  # what pyads' adsGetSymbolInfo asks for
 VALUE_BY_HANDLE = 0xF005
 PLC_GROUP = 0x4020
 
-#: The objects of the default machine: issue 27's 1004, + technology units and spindle,
-#: manual mode, tools and offsets (issue 28: 350 + 108 + 278; G200/G201's manual offset
-#: per axis: 6; the step clock's cnc_cycle_step_w: 1), alarms (issue 29: 6 + 13 fields x
-#: (16 active + 32 history slots); wait reason and its text per channel: 2 x 2). A change
-#: is deliberate: count it here. The cycle thread's scheduling (issue 30): 3. Issue 36's
-#: operator objects: 2 channels x (14 COM + 4 HLI program_block_ignore), distance to go
-#: per axis 6, settings 3; tool name/wear/life: 2 channels x 32 rows x 5.
-DEFAULT_MACHINE_OBJECTS = (1004 + 350 + 108 + 278 + 6 + 1 + 6 + 13 * (16 + 32) + 2 * 2 + 3
-                           + 2 * (14 + 4) + 6 + 3 + 2 * 32 * 5)
 
 
 @pytest.fixture(scope="module")

@@ -3,23 +3,20 @@ where its program store is."""
 
 from __future__ import annotations
 
-import os
 import re
 import signal
 import socket
 import struct
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from cnc_objects.clients import Client
 from cnc_objects.testing.process import service_command
+from tests.support.entry_point import run_service
 from tests.support.service import RunningService, start_service
 
-# Rich draws usage errors in a box as wide as the terminal: wide enough for one line.
-_WIDE = {**os.environ, "COLUMNS": "200"}
 _STORE_LOG = re.compile(r"program store: (/\S+) \((.+)\)$")
 
 
@@ -56,12 +53,6 @@ def _in_tmp_path(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)
 
 
-def run_service(*args: str) -> subprocess.CompletedProcess:
-    """``cnc-service *args`` in the working directory, to its end."""
-    return subprocess.run(
-        [sys.executable, "-m", "cnc_objects.service.main", *args], capture_output=True,
-        text=True, timeout=30, env=_WIDE,
-    )
 
 
 def start_in(cwd: Path, *args: str) -> RunningService:

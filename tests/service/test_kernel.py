@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -14,28 +13,7 @@ from cnc_objects.service.kernel.clock import RealtimeClock, VirtualClock
 from cnc_objects.service.kernel.commands import Refusal, RefusalReason, SetExecutionMode, SetFeedOverride
 from cnc_objects.service.kernel.kernel import Control, ControlCommand, Kernel, ResetCycleStats
 from cnc_objects.service.kernel.state import KernelState, LinkState
-
-
-class Applied:
-    """Collects the result of one submitted command; wait() blocks until it came."""
-
-    def __init__(self) -> None:
-        self.event = threading.Event()
-        self.result: Refusal | None = None
-
-    def __call__(self, result: Refusal | None) -> None:
-        self.result = result
-        self.event.set()
-
-    def wait(self) -> Refusal | None:
-        assert self.event.wait(5), "the kernel did not apply the command"
-        return self.result
-
-
-def submit(kernel: Kernel, command) -> Refusal | None:
-    done = Applied()
-    kernel.submit(command, done)
-    return done.wait()
+from tests.support.kernel_commands import Applied, submit
 
 
 @pytest.fixture

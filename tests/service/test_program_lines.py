@@ -14,8 +14,7 @@ from cnc_objects.protocol.constants import ProgramStoreOffset as Op
 from cnc_objects.service.storage import program_line_index
 from cnc_objects.testing import serving
 from tests.limits.wire import limited_service
-
-from .test_program_upload_chunks import g1_program, leftovers
+from tests.support.uploads import g1_program, leftovers
 
 INVALIDSIZE, INVALIDDATA, NOTFOUND, NOMEMORY = 0x705, 0x706, 0x70C, 0x70A
 

@@ -11,14 +11,13 @@ from __future__ import annotations
 
 import os
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from cnc_objects.clients import Client
 from cnc_objects.service.kernel.realtime_priority import DEFAULT_RT_PRIORITY, SchedPolicy
+from tests.support.realtime import fifo_permitted
 from tests.support.service import serving
 
 GRANT_LOG = r"cycle thread under SCHED_\w+"
@@ -26,21 +25,8 @@ GRANT_LOG = r"cycle thread under SCHED_\w+"
 #: may neither run SCHED_FIFO nor lock its memory.
 DROP_PRIVILEGES = ("setpriv", "--bounding-set=-sys_nice,-ipc_lock",
                    "--inh-caps=-sys_nice,-ipc_lock")
-_PROBE = """
-import os
-try:
-    os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param({priority}))
-    print("granted")
-except OSError:
-    print("refused")
-"""
 
 
-def fifo_permitted(priority: int, wrapper: tuple[str, ...] = ()) -> bool:
-    """Whether a process started like the service may run SCHED_FIFO at ``priority``."""
-    out = subprocess.run([*wrapper, sys.executable, "-c", _PROBE.format(priority=priority)],
-                         capture_output=True, text=True, check=True, timeout=30)
-    return out.stdout.strip() == "granted"
 
 
 def grant_objects(endpoint: str) -> dict[str, object]:

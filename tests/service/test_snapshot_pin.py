@@ -15,7 +15,7 @@ from cnc_objects.service.kernel.clock import VirtualClock
 from cnc_objects.service.kernel.commands import SetFeedOverride
 from cnc_objects.service.kernel.kernel import Kernel
 from cnc_objects.service.kernel.state import Snapshot
-from tests.service.test_kernel import submit
+from tests.support.kernel_commands import submit
 
 
 @pytest.fixture

@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from cnc_objects.service.kernel.realtime_priority import DEFAULT_RT_PRIORITY
-from tests.service.test_realtime_priority import fifo_permitted
+from tests.support.realtime import fifo_permitted
 from tests.support.service import serving
 
 

@@ -9,8 +9,8 @@ from typing import Any
 
 from cnc_objects.testing import ServiceProcess
 from cnc_objects.testing.web import WebProcess
-from tests.service.test_program_upload_chunks import g1_program, leftovers
 from tests.support.browser import WAIT_MS, open_page, page_message
+from tests.support.uploads import g1_program, leftovers
 
 WATCH_PROGRESS = """() => {
     window.progressSeen = [];

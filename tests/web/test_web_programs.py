@@ -17,7 +17,7 @@ from cnc_objects.clients.web.users import WebRole
 from cnc_objects.testing import ServiceProcess
 from cnc_objects.testing.web import WebProcess, serving_web
 from tests.limits.wire import limited_service
-from tests.service.test_program_upload_chunks import (
+from tests.support.uploads import (
     g1_program,
     leftovers,
     peak_rss_bytes,

@@ -20,8 +20,8 @@ from cnc_objects.service.kernel.manual_commands import ManualAxisCommand
 from cnc_objects.service.kernel.manual_view import DisplayState
 from cnc_objects.service.kernel.nc.errors import NcErrorId
 from cnc_objects.service.kernel.state import Snapshot
-from tests.service.kernel.test_manual_mode import LIMIT_MAX_MM, machine
 from tests.support.kernel import KernelHarness
+from tests.support.manual_machine import LIMIT_MAX_MM, machine
 from tests.support.plc_recorder import Recorder
 
 INCREMENT_01UM = 20_000  # 2 mm

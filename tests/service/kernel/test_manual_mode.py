@@ -7,13 +7,11 @@ channel axis and of its drive, the manual views, the channel's state and errors.
 
 from __future__ import annotations
 
-import copy
 from typing import Any
 
 import pytest
 
 from cnc_objects.protocol.values import ChannelMode, ChannelState, ManualOperationMode
-from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.alarms import AlarmClass, Severity
 from cnc_objects.service.kernel.commands import (
     Feedhold,
@@ -26,26 +24,20 @@ from cnc_objects.service.kernel.commands import (
 )
 from cnc_objects.service.kernel.manual_commands import ManualAxisCommand
 from cnc_objects.service.kernel.manual_mode import ManualErrorId
-from cnc_objects.service.machine_config import DEFAULT_MACHINE
 from tests.support.kernel import KernelHarness
+from tests.support.manual_machine import (
+    ACC_MM_S2,
+    HOMING_MM_S,
+    JOG_MM_S,
+    LIMIT_MAX_MM,
+    LIMIT_MIN_MM,
+    REF_MM,
+    machine,
+)
 
 CYCLE_S = 0.001
-ACC_MM_S2 = 500.0  # small, so ramps take many cycles
-JOG_MM_S, RAPID_MM_S, HOMING_MM_S = 20.0, 60.0, 15.0
-LIMIT_MIN_MM, LIMIT_MAX_MM = -5.0, 8.0
-REF_MM = 3.0
 
 
-def machine(**extra: object):
-    """The default machine; X of channel 1 with small limits and its manual parameters."""
-    data = copy.deepcopy(DEFAULT_MACHINE)
-    x = data["channels"][0]["axes"][0]
-    x["limits"] = {"acc_max_mm_s2": ACC_MM_S2, "sw_limit_min_mm": LIMIT_MIN_MM,
-                   "sw_limit_max_mm": LIMIT_MAX_MM}
-    x["manual"] = {"jog_vel_mm_s": JOG_MM_S, "jog_rapid_vel_mm_s": RAPID_MM_S,
-                   "homing_vel_mm_s": HOMING_MM_S, "pos_refpkt_mm": REF_MM}
-    data.update(extra)
-    return build_config(data)
 
 
 @pytest.fixture

@@ -19,8 +19,8 @@ from cnc_objects.service.kernel.commands import (
 )
 from cnc_objects.service.kernel.kernel import Control, ControlCommand, Kernel
 from cnc_objects.service.kernel.step_clock import StepClock, StepCycles
-from tests.service.test_kernel import Applied, submit
 from tests.support.event_speed import observed_values
+from tests.support.kernel_commands import Applied, submit
 
 
 @pytest.fixture
