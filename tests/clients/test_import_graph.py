@@ -4,7 +4,7 @@ the entry package ``cli`` imports the command modules, and only its ``__main__``
 
 from __future__ import annotations
 
-from tests.test_import_graph import import_cycles, internal_graph
+from tests.support.import_graph import import_cycles, internal_graph
 
 CLIENTS = "cnc_objects.clients"
 COMMAND_MODULES = {f"{CLIENTS}.cli.objects", f"{CLIENTS}.cli.machine", f"{CLIENTS}.cli.plot"}
