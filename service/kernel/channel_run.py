@@ -198,7 +198,7 @@ class ChannelRunner:
                            f"mode {mode} cannot be selected; use {names}")
         if not allowed(ch.state, ChannelEvent.SELECT_MODE):
             return _not_ready(ch, "select a mode after the program ends or after RESET")
-        ch.mode = mode
+        ch.mode = ChannelMode(mode)  # one of SELECTABLE_MODES (checked above)
         self._move(ChannelEvent.SELECT_MODE)
         self.manual.publish()  # hb_display_r.state follows the mode
         if mode != ChannelMode.AUTOMATIC:

@@ -13,11 +13,11 @@ from enum import IntFlag
 from typing import Any, NamedTuple, Protocol
 
 from cnc_objects.protocol.units import UM01_PER_MM
+from cnc_objects.protocol.values import ChannelMode, ChannelState, RapidOverrideMode
 
 # Defined with the wire's value sets; the kernel's modules import them from here.
 from cnc_objects.protocol.values import ExecutionMode as ExecutionMode
 from cnc_objects.protocol.values import LinkState as LinkState
-from cnc_objects.protocol.values import RapidOverrideMode
 
 from ..machine_config import ChannelConfig, MachineConfig
 from .alarms import AlarmLog
@@ -170,8 +170,8 @@ class Channel:
     execution_mode_active: int = 0
     dist_prog_start_01um: float = 0.0  # 0.1 um
     output_suspended: bool = False  # suspend_axis_output.state_r: the axes are given up
-    mode: int = 1  # ChannelMode
-    state: int = 1  # ChannelState
+    mode: ChannelMode = ChannelMode.STANDBY
+    state: ChannelState = ChannelState.DESELECTED
     program_name: str = ""  # selected program
     single_block: bool = False
     waiting_for_start: bool = False  # standing at M0/M1 or a single-block stop
