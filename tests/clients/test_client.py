@@ -379,6 +379,15 @@ async def test_a_read_without_reply_names_the_read_not_its_browse(kind: str) -> 
                                  f"from {endpoint} (is cnc-service running?)")
 
 
+async def test_a_subscription_without_reply_names_the_subscription() -> None:
+    endpoint = "tcp://127.0.0.1:9"  # nothing answers
+    async with AsyncClient(endpoint, timeout_s=0.2) as c:
+        with pytest.raises(NoReplyError) as caught:
+            async for _sample in c.subscribe("ch1.mc_active_state_r"):
+                break
+    assert caught.value.request == "SUBSCRIBE ch1.mc_active_state_r"
+
+
 async def test_many_requests_in_flight_are_matched_by_invoke_id(service: RunningService) -> None:
     async with AsyncClient(service.endpoint) as c:
         names = ["ch1.ax1.actual_link_to_physical_axis", "ch1.ax2.actual_link_to_physical_axis",

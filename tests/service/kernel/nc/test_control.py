@@ -171,6 +171,7 @@ def test_loop_guard_counts_passes_without_blocks_only(monkeypatch) -> None:
         ("$GOTO [NOPE]\nM30", NcErrorId.LABEL_NOT_FOUND, 1, 1),
         ("$GOTO X10\nM30", NcErrorId.BAD_GOTO_TARGET, 1, 7),
         ("$GOTO N1 $GOTO N1\nN1: M30", NcErrorId.WORD_REPEATED, 1, 10),
+        ("L sub1 L sub2\nM30", NcErrorId.WORD_REPEATED, 1, 8),  # two calls in one block
         ("#MSG SAVE [\"x %f\"]\nM30", NcErrorId.MESSAGE_FORMAT, 1, 12),
         ("#WAIT\nM30", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1, 1),
         ("N5 #CONTOUR LOOKAHEAD LOG ON\nM30", NcErrorId.CONTOUR_LOOKAHEAD_NOT_ENABLED, 1, 4),

@@ -653,6 +653,14 @@ def test_malformed_pattern(text) -> None:
     assert Channel().error(text).id == E.PATTERN_SYNTAX
 
 
+def test_pattern_call_outside_the_pattern_wrapper() -> None:
+    """#PATTERN CALL belongs to the wrapper a cycle call at a pattern runs."""
+    text = "G01 F100 X1\n#PATTERN CALL\nM30\n"
+    error = Channel().error(text)
+    assert_at(error, E.PATTERN_SYNTAX, text, "#PATTERN CALL")
+    assert "belongs to the pattern wrapper" in str(error)
+
+
 def test_missing_pattern_end_at_program_end() -> None:
     text = "G01 F100 X1\n#PATTERN BEGIN [ID=4]\n#AT [1, 2, 3]\n"
     error = Channel().error(text)

@@ -292,6 +292,17 @@ def test_circle_2d_noisy_matches_newton(degrees) -> None:
     assert fit.variance > 1e-6
 
 
+def test_three_points_of_a_short_arc_where_gauss_newton_overshoots() -> None:
+    """Three points 10 degrees apart whose Kasa start is far off: the plain Gauss-Newton
+    step makes the cost worse, the Marquardt damping takes over and is relaxed again once
+    steps succeed; the result is the circle through the three points."""
+    points = [(50.0629, 0.0), (49.7439, 4.352), (49.5557, 8.738)]
+    fit = fit_circle_2d(points)
+    d = np.linalg.norm(np.asarray(points) - (fit.center_x, fit.center_y), axis=1)
+    assert np.allclose(d, fit.radius, rtol=1e-12, atol=0.0)
+    assert fit.variance < 1e-20
+
+
 def test_geometric_circle_beats_kasa_on_a_partial_arc() -> None:
     centre = (3.0, -4.0)
     points = radially_noisy_2d(centre, 50.0, list(range(0, 46, 5)), 0.05, seed=3)
