@@ -8,8 +8,9 @@ consistent within one cycle and never waits for the kernel.
 from __future__ import annotations
 
 import threading
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from enum import IntFlag
+from operator import attrgetter
 from typing import Any, NamedTuple, Protocol
 
 from cnc_objects.protocol.units import UM01_PER_MM
@@ -247,25 +248,18 @@ class Channel:
         return self.suspend_command_w if self.suspend_enable_w else self.suspend_request_r
 
     def frozen(self) -> Channel:
-        """A copy for the snapshot, with copies of its axes."""
-        return Channel(
-            self.channel_id, self.name, [a.frozen() for a in self.axes],
-            self.feed_override_max, self.feed_override_command, self.feed_override_per_mille,
-            self.execution_mode_command, self.execution_mode_active,
-            self.dist_prog_start_01um, self.output_suspended, self.mode, self.state,
-            self.program_name, self.single_block, self.waiting_for_start, self.block_number,
-            self.line, self.file_name, self.file_offset, self.block_count,
-            self.manual_blocks_done, self.path_velocity_mm_s, self.programmed_velocity_mm_s,
-            self.remaining_in_block_mm, self.program_time_s, self.errors, self.error_count,
-            self.suspend_command_w, self.suspend_enable_w, self.suspend_request_r,
-            self.contour, self.execution_mode_plc_command, self.execution_mode_plc_enable,
-            self.syn_chk, self.decoder_flags, self.messages, self.message_count,
-            self.machining, self.prod_time_trace, self.plc_functions, self.spindle, self.manual,
-            self.tooling, self.wait_reason, self.rapid_override_command,
-            self.rapid_override_per_mille, self.block_ignore_command, self.block_ignore_active,
-            self.m01_stop_enable, self.g00_override_mode, self.tool_cut_cycles,
-            self.block_ignore_plc_command, self.block_ignore_plc_enable,
-        )
+        """A copy for the snapshot, with copies of its axes.
+
+        The values are read in the order of ``dataclasses.fields`` (``_CHANNEL_VALUES``),
+        not a hand-written list: a field added anywhere lands in its own place. Positional
+        on purpose: 53 keywords cost two to three times as much per published cycle."""
+        copy = Channel(*_CHANNEL_VALUES(self))
+        copy.axes = [a.frozen() for a in self.axes]
+        return copy
+
+
+# every field of a Channel in declaration order, read in one C call (Channel.frozen)
+_CHANNEL_VALUES = attrgetter(*(f.name for f in fields(Channel)))
 
 
 @dataclass(slots=True)

@@ -1,7 +1,7 @@
-"""``Channel.frozen()`` copies every field into the same field: it is positional (a
-keyword call costs twice as much on the snapshot's path, 4.7 against 10.4 us a channel),
-so a field inserted in the wrong place would shift values of the same type silently.
-This test gives every field a value of its own and finds such a shift by name."""
+"""``Channel.frozen()`` copies every field into the same field. It is positional (a
+keyword call costs twice as much on the snapshot's path), its order taken from
+``dataclasses.fields`` rather than written by hand; this test gives every field a value
+of its own and would find a shift of values by name."""
 
 from __future__ import annotations
 
