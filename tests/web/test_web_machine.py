@@ -8,12 +8,14 @@ acknowledge-all, and RESET after a manual block in ERROR.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import time
 from collections.abc import Callable
 from typing import Any
 
 import aiohttp
 
+from cnc_objects.clients.web.jog_hold import RENEW_S
 from cnc_objects.clients.web.users import WebRole
 from cnc_objects.testing import ServiceProcess
 from cnc_objects.testing.web import STOP_TIMEOUT_S, WebProcess, start_web
@@ -120,6 +122,15 @@ async def test_continuous_jog_is_released_without_renewal_and_on_release(
         assert "count from 1" in (await socket.receive_json(timeout=WAIT_S))["error"]
 
 
+async def _renew(socket: aiohttp.ClientWebSocketResponse) -> None:
+    """Renew the keys ``socket`` holds every ``RENEW_S``, as cnc-web's page does, until
+    the socket closes."""
+    with contextlib.suppress(ConnectionError):
+        while not socket.closed:
+            await socket.send_json({"renew": True})
+            await asyncio.sleep(RENEW_S)
+
+
 async def test_a_jog_ends_with_its_session_and_a_monitor_cannot_jog(
         signed_web: WebProcess) -> None:
     url = signed_web.url
@@ -128,13 +139,19 @@ async def test_a_jog_ends_with_its_session_and_a_monitor_cannot_jog(
         live = await _live(http, url, [f"{AX1}.manual_jog_minus_w"])
         socket = await _jog_socket(http, url, csrf)
         await socket.send_json({"press": {"channel": 1, "axis": 1, "direction": -1}})
-        await live.until(f"{AX1}.manual_jog_minus_w", lambda held: held is True)
-        async with browser_session() as watcher:  # the operator's live socket ends with the session
-            await _open_session(watcher, url, WebRole.OPERATOR)
-            watching = await _live(watcher, url, [f"{AX1}.manual_jog_minus_w"])
-            await watching.until(f"{AX1}.manual_jog_minus_w", lambda held: held is True)
-            await json_request(http, "POST", url + "/api/logout", csrf, json={})
-            await watching.until(f"{AX1}.manual_jog_minus_w", lambda held: held is False)
+        # held as a page holds it, renewed every RENEW_S (jog.js): a second sign-in takes
+        # longer than HOLD_TIMEOUT_S on a busy machine, and the dead-man would end the jog
+        renewing = asyncio.create_task(_renew(socket))
+        try:
+            await live.until(f"{AX1}.manual_jog_minus_w", lambda held: held is True)
+            async with browser_session() as watcher:  # another session of the operator
+                await _open_session(watcher, url, WebRole.OPERATOR)
+                watching = await _live(watcher, url, [f"{AX1}.manual_jog_minus_w"])
+                await watching.until(f"{AX1}.manual_jog_minus_w", lambda held: held is True)
+                await json_request(http, "POST", url + "/api/logout", csrf, json={})
+                await watching.until(f"{AX1}.manual_jog_minus_w", lambda held: held is False)
+        finally:
+            renewing.cancel()
 
         monitor_csrf = await _open_session(monitor, url, WebRole.MONITOR)
         async with monitor.get(url + f"/ws/jog?csrf={monitor_csrf}") as response:
