@@ -56,12 +56,13 @@ endif
 # The checkers first (ruff: lint and import order; mypy, strict: tools/typecheck.py), then
 # the tests in TEST_WORKERS processes (pytest-xdist; most tests wait on a service, a
 # browser or a subprocess, so 4 workers keep 2 cores busy), without the slow reruns that
-# `make soak` runs (marker soak). TEST_WORKERS=0 runs them in this process, in order.
+# `make soak` runs (marker soak); worksteal: an idle worker takes queued tests from a busy
+# one, so the long tests do not end the run alone. TEST_WORKERS=0: one process, in order.
 TEST_WORKERS ?= 4
 test: $(VENV)/.installed-test $(VENV)/.native
 	$(BIN)/ruff check .
 	$(BIN)/python tools/typecheck.py
-	$(BIN)/python -m pytest -n $(TEST_WORKERS) -m "not soak" $(PYTEST_ARGS)
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist worksteal -m "not soak" $(PYTEST_ARGS)
 
 # The tests of `make test` with line coverage of the package (services, cnc-web and cnc
 # subprocesses included): a table of what is missed, and build/coverage.json, which
