@@ -89,6 +89,16 @@ def positions(run) -> np.ndarray:
     return np.array([s.positions_mm for s in run.samples])
 
 
+def motion(run) -> np.ndarray:
+    """The recorded positions up to the end of the motion: the recording goes on for the
+    cycles the harness takes to see READY, a number that varies with the machine's load."""
+    p = positions(run)
+    end = len(p)
+    while end > 1 and np.array_equal(p[end - 2], p[-1]):
+        end -= 1
+    return p[:end]
+
+
 def speeds(run) -> np.ndarray:
     return np.array([s.path_velocity_mm_s for s in run.samples])
 
@@ -368,7 +378,7 @@ def test_vfbt_has_no_effect_outside_la_on(kernel) -> None:
         assert_finished_at(run, (0.0, 20.0, 0.0))
     assert with_vfbt.channel.program_time_s == pytest.approx(plain.channel.program_time_s,
                                                              abs=1e-9)
-    assert np.array_equal(positions(with_vfbt), positions(plain))
+    assert np.array_equal(motion(with_vfbt), motion(plain))
     # the whole zig-zag fits the buffer: LA_ON with VFBT=1 is exactly as fast
     assert abs(la_on.channel.program_time_s - plain.channel.program_time_s) <= CYCLE_S
 
