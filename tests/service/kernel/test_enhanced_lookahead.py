@@ -36,7 +36,7 @@ from cnc_objects.service.kernel.nc.blocks import Block, MotionKind
 from cnc_objects.service.kernel.path.errors import PathErrorId
 from cnc_objects.service.kernel.path.limits import AxisDynamics
 from cnc_objects.service.kernel.path.section_plan import plan_section
-from tests.support.kernel import KernelHarness
+from tests.support.kernel import KernelHarness, Run
 
 CONFIG = build_config()
 CYCLE_S = CONFIG.cycle_ms / 1000.0
@@ -89,7 +89,7 @@ def positions(run) -> np.ndarray:
     return np.array([s.positions_mm for s in run.samples])
 
 
-def motion(run) -> np.ndarray:
+def motion(run: Run) -> np.ndarray:
     """The recorded positions up to the end of the motion: the recording goes on for the
     cycles the harness takes to see READY, a number that varies with the machine's load."""
     p = positions(run)
