@@ -9,12 +9,14 @@ test switched on is switched off again.
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 
-from cnc_objects.clients import Client
+from cnc_objects.clients import AsyncClient, Client
 from cnc_objects.protocol.values import ExecutionMode
 from cnc_objects.protocol.wait_reasons import WAIT_REASON_TEXTS, WaitReason
 from cnc_objects.testing import ServiceProcess, serving, wait_for
@@ -189,12 +191,27 @@ def test_an_error_waits_for_reset(c: Client) -> None:
     expect(c, WaitReason.NONE)
 
 
-def test_the_path_waits_for_the_decoder(tmp_path: Path) -> None:
+async def test_the_path_waits_for_the_decoder(tmp_path: Path) -> None:
     """Realtime clock: a long loop without motion between two blocks leaves the path
-    without blocks while the decoder computes (the virtual clock would wait for it)."""
+    without blocks while the decoder computes (the virtual clock would wait for it).
+
+    The subscription is live (its first sample arrived) before the program starts: on a
+    loaded machine the SCHED_FIFO service may decode the whole loop before a watcher
+    that subscribes afterwards is heard."""
     loop = "$FOR V.L.K = 1, 200000\n$ENDFOR\n"  # seconds of decoding
-    with serving("--clock", "realtime", program_dir=tmp_path) as service, \
-            Client(service.endpoint, timeout_s=10) as c:
-        run(c, f"#VAR\nV.L.K = 0\n#ENDVAR\nG1 X1 F6000\n{loop}G1 X2\nM30\n")
-        expect(c, WaitReason.DECODER)
-        c.reset(1)
+    program = f"#VAR\nV.L.K = 0\n#ENDVAR\nG1 X1 F6000\n{loop}G1 X2\nM30\n"
+    with serving("--clock", "realtime", program_dir=tmp_path) as service:
+        async with AsyncClient(service.endpoint, timeout_s=10) as c:
+            seen: list[int] = []
+            async with contextlib.aclosing(c.subscribe(REASON, cycle_ms=0)) as samples:
+                seen.append((await anext(samples)).value)
+                await c.upload("wait.nc", program.encode())
+                await c.run_program("wait.nc", 1)
+                async with asyncio.timeout(30):
+                    async for sample in samples:
+                        seen.append(sample.value)
+                        if sample.value == WaitReason.DECODER:
+                            break
+            assert seen[0] == WaitReason.NONE and seen[-1] == WaitReason.DECODER, seen
+            assert await c.read(TEXT) == WAIT_REASON_TEXTS[WaitReason.DECODER]
+            await c.reset(1)

@@ -39,11 +39,11 @@ async def test_each_page_loads(page: Any, web: WebProcess) -> None:
         await page.wait_for_function("() => window.cncStats.messages > 0", timeout=WAIT_MS)
     await open_page(page, web.url, "machine")
     await page.wait_for_function(
-        "() => /DESELECTED/.test(document.querySelector('#channels tbody tr').textContent)",
+        "() => /DESELECTED/.test(document.querySelector('#channels tbody tr')?.textContent ?? '')",
         timeout=WAIT_MS)
     assert await page.locator("#axes tbody tr").count() == 6  # 2 channels x 3 axes
     await page.wait_for_function(
-        "() => document.querySelector('#axes tbody tr td:nth-child(2)').textContent === '0.0000'",
+        "() => document.querySelector('#axes tbody tr td:nth-child(2)')?.textContent === '0.0000'",
         timeout=WAIT_MS)
     await open_page(page, web.url, "mdi")
     assert await page.locator("#jog tbody button.jog").count() == 6  # X Y Z, minus and plus
@@ -141,7 +141,7 @@ async def test_the_objects_page_shows_and_writes_engineering_units(page: Any,
     cell = watched.nth(1).locator("td").nth(1)
     await page.wait_for_function(
         "() => document.querySelectorAll('#watch-table tbody tr')[1]"
-        ".querySelectorAll('td')[1].textContent === '62.5 %'", timeout=WAIT_MS)
+        "?.querySelectorAll('td')[1]?.textContent === '62.5 %'", timeout=WAIT_MS)
     assert await cell.get_attribute("title") == "raw 625 0.1 %"
     value = await page.evaluate(
         "async () => (await (await fetch('/api/read?name=ch1.mc_active_feed_override_r')).json()).value")
@@ -150,7 +150,7 @@ async def test_the_objects_page_shows_and_writes_engineering_units(page: Any,
     await watched.nth(0).locator("button", has_text="Write").click()
     await page.wait_for_function(
         "() => document.querySelectorAll('#watch-table tbody tr')[1]"
-        ".querySelectorAll('td')[1].textContent === '100.0 %'", timeout=WAIT_MS)
+        "?.querySelectorAll('td')[1]?.textContent === '100.0 %'", timeout=WAIT_MS)
 
 
 async def test_a_monitor_finds_every_write_disabled_and_refused(page: Any,

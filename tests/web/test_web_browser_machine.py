@@ -57,7 +57,7 @@ async def test_continuous_jog_is_released_on_key_up_and_on_blur(page: Any,
     await page.keyboard.down("Space")
     await _held(page, True)
     await page.wait_for_function(
-        "() => Number(document.querySelector('#jog tbody td[data-value]').textContent) > 0",
+        "() => Number(document.querySelector('#jog tbody td[data-value]')?.textContent) > 0",
         timeout=WAIT_MS)
     await page.keyboard.up("Space")
     await _held(page, False)
@@ -81,7 +81,7 @@ async def test_the_program_page_opened_while_a_program_runs_shows_it(
     status, _ = await _api(page, "POST", "/api/channel/1/start", {})
     assert status == 200
     await page.wait_for_function(
-        "() => /ACTIVE/.test(document.querySelector('#channels tbody tr').textContent)",
+        "() => /ACTIVE/.test(document.querySelector('#channels tbody tr')?.textContent ?? '')",
         timeout=WAIT_MS)
     await page.goto(f"{web.url}/#program")
     await page.wait_for_function(
@@ -97,7 +97,8 @@ async def test_the_program_page_opened_while_a_program_runs_shows_it(
         }""", timeout=WAIT_MS)
         line = await shown.json_value()
         await page.wait_for_function(
-            "n => !document.querySelectorAll('#program-text li')[n - 1].classList.contains('current')",
+            "n => document.querySelectorAll('#program-text li')[n - 1]?.classList.contains('current')"
+            " === false",
             arg=line, timeout=WAIT_MS)
     # the path run so far is drawn while it runs
     await page.wait_for_function(
@@ -140,6 +141,7 @@ async def test_tool_path_has_axes_scale_and_the_planned_path_in_workpiece_coordi
     # the machine page shows both: machine X 10 (the offset), workpiece X 0
     await page.goto(f"{web.url}/#machine")
     await page.wait_for_function("""() => {
-        const cells = document.querySelector('#axes tbody tr').children;
-        return cells[1].textContent === '10.0000' && cells[2].textContent === '0.0000';
+        const row = document.querySelector('#axes tbody tr');  // absent until the first frame
+        const cells = row ? row.children : [];
+        return cells.length > 2 && cells[1].textContent === '10.0000' && cells[2].textContent === '0.0000';
     }""", timeout=WAIT_MS)
