@@ -45,7 +45,7 @@ def measure(lines: int = 200_000, runs: int = 5) -> dict:
             run = harness.run(text, name="bench.nc", timeout_s=600)
             check_s = time.perf_counter() - started
             channel = run.channel
-            assert channel.state == ChannelState.READY and channel.error_count == 0, (
+            assert channel.state == ChannelState.READY and channel.errors.count == 0, (
                 [str(e) for e in channel.errors])
             split_rates.append(count / split_s)
             check_rates.append(count / check_s)

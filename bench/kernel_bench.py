@@ -39,7 +39,7 @@ def measure(runs: int = 3) -> dict:
             run = harness.run(text, name="bench.nc", timeout_s=600)
             wall = time.perf_counter() - started
             assert run.channel.state == 3, run.channel.errors  # READY
-            sim = run.channel.program_time_s
+            sim = run.channel.path.program_time_s
             ratios.append(sim / wall)
     return {"simulated_s": sim, "sim_per_wall": statistics.median(ratios), "runs": ratios}
 

@@ -107,7 +107,7 @@ def run_program(program: BenchProgram, variant: Variant, keep_run: bool = False)
     warnings = [e.id for e in channel.errors if e.warning]
     end = program.elements[-1].end
     end_error = max(abs(a - b) for a, b in zip(run.positions_mm, end))
-    return Result(program.name, variant, channel.program_time_s,
+    return Result(program.name, variant, channel.path.program_time_s,
                   optimum_time_s(program.elements, axis_limits(config)), violations,
                   warnings, end_error, wall, run if keep_run else None)
 

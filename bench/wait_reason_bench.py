@@ -33,7 +33,7 @@ def per_call_us() -> dict[str, float]:
     """Best-of-5 microseconds per call of the reason and of a whole runner cycle."""
     with KernelHarness() as h:
         h.start("G1 X1000 F1\nM30\n")  # 1000 mm at 1 mm/min: cruising throughout
-        h.wait_for(lambda s: s.channels[0].path_velocity_mm_s > 0)
+        h.wait_for(lambda s: s.channels[0].path.path_velocity_mm_s > 0)
         assert h.command(ControlCommand(Control.STOP)) is None
         runner = h.kernel.state.runners[0]
         assert isinstance(runner, ChannelRunner)
@@ -66,7 +66,7 @@ def with_and_without(pairs: int) -> dict[str, list[float]]:
                     started = time.process_time()
                     run = h.run(text, name="bench.nc", timeout_s=600)
                     cpu_s = time.process_time() - started
-                    runs[label].append(run.channel.program_time_s / cpu_s)
+                    runs[label].append(run.channel.path.program_time_s / cpu_s)
     finally:
         ChannelRunner._wait_reason = real  # type: ignore[method-assign]
     return runs

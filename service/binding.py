@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from functools import partial
+from operator import attrgetter
 from typing import Any
 
 from cnc_objects.objects import AddressSpace, ChannelLayout, CncObject, MachineLayout, build_objects
@@ -77,10 +78,14 @@ def refusal_code(refusal: Refusal) -> AdsReturnCode:
     return REFUSAL_CODES[refusal.reason]
 
 
-def _channel(attr: str) -> Callable[[Kernel, CncObject], Getter]:
+def _channel(path: str) -> Callable[[Kernel, CncObject], Getter]:
+    """A value of a channel: ``path`` is a field (``"mode"``) or a part's field
+    (``"block.line"``, see ``kernel.channel_parts``)."""
+    get = attrgetter(path)
+
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
         ci = kernel.channel_index(obj.channel)
-        return lambda: getattr(kernel.snapshot.channels[ci], attr)
+        return lambda: get(kernel.snapshot.channels[ci])
 
     return bind
 
@@ -170,7 +175,7 @@ def _channel_error(k: int, field: str) -> Callable[[Kernel, CncObject], Getter]:
         ci = kernel.channel_index(obj.channel)
 
         def get() -> Any:
-            errors = kernel.snapshot.channels[ci].errors
+            errors = kernel.snapshot.channels[ci].errors.entries
             return getattr(errors[k - 1], field) if len(errors) >= k else empty
 
         return get
@@ -184,7 +189,7 @@ def _channel_message(k: int) -> Callable[[Kernel, CncObject], Getter]:
         ci = kernel.channel_index(obj.channel)
 
         def get() -> str:
-            messages = kernel.snapshot.channels[ci].messages
+            messages = kernel.snapshot.channels[ci].program.messages
             return messages[k - 1] if len(messages) >= k else ""
 
         return get
@@ -196,15 +201,18 @@ def _machining(attr: str) -> Callable[[Kernel, CncObject], Getter]:
     """A field of the channel's #HSC/#SLOPE/#FILTER/#TRAFO/G133/G134 settings."""
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
         ci = kernel.channel_index(obj.channel)
-        return lambda: getattr(kernel.snapshot.channels[ci].machining, attr)
+        return lambda: getattr(kernel.snapshot.channels[ci].program.machining, attr)
 
     return bind
 
 
-def _scaled(attr: str, factor: float) -> Callable[[Kernel, CncObject], Getter]:
+def _scaled(path: str, factor: float) -> Callable[[Kernel, CncObject], Getter]:
+    """A value of a channel (``path`` as for ``_channel``) times ``factor``."""
+    get = attrgetter(path)
+
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
         ci = kernel.channel_index(obj.channel)
-        return lambda: getattr(kernel.snapshot.channels[ci], attr) * factor
+        return lambda: get(kernel.snapshot.channels[ci]) * factor
 
     return bind
 
@@ -288,7 +296,7 @@ def _syn_chk(name: str) -> Callable[[Kernel, CncObject], Getter]:
 
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
         ci = kernel.channel_index(obj.channel)
-        return lambda: getattr(kernel.snapshot.channels[ci].syn_chk, name)
+        return lambda: getattr(kernel.snapshot.channels[ci].switches.syn_chk, name)
 
     return bind
 
@@ -304,7 +312,7 @@ def _decoder_flag(flag: DecoderFlag) -> Callable[[Kernel, CncObject], Getter]:
 
     def bind(kernel: Kernel, obj: CncObject) -> Getter:
         ci = kernel.channel_index(obj.channel)
-        return lambda: bool(kernel.snapshot.channels[ci].decoder_flags & flag)
+        return lambda: bool(kernel.snapshot.channels[ci].program.decoder_flags & flag)
 
     return bind
 
@@ -313,15 +321,15 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "requested_link_to_physical_axis": _channel_axis("requested_link"),
     "actual_link_to_physical_axis": _channel_axis("actual_link"),
     "link_state": _channel_axis("link_state"),
-    "dist_prog_start": _channel("dist_prog_start_01um"),
-    "mc_command_feed_override_r": _channel("feed_override_command"),
-    "mc_active_feed_override_r": _channel("feed_override_per_mille"),
-    "mc_command_execution_mode_r": _channel("execution_mode_command"),
-    "decoder_mc_control.execution_mode.command_w": _channel("execution_mode_plc_command"),
-    "decoder_mc_control.execution_mode.enable_w": _channel("execution_mode_plc_enable"),
-    "decoder_mc_control.execution_mode.request_r": _channel("execution_mode_command"),
-    "decoder_mc_control.execution_mode.state_r": _channel("execution_mode_active"),
-    "prod_time_trace": _channel("prod_time_trace"),
+    "dist_prog_start": _channel("path.dist_prog_start_01um"),
+    "mc_command_feed_override_r": _channel("switches.feed_override_command"),
+    "mc_active_feed_override_r": _channel("switches.feed_override_per_mille"),
+    "mc_command_execution_mode_r": _channel("switches.execution_mode_command"),
+    "decoder_mc_control.execution_mode.command_w": _channel("switches.execution_mode_plc_command"),
+    "decoder_mc_control.execution_mode.enable_w": _channel("switches.execution_mode_plc_enable"),
+    "decoder_mc_control.execution_mode.request_r": _channel("switches.execution_mode_command"),
+    "decoder_mc_control.execution_mode.state_r": _channel("program.execution_mode_active"),
+    "prod_time_trace": _channel("switches.prod_time_trace"),
     **{f"syn_chk.{name}": _syn_chk(name)
        for name in ("errors_total", "errors_per_block", "interactive", "record_result")},
     "StateDecoder_Data.X_SyntaxCheck": _decoder_flag(DecoderFlag.SYNTAX_CHECK),
@@ -331,7 +339,7 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "StateDecoder_Data.X_WaitContinue": _decoder_flag(DecoderFlag.WAIT_CONTINUE),
     "StateDecoder_Data.X_WaitReleaseNextBlockCleared": _decoder_flag(
         DecoderFlag.WAIT_RELEASE_CLEARED),
-    "mc_active_execution_mode_r": _channel("execution_mode_active"),
+    "mc_active_execution_mode_r": _channel("program.execution_mode_active"),
     "cnc_version_r": _constant(lambda k: f"cnc-objects {__version__}"),
     "cnc_number_of_channel_r": _constant(lambda k: len(k.config.channels)),
     "cnc_number_of_axis_r": _constant(lambda k: len(k.config.physical_axes)),
@@ -354,37 +362,37 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "link_to_logical_axis": _physical_axis("linked_logical_axis"),
     "axis_name": _per_scope(_physical_axis("name"), _channel_axis("name")),
     "logical_axis_number": _channel_axis("logical_number"),
-    "remaining_path_in_block": _scaled("remaining_in_block_mm", UM01_PER_MM),
-    "actual_path_velocity": _scaled("path_velocity_mm_s", 1e3),
-    "programmed_path_velocity": _scaled("programmed_velocity_mm_s", 1e3),
-    "actual_block_number": _channel("block_number"),
-    "actual_block_count": _channel("block_count"),
-    "mc_active_single_block_r": _channel("single_block"),
+    "remaining_path_in_block": _scaled("path.remaining_in_block_mm", UM01_PER_MM),
+    "actual_path_velocity": _scaled("path.path_velocity_mm_s", 1e3),
+    "programmed_path_velocity": _scaled("path.programmed_velocity_mm_s", 1e3),
+    "actual_block_number": _channel("block.block_number"),
+    "actual_block_count": _channel("block.block_count"),
+    "mc_active_single_block_r": _channel("switches.single_block"),
     "mc_active_mode_r": _channel("mode"),
     "mc_active_state_r": _channel("state"),
-    "mc_active_program_name_r": _channel("program_name"),
-    "mc_active_file_name_r": _channel("file_name"),
-    "mc_active_file_offset_r": _channel("file_offset"),
-    "mc_active_line_r": _channel("line"),
-    "mc_block_count_r": _channel("block_count"),
-    "mc_command_feedrate_r": _scaled("programmed_velocity_mm_s", 1e3),
-    "mc_active_feedrate_r": _scaled("path_velocity_mm_s", 1e3),
-    "program_time": _channel("program_time_s"),
-    "mc_waiting_for_start_r": _channel("waiting_for_start"),
+    "mc_active_program_name_r": _channel("program.program_name"),
+    "mc_active_file_name_r": _channel("block.file_name"),
+    "mc_active_file_offset_r": _channel("block.file_offset"),
+    "mc_active_line_r": _channel("block.line"),
+    "mc_block_count_r": _channel("block.block_count"),
+    "mc_command_feedrate_r": _scaled("path.programmed_velocity_mm_s", 1e3),
+    "mc_active_feedrate_r": _scaled("path.path_velocity_mm_s", 1e3),
+    "program_time": _channel("path.program_time_s"),
+    "mc_waiting_for_start_r": _channel("program.waiting_for_start"),
     "mc_wait_reason_r": _channel("wait_reason"),
     "mc_wait_reason_text_r": _wait_reason_text,
-    "mc_manual_blocks_done_r": _channel("manual_blocks_done"),
-    "mc_error_count_r": _channel("error_count"),
+    "mc_manual_blocks_done_r": _channel("block.manual_blocks_done"),
+    "mc_error_count_r": _channel("errors.count"),
     "position_offset": _channel_axis("position_offset_01um"),
     "vel_max": _axis_param("vel_max_mm_s"),
     "acc_max": _axis_param("acc_max_mm_s2"),
     "vel_jump_max": _axis_param("vel_jump_mm_s"),
     "lookahead_blocks": _channel_config("look_ahead_blocks"),
-    "bahn_mc_control.suspend_axis_output.command_w": _channel("suspend_command_w"),
-    "bahn_mc_control.suspend_axis_output.enable_w": _channel("suspend_enable_w"),
-    "bahn_mc_control.suspend_axis_output.request_r": _channel("suspend_request_r"),
-    "bahn_mc_control.suspend_axis_output.state_r": _channel("output_suspended"),
-    "bahn_state.dist_prog_start": _channel("dist_prog_start_01um"),
+    "bahn_mc_control.suspend_axis_output.command_w": _channel("suspend.command_w"),
+    "bahn_mc_control.suspend_axis_output.enable_w": _channel("suspend.enable_w"),
+    "bahn_mc_control.suspend_axis_output.request_r": _channel("suspend.request_r"),
+    "bahn_mc_control.suspend_axis_output.state_r": _channel("suspend.output_suspended"),
+    "bahn_state.dist_prog_start": _channel("path.dist_prog_start_01um"),
     "contour_lookahead.request.start_position": _contour("request_start_position"),
     "contour_lookahead.request.length": _contour("request_length"),
     "contour_lookahead.semaphor_rw": _contour("semaphor"),
@@ -405,7 +413,7 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
         for k in range(1, ERRORS_LISTED + 1)
         for field in ("id", "text", "file", "line", "column", "warning")
     },
-    "mc_message_count_r": _channel("message_count"),
+    "mc_message_count_r": _channel("program.message_count"),
     **{f"mc_message_{k}_text_r": _channel_message(k) for k in range(1, MESSAGES_LISTED + 1)},
     **{f"{name}_r": _machining(attr) for name, attr, *_ in MACHINING_FIELDS},
     **MANUAL_READERS,

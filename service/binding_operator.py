@@ -61,20 +61,20 @@ def _channel_config(kernel: Kernel, obj: CncObject) -> Any:
 
 
 OPERATOR_READERS: dict[str, Binder] = {
-    "mc_command_block_ignore_r": _of_channel(lambda ch: ch.block_ignore_command),
-    "mc_active_block_ignore_r": _of_channel(lambda ch: ch.block_ignore_active),
-    "mc_command_M01_stop_enable_r": _of_channel(lambda ch: ch.m01_stop_enable),
+    "mc_command_block_ignore_r": _of_channel(lambda ch: ch.switches.block_ignore_command),
+    "mc_active_block_ignore_r": _of_channel(lambda ch: ch.program.block_ignore_active),
+    "mc_command_M01_stop_enable_r": _of_channel(lambda ch: ch.switches.m01_stop_enable),
     "decoder_mc_control.program_block_ignore.command_w": _of_channel(
-        lambda ch: ch.block_ignore_plc_command),
+        lambda ch: ch.switches.block_ignore_plc_command),
     "decoder_mc_control.program_block_ignore.enable_w": _of_channel(
-        lambda ch: ch.block_ignore_plc_enable),
+        lambda ch: ch.switches.block_ignore_plc_enable),
     "decoder_mc_control.program_block_ignore.request_r": _of_channel(
-        lambda ch: ch.block_ignore_command),
+        lambda ch: ch.switches.block_ignore_command),
     "decoder_mc_control.program_block_ignore.state_r": _of_channel(
-        lambda ch: ch.block_ignore_active),
-    "mc_command_rapid_override_r": _of_channel(lambda ch: ch.rapid_override_command),
-    "mc_active_rapid_override_r": _of_channel(lambda ch: ch.rapid_override_per_mille),
-    "mc_g00_override_mode_r": _of_channel(lambda ch: ch.g00_override_mode),
+        lambda ch: ch.program.block_ignore_active),
+    "mc_command_rapid_override_r": _of_channel(lambda ch: ch.switches.rapid_override_command),
+    "mc_active_rapid_override_r": _of_channel(lambda ch: ch.switches.rapid_override_per_mille),
+    "mc_g00_override_mode_r": _of_channel(lambda ch: ch.switches.g00_override_mode),
     "mc_coolant_state_r": _of_channel(lambda ch: int(ch.plc_functions.coolant)),
     "mc_all_axes_referenced_r": _of_channel(_all_referenced),
     "mc_referencing_required_r": _referencing_required,

@@ -8,6 +8,8 @@ the ``Step`` the channel runner turns into its state (HOLD, READY, ERROR).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from .alarms import AlarmClass
 from .channel_mode import ChannelState
 from .nc import ModalState
@@ -59,14 +61,13 @@ class ChannelCheck:
         """One GEO cycle: show where the decoder is."""
         ch = self.channel
         run = self.check
-        run.set_single_step(ch.single_block)
+        run.set_single_step(ch.switches.single_block)
         if self._deterministic and ch.state == ChannelState.ACTIVE:
             run.advance()
         p = run.progress()
-        ch.file_name, ch.line, ch.file_offset = p.file, p.line, p.offset
-        ch.block_number = p.block_number
-        ch.block_count = p.blocks
-        ch.program_time_s = time_s - self.started_at_s
+        ch.block = ch.block._replace(file_name=p.file, line=p.line, file_offset=p.offset,
+                                     block_number=p.block_number, block_count=p.blocks)
+        ch.path = ch.path._replace(program_time_s=time_s - self.started_at_s)
         for found in p.errors:
             err = found.error
             self._host.list_error(ErrorEntry(int(err.id), err.message, found.file,
@@ -74,9 +75,10 @@ class ChannelCheck:
                                   to_log=False, keep_last=True,
                                   alarm_class=AlarmClass.CHECK)
         # errors over limits.check_max_errors are counted, not listed
-        ch.error_count += p.left_out - self._left_out
-        self._left_out = p.left_out
-        flags = ch.decoder_flags & DecoderFlag.SYNTAX_CHECK
+        if p.left_out != self._left_out:
+            ch.errors = replace(ch.errors, count=ch.errors.count + p.left_out - self._left_out)
+            self._left_out = p.left_out
+        flags = ch.program.decoder_flags & DecoderFlag.SYNTAX_CHECK
         if p.pause == Pause.AFTER_ERROR:
             flags |= DecoderFlag.WAIT_AFTER_ERROR
         elif p.pause != Pause.NONE:
@@ -86,9 +88,11 @@ class ChannelCheck:
         elif self._released != Pause.NONE:
             flags |= DecoderFlag.WAIT_RELEASE_CLEARED
         self._released = Pause.NONE
-        ch.decoder_flags = flags
         if p.done:
-            ch.decoder_flags = 0
+            flags = DecoderFlag(0)
+        if flags != ch.program.decoder_flags:
+            ch.program = replace(ch.program, decoder_flags=flags)
+        if p.done:
             if p.failure is not None:
                 err = p.failure.error
                 self.failure = ErrorEntry(int(err.id), err.message, p.failure.file,

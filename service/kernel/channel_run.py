@@ -39,6 +39,7 @@ from .alarms import AlarmClass, AlarmLog
 from .axis_params import AxisErrorId, AxisParameters
 from .channel_check import ChannelCheck
 from .channel_mode import SELECTABLE_MODES, ChannelMode, ChannelState, describe
+from .channel_parts import ChannelErrors
 from .channel_transitions import ChannelEvent, allowed, next_state
 from .commands import Refusal, RefusalReason
 from .contour_lookahead import ContourLog
@@ -185,7 +186,7 @@ class ChannelRunner:
         """The channel's state changes only here, as ``TRANSITIONS`` says (an event the
         table does not allow raises ``TransitionNotAllowed``: a kernel bug)."""
         ch = self.channel
-        ch.state = next_state(ch.state, event, ch.mode, bool(ch.program_name))
+        ch.state = next_state(ch.state, event, ch.mode, bool(ch.program.program_name))
 
     # ------------------------------------------------------------ commands
 
@@ -202,7 +203,7 @@ class ChannelRunner:
         self._move(ChannelEvent.SELECT_MODE)
         self.manual.publish()  # hb_display_r.state follows the mode
         if mode != ChannelMode.AUTOMATIC:
-            ch.program_name = ""
+            ch.program = replace(ch.program, program_name="")
         self._modal = None
         return None
 
@@ -215,7 +216,8 @@ class ChannelRunner:
             return _not_ready(ch, f"cannot select {name!r} while it works; hold and RESET first")
         if not name or not self._exists(name):
             return Refusal(RefusalReason.NOT_FOUND, f"no program {name!r} in the program store")
-        ch.mode, ch.program_name = ChannelMode.AUTOMATIC, name
+        ch.mode = ChannelMode.AUTOMATIC
+        ch.program = replace(ch.program, program_name=name)
         self._move(ChannelEvent.SELECT_PROGRAM)
         return None
 
@@ -224,19 +226,19 @@ class ChannelRunner:
         ch = self.channel
         if allowed(ch.state, ChannelEvent.RESUME):
             self._move(ChannelEvent.RESUME)
-            ch.waiting_for_start = False
+            ch.program = replace(ch.program, waiting_for_start=False)
             if self._run is not None:  # None: the start still waits for the axes
                 self._run.resume()
             return None
         if ch.state == ChannelState.ACTIVE:
-            if not ch.waiting_for_start:
+            if not ch.program.waiting_for_start:
                 return _not_ready(ch, "the program is running already")
             moving = self.manual.program_motion()
             if moving is not None:
                 return _not_ready(ch, f"axis {moving} still moves in manual mode (G200): "
                                   "release its jog key or wait, then START")
             self.manual.end_g200()  # "continue motion"
-            ch.waiting_for_start = False
+            ch.program = replace(ch.program, waiting_for_start=False)
             if self._run is not None:
                 self._run.resume()  # M0/M1 or a single-block stop
             return None
@@ -247,7 +249,7 @@ class ChannelRunner:
             return _not_ready(ch, f"axes {names} are not referenced and the machine parameter "
                               "programs_need_referenced_axes is set: home them first (G74 in "
                               "MDI, or homing_start_w in MANUAL)")
-        self._start_when_linked(Job(ch.program_name), keep_open=False, fresh_modal=True)
+        self._start_when_linked(Job(ch.program.program_name), keep_open=False, fresh_modal=True)
         return None
 
     def hold(self) -> Refusal | None:
@@ -267,7 +269,7 @@ class ChannelRunner:
     def manual_block(self, text: str) -> Refusal | None:
         """MDI: run ``text`` as manual blocks (selects MDI when the channel is idle)."""
         ch = self.channel
-        extended = bool(ch.execution_mode_active & ExecutionMode.ADD_MDI_BLOCK)
+        extended = bool(ch.program.execution_mode_active & ExecutionMode.ADD_MDI_BLOCK)
         if not text.strip():
             return Refusal(RefusalReason.INVALID_VALUE, "the manual block is empty")
         if ch.state == ChannelState.ACTIVE and ch.mode == ChannelMode.MDI and extended:
@@ -283,9 +285,9 @@ class ChannelRunner:
             return _not_ready(ch, "a manual block needs a channel that is not working")
         if ch.mode != ChannelMode.MDI:
             ch.mode = ChannelMode.MDI
-            ch.program_name = ""
+            ch.program = replace(ch.program, program_name="")
             self._modal = None
-        extended = bool(ch.execution_mode_command & ExecutionMode.ADD_MDI_BLOCK)
+        extended = bool(ch.switches.execution_mode_command & ExecutionMode.ADD_MDI_BLOCK)
         self._start_when_linked(
             Job(_MDI_NAME, text, manual=True), keep_open=extended, fresh_modal=False
         )
@@ -304,7 +306,7 @@ class ChannelRunner:
         self.reset_pending.clear()
         self._drop_run()
         self.manual.stop_at_once()
-        ch.decoder_flags = 0
+        ch.program = replace(ch.program, decoder_flags=0, waiting_for_start=False)
         self._pending_start = None
         self._queued_jobs.clear()
         if self._contour is not None:
@@ -312,11 +314,9 @@ class ChannelRunner:
             show_contour_state(ch, self._contour)
         self._internal_hold = False
         self.plc.reset()
-        ch.plc_functions = self.plc.unit
-        ch.errors, ch.error_count = (), 0
+        ch.errors = ChannelErrors()
         self.alarms.reset_channel(ch.channel_id)  # ISG: RESET clears the channel's errors
-        ch.waiting_for_start = False
-        ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
+        ch.path = ch.path._replace(path_velocity_mm_s=0.0, remaining_in_block_mm=0.0)
         for axis in ch.axes:
             axis.distance_to_go_01um = 0  # no block in the interpolator
         self._move(ChannelEvent.RESET)
@@ -384,7 +384,7 @@ class ChannelRunner:
     def axes_ready(self) -> bool:
         """The channel's output is not suspended and every axis in it is linked."""
         ch = self.channel
-        if ch.output_suspended:
+        if ch.suspend.output_suspended:
             return False
         for axis in ch.axes:
             if not axis.actual_link and not axis.released:
@@ -394,7 +394,7 @@ class ChannelRunner:
     @property
     def moving(self) -> bool:
         """The path is not at standstill."""
-        return isinstance(self._run, ProgramRun) and self.channel.path_velocity_mm_s > 0.0
+        return isinstance(self._run, ProgramRun) and self.channel.path.path_velocity_mm_s > 0.0
 
     def internal_hold(self) -> bool:
         """Brake the path for a suspend request (the channel stays ACTIVE); True when
@@ -424,9 +424,10 @@ class ChannelRunner:
         for axis in ch.axes:
             axis.released = False
         self._move(ChannelEvent.START)
-        ch.waiting_for_start = False
-        ch.errors, ch.error_count = (), 0
-        ch.block_ignore_active = ch.block_ignore_commanded  # ISG: read at program start
+        ch.program = replace(  # ISG: the skip levels are read at program start
+            ch.program, waiting_for_start=False,
+            block_ignore_active=ch.switches.block_ignore_commanded)
+        ch.errors = ChannelErrors()
         self._pending_start = (job, keep_open, fresh_modal)
         if self.axes_ready or self._checks_only(job):
             self._begin_pending()
@@ -434,7 +435,7 @@ class ChannelRunner:
     def _checks_only(self, job: Job) -> bool:
         """The run is a syntax check or dry run: it needs no axis output (it starts and
         runs while the output is suspended)."""
-        mode = self.channel.execution_mode_commanded
+        mode = self.channel.switches.execution_mode_commanded
         return (not job.manual and bool(mode & _CHECK_MODES)
                 and not mode & ExecutionMode.PROD_TIME)
 
@@ -451,7 +452,7 @@ class ChannelRunner:
     def _active_mode(self) -> int:
         """The commanded execution mode as it takes effect at this start: SYNCHK implies
         MACHINE_LOCK (warning 21309 when it was not commanded) and SUPPRESS_TECHNO_OUTPUT."""
-        mode = self.channel.execution_mode_commanded
+        mode = self.channel.switches.execution_mode_commanded
         if mode & ExecutionMode.SYNCHK:
             if not mode & ExecutionMode.MACHINE_LOCK:
                 self.list_error(ErrorEntry(
@@ -464,13 +465,12 @@ class ChannelRunner:
         ch = self.channel
         mode: int
         if job.manual:  # the simulation modes act on programs; manual blocks run as usual
-            mode = ch.execution_mode_commanded & ~_PROGRAM_MODES
+            mode = ch.switches.execution_mode_commanded & ~_PROGRAM_MODES
         else:
             mode = self._active_mode()
         if not job.manual and mode & ExecutionMode.PROD_TIME:
-            self._mode_before_prod_time = ch.execution_mode_active
-        ch.execution_mode_active = mode
-        ch.decoder_flags = 0
+            self._mode_before_prod_time = ch.program.execution_mode_active
+        ch.program = replace(ch.program, execution_mode_active=mode, decoder_flags=0)
         if not job.manual and mode & _CHECK_MODES and not mode & ExecutionMode.PROD_TIME:
             self._begin_check(job, mode)
             return
@@ -489,7 +489,7 @@ class ChannelRunner:
             section_planner=partial(plan_section, dynamics=dynamics,
                                     buffer_blocks=self._buffer_blocks, cycle_s=self._cycle_s),
             interrupted=self._waiting, workers=self.workers,
-            skip_levels=ch.block_ignore_active,
+            skip_levels=ch.program.block_ignore_active,
         )
         feed.add(job)
         for more in self._queued_jobs:
@@ -503,7 +503,7 @@ class ChannelRunner:
         )
         prod_time = not job.manual and bool(mode & ExecutionMode.PROD_TIME)
         # the machining time calculation runs through without stops
-        executor.single_block = ch.single_block and not prod_time
+        executor.single_block = ch.switches.single_block and not prod_time
         self._modal.contour_log_area = LogArea.NONE  # as the new log: no marked area yet
         contour = None
         if self.config.contour_lookahead:  # the log is cleared at every program start
@@ -511,7 +511,7 @@ class ChannelRunner:
                                                  self._buffer_blocks)
         if prod_time:
             trace = None
-            if ch.prod_time_trace:
+            if ch.switches.prod_time_trace:
                 trace = ProdTimeTrace(job.name, ch.channel_id, self._axes, self._cycle_s)
                 trace.record(0.0, position, 0.0, 0.0, 0.0, 0)
             self._run = ProdTimeRun(
@@ -544,14 +544,13 @@ class ChannelRunner:
         """What a run or check shows at its start: counters at 0, the job's file; a
         program also starts with no messages and default high-speed settings."""
         ch = self.channel
-        ch.block_count = 0
-        ch.dist_prog_start_01um = 0.0
-        ch.program_time_s = 0.0
-        ch.file_name, ch.line, ch.file_offset, ch.block_number = job.name, 0, 0, -1
+        ch.block = ch.block._replace(file_name=job.name, line=0, file_offset=0,
+                                     block_number=-1, block_count=0)
+        ch.path = ch.path._replace(dist_prog_start_01um=0.0, program_time_s=0.0)
         if not job.manual:
             self._messages.clear()
-            ch.messages, ch.message_count = (), 0
-            ch.machining = MachiningSettings()
+            ch.program = replace(ch.program, messages=(), message_count=0,
+                                 machining=MachiningSettings())
 
     def show_decoder_state(self) -> None:
         """The #MSG texts and the #HSC/G133/.. settings the decoder reached."""
@@ -560,10 +559,12 @@ class ChannelRunner:
         while self._messages:
             new.append(self._messages.popleft())
         if new:
-            ch.messages = (tuple(reversed(new)) + ch.messages)[:MESSAGES_LISTED]
-            ch.message_count += len(new)
-        if self._modal is not None and self._modal.settings != ch.machining:
-            ch.machining = replace(self._modal.settings)
+            ch.program = replace(
+                ch.program,
+                messages=(tuple(reversed(new)) + ch.program.messages)[:MESSAGES_LISTED],
+                message_count=ch.program.message_count + len(new))
+        if self._modal is not None and self._modal.settings != ch.program.machining:
+            ch.program = replace(ch.program, machining=replace(self._modal.settings))
         modal = self._modal
         if modal is not None:
             tables = modal.tooling
@@ -596,7 +597,7 @@ class ChannelRunner:
             contour_lookahead=self.config.contour_lookahead,
             start_mm=tuple(a.position_mm for a in ch.axes),
             dynamics=dynamics, sw_limits_mm=sw_limits,
-            settings=ch.syn_chk if synchk else None, single_step=ch.single_block,
+            settings=ch.switches.syn_chk if synchk else None, single_step=ch.switches.single_block,
             deterministic=self._deterministic, files=self._files,
             surroundings=self._surroundings,
             modal=self.new_modal(tuple(a.position_mm for a in ch.axes)),
@@ -605,7 +606,8 @@ class ChannelRunner:
         )
         self._run = ChannelCheck(self, ch, check, started_at_s=self.time_s,
                                  deterministic=self._deterministic)
-        ch.decoder_flags = DecoderFlag.SYNTAX_CHECK if synchk else 0
+        ch.program = replace(ch.program,
+                             decoder_flags=DecoderFlag.SYNTAX_CHECK if synchk else 0)
         self._show_start(job)
 
     # ------------------------------------------------------------ cycle
@@ -702,7 +704,7 @@ class ChannelRunner:
                 self._fail(run.failure)
             case Step.PAUSED:
                 self._move(ChannelEvent.CHECK_PAUSE)
-                ch.waiting_for_start = True
+                ch.program = replace(ch.program, waiting_for_start=True)
         return False
 
     # ------------------------------------------------------------ run ends
@@ -713,7 +715,8 @@ class ChannelRunner:
         run, self._run = self._run, None
         self.manual.clear_program()  # the axes stand where path and manual offset put them
         if isinstance(run, ProdTimeRun):
-            self.channel.execution_mode_active = self._mode_before_prod_time
+            self.channel.program = replace(self.channel.program,
+                                           execution_mode_active=self._mode_before_prod_time)
         if run is not None:
             modal = run.cancel()
             if modal is not None and self._modal is not None:
@@ -727,11 +730,11 @@ class ChannelRunner:
             # M30 reached before the end of the data was taken: what a loop held back
             # is logged now
             if self._contour.end_of_data():
-                self.list_error(log_full_warning(self._contour, ch.file_name))
+                self.list_error(log_full_warning(self._contour, ch.block.file_name))
             show_contour_state(ch, self._contour)
         self._move(ChannelEvent.PROGRAM_END)
-        ch.waiting_for_start = False
-        ch.path_velocity_mm_s = ch.remaining_in_block_mm = 0.0
+        ch.program = replace(ch.program, waiting_for_start=False)
+        ch.path = ch.path._replace(path_velocity_mm_s=0.0, remaining_in_block_mm=0.0)
         self._ended(run, "READY")
 
     def _fail(self, error: ErrorEntry) -> None:
@@ -745,8 +748,7 @@ class ChannelRunner:
         # the program is aborted (ISG reaction class 2): what it output waits for
         # nobody, and the spindle stops as the path did (docs/manual.md)
         self.plc.reset()
-        ch.plc_functions = self.plc.unit
-        ch.waiting_for_start = False
+        ch.program = replace(ch.program, waiting_for_start=False)
         self._ended(run, f"ERROR {error.id}")
 
     def _ended(self, run: ChannelRun | None, how: str) -> None:
@@ -754,7 +756,8 @@ class ChannelRunner:
         the output area (``how``: its last row)."""
         if run is None:
             return
-        self.channel.program_time_s = self.time_s - run.started_at_s
+        self.channel.path = self.channel.path._replace(
+            program_time_s=self.time_s - run.started_at_s)
         if isinstance(run, ProdTimeRun):
             run.write_trace(how, self._files)
 
@@ -769,9 +772,10 @@ class ChannelRunner:
         if to_log:
             log.info("channel %d: %s", ch.channel_id, error)
             self._files(self.error_log_name, f"{self.time_s:.3f} s {error}\n".encode())
-        ch.error_count += 1
-        if len(ch.errors) < ERRORS_LISTED - keep_last:
-            ch.errors = (*ch.errors, error)
+        listed = ch.errors.entries
+        if len(listed) < ERRORS_LISTED - keep_last:
+            listed = (*listed, error)
+        ch.errors = ChannelErrors(listed, ch.errors.count + 1)
 
     # ------------------------------------------------------------ contour look-ahead
 

@@ -14,10 +14,11 @@ from typing import Any, ClassVar, Protocol
 from .axis_params import update_axis
 from .channel_mode import ChannelState
 from .contour_lookahead import RequestError, check_request
+from .kernel_state import KernelState
 from .operator_switches import rapid_override_per_mille
 from .refusal import Refusal as Refusal  # the commands' answer, imported from here too
 from .refusal import RefusalReason as RefusalReason
-from .state import ExecutionMode, KernelState
+from .state import ExecutionMode
 
 
 class Command(Protocol):
@@ -69,15 +70,16 @@ class SetFeedOverride:
 
     def apply(self, state: KernelState) -> Refusal | None:
         channel = state.channels[self.channel_index]
-        if not 0 <= self.value <= channel.feed_override_max:
+        if not 0 <= self.value <= channel.switches.feed_override_max:
             return Refusal(
                 RefusalReason.INVALID_VALUE,
                 f"feed override {self.value / 10:g} % is outside "
-                f"0..{channel.feed_override_max / 10:g} %",
+                f"0..{channel.switches.feed_override_max / 10:g} %",
             )
-        channel.feed_override_command = self.value
-        channel.feed_override_per_mille = self.value
-        channel.rapid_override_per_mille = rapid_override_per_mille(channel)  # G0 may follow
+        channel.switches = replace(channel.switches, feed_override_command=self.value,
+                                   feed_override_per_mille=self.value)
+        channel.switches = replace(  # G0 may follow the feed override
+            channel.switches, rapid_override_per_mille=rapid_override_per_mille(channel))
         return None
 
 
@@ -92,7 +94,8 @@ class SetExecutionMode:
     def apply(self, state: KernelState) -> Refusal | None:
         refused = execution_mode_refused(self.value)
         if refused is None:
-            state.channels[self.channel_index].execution_mode_command = self.value
+            channel = state.channels[self.channel_index]
+            channel.switches = replace(channel.switches, execution_mode_command=self.value)
         return refused
 
 
@@ -106,7 +109,8 @@ class SetExecutionModePlc:
     def apply(self, state: KernelState) -> Refusal | None:
         refused = execution_mode_refused(self.value)
         if refused is None:
-            state.channels[self.channel_index].execution_mode_plc_command = self.value
+            channel = state.channels[self.channel_index]
+            channel.switches = replace(channel.switches, execution_mode_plc_command=self.value)
         return refused
 
 
@@ -119,7 +123,8 @@ class SetExecutionModeEnable:
     value: bool
 
     def apply(self, state: KernelState) -> Refusal | None:
-        state.channels[self.channel_index].execution_mode_plc_enable = bool(self.value)
+        channel = state.channels[self.channel_index]
+        channel.switches = replace(channel.switches, execution_mode_plc_enable=bool(self.value))
         return None
 
 
@@ -139,7 +144,8 @@ class SetSyntaxCheckParameter:
                            f"syn_chk.{self.name} {value} is outside 0..65535")
         if self.name in ("interactive", "record_result"):
             value = bool(value)
-        channel.syn_chk = channel.syn_chk.model_copy(update={self.name: value})
+        syn_chk = channel.switches.syn_chk.model_copy(update={self.name: value})
+        channel.switches = replace(channel.switches, syn_chk=syn_chk)
         return None
 
 
@@ -151,7 +157,8 @@ class SetSingleBlock:
     value: bool
 
     def apply(self, state: KernelState) -> Refusal | None:
-        state.channels[self.channel_index].single_block = bool(self.value)
+        channel = state.channels[self.channel_index]
+        channel.switches = replace(channel.switches, single_block=bool(self.value))
         return None
 
 
@@ -163,7 +170,8 @@ class SetProdTimeTrace:
     value: bool
 
     def apply(self, state: KernelState) -> Refusal | None:
-        state.channels[self.channel_index].prod_time_trace = bool(self.value)
+        channel = state.channels[self.channel_index]
+        channel.switches = replace(channel.switches, prod_time_trace=bool(self.value))
         return None
 
 
@@ -234,8 +242,8 @@ def _suspend_refused(
 ) -> Refusal | None:
     """Suspending the axis output is not possible while the channel is in error."""
     channel = state.channels[channel_index]
-    wants = command if enable else channel.suspend_request_r
-    if wants and not channel.output_suspended and channel.state == ChannelState.ERROR:
+    wants = command if enable else channel.suspend.request_r
+    if wants and not channel.suspend.output_suspended and channel.state == ChannelState.ERROR:
         return Refusal(
             RefusalReason.NOT_READY,
             f"channel {channel.channel_id} is in error: its axis output cannot be suspended; "
@@ -254,9 +262,9 @@ class SetSuspendCommand:
     def apply(self, state: KernelState) -> Refusal | None:
         channel = state.channels[self.channel_index]
         refused = _suspend_refused(state, self.channel_index, bool(self.value),
-                                   channel.suspend_enable_w)
+                                   channel.suspend.enable_w)
         if refused is None:
-            channel.suspend_command_w = bool(self.value)
+            channel.suspend = replace(channel.suspend, command_w=bool(self.value))
         return refused
 
 
@@ -269,10 +277,10 @@ class SetSuspendEnable:
 
     def apply(self, state: KernelState) -> Refusal | None:
         channel = state.channels[self.channel_index]
-        refused = _suspend_refused(state, self.channel_index, channel.suspend_command_w,
+        refused = _suspend_refused(state, self.channel_index, channel.suspend.command_w,
                                    bool(self.value))
         if refused is None:
-            channel.suspend_enable_w = bool(self.value)
+            channel.suspend = replace(channel.suspend, enable_w=bool(self.value))
         return refused
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .commands import Refusal, RefusalReason
-from .state import KernelState
+from .kernel_state import KernelState
 
 
 @dataclass(frozen=True, slots=True)

@@ -25,10 +25,11 @@ from .axis_params import AxisParameters, initialise_axes
 from .channel_run import ChannelRunner
 from .clock import Clock, LatenessHistogram, VirtualClock
 from .commands import Command, Refusal, RefusalReason, ResetChannel
+from .kernel_state import KernelState
 from .nc.source import NcText
 from .nc.tool_data import ToolingTables
 from .realtime_priority import RealtimeGrant, worker_priority
-from .state import CycleStats, ErrorEntry, KernelState, Snapshot
+from .state import CycleStats, ErrorEntry, Snapshot
 from .step_clock import NOT_STEPPING, STEP_RUNNING, StepClock, StepCycles
 from .switchover import Switchover
 from .syntax_check import CHECK_MAX_ERRORS

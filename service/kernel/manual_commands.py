@@ -9,8 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .commands import Refusal
+from .kernel_state import KernelState
 from .manual_mode import ManualMode
-from .state import KernelState
 
 
 @dataclass(frozen=True, slots=True)

@@ -40,11 +40,11 @@ from ..machine_config import MachineConfig, ManualAxisConfig
 from .axis_params import AxisParameters
 from .channel_mode import ChannelMode, ChannelState, describe
 from .channel_transitions import ChannelEvent, allowed
-from .commands import Refusal, RefusalReason
 from .homing import HomingState
 from .manual_motion import AxisDynamicsLimits, AxisMotion
 from .manual_view import DisplayState, ManualAxisView
 from .nc.blocks import ManualModeKind, ManualModeRequest
+from .refusal import Refusal, RefusalReason
 from .state import Channel, ErrorEntry
 
 INCREMENT_MIN_01UM = 1  # 0.1 um: the smallest jog increment
@@ -340,7 +340,7 @@ class ManualMode:
             if motion is None:
                 continue
             logical = ch.axes[k]
-            if ch.output_suspended or not (logical.actual_link or logical.released):
+            if ch.suspend.output_suspended or not (logical.actual_link or logical.released):
                 axis.motion = None  # the drive was given up (jog of path): the axis stands
                 continue
             position = motion.step(self._cycle_s)
@@ -394,7 +394,7 @@ class ManualMode:
         applied, capped at the axis's maximum velocity."""
         config = axis.config
         speed = config.jog_rapid_vel_mm_s if axis.rapid else config.jog_vel_mm_s
-        speed *= self._channel.feed_override_per_mille / 1000
+        speed *= self._channel.switches.feed_override_per_mille / 1000
         return min(speed, self._params[axis.number].vel_max_mm_s)
 
     def _motion(self, axis_index: int, vel_mm_s: float) -> AxisMotion:
@@ -451,7 +451,7 @@ class ManualMode:
                 return self._not_ready(axis_index, f"{program.name} manual mode moves only "
                                        "while the program runs (ACTIVE); START first")
             logical = ch.axes[axis_index]
-            if ch.output_suspended or (not logical.actual_link and not logical.released):
+            if ch.suspend.output_suspended or (not logical.actual_link and not logical.released):
                 return self._not_ready(axis_index, "the axis is not linked to its drive")
             return None
         if ch.state == ChannelState.HOLD:
@@ -460,7 +460,7 @@ class ManualMode:
         if ch.state != ChannelState.ACTIVE and not allowed(ch.state, ChannelEvent.START):
             return self._not_ready(axis_index, "RESET clears the error first")
         logical = ch.axes[axis_index]
-        if ch.output_suspended or (not logical.actual_link and not logical.released):
+        if ch.suspend.output_suspended or (not logical.actual_link and not logical.released):
             return self._not_ready(axis_index, "the axis is not linked to its drive")
         homing = self._axes[axis_index].homing
         if homing is not None and homing.active:

@@ -20,9 +20,10 @@ from dataclasses import dataclass, replace
 
 from cnc_objects.protocol.values import RapidOverrideMode
 
+from .kernel_state import KernelState
 from .nc.blocks import Block, StopKind
 from .refusal import Refusal, RefusalReason
-from .state import Channel, KernelState
+from .state import Channel
 
 RAPID_OVERRIDE_MAX = 1000  # 0.1 %: G0 never runs faster than the axes' rapid speed
 SKIP_LEVELS_MASK = 0x3FF  # skip levels 1..10
@@ -30,8 +31,8 @@ SKIP_LEVELS_MASK = 0x3FF  # skip levels 1..10
 
 def rapid_override_per_mille(ch: Channel) -> int:
     """The override G0 blocks run with (0.1 %), from the channel's g00_override_mode."""
-    feed, rapid = ch.feed_override_per_mille, ch.rapid_override_command
-    match ch.g00_override_mode:
+    feed, rapid = ch.switches.feed_override_per_mille, ch.switches.rapid_override_command
+    match ch.switches.g00_override_mode:
         case RapidOverrideMode.NOT_USED:
             return feed
         case RapidOverrideMode.MINIMUM_OF_G0_G1:
@@ -42,7 +43,7 @@ def rapid_override_per_mille(ch: Channel) -> int:
 
 def with_optional_stop(block: Block, ch: Channel) -> Block:
     """``block`` as the path runs it: an M1 whose switch is off does not stop."""
-    if block.stop == StopKind.OPTIONAL and not ch.m01_stop_enable:
+    if block.stop == StopKind.OPTIONAL and not ch.switches.m01_stop_enable:
         return replace(block, stop=StopKind.NONE)
     return block
 
@@ -60,8 +61,8 @@ class SetRapidOverride:
             return Refusal(RefusalReason.INVALID_VALUE,
                            f"rapid override {self.value / 10:g} % is outside "
                            f"0..{RAPID_OVERRIDE_MAX / 10:g} %")
-        ch.rapid_override_command = self.value
-        ch.rapid_override_per_mille = rapid_override_per_mille(ch)
+        ch.switches = replace(ch.switches, rapid_override_command=self.value)
+        ch.switches = replace(ch.switches, rapid_override_per_mille=rapid_override_per_mille(ch))
         return None
 
 
@@ -84,7 +85,8 @@ class SetBlockIgnore:
     def apply(self, state: KernelState) -> Refusal | None:
         refused = skip_mask_refused(self.value)
         if refused is None:
-            state.channels[self.channel_index].block_ignore_command = self.value
+            ch = state.channels[self.channel_index]
+            ch.switches = replace(ch.switches, block_ignore_command=self.value)
         return refused
 
 
@@ -98,7 +100,8 @@ class SetBlockIgnorePlc:
     def apply(self, state: KernelState) -> Refusal | None:
         refused = skip_mask_refused(self.value)
         if refused is None:
-            state.channels[self.channel_index].block_ignore_plc_command = self.value
+            ch = state.channels[self.channel_index]
+            ch.switches = replace(ch.switches, block_ignore_plc_command=self.value)
         return refused
 
 
@@ -111,7 +114,8 @@ class SetBlockIgnorePlcEnable:
     value: bool
 
     def apply(self, state: KernelState) -> Refusal | None:
-        state.channels[self.channel_index].block_ignore_plc_enable = bool(self.value)
+        ch = state.channels[self.channel_index]
+        ch.switches = replace(ch.switches, block_ignore_plc_enable=bool(self.value))
         return None
 
 
@@ -123,5 +127,6 @@ class SetM01StopEnable:
     value: bool
 
     def apply(self, state: KernelState) -> Refusal | None:
-        state.channels[self.channel_index].m01_stop_enable = bool(self.value)
+        ch = state.channels[self.channel_index]
+        ch.switches = replace(ch.switches, m01_stop_enable=bool(self.value))
         return None

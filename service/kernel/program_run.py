@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from enum import IntEnum
 from functools import partial
 from typing import Protocol
@@ -27,6 +28,7 @@ from cnc_objects.protocol.values import ExecutionMode
 
 from .alarms import AlarmClass
 from .channel_mode import ChannelMode, ChannelState
+from .channel_parts import BlockShown, PathShown
 from .contour_lookahead import LOG_FULL_WARNING, ContourLog
 from .decoder_feed import DecodeEnd, DecoderFeed, Item, Job
 from .nc import ModalState, NcError
@@ -189,8 +191,8 @@ class ProgramRun:
         acknowledge at a block end, override 0, or blocks from the decoder (or the
         operator, in extended MDI)."""
         executor, ch = self.executor, self.channel
-        override = (ch.rapid_override_per_mille if executor.in_rapid  # G0: rapid override
-                    else ch.feed_override_per_mille)
+        override = (ch.switches.rapid_override_per_mille if executor.in_rapid  # G0: rapid override
+                    else ch.switches.feed_override_per_mille)
         if executor.running:  # the common case, kept short
             return _NOT_WAITING if override else _OVERRIDE_ZERO
         waiting = executor.waiting
@@ -204,7 +206,7 @@ class ProgramRun:
 
     def cycle(self, time_s: float) -> Step:
         """One interpolation cycle of the path, output to the channel's axes."""
-        return self._motion_cycle(time_s, self.channel.feed_override_per_mille / 1000.0,
+        return self._motion_cycle(time_s, self.channel.switches.feed_override_per_mille / 1000.0,
                                   output=True)
 
     def _motion_cycle(self, time_s: float, override: float, output: bool) -> Step:
@@ -212,8 +214,8 @@ class ProgramRun:
         they are (PROD_TIME)."""
         ch = self.channel
         executor = self.executor
-        if output and executor.single_block != ch.single_block:
-            executor.single_block = ch.single_block
+        if output and executor.single_block != ch.switches.single_block:
+            executor.single_block = ch.switches.single_block
         if self._sync is not None and executor.idle:
             failure = self._apply_sync()
             if failure is not None:
@@ -231,17 +233,18 @@ class ProgramRun:
                 self._show_contour_state()
         # the buffer is full and more blocks wait: does its end hold the speed down?
         full = not (self._buffer_warned or self._fed_all) and executor.free_slots() == 0
-        executor.set_rapid_override(ch.rapid_override_per_mille / 1000.0)
+        executor.set_rapid_override(ch.switches.rapid_override_per_mille / 1000.0)
         step = executor.step(override)
         if full and executor.buffer_limits_speed():
             self._warn_buffer_limits()
         self._show_cycles(step, time_s, 1, output)
         self._stepped(step)
+        counted = manual_done = 0
         for block in step.finished:
             if plc is not None and plc.block_finished(block, time_s):
                 self._technology_part = block
                 continue  # a pre/post block of the technology output, not counted
-            ch.block_count += 1
+            counted += 1
             if block.homing_axes and output:  # G74 done: the axes are referenced
                 self._host.referenced(block.homing_axes)
             if block.manual_mode is not None and output:  # G200 / G201 / G202
@@ -250,12 +253,22 @@ class ProgramRun:
                     block.contour.kind == ContourKind.DISTANCE_CLEAR):
                 self.contour.distance_cleared()  # mode 2 answers in the new distances
             if self.feed.is_marker(block):
-                ch.manual_blocks_done += 1
+                manual_done += 1
         shown = step.current or (step.finished[-1] if step.finished else None)
         if shown is not None and not self.feed.is_marker(shown):
             src = shown.source
-            ch.file_name, ch.line, ch.file_offset = src.file, src.line, src.offset
-            ch.block_number = shown.number if shown.number is not None else -1
+            number = shown.number if shown.number is not None else -1
+            was = ch.block
+            if (counted or manual_done or src.line != was.line or src.file != was.file_name
+                    or number != was.block_number):
+                ch.block = BlockShown(
+                    file_name=src.file, line=src.line, file_offset=src.offset,
+                    block_number=number, block_count=was.block_count + counted,
+                    manual_blocks_done=was.manual_blocks_done + manual_done)
+        elif counted or manual_done:
+            ch.block = ch.block._replace(
+                block_count=ch.block.block_count + counted,
+                manual_blocks_done=ch.block.manual_blocks_done + manual_done)
         if (executor.waiting == Waiting.SINGLE_BLOCK and step.current is not None
                 and step.current is self._technology_part):
             executor.resume()  # not a block of the program: single block goes on
@@ -263,9 +276,11 @@ class ProgramRun:
         if stopped is not None and stopped.stop == StopKind.PROGRAM_END:
             return Step.ENDED
         # M0/M1 or a single-block stop: the path stands at a block end until START.
-        ch.waiting_for_start = ch.state == ChannelState.ACTIVE and executor.waiting in (
+        waiting_for_start = ch.state == ChannelState.ACTIVE and executor.waiting in (
             Waiting.PROGRAMMED_STOP, Waiting.SINGLE_BLOCK,
         )
+        if waiting_for_start != ch.program.waiting_for_start:
+            ch.program = replace(ch.program, waiting_for_start=waiting_for_start)
         if executor.idle:
             if self._pending_error is not None:
                 return self._fail(self._pending_error)
@@ -279,13 +294,16 @@ class ProgramRun:
         """What every cycle shows, stepped or the last of a bulk (``cruise``): the path's
         values and the axes (``output`` False: they stay, PROD_TIME), the tool life of
         ``cycles`` cycles (a dry run cuts nothing), the program time at ``time_s``."""
+        program_time_s = time_s - self.started_at_s
         if output:
-            self._output(step)
+            self._output(step, program_time_s)
             count_cutting(self.channel, step.current, cycles)
-        self.channel.program_time_s = time_s - self.started_at_s
+        else:
+            self.channel.path = self.channel.path._replace(program_time_s=program_time_s)
 
-    def _output(self, step: StepResult) -> None:
-        """The cycle's path values shown in the channel, its axes' command positions."""
+    def _output(self, step: StepResult, program_time_s: float) -> None:
+        """The cycle's path values shown in the channel (``program_time_s``: since the
+        start), its axes' command positions."""
         ch = self.channel
         offsets = self._host.manual_offsets_mm  # G200/G201 (None: no offset)
         positions = step.position_mm if offsets is None else tuple(
@@ -298,10 +316,12 @@ class ProgramRun:
         for k, axis in enumerate(ch.axes):  # distance to go: to the block's end point
             axis.distance_to_go_01um = round(
                 (ends[k] - step.position_mm[k]) * UM01_PER_MM) if k < len(ends) else 0
-        ch.path_velocity_mm_s = step.path_velocity_mm_s
-        ch.programmed_velocity_mm_s = step.programmed_velocity_mm_s
-        ch.remaining_in_block_mm = step.remaining_in_block_mm
-        ch.dist_prog_start_01um = step.distance_mm * UM01_PER_MM
+        ch.path = PathShown(
+            path_velocity_mm_s=step.path_velocity_mm_s,
+            programmed_velocity_mm_s=step.programmed_velocity_mm_s,
+            remaining_in_block_mm=step.remaining_in_block_mm,
+            dist_prog_start_01um=step.distance_mm * UM01_PER_MM,
+            program_time_s=program_time_s)
 
     def cruise_budget(self, most: int) -> int:
         """How many of the next cycles (at most ``most``) would do nothing but move
@@ -311,14 +331,14 @@ class ProgramRun:
         cycle it allows runs as ``cruise(1)``, more as a bulk; else ``cycle`` runs."""
         ch, executor = self.channel, self.executor
         if (not self._skips_cycles or self._sync is not None or self._contour_changed
-                or self._pending_error is not None or executor.single_block != ch.single_block
-                or executor.rapid_override != ch.rapid_override_per_mille / 1000.0
+                or self._pending_error is not None or executor.single_block != ch.switches.single_block
+                or executor.rapid_override != ch.switches.rapid_override_per_mille / 1000.0
                 or not (self._fed_all or executor.free_slots() == 0)):
             return 0
         # as ``_motion_cycle``: with the buffer full, a cycle that leaves the path held
         # down by the buffer's end shows a warning (once), so it is a cycle of its own
         full = not (self._buffer_warned or self._fed_all)
-        return executor.cruise_budget(ch.feed_override_per_mille / 1000.0, most, full)
+        return executor.cruise_budget(ch.switches.feed_override_per_mille / 1000.0, most, full)
 
     def cruise(self, cycles: int, time_s: float) -> None:
         """Run ``cycles`` cycles that ``cruise_budget`` allowed at once, the last at
@@ -327,7 +347,7 @@ class ProgramRun:
 
     def _technology(self) -> PlcFunctions | None:
         """The channel's technology output, None while it is suppressed (PROD_TIME)."""
-        if self.channel.execution_mode_active & _SUPPRESS_TECHNO:
+        if self.channel.program.execution_mode_active & _SUPPRESS_TECHNO:
             return None
         return self._host.plc
 
@@ -344,10 +364,11 @@ class ProgramRun:
         block, self._sync = self._sync, None
         assert block is not None
         ch = self.channel
-        ch.block_count += 1
         src = block.source
-        ch.file_name, ch.line, ch.file_offset = src.file, src.line, src.offset
-        ch.block_number = block.number if block.number is not None else -1
+        ch.block = ch.block._replace(
+            file_name=src.file, line=src.line, file_offset=src.offset,
+            block_number=block.number if block.number is not None else -1,
+            block_count=ch.block.block_count + 1)
         if self.contour is not None:
             self.contour.count_block()
         exchange: AxisExchange | None = block.axis_exchange
@@ -474,14 +495,14 @@ class ProgramRun:
         self._host.list_error(ErrorEntry(
             int(PathErrorId.BUFFER_LIMITS_SPEED),
             f"the look-ahead buffer of {self._buffer_blocks} blocks limits the path speed "
-            f"to {ch.path_velocity_mm_s:.1f} mm/s (the path must be able to stop after the "
+            f"to {ch.path.path_velocity_mm_s:.1f} mm/s (the path must be able to stop after the "
             "last buffered block): choose a larger buffer (interpolator_function, "
-            "P-CHAN-00650) or program LA_ON", ch.file_name, ch.line, BLOCK_START_COLUMN,
+            "P-CHAN-00650) or program LA_ON", ch.block.file_name, ch.block.line, BLOCK_START_COLUMN,
             warning=True))
 
     def _warn_log_full(self) -> None:
         assert self.contour is not None
-        self._host.list_error(log_full_warning(self.contour, self.channel.file_name))
+        self._host.list_error(log_full_warning(self.contour, self.channel.block.file_name))
 
     def _show_contour_state(self) -> None:
         assert self.contour is not None
@@ -535,14 +556,14 @@ class ProdTimeRun(ProgramRun):
                 return step
             if self.executor.waiting in (Waiting.PROGRAMMED_STOP, Waiting.SINGLE_BLOCK):
                 self.executor.resume()  # M0/M1: the calculation does not wait
-                self.channel.waiting_for_start = False
+                self.channel.program = replace(self.channel.program, waiting_for_start=False)
         return Step.BUSY
 
     def _stepped(self, step: StepResult) -> None:
         if self.trace is not None:
             ch = self.channel
             shown_line = step.current.source.line if step.current is not None else 0
-            self.trace.record(ch.program_time_s, step.position_mm, step.distance_mm,
+            self.trace.record(ch.path.program_time_s, step.position_mm, step.distance_mm,
                               step.path_velocity_mm_s, step.programmed_velocity_mm_s,
                               shown_line)
 

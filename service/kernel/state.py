@@ -7,26 +7,29 @@ consistent within one cycle and never waits for the kernel.
 
 from __future__ import annotations
 
-import threading
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from enum import IntFlag
-from operator import attrgetter
-from typing import Any, NamedTuple, Protocol
+from typing import NamedTuple
 
 from cnc_objects.protocol.units import UM01_PER_MM
-from cnc_objects.protocol.values import ChannelMode, ChannelState, RapidOverrideMode
+from cnc_objects.protocol.values import ChannelMode, ChannelState
 
 # Defined with the wire's value sets; the kernel's modules import them from here.
 from cnc_objects.protocol.values import ExecutionMode as ExecutionMode
 from cnc_objects.protocol.values import LinkState as LinkState
 
-from ..machine_config import ChannelConfig, MachineConfig
-from .alarms import AlarmLog
-from .axis_params import AxisParameters
-from .nc.technology import MachiningSettings
-from .nc.tool_data import ToolingTables
-from .plc_functions import PlcFunctions, PlcFunctionsUnit
-from .refusal import Refusal
+from .channel_parts import BLOCK_START_COLUMN as BLOCK_START_COLUMN
+from .channel_parts import (
+    BlockShown,
+    ChannelErrors,
+    ChannelSwitches,
+    PathShown,
+    ProgramShown,
+    SuspendUnit,
+)
+from .channel_parts import ErrorEntry as ErrorEntry
+from .manual_view import ManualAxisView
+from .plc_functions import PlcFunctionsUnit
 from .spindle import SpindleState
 from .tooling_view import ChannelTooling
 
@@ -99,29 +102,6 @@ class LogicalAxis:
         self.position_mm = incr / UM01_PER_MM
 
 
-BLOCK_START_COLUMN = 1  # the column of an error about a whole block: the block's start
-
-
-@dataclass(frozen=True, slots=True)
-class ErrorEntry:
-    """An error of a channel: ISG-style id, text, and where in which NC file it arose.
-
-    Lines and columns count from 1; 0 means none. An error about a whole block (not a word
-    of it) is at the block's first column, ``BLOCK_START_COLUMN``."""
-
-    id: int
-    text: str
-    file: str = ""
-    line: int = 0
-    column: int = 0
-    warning: bool = False  # a warning is listed but does not stop the channel
-
-    def __str__(self) -> str:
-        where = f"{self.file}:{self.line}:{self.column}: " if self.file else ""
-        kind = "warning" if self.warning else "error"
-        return f"{kind} {self.id}: {where}{self.text}"
-
-
 class ContourElement(NamedTuple):
     """One entry of a contour look-ahead reply (``HLI_CONTOUR_LOOKAHEAD_BLOCK``).
 
@@ -159,107 +139,43 @@ class ContourLookaheadUnit:
 
 @dataclass(slots=True)
 class Channel:
-    """A channel: its axes, override, execution mode and path distance."""
+    """A channel: its axes, its mode and state, and its immutable parts
+    (``channel_parts``: each replaced whole by the one module that owns it)."""
 
     channel_id: int
     name: str
     axes: list[LogicalAxis]
-    feed_override_max: int
-    feed_override_command: int = 1000  # 0.1 %
-    feed_override_per_mille: int = 1000  # 0.1 %
-    execution_mode_command: int = 0
-    execution_mode_active: int = 0
-    dist_prog_start_01um: float = 0.0  # 0.1 um
-    output_suspended: bool = False  # suspend_axis_output.state_r: the axes are given up
+    switches: ChannelSwitches
+    suspend: SuspendUnit = field(default_factory=SuspendUnit)
     mode: ChannelMode = ChannelMode.STANDBY
     state: ChannelState = ChannelState.DESELECTED
-    program_name: str = ""  # selected program
-    single_block: bool = False
-    waiting_for_start: bool = False  # standing at M0/M1 or a single-block stop
-    block_number: int = -1  # N of the block in the interpolator; -1 = none
-    line: int = 0  # its line in file_name (1-based; 0 = none)
-    file_name: str = ""  # file of the block in the interpolator
-    file_offset: int = 0  # byte offset of its line in that file
-    block_count: int = 0  # blocks finished since program start
-    manual_blocks_done: int = 0  # manual blocks finished since the channel started
-    path_velocity_mm_s: float = 0.0
-    programmed_velocity_mm_s: float = 0.0
-    remaining_in_block_mm: float = 0.0
-    program_time_s: float = 0.0
-    errors: tuple[ErrorEntry, ...] = ()
-    error_count: int = 0
-    # gpCh[i].bahn_mc_control.suspend_axis_output (ISG control unit, see docs/jog-of-path.md)
-    suspend_command_w: bool = False
-    suspend_enable_w: bool = True
-    suspend_request_r: bool = False
-    contour: ContourLookaheadUnit = field(default_factory=ContourLookaheadUnit)
-    # gpCh[i].decoder_mc_control.execution_mode (ISG control unit): request_r is the HMI's
-    # execution_mode_command; the PLC's command_w counts while enable_w is TRUE
-    execution_mode_plc_command: int = 0
-    execution_mode_plc_enable: bool = False
-    syn_chk: Any = None  # SyntaxCheckConfig for the next check (ch<c>.syn_chk.*)
-    decoder_flags: int = 0  # DecoderFlag bits (pMC[i].StateDecoder_Data)
-    # #MSG texts of the program, newest first (at most MESSAGES_LISTED), and their count
-    messages: tuple[str, ...] = ()
-    message_count: int = 0
-    # #TRAFO/#HSC/#SLOPE/#FILTER/G133/G134 as decoded so far (nc.technology)
-    machining: MachiningSettings = field(default_factory=MachiningSettings)
-    prod_time_trace: bool = False  # PROD_TIME runs write their path (ch<c>.prod_time_trace)
-    # M/S/T functions output to the PLC and the spindle (kernel.plc_functions, .spindle)
-    plc_functions: PlcFunctionsUnit = field(default_factory=PlcFunctionsUnit)
-    spindle: SpindleState = field(default_factory=SpindleState)
-    manual: tuple[Any, ...] = ()  # ManualAxisView per axis (manual_mode.ManualMode sets)
-    tooling: ChannelTooling = field(default_factory=ChannelTooling)  # T, D, zero offsets
     wait_reason: int = 0  # WaitReason: why the channel stands (kernel.wait_reason)
-    # operator switches and the rapid override (docs/kernel.md "Operator switches")
-    rapid_override_command: int = 1000  # 0.1 %, mc_command_rapid_override_w
-    rapid_override_per_mille: int = 1000  # 0.1 %, in effect on G0 (P-CHAN-00181 mode)
-    block_ignore_command: int = 0  # skip levels /1../10 (bit n-1), mc_command_block_ignore_w
-    block_ignore_active: int = 0  # the mask the running program was started with
-    m01_stop_enable: bool = False  # M1 stops only while TRUE (mc_command_M01_stop_enable_w)
-    g00_override_mode: int = 2  # RapidOverrideMode (P-CHAN-00181), from the configuration
+    program: ProgramShown = field(default_factory=ProgramShown)
+    block: BlockShown = BlockShown()
+    path: PathShown = PathShown()
+    errors: ChannelErrors = field(default_factory=ChannelErrors)
+    manual: tuple[ManualAxisView, ...] = ()  # per axis (manual_mode.ManualMode.publish)
+    tooling: ChannelTooling = field(default_factory=ChannelTooling)  # T, D, zero offsets
     # cycles each tool (by T number) has cut: kernel.tool_life; replaced, never changed
     tool_cut_cycles: dict[int, int] = field(default_factory=dict)
-    # gpCh[i].decoder_mc_control.program_block_ignore (ISG control unit): the PLC's
-    # command_w counts at program start while enable_w is TRUE
-    block_ignore_plc_command: int = 0
-    block_ignore_plc_enable: bool = False
-
-    @property
-    def execution_mode_commanded(self) -> int:
-        """The execution mode the next program start takes: the PLC's ``command_w``
-        while it enables the unit, else the HMI's request."""
-        if self.execution_mode_plc_enable:
-            return self.execution_mode_plc_command
-        return self.execution_mode_command
-
-    @property
-    def block_ignore_commanded(self) -> int:
-        """The skip levels the next program start takes: the PLC's ``command_w`` while
-        it enables the control unit, else the HMI's ``mc_command_block_ignore_w``."""
-        if self.block_ignore_plc_enable:
-            return self.block_ignore_plc_command
-        return self.block_ignore_command
-
-    @property
-    def suspend_commanded(self) -> bool:
-        """The value the unit commands: ``command_w`` while the PLC enables the unit,
-        else the CNC's own request."""
-        return self.suspend_command_w if self.suspend_enable_w else self.suspend_request_r
+    contour: ContourLookaheadUnit = field(default_factory=ContourLookaheadUnit)
+    # M/S/T functions output to the PLC and the spindle: the state of the channel's
+    # plc_functions.PlcFunctions and spindle.Spindle, which keep it here (no copy)
+    plc_functions: PlcFunctionsUnit = field(default_factory=PlcFunctionsUnit)
+    spindle: SpindleState = field(default_factory=SpindleState)
 
     def frozen(self) -> Channel:
-        """A copy for the snapshot, with copies of its axes.
-
-        The values are read in the order of ``dataclasses.fields`` (``_CHANNEL_VALUES``),
-        not a hand-written list: a field added anywhere lands in its own place. Positional
-        on purpose: 53 keywords cost two to three times as much per published cycle."""
-        copy = Channel(*_CHANNEL_VALUES(self))
-        copy.axes = [a.frozen() for a in self.axes]
-        return copy
-
-
-# every field of a Channel in declaration order, read in one C call (Channel.frozen)
-_CHANNEL_VALUES = attrgetter(*(f.name for f in fields(Channel)))
+        """A copy for the snapshot: copies of its axes, its parts shared (they are
+        immutable). Built by keyword: a field added anywhere lands in its own place."""
+        return Channel(
+            channel_id=self.channel_id, name=self.name,
+            axes=[a.frozen() for a in self.axes],
+            switches=self.switches, suspend=self.suspend, mode=self.mode,
+            state=self.state, wait_reason=self.wait_reason, program=self.program,
+            block=self.block, path=self.path, errors=self.errors, manual=self.manual,
+            tooling=self.tooling, tool_cut_cycles=self.tool_cut_cycles,
+            contour=self.contour, plc_functions=self.plc_functions, spindle=self.spindle,
+        )
 
 
 @dataclass(slots=True)
@@ -304,177 +220,3 @@ class Snapshot:
     stats: CycleStats
     channels: tuple[Channel, ...]
     physical_axes: tuple[PhysicalAxis, ...]
-
-
-class ChannelRunnerView(Protocol):
-    """What the kernel, its commands and the switchover use of a channel's runner
-    (``channel_run.ChannelRunner``, which imports this module)."""
-
-    config: ChannelConfig  # the channel's configuration
-    touched: bool  # the last cycle changed the channel's state
-    # set when a RESET of the channel is queued: a cycle waiting for its decoder stops
-    reset_pending: threading.Event
-    plc: PlcFunctions  # the channel's M/S/T functions to the PLC and its spindle
-    channel: Channel  # the channel's state, as objects show it
-    tables: ToolingTables  # the channel's tool list and zero offset table (live)
-    # manual mode of the channel's axes: a manual_mode.ManualMode (that module imports
-    # this one, so it is named where it is used: manual_commands)
-    manual: Any
-
-    @property
-    def moving(self) -> bool:
-        """The path is not at standstill."""
-
-    def select_mode(self, mode: int) -> Refusal | None:
-        """Choose the operation mode."""
-
-    def select_program(self, name: str) -> Refusal | None:
-        """Select a program of the store."""
-
-    def start(self) -> Refusal | None:
-        """START."""
-
-    def hold(self) -> Refusal | None:
-        """Feedhold."""
-
-    def reset(self) -> Refusal | None:
-        """RESET."""
-
-    def manual_block(self, text: str) -> Refusal | None:
-        """Run ``text`` as manual blocks (MDI)."""
-
-    def answer_contour_request(self) -> None:
-        """Fill the contour look-ahead's response (the PLC set the semaphore)."""
-
-    def internal_hold(self) -> bool:
-        """Brake the path for a suspend request; True when this started it."""
-
-    def release_internal_hold(self) -> bool:
-        """End the internal feedhold; True when one was active."""
-
-    def initialise_channel(self) -> None:
-        """Channel init (start-up, RESET)."""
-
-    def report(self, error: ErrorEntry) -> None:
-        """List ``error``."""
-
-    def cycle(self, time_s: float) -> bool:
-        """One GEO cycle; True while the channel has motion or decoding to do."""
-
-    def cruise_budget(self, most: int) -> int | None:
-        """Cycles (at most ``most``) that may run in bulk; None: its cycles change nothing."""
-
-    def cruise(self, cycles: int, time_s: float) -> None:
-        """Run ``cycles`` cycles that ``cruise_budget`` allowed, the last at ``time_s``."""
-
-
-@dataclass(slots=True)
-class KernelState:
-    """The live state the cycle thread works on."""
-
-    channels: list[Channel] = field(default_factory=list)
-    physical_axes: list[PhysicalAxis] = field(default_factory=list)
-    runners: list[ChannelRunnerView] = field(default_factory=list)  # per channel (kernel sets)
-    # by logical axis number
-    axis_params: dict[int, AxisParameters] = field(default_factory=dict)
-    alarms: AlarmLog = field(default_factory=AlarmLog)  # the kernel's (kernel sets)
-
-    @classmethod
-    def from_config(cls, config: MachineConfig) -> KernelState:
-        """Initial state: every channel links its axes unless its output is suspended."""
-        state = cls(
-            channels=[_channel_from_config(c, config) for c in config.channels],
-            physical_axes=[PhysicalAxis(a.number, a.name) for a in config.physical_axes],
-        )
-        by_number = state.drive_by_number()
-        for channel in state.channels:
-            if channel.output_suspended:
-                continue
-            for axis in channel.axes:
-                drive = by_number[axis.requested_link]
-                if drive.linked_logical_axis == 0:
-                    drive.linked_logical_axis = drive.last_logical_axis = axis.logical_number
-                    axis.actual_link = drive.number
-                    axis.link_state = LinkState.LINKED
-                else:  # another channel holds it: the request waits for it
-                    axis.link_state = LinkState.WAITING_ACK
-        return state
-
-    def drive_by_number(self) -> dict[int, PhysicalAxis]:
-        """The physical axes by number."""
-        return {p.number: p for p in self.physical_axes}
-
-    def drive_axes(self) -> None:
-        """Position controller: each physical axis follows the increments of the logical
-        axis linked to it (ideal drive: actual position = command position). A logical
-        axis without a link keeps its output where it was: no step is lost or invented
-        when it links again."""
-        drives = self.physical_axes
-        for channel in self.channels:
-            for axis in channel.axes:
-                delta = axis.command_position_01um - axis.output_01um
-                if not delta or not axis.actual_link:
-                    continue
-                for drive in drives:
-                    if drive.number == axis.actual_link:
-                        drive.command_position_01um += delta
-                        drive.actual_position_01um = drive.command_position_01um
-                        break
-                axis.output_01um = axis.command_position_01um
-
-    def snapshot(
-        self,
-        cycle: int,
-        time_ns: int,
-        wall_ns: int,
-        stats: CycleStats,
-        previous: Snapshot | None = None,
-        changed: list[bool] | None = None,
-        drives_changed: bool = True,
-    ) -> Snapshot:
-        """Frozen copies of everything readable.
-
-        With ``previous`` and ``changed`` (one flag per channel), a channel that did not
-        change this cycle keeps its frozen copy from ``previous``: an idle channel costs
-        nothing per cycle. Without them every channel is copied; the physical axes are
-        copied unless ``drives_changed`` is False (with ``previous``). ``time_ns`` and
-        ``wall_ns``: kernel time and wall-clock time of the cycle (see ``Snapshot``).
-        """
-        if previous is None or changed is None:
-            channels = tuple(c.frozen() for c in self.channels)
-        elif not any(changed):
-            channels = previous.channels
-        else:
-            channels = tuple(
-                c.frozen() if touched else old
-                for c, touched, old in zip(self.channels, changed, previous.channels, strict=True)
-            )
-        drives = (previous.physical_axes if previous is not None and not drives_changed
-                  else tuple(p.frozen() for p in self.physical_axes))
-        return Snapshot(cycle, time_ns, wall_ns, stats.frozen(), channels, drives)
-
-
-def _channel_from_config(config: ChannelConfig, machine: MachineConfig) -> Channel:
-    suspended = config.suspend_output_at_start
-    axes = [
-        LogicalAxis(
-            a.name,
-            a.logical_number,
-            machine.link_of(a.logical_number),
-            link_state=LinkState.REQUESTED if suspended else LinkState.LINKED,
-        )
-        for a in config.axes
-    ]
-    return Channel(
-        config.id,
-        config.name,
-        axes,
-        config.feed_override_max,
-        feed_override_command=min(1000, config.feed_override_max),
-        feed_override_per_mille=min(1000, config.feed_override_max),
-        output_suspended=suspended,
-        suspend_command_w=suspended,
-        suspend_request_r=suspended,
-        syn_chk=config.syn_chk,
-        g00_override_mode=RapidOverrideMode[config.g00_override_mode],
-    )

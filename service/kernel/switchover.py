@@ -22,9 +22,12 @@ init) it reads 0.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from .axis_params import AxisParameters
 from .channel_mode import ChannelState
-from .state import Channel, KernelState, LinkState, LogicalAxis, PhysicalAxis
+from .kernel_state import KernelState
+from .state import Channel, LinkState, LogicalAxis, PhysicalAxis
 
 
 class Switchover:
@@ -55,7 +58,7 @@ class Switchover:
                     self._unlink(axis, drive)
                     changed[ci] = True
                 continue
-            if channels[ci].output_suspended or axis.released:
+            if channels[ci].suspend.output_suspended or axis.released:
                 continue
             if axis.link_state == LinkState.REQUESTED:
                 axis.link_state = LinkState.WAITING_ACK  # the position controller has it
@@ -78,10 +81,10 @@ class Switchover:
             return False
         channels = self._state.channels
         for channel in channels:
-            if channel.suspend_commanded != channel.output_suspended:
+            if channel.suspend.commanded != channel.suspend.output_suspended:
                 return False
         for ci, axis, _drive in self._axes:
-            if axis.released or not (axis.actual_link or channels[ci].output_suspended):
+            if axis.released or not (axis.actual_link or channels[ci].suspend.output_suspended):
                 return False
         return True
 
@@ -110,19 +113,19 @@ class Switchover:
     def _suspend_unit(self, ci: int, channel: Channel) -> bool:
         """Apply the unit's command to the channel; True when something changed."""
         runner = self._state.runners[ci]
-        if channel.suspend_commanded:
-            if channel.output_suspended or channel.state == ChannelState.ERROR:
+        if channel.suspend.commanded:
+            if channel.suspend.output_suspended or channel.state == ChannelState.ERROR:
                 return False
             if runner.moving:
                 return runner.internal_hold()
             for axis in channel.axes:
                 if axis.actual_link and not axis.released:  # a released axis keeps its
                     self._unlink(axis, self._drives[axis.actual_link])  # link (P-AXIS-00483)
-            channel.output_suspended = True
+            channel.suspend = replace(channel.suspend, output_suspended=True)
             return True
         changed = runner.release_internal_hold()
-        if channel.output_suspended:
-            channel.output_suspended = False
+        if channel.suspend.output_suspended:
+            channel.suspend = replace(channel.suspend, output_suspended=False)
             for axis in channel.axes:
                 if not axis.actual_link:
                     axis.link_state = LinkState.REQUESTED

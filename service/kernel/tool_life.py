@@ -13,9 +13,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .kernel_state import KernelState
 from .nc.blocks import Block, MotionKind
 from .refusal import Refusal, RefusalReason
-from .state import Channel, KernelState
+from .state import Channel
 
 
 def count_cutting(ch: Channel, block: Block | None, cycles: int) -> None:

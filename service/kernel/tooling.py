@@ -18,6 +18,7 @@ from cnc_objects.protocol.constants import TOOL_LIFE_MAX_S
 
 from ..machine_config import MachineConfig
 from .commands import Refusal, RefusalReason
+from .kernel_state import KernelState
 from .nc.modal import ModalState
 from .nc.tool_data import (
     ToolData,
@@ -27,7 +28,7 @@ from .nc.tool_data import (
     ZeroOffsetTable,
     program_shift_mm,
 )
-from .state import Channel, KernelState
+from .state import Channel
 from .tooling_view import ChannelTooling
 
 # |tool length|, radius and zero offsets the tables take (0.1 um): the largest position

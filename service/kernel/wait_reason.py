@@ -33,10 +33,10 @@ def channel_wait_reason(
     if state not in WORKING_STATES:
         return WaitReason.ERROR if state == ChannelState.ERROR else WaitReason.NONE
     if state == ChannelState.HOLD:
-        if channel.decoder_flags & _CHECK_PAUSED:
+        if channel.program.decoder_flags & _CHECK_PAUSED:
             return WaitReason.CHECK_PAUSE
         return WaitReason.FEED_HOLD
-    if internal_hold or (axes_missing and channel.output_suspended):
+    if internal_hold or (axes_missing and channel.suspend.output_suspended):
         return WaitReason.OUTPUT_SUSPENDED
     if axes_missing:
         return WaitReason.AXIS_LINK

@@ -64,12 +64,12 @@ def test_prod_time_on_the_realtime_clock_waits_for_a_slow_decoder(cnc_client: Cl
     program = ("#VAR\nV.L.I = 0\n#ENDVAR\n$WHILE V.L.I < 20000\nV.L.I = V.L.I + 1\n$ENDWHILE\n"
                "G1 X10 F6000\nG2 X20 I5 J0\nG1 X0\nM30\n")
     with KernelHarness() as harness:
-        expected = harness.run(program, "p.nc").channel.program_time_s
+        expected = harness.run(program, "p.nc").channel.path.program_time_s
         assert harness.command(SetExecutionMode(0, 0x10)) is None
         # the same cycles; their sum may round in its last bit otherwise when the
         # calculation waited for the decoder (seen under parallel load: 0.508 against
         # 0.5079999999999999), so a nanosecond's tolerance, far below one 1 ms cycle
-        assert harness.run(program, "p.nc").channel.program_time_s == pytest.approx(
+        assert harness.run(program, "p.nc").channel.path.program_time_s == pytest.approx(
             expected, abs=1e-9)
     api = cnc_client
     api.upload("p.nc", program.encode())

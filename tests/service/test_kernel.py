@@ -12,7 +12,8 @@ from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.clock import RealtimeClock, VirtualClock
 from cnc_objects.service.kernel.commands import Refusal, RefusalReason, SetExecutionMode, SetFeedOverride
 from cnc_objects.service.kernel.kernel import Control, ControlCommand, Kernel, ResetCycleStats
-from cnc_objects.service.kernel.state import KernelState, LinkState
+from cnc_objects.service.kernel.kernel_state import KernelState
+from cnc_objects.service.kernel.state import LinkState
 from tests.support.kernel_commands import Applied, submit
 
 
@@ -30,7 +31,7 @@ def test_initial_links_follow_the_configuration() -> None:
     assert [(a.requested_link, a.actual_link, a.link_state) for a in main.axes] == [
         (1, 1, LinkState.LINKED), (2, 2, LinkState.LINKED), (3, 3, LinkState.LINKED)
     ]
-    assert jog.output_suspended
+    assert jog.suspend.output_suspended
     assert [(a.requested_link, a.actual_link, a.link_state) for a in jog.axes] == [
         (1, 0, LinkState.REQUESTED), (2, 0, LinkState.REQUESTED), (3, 0, LinkState.REQUESTED)
     ]
@@ -40,14 +41,14 @@ def test_initial_links_follow_the_configuration() -> None:
 def test_command_is_visible_in_the_snapshot_once_applied(kernel: Kernel) -> None:
     assert submit(kernel, SetFeedOverride(0, 420)) is None
     snapshot = kernel.snapshot
-    assert snapshot.channels[0].feed_override_per_mille == 420
-    assert snapshot.channels[1].feed_override_per_mille == 1000
+    assert snapshot.channels[0].switches.feed_override_per_mille == 420
+    assert snapshot.channels[1].switches.feed_override_per_mille == 1000
 
 
 def test_snapshot_is_a_copy_the_kernel_does_not_change(kernel: Kernel) -> None:
     before = kernel.snapshot
     assert submit(kernel, SetFeedOverride(0, 10)) is None
-    assert before.channels[0].feed_override_per_mille == 1000
+    assert before.channels[0].switches.feed_override_per_mille == 1000
     assert kernel.snapshot.cycle > before.cycle
 
 
@@ -66,7 +67,7 @@ def test_commands_apply_in_arrival_order(kernel: Kernel) -> None:
     for value, done in enumerate(results):
         kernel.submit(SetFeedOverride(0, value), done)
     assert all(d.wait() is None for d in results)
-    assert kernel.snapshot.channels[0].feed_override_command == 49
+    assert kernel.snapshot.channels[0].switches.feed_override_command == 49
 
 
 def test_stop_refuses_commands_and_run_resumes(kernel: Kernel) -> None:
@@ -83,7 +84,7 @@ def test_stop_refuses_commands_and_run_resumes(kernel: Kernel) -> None:
 def test_reset_reinitialises_state(kernel: Kernel) -> None:
     assert submit(kernel, SetFeedOverride(0, 5)) is None
     assert submit(kernel, ControlCommand(Control.RESET)) is None
-    assert kernel.snapshot.channels[0].feed_override_command == 1000
+    assert kernel.snapshot.channels[0].switches.feed_override_command == 1000
 
 
 @dataclass(frozen=True)

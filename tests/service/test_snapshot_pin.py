@@ -39,11 +39,11 @@ def test_a_pinned_snapshot_holds_on_its_thread_only(kernel: Kernel) -> None:
     with kernel.reading() as pinned:
         assert submit(kernel, SetFeedOverride(0, 420)) is None  # published after pinning
         assert kernel.snapshot is pinned
-        assert pinned.channels[0].feed_override_per_mille == 1000
+        assert pinned.channels[0].switches.feed_override_per_mille == 1000
         newest = seen_by_another_thread(kernel)
         assert newest.cycle > pinned.cycle
-        assert newest.channels[0].feed_override_per_mille == 420
-    assert kernel.snapshot.channels[0].feed_override_per_mille == 420  # unpinned
+        assert newest.channels[0].switches.feed_override_per_mille == 420
+    assert kernel.snapshot.channels[0].switches.feed_override_per_mille == 420  # unpinned
 
 
 def test_a_given_snapshot_is_pinned_and_a_nested_block_keeps_the_outer_pin(

@@ -85,8 +85,8 @@ class KernelHarness:
         ch = snap.channels[0]
         if self._recording is not None:
             self._recording.append(Sample(
-                snap.cycle, tuple(a.position_mm for a in ch.axes), ch.path_velocity_mm_s,
-                ch.state, ch.block_count,
+                snap.cycle, tuple(a.position_mm for a in ch.axes), ch.path.path_velocity_mm_s,
+                ch.state, ch.block.block_count,
             ))
         if self._watching and ch.state in _DONE_STATES:
             self._finished.set()

@@ -70,7 +70,7 @@ def test_a_program_error_raises_one_alarm_with_its_place(harness, text, error_id
     assert alarm.channel == 1 and alarm.sequence == view.raised == 1
     assert before_ns <= alarm.wall_ns <= time.time_ns()
     assert alarm.cycle > 0 and alarm.kernel_ns == alarm.cycle * harness.kernel.cycle_ns
-    assert alarm.text == run.channel.errors[0].text  # the same error as the channel lists
+    assert alarm.text == run.channel.errors.entries[0].text  # the same error as the channel lists
     assert view.history == view.active
 
 

@@ -8,7 +8,8 @@ from __future__ import annotations
 from dataclasses import fields
 
 from cnc_objects.service.config import build_config
-from cnc_objects.service.kernel.state import Channel, KernelState
+from cnc_objects.service.kernel.kernel_state import KernelState
+from cnc_objects.service.kernel.state import Channel
 
 
 def test_frozen_copies_every_field_into_the_field_of_its_name() -> None:

@@ -41,7 +41,8 @@ from cnc_objects.service.kernel.commands import (
     SetSingleBlock,
     StartProgram,
 )
-from cnc_objects.service.kernel.state import DecoderFlag, ErrorEntry, KernelState
+from cnc_objects.service.kernel.kernel_state import KernelState
+from cnc_objects.service.kernel.state import DecoderFlag, ErrorEntry
 from tests.support.kernel import KernelHarness
 
 S, E = ChannelState, ChannelEvent
@@ -126,12 +127,12 @@ def _reach(h: KernelHarness, state: ChannelState, *, mdi: bool = False) -> None:
 
 
 def _key(ch: Any) -> tuple:
-    return ch.mode, ch.state, ch.program_name, ch.error_count, ch.waiting_for_start
+    return ch.mode, ch.state, ch.program.program_name, ch.errors.count, ch.program.waiting_for_start
 
 
 def _expected(state: ChannelState, event: ChannelEvent, ch: Any) -> ChannelState:
     """The table's target for ``ch`` (named targets resolved with its mode and program)."""
-    return resolve(TRANSITIONS[state][event], ch.mode, bool(ch.program_name))
+    return resolve(TRANSITIONS[state][event], ch.mode, bool(ch.program.program_name))
 
 
 # ---------------------------------------------------------------- the entries
@@ -162,23 +163,23 @@ def _reset(h: KernelHarness) -> None:
 
 
 def _report(h: KernelHarness) -> None:
-    before = _ch(h).error_count
+    before = _ch(h).errors.count
     _ok(h, Report())
-    assert _ch(h).error_count == before + 1
+    assert _ch(h).errors.count == before + 1
 
 
 def _to_the_end(h: KernelHarness) -> None:
     _ok(h, ResetChannel(0, True))
     _ok(h, SelectProgram(0, "short.nc"))
     h.begin(StartProgram(0, True))
-    assert h.wait().channel.error_count == 0
+    assert h.wait().channel.errors.count == 0
 
 
 def _program_error(h: KernelHarness) -> None:
     _ok(h, ResetChannel(0, True))
     _ok(h, SelectProgram(0, "limit.nc"))
     h.begin(StartProgram(0, True))
-    assert h.wait().channel.errors[0].line == 2
+    assert h.wait().channel.errors.entries[0].line == 2
 
 
 def _check_pauses(h: KernelHarness) -> None:
@@ -189,7 +190,7 @@ def _check_pauses(h: KernelHarness) -> None:
     _ok(h, SelectProgram(0, "check.nc"))
     _ok(h, StartProgram(0, True))
     ch = _ch(h)
-    assert ch.waiting_for_start and ch.decoder_flags & DecoderFlag.WAIT_CONTINUE
+    assert ch.program.waiting_for_start and ch.program.decoder_flags & DecoderFlag.WAIT_CONTINUE
 
 
 def _check_still_paused(h: KernelHarness) -> None:
@@ -198,7 +199,7 @@ def _check_still_paused(h: KernelHarness) -> None:
     cycle = h.kernel.snapshot.cycle
     _ok(h, SetFeedOverride(0, 1000))
     assert h.kernel.snapshot.cycle > cycle
-    assert _ch(h).waiting_for_start
+    assert _ch(h).program.waiting_for_start
 
 
 def _end_while_braking(h: KernelHarness) -> None:
@@ -214,10 +215,10 @@ def _end_while_braking(h: KernelHarness) -> None:
         if sent_at and states[-1] != S.HOLD and states[-1] != S.ACTIVE:
             return True  # ended: record no more
         states.append(ch.state)
-        if not sent_at and ch.state == S.ACTIVE and 0.0 < ch.path_velocity_mm_s < last_v[0]:
+        if not sent_at and ch.state == S.ACTIVE and 0.0 < ch.path.path_velocity_mm_s < last_v[0]:
             sent_at.append(len(states))
             h.kernel.submit(Feedhold(0, True), lambda refusal: None)
-        last_v[0] = ch.path_velocity_mm_s
+        last_v[0] = ch.path.path_velocity_mm_s
         return bool(sent_at) and ch.state not in (S.ACTIVE, S.HOLD)
 
     ended = h.watch(watch)
@@ -226,7 +227,7 @@ def _end_while_braking(h: KernelHarness) -> None:
     after = states[sent_at[0]:]
     assert after[0] == S.HOLD, after  # applied in the next cycle, still braking
     assert set(after[:-1]) == {S.HOLD} and after[-1] == S.READY, after
-    assert _ch(h).error_count == 0
+    assert _ch(h).errors.count == 0
 
 
 @dataclass(frozen=True)

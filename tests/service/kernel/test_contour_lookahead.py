@@ -170,7 +170,7 @@ def g42_expected() -> list[tuple[Expected, float]]:
 
 def test_every_field_of_a_g41_contour(kernel) -> None:
     run = kernel.run(G41_PROGRAM)
-    assert run.channel.state == ChannelState.READY, run.channel.errors
+    assert run.channel.state == ChannelState.READY, run.channel.errors.entries
     expected = g41_expected()
     assert_entries(request(kernel, 0), expected)
     unit = kernel.kernel.snapshot.channels[0].contour
@@ -178,12 +178,12 @@ def test_every_field_of_a_g41_contour(kernel) -> None:
     assert unit.log_active is False
     end_mm = expected[-1][1]  # LOG OFF sits at the end of the path
     assert unit.max_dist_prog_start_01um == pytest.approx(end_mm * INCR, abs=1e-3)
-    assert run.channel.dist_prog_start_01um == pytest.approx(end_mm * INCR, abs=1e-3)
+    assert run.channel.path.dist_prog_start_01um == pytest.approx(end_mm * INCR, abs=1e-3)
 
 
 def test_every_field_of_a_g42_contour(kernel) -> None:
     run = kernel.run(G42_PROGRAM)
-    assert run.channel.state == ChannelState.READY, run.channel.errors
+    assert run.channel.state == ChannelState.READY, run.channel.errors.entries
     assert_entries(request(kernel, 0), g42_expected())
 
 
@@ -260,7 +260,7 @@ def body(first_variation: float, start_count: int) -> list[Expected]:
 
 def test_log_inside_a_real_time_loop_gives_the_body_once_with_the_entry(kernel) -> None:
     run = kernel.run(rt_program(inside=True))
-    assert run.channel.state == ChannelState.READY, run.channel.errors
+    assert run.channel.state == ChannelState.READY, run.channel.errors.entries
     entry = angle((1, 0), (1, 1))  # from N10 (+X) into N80
     # blocks: N10 = 1, LOG ON (pass 1) = 2, N80.. = 3..5, LOG OFF = 6
     expected = with_starts(10.0, [Expected(LOG_ON, 70, 2, 1.0), *body(entry, 3),
@@ -270,7 +270,7 @@ def test_log_inside_a_real_time_loop_gives_the_body_once_with_the_entry(kernel) 
 
 def test_log_around_a_real_time_loop_gives_three_transitions(kernel) -> None:
     run = kernel.run(rt_program(inside=False, passes=5))
-    assert run.channel.state == ChannelState.READY, run.channel.errors
+    assert run.channel.state == ChannelState.READY, run.channel.errors.entries
     entry = angle((1, 0), (1, 1))  # start of loop: from N10 into N80
     loop = angle((-1, 0), (1, 1))  # loop to loop: from N100 (-X) into N80
     # blocks: N10 = 1, LOG ON = 2, passes of three blocks: 3..5, 6..8, .., 15..17
@@ -309,14 +309,14 @@ def test_only_the_first_area_until_clear_which_flushes_and_waits(kernel) -> None
     def watch(snap) -> bool:
         ch = snap.channels[0]
         if ch.state == ChannelState.ACTIVE:
-            seen.append((ch.dist_prog_start_01um / INCR, ch.contour.count_logged_blocks,
-                         ch.path_velocity_mm_s))
+            seen.append((ch.path.dist_prog_start_01um / INCR, ch.contour.count_logged_blocks,
+                         ch.path.path_velocity_mm_s))
         return False
 
     kernel.watch(watch)
     run = kernel.run(CLEAR_PROGRAM)
     kernel.wait_for(lambda snap: True)  # stop watching
-    assert run.channel.state == ChannelState.READY, run.channel.errors
+    assert run.channel.state == ChannelState.READY, run.channel.errors.entries
     # before the path reaches CLEAR at 20 mm the log holds the first area only: the
     # second LOG ON (N40) was ignored, and nothing after CLEAR was prepared
     before = [count for dist, count, _ in seen if dist < 20.0 - 1e-9]
@@ -334,7 +334,7 @@ def test_clear_inside_a_real_time_loop_is_error_22073(kernel) -> None:
     run = kernel.run("N10 G1 X10 F600\nN20 #RT WHILE [TRUE]\n"
                      "N30   #CONTOUR LOOKAHEAD LOG CLEAR\nN40 #RT ENDWHILE\nM30\n")
     assert run.channel.state == ChannelState.ERROR
-    error = run.channel.errors[0]
+    error = run.channel.errors.entries[0]
     assert (error.id, error.line, error.column) == (22073, 3, 7)
     assert run.positions_mm[0] == pytest.approx(10.0)  # the block before it ran
 
@@ -343,7 +343,7 @@ def test_distance_prog_start_clear_restarts_the_distance(kernel) -> None:
     run = kernel.run("N10 #CONTOUR LOOKAHEAD LOG ON\nN20 G1 X10 F600\n"
                      "N30 #DISTANCE PROG START CLEAR\nN40 G1 X15\n"
                      "N50 #CONTOUR LOOKAHEAD LOG OFF\nM30\n")
-    assert run.channel.dist_prog_start_01um == pytest.approx(5.0 * INCR)
+    assert run.channel.path.dist_prog_start_01um == pytest.approx(5.0 * INCR)
     reply = request(kernel, 0)
     assert [(e.block_number, e.start_position / INCR) for e in reply] == [
         (10, 0.0), (20, 0.0), (40, 0.0), (50, 5.0)]
@@ -359,7 +359,7 @@ def test_the_log_keeps_contour_lookahead_log_max_entries_and_warns() -> None:
     with KernelHarness(config=config) as harness:
         run = harness.run(program)
         assert run.channel.state == ChannelState.READY  # a warning does not stop it
-        warning = run.channel.errors[0]
+        warning = run.channel.errors.entries[0]
         assert warning.warning and warning.id == 22074 and "P-CHAN-00658" in warning.text
         assert (warning.file, warning.line) == ("test.nc", 5)  # N23: the fifth entry
         reply = request(harness, 0)
@@ -372,7 +372,7 @@ def test_contour_commands_need_fct_contour_lah() -> None:
     config = build_config({"channels": [{**base, "interpolator_function": "FCT_IPO_DEFAULT"}]})
     with KernelHarness(config=config) as harness:
         run = harness.run("N10 G1 X1 F600\nN20 #CONTOUR LOOKAHEAD LOG ON\nM30\n")
-        error = run.channel.errors[0]
+        error = run.channel.errors.entries[0]
         assert (error.id, error.line, error.column) == (22070, 2, 5)
         assert "FCT_CONTOUR_LAH" in error.text
         harness.command(ResetChannel(0, True))
@@ -385,15 +385,15 @@ def test_the_marked_area_is_there_before_it_runs_and_through_feedhold(kernel) ->
                + "".join(f"N{20 + k} G1 X{10 * (k + 1)} F600\n" for k in range(8))
                + "N90 #CONTOUR LOOKAHEAD LOG OFF\nM30\n")
     kernel.start(program)
-    snap = kernel.wait_for(lambda s: s.channels[0].dist_prog_start_01um > 0.0)
-    assert snap.channels[0].dist_prog_start_01um < 10 * INCR  # still in the first element
+    snap = kernel.wait_for(lambda s: s.channels[0].path.dist_prog_start_01um > 0.0)
+    assert snap.channels[0].path.dist_prog_start_01um < 10 * INCR  # still in the first element
     assert snap.channels[0].contour.count_logged_blocks == 10
     reply = request(kernel, 0)
     assert [e.block_type for e in reply] == [LOG_ON] + [LINEAR] * 8 + [LOG_OFF]
     max_before = kernel.kernel.snapshot.channels[0].contour.max_dist_prog_start_01um
     assert max_before == pytest.approx(80 * INCR)
     assert kernel.command(Feedhold(0, True)) is None
-    held = kernel.wait_for(lambda s: s.channels[0].path_velocity_mm_s == 0.0)
+    held = kernel.wait_for(lambda s: s.channels[0].path.path_velocity_mm_s == 0.0)
     assert held.channels[0].state == ChannelState.HOLD
     assert held.channels[0].contour.max_dist_prog_start_01um == max_before  # feedhold: same
     assert [e.block_type for e in request(kernel, 0)] == [e.block_type for e in reply]
@@ -417,7 +417,7 @@ def test_clear_with_radius_compensation_is_error_22072_and_nothing_jumps(kernel)
     run = kernel.run("N10 G41 D1 G1 X10 Y0 F600\nN20 X20\n"
                      "N25 #CONTOUR LOOKAHEAD LOG CLEAR\nN30 X30\nN40 G40 X40\nM30\n",
                      record=True)
-    error = run.channel.errors[0]
+    error = run.channel.errors.entries[0]
     assert (error.id, error.line, error.column) == (22072, 3, 5) and "G40" in error.text
     # the blocks before it ran to their end on the offset path, without a jump
     assert run.positions_mm[:2] == pytest.approx((20.0, 1.0))
@@ -429,7 +429,7 @@ def test_clear_with_radius_compensation_is_error_22072_and_nothing_jumps(kernel)
 def test_mode_2_sees_every_element_still_in_the_look_ahead_buffer(kernel) -> None:
     squares = "".join("G1 Y10\nX10\nY0\nX0\n" for _ in range(40))  # 2 elements per corner
     kernel.start(f"N2 G41 D1 G1 X0 Y0.5 F600\n{squares}G40 G1 X-5 Y-5\nM30\n")
-    snap = kernel.wait_for(lambda s: s.channels[0].dist_prog_start_01um > 0.0)
+    snap = kernel.wait_for(lambda s: s.channels[0].path.dist_prog_start_01um > 0.0)
     ahead = snap.channels[0].contour.max_dist_prog_start_01um
     assert ahead > 1000 * INCR  # the buffer holds 120 blocks, far more elements than 128
     reply = request(kernel, 0.0, 12 * INCR)  # the first elements are still to come
@@ -458,12 +458,12 @@ def test_loop_markers_are_no_blocks_of_the_path(kernel) -> None:
         kernel.start(program)
         seen = []
         while True:
-            snap = kernel.wait_for(lambda s: s.channels[0].waiting_for_start
+            snap = kernel.wait_for(lambda s: s.channels[0].program.waiting_for_start
                                    or s.channels[0].state != ChannelState.ACTIVE)
             ch = snap.channels[0]
             if ch.state != ChannelState.ACTIVE:
                 break
-            seen.append((ch.axes[0].position_mm, ch.axes[1].position_mm, ch.block_count))
+            seen.append((ch.axes[0].position_mm, ch.axes[1].position_mm, ch.block.block_count))
             # applied and published before it returns: a stop seen next is the next one
             assert kernel.command(StartProgram(0, True)) is None
         kernel.command(SetSingleBlock(0, False))
@@ -478,11 +478,11 @@ def test_mode_2_answers_in_the_distances_dist_prog_start_counts(kernel) -> None:
     lines = "".join(f"N{100 + k} X{k + 1}\n" for k in range(40))
     more = "".join(f"N{600 + k} X{41 + k}\n" for k in range(40))
     kernel.start(f"G90 G1 F600\n{lines}N500 #DISTANCE PROG START CLEAR\n{more}M30\n")
-    kernel.wait_for(lambda s: s.channels[0].dist_prog_start_01um > 0.0)
+    kernel.wait_for(lambda s: s.channels[0].path.dist_prog_start_01um > 0.0)
     # before the path reaches the CLEAR: the elements of the first 40 mm
     assert [e.block_number for e in request(kernel, 0, 2.5 * INCR)] == [100, 101, 102]
     run = kernel.wait()
-    assert run.channel.dist_prog_start_01um == pytest.approx(40 * INCR)
+    assert run.channel.path.dist_prog_start_01um == pytest.approx(40 * INCR)
     # after it: the same window holds the elements after the CLEAR only
     assert [e.block_number for e in request(kernel, 0, 2.5 * INCR)] == [600, 601, 602]
 

@@ -82,7 +82,7 @@ def corner_limit(u_in, u_out) -> float:
 
 def errors(run) -> list:
     """The channel's errors that are not warnings."""
-    return [e for e in run.channel.errors if not e.warning]
+    return [e for e in run.channel.errors.entries if not e.warning]
 
 
 def positions(run) -> np.ndarray:
@@ -108,7 +108,7 @@ def max_axis_speed(run) -> float:
 
 
 def assert_finished_at(run, end) -> None:
-    assert run.channel.state == READY, run.channel.errors
+    assert run.channel.state == READY, run.channel.errors.entries
     assert errors(run) == []
     assert run.positions_mm == pytest.approx(end, abs=EPS)
 
@@ -160,15 +160,15 @@ def test_la_on_runs_1um_chords_of_a_small_circle_at_the_optimum(kernel) -> None:
         assert_finished_at(run, end)
         assert max_axis_speed(run) <= V * (1 + EPS)
         assert float(np.max(speeds(run))) <= 100.0 * (1 + EPS)  # F6000
-    t_on, t_off = on.channel.program_time_s, off.channel.program_time_s
+    t_on, t_off = on.channel.path.program_time_s, off.channel.path.program_time_s
     # the time-optimal plan of the same model is a lower bound (up to the last cycle)
     assert optimum - CYCLE_S <= t_on <= 1.01 * optimum, (t_on, optimum)
     # 120 buffered chords are 0.12 mm: LA_OFF must be able to stop within them
     assert t_off > 1.5 * t_on, (t_off, t_on)
-    assert BUFFER_LIMITS_SPEED in [e.id for e in off.channel.errors if e.warning]
-    assert on.channel.errors == ()
+    assert BUFFER_LIMITS_SPEED in [e.id for e in off.channel.errors.entries if e.warning]
+    assert on.channel.errors.entries == ()
     # each programmed chord is one block (1 um chords are too short to be split)
-    assert on.channel.block_count == off.channel.block_count == program.blocks + 1
+    assert on.channel.block.block_count == off.channel.block.block_count == program.blocks + 1
 
 
 # ------------------------------------------------------------------------ 2. METB
@@ -181,22 +181,22 @@ def test_metb_splits_a_long_line_without_changing_its_time(kernel) -> None:
     expected_s = trapezoid_s(200.0, 200.0, A)
     off = run_from_origin(kernel, "N10 G1 X200 F12000\nN20 M30\n")
     assert_finished_at(off, (200.0, 0.0, 0.0))
-    assert off.channel.block_count == 2
-    assert abs(off.channel.program_time_s - expected_s) <= 2 * CYCLE_S
+    assert off.channel.block.block_count == 2
+    assert abs(off.channel.path.program_time_s - expected_s) <= 2 * CYCLE_S
     counts, times = {}, {}
     for metb in (0.01, 0.02, 0.05):
         run = run_from_origin(kernel, LONG_LINE.format(metb=metb))
         assert_finished_at(run, (200.0, 0.0, 0.0))
-        counts[metb] = run.channel.block_count
-        times[metb] = run.channel.program_time_s
+        counts[metb] = run.channel.block.block_count
+        times[metb] = run.channel.path.program_time_s
         # the sub-blocks pass through the block counter as blocks of their own
         assert counts[metb] == len(plan(LONG_LINE.format(metb=metb)).blocks) + 1
         assert float(np.max(speeds(run))) <= 200.0 * (1 + EPS)
     # ramp of 40 ms: METB 10 ms -> 3 ramp sub-blocks each side, 20 ms -> 1, 50 ms -> none
     assert counts == {0.01: 8, 0.02: 4, 0.05: 2}
     assert abs(times[0.01] - times[0.05]) <= CYCLE_S
-    assert abs(times[0.01] - off.channel.program_time_s) <= 0.01 * off.channel.program_time_s
-    assert abs(times[0.02] - off.channel.program_time_s) <= 0.01 * off.channel.program_time_s
+    assert abs(times[0.01] - off.channel.path.program_time_s) <= 0.01 * off.channel.path.program_time_s
+    assert abs(times[0.02] - off.channel.path.program_time_s) <= 0.01 * off.channel.path.program_time_s
 
 
 @pytest.mark.parametrize("metb", [0.005, 0.01, 0.015])
@@ -280,7 +280,7 @@ def test_arc_sub_blocks_lie_on_the_circle(kernel, case) -> None:
     # the kernel runs the sub-blocks along the same circle to the programmed end
     run = run_from_origin(kernel, text)
     assert_finished_at(run, original.motion.end_mm)
-    assert run.channel.block_count == len(blocks) + 2  # G0, sub-blocks, M30
+    assert run.channel.block.block_count == len(blocks) + 2  # G0, sub-blocks, M30
     on_arc = [pos for pos, s in zip(positions(run), run.samples)
               if s.block_count >= 1 and s.state == ChannelState.ACTIVE]
     assert len(on_arc) > 100
@@ -315,7 +315,7 @@ def test_metb_error_stops_the_kernel_run_at_its_line(kernel) -> None:
                           name="metb.nc")
     ch = run.channel
     assert ch.state == ChannelState.ERROR
-    e = ch.errors[0]
+    e = ch.errors.entries[0]
     assert (e.id, e.file, e.line, e.column) == (int(NcErrorId.VALUE_OUT_OF_RANGE), "metb.nc",
                                                 3, 8), e
     assert "METB" in e.text
@@ -364,7 +364,7 @@ def test_vfbt_lowers_the_speed_at_corners_of_the_section(kernel) -> None:
         # at most one cycle of acceleration above it
         for m in minima:
             assert vfbt * limit - 1e-6 <= m <= vfbt * limit + A * CYCLE_S + 1e-6, minima
-        results[vfbt] = (run.channel.program_time_s, float(np.mean(minima)))
+        results[vfbt] = (run.channel.path.program_time_s, float(np.mean(minima)))
     assert results[0.5][0] > results[1.0][0] + 0.02  # 19 slower corners
     assert 0.4 <= results[0.5][1] / results[1.0][1] <= 0.65
 
@@ -376,11 +376,11 @@ def test_vfbt_has_no_effect_outside_la_on(kernel) -> None:
     la_on = run_from_origin(kernel, f"LA_ON\n{body}LA_OFF\nM30\n")
     for run in (plain, with_vfbt, la_on):
         assert_finished_at(run, (0.0, 20.0, 0.0))
-    assert with_vfbt.channel.program_time_s == pytest.approx(plain.channel.program_time_s,
+    assert with_vfbt.channel.path.program_time_s == pytest.approx(plain.channel.path.program_time_s,
                                                              abs=1e-9)
     assert np.array_equal(motion(with_vfbt), motion(plain))
     # the whole zig-zag fits the buffer: LA_ON with VFBT=1 is exactly as fast
-    assert abs(la_on.channel.program_time_s - plain.channel.program_time_s) <= CYCLE_S
+    assert abs(la_on.channel.path.program_time_s - plain.channel.path.program_time_s) <= CYCLE_S
 
 
 # ------------------------------------------------------------------------ 6. BBTRC
@@ -459,7 +459,7 @@ def test_bbtrc_finds_the_bottleneck_and_stops_before_it(kernel, bbtrc, named, cr
     run = run_from_origin(kernel, text, name="keyhole.nc")
     ch = run.channel
     assert ch.state == ChannelState.ERROR
-    e = ch.errors[0]
+    e = ch.errors.entries[0]
     line = next(n for n, t in enumerate(text.splitlines(), 1) if t.startswith(f"N{named} "))
     assert (e.id, e.file, e.line) == (BOTTLENECK, "keyhole.nc", line), e
     pos = positions(run)
@@ -483,7 +483,7 @@ def test_bbtrc_too_short_to_reach_the_crossing_runs_the_program(kernel, bbtrc) -
     assert plan(text).error is None
     run = run_from_origin(kernel, text)
     assert_finished_at(run, (50.0, 0.0, 0.0))
-    assert run.channel.block_count == 11  # compensated blocks are never split
+    assert run.channel.block.block_count == 11  # compensated blocks are never split
 
 
 def test_bbtrc_ignores_moves_without_compensation() -> None:
@@ -528,17 +528,17 @@ def test_dwell_ends_the_section_and_the_path_stops_there(kernel) -> None:
     assert np.all(pos[:at_stop[0]] < 50.0) and np.all(pos[at_stop[-1] + 1:] > 50.0)
     # two rest-to-rest moves plus the dwell (without the stop it would be one 100 mm move)
     expected = 2 * trapezoid_s(50.0, 100.0, A) + 0.1
-    assert abs(run.channel.program_time_s - expected) <= 4 * CYCLE_S
+    assert abs(run.channel.path.program_time_s - expected) <= 4 * CYCLE_S
 
 
 def test_m0_inside_a_section_stops_and_start_continues(kernel) -> None:
     kernel.command(ResetChannel(0, True))
     kernel.mdi("G90 G40 G0 X0 Y0 Z0")
     kernel.start("LA_ON\nG1 X50 F12000\nM0\nX100\nLA_OFF\nM30\n", record=True)
-    snap = kernel.wait_for(lambda s: s.channels[0].waiting_for_start)
+    snap = kernel.wait_for(lambda s: s.channels[0].program.waiting_for_start)
     ch = snap.channels[0]
     assert ch.axes[0].position_mm == pytest.approx(50.0, abs=EPS)
-    assert ch.path_velocity_mm_s == 0.0
+    assert ch.path.path_velocity_mm_s == 0.0
     assert kernel.command(StartProgram(0, True)) is None
     run = kernel.wait()
     assert_finished_at(run, (100.0, 0.0, 0.0))
@@ -578,7 +578,7 @@ def test_feed_override_halves_the_speed_of_a_section(kernel) -> None:
     half = kernel.run(text, record=True)
     assert_finished_at(half, (100.0, 0.0, 0.0))
     assert_within_limits(half, 100.0)
-    ratio = half.channel.program_time_s / full.channel.program_time_s
+    ratio = half.channel.path.program_time_s / full.channel.path.program_time_s
     assert 1.9 <= ratio <= 2.05, ratio
 
 
@@ -586,9 +586,9 @@ def test_feed_override_changed_at_full_speed_stays_within_limits(kernel) -> None
     kernel.command(ResetChannel(0, True))
     kernel.mdi("G90 G40 G0 X0 Y0 Z0")
     kernel.start(fine_line(), record=True)
-    kernel.wait_for(lambda s: s.channels[0].path_velocity_mm_s >= 199.0)
+    kernel.wait_for(lambda s: s.channels[0].path.path_velocity_mm_s >= 199.0)
     assert kernel.command(SetFeedOverride(0, 300)) is None
-    kernel.wait_for(lambda s: s.channels[0].path_velocity_mm_s <= 60.0 + EPS)
+    kernel.wait_for(lambda s: s.channels[0].path.path_velocity_mm_s <= 60.0 + EPS)
     assert kernel.command(SetFeedOverride(0, 1000)) is None
     run = kernel.wait()
     assert_finished_at(run, (100.0, 0.0, 0.0))
@@ -605,12 +605,12 @@ def test_single_block_stops_at_every_sub_block_end(kernel) -> None:
     kernel.start(text, record=True)
     stops = []
     for _ in range(len(ends) + 2):
-        snap = kernel.wait_for(lambda s: s.channels[0].waiting_for_start
+        snap = kernel.wait_for(lambda s: s.channels[0].program.waiting_for_start
                                or s.channels[0].state == READY)
         ch = snap.channels[0]
         if ch.state == READY:
             break
-        assert ch.path_velocity_mm_s == 0.0
+        assert ch.path.path_velocity_mm_s == 0.0
         stops.append(ch.axes[0].position_mm)
         assert kernel.command(StartProgram(0, True)) is None
     run = kernel.wait()
@@ -646,8 +646,8 @@ def test_la_on_while_compensation_holds_a_block_passes_unplanned(kernel) -> None
         "LA_OFF\n", ""))
     for run in (la_on, plain):
         assert_finished_at(run, (0.0, 0.0, 0.0))
-        assert run.channel.block_count == 6
-    assert abs(la_on.channel.program_time_s - plain.channel.program_time_s) <= CYCLE_S
+        assert run.channel.block.block_count == 6
+    assert abs(la_on.channel.path.program_time_s - plain.channel.path.program_time_s) <= CYCLE_S
 
 
 # ------------------------------------- block rate: bare blocks take a buffer slot each
@@ -669,7 +669,7 @@ def test_zero_length_blocks_in_a_section_keep_the_path_within_its_limits(kernel)
     for run in (on, off):
         assert_finished_at(run, (3.0, 0.0, 0.0))
         assert_within_limits(run, 100.0)
-    assert on.channel.program_time_s < 0.7 * off.channel.program_time_s
+    assert on.channel.path.program_time_s < 0.7 * off.channel.path.program_time_s
     # 120 slots hold 60 chords: the path may pass 119 slots, 59.5 chords, per cycle;
     # each chord stands for itself and the zero-length blocks on both sides
     assert float(np.max(speeds(on))) <= 0.001 * (BUFFER - 1) / 3 / CYCLE_S * (1 + EPS)

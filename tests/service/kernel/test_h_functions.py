@@ -76,7 +76,7 @@ def test_a_mos_h_function_never_stops_the_path_and_no_synch_is_not_output() -> N
         unit = _units(rec.rows[-1])[0]
         assert (unit.type, unit.number, unit.acknowledged) == (TechnoType.H, 20, True)
         assert not [s for s in rec.rows if 10.0 < _x(s) < 30.0
-                    and s.channels[0].path_velocity_mm_s == 0.0]
+                    and s.channels[0].path.path_velocity_mm_s == 0.0]
     with KernelHarness(config=_config()) as h:
         h.run(PROGRAM.format(h=24))
         assert _units(h.kernel.snapshot) == ()
@@ -117,5 +117,5 @@ def test_a_bad_h_word_is_an_isg_error_with_line_and_column(
     with KernelHarness(config=_config(auto=True)) as h:
         run = h.run(f"G01 X1 F600\n{line}\nM30\n")
         assert run.channel.state == ChannelState.ERROR
-        error = run.channel.errors[0]
+        error = run.channel.errors.entries[0]
         assert (error.id, error.line, error.column) == (int(error_id), 2, column)

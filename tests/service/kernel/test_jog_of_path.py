@@ -40,7 +40,7 @@ class Machine:
 
     def suspend(self, ci: int, on: bool) -> None:
         assert self.h.command(SetSuspendCommand(ci, on)) is None
-        self.h.wait_for(lambda s: s.channels[ci].output_suspended == on)
+        self.h.wait_for(lambda s: s.channels[ci].suspend.output_suspended == on)
 
     def linked(self, ci: int) -> Snapshot:
         return self.h.wait_for(
@@ -52,8 +52,8 @@ class Machine:
         self.done[ci] += 1
         want = self.done[ci]
         return self.h.wait_for(
-            lambda s: s.channels[ci].manual_blocks_done >= want
-            and s.channels[ci].path_velocity_mm_s == 0.0
+            lambda s: s.channels[ci].block.manual_blocks_done >= want
+            and s.channels[ci].path.path_velocity_mm_s == 0.0
             or s.channels[ci].state == ChannelState.ERROR
         )
 
@@ -87,7 +87,7 @@ def switch_to(m: Machine, ci: int) -> None:
 
 def test_the_function_description_table_step_by_step(machine: Machine) -> None:
     m = machine
-    assert m.snap().channels[1].output_suspended  # channel 2 starts suspended
+    assert m.snap().channels[1].suspend.output_suspended  # channel 2 starts suspended
     m.mdi(0, "G01 G90 X50 F6000")
     assert m.row() == (50, 0, 50, 0, 0)
     switch_to(m, 1)
@@ -172,8 +172,8 @@ def test_request_waits_while_the_other_channel_holds_the_axis(machine: Machine) 
     m.suspend(0, True)
     s = m.linked(1)
     m.done[1] += 1
-    s = m.h.wait_for(lambda s: s.channels[1].manual_blocks_done >= 1
-                     and s.channels[1].path_velocity_mm_s == 0)
+    s = m.h.wait_for(lambda s: s.channels[1].block.manual_blocks_done >= 1
+                     and s.channels[1].path.path_velocity_mm_s == 0)
     assert s.channels[1].axes[0].command_position_01um == 1 * INCR  # started at 5 (adjusted)
     assert s.physical_axes[0].command_position_01um == 1 * INCR
 
@@ -182,18 +182,18 @@ def test_suspending_a_moving_channel_brakes_it_first_then_it_continues(machine: 
     m = machine
     h = m.h
     assert h.command(ManualBlock(0, "G01 G90 X200 F30000")) is None
-    h.wait_for(lambda s: s.channels[0].path_velocity_mm_s > 100)
+    h.wait_for(lambda s: s.channels[0].path.path_velocity_mm_s > 100)
     assert h.command(SetSuspendCommand(0, True)) is None
-    s = h.wait_for(lambda s: s.channels[0].output_suspended)
+    s = h.wait_for(lambda s: s.channels[0].suspend.output_suspended)
     ch = s.channels[0]
-    assert ch.path_velocity_mm_s == 0.0 and ch.state == ChannelState.ACTIVE
+    assert ch.path.path_velocity_mm_s == 0.0 and ch.state == ChannelState.ACTIVE
     stopped_at = ch.axes[0].command_position_01um
     assert 0 < stopped_at < 200 * INCR
     assert s.physical_axes[0].linked_logical_axis == 0
     m.suspend(0, False)
     m.linked(0)
-    s = h.wait_for(lambda s: s.channels[0].manual_blocks_done >= 1
-                   and s.channels[0].path_velocity_mm_s == 0)
+    s = h.wait_for(lambda s: s.channels[0].block.manual_blocks_done >= 1
+                   and s.channels[0].path.path_velocity_mm_s == 0)
     assert s.channels[0].axes[0].command_position_01um == 200 * INCR
     assert s.physical_axes[0].command_position_01um == 200 * INCR
 
@@ -205,8 +205,8 @@ def test_suspending_is_refused_in_error_state_and_works_after_reset(machine: Mac
     refusal = m.h.command(SetSuspendCommand(0, True))
     assert refusal is not None and refusal.reason == RefusalReason.NOT_READY
     assert "in error" in refusal.message and "RESET" in refusal.message
-    assert not m.snap().channels[0].suspend_command_w
-    assert not m.snap().channels[0].output_suspended
+    assert not m.snap().channels[0].suspend.command_w
+    assert not m.snap().channels[0].suspend.output_suspended
     assert m.h.command(ResetChannel(0, True)) is None
     m.suspend(0, True)
     assert m.snap().physical_axes[0].linked_logical_axis == 0
@@ -219,9 +219,9 @@ def test_enable_false_hands_the_unit_to_the_cnc_request(machine: Machine) -> Non
     assert m.h.command(SetSuspendEnable(1, False)) is None
     assert m.h.command(SetSuspendCommand(1, False)) is None
     s = m.snap()
-    assert s.channels[1].output_suspended and s.channels[1].suspend_request_r
+    assert s.channels[1].suspend.output_suspended and s.channels[1].suspend.request_r
     assert m.h.command(SetSuspendEnable(1, True)) is None
-    m.h.wait_for(lambda s: not s.channels[1].output_suspended)
+    m.h.wait_for(lambda s: not s.channels[1].suspend.output_suspended)
 
 
 # ------------------------------------------------------------------ configuration
@@ -247,7 +247,7 @@ def test_clone_takes_the_master_parameters_and_overrides_what_it_lists() -> None
         assert (p[11].vel_max_mm_s, p[11].acc_max_mm_s2, p[11].cloned) == (300.0, 2000.0, True)
         assert p[12].acc_max_mm_s2 == 1234.0 and p[12].vel_max_mm_s == p[2].vel_max_mm_s
         assert p[12].link_to == 2  # inherited from the master
-        assert h.kernel.snapshot.channels[1].errors == ()
+        assert h.kernel.snapshot.channels[1].errors.entries == ()
         # A later change of the master does not reach the clone.
         assert h.command(UpdateAxisParameters({"logical_number": 1,
                                                "limits": {"vel_max_mm_s": 100.0}})) is None
@@ -267,8 +267,8 @@ def test_clone_of_a_missing_master_reports_70172_and_50462_and_is_uncloned() -> 
     ])
     with KernelHarness(config=config) as h:
         ch2 = h.kernel.snapshot.channels[1]
-        assert [e.id for e in ch2.errors] == [70172, 50462]
-        assert all(e.warning for e in ch2.errors) and "99" in ch2.errors[0].text
+        assert [e.id for e in ch2.errors.entries] == [70172, 50462]
+        assert all(e.warning for e in ch2.errors.entries) and "99" in ch2.errors.entries[0].text
         assert ch2.state != ChannelState.ERROR  # warnings: the channel works
         assert not h.kernel.axis_params[11].cloned
         assert h.kernel.axis_params[11].vel_max_mm_s == 500.0  # its own (default) value
@@ -283,12 +283,12 @@ def test_jog_of_path_only_channel_with_a_non_clone_axis_is_in_error() -> None:
     with KernelHarness(config=config) as h:
         ch2 = h.kernel.snapshot.channels[1]
         assert ch2.state == ChannelState.ERROR
-        assert ch2.errors[0].id == AxisErrorId.JOG_OF_PATH_AXIS_NOT_CLONE
-        assert "axis Y" in ch2.errors[0].text and "12" in ch2.errors[0].text
+        assert ch2.errors.entries[0].id == AxisErrorId.JOG_OF_PATH_AXIS_NOT_CLONE
+        assert "axis Y" in ch2.errors.entries[0].text and "12" in ch2.errors.entries[0].text
         # Checked again at RESET: the error comes back.
         assert h.command(ResetChannel(1, True)) is None
         ch2 = h.kernel.snapshot.channels[1]
-        assert ch2.state == ChannelState.ERROR and ch2.errors[0].id == 70900
+        assert ch2.state == ChannelState.ERROR and ch2.errors.entries[0].id == 70900
 
 
 # ------------------------------------------------------------------ axis release

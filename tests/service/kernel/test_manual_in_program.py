@@ -56,7 +56,7 @@ def _incremental(k: KernelHarness, axis: int = 0) -> None:
 
 def test_g200_stops_the_program_jogs_the_axis_and_start_goes_on_with_the_offset(k: Any) -> None:
     k.start("G01 X1 Y0 F600\nG200 X1\nG01 X4 Y1\nM30\n")
-    stopped = k.wait_for(lambda s: s.channels[0].waiting_for_start)
+    stopped = k.wait_for(lambda s: s.channels[0].program.waiting_for_start)
     assert (_x(stopped), _view(stopped).state) == (1.0, DisplayState.ENABLED)
     assert stopped.channels[0].wait_reason == WaitReason.MANUAL_MODE
     assert _view(stopped, 1).state == DisplayState.DEACTIVATED  # Y was not named
@@ -78,7 +78,7 @@ def test_g200_stops_the_program_jogs_the_axis_and_start_goes_on_with_the_offset(
 
 def test_start_is_refused_while_a_g200_jog_still_moves(k: Any) -> None:
     k.start("G200 X1\nM30\n")
-    k.wait_for(lambda s: s.channels[0].waiting_for_start)
+    k.wait_for(lambda s: s.channels[0].program.waiting_for_start)
     assert write(k, "operation_mode", ManualOperationMode.CONTINUOUS) is None
     assert write(k, "jog_plus", True) is None
     k.wait_for(lambda s: _view(s).moving)
@@ -93,7 +93,7 @@ def test_start_is_refused_while_a_g200_jog_still_moves(k: Any) -> None:
 
 def test_a_g200_jog_stops_at_the_software_limit_of_path_plus_offset(k: Any) -> None:
     k.start("G01 X7 F6000\nG200\nM30\n")
-    k.wait_for(lambda s: s.channels[0].waiting_for_start)
+    k.wait_for(lambda s: s.channels[0].program.waiting_for_start)
     _incremental(k)  # 2 mm from X7 would pass the limit at 8 mm
     assert write(k, "jog_plus", True) is None
     s = k.wait_for(lambda s: _view(s).limit_warning and not _view(s).moving)
@@ -116,7 +116,7 @@ def test_g201_jogs_in_parallel_to_the_path_until_g202(k: Any) -> None:
     after_g202 = [s for s in rec.rows if _x(s) > 5.0]
     assert after_g202 and all(_view(s, 1).state == DisplayState.DEACTIVATED
                               for s in after_g202)
-    assert all(s.channels[0].path_velocity_mm_s > 0.0 for s in rec.rows
+    assert all(s.channels[0].path.path_velocity_mm_s > 0.0 for s in rec.rows
                if 0.1 < _x(s) < 4.9)  # the path never stopped for the jog
 
 
@@ -128,7 +128,7 @@ def test_a_feedhold_brakes_the_g201_jog_too(k: Any) -> None:
     k.wait_for(lambda s: _view(s, 1).moving)
     assert k.command(Feedhold(0, True)) is None
     held = k.wait_for(lambda s: not _view(s, 1).moving
-                      and s.channels[0].path_velocity_mm_s == 0.0)
+                      and s.channels[0].path.path_velocity_mm_s == 0.0)
     assert held.channels[0].state == ChannelState.HOLD
     refused = write(k, "jog_plus", True, axis=1)
     assert refused is not None and "ACTIVE" in refused.message
@@ -153,5 +153,5 @@ def test_bad_manual_mode_blocks_are_isg_errors_with_line_and_column(
 ) -> None:
     run = k.run(f"G01 X1 F600\n{line}\nM30\n")
     assert run.channel.state == ChannelState.ERROR
-    error = run.channel.errors[0]
+    error = run.channel.errors.entries[0]
     assert (error.id, error.line, error.column) == (int(error_id), 2, column)

@@ -164,7 +164,7 @@ def test_continuous_jog_stops_exactly_at_the_software_limit_with_a_warning(k) ->
     assert view(k).limit_warning
     ch = k.kernel.snapshot.channels[0]
     assert ch.state == ChannelState.READY  # a warning, not an error
-    [warning] = [e for e in ch.errors if e.id == ManualErrorId.SW_LIMIT_REACHED]
+    [warning] = [e for e in ch.errors.entries if e.id == ManualErrorId.SW_LIMIT_REACHED]
     assert warning.warning and "software limit" in warning.text
     # ... and an alarm of the axes, a warning (docs/alarms.md)
     [alarm] = [a for a in k.kernel.alarms.view.active if a.id == ManualErrorId.SW_LIMIT_REACHED]
@@ -278,7 +278,7 @@ def test_hb_display_state_follows_the_mode_and_operation_mode(k) -> None:
 def test_g74_in_a_program_homes_the_axes_in_its_sequence(k) -> None:
     k.mdi("G01 X-2 Y4 Z1 F600")
     run = k.run("N10 G74 Z1\nN20 G74 X1 Y1\nN30 G01 X5 F600\nM30\n", record=True)
-    assert run.channel.state == ChannelState.READY, run.channel.errors
+    assert run.channel.state == ChannelState.READY, run.channel.errors.entries
     assert [m.referenced for m in run.channel.manual] == [True, True, True]
     # Z homed alone first (to 0), then X (to its pos_refpkt 3 mm) and Y together
     z_home = next(n for n, s in enumerate(run.samples) if s.positions_mm[2] == 0.0)
@@ -306,7 +306,7 @@ def test_bad_g74_blocks_stop_with_20136_naming_the_place(k, text, column, words)
     k.command(ResetChannel(0, True))
     run = k.run(f"N10 G01 X1 F600\n{text}\nM30\n", name="bad.nc")
     assert run.channel.state == ChannelState.ERROR
-    [error] = run.channel.errors
+    [error] = run.channel.errors.entries
     assert (error.id, error.file, error.line, error.column) == (20136, "bad.nc", 2, column)
     assert words in error.text
     assert run.positions_mm[0] == pytest.approx(1.0)  # the blocks before it ran
@@ -320,11 +320,11 @@ def test_suspending_the_axis_output_stops_a_jog_and_refuses_the_next(k) -> None:
     samples = record_until_rest(k, ("jog_plus", True), then=moving)
     stopped_mm = samples[-1][0]
     assert 0.0 < stopped_mm < LIMIT_MAX_MM and not view(k).moving
-    assert k.kernel.snapshot.channels[0].output_suspended
+    assert k.kernel.snapshot.channels[0].suspend.output_suspended
     refusal = write(k, "jog_plus", True)
     assert refusal is not None and "not linked" in refusal.message
     assert k.command(SetSuspendCommand(0, False)) is None
-    k.wait_for(lambda s: not s.channels[0].output_suspended)
+    k.wait_for(lambda s: not s.channels[0].suspend.output_suspended)
 
 
 def test_true_on_a_pressed_key_renews_it_and_is_no_new_press(k) -> None:

@@ -76,7 +76,7 @@ def test_mvs_svs_output_before_the_motion_which_waits_for_the_acknowledge() -> N
         rec, out = _run_until_output(h, 11)
         unit = _units(out)[0]
         assert (unit.number, unit.sync, unit.acknowledged) == (11, SyncKind.MVS_SVS, False)
-        assert _x(out) == 10.0 and out.channels[0].path_velocity_mm_s == 0.0
+        assert _x(out) == 10.0 and out.channels[0].path.path_velocity_mm_s == 0.0
         h.wait_for(lambda s: s.cycle >= out.cycle + 50)  # the PLC takes 50 cycles or more
         acked = _ack(h, rec)
         waited = [s for s in rec.rows if out.cycle <= s.cycle < acked.cycle]
@@ -89,7 +89,7 @@ def test_mvs_sns_output_before_the_motion_waited_for_at_the_block_end() -> None:
     with KernelHarness(config=_config()) as h:
         rec, out = _run_until_output(h, 12)
         assert _passes(rec, out, 10.0)  # output where the block's motion starts ...
-        h.wait_for(lambda s: _x(s) == 20.0 and s.channels[0].path_velocity_mm_s == 0.0)
+        h.wait_for(lambda s: _x(s) == 20.0 and s.channels[0].path.path_velocity_mm_s == 0.0)
         before_ack = h.wait_for(lambda s: s.cycle >= rec.first(lambda r: _x(r) == 20.0).cycle
                                 + 50)
         assert _x(before_ack) == 20.0 and _pending(before_ack)  # ... stands at its end
@@ -103,7 +103,7 @@ def test_mvs_sns_output_before_the_motion_waited_for_at_the_block_end() -> None:
 def test_mns_sns_output_at_the_block_end_and_waited_for_there() -> None:
     with KernelHarness(config=_config()) as h:
         rec, out = _run_until_output(h, 13)
-        assert _x(out) == 20.0 and out.channels[0].path_velocity_mm_s == 0.0
+        assert _x(out) == 20.0 and out.channels[0].path.path_velocity_mm_s == 0.0
         assert not any(_units(s) for s in rec.rows if _x(s) < 20.0)  # not before the end
         h.wait_for(lambda s: s.cycle >= out.cycle + 50)
         acked = _ack(h, rec)
@@ -120,7 +120,7 @@ def test_mos_output_without_waiting() -> None:
         assert _passes(rec, out, 10.0)  # output at the start of N20's motion
         assert h.wait().channel.state == ChannelState.READY  # no acknowledge needed
         stands = [s for s in rec.rows if 10.0 < _x(s) < 30.0
-                  and s.channels[0].path_velocity_mm_s == 0.0]
+                  and s.channels[0].path.path_velocity_mm_s == 0.0]
         assert stands == []  # the path never stopped on the way
 
 
@@ -155,4 +155,4 @@ def test_prod_time_outputs_nothing_and_waits_for_no_plc() -> None:
         run = h.run(PROGRAM.format(m=11))
         assert run.channel.state == ChannelState.READY
         assert _units(run.final) == ()
-        assert run.channel.program_time_s > 0.0
+        assert run.channel.path.program_time_s > 0.0

@@ -27,15 +27,15 @@ INCR = 10_000  # 0.1 um per mm
 def _mdi(h: KernelHarness, ci: int, text: str, done_before: int) -> Snapshot:
     assert h.command(ManualBlock(ci, text)) is None
     return h.wait_for(
-        lambda s: s.channels[ci].manual_blocks_done > done_before
-        and s.channels[ci].path_velocity_mm_s == 0.0
+        lambda s: s.channels[ci].block.manual_blocks_done > done_before
+        and s.channels[ci].path.path_velocity_mm_s == 0.0
         or s.channels[ci].state == ChannelState.ERROR
     )
 
 
 def _suspend(h: KernelHarness, ci: int, on: bool) -> None:
     assert h.command(SetSuspendCommand(ci, on)) is None
-    h.wait_for(lambda s: s.channels[ci].output_suspended == on)
+    h.wait_for(lambda s: s.channels[ci].suspend.output_suspended == on)
 
 
 def _run_example(h: KernelHarness) -> Snapshot:
@@ -53,7 +53,7 @@ def test_the_example_runs_as_printed() -> None:
     with KernelHarness() as h:
         s = _run_example(h)
         ch2 = s.channels[1]
-        assert ch2.state != ChannelState.ERROR, ch2.errors
+        assert ch2.state != ChannelState.ERROR, ch2.errors.entries
         assert s.physical_axes[1].command_position_01um == 30 * INCR  # Y 20 -> 30
         assert ch2.axes[1].command_position_01um == 30 * INCR
         _suspend(h, 0, False)  # 5.
@@ -73,7 +73,7 @@ def test_without_the_start_feed_step_4_is_the_no_feed_error() -> None:
         s = _run_example(h)
         ch2 = s.channels[1]
         assert ch2.state == ChannelState.ERROR
-        errors = [(e.id, e.line, e.column) for e in ch2.errors]
+        errors = [(e.id, e.line, e.column) for e in ch2.errors.entries]
         assert errors == [(NcErrorId.NO_FEED, 1, 5)]  # at Y10
 
 

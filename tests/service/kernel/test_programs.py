@@ -75,12 +75,12 @@ def test_program_finishes_where_and_when_expected(kernel, case) -> None:
     text, final, time_s, stops = FINISHING[case]
     run = kernel.run(text)
     ch = run.channel
-    assert ch.state == ChannelState.READY and ch.mode == ChannelMode.AUTOMATIC, ch.errors
+    assert ch.state == ChannelState.READY and ch.mode == ChannelMode.AUTOMATIC, ch.errors.entries
     assert run.positions_mm == pytest.approx(final, abs=1e-9)
     drives = [p.command_position_01um for p in run.final.physical_axes]
     assert drives == [round(x * 10_000) for x in final]  # physical axes followed
     if time_s is not None:
-        assert abs(ch.program_time_s - time_s) <= (stops + 1) * CYCLE_S, (ch.program_time_s, time_s)
+        assert abs(ch.path.program_time_s - time_s) <= (stops + 1) * CYCLE_S, (ch.path.program_time_s, time_s)
 
 
 # (program, error line, error column, final X in mm)
@@ -107,8 +107,8 @@ def test_wrong_program_stops_with_a_precise_error(kernel, case) -> None:
     run = kernel.run(text, name="bad.nc")
     ch = run.channel
     assert ch.state == ChannelState.ERROR
-    assert ch.error_count >= 1
-    error = ch.errors[0]
+    assert ch.errors.count >= 1
+    error = ch.errors.entries[0]
     assert error.id > 0 and error.text
     assert error.file == "bad.nc"
     if line is not None:
@@ -118,7 +118,7 @@ def test_wrong_program_stops_with_a_precise_error(kernel, case) -> None:
     assert run.positions_mm[0] == pytest.approx(final_x, abs=1e-9)
     assert kernel.command(ResetChannel(0, True)) is None
     assert kernel.kernel.snapshot.channels[0].state == ChannelState.READY
-    assert kernel.kernel.snapshot.channels[0].errors == ()
+    assert kernel.kernel.snapshot.channels[0].errors.entries == ()
 
 
 def test_same_program_twice_gives_the_same_cycles(kernel) -> None:
@@ -172,9 +172,9 @@ def test_arc_samples_lie_on_the_circle(kernel) -> None:
 
 def test_feedhold_stops_within_limits_and_resume_finishes(kernel) -> None:
     kernel.start("G1 X200 F12000\nM30\n", record=True)
-    kernel.wait_for(lambda s: s.channels[0].path_velocity_mm_s >= 199.0)
+    kernel.wait_for(lambda s: s.channels[0].path.path_velocity_mm_s >= 199.0)
     assert kernel.command(Feedhold(0, True)) is None
-    held = kernel.wait_for(lambda s: s.channels[0].path_velocity_mm_s == 0.0)
+    held = kernel.wait_for(lambda s: s.channels[0].path.path_velocity_mm_s == 0.0)
     ch = held.channels[0]
     assert ch.state == ChannelState.HOLD
     assert 0 < ch.axes[0].position_mm < 200
@@ -190,10 +190,10 @@ def test_single_block_stops_after_each_block(kernel) -> None:
     try:
         kernel.start("G1 X10 F6000\nX20\nX30\nM30\n")
         for x in (10.0, 20.0):
-            snap = kernel.wait_for(lambda s: s.channels[0].waiting_for_start)
+            snap = kernel.wait_for(lambda s: s.channels[0].program.waiting_for_start)
             assert snap.channels[0].axes[0].position_mm == pytest.approx(x, abs=1e-9)
             assert kernel.command(StartProgram(0, True)) is None
-        kernel.wait_for(lambda s: s.channels[0].waiting_for_start
+        kernel.wait_for(lambda s: s.channels[0].program.waiting_for_start
                         or s.channels[0].state == ChannelState.READY)
         if kernel.kernel.snapshot.channels[0].state != ChannelState.READY:
             kernel.command(StartProgram(0, True))
@@ -205,7 +205,7 @@ def test_single_block_stops_after_each_block(kernel) -> None:
 
 def test_m0_waits_for_start(kernel) -> None:
     kernel.start("G1 X10 F6000\nM0\nG1 X20\nM30\n")
-    snap = kernel.wait_for(lambda s: s.channels[0].waiting_for_start)
+    snap = kernel.wait_for(lambda s: s.channels[0].program.waiting_for_start)
     assert snap.channels[0].axes[0].position_mm == pytest.approx(10.0, abs=1e-9)
     assert kernel.command(StartProgram(0, True)) is None
     assert kernel.wait().positions_mm[0] == pytest.approx(20.0, abs=1e-9)
@@ -221,16 +221,16 @@ def test_manual_block_runs_in_mdi(kernel) -> None:
 def test_extended_manual_blocks_continue_one_program(kernel) -> None:
     assert kernel.command(SetExecutionMode(0, 0x80)) is None
     try:
-        done = kernel.kernel.snapshot.channels[0].manual_blocks_done
+        done = kernel.kernel.snapshot.channels[0].block.manual_blocks_done
         kernel.begin(ManualBlock(0, "G1 X5 F600"))
-        snap = kernel.wait_for(lambda s: s.channels[0].manual_blocks_done == done + 1)
+        snap = kernel.wait_for(lambda s: s.channels[0].block.manual_blocks_done == done + 1)
         assert snap.channels[0].state == ChannelState.ACTIVE  # not the end of the program
-        time_after_first = snap.channels[0].program_time_s
+        time_after_first = snap.channels[0].path.program_time_s
         # F600 and the modal state carry over to the next manual block
         assert kernel.command(ManualBlock(0, "G91 X5")) is None
-        snap = kernel.wait_for(lambda s: s.channels[0].manual_blocks_done == done + 2)
+        snap = kernel.wait_for(lambda s: s.channels[0].block.manual_blocks_done == done + 2)
         assert snap.channels[0].axes[0].position_mm == pytest.approx(10.0, abs=1e-9)
-        assert snap.channels[0].program_time_s > time_after_first
+        assert snap.channels[0].path.program_time_s > time_after_first
         assert kernel.command(ManualBlock(0, "M30")) is None
         end = kernel.wait_for(lambda s: s.channels[0].state == ChannelState.READY)
         assert end.channels[0].axes[0].position_mm == pytest.approx(10.0, abs=1e-9)
@@ -261,7 +261,7 @@ def test_tool_radius_compensation_offsets_the_square(kernel) -> None:
         "G0 X-20 Y-20\nG41 D3 G1 X0 Y0 F3000\nG1 Y40\nX40\nY0\nX0\nG40 G1 X-20 Y-20\nM30\n"
     )
     run = kernel.run(text, record=True)
-    assert run.channel.state == ChannelState.READY, run.channel.errors
+    assert run.channel.state == ChannelState.READY, run.channel.errors.entries
     assert run.positions_mm[:2] == pytest.approx((-20, -20), abs=1e-9)
     # Samples in the middle of each edge: 5 mm outside the programmed square.
     edges = {2: (0, -5.0), 3: (1, 45.0), 4: (0, 45.0), 5: (1, -5.0)}  # block_count -> axis, value

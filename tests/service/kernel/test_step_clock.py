@@ -34,7 +34,7 @@ def kernel() -> Iterator[Kernel]:
 def test_no_cycle_runs_until_granted_and_a_step_runs_exactly_its_cycles(kernel: Kernel) -> None:
     assert submit(kernel, SetFeedOverride(0, 500)) is None  # applied without a cycle
     assert kernel.snapshot.cycle == 0
-    assert kernel.snapshot.channels[0].feed_override_command == 500
+    assert kernel.snapshot.channels[0].switches.feed_override_command == 500
     assert submit(kernel, StepCycles(7)) is None
     assert (kernel.snapshot.cycle, kernel.stats.cycles) == (7, 7)
     assert kernel.snapshot.time_ns == 7 * kernel.cycle_ns
@@ -155,7 +155,7 @@ def test_granted_cycles_of_a_machine_at_rest_run_in_bulk(kernel: Kernel) -> None
     assert kernel.snapshot.time_ns == 1000 * kernel.cycle_ns
     assert kernel.stats.bulk_cycles >= 998
     after = kernel.snapshot.channels[0]
-    assert (after.state, after.feed_override_command) == (before.state, 500)
+    assert (after.state, after.switches.feed_override_command) == (before.state, 500)
 
 
 def test_a_step_publishes_the_cycles_an_observer_is_due_at_and_its_last() -> None:
