@@ -166,8 +166,9 @@ class ChannelRunner:
         # the decoder or the check (virtual clock) stops waiting; cleared by ``reset``
         self.reset_pending = threading.Event()
         self._check_max_errors = check_max_errors  # errors kept per check
-        self.plc = PlcFunctions(config.techno, Spindle(config.techno.spindel), machine.plc)
-        channel.spindle, channel.plc_functions = self.plc.spindle.state, self.plc.unit
+        # the spindle's state and the unit are kept in the channel's parts (no copy)
+        self.plc = PlcFunctions(config.techno, Spindle(config.techno.spindel, channel),
+                                machine.plc, channel)
         self.touched = False  # the last cycle changed the channel's state
         # #MSG texts from the decoder thread (deque appends are thread-safe)
         self._messages: deque[str] = deque(maxlen=MESSAGES_LISTED)
@@ -616,7 +617,7 @@ class ChannelRunner:
         """One GEO cycle of the channel; True while it has motion, decoding or a
         spindle ramp to do."""
         busy = self._run_cycle(time_s)
-        if show_technology(self.channel, self.plc, time_s, self._cycle_s):
+        if show_technology(self.plc, time_s, self._cycle_s):
             self.touched = True
             busy = True
         reason = self._wait_reason()
@@ -641,8 +642,7 @@ class ChannelRunner:
         nothing (no run, the technology at rest), else what its program run's cruise
         allows (0: the next cycle must be run as a cycle, ``cycle``)."""
         plc, ch = self.plc, self.channel
-        if (not plc.spindle.reached or ch.spindle is not plc.spindle.state
-                or ch.plc_functions is not plc.unit
+        if (not plc.spindle.reached
                 or any(u.pending and u.ack_due_s is not None for u in plc.unit.units)):
             return 0  # a ramp or an acknowledge runs in time
         if ch.state not in WORKING_STATES:

@@ -24,8 +24,6 @@ class AcknowledgeTechnoUnit:
         why = runner.plc.acknowledge(self.index)
         if why is not None:
             return Refusal(RefusalReason.INVALID_VALUE, why)
-        # shown at once: under the step clock the write is published between cycles
-        runner.channel.plc_functions = runner.plc.unit
         return None
 
 
@@ -41,6 +39,4 @@ class SetSpindleOverride:
         why = runner.plc.spindle.set_override(self.value)
         if why is not None:
             return Refusal(RefusalReason.INVALID_VALUE, why)
-        # shown at once: under the step clock the write is published between cycles
-        runner.channel.spindle = runner.plc.spindle.state
         return None

@@ -31,7 +31,7 @@ from cnc_objects.protocol.values import CoolantState
 
 from ..machine_config import PlcConfig, PlcFunctionsConfig, SyncKind
 from .nc.blocks import Block, StopKind
-from .spindle import SPINDLE_M_FUNCTIONS, Spindle, SpindleState
+from .spindle import SPINDLE_M_FUNCTIONS, Spindle
 
 
 class TechnoType(IntEnum):
@@ -96,9 +96,12 @@ class PlcFunctions:
     """A channel's technology output, acknowledges and waits (GEO side)."""
 
     def __init__(self, config: PlcFunctionsConfig, spindle: Spindle,
-                 plc_acknowledges: PlcConfig | None = None) -> None:
+                 plc_acknowledges: PlcConfig | None = None,
+                 shown: ShowsUnit | None = None) -> None:
         self.config = config
         self.spindle = spindle
+        # where the unit is kept: the channel's ``plc_functions`` part (one place)
+        self._shown: ShowsUnit = shown if shown is not None else _OwnUnit()
         # [plc] acknowledges: (type, number) the real PLC acknowledges over ADS
         acks = plc_acknowledges or PlcConfig()
         self._plc_acks = frozenset({(TechnoType.M, n) for n in acks.numbers("M")}
@@ -106,6 +109,15 @@ class PlcFunctions:
         self.unit = PlcFunctionsUnit()
         self._extra: set[int] = set()  # ids of the pre/post blocks ``split`` made
         self._spindle_waits = False  # a spindle function waits for the spindle
+
+    @property
+    def unit(self) -> PlcFunctionsUnit:
+        """What the PLC side reads (immutable; replaced on every change)."""
+        return self._shown.plc_functions
+
+    @unit.setter
+    def unit(self, unit: PlcFunctionsUnit) -> None:
+        self._shown.plc_functions = unit
 
     # -- decoder side -----------------------------------------------------------------
 
@@ -253,21 +265,23 @@ class PlcFunctions:
         self._spindle_waits = False
 
 
-class ShowsTechnology(Protocol):
-    """Where a channel shows its technology units and spindle (``state.Channel``)."""
+class ShowsUnit(Protocol):
+    """Where the unit is kept: the channel's ``plc_functions`` part (``state.Channel``),
+    which the snapshot shares; ``PlcFunctions`` keeps it nowhere else."""
 
     plc_functions: PlcFunctionsUnit
-    spindle: SpindleState
 
 
-def show_technology(
-    channel: ShowsTechnology, plc: PlcFunctions, now_s: float, cycle_s: float
-) -> bool:
-    """One cycle of ``plc`` (acknowledges due, spindle ramp), shown in ``channel``; True
-    when something changed or the spindle still ramps."""
+@dataclass(slots=True)
+class _OwnUnit:
+    """The place of the unit when no channel shows it (functions alone, in tests)."""
+
+    plc_functions: PlcFunctionsUnit = PlcFunctionsUnit()
+
+
+def show_technology(plc: PlcFunctions, now_s: float, cycle_s: float) -> bool:
+    """One cycle of ``plc`` (acknowledges due, spindle ramp); True when its unit or
+    spindle changed or the spindle still ramps."""
+    unit, spindle = plc.unit, plc.spindle.state
     plc.tick(now_s, cycle_s)
-    changed = (channel.plc_functions is not plc.unit
-               or channel.spindle is not plc.spindle.state)
-    channel.plc_functions = plc.unit
-    channel.spindle = plc.spindle.state
-    return changed or not plc.spindle.reached
+    return unit is not plc.unit or spindle is not plc.spindle.state or not plc.spindle.reached

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import IntEnum
+from typing import Protocol
 
 from cnc_objects.protocol.values import SpindleMode
 
@@ -55,14 +56,43 @@ class SpindleState:
     reached: bool = True  # actual == commanded (M19: oriented)
 
 
-class Spindle:
-    """One spindle's commands and ramp (GEO side)."""
+class ShowsSpindle(Protocol):
+    """Where a spindle keeps its state: the channel's ``spindle`` part
+    (``state.Channel``), which the snapshot shares; the spindle writes nothing else."""
 
-    def __init__(self, config: SpindleConfig) -> None:
+    spindle: SpindleState
+
+
+@dataclass(slots=True)
+class _OwnState:
+    """The place of a spindle's state when no channel shows it (a spindle alone)."""
+
+    spindle: SpindleState
+
+
+class Spindle:
+    """One spindle's commands and ramp (GEO side). Its state is kept in ``shown`` (the
+    channel's ``spindle`` part): one place, so the channel never shows an old copy."""
+
+    def __init__(self, config: SpindleConfig, shown: ShowsSpindle | None = None) -> None:
         self.config = config
         self.acc_rpm_s = config.a_max / DEG_S2_PER_RPM_S
-        self.state = SpindleState(name=config.bezeichnung)
+        initial = SpindleState(name=config.bezeichnung)
+        if shown is None:
+            shown = _OwnState(initial)
+        else:
+            shown.spindle = initial
+        self._shown = shown
         self._orient_deg = 0.0  # S.POS of the last M19
+
+    @property
+    def state(self) -> SpindleState:
+        """The spindle's state (immutable; replaced on every change)."""
+        return self._shown.spindle
+
+    @state.setter
+    def state(self, state: SpindleState) -> None:
+        self._shown.spindle = state
 
     @property
     def reached(self) -> bool:

@@ -27,7 +27,7 @@ def observed_values(snap: Snapshot) -> tuple[Any, ...]:
     ch = snap.channels[0]
     return (
         tuple(a.position_mm for a in ch.axes), tuple(a.command_position_01um for a in ch.axes),
-        ch.path, ch.block.block_count, ch.block.line, int(ch.state),
+        *ch.path, ch.block.block_count, ch.block.line, int(ch.state),
         ch.switches.feed_override_per_mille, ch.spindle, ch.plc_functions,
         tuple((p.command_position_01um, p.actual_position_01um) for p in snap.physical_axes),
     )
