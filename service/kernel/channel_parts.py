@@ -11,14 +11,14 @@ part                owner
 ==================  =====================================================================
 ``switches``        ``commands``, ``operator_switches`` (what operators and the PLC command)
 ``suspend``         ``commands`` (the PLC's unit), ``switchover`` (the output's state)
-``program``         ``channel_run`` (select, start, messages, decoder flags), ``program_run``
+``program``         ``channel_run`` (select, start, messages), ``program_run``, ``channel_check``
 ``block``           ``program_run``, ``channel_check``, ``channel_run`` (its start)
-``path``            ``program_run`` (every cycle of a run), ``channel_run`` (start, stop)
+``path``            ``program_run`` (each cycle of a run), ``channel_check``, ``channel_run``
 ``errors``          ``channel_run`` (``report``, RESET), ``channel_check`` (the check's count)
 ``manual``          ``manual_mode``: ``manual_view.ManualAxisView`` per axis
 ``tooling``         ``tooling``, ``channel_run``: ``tooling_view.ChannelTooling``
 ``tool_cut_cycles`` ``tool_life``
-``contour``         ``contour_lookahead`` via ``commands`` and ``channel_run``
+``contour``         ``commands`` (the PLC's request), ``channel_run``, ``program_run``
 ``spindle``         ``spindle.Spindle`` (its ``state`` is this part)
 ``plc_functions``   ``plc_functions.PlcFunctions`` (its ``unit`` is this part)
 ==================  =====================================================================

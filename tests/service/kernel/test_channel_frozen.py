@@ -1,7 +1,6 @@
-"""``Channel.frozen()`` copies every field into the same field. It is positional (a
-keyword call costs twice as much on the snapshot's path), its order taken from
-``dataclasses.fields`` rather than written by hand; this test gives every field a value
-of its own and would find a shift of values by name."""
+"""``Channel.frozen()`` copies every field into the same field (by keyword: with the
+channel made of a few parts, a keyword call is cheap); this test gives every field a
+value of its own and finds a field the copy forgets or puts in another's place."""
 
 from __future__ import annotations
 
