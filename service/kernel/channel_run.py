@@ -27,16 +27,15 @@ from __future__ import annotations
 import logging
 import threading
 from collections import deque
-from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
 
 from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import ERRORS_LISTED, MESSAGES_LISTED, WORKING_STATES, ExecutionMode
 
-from ..machine_config import ChannelConfig, MachineConfig
-from .alarms import AlarmClass, AlarmLog
-from .axis_params import AxisErrorId, AxisParameters
+from ..machine_config import ChannelConfig
+from .alarms import AlarmClass
+from .axis_params import AxisErrorId
 from .channel_check import ChannelCheck
 from .channel_mode import SELECTABLE_MODES, ChannelMode, ChannelState, describe
 from .channel_parts import ChannelErrors
@@ -47,7 +46,6 @@ from .decoder_feed import DecoderFeed, Job
 from .manual_mode import ManualMode
 from .nc import ModalState
 from .nc.blocks import LogArea, LookAheadMark, ManualModeRequest
-from .nc.source import NcText
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
 from .nc.tool_data import ToolingTables
 from .path.executor import AxisDynamics, PathExecutor
@@ -62,14 +60,13 @@ from .program_run import (
     log_full_warning,
     show_contour_state,
 )
+from .runner_services import RunnerServices
 from .spindle import Spindle
 from .state import Channel, DecoderFlag, ErrorEntry
-from .switchover import Switchover
-from .syntax_check import CHECK_MAX_ERRORS, SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
+from .syntax_check import SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
 from .tooling import seed_modal, tables_from_config, tooling_of
 from .tooling_view import after_reset, initial_tooling
 from .wait_reason import WaitReason, channel_wait_reason
-from .workers import Workers
 
 log = logging.getLogger(__name__)
 
@@ -91,51 +88,24 @@ def _not_ready(channel: Channel, what: str) -> Refusal:
 class ChannelRunner:
     """The working parts of one channel, driven by the GEO cycle."""
 
-    def __init__(
-        self,
-        channel: Channel,
-        config: ChannelConfig,
-        machine: MachineConfig,
-        loader: Callable[[str], NcText],
-        exists: Callable[[str], bool],
-        cycle_s: float,
-        deterministic: bool,
-        files: Callable[..., None] = lambda name, data, replace=False: None,
-        *,
-        params: dict[int, AxisParameters],
-        switchover: Switchover,
-        save: Callable[[str, bytes, bool], None] = lambda name, data, replace: None,
-        check_max_errors: int = CHECK_MAX_ERRORS,
-        on_wait: Callable[[], None] = lambda: None,
-        alarms: AlarmLog | None = None,
-        tables: ToolingTables | None = None,
-        workers: Workers | None = None,
-        idle_steps_max: int | None = None,
-    ) -> None:
-        """``params`` are the kernel's effective axis parameters (read at each program
-        start, so a parameter update applies from the next run); ``switchover`` links
-        the channel's axes to the drives; ``files`` writes the channel's own files (logs,
-        reports), ``save`` those its NC programs write, both into the output area;
-        ``check_max_errors``: errors a syntax check keeps ([limits] check_max_errors), the
-        rest are counted only; ``on_wait``: called while a cycle waits for the decoder or
-        the check (virtual clock), so that the kernel answers the cycle's commands
-        meanwhile; ``alarms``: the kernel's alarm log, which every listed error and
-        warning is raised in (a log of its own when not given); ``tables``: the tool list
-        and zero offsets to start with (the operator data the service kept), else the
-        configured ones; ``workers``: the kernel's worker registry, which runs the
-        decoder and check threads (one of its own when not given); ``idle_steps_max``:
-        the decoder's endless-program guard ([limits] decoder_idle_steps_max; None:
-        ``nc.work_guard.IDLE_STEPS_MAX``)."""
-        self.workers = Workers() if workers is None else workers
-        self._on_wait = on_wait
-        self.alarms = AlarmLog() if alarms is None else alarms
+    def __init__(self, channel: Channel, config: ChannelConfig, services: RunnerServices,
+                 tables: ToolingTables | None = None) -> None:
+        """``channel`` is the state the runner works on, ``config`` its configuration;
+        ``services`` what the kernel shares with every channel (``RunnerServices``);
+        ``tables``: the tool list and zero offsets to start with (the operator data the
+        service kept), else the configured ones."""
+        machine, cycle_s, save = services.machine, services.cycle_s, services.save
+        params = services.params
+        self.workers = services.workers
+        self._on_wait = services.on_wait
+        self.alarms = services.alarms
         self.channel = channel
         self.config = config
-        self._loader = loader
-        self._exists = exists
+        self._loader = services.loader
+        self._exists = services.exists
         self._cycle_s = cycle_s
-        self._deterministic = deterministic  # virtual clock: wait for the decoder
-        self._files = files  # the output area's writer: queues, never blocks this thread
+        self._deterministic = services.deterministic  # virtual clock: wait for the decoder
+        self._files = services.files  # the output area's writer: queues, never blocks
         self.error_log_name = f"errors-ch{channel.channel_id}.log"
         self._axes = tuple(a.name for a in config.axes)
         self._axis_numbers = tuple(a.logical_number for a in config.axes)
@@ -144,7 +114,7 @@ class ChannelRunner:
         channel.tooling = initial_tooling(self.tables, len(config.axes))
         self._tools = self.tables.tools  # the radii, for decoders without modal tables
         self._params = params
-        self._switchover = switchover
+        self._switchover = services.switchover
         self._buffer_blocks = config.look_ahead_blocks
         self._pending_start: tuple[Job, bool, bool] | None = None  # waits for the axes
         self._queued_jobs: list[Job] = []  # manual blocks sent while the start waits
@@ -165,7 +135,7 @@ class ChannelRunner:
         # set by the kernel when a RESET of this channel is queued: a cycle waiting for
         # the decoder or the check (virtual clock) stops waiting; cleared by ``reset``
         self.reset_pending = threading.Event()
-        self._check_max_errors = check_max_errors  # errors kept per check
+        self._check_max_errors = services.check_max_errors  # errors kept per check
         # the spindle's state and the unit are kept in the channel's parts (no copy)
         self.plc = PlcFunctions(config.techno, Spindle(config.techno.spindel, channel),
                                 machine.plc, channel)
@@ -178,7 +148,7 @@ class ChannelRunner:
             hscs={mode.upper(): HscProgram(c.prog, c.tolerance / UM01_PER_MM)
                   for mode, c in config.hscs},
             kinematics=False,  # this kernel configures no kinematic transformation
-            idle_steps_max=idle_steps_max,
+            idle_steps_max=services.idle_steps_max,
         )
         self._programs_need_referenced_axes = machine.programs_need_referenced_axes
         self.manual = ManualMode(channel, machine, params, cycle_s, self._move, self.report)

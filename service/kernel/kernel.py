@@ -29,6 +29,7 @@ from .kernel_state import KernelState
 from .nc.source import NcText
 from .nc.tool_data import ToolingTables
 from .realtime_priority import RealtimeGrant, worker_priority
+from .runner_services import RunnerServices
 from .state import CycleStats, ErrorEntry, Snapshot
 from .step_clock import NOT_STEPPING, STEP_RUNNING, StepClock, StepCycles
 from .switchover import Switchover
@@ -232,14 +233,15 @@ class Kernel:
         # for the decoder.
         self._deterministic = deterministic = isinstance(self._clock,
                                                          VirtualClock | StepClock)
+        services = RunnerServices(
+            machine=self.config, loader=self._loader, exists=self._exists,
+            cycle_s=self.cycle_s, deterministic=deterministic, params=params,
+            switchover=self.switchover, files=self._files, save=self._save,
+            on_wait=self._reply_while_waiting, alarms=self.alarms, workers=self.workers,
+            check_max_errors=self._check_max_errors, idle_steps_max=self._idle_steps_max)
         state.runners = [
-            ChannelRunner(channel, cfg, self.config, self._loader, self._exists, self.cycle_s,
-                          deterministic, self._files, params=params, switchover=self.switchover,
-                          save=self._save,
-                          check_max_errors=self._check_max_errors,
-                          on_wait=self._reply_while_waiting, alarms=self.alarms,
-                          tables=self._tables[k] if k < len(self._tables) else None,
-                          workers=self.workers, idle_steps_max=self._idle_steps_max)
+            ChannelRunner(channel, cfg, services,
+                          self._tables[k] if k < len(self._tables) else None)
             for k, (channel, cfg) in enumerate(zip(state.channels, self.config.channels,
                                                    strict=True))
         ]
