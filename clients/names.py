@@ -302,7 +302,7 @@ class _ChAx:
 
 
 class _ChSynChk:
-    """Objects below ``ch.switches.syn_chk``."""
+    """Objects below ``ch.syn_chk``."""
 
     __slots__ = ("_prefix",)
 

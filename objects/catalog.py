@@ -1,7 +1,9 @@
 """The catalog: every CNC object the kernel offers, declared once.
 
 Each ``ObjectTemplate`` is one row of the ISG object tables (reference/cnc-objects.md);
-``build_objects`` expands the rows over a machine layout into object instances. The
+the rows are grouped in areas (``AREAS``: this module's own and one module each for
+technology, manual mode, operator switches, tools, alarms), each a function of the
+machine's table sizes; ``build_objects`` expands them over a machine layout. The
 service binds each instance to kernel state by its ``element`` name; this module holds
 no kernel logic.
 
@@ -12,8 +14,8 @@ stable and found by name through the COM object directory, as ISG tools do.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from enum import Enum, IntEnum
+from collections.abc import Callable
+from enum import IntEnum
 
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16, UNS32, DataType
@@ -27,70 +29,20 @@ from cnc_objects.protocol.values import (
 )
 from cnc_objects.protocol.wait_reasons import WAIT_REASON_TEXT_CHARS, WaitReason
 
-from .addressing import GroupBase, axis_offset, channel_group
-from .catalog_manual import MANUAL_ROWS
-from .catalog_operator import OPERATOR_ROWS
-from .catalog_technology import TECHNOLOGY_ROWS
+from .addressing import GroupBase
+from .catalog_alarms import alarm_templates
+from .catalog_manual import manual_templates
+from .catalog_operator import operator_templates
+from .catalog_technology import technology_templates
+from .catalog_tools import tool_templates
 from .model import Access, CncObject
-
-
-class Scope(Enum):
-    """What one template is instantiated for."""
-
-    PLATFORM = "platform"  # once: name = element
-    PHYSICAL_AXIS = "physical_axis"  # per drive: ax<A>.element, offset 0x<A>00xx
-    CHANNEL = "channel"  # per channel: ch<c>.element, group + CID
-    CHANNEL_AXIS = "channel_axis"  # per axis of a channel: ch<c>.ax<a>.element
-    PLC_CHANNEL = "plc_channel"  # HLI per channel: gpCh[i].element, i = channel index from 0
-    PLC_MC = "plc_mc"  # older HLI per channel: pMC[i].element (same address block as gpCh[i])
-    PLC_AXIS = "plc_axis"  # HLI per axis: gpAx[i].element, i = HLI axis slot from 0
-    PLC_CHANNEL_AXIS = "plc_channel_axis"  # HLI per axis of a channel:
-    # gpCh[i].bahn_state.coord_r[k].element, k = axis index in the channel from 0
-
-
-@dataclass(frozen=True, slots=True)
-class ObjectTemplate:
-    """One object of the tables, before channel and axis are filled in. ``values``:
-    the value set of an enumeration object (its value names go out with browse)."""
-
-    element: str
-    scope: Scope
-    port: CncPort
-    group_base: int
-    offset: int
-    dtype: DataType
-    access: Access
-    unit: str
-    description: str
-    values: type[IntEnum] | None = None
-
-
-@dataclass(frozen=True, slots=True)
-class ChannelLayout:
-    """A channel: its logical id and the number of axes it has."""
-
-    channel_id: int
-    axis_count: int
-
-
-@dataclass(frozen=True, slots=True)
-class MachineLayout:
-    """What the catalog is expanded over: channels, physical axis numbers, and the axis
-    numbers of the HLI axis slots ``gpAx[0..]`` in slot order."""
-
-    channels: tuple[ChannelLayout, ...]
-    physical_axes: tuple[int, ...]
-    hli_axes: tuple[int, ...] = ()
-
-
-# PLC symbols (port 851) live in the PLC's memory area like TwinCAT PLC variables; the
-# offsets are this project's layout (clients find symbols by name or handle).
-PLC_GROUP = 0x4020
-PLC_CHANNEL_BASE, PLC_CHANNEL_STRIDE = 0x10000, 0x1000
-PLC_AXIS_BASE, PLC_AXIS_STRIDE = 0x80000, 0x100
-# gpCh[i].bahn_state.coord_r[k] (per axis of the channel, k from 0), after the technology
-# units and the spindle (0xD00..0xE30): room for 28 axes before the next channel's area
-PLC_COORD_BASE, PLC_COORD_STRIDE = 0xE40, 0x10
+from .templates import PLC_GROUP as PLC_GROUP
+from .templates import CatalogSizes as CatalogSizes
+from .templates import ChannelLayout as ChannelLayout
+from .templates import MachineLayout as MachineLayout
+from .templates import ObjectTemplate as ObjectTemplate
+from .templates import Scope as Scope
+from .templates import instances
 
 # gpCh[i].contour_lookahead.response.block[0..N-1] (HLI_CONTOUR_LOOKAHEAD_BLOCK)
 CONTOUR_RESPONSE_BLOCKS = 32
@@ -134,7 +86,7 @@ MACHINING_FIELDS: tuple[tuple[str, str, DataType, str, str], ...] = (
     ("ramp_weight", "ramp_weight_pct", REAL64, "%", "G134 = ..: ramp time weighting"),
 )
 
-TEMPLATES: tuple[ObjectTemplate, ...] = (
+CORE_TEMPLATES: tuple[ObjectTemplate, ...] = (
     # --- GEO interpolator, channel axes (FCT-C15 "CNC objects") -------------------------
     ObjectTemplate(
         "requested_link_to_physical_axis", Scope.CHANNEL_AXIS, GEO, IPO, 0x16, UNS16, R, "-",
@@ -627,89 +579,36 @@ TEMPLATES: tuple[ObjectTemplate, ...] = (
     ),
 )
 
-# technology output and spindle: HLI symbols of gpCh[i] and COM objects of the channel
-TEMPLATES = TEMPLATES + tuple(
-    ObjectTemplate(r.element, Scope.PLC_CHANNEL if r.hli else Scope.CHANNEL,
-                   PLC if r.hli else COM, PLC_GROUP if r.hli else COM_CH, r.offset, r.dtype,
-                   r.access, r.unit, r.description, r.values)
-    for r in TECHNOLOGY_ROWS
+
+
+def core_templates(sizes: CatalogSizes) -> tuple[ObjectTemplate, ...]:
+    """The platform's, drives', channels' and axes' own objects (this module's rows)."""
+    return CORE_TEMPLATES
+
+
+#: The catalog's areas in the order their objects are listed. Each is a function of the
+#: machine's table sizes giving its templates; a new area is a module with one such
+#: function, named here (its bindings go in ``service.binding``'s list of the same areas).
+AREAS: tuple[Callable[[CatalogSizes], tuple[ObjectTemplate, ...]], ...] = (
+    core_templates,
+    technology_templates,  # technology output and spindle (catalog_technology)
+    manual_templates,  # manual mode and homing (catalog_manual)
+    operator_templates,  # operator switches, machine state, settings (catalog_operator)
+    tool_templates,  # tools and work offsets, as many as configured (catalog_tools)
+    alarm_templates,  # alarms, as many history slots as the log keeps (catalog_alarms)
 )
 
 
-# manual mode and homing (objects/catalog_manual.py: rows of plain data, no import back)
-TEMPLATES += tuple(ObjectTemplate(r.element, Scope(r.scope), *r[2:]) for r in MANUAL_ROWS)
-# operator switches, machine state, settings (objects/catalog_operator.py)
-TEMPLATES += tuple(ObjectTemplate(r.element, Scope(r.scope), *r[2:]) for r in OPERATOR_ROWS)
+NO_TABLES = CatalogSizes()  # the fixed objects only: no tool rows, offsets, history
 
 
-def _instantiate(
-    t: ObjectTemplate, channel: int = 0, axis: int = 0, index: int = 0
-) -> CncObject:
-    match t.scope:
-        case Scope.PLC_CHANNEL | Scope.PLC_MC:
-            prefix = "gpCh" if t.scope == Scope.PLC_CHANNEL else "pMC"
-            name, group = f"{prefix}[{index}].{t.element}", t.group_base
-            offset = PLC_CHANNEL_BASE + index * PLC_CHANNEL_STRIDE + t.offset
-        case Scope.PLC_AXIS:
-            name, group = f"gpAx[{index}].{t.element}", t.group_base
-            offset = PLC_AXIS_BASE + index * PLC_AXIS_STRIDE + t.offset
-        case Scope.PLC_CHANNEL_AXIS:
-            name, group = f"gpCh[{index}].bahn_state.coord_r[{axis - 1}].{t.element}", t.group_base
-            offset = (PLC_CHANNEL_BASE + index * PLC_CHANNEL_STRIDE + PLC_COORD_BASE
-                      + (axis - 1) * PLC_COORD_STRIDE + t.offset)
-        case Scope.PLATFORM:
-            name, group, offset = t.element, t.group_base, t.offset
-        case Scope.PHYSICAL_AXIS:
-            name, group, offset = f"ax{axis}.{t.element}", t.group_base, axis_offset(axis, t.offset)
-        case Scope.CHANNEL:
-            name, group, offset = (
-                f"ch{channel}.{t.element}",
-                channel_group(t.group_base, channel),
-                t.offset,
-            )
-        case Scope.CHANNEL_AXIS:
-            name, group, offset = (
-                f"ch{channel}.ax{axis}.{t.element}",
-                channel_group(t.group_base, channel),
-                axis_offset(axis, t.offset),
-            )
-    return CncObject(
-        name, t.element, t.port, group, offset, t.dtype, t.access, t.unit, t.description,
-        channel, axis, t.values,
-    )
+def templates(sizes: CatalogSizes = NO_TABLES) -> tuple[ObjectTemplate, ...]:
+    """Every template of the catalog for a machine with table sizes ``sizes``."""
+    return tuple(t for area in AREAS for t in area(sizes))
 
 
 def build_objects(
-    layout: MachineLayout, templates: tuple[ObjectTemplate, ...] = TEMPLATES
+    layout: MachineLayout, sizes: CatalogSizes = NO_TABLES
 ) -> list[CncObject]:
-    """Every object instance of ``layout``: platform, physical axes, channels, their axes."""
-    objects: list[CncObject] = []
-    for t in templates:
-        match t.scope:
-            case Scope.PLATFORM:
-                objects.append(_instantiate(t))
-            case Scope.PHYSICAL_AXIS:
-                objects.extend(_instantiate(t, axis=a) for a in layout.physical_axes)
-            case Scope.CHANNEL:
-                objects.extend(_instantiate(t, c.channel_id) for c in layout.channels)
-            case Scope.CHANNEL_AXIS:
-                objects.extend(
-                    _instantiate(t, c.channel_id, a)
-                    for c in layout.channels
-                    for a in range(1, c.axis_count + 1)
-                )
-            case Scope.PLC_CHANNEL | Scope.PLC_MC:
-                objects.extend(
-                    _instantiate(t, c.channel_id, index=i) for i, c in enumerate(layout.channels)
-                )
-            case Scope.PLC_CHANNEL_AXIS:
-                objects.extend(
-                    _instantiate(t, c.channel_id, a, index=i)
-                    for i, c in enumerate(layout.channels)
-                    for a in range(1, c.axis_count + 1)
-                )
-            case Scope.PLC_AXIS:
-                objects.extend(
-                    _instantiate(t, axis=n, index=i) for i, n in enumerate(layout.hli_axes)
-                )
-    return objects
+    """Every object instance of ``layout`` (with tables of ``sizes``)."""
+    return instances(layout, templates(sizes))

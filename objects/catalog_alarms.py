@@ -19,8 +19,8 @@ from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.datatypes import BOOLEAN, STRING, UNS16, UNS32, UNS64, DataType
 
 from .addressing import GroupBase
-from .catalog import MachineLayout, ObjectTemplate, Scope, build_objects
-from .model import Access, CncObject
+from .model import Access
+from .templates import CatalogSizes, ObjectTemplate, Scope
 
 R, W = Access.READ, Access.WRITE
 COM = CncPort.COM
@@ -105,14 +105,10 @@ def _slots(element: str, offset: int, count: int, what: str) -> tuple[ObjectTemp
     )
 
 
-def alarm_templates(history_max: int) -> tuple[ObjectTemplate, ...]:
-    """Every alarm object: counters, commands, the active slots and ``history_max``
+def alarm_templates(sizes: CatalogSizes) -> tuple[ObjectTemplate, ...]:
+    """Every alarm object: counters, commands, the active slots and ``alarm_history``
     history slots."""
     return (ALARM_TEMPLATES
             + _slots("alarm_active", ACTIVE_OFFSET, ACTIVE_SLOTS, "Active alarm")
-            + _slots("alarm_history", HISTORY_OFFSET, history_max, "Alarm of the history"))
-
-
-def build_alarm_objects(layout: MachineLayout, history_max: int) -> list[CncObject]:
-    """The alarm objects of ``layout``."""
-    return build_objects(layout, alarm_templates(history_max))
+            + _slots("alarm_history", HISTORY_OFFSET, sizes.alarm_history,
+                     "Alarm of the history"))

@@ -22,6 +22,7 @@ from cnc_objects.protocol.values import ManualOperationMode
 
 from .addressing import GroupBase
 from .model import Access
+from .templates import PLC_GROUP, CatalogSizes, ObjectTemplate, Scope
 
 
 class ManualRow(NamedTuple):
@@ -43,7 +44,6 @@ R, W, RW = Access.READ, Access.WRITE, Access.READ_WRITE
 _AXIS, _HLI = "channel_axis", "plc_channel_axis"
 COM, PLC = CncPort.COM, CncPort.PLC
 COM_CH = GroupBase.COM_CHANNEL
-PLC_GROUP = 0x4020  # the PLC memory area of catalog.PLC_GROUP
 
 _MODES = "0 none, 1 handwheel, 2 continuous jog, 3 jog by increments"
 
@@ -99,3 +99,8 @@ MANUAL_ROWS: tuple[ManualRow, ...] = (
               "Manual offset summed by G200/G201 jogs in the running program, added to the "
               "path's output; 0 again when the program ends (project)"),
 )
+
+
+def manual_templates(sizes: CatalogSizes) -> tuple[ObjectTemplate, ...]:
+    """The templates of manual mode and homing (one per row)."""
+    return tuple(ObjectTemplate(r.element, Scope(r.scope), *r[2:]) for r in MANUAL_ROWS)

@@ -21,12 +21,12 @@ from cnc_objects.protocol.values import CoolantState, RapidOverrideMode
 from .addressing import GroupBase
 from .catalog_manual import ManualRow
 from .model import Access
+from .templates import PLC_GROUP, CatalogSizes, ObjectTemplate, Scope
 
 R, W, RW = Access.READ, Access.WRITE, Access.READ_WRITE
 _CH, _AXIS, _PLATFORM, _HLI_CH = "channel", "channel_axis", "platform", "plc_channel"
 COM, PLC = CncPort.COM, CncPort.PLC
 COM_CH = GroupBase.COM_CHANNEL
-PLC_GROUP = 0x4020  # the PLC memory area of catalog.PLC_GROUP
 PLC_ACKNOWLEDGES_CHARS = 256  # "M6 M8 M9 ...": the [plc] acknowledges list as text
 
 OPERATOR_ROWS: tuple[ManualRow, ...] = (
@@ -98,3 +98,8 @@ OPERATOR_ROWS: tuple[ManualRow, ...] = (
               "Configuration techno.auto_acknowledge: the embedded PLC acknowledges M/H "
               "functions ([plc] acknowledges excepted) (project)"),
 )
+
+
+def operator_templates(sizes: CatalogSizes) -> tuple[ObjectTemplate, ...]:
+    """The templates of operator switches, machine state and settings (one per row)."""
+    return tuple(ObjectTemplate(r.element, Scope(r.scope), *r[2:]) for r in OPERATOR_ROWS)

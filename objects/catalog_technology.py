@@ -12,10 +12,13 @@ from __future__ import annotations
 from enum import IntEnum
 from typing import NamedTuple
 
+from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, UNS16, UNS32, DataType
 from cnc_objects.protocol.values import SpindleMode
 
+from .addressing import GroupBase
 from .model import Access
+from .templates import PLC_GROUP, CatalogSizes, ObjectTemplate, Scope
 
 R, RW = Access.READ, Access.READ_WRITE
 
@@ -109,3 +112,14 @@ TECHNOLOGY_ROWS: tuple[TechnologyRow, ...] = (
         for n, (name, _offset, dtype, access, unit, text) in enumerate(SPINDLE_FIELDS)
     ),
 )
+
+
+def technology_templates(sizes: CatalogSizes) -> tuple[ObjectTemplate, ...]:
+    """The templates of the rows: HLI symbols of gpCh[i] and COM objects of the channel."""
+    return tuple(
+        ObjectTemplate(r.element, Scope.PLC_CHANNEL if r.hli else Scope.CHANNEL,
+                       CncPort.PLC if r.hli else CncPort.COM,
+                       PLC_GROUP if r.hli else GroupBase.COM_CHANNEL, r.offset, r.dtype,
+                       r.access, r.unit, r.description, r.values)
+        for r in TECHNOLOGY_ROWS
+    )

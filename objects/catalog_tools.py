@@ -17,8 +17,8 @@ from cnc_objects.protocol.constants import TOOL_NAME_CHARS, CncPort
 from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, STRING, UNS16, UNS32
 
 from .addressing import GroupBase
-from .catalog import MachineLayout, ObjectTemplate, Scope, build_objects
-from .model import Access, CncObject
+from .model import Access
+from .templates import CatalogSizes, ObjectTemplate, Scope
 
 R, RW = Access.READ, Access.READ_WRITE
 GEO, COM = CncPort.GEO, CncPort.COM
@@ -149,9 +149,6 @@ def _g_function(group: int) -> str:
     return f"G{53 + group}" if group <= 6 else f"G159 = {group}"
 
 
-def build_tool_objects(
-    layout: MachineLayout, tool_entries: int, zero_offset_groups: int
-) -> list[CncObject]:
-    """The tool and work offset objects of ``layout``."""
-    templates = TOOL_TEMPLATES + table_templates(tool_entries, zero_offset_groups)
-    return build_objects(layout, templates)
+def tool_templates(sizes: CatalogSizes) -> tuple[ObjectTemplate, ...]:
+    """The tool and work offset templates: the fixed ones and the tables of ``sizes``."""
+    return TOOL_TEMPLATES + table_templates(sizes.tool_entries, sizes.zero_offset_groups)

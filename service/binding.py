@@ -10,26 +10,21 @@ from __future__ import annotations
 from collections.abc import Callable
 from functools import partial
 from operator import attrgetter
-from typing import Any
+from typing import Any, TypeVar
 
 from cnc_objects.objects import AddressSpace, ChannelLayout, CncObject, MachineLayout, build_objects
 from cnc_objects.objects.addressing import LOGICAL_BIT, GroupBase, index_based
 from cnc_objects.objects.catalog import CONTOUR_BLOCK_FIELDS, CONTOUR_RESPONSE_BLOCKS, MACHINING_FIELDS
-from cnc_objects.objects.catalog_alarms import build_alarm_objects
-from cnc_objects.objects.catalog_tools import build_tool_objects
 from cnc_objects.objects.directory import ObjectDirectory
+from cnc_objects.objects.templates import CatalogSizes
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import ERRORS_LISTED, MESSAGES_LISTED
 from cnc_objects.protocol.wait_reasons import wait_reason_text
 
-from . import __version__
-from .binding_alarms import ALARM_WRITERS, alarm_readers
-from .binding_manual import MANUAL_READERS, MANUAL_WRITERS
-from .binding_operator import OPERATOR_READERS, OPERATOR_WRITERS
-from .binding_technology import TECHNOLOGY_READERS, TECHNOLOGY_WRITERS
-from .binding_tools import tool_readers, tool_writers
+from . import __version__, binding_alarms, binding_manual, binding_operator, binding_technology, binding_tools
+from .binding_types import AreaBinding, Binder, CommandFactory, Getter, WriteBinder
 from .kernel.commands import (
     Command,
     Feedhold,
@@ -53,16 +48,13 @@ from .kernel.commands import (
     StartProgram,
     UpdateAxisParameters,
 )
-from .kernel.kernel import Kernel, KernelCommand, ResetCycleStats
+from .kernel.kernel import Kernel, ResetCycleStats
 from .kernel.state import DecoderFlag
 from .kernel.step_clock import StepCycles
 from .kernel.tooling import tool_list_size
 from .machine_config import MachineConfig
 from .notifications import NotificationCounts
 from .param_list import ParamListError, parse_axis_list
-
-Getter = Callable[[], Any]
-CommandFactory = Callable[[Any], KernelCommand]
 
 REFUSAL_CODES: dict[RefusalReason, AdsReturnCode] = {
     RefusalReason.INVALID_VALUE: AdsReturnCode.DEVICE_INVALIDDATA,
@@ -71,6 +63,9 @@ REFUSAL_CODES: dict[RefusalReason, AdsReturnCode] = {
     RefusalReason.NOT_FOUND: AdsReturnCode.DEVICE_NOTFOUND,
     RefusalReason.NOT_SUPPORTED: AdsReturnCode.DEVICE_SRVNOTSUPP,
 }
+
+
+_B = TypeVar("_B", Binder, WriteBinder)
 
 
 def refusal_code(refusal: Refusal) -> AdsReturnCode:
@@ -416,7 +411,6 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "mc_message_count_r": _channel("program.message_count"),
     **{f"mc_message_{k}_text_r": _channel_message(k) for k in range(1, MESSAGES_LISTED + 1)},
     **{f"{name}_r": _machining(attr) for name, attr, *_ in MACHINING_FIELDS},
-    **MANUAL_READERS,
 }
 
 
@@ -468,14 +462,47 @@ WRITERS: dict[str, Callable[[Kernel, CncObject], CommandFactory]] = {
         lambda ci, value: SetContourRequest(ci, "length", value)
     ),
     "contour_lookahead.semaphor_rw": _channel_command(SetContourSemaphore),
-    **MANUAL_WRITERS,
 }
 
+#: The binders of the catalog's areas (``objects.catalog.AREAS``), in the same order:
+#: this module's own (the core rows), then one module per area. A new area of objects
+#: is one catalog module and one binding module, each named once in its list.
+AREAS: tuple[AreaBinding, ...] = (
+    AreaBinding(lambda sizes: READERS, lambda sizes: WRITERS),
+    binding_technology.BINDING,
+    binding_manual.BINDING,
+    binding_operator.BINDING,
+    binding_tools.BINDING,
+    binding_alarms.BINDING,
+)
 
-READERS |= TECHNOLOGY_READERS  # techno units and spindle (binding_technology)
-WRITERS |= TECHNOLOGY_WRITERS
-READERS |= OPERATOR_READERS  # switches, machine state, settings (binding_operator)
-WRITERS |= OPERATOR_WRITERS
+
+def _merged(parts: list[dict[str, _B]], kind: str) -> dict[str, _B]:
+    """One table of the areas' binders; an element bound by two areas is a bug."""
+    merged: dict[str, _B] = {}
+    for part in parts:
+        twice = merged.keys() & part.keys()
+        if twice:
+            raise ValueError(f"{kind} bound twice: {', '.join(sorted(twice))}")
+        merged |= part
+    return merged
+
+
+def area_readers(sizes: CatalogSizes) -> dict[str, Binder]:
+    """The readers of every area, by element name."""
+    return _merged([area.readers(sizes) for area in AREAS], "readers")
+
+
+def area_writers(sizes: CatalogSizes) -> dict[str, WriteBinder]:
+    """The writers of every area, by element name."""
+    return _merged([area.writers(sizes) for area in AREAS], "writers")
+
+
+def catalog_sizes(kernel: Kernel) -> CatalogSizes:
+    """The table sizes of the kernel's machine: tool list rows, zero offset groups and
+    alarm history slots."""
+    return CatalogSizes(tool_list_size(kernel.config), kernel.config.zero_offset_groups,
+                        kernel.alarms.history_max)
 
 
 def _axis_parameter_update(text: str) -> Command:
@@ -545,16 +572,9 @@ def build_address_space(
     """Every catalog object bound to ``kernel``, plus the COM object directories; the
     service's own figures read ``notifications`` (the hub's counts; zero without one)."""
     space = AddressSpace()
-    layout = machine_layout(kernel)
-    objects = build_objects(layout)
-    # tools and work offsets: their tables are as large as the machine configures
-    size, groups = tool_list_size(kernel.config), kernel.config.zero_offset_groups
-    objects += build_tool_objects(layout, size, groups)
-    # alarms: as many history slots as the log keeps
-    history_max = kernel.alarms.history_max
-    objects += build_alarm_objects(layout, history_max)
-    readers = {**READERS, **tool_readers(size, groups), **alarm_readers(history_max)}
-    writers = {**WRITERS, **tool_writers(size, groups), **ALARM_WRITERS}
+    sizes = catalog_sizes(kernel)
+    objects = build_objects(machine_layout(kernel), sizes)
+    readers, writers = area_readers(sizes), area_writers(sizes)
     counts = notifications if notifications is not None else NotificationCounts()
     for obj in objects:
         service = SERVICE_READERS.get(obj.element)

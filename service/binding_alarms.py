@@ -18,14 +18,12 @@ from cnc_objects.objects.catalog_alarms import (
     active_element,
     history_element,
 )
+from cnc_objects.objects.templates import CatalogSizes
 
+from .binding_types import AreaBinding, Binder, Getter, WriteBinder
 from .kernel.alarms import Alarm, AlarmView
-from .kernel.commands import AcknowledgeAlarm, AcknowledgeAllAlarms, Command
+from .kernel.commands import AcknowledgeAlarm, AcknowledgeAllAlarms
 from .kernel.kernel import Kernel
-
-Getter = Callable[[], Any]
-Binder = Callable[[Kernel, CncObject], Getter]
-WriteBinder = Callable[[Kernel, CncObject], Callable[[Any], Command]]
 
 #: what each field of a slot reads from an alarm
 _FIELD_VALUE: dict[str, Callable[[Alarm], Any]] = {
@@ -70,8 +68,8 @@ def _slot(alarms_of: Callable[[AlarmView], tuple[Alarm, ...]], k: int, field: st
     return bind
 
 
-def alarm_readers(history_max: int) -> dict[str, Binder]:
-    """Readers of every alarm object (``history_max`` history slots)."""
+def alarm_readers(sizes: CatalogSizes) -> dict[str, Binder]:
+    """Readers of every alarm object (``sizes.alarm_history`` history slots)."""
     readers: dict[str, Binder] = {
         "alarm_changes_r": _view(lambda v: v.changes & 0xFFFFFFFF),
         "alarm_active_count_r": _view(lambda v: len(v.active)),
@@ -81,7 +79,7 @@ def alarm_readers(history_max: int) -> dict[str, Binder]:
     for name, *_ in ALARM_FIELDS:
         for k in range(1, ACTIVE_SLOTS + 1):
             readers[active_element(k, name)] = _slot(lambda v: v.active, k, name)
-        for k in range(1, history_max + 1):
+        for k in range(1, sizes.alarm_history + 1):
             readers[history_element(k, name)] = _slot(lambda v: v.history, k, name)
     return readers
 
@@ -90,3 +88,7 @@ ALARM_WRITERS: dict[str, WriteBinder] = {
     "alarm_acknowledge_w": lambda kernel, obj: AcknowledgeAlarm,
     "alarm_acknowledge_all_w": lambda kernel, obj: AcknowledgeAllAlarms,
 }
+
+
+#: alarms, as many history slots as the log keeps (``objects.catalog_alarms``)
+BINDING = AreaBinding(alarm_readers, lambda sizes: ALARM_WRITERS)

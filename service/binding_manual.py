@@ -11,10 +11,9 @@ from typing import Any
 
 from cnc_objects.objects import CncObject
 
+from .binding_types import AreaBinding, Binder, Getter, WriteBinder
+from .kernel.commands_manual import ManualAxisCommand
 from .kernel.kernel import Kernel
-from .kernel.manual_commands import ManualAxisCommand
-
-Getter = Callable[[], Any]
 
 
 def _view(attr: str, wrap: Callable[[Any], Any] = lambda v: v
@@ -40,7 +39,7 @@ def _int32(value: float) -> int:
     return max(-0x8000_0000, min(0x7FFF_FFFF, round(value)))
 
 
-MANUAL_READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
+MANUAL_READERS: dict[str, Binder] = {
     "hb_display_r.state": _view("state"),
     "hb_display_r.operation_mode": _view("operation_mode"),
     "hb_display_r.control_element": _view("control_element"),
@@ -61,7 +60,7 @@ MANUAL_READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "manual_offset_r": _view("offset_01um", _int32),
 }
 
-MANUAL_WRITERS: dict[str, Callable[[Kernel, CncObject], Callable[[Any], ManualAxisCommand]]] = {
+MANUAL_WRITERS: dict[str, WriteBinder] = {
     "manual_operation_mode_w": _write("operation_mode"),
     "manual_jog_plus_w": _write("jog_plus"),
     "manual_jog_minus_w": _write("jog_minus"),
@@ -71,3 +70,7 @@ MANUAL_WRITERS: dict[str, Callable[[Kernel, CncObject], Callable[[Any], ManualAx
     "manual_hr_aufloesung_w": _write("resolution"),
     "homing_start_w": _write("homing_start"),
 }
+
+
+#: manual mode and homing (``objects.catalog_manual``)
+BINDING = AreaBinding(lambda sizes: MANUAL_READERS, lambda sizes: MANUAL_WRITERS)

@@ -9,19 +9,17 @@ from typing import Any
 
 from cnc_objects.objects import CncObject
 
+from .binding_types import AreaBinding, Binder, Getter, WriteBinder
 from .kernel.commands import Command
-from .kernel.kernel import Kernel
-from .kernel.operator_switches import (
+from .kernel.commands_operator import (
     SetBlockIgnore,
     SetBlockIgnorePlc,
     SetBlockIgnorePlcEnable,
     SetM01StopEnable,
     SetRapidOverride,
 )
+from .kernel.kernel import Kernel
 from .kernel.state import Channel
-
-Getter = Callable[[], Any]
-Binder = Callable[[Kernel, CncObject], Getter]
 
 
 def _of_channel(value: Callable[[Channel], Any]) -> Binder:
@@ -97,10 +95,14 @@ def _command(make: Callable[[int, Any], Command]) -> Callable[..., Callable[[Any
     return bind
 
 
-OPERATOR_WRITERS: dict[str, Callable[..., Callable[[Any], Command]]] = {
+OPERATOR_WRITERS: dict[str, WriteBinder] = {
     "mc_command_block_ignore_w": _command(SetBlockIgnore),
     "decoder_mc_control.program_block_ignore.command_w": _command(SetBlockIgnorePlc),
     "decoder_mc_control.program_block_ignore.enable_w": _command(SetBlockIgnorePlcEnable),
     "mc_command_M01_stop_enable_w": _command(SetM01StopEnable),
     "mc_command_rapid_override_w": _command(SetRapidOverride),
 }
+
+
+#: operator switches, machine state, settings (``objects.catalog_operator``)
+BINDING = AreaBinding(lambda sizes: OPERATOR_READERS, lambda sizes: OPERATOR_WRITERS)

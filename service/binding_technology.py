@@ -17,13 +17,13 @@ from cnc_objects.objects.catalog_technology import (
     com_name,
 )
 
+from .binding_types import AreaBinding, Binder, Getter, WriteBinder
 from .kernel.commands import Command
 from .kernel.commands_technology import AcknowledgeTechnoUnit, SetSpindleOverride
 from .kernel.kernel import Kernel
 from .kernel.plc_functions import TechnoUnit
 from .kernel.spindle import SpindleState
 
-Getter = Callable[[], Any]
 RPM_TO_MDEG_S = 6000.0  # 1 rpm = 6000 x 0.001 degrees/s
 
 _UNIT_VALUE: dict[str, Callable[[TechnoUnit], Any]] = {
@@ -90,7 +90,7 @@ def _override(kernel: Kernel, obj: CncObject) -> Callable[[Any], Command]:
     return lambda value: SetSpindleOverride(ci, int(value))
 
 
-TECHNOLOGY_READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
+TECHNOLOGY_READERS: dict[str, Binder] = {
     **{f"techno_unit_std_sync[{k}].{f[0]}": _unit(k, f[0])
        for k in range(TECHNO_UNITS) for f in TECHNO_UNIT_FIELDS},
     **{com_name(k, f[0]): _unit(k, f[0]) for k in range(TECHNO_UNITS) for f in TECHNO_UNIT_FIELDS},
@@ -99,9 +99,13 @@ TECHNOLOGY_READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     **{f"mc_spindle_{f[0]}": _spindle(f[0]) for f in SPINDLE_FIELDS},
 }
 
-TECHNOLOGY_WRITERS: dict[str, Callable[[Kernel, CncObject], Callable[[Any], Command]]] = {
+TECHNOLOGY_WRITERS: dict[str, WriteBinder] = {
     **{f"techno_unit_std_sync[{k}].command_w": _acknowledge(k) for k in range(TECHNO_UNITS)},
     **{com_name(k, "command_w"): _acknowledge(k) for k in range(TECHNO_UNITS)},
     "spindle.override_w": _override,
     "mc_spindle_override_w": _override,
 }
+
+
+#: technology output and spindle (``objects.catalog_technology``)
+BINDING = AreaBinding(lambda sizes: TECHNOLOGY_READERS, lambda sizes: TECHNOLOGY_WRITERS)

@@ -11,16 +11,12 @@ from typing import Any
 
 from cnc_objects.objects import CncObject
 
+from .binding_types import Binder, Getter, WriteBinder
 from .kernel.commands import Command
+from .kernel.commands_tooling import SetToolData, SetToolLifeUsed
 from .kernel.kernel import Kernel
 from .kernel.nc.tool_data import ToolData, ToolField
 from .kernel.state import Channel
-from .kernel.tool_life import SetToolLifeUsed
-from .kernel.tooling import SetToolData
-
-Getter = Callable[[], Any]
-Binder = Callable[[Kernel, CncObject], Getter]
-WriteBinder = Callable[[Kernel, CncObject], Callable[[Any], Command]]
 
 _ROW_FIELD = {"name": ToolField.NAME, "wear": ToolField.WEAR, "life_max": ToolField.LIFE_MAX}
 

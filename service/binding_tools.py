@@ -17,18 +17,16 @@ from cnc_objects.objects.catalog_tools import (
     tool_row_element,
     zero_offset_element,
 )
+from cnc_objects.objects.templates import CatalogSizes
 
 from ..protocol.units import UM01_PER_MM
 from .binding_tool_life import tool_extra_reader, tool_extra_writer
+from .binding_types import AreaBinding, Binder, Getter, WriteBinder
 from .kernel.commands import Command
+from .kernel.commands_tooling import SetToolData, SetZeroOffset
 from .kernel.kernel import Kernel
 from .kernel.nc.tool_data import ToolField
-from .kernel.tooling import SetToolData, SetZeroOffset
 from .kernel.tooling_view import ChannelTooling
-
-Getter = Callable[[], Any]
-Binder = Callable[[Kernel, CncObject], Getter]
-WriteBinder = Callable[[Kernel, CncObject], Callable[[Any], Command]]
 
 _FIELD_OF = {"valid": ToolField.VALID, "radius": ToolField.RADIUS, "laenge": ToolField.LENGTH}
 
@@ -94,15 +92,15 @@ FIXED_READERS: dict[str, Binder] = {
 }
 
 
-def tool_readers(tool_entries: int, zero_offset_groups: int) -> dict[str, Binder]:
+def tool_readers(sizes: CatalogSizes) -> dict[str, Binder]:
     """Readers of every tool and work offset object of a machine."""
     readers = dict(FIXED_READERS)
-    for i in range(1, tool_entries + 1):
+    for i in range(1, sizes.tool_entries + 1):
         for name, *_ in TOOL_ROW_FIELDS:
             readers[tool_row_element(i, name)] = _tool_field(i, name)
         for name, *_ in TOOL_EXTRA_FIELDS:  # name, wear, life (binding_tool_life)
             readers[tool_row_element(i, name)] = tool_extra_reader(i, name)
-    for g in range(1, zero_offset_groups):
+    for g in range(1, sizes.zero_offset_groups):
         readers[zero_offset_element(g)] = _zero_offset(g)
     return readers
 
@@ -123,16 +121,20 @@ def _zero_offset_write(group: int) -> WriteBinder:
     return bind
 
 
-def tool_writers(tool_entries: int, zero_offset_groups: int) -> dict[str, WriteBinder]:
+def tool_writers(sizes: CatalogSizes) -> dict[str, WriteBinder]:
     """Writers of the tool list and the zero offset table."""
     writers: dict[str, WriteBinder] = {}
-    for i in range(1, tool_entries + 1):
+    for i in range(1, sizes.tool_entries + 1):
         for name, *_ in TOOL_ROW_FIELDS:
             writers[tool_row_element(i, name)] = _tool_write(i, name)
         for name, *_ in TOOL_EXTRA_FIELDS:
             extra = tool_extra_writer(i, name)
             if extra is not None:
                 writers[tool_row_element(i, name)] = extra
-    for g in range(1, zero_offset_groups):
+    for g in range(1, sizes.zero_offset_groups):
         writers[zero_offset_element(g)] = _zero_offset_write(g)
     return writers
+
+
+#: tools and work offsets, as many as the machine configures (``objects.catalog_tools``)
+BINDING = AreaBinding(tool_readers, tool_writers)

@@ -22,9 +22,7 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from cnc_objects.objects.catalog import ChannelLayout, MachineLayout, build_objects
-from cnc_objects.objects.catalog_alarms import build_alarm_objects
-from cnc_objects.objects.catalog_tools import build_tool_objects
+from cnc_objects.objects.catalog import CatalogSizes, ChannelLayout, MachineLayout, build_objects
 from cnc_objects.objects.model import CncObject
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
@@ -41,8 +39,8 @@ _INDEXED = re.compile(r"^([A-Za-z_]\w*)\[(\d+)\]$")
 
 def catalog_objects() -> list[CncObject]:
     """Every object of a machine with one of everything."""
-    return (build_objects(_LAYOUT) + build_tool_objects(_LAYOUT, 1, 2)
-            + build_alarm_objects(_LAYOUT, 1))
+    return build_objects(_LAYOUT, CatalogSizes(tool_entries=1, zero_offset_groups=2,
+                                               alarm_history=1))
 
 
 @dataclass(frozen=True)

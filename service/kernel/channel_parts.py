@@ -9,7 +9,7 @@ that build or replace a part; ``tests/service/kernel/test_channel_parts.py`` che
 ==================  =====================================================================
 part                owner
 ==================  =====================================================================
-``switches``        ``commands``, ``operator_switches`` (what operators and the PLC command)
+``switches``        ``commands``, ``commands_operator`` (what operators and the PLC command)
 ``suspend``         ``commands`` (the PLC's unit), ``switchover`` (the output's state)
 ``program``         ``channel_run`` (select, start, messages), ``program_run``, ``channel_check``
 ``block``           ``program_run``, ``channel_check``, ``channel_run`` (its start)
@@ -17,7 +17,7 @@ part                owner
 ``errors``          ``channel_run`` (``report``, RESET), ``channel_check`` (the check's count)
 ``manual``          ``manual_mode``: ``manual_view.ManualAxisView`` per axis
 ``tooling``         ``tooling``, ``channel_run``: ``tooling_view.ChannelTooling``
-``tool_cut_cycles`` ``tool_life``
+``tool_cut_cycles`` ``tool_life``, ``commands_tooling``
 ``contour``         ``commands`` (the PLC's request), ``channel_run``, ``program_run``
 ``spindle``         ``spindle.Spindle`` (its ``state`` is this part)
 ``plc_functions``   ``plc_functions.PlcFunctions`` (its ``unit`` is this part)

@@ -11,11 +11,7 @@ place, so a snapshot may keep the old one.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-from .kernel_state import KernelState
 from .nc.blocks import Block, MotionKind
-from .refusal import Refusal, RefusalReason
 from .state import Channel
 
 
@@ -31,25 +27,3 @@ def count_cutting(ch: Channel, block: Block | None, cycles: int) -> None:
     ch.tool_cut_cycles = used
 
 
-@dataclass(frozen=True, slots=True)
-class SetToolLifeUsed:
-    """Write ``wz[index].life_used`` (s): typically 0 after a regrind or a new tool."""
-
-    channel_index: int
-    index: int
-    value_s: float
-    cycle_s: float
-
-    def apply(self, state: KernelState) -> Refusal | None:
-        ch = state.channels[self.channel_index]
-        size = ch.tooling.tools.size
-        if not 1 <= self.index <= size:
-            return Refusal(RefusalReason.INVALID_VALUE,
-                           f"wz[{self.index}]: the tool list has the entries 1..{size}")
-        if not 0.0 <= self.value_s <= 1e9:  # NaN fails too
-            return Refusal(RefusalReason.INVALID_VALUE,
-                           f"wz[{self.index}].life_used: {self.value_s:g} s is outside 0..1e9")
-        used = dict(ch.tool_cut_cycles)
-        used[self.index] = round(self.value_s / self.cycle_s)
-        ch.tool_cut_cycles = used
-        return None

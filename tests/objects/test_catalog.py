@@ -7,6 +7,8 @@ offset (``0x<AID>00xx``), the types, access and units of the ISG tables.
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from cnc_objects.objects.addressing import (
@@ -18,15 +20,18 @@ from cnc_objects.objects.addressing import (
     split_axis_offset,
 )
 from cnc_objects.objects.catalog import (
+    AREAS,
     PLC_GROUP,
-    TEMPLATES,
+    CatalogSizes,
     ChannelLayout,
     MachineLayout,
     Scope,
     build_objects,
+    templates,
 )
 from cnc_objects.objects.model import Access, CncObject
 from cnc_objects.objects.units import EngineeringScale
+from cnc_objects.protocol.alarm_values import AlarmClass, AlarmState
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.datatypes import REAL64, SGN32, UNS16, UNS32, DataType
 from cnc_objects.protocol.values import (
@@ -46,11 +51,14 @@ PLC = CncPort.PLC
 LAYOUT = MachineLayout(
     (ChannelLayout(1, 3), ChannelLayout(2, 3)), (1, 2, 3), hli_axes=(1, 2, 3, 11, 12, 13)
 )
+# two tool rows, G54 and G55, two alarm history slots: every area's tables appear
+SIZES = CatalogSizes(tool_entries=2, zero_offset_groups=3, alarm_history=2)
+TEMPLATES = templates(SIZES)
 
 
 @pytest.fixture(scope="module")
 def by_name() -> dict[str, CncObject]:
-    return {o.name: o for o in build_objects(LAYOUT)}
+    return {o.name: o for o in build_objects(LAYOUT, SIZES)}
 
 
 # (name, port, group, offset, type, access, unit)
@@ -114,14 +122,14 @@ def test_platform_objects_have_plain_names(by_name: dict[str, CncObject]) -> Non
 
 
 def test_names_are_unique() -> None:
-    names = [o.name for o in build_objects(LAYOUT)]
+    names = [o.name for o in build_objects(LAYOUT, SIZES)]
     assert len(names) == len(set(names))
     lowered = [n.lower() for n in names]
     assert len(lowered) == len(set(lowered))
 
 
 def test_addresses_are_unique() -> None:
-    addresses = [(o.port, o.group, o.offset) for o in build_objects(LAYOUT)]
+    addresses = [(o.port, o.group, o.offset) for o in build_objects(LAYOUT, SIZES)]
     assert len(addresses) == len(set(addresses))
 
 
@@ -141,7 +149,7 @@ def _scope(obj) -> Scope:
 
 
 def test_every_template_is_instantiated_once_per_scope_member() -> None:
-    objects = build_objects(LAYOUT)
+    objects = build_objects(LAYOUT, SIZES)
     expected = {
         Scope.PLATFORM: 1,
         Scope.PHYSICAL_AXIS: len(LAYOUT.physical_axes),
@@ -160,10 +168,18 @@ def test_every_template_is_instantiated_once_per_scope_member() -> None:
     assert len(objects) == sum(expected[t.scope] for t in TEMPLATES)
 
 
+def test_the_areas_are_one_list_and_sizes_size_their_tables() -> None:
+    assert TEMPLATES == tuple(t for area in AREAS for t in area(SIZES))
+    fixed = {t.element for t in templates()}
+    sized = {t.element for t in TEMPLATES} - fixed
+    assert "wz[2].radius" in sized and "np_grp[2].v" in sized
+    assert "alarm_history[2].id" in sized and "wz[3].radius" not in sized
+
+
 def test_every_object_follows_the_address_rules() -> None:
     templates = {(t.element, t.scope): t for t in TEMPLATES}
     assert len(templates) == len(TEMPLATES), "an element name repeats within one scope"
-    for obj in build_objects(LAYOUT):
+    for obj in build_objects(LAYOUT, SIZES):
         t = templates[obj.element, _scope(obj)]
         assert obj.port == PLC or obj.group & LOGICAL_BIT, obj.name
         assert obj.port == t.port and obj.dtype is t.dtype and obj.access is t.access
@@ -209,7 +225,7 @@ def test_layout_drives_the_instances() -> None:
 
 
 def test_empty_layout_keeps_platform_objects_only() -> None:
-    objects = build_objects(MachineLayout((), ()))
+    objects = build_objects(MachineLayout((), ()), SIZES)
     platform = {t.element for t in TEMPLATES if t.scope is Scope.PLATFORM}
     assert {o.name for o in objects} == platform
 
@@ -303,8 +319,10 @@ def test_objects_without_a_unit_or_with_value_names_have_no_scale(
     for obj in by_name.values():
         if obj.unit in ("-", "byte", "pulses") or obj.values is not None:
             assert obj.scale is None and obj.describe()[10] == [], obj.name
-    # every unit of the catalog is either scaled or deliberately left as it is
-    assert {o.unit for o in by_name.values() if o.scale is None} <= {"-", "byte", "pulses"}
+    # every unit of the catalog is either scaled or deliberately left as it is (ns: the
+    # alarms' wall-clock and kernel timestamps, counts since the epoch, not quantities)
+    assert {o.unit for o in by_name.values() if o.scale is None} <= {
+        "-", "byte", "pulses", "ns"}
 
 
 # --------------------------------------------------------------------------- value names
@@ -323,7 +341,19 @@ ENUMERATIONS = {
     "mc_spindle_mode_r": SpindleMode,
     "mc_coolant_state_r": CoolantState,
     "mc_g00_override_mode_r": RapidOverrideMode,
+    # alarm slots (by their element with the slot number left out)
+    "alarm_active[].class": AlarmClass,
+    "alarm_active[].state": AlarmState,
+    "alarm_history[].class": AlarmClass,
+    "alarm_history[].state": AlarmState,
 }
+
+
+def _enumeration_key(element: str) -> str:
+    """The key of ``element`` in ``ENUMERATIONS``: an alarm slot's field without its
+    number, else the last step of the element."""
+    slot = re.sub(r"\[\d+\]", "[]", element)
+    return slot if slot in ENUMERATIONS else element.rsplit(".", 1)[-1]
 
 
 def test_enumeration_objects_name_their_values(by_name: dict[str, CncObject]) -> None:
@@ -346,7 +376,7 @@ def test_only_enumerations_carry_value_names(by_name: dict[str, CncObject]) -> N
     """Bit sets (execution mode), booleans, counters and sentinels ("-1 = none") are not
     enumerations: their value names are empty."""
     for obj in by_name.values():
-        element = obj.element.rsplit(".", 1)[-1]
+        element = _enumeration_key(obj.element)
         assert obj.values is ENUMERATIONS.get(element), obj.name
         assert bool(obj.value_names) == (element in ENUMERATIONS), obj.name
     assert by_name["ch1.mc_active_execution_mode_r"].value_names == {}

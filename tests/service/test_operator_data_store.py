@@ -9,8 +9,8 @@ from pathlib import Path
 from cnc_objects.objects.operator_data import loads
 from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.alarms import AlarmLog
+from cnc_objects.service.kernel.commands_tooling import SetToolData, SetZeroOffset
 from cnc_objects.service.kernel.nc.tool_data import ToolField
-from cnc_objects.service.kernel.tooling import SetToolData, SetZeroOffset
 from cnc_objects.service.storage.operator_data_store import UNREADABLE_ID, OperatorDataStore
 from tests.support.kernel import KernelHarness
 

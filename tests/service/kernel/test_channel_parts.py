@@ -19,7 +19,7 @@ KERNEL = Path(__file__).resolve().parents[3] / "service" / "kernel"
 
 # part -> the modules (of service/kernel) that may assign it
 OWNERS: dict[str, set[str]] = {
-    "switches": {"commands", "operator_switches"},
+    "switches": {"commands", "commands_operator"},
     "suspend": {"commands", "switchover"},
     "program": {"channel_run", "program_run", "channel_check"},
     "block": {"channel_run", "program_run", "channel_check"},
@@ -27,7 +27,7 @@ OWNERS: dict[str, set[str]] = {
     "errors": {"channel_run", "channel_check"},
     "manual": {"manual_mode"},
     "tooling": {"channel_run", "tooling"},
-    "tool_cut_cycles": {"tool_life"},
+    "tool_cut_cycles": {"tool_life", "commands_tooling"},
     "contour": {"commands", "channel_run", "program_run"},
     "spindle": {"spindle"},
     "plc_functions": {"plc_functions"},

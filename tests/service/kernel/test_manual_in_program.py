@@ -16,7 +16,7 @@ import pytest
 from cnc_objects.protocol.values import ChannelState, ManualOperationMode
 from cnc_objects.protocol.wait_reasons import WaitReason
 from cnc_objects.service.kernel.commands import Feedhold, RefusalReason, StartProgram
-from cnc_objects.service.kernel.manual_commands import ManualAxisCommand
+from cnc_objects.service.kernel.commands_manual import ManualAxisCommand
 from cnc_objects.service.kernel.manual_view import DisplayState
 from cnc_objects.service.kernel.nc.errors import NcErrorId
 from cnc_objects.service.kernel.state import Snapshot

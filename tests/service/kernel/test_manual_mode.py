@@ -22,7 +22,7 @@ from cnc_objects.service.kernel.commands import (
     SetSuspendCommand,
     StartProgram,
 )
-from cnc_objects.service.kernel.manual_commands import ManualAxisCommand
+from cnc_objects.service.kernel.commands_manual import ManualAxisCommand
 from cnc_objects.service.kernel.manual_mode import ManualErrorId
 from tests.support.kernel import KernelHarness
 from tests.support.manual_machine import (
