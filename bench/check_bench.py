@@ -46,7 +46,7 @@ def measure(lines: int = 200_000, runs: int = 5) -> dict:
             check_s = time.perf_counter() - started
             channel = run.channel
             assert channel.state == ChannelState.READY and channel.errors.count == 0, (
-                [str(e) for e in channel.errors])
+                [str(e) for e in channel.errors.entries])
             split_rates.append(count / split_s)
             check_rates.append(count / check_s)
             ratios.append(split_s / check_s)

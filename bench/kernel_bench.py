@@ -38,7 +38,7 @@ def measure(runs: int = 3) -> dict:
             started = time.perf_counter()
             run = harness.run(text, name="bench.nc", timeout_s=600)
             wall = time.perf_counter() - started
-            assert run.channel.state == 3, run.channel.errors  # READY
+            assert run.channel.state == 3, run.channel.errors.entries  # READY
             sim = run.channel.path.program_time_s
             ratios.append(sim / wall)
     return {"simulated_s": sim, "sim_per_wall": statistics.median(ratios), "runs": ratios}

@@ -102,9 +102,9 @@ def run_program(program: BenchProgram, variant: Variant, keep_run: bool = False)
         run = harness.run(text, name=f"{program.name}.nc", record=True, timeout_s=600.0)
         wall = time.perf_counter() - t0
     channel = run.channel
-    violations = [f"error {e.id}: {e.text}" for e in channel.errors if not e.warning]
+    violations = [f"error {e.id}: {e.text}" for e in channel.errors.entries if not e.warning]
     violations += check_samples(run, program, config)
-    warnings = [e.id for e in channel.errors if e.warning]
+    warnings = [e.id for e in channel.errors.entries if e.warning]
     end = program.elements[-1].end
     end_error = max(abs(a - b) for a, b in zip(run.positions_mm, end))
     return Result(program.name, variant, channel.path.program_time_s,

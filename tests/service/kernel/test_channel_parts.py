@@ -48,6 +48,8 @@ def _assignments() -> list[tuple[str, str, int]]:
                 targets = node.targets
             elif isinstance(node, (ast.AugAssign, ast.AnnAssign)):
                 targets = [node.target]
+            else:
+                continue
             for target in targets:
                 for element in target.elts if isinstance(target, ast.Tuple) else [target]:
                     if (isinstance(element, ast.Attribute) and element.attr in OWNERS
@@ -73,8 +75,8 @@ def test_the_channel_is_its_identity_axes_mode_state_and_parts() -> None:
 def test_a_part_cannot_be_changed_in_place(part: str) -> None:
     channel = KernelState.from_config(build_config()).channels[0]
     value = getattr(channel, part)
-    field = (value._fields if isinstance(value, tuple)
-             else [f.name for f in dataclasses.fields(value)])[0]
+    names: tuple[str, ...] = getattr(value, "_fields", ())  # a NamedTuple's
+    field = names[0] if names else dataclasses.fields(value)[0].name
     with pytest.raises((AttributeError, dataclasses.FrozenInstanceError)):
         setattr(value, field, getattr(value, field))
 
