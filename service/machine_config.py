@@ -29,6 +29,10 @@ class AxisLimits(Strict):
     vel_jump_mm_s: float = Field(
         20.0, ge=0, description="permitted velocity jump of the axis at a block junction (mm/s)"
     )
+    sw_limit_check: Literal[-1, 0, 1] = Field(
+        -1, description="P-AXIS-00705 kenngr.swe_check: -1 the software limits are "
+        "monitored once the axis is referenced (ISG's default for a translatory axis), "
+        "0 never, 1 always (also before homing)")
 
     @model_validator(mode="after")
     def _limits_ordered(self) -> AxisLimits:

@@ -96,6 +96,7 @@ def _ranged(low: int, high: int) -> Callable[[str], int]:
 _UNS16 = _ranged(1, 0xFFFF)  # 0 is no valid axis number in ISG, hence from 1
 _UNS32 = _ranged(1, 0xFFFF_FFFF)
 _SGN32 = _ranged(-(2**31), 2**31 - 1)
+_swe_check = _ranged(-1, 1)  # SGN08 of P-AXIS-00705: -1 by axis type, 0 off, 1 on
 
 
 def _boolean(text: str) -> bool:
@@ -256,6 +257,7 @@ _AXIS_PARAMS = {
                ("limits", "sw_limit_min_mm")),
         _Param("kenngr.swe_pos", "P-AXIS-00178", lambda t: _SGN32(t) / UM01_PER_MM,
                ("limits", "sw_limit_max_mm")),
+        _Param("kenngr.swe_check", "P-AXIS-00705", _swe_check, ("limits", "sw_limit_check")),
         # um/s in the list, mm/s in the configuration.
         _Param("getriebe[0].dynamik.vb_max", "P-AXIS-00212", lambda t: _UNS32(t) / 1_000,
                ("limits", "vel_max_mm_s"), _GEAR_STAGE_0),

@@ -14,6 +14,7 @@ channel, axis by axis), the way the ISG kernel initialises its axes (FCT-C15, P-
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from enum import IntEnum
 from typing import Any
@@ -44,6 +45,7 @@ class AxisParameters:
     vel_jump_mm_s: float
     sw_limit_min_mm: float
     sw_limit_max_mm: float
+    sw_limit_check: int  # P-AXIS-00705: -1 once referenced, 0 never, 1 always
 
 
 @dataclass(frozen=True, slots=True)
@@ -170,3 +172,16 @@ def update_axis(
         if getattr(updated, name) <= 0:
             return None, f"{name} of axis {number} must be positive"
     return updated, ""
+
+
+UNLIMITED_MM = (-math.inf, math.inf)  # an axis whose software limits are not monitored
+
+
+def monitored_limits_mm(params: AxisParameters, referenced: bool) -> tuple[float, float]:
+    """The software limits in force for an axis (``UNLIMITED_MM`` when not monitored):
+    P-AXIS-00705 ``kenngr.swe_check`` -1 (ISG's default) monitors them once the axis is
+    referenced, 0 never, 1 always."""
+    check = params.sw_limit_check
+    if check == 1 or (check == -1 and referenced):
+        return params.sw_limit_min_mm, params.sw_limit_max_mm
+    return UNLIMITED_MM

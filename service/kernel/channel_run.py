@@ -35,7 +35,7 @@ from cnc_objects.protocol.values import ERRORS_LISTED, MESSAGES_LISTED, WORKING_
 
 from ..machine_config import ChannelConfig
 from .alarms import AlarmClass
-from .axis_params import AxisErrorId
+from .axis_params import AxisErrorId, monitored_limits_mm
 from .channel_check import ChannelCheck
 from .channel_mode import SELECTABLE_MODES, ChannelMode, ChannelState, describe
 from .channel_parts import ChannelErrors
@@ -555,7 +555,9 @@ class ChannelRunner:
         dynamics = tuple(
             AxisDynamics(p.vel_max_mm_s, p.acc_max_mm_s2, p.vel_jump_mm_s) for p in params
         )
-        return dynamics, tuple((p.sw_limit_min_mm, p.sw_limit_max_mm) for p in params)
+        # P-AXIS-00705: by default an axis's limits count once it is referenced
+        return dynamics, tuple(monitored_limits_mm(p, self.manual.referenced(k))
+                               for k, p in enumerate(params))
 
     def _begin_check(self, job: Job, mode: int) -> None:
         """Start the syntax check (SYNCHK) or dry run (MACHINE_LOCK) of the program."""

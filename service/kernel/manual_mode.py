@@ -37,7 +37,7 @@ from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import WORKING_STATES, ManualOperationMode
 
 from ..machine_config import MachineConfig, ManualAxisConfig
-from .axis_params import AxisParameters
+from .axis_params import AxisParameters, monitored_limits_mm
 from .channel_mode import ChannelMode, ChannelState, describe
 from .channel_transitions import ChannelEvent, allowed
 from .homing import HomingState
@@ -401,8 +401,8 @@ class ManualMode:
         """The axis's motion (a new one at its position), with the limits in force now."""
         axis = self._axes[axis_index]
         p = self._params[axis.number]
-        limits = AxisDynamicsLimits(max(vel_mm_s, 1e-6), p.acc_max_mm_s2,
-                                    p.sw_limit_min_mm, p.sw_limit_max_mm)
+        low_mm, high_mm = monitored_limits_mm(p, self.referenced(axis_index))
+        limits = AxisDynamicsLimits(max(vel_mm_s, 1e-6), p.acc_max_mm_s2, low_mm, high_mm)
         start_mm = self._channel.axes[axis_index].position_mm
         if axis.program is not None and self._channel.mode != ChannelMode.MANUAL:
             start_mm = axis.offset_mm  # G200/G201: the motion moves the manual offset
@@ -420,8 +420,9 @@ class ManualMode:
         axis = self._axes[axis_index]
         p = self._params[axis.number]
         path_mm = self._channel.axes[axis_index].position_mm - axis.offset_mm
-        motion.limits = replace(motion.limits, sw_limit_min_mm=p.sw_limit_min_mm - path_mm,
-                                sw_limit_max_mm=p.sw_limit_max_mm - path_mm)
+        low_mm, high_mm = monitored_limits_mm(p, self.referenced(axis_index))
+        motion.limits = replace(motion.limits, sw_limit_min_mm=low_mm - path_mm,
+                                sw_limit_max_mm=high_mm - path_mm)
 
     def _started(self, axis_index: int) -> None:
         """A motion began: the channel works (ACTIVE); a goal cut at a limit warns now."""

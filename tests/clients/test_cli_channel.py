@@ -7,7 +7,7 @@ from pathlib import Path
 
 from cnc_objects.clients import Client
 from tests.support.cli import cnc, json_lines
-from tests.support.service import RunningService
+from tests.support.service import RunningService, home_channel
 
 CLEAN = "N10 G1 X10 Y5 F6000\nN20 M30\n"
 BEYOND_LIMIT = "N10 G1 X5000 F100\nN20 M30\n"  # the default X limit is 1000 mm
@@ -66,6 +66,7 @@ def test_run_in_error_is_refused_naming_the_error_until_reset(
     service: RunningService, tmp_path: Path
 ) -> None:
     ep = service.endpoint
+    home_channel(ep)  # the software limits count once the axes are referenced
     failed = cnc("run", nc_file(tmp_path, "far.nc", BEYOND_LIMIT), "--wait", endpoint=ep)
     assert failed.returncode == 4, failed.stderr
     good = nc_file(tmp_path, "good.nc", CLEAN)

@@ -8,7 +8,7 @@ from pathlib import Path
 from cnc_objects.clients import Client
 from cnc_objects.clients.channel_ops import CheckError, CheckResult, parse_check_log
 from tests.support.cli import cnc, json_lines
-from tests.support.service import RunningService
+from tests.support.service import RunningService, home_channel
 
 EXAMPLE_PATH = Path(__file__).resolve().parents[2] / "docs" / "examples" / "check-syntax.nc"
 # the example program of the function description (FCT-C9), character for character
@@ -143,6 +143,7 @@ def test_check_that_does_not_end_is_reset_after_timeout(
 
 def test_software_limit_violation_aborts(service: RunningService, tmp_path: Path) -> None:
     ep = service.endpoint
+    home_channel(ep)  # the software limits count once the axes are referenced
     result = cnc("--json", "check", nc_file(tmp_path, "far.nc", BEYOND_LIMIT), endpoint=ep)
     assert result.returncode == 1, result.stderr
     [abort] = json_lines(result)
@@ -204,6 +205,7 @@ def test_check_does_not_move_the_axes(service: RunningService, tmp_path: Path) -
 
 
 def test_client_syntax_check(service: RunningService) -> None:
+    home_channel(service.endpoint)  # the software limits count once the axes are referenced
     with Client(service.endpoint) as c:
         c.upload("example.nc", SEED_EXAMPLE.encode())
         c.upload("clean.nc", CLEAN.encode())

@@ -88,11 +88,12 @@ def test_handwheel_counter_written_by_the_plc(machine: ServiceProcess) -> None:
 def test_cnc_jog_and_cnc_home(machine: ServiceProcess) -> None:
     e = machine.endpoint
     assert cnc("reset", endpoint=e).returncode == 0
-    result = cnc("--json", "home", "X", "Y", endpoint=e)
+    # homed: from then on the software limits are monitored (P-AXIS-00705)
+    result = cnc("--json", "home", "X", "Y", "Z", endpoint=e)
     assert result.returncode == 0, result.stderr
     records = json_lines(result)
     assert [(r["axis"], r["position_mm"], r["referenced"]) for r in records] == [
-        ("X", 0.0, True), ("Y", 0.0, True)]
+        ("X", 0.0, True), ("Y", 0.0, True), ("Z", 0.0, True)]
     result = cnc("--json", "jog", "X", "+", "--increment", "2.5", endpoint=e)
     assert result.returncode == 0, result.stderr
     [record] = json_lines(result)

@@ -112,7 +112,8 @@ def test_bad_axis_list_reports_every_problem_at_its_line() -> None:
         (8, "kenngr.swe_neg (P-AXIS-00177): '-1e6' is not an integer"),
         (9, "unknown key 'kenngr.referenz' (supported: kopf.achs_nr, kopf.link_to, "
             "kopf.clone_of, kenngr.auto_release_of_axis_link, kenngr.achs_typ, kenngr.swe_neg, "
-            "kenngr.swe_pos, getriebe[0].dynamik.vb_max, getriebe[0].dynamik.a_max)"),
+            "kenngr.swe_pos, kenngr.swe_check, getriebe[0].dynamik.vb_max, "
+            "getriebe[0].dynamik.a_max)"),
         (10, "only getriebe[0] (gear stage 0) is supported"),
         (11, "malformed key 'getriebe[0.dynamik.a_max'"),
         (12, "getriebe[0].dynamik.a_max (P-AXIS-00008): 0 is out of range 1..4294967295"),

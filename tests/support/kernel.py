@@ -170,6 +170,14 @@ class KernelHarness:
         self.start(text, name, record, timeout_s)
         return self.wait(timeout_s)
 
+    def home(self, timeout_s: float = 60.0) -> Run:
+        """Home every axis of channel 1 (``G74`` in MDI): from then on its software
+        limits are monitored (P-AXIS-00705, ISG's default)."""
+        axes = " ".join(f"{a.name}1" for a in self.config.channels[0].axes)
+        run = self.mdi(f"G74 {axes}", timeout_s=timeout_s)
+        assert run.channel.errors.entries == (), run.channel.errors.entries
+        return run
+
     def mdi(self, text: str, record: bool = False, timeout_s: float = 60.0) -> Run:
         """Run ``text`` as a manual block and wait until the channel is idle again."""
         return self._run(ManualBlock(0, text), record, timeout_s)

@@ -15,8 +15,8 @@ from cnc_objects.testing import serving, start_service
 
 ROOT = Path(__file__).resolve().parents[2]
 
-__all__ = ["ROOT", "RunningService", "reset_client", "serving", "serving_config",
-           "start_service"]
+__all__ = ["ROOT", "RunningService", "home_channel", "reset_client", "serving",
+           "serving_config", "start_service"]
 
 
 @contextlib.contextmanager
@@ -34,3 +34,11 @@ def reset_client(service: RunningService, timeout_s: float = 10.0) -> Iterator[C
     with Client(service.endpoint, timeout_s=timeout_s) as client:
         client.reset(1)
         yield client
+
+
+def home_channel(endpoint: str, channel: int = 1, axes: str = "X1 Y1 Z1") -> None:
+    """Home the axes of ``channel`` (``G74`` in MDI, the default machine's X Y Z): from
+    then on their software limits are monitored (P-AXIS-00705, ISG's default)."""
+    with Client(endpoint, timeout_s=30.0) as client:
+        before = client.mdi(f"G74 {axes}", channel)
+        client.wait_mdi(before, channel, timeout_s=60.0)

@@ -120,6 +120,7 @@ def _reach(h: KernelHarness, state: ChannelState, *, mdi: bool = False) -> None:
         if state == S.HOLD:
             _ok(h, Feedhold(0, True))
     elif state == S.ERROR:
+        h.home()  # the software limits count once the axes are referenced
         _ok(h, SelectProgram(0, "limit.nc"))
         h.begin(StartProgram(0, True))
         h.wait()
@@ -177,6 +178,7 @@ def _to_the_end(h: KernelHarness) -> None:
 
 def _program_error(h: KernelHarness) -> None:
     _ok(h, ResetChannel(0, True))
+    h.home()  # the software limits count once the axes are referenced
     _ok(h, SelectProgram(0, "limit.nc"))
     h.begin(StartProgram(0, True))
     assert h.wait().channel.errors.entries[0].line == 2

@@ -104,6 +104,7 @@ FAILING = {
 @pytest.mark.parametrize("case", FAILING, ids=list(FAILING))
 def test_wrong_program_stops_with_a_precise_error(kernel, case) -> None:
     text, line, column, final_x = FAILING[case]
+    kernel.home()  # the software limits count once the axes are referenced (P-AXIS-00705)
     run = kernel.run(text, name="bad.nc")
     ch = run.channel
     assert ch.state == ChannelState.ERROR

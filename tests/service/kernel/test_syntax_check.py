@@ -215,6 +215,7 @@ def test_stop_interrupts_decoding_and_resume_goes_on(harness) -> None:
 
 
 def test_a_software_limit_violation_aborts_the_check(harness) -> None:
+    harness.home()  # the software limits count once the axes are referenced (P-AXIS-00705)
     _mode(harness, SYNCHK | MACHINE_LOCK)
     # both ends inside +-1000 mm, the arc's bulge reaches X 1005
     run = harness.run("G1 X990 F1000\nG2 X990 Y-10 I0 J-5\nG1 Q1\nG2 X990 Y-30 I5 J-10\n"
@@ -280,6 +281,7 @@ def test_a_loop_without_blocks_does_not_block_the_cycle_and_reset_ends_it(harnes
 @pytest.mark.parametrize("after", ["G1 X10\nG40 X0 Y0\nM30\n", "M30\n", "G40\nG1 X0 Y0\nM30\n"])
 @pytest.mark.parametrize("mode", [SYNCHK | MACHINE_LOCK, MACHINE_LOCK])
 def test_a_compensated_arc_over_a_limit_aborts_as_in_a_real_run(harness, mode, after) -> None:
+    harness.home()  # the software limits count once the axes are referenced (P-AXIS-00705)
     # G42 with D3: the compensated arc of line 4 reaches beyond X 1000; the error comes
     # when compensation releases the held arc (next block, G40 or the end of the data)
     _mode(harness, mode)
@@ -300,6 +302,7 @@ def test_manual_blocks_run_as_usual_and_show_no_simulation_mode(harness, mode) -
 
 
 def test_the_error_that_ends_a_check_is_listed_after_many_findings(harness) -> None:
+    harness.home()  # the software limits count once the axes are referenced (P-AXIS-00705)
     _mode(harness, SYNCHK | MACHINE_LOCK)
     text = "".join(f"G1 X1 F100 Q{k}\n" for k in range(10)) + "G1 X5000\nM30\n"
     ch = harness.run(text, "a.nc").channel
