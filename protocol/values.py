@@ -100,6 +100,18 @@ class ManualOperationMode(IntEnum):
     INCREMENTAL = 3  # jog mode: one increment per key press
 
 
+class SpindleM(IntEnum):
+    """The spindle M functions (ISG: a spindle takes one of them per block, error 20155)."""
+
+    CW = 3  # M3
+    CCW = 4  # M4
+    STOP = 5  # M5
+    ORIENT = 19  # M19
+
+
+SPINDLE_M_FUNCTIONS = frozenset(int(m) for m in SpindleM)
+
+
 class SpindleMode(IntEnum):
     """Mode of the spindle (HLI ``gpAx[..]^.ipo_state.spindle.mode_r``; the object
     ``ch<c>.mc_spindle_mode_r``)."""

@@ -12,9 +12,10 @@ own acknowledge of the last function (speed reached, stopped, oriented).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import IntEnum
 from typing import Protocol
 
+from cnc_objects.protocol.values import SPINDLE_M_FUNCTIONS as SPINDLE_M_FUNCTIONS
+from cnc_objects.protocol.values import SpindleM as SpindleM
 from cnc_objects.protocol.values import SpindleMode
 
 from ..machine_config import SpindleConfig
@@ -27,16 +28,6 @@ __all__ = [  # SpindleMode is the value set of protocol.values, used here
 DEG_S2_PER_RPM_S = 6.0  # 1 rpm/s = 360 degrees / 60 s per s
 
 
-class SpindleM(IntEnum):
-    """The spindle M functions."""
-
-    CW = 3  # M3
-    CCW = 4  # M4
-    STOP = 5  # M5
-    ORIENT = 19  # M19
-
-
-SPINDLE_M_FUNCTIONS = frozenset(int(m) for m in SpindleM)
 _MODE_OF = {SpindleM.CW: SpindleMode.M03, SpindleM.CCW: SpindleMode.M04,
             SpindleM.STOP: SpindleMode.M05, SpindleM.ORIENT: SpindleMode.M19}
 OVERRIDE_MAX = 1500  # 0.1 %: the largest spindle override accepted

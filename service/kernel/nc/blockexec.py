@@ -28,6 +28,7 @@ from dataclasses import replace
 from enum import IntEnum
 
 from cnc_objects.protocol.units import UM01_PER_MM
+from cnc_objects.protocol.values import SPINDLE_M_FUNCTIONS
 
 from .blocks import (
     AxisExchange,
@@ -262,7 +263,18 @@ class BlockExecutor:
         flow = Flow.NONE
         flow_pos = -1
         m_functions: list[int] = []
+        spindle_m: int | None = None  # the block's spindle M function (one at most)
+        seen_m: set[int] = set()  # a set: a 1 MB line of distinct M words stays linear
         for number, pos, k in m_codes:
+            twice = self._m_twice(number, seen_m, spindle_m, pos, err)
+            if twice is not None:
+                if on_error is None:
+                    raise twice
+                on_error(twice, k)  # this M is left out
+                continue
+            seen_m.add(number)
+            if number in SPINDLE_M_FUNCTIONS:
+                spindle_m = number
             if number == M_TOOL_CHANGE:
                 dwell_s += self._tool_change(pos, err)
             action = _M_FLOW.get(number)
@@ -341,6 +353,19 @@ class BlockExecutor:
                 self._zero_offset_index(value, item.pos, groups, err)
             case _:  # F S T D R
                 words[item.kind] = (value, item.pos)
+
+    @staticmethod
+    def _m_twice(number: int, before: set[int], spindle_m: int | None, pos: int,
+                 err: ErrorAt) -> NcError | None:
+        """The error of an M function the block has already (20765), or of a second
+        spindle M function (20155: ISG's spindle takes one of M3/M4/M5/M19 a block)."""
+        if number in before:
+            return err(NcErrorId.M_FUNCTION_TWICE, f"M{number} twice in one block", pos)
+        if number in SPINDLE_M_FUNCTIONS and spindle_m is not None:
+            return err(NcErrorId.SPINDLE_M_TWICE,
+                       f"M{number} after M{spindle_m} in one block: the spindle takes one "
+                       "of M3, M4, M5, M19 per block", pos)
+        return None
 
     def exchange(self, stmt: AxisCommand, env: Env) -> Block | None:
         """Run ``#AX RELEASE`` / ``#AX REQUEST``: the block that hands the axes over, or

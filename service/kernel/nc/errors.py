@@ -51,6 +51,8 @@ class NcErrorId(IntEnum):
     TOOL_CHANGE_WITHOUT_TOOL = 20137  # M6 before any T was programmed (project id)
     INVALID_H_CODE = 20138  # H negative or over 65535 (project id: ISG names no id)
     H_FUNCTION_TWICE = 20766  # ISG: the same H function twice in one block
+    M_FUNCTION_TWICE = 20765  # ISG: the same M function twice in one block (M8 M8)
+    SPINDLE_M_TWICE = 20155  # ISG: a second spindle M function (M3/M4/M5/M19) in a block
     MANUAL_MODE_TWICE = 20129  # ISG: more than one of G200/G201/G202 in one block
     MANUAL_MODE_WITHOUT_AXES = 20139  # G201 without an axis (project id)
     UNKNOWN_TOOL = 21915  # ISG: unknown tool id (T of no valid wz[i] row)

@@ -97,3 +97,30 @@ def test_s_with_s_synch_mvs_svs_waits_for_the_new_speed() -> None:
         assert moving.cycle > reached.cycle
         units = h.kernel.snapshot.channels[0].plc_functions.units
         assert [(u.number, u.acknowledged) for u in units] == [(1000, True), (3000, True)]
+
+
+@pytest.mark.parametrize(("line", "error_id", "column"), [
+    ("S1000 M3 M5", 20155, 10),  # ISG: a second spindle M function in the block
+    ("G01 X10 F600 M3 M19", 20155, 17),
+    ("G01 X10 F600 M8 M8", 20765, 17),  # ISG: the same M function twice in a block
+])
+def test_a_block_with_two_spindle_m_functions_or_one_m_twice_is_an_isg_error(
+        line: str, error_id: int, column: int) -> None:
+    with KernelHarness() as h:
+        run = h.run(f"G01 X1 F600\n{line}\nM30\n")
+        assert run.channel.state == ChannelState.ERROR
+        error = run.channel.errors.entries[0]
+        assert (error.id, error.line, error.column) == (error_id, 2, column)
+        assert _spindle(h.kernel.snapshot).mode == SpindleMode.M05  # nothing was output
+
+
+def test_a_syntax_check_lists_both_and_goes_on() -> None:
+    from cnc_objects.protocol.values import ExecutionMode
+    from cnc_objects.service.kernel.commands import SetExecutionMode
+
+    with KernelHarness() as h:
+        check = int(ExecutionMode.SYNCHK | ExecutionMode.MACHINE_LOCK)
+        assert h.command(SetExecutionMode(0, check)) is None
+        run = h.run("S1000 M3 M5\nM8 M8\nG01 X1 F600\nM30\n")
+        found = [(e.id, e.line) for e in run.channel.errors.entries if e.id != 21309]
+        assert found == [(20155, 1), (20765, 2)]
