@@ -1,7 +1,7 @@
 """Objects of manual mode and homing (docs/manual.md lists each with its ISG source).
 
-Rows of plain data that ``catalog.py`` turns into its templates (this module imports
-nothing of the catalog, so the two are no circle). Per axis of a channel:
+Templates (``templates.ObjectTemplate``), one area of ``catalog.AREAS``. Per axis of a
+channel:
 
 - ``hb_display_r.*``: ISG's status of manual mode, an HLI symbol on port 851
   (``gpCh[i].bahn_state.coord_r[k].hb_display_r.state`` ...);
@@ -13,89 +13,70 @@ nothing of the catalog, so the two are no circle). Per axis of a channel:
 
 from __future__ import annotations
 
-from enum import IntEnum
-from typing import NamedTuple
-
 from cnc_objects.protocol.constants import CncPort
-from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, UNS16, UNS32, DataType
+from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, SGN32, UNS16, UNS32
 from cnc_objects.protocol.values import ManualOperationMode
 
 from .addressing import GroupBase
 from .model import Access
 from .templates import PLC_GROUP, CatalogSizes, ObjectTemplate, Scope
 
-
-class ManualRow(NamedTuple):
-    """One template's fields (``catalog.ObjectTemplate``); ``scope`` is a ``Scope`` value."""
-
-    element: str
-    scope: str
-    port: CncPort
-    group_base: int
-    offset: int
-    dtype: DataType
-    access: Access
-    unit: str
-    description: str
-    values: type[IntEnum] | None = None
-
-
 R, W, RW = Access.READ, Access.WRITE, Access.READ_WRITE
-_AXIS, _HLI = "channel_axis", "plc_channel_axis"
+_AXIS, _HLI = Scope.CHANNEL_AXIS, Scope.PLC_CHANNEL_AXIS
 COM, PLC = CncPort.COM, CncPort.PLC
 COM_CH = GroupBase.COM_CHANNEL
 
 _MODES = "0 none, 1 handwheel, 2 continuous jog, 3 jog by increments"
 
-MANUAL_ROWS: tuple[ManualRow, ...] = (
+MANUAL_ROWS: tuple[ObjectTemplate, ...] = (
     # --- HLI status of manual mode: gpCh[i].bahn_state.coord_r[k].hb_display_r --------
-    ManualRow("hb_display_r.state", _HLI, PLC, PLC_GROUP, 0x0, UNS16, R, "-",
+    ObjectTemplate("hb_display_r.state", _HLI, PLC, PLC_GROUP, 0x0, UNS16, R, "-",
               "State of manual mode for the axis: 0 deactivated, 1 enabled without a control "
               "element, 2 enabled and assigned to a control element (an operation mode)"),
-    ManualRow("hb_display_r.operation_mode", _HLI, PLC, PLC_GROUP, 0x2, UNS16, R, "-",
+    ObjectTemplate("hb_display_r.operation_mode", _HLI, PLC, PLC_GROUP, 0x2, UNS16, R, "-",
               f"Operation mode of manual mode: {_MODES}", ManualOperationMode),
-    ManualRow("hb_display_r.control_element", _HLI, PLC, PLC_GROUP, 0x4, UNS16, R, "-",
+    ObjectTemplate("hb_display_r.control_element", _HLI, PLC, PLC_GROUP, 0x4, UNS16, R, "-",
               "Logical number of the control element linked to the axis; 0 = none "
               "(this kernel: 1 while an operation mode is selected)"),
-    ManualRow("hb_display_r.hr_aufloesung", _HLI, PLC, PLC_GROUP, 0x6, SGN32, R, "0.1 um",
+    ObjectTemplate("hb_display_r.hr_aufloesung", _HLI, PLC, PLC_GROUP, 0x6, SGN32, R, "0.1 um",
               "Handwheel resolution: path per handwheel pulse"),
-    ManualRow("hb_display_r.tipp_geschw", _HLI, PLC, PLC_GROUP, 0xA, SGN32, R, "um/s",
+    ObjectTemplate("hb_display_r.tipp_geschw", _HLI, PLC, PLC_GROUP, 0xA, SGN32, R, "um/s",
               "Velocity of the axis in continuous jog mode (rapid key and feed override "
               "applied)"),
     # --- manual mode by object (project) -------------------------------------------------
-    ManualRow("manual_operation_mode_w", _AXIS, COM, COM_CH, 0x3300, UNS16, RW, "-",
+    ObjectTemplate("manual_operation_mode_w", _AXIS, COM, COM_CH, 0x3300, UNS16, RW, "-",
               f"Select the axis's operation mode in manual mode: {_MODES}; at standstill "
               "(project)", ManualOperationMode),
-    ManualRow("manual_jog_plus_w", _AXIS, COM, COM_CH, 0x3301, BOOLEAN, RW, "-",
+    ObjectTemplate("manual_jog_plus_w", _AXIS, COM, COM_CH, 0x3301, BOOLEAN, RW, "-",
               "Jog key +: TRUE pressed, FALSE released. Continuous jog moves while pressed; "
               "jog by increments moves one increment per press (project)"),
-    ManualRow("manual_jog_minus_w", _AXIS, COM, COM_CH, 0x3302, BOOLEAN, RW, "-",
+    ObjectTemplate("manual_jog_minus_w", _AXIS, COM, COM_CH, 0x3302, BOOLEAN, RW, "-",
               "Jog key -: as manual_jog_plus_w, in the negative direction (project)"),
-    ManualRow("manual_rapid_w", _AXIS, COM, COM_CH, 0x3303, BOOLEAN, RW, "-",
+    ObjectTemplate("manual_rapid_w", _AXIS, COM, COM_CH, 0x3303, BOOLEAN, RW, "-",
               "Rapid key: TRUE jogs at the rapid jog speed (jog_rapid_vel_mm_s) (project)"),
-    ManualRow("manual_increment_w", _AXIS, COM, COM_CH, 0x3304, UNS32, RW, "0.1 um",
+    ObjectTemplate("manual_increment_w", _AXIS, COM, COM_CH, 0x3304, UNS32, RW, "0.1 um",
               "Jog increment: 1 (0.1 um) .. 100000 (10 mm); others are refused (project)"),
-    ManualRow("manual_handwheel_counter_w", _AXIS, COM, COM_CH, 0x3305, SGN32, RW, "pulses",
+    ObjectTemplate("manual_handwheel_counter_w", _AXIS, COM, COM_CH, 0x3305, SGN32, RW, "pulses",
               "Handwheel counter the PLC or HMI writes; in handwheel mode the axis moves by "
               "(new - old) x hr_aufloesung; 32-bit wrap-around is a small step (project)"),
-    ManualRow("manual_hr_aufloesung_w", _AXIS, COM, COM_CH, 0x3306, SGN32, RW, "0.1 um",
+    ObjectTemplate("manual_hr_aufloesung_w", _AXIS, COM, COM_CH, 0x3306, SGN32, RW, "0.1 um",
               "Handwheel resolution: path per pulse, 1 .. 100000 (project)"),
-    ManualRow("manual_velocity_r", _AXIS, COM, COM_CH, 0x3307, REAL64, R, "um/s",
+    ObjectTemplate("manual_velocity_r", _AXIS, COM, COM_CH, 0x3307, REAL64, R, "um/s",
               "Velocity of the axis's manual motion (signed; 0 at standstill) (project)"),
-    ManualRow("manual_moving_r", _AXIS, COM, COM_CH, 0x3308, BOOLEAN, R, "-",
+    ObjectTemplate("manual_moving_r", _AXIS, COM, COM_CH, 0x3308, BOOLEAN, R, "-",
               "TRUE while a manual motion (jog, handwheel, homing) of the axis is under way "
               "(project)"),
-    ManualRow("manual_limit_warning_r", _AXIS, COM, COM_CH, 0x3309, BOOLEAN, R, "-",
+    ObjectTemplate("manual_limit_warning_r", _AXIS, COM, COM_CH, 0x3309, BOOLEAN, R, "-",
               "TRUE: the axis's last manual motion stopped at a software limit (warning "
               "70910 is listed); the next motion away or RESET clears it (project)"),
-    ManualRow("homing_start_w", _AXIS, COM, COM_CH, 0x3310, BOOLEAN, W, "-",
+    ObjectTemplate("homing_start_w", _AXIS, COM, COM_CH, 0x3310, BOOLEAN, W, "-",
               "Write TRUE in MANUAL: home the axis (to P-AXIS-00152 pos_refpkt at "
               "homing_vel_mm_s) (project)"),
-    ManualRow("homing_referenced_r", _AXIS, COM, COM_CH, 0x3311, BOOLEAN, R, "-",
+    ObjectTemplate("homing_referenced_r", _AXIS, COM, COM_CH, 0x3311, BOOLEAN, R, "-",
               "TRUE once the axis is homed (G74 or homing_start_w) (project)"),
-    ManualRow("homing_active_r", _AXIS, COM, COM_CH, 0x3312, BOOLEAN, R, "-",
+    ObjectTemplate("homing_active_r", _AXIS, COM, COM_CH, 0x3312, BOOLEAN, R, "-",
               "TRUE while the axis's homing run is under way (project)"),
-    ManualRow("manual_offset_r", _AXIS, COM, COM_CH, 0x3313, SGN32, R, "0.1 um",
+    ObjectTemplate("manual_offset_r", _AXIS, COM, COM_CH, 0x3313, SGN32, R, "0.1 um",
               "Manual offset summed by G200/G201 jogs in the running program, added to the "
               "path's output; 0 again when the program ends (project)"),
 )
@@ -103,4 +84,4 @@ MANUAL_ROWS: tuple[ManualRow, ...] = (
 
 def manual_templates(sizes: CatalogSizes) -> tuple[ObjectTemplate, ...]:
     """The templates of manual mode and homing (one per row)."""
-    return tuple(ObjectTemplate(r.element, Scope(r.scope), *r[2:]) for r in MANUAL_ROWS)
+    return MANUAL_ROWS
