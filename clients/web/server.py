@@ -17,7 +17,7 @@ from aiohttp import web
 
 from cnc_objects.clients.client import AsyncClient
 
-from . import api, machine_api, program_api
+from . import api, facts, machine_api, program_api
 from .access import ACCESS_KEY, Access, session_middleware, sweep_sessions
 from .budgets import WatchBudgets
 from .closing import OPEN_SOCKETS_KEY, close_open_sockets
@@ -111,6 +111,7 @@ def make_app(link: ServiceLink, access: Access, hosts: AllowedHosts,
     app.router.add_get("/api/stats", stats)
     app.router.add_static("/static/", STATIC_DIR)
     api.add_routes(app)
+    facts.add_routes(app)
     machine_api.add_routes(app)
     program_api.add_routes(app)
     return app

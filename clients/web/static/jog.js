@@ -1,7 +1,7 @@
 // cnc-web: jog on the MDI / Jog page: by increments, continuous (held by the dead-man
-// socket /ws/jog), handwheel, homing. A classic script after app.js: it shares its state
-// and helpers.
-"use strict";
+// socket /ws/jog), handwheel, homing; the jog table with the axes' positions.
+
+import { $, api, currentChannel, el, facts, mm, named, referenced, say, state, v } from "./core.js";
 
 const jogMode = () => $("#jog-mode").value;
 
@@ -39,7 +39,7 @@ function jogButton(ch, ax, direction) {
   return button;
 }
 
-function renderJog() {
+export function renderJog() {
   const ch = currentChannel();
   const tbody = $("#jog tbody");
   if (!ch) return;
@@ -67,7 +67,8 @@ function renderJog() {
     if (cell.textContent !== text) cell.textContent = text;
   }
   for (const button of tbody.querySelectorAll("button[data-key]")) button.classList.toggle("held", v(button.dataset.key) === true);
-  $("#mdi-state").textContent = `channel ${ch.id}: ${named(state.machine.states, v(`ch${ch.id}.mc_active_state_r`))}`;
+  const said = `channel ${ch.id}: ${named(facts.states, v(`ch${ch.id}.mc_active_state_r`))}`;
+  if ($("#mdi-state").textContent !== said) $("#mdi-state").textContent = said;
 }
 
 async function stepJog(axis, direction) {

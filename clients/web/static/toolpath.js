@@ -1,11 +1,23 @@
 // cnc-web: the tool path of the program page (XY): the planned path, the path run so far
 // and the tool, on equal scales with axes and a grid in mm, in workpiece coordinates while
-// an offset is in effect. A classic script after app.js: it shares its state and helpers.
-"use strict";
+// an offset is in effect. The path run so far is recorded every frame whatever page is
+// shown (cheap); it is drawn only on the program page.
+
+import { $, currentXY, state, v, working } from "./core.js";
+import { onChannel, onEveryFrame } from "./router.js";
+
+const LIVE_POINTS_MAX = 5000;
+const path = {
+  planned: null,  // {x: [], y: []} of the planned tool path (machine coordinates)
+  live: [],       // [x, y] machine positions of the tool while a program runs
+  extent: null,   // [minX, minY, maxX, maxY] of the view: grows, never shrinks
+  extentKey: null,
+  gridKey: null,
+};
 
 // What lies between machine and workpiece coordinates now (zero offset and tool
 // length: machine - workpiece), and the name of the coordinates the path is drawn in.
-function pathFrame() {
+export function pathFrame() {
   const acs = currentXY("acs");
   const pcs = currentXY("pcs");
   const shift = acs && pcs ? [acs[0] - pcs[0], acs[1] - pcs[1]] : [0, 0];
@@ -17,39 +29,63 @@ function pathFrame() {
 function recordLivePath() {
   const here = currentXY();
   if (!here || !working()) return;
-  const last = state.live[state.live.length - 1];
+  const last = path.live[path.live.length - 1];
   if (!last || last[0] !== here[0] || last[1] !== here[1]) {
-    state.live.push(here);
-    if (state.live.length > 5000) state.live.splice(0, state.live.length - 5000);
+    path.live.push(here);
+    if (path.live.length > LIVE_POINTS_MAX) path.live.splice(0, path.live.length - LIVE_POINTS_MAX);
   }
 }
+onEveryFrame(recordLivePath);
+
+// A new run, or another channel: the path so far starts anew.
+export function clearLive() {
+  path.live = [];
+}
+
+// Another program: no planned path yet, and the view starts anew.
+export function clearPlanned() {
+  path.planned = null;
+  path.extent = null;
+}
+
+export function setPlanned(trace) {
+  const [xName, yName] = Object.keys(trace.positions_mm);
+  path.planned = { x: trace.positions_mm[xName] || [], y: trace.positions_mm[yName] || [] };
+  path.extent = null;
+  drawPath();
+}
+
+onChannel(() => {
+  path.live = [];
+  path.extent = null;
+});
 
 function niceStep(span) {
-  const raw = span / 5;
-  const power = 10 ** Math.floor(Math.log10(raw));
-  return [1, 2, 5, 10].map((f) => f * power).find((step) => step >= raw);
+  const rough = span / 5;
+  const power = 10 ** Math.floor(Math.log10(rough));
+  return [1, 2, 5, 10].map((f) => f * power).find((step) => step >= rough);
 }
 
 const PLOT = { left: 46, top: 10, width: 344, height: 262 }; // inside the 400 x 300 view box
 
-function drawPath() {
+export function drawPath() {
   const frame = pathFrame();
   const [dx, dy] = frame.shift;
   const toView = ([x, y]) => [x - dx, y - dy];
-  const planned = state.planned ? state.planned.x.map((x, k) => toView([x, state.planned.y[k]])) : [];
-  const live = state.live.map(toView);
+  const planned = path.planned ? path.planned.x.map((x, k) => toView([x, path.planned.y[k]])) : [];
+  const live = path.live.map(toView);
   const acs = currentXY();
   const here = acs ? toView(acs) : null;
   // The view holds the planned path from the start and grows when the tool leaves it:
   // it never shrinks to the path so far. A new offset (G53 -> G54) starts it anew.
   const key = `${dx},${dy}`;
-  let e = state.extentKey === key ? state.extent : null;
+  let e = path.extentKey === key ? path.extent : null;
   for (const [x, y] of planned.concat(live, here ? [here] : [])) {
     e = e ? [Math.min(e[0], x), Math.min(e[1], y), Math.max(e[2], x), Math.max(e[3], y)] : [x, y, x, y];
   }
   if (!e) return;
-  state.extent = e;
-  state.extentKey = key;
+  path.extent = e;
+  path.extentKey = key;
   const span = Math.max((e[2] - e[0]) * PLOT.height / PLOT.width, e[3] - e[1], 1) * 1.1;
   const scale = PLOT.height / span; // px per mm, the same on both axes
   const [cx, cy] = [(e[0] + e[2]) / 2, (e[1] + e[3]) / 2];
@@ -68,8 +104,8 @@ function drawPath() {
 // The axes, the grid and its labels in mm: drawn again only when the view changes.
 function drawGrid(frameName, scale, cx, cy, sx, sy) {
   const key = `${frameName} ${scale} ${cx} ${cy}`;
-  if (state.gridKey === key) return;
-  state.gridKey = key;
+  if (path.gridKey === key) return;
+  path.gridKey = key;
   const step = niceStep(PLOT.width / scale);
   const [x0, x1] = [cx - PLOT.width / 2 / scale, cx + PLOT.width / 2 / scale];
   const [y0, y1] = [cy - PLOT.height / 2 / scale, cy + PLOT.height / 2 / scale];

@@ -1,7 +1,9 @@
 // cnc-web: the Tools / Offsets page: the tool list and the zero offset table of the channel,
-// edited row by row. A classic script after app.js: it shares its state and helpers.
-"use strict";
+// edited row by row. Loaded when the page is shown and when the channel changes on it;
+// nothing live to draw.
 
+import { $, api, el, say, state } from "./core.js";
+import { definePage, onChannel } from "./router.js";
 
 function numberInput(value) {
   const input = el("input", { type: "number", step: "any", className: "write", value: String(value) });
@@ -66,3 +68,6 @@ async function loadTools() {
     return tr;
   }));
 }
+
+onChannel(() => { if (state.page === "tools") loadTools().catch(() => {}); });
+definePage("tools", { show: loadTools });
