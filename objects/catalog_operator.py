@@ -2,7 +2,8 @@
 that change behaviour (docs/kernel.md "Operator switches", docs/configuration.md
 "Settings as objects").
 
-Templates (``templates.ObjectTemplate``), one area of ``catalog.AREAS``. ISG's names, offsets and units where ISG documents them:
+Templates (``templates.ObjectTemplate``), one area of ``catalog.AREAS``. ISG's names,
+offsets and units where ISG documents them:
 ``mc_command_block_ignore_w`` / ``_r`` and ``mc_active_block_ignore_r`` (COM 0x4/0x5/0x6,
 TF5200 "Skipping of NC blocks", CNC objects); the channel axis's distance to go (COM
 0x<a>0004, SGN32, 0.1 um: the offset TwinSharp reads). ``mc_command_M01_stop_enable_w``

@@ -17,8 +17,7 @@ from typing import Any
 from aiohttp import web
 
 from cnc_objects.clients.channel_ops import CONTOUR_BLOCK_TYPES, MODES, STATES
-from cnc_objects.objects.catalog import TEMPLATES, Scope
-from cnc_objects.objects.catalog_tools import TOOL_TEMPLATES
+from cnc_objects.objects.catalog import Scope, templates
 from cnc_objects.objects.units import scale_of
 from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import WORKING_STATES, LinkState, SpindleMode
@@ -47,7 +46,7 @@ def leaf_scales() -> dict[str, dict[str, Any]]:
     """``{leaf: {unit, factor, decimals}}`` of every channel and axis object whose
     catalog unit has an engineering scale (``mc_active_feedrate_r``: mm/min, 0.06)."""
     scales: dict[str, dict[str, Any]] = {}
-    for template in TEMPLATES + TOOL_TEMPLATES:
+    for template in templates():  # every area's fixed objects (no table rows)
         scale = scale_of(template.unit)
         if template.scope not in _LEAF_SCOPES or scale is None:
             continue

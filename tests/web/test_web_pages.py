@@ -14,7 +14,7 @@ from typing import Any
 
 from cnc_objects.clients.channel_ops import CONTOUR_BLOCK_TYPES
 from cnc_objects.clients.web.server import STATIC_DIR
-from cnc_objects.objects.catalog import TEMPLATES, Scope
+from cnc_objects.objects.catalog import Scope, templates
 from cnc_objects.objects.units import scale_of
 from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import (
@@ -81,7 +81,7 @@ async def test_the_facts_are_the_python_constants(web: WebProcess) -> None:
     assert {k: facts["spindle_modes"][str(int(k))] for k in (SpindleMode.M05, SpindleMode.M03,
             SpindleMode.M04, SpindleMode.M19)} == {SpindleMode.M05: "M5", SpindleMode.M03: "M3",
                                                    SpindleMode.M04: "M4", SpindleMode.M19: "M19"}
-    channel_units = {t.element: t.unit for t in TEMPLATES
+    channel_units = {t.element: t.unit for t in templates()
                      if t.scope in (Scope.CHANNEL, Scope.CHANNEL_AXIS) and scale_of(t.unit)}
     assert set(channel_units) <= set(facts["scales"])
     for leaf, unit in channel_units.items():
