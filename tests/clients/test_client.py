@@ -26,6 +26,7 @@ from cnc_objects.clients import (
 )
 from cnc_objects.clients.transport import EARLY_HANDLES, _Transport
 from cnc_objects.objects.catalog_manual import MANUAL_ROWS
+from cnc_objects.objects.templates import Scope
 from cnc_objects.protocol.constants import AdsState
 from cnc_objects.protocol.frames import Notification
 from cnc_objects.protocol.frames import RawSample as FrameSample
@@ -185,7 +186,7 @@ async def test_browse_describes_objects(api: Any) -> None:
         "ch1.ax1.vel_max",
         "ch1.ax1.acc_max",
         "ch1.ax1.vel_jump_max",
-        *(f"ch1.ax1.{row.element}" for row in MANUAL_ROWS if row.scope == "channel_axis"),
+        *(f"ch1.ax1.{row.element}" for row in MANUAL_ROWS if row.scope == Scope.CHANNEL_AXIS),
         # tools and work offsets: positions in workpiece coordinates, zero offsets
         "ch1.ax1.command_position_pcs",
         "ch1.ax1.actual_position_pcs",

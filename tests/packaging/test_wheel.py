@@ -65,7 +65,8 @@ def test_the_web_hmis_pages_and_command_are_in_the_wheel(wheel: Path) -> None:
         [entry] = [n for n in names if n.endswith(".dist-info/entry_points.txt")]
         text = archive.read(entry).decode()
     assert {"cnc_objects/clients/web/static/index.html",
-            "cnc_objects/clients/web/static/app.js"} <= expected <= names
+            "cnc_objects/clients/web/static/main.js",
+            "cnc_objects/clients/web/static/core.js"} <= expected <= names
     entry_points = configparser.ConfigParser()
     entry_points.read_string(text)
     assert entry_points["console_scripts"]["cnc-web"] == "cnc_objects.clients.web.cli:main"
