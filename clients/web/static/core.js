@@ -115,24 +115,40 @@ export function currentXY(cs = "acs") {
   return x === undefined || y === undefined ? null : [toMm(x), toMm(y)];
 }
 
+// ------------------------------------------------------------------ drawing
+// Writing the text or attribute a node already has still costs the browser a style and
+// layout pass: a frame writes only what changed.
+
+export function setText(node, text) {
+  if (node.textContent !== text) node.textContent = text;
+}
+
+export function setAttr(node, name, value) {
+  if (node.getAttribute(name) !== value) node.setAttribute(name, value);
+}
+
 // ------------------------------------------------------------------ tables
 
 export function cells(row, values) {
   if (row.children.length !== values.length) row.replaceChildren(...values.map(() => el("td")));
   values.forEach((value, k) => {
     const cell = row.children[k];
-    const text = String(value);
-    if (cell.textContent !== text) cell.textContent = text;
+    setText(cell, String(value));
     if (typeof value === "string" && /^-?\d+\.\d+$/.test(value)) cell.className = "num";
   });
 }
 
+const tableRows = new WeakMap(); // tbody -> Map(key -> row): no query per row and frame
+
 export function rowFor(tbody, key) {
-  let row = tbody.querySelector(`tr[data-key="${CSS.escape(key)}"]`);
-  if (!row) {
+  if (!tableRows.has(tbody)) tableRows.set(tbody, new Map());
+  const rows = tableRows.get(tbody);
+  let row = rows.get(key);
+  if (!row || row.parentNode !== tbody) {
     row = el("tr");
     row.dataset.key = key;
     tbody.append(row);
+    rows.set(key, row);
   }
   return row;
 }

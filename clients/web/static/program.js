@@ -2,7 +2,7 @@
 // shown (a window of its lines), select / start / syntax check / dry run, and its tool
 // path; in step with the channel's running program.
 
-import { $, api, currentXY, el, facts, named, say, sizeText, state, v, working } from "./core.js";
+import { $, api, currentXY, el, facts, named, say, setText, sizeText, state, v, working } from "./core.js";
 import { definePage } from "./router.js";
 import { WINDOW_LEAD, fetchLines, goToLine, lines, showWindow, windowFirst } from "./program_lines.js";
 import { clearLive, clearPlanned, drawPath, pathFrame, setPlanned } from "./toolpath.js";
@@ -140,10 +140,10 @@ function renderProgramPage() {
     else showProgram(active).catch(() => {}).finally(() => { shown.following = false; });
   }
   const here = currentXY(pathFrame().name.startsWith("workpiece") ? "pcs" : "acs");
-  if (here) $("#position-line").textContent = `X ${here[0].toFixed(4)}  Y ${here[1].toFixed(4)} mm`;
-  $("#program-state").textContent = named(facts.states, v(`${c}.mc_active_state_r`));
+  if (here) setText($("#position-line"), `X ${here[0].toFixed(4)}  Y ${here[1].toFixed(4)} mm`);
+  setText($("#program-state"), named(facts.states, v(`${c}.mc_active_state_r`)));
   const block = v(`${c}.actual_block_number`);
-  $("#program-block").textContent = block === undefined || block < 0 ? "-" : `N${block} line ${v(`${c}.mc_active_line_r`)}`;
+  setText($("#program-block"), block === undefined || block < 0 ? "-" : `N${block} line ${v(`${c}.mc_active_line_r`)}`);
   const items = $("#program-text").children;
   const line = v(`${c}.mc_active_file_name_r`) === state.program ? v(`${c}.mc_active_line_r`) : null;
   const first = windowFirst();

@@ -3,16 +3,18 @@
 // an offset is in effect. The path run so far is recorded every frame whatever page is
 // shown (cheap); it is drawn only on the program page.
 
-import { $, currentXY, state, v, working } from "./core.js";
+import { $, currentXY, setAttr, state, v, working } from "./core.js";
 import { onChannel, onEveryFrame } from "./router.js";
 
-const LIVE_POINTS_MAX = 5000;
+const LIVE_POINTS_MAX = 5000;  // the oldest points of a longer run are dropped,
+const LIVE_POINTS_KEPT = 4000; // a thousand at a time (the polyline is redrawn then)
 const path = {
   planned: null,  // {x: [], y: []} of the planned tool path (machine coordinates)
   live: [],       // [x, y] machine positions of the tool while a program runs
   extent: null,   // [minX, minY, maxX, maxY] of the view: grows, never shrinks
   extentKey: null,
   gridKey: null,
+  drawn: { view: null, planned: null, live: null, liveCount: 0, liveText: "" }, // polylines drawn
 };
 
 // What lies between machine and workpiece coordinates now (zero offset and tool
@@ -32,7 +34,7 @@ function recordLivePath() {
   const last = path.live[path.live.length - 1];
   if (!last || last[0] !== here[0] || last[1] !== here[1]) {
     path.live.push(here);
-    if (path.live.length > LIVE_POINTS_MAX) path.live.splice(0, path.live.length - LIVE_POINTS_MAX);
+    if (path.live.length > LIVE_POINTS_MAX) path.live = path.live.slice(-LIVE_POINTS_KEPT);
   }
 }
 onEveryFrame(recordLivePath);
@@ -92,12 +94,31 @@ export function drawPath() {
   const sx = (x) => PLOT.left + PLOT.width / 2 + (x - cx) * scale;
   const sy = (y) => PLOT.top + PLOT.height / 2 - (y - cy) * scale;
   drawGrid(frame.name, scale, cx, cy, sx, sy);
-  const line = (pts) => pts.map(([x, y]) => `${sx(x).toFixed(2)},${sy(y).toFixed(2)}`).join(" ");
-  $("#path-planned").setAttribute("points", line(planned));
-  $("#path-live").setAttribute("points", line(live));
+  const point = ([x, y]) => `${sx(x).toFixed(2)},${sy(y).toFixed(2)}`;
+  // The polylines are drawn again only when the view or the path changed; a path run
+  // further in the same view only gets its new points.
+  const drawn = path.drawn;
+  const view = `${key} ${scale} ${cx} ${cy}`;
+  if (drawn.view !== view || drawn.planned !== path.planned) {
+    $("#path-planned").setAttribute("points", planned.map(point).join(" "));
+    drawn.planned = path.planned;
+  }
+  const liveBefore = drawn.liveText;
+  if (drawn.view !== view || drawn.live !== path.live || live.length < drawn.liveCount) {
+    drawn.liveText = live.map(point).join(" ");
+  } else if (live.length > drawn.liveCount) {
+    const more = live.slice(drawn.liveCount).map(point).join(" ");
+    drawn.liveText = drawn.liveText ? `${drawn.liveText} ${more}` : more;
+  }
+  drawn.view = view;
+  drawn.live = path.live;
+  drawn.liveCount = live.length;
+  if (drawn.liveText !== liveBefore) {
+    $("#path-live").setAttribute("points", drawn.liveText);
+  }
   if (here) {
-    $("#path-tool").setAttribute("cx", sx(here[0]).toFixed(2));
-    $("#path-tool").setAttribute("cy", sy(here[1]).toFixed(2));
+    setAttr($("#path-tool"), "cx", sx(here[0]).toFixed(2));
+    setAttr($("#path-tool"), "cy", sy(here[1]).toFixed(2));
   }
 }
 
