@@ -156,6 +156,10 @@ class ProgramRun:
         self._buffer_warned = False  # BUFFER_LIMITS_SPEED shown in this run
         self._pending_error: ErrorEntry | None = None  # takes effect where the path stops
         self._fed_all = False
+        # manual blocks of a plain MDI run finished but not shown yet: they are counted
+        # with the run's end, so that a client that waits on the count finds the channel
+        # ready for the next manual block (the decoder's end may come cycles later)
+        self._manual_done_at_end = 0
         self._technology_part: Block | None = None  # the last pre/post block finished
         self.failure: ErrorEntry | None = None
         if contour is not None:
@@ -254,6 +258,9 @@ class ProgramRun:
                 self.contour.distance_cleared()  # mode 2 answers in the new distances
             if self.feed.is_marker(block):
                 manual_done += 1
+        if manual_done and not self.feed.keep_open:
+            self._manual_done_at_end += manual_done
+            manual_done = 0
         shown = step.current or (step.finished[-1] if step.finished else None)
         if shown is not None and not self.feed.is_marker(shown):
             src = shown.source
@@ -274,7 +281,7 @@ class ProgramRun:
             executor.resume()  # not a block of the program: single block goes on
         stopped = step.stopped_at
         if stopped is not None and stopped.stop == StopKind.PROGRAM_END:
-            return Step.ENDED
+            return self._ended()
         # M0/M1 or a single-block stop: the path stands at a block end until START.
         waiting_for_start = ch.state == ChannelState.ACTIVE and executor.waiting in (
             Waiting.PROGRAMMED_STOP, Waiting.SINGLE_BLOCK,
@@ -285,10 +292,20 @@ class ProgramRun:
             if self._pending_error is not None:
                 return self._fail(self._pending_error)
             if self._fed_all:
-                return Step.ENDED
+                return self._ended()
             if ch.mode == ChannelMode.MDI and self.feed.keep_open:
                 return Step.WAITING  # extended MDI: waiting for the next manual block
         return Step.BUSY
+
+    def _ended(self) -> Step:
+        """The run has ended: the manual blocks it held back are counted now, in the
+        same cycle as the channel's return to READY."""
+        if self._manual_done_at_end:
+            block = self.channel.block
+            self.channel.block = block._replace(
+                manual_blocks_done=block.manual_blocks_done + self._manual_done_at_end)
+            self._manual_done_at_end = 0
+        return Step.ENDED
 
     def _show_cycles(self, step: StepResult, time_s: float, cycles: int, output: bool) -> None:
         """What every cycle shows, stepped or the last of a bulk (``cruise``): the path's
