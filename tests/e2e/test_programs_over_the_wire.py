@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
@@ -23,13 +24,13 @@ def machine() -> Iterator[ServiceProcess]:
 
 
 @pytest.fixture
-def c(machine):
+def c(machine: ServiceProcess) -> Iterator[Client]:
     with Client(machine.endpoint, timeout_s=10) as client:
         client.reset(1)
         yield client
 
 
-def test_store_upload_list_download_delete(c) -> None:
+def test_store_upload_list_download_delete(c: Client) -> None:
     c.upload("square.nc", SQUARE.encode())
     assert ("square.nc", len(SQUARE)) in [(p.name, p.size_bytes) for p in c.programs()]
     assert c.download("square.nc") == SQUARE.encode()
@@ -41,7 +42,7 @@ def test_store_upload_list_download_delete(c) -> None:
     ("name", "code"),
     [("../etc/passwd", 0x706), ("a/b.nc", 0x706), ("x" * 90, 0x706), ("", 0x706)],
 )
-def test_bad_names_are_refused_and_change_nothing(c, name, code) -> None:
+def test_bad_names_are_refused_and_change_nothing(c: Client, name: str, code: int) -> None:
     before = c.programs()
     with pytest.raises(AdsError) as info:
         c.upload(name, b"M30\n")
@@ -50,13 +51,13 @@ def test_bad_names_are_refused_and_change_nothing(c, name, code) -> None:
     assert c.programs() == before
 
 
-def test_a_program_larger_than_a_frame_goes_in_chunks(c) -> None:
+def test_a_program_larger_than_a_frame_goes_in_chunks(c: Client) -> None:
     c.upload("big.nc", b"M30\n")
     c.upload("big.nc", b";" * (PROGRAM_MAX_BYTES + 1))  # in chunks, replacing the old
     assert ("big.nc", PROGRAM_MAX_BYTES + 1) in [(p.name, p.size_bytes) for p in c.programs()]
 
 
-def test_missing_program_is_not_found(c) -> None:
+def test_missing_program_is_not_found(c: Client) -> None:
     with pytest.raises(AdsError) as info:
         c.download("nothing.nc")
     assert info.value.code == 0x70C
@@ -65,13 +66,13 @@ def test_missing_program_is_not_found(c) -> None:
     assert info.value.code == 0x70C
 
 
-def test_unknown_store_offset(c) -> None:
+def test_unknown_store_offset(c: Client) -> None:
     with pytest.raises(AdsError) as info:
         c.read_raw(CncPort.COM, PROGRAM_STORE_GROUP, 99, 100)
     assert info.value.code == 0x703
 
 
-def test_run_square_and_read_the_objects(c) -> None:
+def test_run_square_and_read_the_objects(c: Client) -> None:
     c.upload("square.nc", SQUARE.encode())
     s = run_program(c, "square.nc", timeout_s=30)
     assert (s.mode, s.state, s.program) == ("AUTOMATIC", "READY", "square.nc")
@@ -83,7 +84,7 @@ def test_run_square_and_read_the_objects(c) -> None:
     assert values["ch1.dist_prog_start"] == pytest.approx(40 * 10_000, abs=1)
 
 
-def test_error_is_readable_through_objects(c) -> None:
+def test_error_is_readable_through_objects(c: Client) -> None:
     c.upload("bad.nc", b"G1 X10 F600\nG1 Y10 Q7\nM30\n")
     c.run_program("bad.nc")
     with pytest.raises(ChannelError) as info:
@@ -109,7 +110,7 @@ def test_error_is_readable_through_objects(c) -> None:
     assert "errors-ch1.log" not in [p.name for p in c.programs()]
 
 
-def test_start_without_program_is_refused_with_a_reason(c) -> None:
+def test_start_without_program_is_refused_with_a_reason(c: Client) -> None:
     c.mdi("G0 X0")  # MDI mode: START has nothing selected
     c.wait_program(1, timeout_s=30)
     with pytest.raises(AdsError) as info:
@@ -118,7 +119,7 @@ def test_start_without_program_is_refused_with_a_reason(c) -> None:
     assert "READY" in str(info.value)
 
 
-def test_hold_and_resume_over_the_wire(c) -> None:
+def test_hold_and_resume_over_the_wire(c: Client) -> None:
     # 30 min of machining: the event-speed clock runs a 30 s move in a few ms of wall
     # time, before the HOLD written after START could arrive
     c.upload("long.nc", b"G1 X300 F10\nG0 X0\nM30\n")
@@ -133,7 +134,7 @@ def test_hold_and_resume_over_the_wire(c) -> None:
     assert c.read("ax1.actual_position_acs") == 0
 
 
-def test_cli_run_wait_status(machine, tmp_path) -> None:
+def test_cli_run_wait_status(machine: ServiceProcess, tmp_path: Path) -> None:
     program = tmp_path / "cli.nc"
     program.write_text("G1 X12.5 Y-3 F6000\nM30\n")
     result = cnc("run", str(program), "--wait", "--wait-timeout", "30", endpoint=machine.endpoint)
@@ -151,7 +152,7 @@ def test_cli_run_wait_status(machine, tmp_path) -> None:
     cnc("reset", endpoint=machine.endpoint)
 
 
-def test_cli_wait_reports_the_error(machine, tmp_path) -> None:
+def test_cli_wait_reports_the_error(machine: ServiceProcess, tmp_path: Path) -> None:
     program = tmp_path / "broken.nc"
     program.write_text("G1 X1 F600\nG77\nM30\n")
     result = cnc("run", str(program), "--wait", endpoint=machine.endpoint)
@@ -162,7 +163,7 @@ def test_cli_wait_reports_the_error(machine, tmp_path) -> None:
     assert cnc("reset", endpoint=machine.endpoint).returncode == 0
 
 
-def test_cli_mdi_and_bad_upload(machine, tmp_path) -> None:
+def test_cli_mdi_and_bad_upload(machine: ServiceProcess, tmp_path: Path) -> None:
     result = cnc("mdi", "G90 G1 X3 F600\\nY4", "--wait", endpoint=machine.endpoint)
     assert result.returncode == 0, result.stderr
     status = json_lines(cnc("--json", "status", endpoint=machine.endpoint))[0]
@@ -175,7 +176,7 @@ def test_cli_mdi_and_bad_upload(machine, tmp_path) -> None:
     assert missing.returncode == 2 and "cannot read" in missing.stderr
 
 
-def test_a_manual_block_waited_for_leaves_the_channel_ready_for_the_next(c) -> None:
+def test_a_manual_block_waited_for_leaves_the_channel_ready_for_the_next(c: Client) -> None:
     """``wait_mdi`` returns once the block's run has ended: the next manual block is
     taken at once. Before, the count of finished manual blocks went up when the block
     ended and the channel went back to READY only when the decoder's end arrived, a
@@ -192,7 +193,7 @@ def test_a_manual_block_waited_for_leaves_the_channel_ready_for_the_next(c) -> N
     assert c.read("ch1.mc_active_state_r") == ChannelState.READY
 
 
-def test_cli_lists_downloads_and_deletes_output_files(machine, c) -> None:
+def test_cli_lists_downloads_and_deletes_output_files(machine: ServiceProcess, c: Client) -> None:
     c.wait_mdi(c.mdi('#FILE NAME [MSG="cli-out.txt"]\n#MSG SAVE ["hello %d", 7]'), timeout_s=30)
     ep = machine.endpoint
     listed = cnc("outputs", endpoint=ep)

@@ -52,13 +52,13 @@ def turn_np(axis: tuple[float, float, float], deg: float) -> np.ndarray:
     u = np.array(axis, dtype=float) / np.linalg.norm(axis)
     k = np.array([[0, -u[2], u[1]], [u[2], 0, -u[0]], [-u[1], u[0], 0]])
     t = math.radians(deg)
-    return np.eye(3) + math.sin(t) * k + (1 - math.cos(t)) * k @ k
+    return np.asarray(np.eye(3) + math.sin(t) * k + (1 - math.cos(t)) * k @ k, dtype=np.float64)
 
 
 def about_line(axis: tuple[float, float, float], point: tuple[float, float, float],
                deg: float, p: np.ndarray) -> np.ndarray:
     q = np.array(point)
-    return turn_np(axis, deg) @ (p - q) + q
+    return np.asarray(turn_np(axis, deg) @ (p - q) + q, dtype=np.float64)
 
 
 def table_ac_model(x: float, y: float, z: float, a: float, c: float,
