@@ -209,6 +209,10 @@ class _ChAx:
         return self._prefix + "axis_name"
 
     @property
+    def axis_type(self) -> str:
+        return self._prefix + "axis_type"
+
+    @property
     def command_position_acs(self) -> str:
         return self._prefix + "command_position_acs"
 

@@ -307,6 +307,11 @@ CORE_TEMPLATES: tuple[ObjectTemplate, ...] = (
         "axis_name", Scope.CHANNEL_AXIS, COM, COM_CH, 0x02, STRING(16), R, "-",
         "Name of the channel axis",
     ),
+    ObjectTemplate(
+        "axis_type", Scope.CHANNEL_AXIS, COM, COM_CH, 0x03, UNS16, R, "-",
+        "kenngr.achs_typ (P-AXIS-00018): 1 translatory (positions 0.1 um), 2 rotary "
+        "(positions 0.0001 degree)",
+    ),
     # --- COM platform (project offsets; found by name through the directory) -------------
     ObjectTemplate(
         "cnc_version_r", Scope.PLATFORM, COM, COM_CH, 0x1001, STRING(32), R, "-",

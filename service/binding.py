@@ -52,7 +52,7 @@ from .kernel.kernel import Kernel, ResetCycleStats
 from .kernel.state import DecoderFlag
 from .kernel.step_clock import StepCycles
 from .kernel.tooling import tool_list_size
-from .machine_config import MachineConfig
+from .machine_config import AXIS_TYPE_CODES, MachineConfig
 from .notifications import NotificationCounts
 from .param_list import ParamListError, parse_axis_list
 
@@ -91,6 +91,13 @@ def _channel_axis(attr: str) -> Callable[[Kernel, CncObject], Getter]:
         return lambda: getattr(kernel.snapshot.channels[ci].axes[ai], attr)
 
     return bind
+
+
+def _axis_type(kernel: Kernel, obj: CncObject) -> Getter:
+    """kenngr.achs_typ of a channel axis: its configuration, fixed while running."""
+    axis = kernel.config.channels[kernel.channel_index(obj.channel)].axes[obj.axis - 1]
+    code = AXIS_TYPE_CODES[axis.axis_type]
+    return lambda: code
 
 
 def _physical_axis(attr: str) -> Callable[[Kernel, CncObject], Getter]:
@@ -357,6 +364,7 @@ READERS: dict[str, Callable[[Kernel, CncObject], Getter]] = {
     "link_to_logical_axis": _physical_axis("linked_logical_axis"),
     "axis_name": _per_scope(_physical_axis("name"), _channel_axis("name")),
     "logical_axis_number": _channel_axis("logical_number"),
+    "axis_type": _axis_type,
     "remaining_path_in_block": _scaled("path.remaining_in_block_mm", UM01_PER_MM),
     "actual_path_velocity": _scaled("path.path_velocity_mm_s", 1e3),
     "programmed_path_velocity": _scaled("path.programmed_velocity_mm_s", 1e3),

@@ -70,6 +70,10 @@ class PhysicalAxisConfig(Strict):
     name: str = Field(min_length=1, max_length=15)
 
 
+AXIS_TYPE_CODES: dict[str, int] = {"linear": 1, "rotary": 2}
+"""ISG's codes of kenngr.achs_typ (ACHSTYP_TRANSLATOR, ACHSTYP_ROTATOR)."""
+
+
 class AxisConfig(Strict):
     """A logical axis of a channel: its name there and its axis parameter list.
 
@@ -86,7 +90,10 @@ class AxisConfig(Strict):
     clone_of: int | None = Field(
         None, ge=1, le=0xFFFE, description="kopf.clone_of (P-AXIS-00040)"
     )
-    axis_type: Literal["linear"] = Field("linear", description="kenngr.achs_typ (P-AXIS-00018)")
+    axis_type: Literal["linear", "rotary"] = Field(
+        "linear", description="kenngr.achs_typ (P-AXIS-00018): a rotary axis is "
+        "programmed, limited and shown in degrees (its limits' _mm values are degrees), "
+        "and tracks the main axes (docs/kernel.md \"Rotary axes\")")
     auto_release_of_axis_link: bool = Field(
         False, description="kenngr.auto_release_of_axis_link (P-AXIS-00483)"
     )

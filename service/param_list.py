@@ -285,10 +285,6 @@ def parse_axis_list(text: str, source: str) -> dict[str, Any]:
         if item.value is _INVALID:
             continue
         if item.key == "kenngr.achs_typ":
-            if item.value == _ROTARY:
-                problems.append(Problem(source, item.line, "rotary axes (kenngr.achs_typ 2) "
-                                        "are not supported by this kernel"))
-                continue
             if item.value == _SPINDLE:
                 # A spindle clone is refused by ISG itself; saying so is the more useful
                 # message, as dropping clone_of alone would not make the list acceptable.
@@ -297,7 +293,7 @@ def parse_axis_list(text: str, source: str) -> dict[str, Any]:
                            "spindle axes (kenngr.achs_typ 4) are not supported by this kernel")
                 problems.append(Problem(source, item.line, message))
                 continue
-            _store(result, item.param.field, "linear")
+            _store(result, item.param.field, "rotary" if item.value == _ROTARY else "linear")
             continue
         _store(result, item.param.field, item.value)
     if problems:

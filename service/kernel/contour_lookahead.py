@@ -65,8 +65,19 @@ class RequestError(ValueError):
     """A request the CNC cannot answer (the semaphore write is refused)."""
 
 
+def _unit(v: Sequence[float]) -> Sequence[float]:
+    norm = math.sqrt(sum(x * x for x in v))
+    if norm == 0.0 or abs(norm - 1.0) <= 1e-12:
+        return v  # a unit vector already: left exactly as it is
+    return [x / norm for x in v]
+
+
 def tangent_angle_rad(a: Sequence[float], b: Sequence[float]) -> float:
-    """Angle between unit vectors ``a`` and ``b`` in [0, pi], exact near 0 and pi."""
+    """Angle between unit vectors ``a`` and ``b`` in [0, pi], exact near 0 and pi.
+
+    A line that moves tracking axes besides the main axes has a tangent longer than 1
+    (its motion per mm of path, ``geometry.Line``): such tangents are made unit first."""
+    a, b = _unit(a), _unit(b)
     diff = math.sqrt(sum((x - y) * (x - y) for x, y in zip(a, b, strict=True)))
     total = math.sqrt(sum((x + y) * (x + y) for x, y in zip(a, b, strict=True)))
     return 2.0 * math.atan2(diff, total)

@@ -8,6 +8,7 @@ from __future__ import annotations
 #: (16 active + 32 history slots); wait reason and its text per channel: 2 x 2). A change
 #: is deliberate: count it here. The cycle thread's scheduling (issue 30): 3. Issue 36's
 #: operator objects: 2 channels x (14 COM + 4 HLI program_block_ignore), distance to go
-#: per axis 6, settings 3; tool name/wear/life: 2 channels x 32 rows x 5.
+#: per axis 6, settings 3; tool name/wear/life: 2 channels x 32 rows x 5. Issue 39: the
+#: axis type per channel axis, 6.
 DEFAULT_MACHINE_OBJECTS = (1004 + 350 + 108 + 278 + 6 + 1 + 6 + 13 * (16 + 32) + 2 * 2 + 3
-                           + 2 * (14 + 4) + 6 + 3 + 2 * 32 * 5)
+                           + 2 * (14 + 4) + 6 + 3 + 2 * 32 * 5 + 6)

@@ -32,8 +32,21 @@ def with_plane(base_mm: Sequence[float], plane: tuple[int, int], p: float, q: fl
     return tuple(out)
 
 
+FEED_AXES = 3
+"""The default feed group: the channel's main axes (indices 0, 1, 2)."""
+
+
 class Line:
-    """A straight line from ``start_mm`` to ``end_mm`` (any number of axes)."""
+    """A straight line from ``start_mm`` to ``end_mm`` (any number of axes).
+
+    Its length, along which the programmed feed acts, is measured over the feed group:
+    ISG's default feed group is the channel's three main axes; every other axis (a
+    rotary axis, a fourth linear axis) is a tracking axis that reaches its end together
+    with them (infosys.beckhoff.com tf5200_programming_manual/207471243.html, #FGROUP;
+    P-CHAN-00011). A line that moves tracking axes only is measured over them (F in
+    degrees/min for a rotary axis, G94). ``direction`` is the axes' motion per mm of
+    path: a unit vector when only main axes move, longer when tracking axes move too.
+    """
 
     __slots__ = ("start_mm", "end_mm", "length_mm", "direction", "_pairs")
 
@@ -41,7 +54,12 @@ class Line:
         start, end = tuple(start_mm), tuple(end_mm)
         self.start_mm: Point = start
         self.end_mm: Point = end
-        self.length_mm = length = math.dist(start, end)
+        length = math.dist(start, end)
+        if len(start) > FEED_AXES and length > 0.0:
+            main = math.dist(start[:FEED_AXES], end[:FEED_AXES])
+            if main > 0.0:
+                length = main
+        self.length_mm = length
         inv = 1.0 / length if length > 0.0 else 0.0
         self.direction: Point = tuple([(e - s) * inv for s, e in zip(start, end)])
         self._pairs = tuple(zip(start, self.direction))
