@@ -45,12 +45,12 @@ WEB_PORT ?= 8080
 run: $(VENV)/.installed $(VENV)/.native
 ifeq ($(WEB),0)
 	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) \
-		$(if $(DATA_DIR),--data-dir $(DATA_DIR)) $(if $(CONFIG),--config $(CONFIG))
+		$(if $(DATA_DIR),--data-dir $(DATA_DIR)) $(if $(CONFIG),--config $(CONFIG)) $(if $(MACHINE),--machine $(MACHINE))
 else
 	$(BIN)/cnc-web --endpoint $(ENDPOINT) --port $(WEB_PORT) & web=$$!; \
 	trap 'kill $$web 2>/dev/null' EXIT INT TERM; \
 	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) \
-		$(if $(DATA_DIR),--data-dir $(DATA_DIR)) $(if $(CONFIG),--config $(CONFIG))
+		$(if $(DATA_DIR),--data-dir $(DATA_DIR)) $(if $(CONFIG),--config $(CONFIG)) $(if $(MACHINE),--machine $(MACHINE))
 endif
 
 # The checkers first (ruff: lint and import order; mypy, strict: tools/typecheck.py), then

@@ -20,7 +20,7 @@ from pydantic import Field, ValidationError
 from .frontend_config import AdsConfig, SecurityConfig
 from .kernel.realtime_priority import DEFAULT_RT_PRIORITY, RT_PRIORITY_MAX
 from .limits import LimitsConfig
-from .machine_config import DEFAULT_MACHINE, MachineConfig, Strict
+from .machine_config import EMBEDDED_MACHINES, EmbeddedMachine, MachineConfig, Strict
 from .param_list import ParamListError, read_axis_list, read_channel_list
 
 
@@ -180,12 +180,13 @@ def _apply_parameter_lists(data: dict[str, Any], base_dir: Path) -> dict[str, An
 
 
 def build_config(
-    overrides: dict[str, Any] | None = None, source: str = "config", base_dir: Path | None = None
+    overrides: dict[str, Any] | None = None, source: str = "config", base_dir: Path | None = None,
+    machine: EmbeddedMachine = EmbeddedMachine.THREE_AXIS,
 ) -> ServiceConfig:
-    """The default machine with ``overrides`` laid over it, validated. Parameter lists
-    the overrides name are read relative to ``base_dir`` (default: the working
-    directory)."""
-    merged = _merge(DEFAULT_MACHINE, overrides or {})
+    """The embedded ``machine`` (``EMBEDDED_MACHINES``; the default machine) with
+    ``overrides`` laid over it, validated. Parameter lists the overrides name are read
+    relative to ``base_dir`` (default: the working directory)."""
+    merged = _merge(EMBEDDED_MACHINES[EmbeddedMachine(machine)], overrides or {})
     if "axis_parameter_lists" in merged or any(
         isinstance(c, dict) and "parameter_list" in c for c in merged.get("channels", [])
     ):
@@ -196,14 +197,15 @@ def build_config(
         raise _explain(exc, source) from None
 
 
-def load_config(path: Path | None) -> ServiceConfig:
-    """Read ``path`` (TOML) over the default machine; the default alone when None."""
+def load_config(path: Path | None,
+                machine: EmbeddedMachine = EmbeddedMachine.THREE_AXIS) -> ServiceConfig:
+    """Read ``path`` (TOML) over the embedded ``machine``; that machine alone when None."""
     if path is None:
-        return build_config()
+        return build_config(machine=machine)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except OSError as exc:
         raise ConfigError(f"{path}: cannot read: {exc.strerror}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from None
-    return build_config(data, str(path), path.parent)
+    return build_config(data, str(path), path.parent, machine)

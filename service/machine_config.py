@@ -7,10 +7,14 @@ depend on front ends, keys or limits. The embedded default machine is ``DEFAULT_
 
 from __future__ import annotations
 
+import copy
 from enum import IntEnum, StrEnum
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from pydantic import AliasChoices, BaseModel, ConfigDict, Field, field_validator, model_validator
+
+if TYPE_CHECKING:
+    from .kernel.path.kinematics import Kinematics
 
 
 class Strict(BaseModel):
@@ -371,6 +375,37 @@ class PlcConfig(Strict):
         return frozenset(int(n[1:]) for n in self.acknowledges if n[0] == letter)
 
 
+class KinematicAxisConfig(Strict):
+    """One axis of a kinematic chain (ISG's Universal Kinematics, P-CHAN-00290 ..
+    P-CHAN-00293), in its order from the workpiece to the tool tip."""
+
+    axis: str = Field(min_length=1, max_length=15, description="the channel axis's name")
+    type: Literal["translator", "rotator"] = Field(
+        description="P-CHAN-00291 trafo[j].axis[k].type: 1 translator, 2 rotator")
+    direction: tuple[float, float, float] = Field(
+        description="P-CHAN-00292 trafo[j].axis[k].orientation: the axis's direction; "
+        "times -1 for an axis on the workpiece side (it moves the workpiece)")
+    point_mm: tuple[float, float, float] = Field(
+        (0.0, 0.0, 0.0), description="P-CHAN-00293 trafo[j].axis[k].point: a point on a "
+        "rotator's line, with every axis at 0 (mm)")
+
+
+class KinematicsConfig(Strict):
+    """A channel's five-axis kinematics (docs/kernel.md "Rotary axes, the feed group and
+    the kinematic chain"): three translators and two rotators of the channel."""
+
+    id: int = Field(91, ge=1, le=0xFFFF, description="P-CHAN-00262 trafo[j].id")
+    zero_orientation: tuple[float, float, float] = Field(
+        (0.0, 0.0, 1.0), description="P-CHAN-00285: the tool's direction (tip towards "
+        "spindle) with every axis at 0")
+    zero_position_mm: tuple[float, float, float] = Field(
+        description="P-CHAN-00286: the tool tip (tool length 0: the spindle nose) with "
+        "every axis at 0 (mm)")
+    axes: tuple[KinematicAxisConfig, ...] = Field(
+        min_length=5, max_length=5, description="P-CHAN-00290: the chain from the "
+        "workpiece to the tool tip")
+
+
 class ChannelConfig(Strict):
     """A channel and its axes."""
 
@@ -417,6 +452,9 @@ class ChannelConfig(Strict):
         default_factory=PlcFunctionsConfig,
         description="M/S/T functions to the PLC and the spindle (docs/spindle-plc.md)",
     )
+    kinematics: KinematicsConfig | None = Field(
+        None, description="the five-axis kinematics #TRAFO ON selects (none: a "
+        "three-axis channel, #TRAFO ON is NC error 20519)")
 
     @field_validator("interpolator_function")
     @classmethod
@@ -449,6 +487,35 @@ class ChannelConfig(Strict):
         if len(set(names)) != len(names):
             raise ValueError(f"axis names repeat in channel {self.id}: {names}")
         return self
+
+    @model_validator(mode="after")
+    def _kinematics_of_this_channel(self) -> ChannelConfig:
+        if self.kinematics is not None:
+            self.kinematic_chain()  # ValueError (KinematicsError) with the reason
+        return self
+
+    def kinematic_chain(self) -> Kinematics | None:
+        """The channel's kinematics as the kernel computes with it (None: none)."""
+        if self.kinematics is None:
+            return None
+        # here, not at the top: the kernel's path package imports this module
+        from .kernel.path.kinematics import ChainAxis, JointKind, Kinematics
+
+        index = {a.name: k for k, a in enumerate(self.axes)}
+        chain = []
+        for link in self.kinematics.axes:
+            if link.axis not in index:
+                raise ValueError(f"kinematics of channel {self.id}: no axis {link.axis!r} "
+                                 f"in the channel (its axes: {', '.join(index)})")
+            axis = self.axes[index[link.axis]]
+            wanted = "linear" if link.type == "translator" else "rotary"
+            if axis.axis_type != wanted:
+                raise ValueError(f"kinematics of channel {self.id}: {link.axis} is a "
+                                 f"{link.type} in the chain but a {axis.axis_type} axis")
+            chain.append(ChainAxis(index[link.axis], JointKind[link.type.upper()],
+                                   link.direction, link.point_mm))
+        return Kinematics.from_chain(self.kinematics.id, self.kinematics.zero_orientation,
+                                     self.kinematics.zero_position_mm, chain)
 
 
 class MachineConfig(Strict):
@@ -577,3 +644,77 @@ DEFAULT_MACHINE: dict[str, Any] = {
         },
     ],
 }
+
+
+def _five_axis(name: str, rotary: tuple[dict[str, Any], dict[str, Any]],
+               kinematics: dict[str, Any]) -> dict[str, Any]:
+    """The default machine with two rotary axes added to channel 1 (drives 4 and 5)
+    and its kinematics; channel 2 stays as it is."""
+    machine = copy.deepcopy(DEFAULT_MACHINE)
+    machine["name"] = name
+    for number, axis in enumerate(rotary, start=4):
+        machine["physical_axes"].append({"number": number, "name": axis["name"]})
+        machine["channels"][0]["axes"].append(
+            {"logical_number": number, "link_to": number, "axis_type": "rotary", **axis})
+    machine["channels"][0]["kinematics"] = kinematics
+    return machine
+
+
+_TRANSLATORS = [
+    {"axis": "X", "type": "translator", "direction": (1.0, 0.0, 0.0)},
+    {"axis": "Y", "type": "translator", "direction": (0.0, 1.0, 0.0)},
+    {"axis": "Z", "type": "translator", "direction": (0.0, 0.0, 1.0)},
+]
+# 60 degrees/s, 600 degrees/s^2: a machine tool's rotary table / head of this size
+_ROTARY_DYNAMICS = {"vel_max_mm_s": 60.0, "acc_max_mm_s2": 600.0, "vel_jump_mm_s": 2.0}
+
+FIVE_AXIS_AC: dict[str, Any] = _five_axis(
+    "cnc-objects-5ax-ac",
+    ({"name": "A", "limits": {**_ROTARY_DYNAMICS, "sw_limit_min_mm": -120.0,
+                              "sw_limit_max_mm": 120.0}},
+     {"name": "C", "limits": {**_ROTARY_DYNAMICS, "sw_limit_min_mm": -36000.0,
+                              "sw_limit_max_mm": 36000.0}}),
+    # a table-table machine: the C table rides on an A cradle whose axis lies 100 mm
+    # below the table's face; X Y Z carry the spindle, whose nose is 300 mm above the
+    # table's centre with every axis at 0. Table axes move the workpiece: directions -1.
+    {"id": 91, "zero_orientation": (0.0, 0.0, 1.0), "zero_position_mm": (0.0, 0.0, 300.0),
+     "axes": [{"axis": "C", "type": "rotator", "direction": (0.0, 0.0, -1.0)},
+              {"axis": "A", "type": "rotator", "direction": (-1.0, 0.0, 0.0),
+               "point_mm": (0.0, 0.0, -100.0)},
+              *_TRANSLATORS]},
+)
+"""A five-axis machine with a table-table A/C kinematics (``--machine five-axis-ac``)."""
+
+FIVE_AXIS_BC: dict[str, Any] = _five_axis(
+    "cnc-objects-5ax-bc",
+    ({"name": "B", "limits": {**_ROTARY_DYNAMICS, "sw_limit_min_mm": -95.0,
+                              "sw_limit_max_mm": 95.0}},
+     {"name": "C", "limits": {**_ROTARY_DYNAMICS, "sw_limit_min_mm": -36000.0,
+                              "sw_limit_max_mm": 36000.0}}),
+    # a head-table machine: a C table, X Y Z carry a head that swivels about Y (B) at a
+    # pivot 150 mm above the spindle nose; the nose is 300 mm above the table's centre
+    # with every axis at 0. The table moves the workpiece: direction -1.
+    {"id": 91, "zero_orientation": (0.0, 0.0, 1.0), "zero_position_mm": (0.0, 0.0, 300.0),
+     "axes": [{"axis": "C", "type": "rotator", "direction": (0.0, 0.0, -1.0)},
+              *_TRANSLATORS,
+              {"axis": "B", "type": "rotator", "direction": (0.0, 1.0, 0.0),
+               "point_mm": (0.0, 0.0, 450.0)}]},
+)
+"""A five-axis machine with a head-table B/C kinematics (``--machine five-axis-bc``)."""
+
+
+
+class EmbeddedMachine(StrEnum):
+    """The machines ``cnc-service --machine NAME`` starts on."""
+
+    THREE_AXIS = "three-axis"  # the default
+    FIVE_AXIS_AC = "five-axis-ac"
+    FIVE_AXIS_BC = "five-axis-bc"
+
+
+EMBEDDED_MACHINES: dict[EmbeddedMachine, dict[str, Any]] = {
+    EmbeddedMachine.THREE_AXIS: DEFAULT_MACHINE,
+    EmbeddedMachine.FIVE_AXIS_AC: FIVE_AXIS_AC,
+    EmbeddedMachine.FIVE_AXIS_BC: FIVE_AXIS_BC,
+}
+"""Each embedded machine's configuration (``--config`` is laid over it)."""

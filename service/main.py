@@ -1,6 +1,6 @@
 """``cnc-service``: the composition root. Builds kernel, address space and servers, runs them.
 
-    cnc-service [--config FILE] [--endpoint URL] [--ads HOST[:PORT]|off] [--ams-net-id ID]
+    cnc-service [--config FILE] [--machine NAME] [--endpoint URL] [--ads HOST[:PORT]|off] [--ams-net-id ID]
                 [--keys DIR] [--insecure]
                 [--clock realtime|virtual|virtual-step|step] [--speed X] [--cycle-ms MS]
                 [--samples latest|repeatable]
@@ -60,6 +60,7 @@ from .kernel.realtime_priority import DEFAULT_RT_PRIORITY, RT_PRIORITY_MAX, serv
 from .kernel.state import Snapshot
 from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
 from .limits import notification_limits, rate_limiter
+from .machine_config import EmbeddedMachine
 from .notifications import NotificationCounts
 from .output_service import OutputService
 from .program_service import ProgramStoreService
@@ -327,6 +328,11 @@ def run(
     cycle_ms: float | None = typer.Option(
         None, "--cycle-ms", metavar="MS", help="Cycle time in ms (overrides the configuration).",
     ),
+    machine: EmbeddedMachine = typer.Option(
+        EmbeddedMachine.THREE_AXIS, "--machine",
+        help="Embedded machine that --config is laid over: three-axis (X Y Z), "
+        "five-axis-ac (table-table A/C) or five-axis-bc (head-table B/C).",
+    ),
     samples: SampleMode | None = typer.Option(
         None, "--samples",
         help="How subscriptions are sampled: latest (the kernel never waits for a reader) "
@@ -387,7 +393,7 @@ def run(
     )
     if speed is not None and (clock is ClockKind.REALTIME or speed <= 0):
         _usage("--speed takes a positive factor and needs --clock virtual or virtual-step")
-    config = _machine_config(config_file, cycle_ms)
+    config = _machine_config(config_file, cycle_ms, machine)
     if rt_priority is not None:  # typer checked the range
         config = config.model_copy(update={"rt_priority": rt_priority})
     if samples is not None:
@@ -464,10 +470,11 @@ def _ads_listen(
                      open_to_all=insecure and not local and not config.ads.routes)
 
 
-def _machine_config(path: Path | None, cycle_ms: float | None) -> ServiceConfig:
-    """The configuration file over the default machine, ``--cycle-ms`` over both."""
+def _machine_config(path: Path | None, cycle_ms: float | None,
+                    machine: EmbeddedMachine = EmbeddedMachine.THREE_AXIS) -> ServiceConfig:
+    """The configuration file over the embedded machine, ``--cycle-ms`` over both."""
     try:
-        config = load_config(path)
+        config = load_config(path, machine)
         if cycle_ms is not None:
             config = ServiceConfig.model_validate({**config.model_dump(), "cycle_ms": cycle_ms})
     except ConfigError as exc:

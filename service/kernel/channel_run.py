@@ -147,7 +147,9 @@ class ChannelRunner:
             show_message=self._messages.append,
             hscs={mode.upper(): HscProgram(c.prog, c.tolerance / UM01_PER_MM)
                   for mode, c in config.hscs},
-            kinematics=False,  # this kernel configures no kinematic transformation
+            kinematics=False,  # this kernel builds no kinematic transformation yet
+            kinematics_without_trafo=(None if config.kinematics is None
+                                      else config.kinematics.id),
             idle_steps_max=services.idle_steps_max,
         )
         self._programs_need_referenced_axes = machine.programs_need_referenced_axes

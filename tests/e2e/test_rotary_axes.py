@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from cnc_objects.clients import Client
+from cnc_objects.clients import ChannelError, Client
 from cnc_objects.testing import run_program
-from tests.support.service import RunningService, serving_config
+from tests.support.service import RunningService, serving, serving_config
 
 MACHINE = """
 [[physical_axes]]
@@ -92,3 +92,23 @@ def test_c_alone_turns_at_f_degrees_per_minute(client: Client) -> None:
     assert client.read("ch1.dist_prog_start") == pytest.approx(45 * TENTH_UM_PER_MM)
     # 45 degrees at 30 degrees/s, plus reaching and leaving that speed
     assert client.read("ch1.program_time") == pytest.approx(1.5, abs=0.05)
+
+
+def test_the_five_axis_machine_moves_its_rotary_axes_and_refuses_trafo_on() -> None:
+    with serving("--machine", "five-axis-ac") as service, \
+            Client(service.endpoint, timeout_s=10) as c:
+        assert [c.read(f"ch1.ax{a}.axis_name") for a in range(1, 6)] == list("XYZAC")
+        assert [c.read(f"ch1.ax{a}.axis_type") for a in range(1, 6)] == [1, 1, 1, 2, 2]
+        c.upload("tilt.nc", b"G90 G01 X10 A30 C90 F600\nM30\n")
+        status = run_program(c, "tilt.nc")
+        assert (status.positions_mm["A"], status.positions_mm["C"]) == pytest.approx(
+            (30.0, 90.0))
+        c.upload("rtcp.nc", b"#TRAFO ON\nG01 X20 A45 F600\nM30\n")
+        with pytest.raises(ChannelError) as caught:
+            run_program(c, "rtcp.nc")
+        assert len(caught.value.errors) == 1
+        assert caught.value.errors[0].startswith("error 20500: rtcp.nc:1:1:")
+        assert "kinematics (ID 91) is configured, but the kinematic transformation is " \
+            "not built yet" in caught.value.errors[0]
+        after = c.status(1).positions_mm  # the program stopped before its first motion
+        assert (after["X"], after["A"]) == pytest.approx((10.0, 30.0))

@@ -227,6 +227,13 @@ def _tolerance(stmt: Instruction, decoder: CallingDecoder, key: str) -> float:
 
 
 def _trafo(stmt: Instruction, decoder: CallingDecoder) -> None:
+    kinematics = decoder.surroundings.kinematics_without_trafo
+    if stmt.on and kinematics is not None:
+        raise stmt.line.error(
+            NcErrorId.INSTRUCTION_NOT_SUPPORTED,
+            f"#TRAFO ON: this channel's kinematics (ID {kinematics}) is configured, but "
+            "the kinematic transformation is not built yet (issue 39): program the "
+            "machine axes", stmt.pos)
     decoder.modal.settings.trafo = stmt.on
 
 

@@ -75,4 +75,8 @@ class Surroundings:
     show_message: Callable[[str], None] = _ignore
     hscs: Mapping[str, HscProgram] = field(default_factory=dict)
     kinematics: bool = False
+    # the channel has a five-axis kinematics configured (its ID), but the transformation
+    # that #TRAFO ON selects is not built yet: #TRAFO ON is refused rather than run
+    # without it (the tool tip would not be where the program says)
+    kinematics_without_trafo: int | None = None
     idle_steps_max: int | None = None  # the endless-program guard; None: IDLE_STEPS_MAX

@@ -56,7 +56,7 @@ class JointKind(enum.IntEnum):
     ROTATOR = 2
 
 
-class KinematicsError(Exception):
+class KinematicsError(ValueError):
     """The chain is not a five-axis machine, or a pose cannot be reached."""
 
 

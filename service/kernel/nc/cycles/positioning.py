@@ -111,12 +111,17 @@ def _rotation(context: CycleContext) -> Matrix:
 def _run(context: CycleContext) -> str | None:
     p = context.params
     mode = int(p[1])
-    if mode in (1, 2) and not context.decoder.surroundings.kinematics:
+    surroundings = context.decoder.surroundings
+    if mode in (1, 2) and not surroundings.kinematics:
+        why = ("none is configured for this channel"
+               if surroundings.kinematics_without_trafo is None else
+               f"this channel's kinematics (ID {surroundings.kinematics_without_trafo}) is "
+               "configured, but its transformation is not built yet (issue 39)")
         raise context.error(
             NcErrorId.TRAFO_NOT_CONFIGURED,
             f"SysPosRotationToPlane.ecy @P1={mode} rotates the tool, which needs a kinematic "
-            "transformation; none is configured for this channel (use @P1=3 to rotate only "
-            "the machining coordinate system)", 1)
+            f"transformation; {why} (use @P1=3 to rotate only the machining coordinate "
+            "system)", 1)
     rotation = _rotation(context)
     origin = tuple(float(p[n]) for n in (3, 4, 5))
     a, b, c = angles_from_rotation(rotation, RotationOrder.ZYX, True)
