@@ -300,6 +300,7 @@ def kernel(runs: int) -> None:
     dec = decoder_bench.measure(runs=runs)
     chk = check_bench.measure(runs=min(runs, 3))
     ipo = kernel_bench.measure(runs=min(runs, 3))
+    trafo = kernel_bench.measure_trafo(runs=min(runs, 3))
     plan = planner_bench.measure(runs=min(runs, 3))
     print(f"\n{'measurement':52} {'value':>12} {'ratio':>7}  target")
     print(f"{'decoder, 200,000 lines (lines/s)':52} {dec['decoder_lines_s']:12,.0f} "
@@ -312,6 +313,11 @@ def kernel(runs: int) -> None:
     print(f"{'interpolator, 3-axis program (simulated s / wall s)':52} "
           f"{ipo['sim_per_wall']:12.1f} {'':7}  >= 50: "
           f"{'met' if ipo['sim_per_wall'] >= 50 else 'NOT met'}")
+    for unit in ("cycle", "block"):
+        label = f"#TRAFO ON, 5-axis A/C lines (us per {unit})"
+        print(f"{label:52} {trafo[f'trafo_us_per_{unit}']:12.2f} "
+              f"{trafo[f'{unit}_ratio']:7.2f}  of the same lines without #TRAFO "
+              f"({trafo[f'plain_us_per_{unit}']:.2f} us)")
     for name, label in (("spiral", "spiral 10,000 x 0.05 mm F6000"),
                         ("pocket", "pocket, 90 deg corners")):
         ratio = plan[f"{name}_ratio"]

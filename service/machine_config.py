@@ -512,6 +512,10 @@ class ChannelConfig(Strict):
             if axis.axis_type != wanted:
                 raise ValueError(f"kinematics of channel {self.id}: {link.axis} is a "
                                  f"{link.type} in the chain but a {axis.axis_type} axis")
+            if link.type == "translator" and link.axis not in "XYZ":
+                raise ValueError(f"kinematics of channel {self.id}: the translators are the "
+                                 f"main axes X, Y, Z (they hold the tool tip), not "
+                                 f"{link.axis}")
             chain.append(ChainAxis(index[link.axis], JointKind[link.type.upper()],
                                    link.direction, link.point_mm))
         return Kinematics.from_chain(self.kinematics.id, self.kinematics.zero_orientation,
@@ -675,9 +679,10 @@ FIVE_AXIS_AC: dict[str, Any] = _five_axis(
      {"name": "C", "limits": {**_ROTARY_DYNAMICS, "sw_limit_min_mm": -36000.0,
                               "sw_limit_max_mm": 36000.0}}),
     # a table-table machine: the C table rides on an A cradle whose axis lies 100 mm
-    # below the table's face; X Y Z carry the spindle, whose nose is 300 mm above the
-    # table's centre with every axis at 0. Table axes move the workpiece: directions -1.
-    {"id": 91, "zero_orientation": (0.0, 0.0, 1.0), "zero_position_mm": (0.0, 0.0, 300.0),
+    # below the table's face; X Y Z carry the spindle, whose nose (tool length 0) is at
+    # the table's centre with every axis at 0, as a three-axis channel's positions have
+    # it. Table axes move the workpiece: directions -1.
+    {"id": 91, "zero_orientation": (0.0, 0.0, 1.0), "zero_position_mm": (0.0, 0.0, 0.0),
      "axes": [{"axis": "C", "type": "rotator", "direction": (0.0, 0.0, -1.0)},
               {"axis": "A", "type": "rotator", "direction": (-1.0, 0.0, 0.0),
                "point_mm": (0.0, 0.0, -100.0)},
@@ -692,13 +697,13 @@ FIVE_AXIS_BC: dict[str, Any] = _five_axis(
      {"name": "C", "limits": {**_ROTARY_DYNAMICS, "sw_limit_min_mm": -36000.0,
                               "sw_limit_max_mm": 36000.0}}),
     # a head-table machine: a C table, X Y Z carry a head that swivels about Y (B) at a
-    # pivot 150 mm above the spindle nose; the nose is 300 mm above the table's centre
-    # with every axis at 0. The table moves the workpiece: direction -1.
-    {"id": 91, "zero_orientation": (0.0, 0.0, 1.0), "zero_position_mm": (0.0, 0.0, 300.0),
+    # pivot 150 mm above the spindle nose; the nose is at the table's centre with every
+    # axis at 0. The table moves the workpiece: direction -1.
+    {"id": 91, "zero_orientation": (0.0, 0.0, 1.0), "zero_position_mm": (0.0, 0.0, 0.0),
      "axes": [{"axis": "C", "type": "rotator", "direction": (0.0, 0.0, -1.0)},
               *_TRANSLATORS,
               {"axis": "B", "type": "rotator", "direction": (0.0, 1.0, 0.0),
-               "point_mm": (0.0, 0.0, 450.0)}]},
+               "point_mm": (0.0, 0.0, 150.0)}]},
 )
 """A five-axis machine with a head-table B/C kinematics (``--machine five-axis-bc``)."""
 

@@ -45,11 +45,12 @@ from .contour_lookahead import ContourLog
 from .decoder_feed import DecoderFeed, Job
 from .manual_mode import ManualMode
 from .nc import ModalState
-from .nc.blocks import LogArea, LookAheadMark, ManualModeRequest
+from .nc.blocks import LogArea, LookAheadMark, ManualModeRequest, TrafoUse
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
 from .nc.tool_data import ToolingTables
 from .path.executor import AxisDynamics, PathExecutor
 from .path.section_plan import plan_section
+from .path_kinematics import PathKinematics
 from .plc_functions import PlcFunctions, show_technology
 from .prod_time_trace import ProdTimeTrace
 from .program_run import (
@@ -147,9 +148,8 @@ class ChannelRunner:
             show_message=self._messages.append,
             hscs={mode.upper(): HscProgram(c.prog, c.tolerance / UM01_PER_MM)
                   for mode, c in config.hscs},
-            kinematics=False,  # this kernel builds no kinematic transformation yet
-            kinematics_without_trafo=(None if config.kinematics is None
-                                      else config.kinematics.id),
+            kinematics=False,  # SysPosRotationToPlane's tool-turning modes: not yet
+            kinematic_chain=config.kinematic_chain(),
             idle_steps_max=services.idle_steps_max,
         )
         self._programs_need_referenced_axes = machine.programs_need_referenced_axes
@@ -450,10 +450,19 @@ class ChannelRunner:
         dynamics, sw_limits = self._axis_limits()
         self.manual.clear_program()  # a run starts where the axes stand
         position = tuple(a.position_mm for a in ch.axes)
+        kinematics = self._path_kinematics(sw_limits)
+        trafo = None
         if fresh_modal or self._modal is None:
             self._modal = self.new_modal(position)
         else:
             self._modal.position_mm = position
+            if self._modal.settings.trafo and kinematics is not None:
+                # a manual block after one that left #TRAFO ON: it goes on in the
+                # programmed coordinates
+                tool = self._modal.tool_offset
+                trafo = TrafoUse(self._modal.tooling.tools.length_mm(tool) if tool else 0.0)
+                position = kinematics.program_of(position, trafo.tool_length_mm)
+                self._modal.position_mm = position
         feed = DecoderFeed(
             channel_id=ch.channel_id, axes=self._axes, loader=self._loader, tools=self._tools,
             modal=self._modal, capacity=self._buffer_blocks + _FEED_MARGIN_BLOCKS,
@@ -471,8 +480,8 @@ class ChannelRunner:
         if not keep_open:
             feed.finish()
         executor = PathExecutor(
-            dynamics, position, cycle_s=self._cycle_s,
-            buffer_blocks=self._buffer_blocks, sw_limits_mm=sw_limits,
+            dynamics, position, cycle_s=self._cycle_s, buffer_blocks=self._buffer_blocks,
+            sw_limits_mm=None if trafo is not None else sw_limits,
         )
         prod_time = not job.manual and bool(mode & ExecutionMode.PROD_TIME)
         # the machining time calculation runs through without stops
@@ -490,11 +499,12 @@ class ChannelRunner:
             self._run = ProdTimeRun(
                 self, ch, feed, executor, contour, started_at_s=self.time_s,
                 buffer_blocks=self._buffer_blocks, deterministic=self._deterministic,
-                cycle_s=self._cycle_s, trace=trace)
+                cycle_s=self._cycle_s, trace=trace, kinematics=kinematics, trafo=trafo)
         else:
             self._run = ProgramRun(
                 self, ch, feed, executor, contour, started_at_s=self.time_s,
-                buffer_blocks=self._buffer_blocks, deterministic=self._deterministic)
+                buffer_blocks=self._buffer_blocks, deterministic=self._deterministic,
+                kinematics=kinematics, trafo=trafo)
         if contour is not None:
             show_contour_state(ch, contour)
         self._show_start(job)  # state, errors: set by _start_when_linked
@@ -560,6 +570,15 @@ class ChannelRunner:
         # P-AXIS-00705: by default an axis's limits count once it is referenced
         return dynamics, tuple(monitored_limits_mm(p, self.manual.referenced(k))
                                for k, p in enumerate(params))
+
+    def _path_kinematics(self, sw_limits: tuple[tuple[float, float], ...]
+                         ) -> PathKinematics | None:
+        """The channel's kinematics for a run (None: a three-axis channel)."""
+        chain = self._surroundings.kinematic_chain
+        if chain is None:
+            return None
+        x, y, z = (self._axes.index(name) for name in "XYZ")
+        return PathKinematics(chain, (x, y, z), sw_limits, self._axes)
 
     def _begin_check(self, job: Job, mode: int) -> None:
         """Start the syntax check (SYNCHK) or dry run (MACHINE_LOCK) of the program."""

@@ -40,6 +40,7 @@ from .nc.blocks import (
     ManualModeRequest,
     SourceRef,
     StopKind,
+    TrafoUse,
 )
 from .nc.contour import LOOP_MARKERS
 from .operator_switches import with_optional_stop
@@ -47,6 +48,7 @@ from .path.errors import PathErrorId
 from .path.executor import PathError, PathExecutor
 from .path.interpolator import StepResult, Waiting
 from .path.segments import Segment
+from .path_kinematics import PathKinematics
 from .plc_functions import PlcFunctions
 from .prod_time_trace import ProdTimeTrace, trace_file_name
 from .state import BLOCK_START_COLUMN, Channel, ContourLookaheadUnit, ErrorEntry
@@ -138,9 +140,15 @@ class ProgramRun:
 
     def __init__(self, host: RunHost, channel: Channel, feed: DecoderFeed,
                  executor: PathExecutor, contour: ContourLog | None, *,
-                 started_at_s: float, buffer_blocks: int, deterministic: bool) -> None:
-        """``contour``: the contour look-ahead log of this run (None: not configured)."""
+                 started_at_s: float, buffer_blocks: int, deterministic: bool,
+                 kinematics: PathKinematics | None = None,
+                 trafo: TrafoUse | None = None) -> None:
+        """``contour``: the contour look-ahead log of this run (None: not configured);
+        ``kinematics``: the channel's (None: none); ``trafo``: #TRAFO ON is in effect
+        from the start (the executor's position is then in programmed coordinates)."""
         self._host = host
+        self._kinematics = kinematics
+        self._trafo = trafo  # #TRAFO ON: the path's positions are tip and orientation
         self.channel = channel
         self.feed = feed
         self.executor = executor
@@ -323,8 +331,13 @@ class ProgramRun:
         start), its axes' command positions."""
         ch = self.channel
         offsets = self._host.manual_offsets_mm  # G200/G201 (None: no offset)
-        positions = step.position_mm if offsets is None else tuple(
-            p + o for p, o in zip(step.position_mm, offsets, strict=True))
+        positions = step.position_mm
+        if self._trafo is not None and self._kinematics is not None:
+            current = step.current
+            trafo = current.trafo if current is not None and current.trafo else self._trafo
+            positions = self._kinematics.axes_of(positions, trafo.tool_length_mm)
+        if offsets is not None:
+            positions = tuple(p + o for p, o in zip(positions, offsets, strict=True))
         for axis, pos in zip(ch.axes, positions, strict=True):
             axis.position_mm = pos
             axis.command_position_01um = round(pos * UM01_PER_MM)
@@ -388,6 +401,9 @@ class ProgramRun:
             block_count=ch.block.block_count + 1)
         if self.contour is not None:
             self.contour.count_block()
+        if block.trafo_switch:
+            self._switch_trafo(block.trafo)
+            return None
         exchange: AxisExchange | None = block.axis_exchange
         if exchange is None:  # #CONTOUR LOOKAHEAD LOG CLEAR
             if self.contour is not None:
@@ -435,6 +451,13 @@ class ProgramRun:
                     if self._close(item):
                         self._sync = item
                     return
+                if item.trafo is not None and self._kinematics is not None:
+                    beyond = self._kinematics.limit_error(item)
+                    if beyond is not None:
+                        src = item.source
+                        self._stop_feeding(ErrorEntry(beyond[0], beyond[1], src.file,
+                                                      src.line, src.column))
+                        return
                 item = with_optional_stop(item, channel)  # M1 and its switch
                 if contour is not None:
                     contour.expect(item)
@@ -459,6 +482,19 @@ class ProgramRun:
                     if contour.end_of_data():
                         self._warn_log_full()
                     self._show_contour_state()
+
+    def _switch_trafo(self, trafo: TrafoUse | None) -> None:
+        """#TRAFO ON/OFF at standstill: the path's position in the other coordinates."""
+        kinematics, executor = self._kinematics, self.executor
+        assert kinematics is not None  # the decoder switches only with kinematics
+        if trafo is not None:
+            position = kinematics.program_of(executor.position_mm, trafo.tool_length_mm)
+            executor.relocate(position, None)  # the limits hold for the axes: checked here
+        else:
+            assert self._trafo is not None
+            position = kinematics.axes_of(executor.position_mm, self._trafo.tool_length_mm)
+            executor.relocate(position, kinematics.sw_limits_mm)
+        self._trafo = trafo
 
     def _section_pending(self) -> int:
         """Blocks of the planned LA_ON section still to come after the last one pushed:
@@ -537,9 +573,12 @@ class ProdTimeRun(ProgramRun):
     def __init__(self, host: RunHost, channel: Channel, feed: DecoderFeed,
                  executor: PathExecutor, contour: ContourLog | None, *,
                  started_at_s: float, buffer_blocks: int, deterministic: bool,
-                 cycle_s: float, trace: ProdTimeTrace | None) -> None:
+                 cycle_s: float, trace: ProdTimeTrace | None,
+                 kinematics: PathKinematics | None = None,
+                 trafo: TrafoUse | None = None) -> None:
         super().__init__(host, channel, feed, executor, contour, started_at_s=started_at_s,
-                         buffer_blocks=buffer_blocks, deterministic=deterministic)
+                         buffer_blocks=buffer_blocks, deterministic=deterministic,
+                         kinematics=kinematics, trafo=trafo)
         self._cycle_s = cycle_s
         self.sim_steps = 0  # cycles simulated so far
         self.trace = trace
@@ -632,7 +671,8 @@ def _path_error(exc: PathError, block: Block | None) -> ErrorEntry:
 
 
 def _waits_for_standstill(block: Block) -> bool:
-    """An axis exchange or a LOG CLEAR: the path stops, the block runs at standstill."""
-    if block.axis_exchange is not None:
+    """An axis exchange, a LOG CLEAR or #TRAFO ON/OFF: the path stops, the block runs
+    at standstill."""
+    if block.axis_exchange is not None or block.trafo_switch:
         return True
     return block.contour is not None and block.contour.kind == ContourKind.LOG_CLEAR

@@ -94,21 +94,17 @@ def test_c_alone_turns_at_f_degrees_per_minute(client: Client) -> None:
     assert client.read("ch1.program_time") == pytest.approx(1.5, abs=0.05)
 
 
-def test_the_five_axis_machine_moves_its_rotary_axes_and_refuses_trafo_on() -> None:
+def test_the_five_axis_machine_runs_rtcp_over_the_wire() -> None:
     with serving("--machine", "five-axis-ac") as service, \
             Client(service.endpoint, timeout_s=10) as c:
         assert [c.read(f"ch1.ax{a}.axis_name") for a in range(1, 6)] == list("XYZAC")
         assert [c.read(f"ch1.ax{a}.axis_type") for a in range(1, 6)] == [1, 1, 1, 2, 2]
-        c.upload("tilt.nc", b"G90 G01 X10 A30 C90 F600\nM30\n")
+        c.upload("tilt.nc", b"G90 G01 X10 Y0 Z50 A0 C0 F3000\n#TRAFO ON\n"
+                 b"G01 C90 F600\nM30\n")
         status = run_program(c, "tilt.nc")
-        assert (status.positions_mm["A"], status.positions_mm["C"]) == pytest.approx(
-            (30.0, 90.0))
-        c.upload("rtcp.nc", b"#TRAFO ON\nG01 X20 A45 F600\nM30\n")
-        with pytest.raises(ChannelError) as caught:
-            run_program(c, "rtcp.nc")
-        assert len(caught.value.errors) == 1
-        assert caught.value.errors[0].startswith("error 20500: rtcp.nc:1:1:")
-        assert "kinematics (ID 91) is configured, but the kinematic transformation is " \
-            "not built yet" in caught.value.errors[0]
-        after = c.status(1).positions_mm  # the program stopped before its first motion
-        assert (after["X"], after["A"]) == pytest.approx((10.0, 30.0))
+        # the tip stayed at the workpiece's (10, 0, 50) while the table turned 90: the
+        # machine follows it to (0, 10, 50)
+        assert [status.positions_mm[n] for n in "XYZAC"] == pytest.approx(
+            [0.0, 10.0, 50.0, 0.0, 90.0])
+        assert c.read("ch1.trafo_active_r") is True
+        assert c.read("ch1.ax2.command_position_acs") == 10 * TENTH_UM_PER_MM

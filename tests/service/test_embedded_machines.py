@@ -29,11 +29,12 @@ def test_every_embedded_machine_is_valid(machine: EmbeddedMachine) -> None:
 def test_the_ac_machine_turns_its_cradle_about_a_line_below_the_table() -> None:
     chain = build_config(machine=EmbeddedMachine.FIVE_AXIS_AC).channels[0].kinematic_chain()
     assert chain is not None
-    # A = 90: the spindle nose (0, 0, 300), seen from the workpiece turned by -90 about
-    # the cradle's line (y 0, z -100): relative (0, 0, 400) -> (0, 400, 0), back on the
-    # line (0, 400, -100); the tool points along the workpiece's +Y
+    # A = 90: the spindle nose at the table's centre (0, 0, 0), seen from the workpiece
+    # turned by -90 about the cradle's line (y 0, z -100): relative (0, 0, 100) ->
+    # (0, 100, 0), back on the line (0, 100, -100); the tool points along the
+    # workpiece's +Y
     pose = chain.forward({3: 90.0})
-    assert pose.tip_mm == pytest.approx((0.0, 400.0, -100.0))
+    assert pose.tip_mm == pytest.approx((0.0, 100.0, -100.0))
     assert pose.orientation == pytest.approx((0.0, 1.0, 0.0))
 
 
@@ -49,6 +50,7 @@ def _ac_with(change: Any) -> dict[str, Any]:
      "C is a translator in the chain but a rotary axis"),
     (lambda k: k["axes"].pop(), "at least 5 items"),
     (lambda k: k["axes"][4].update(axis="X"), "an axis is in the chain twice"),
+    (lambda k: k["axes"][2].update(axis="A", type="translator"), "is a translator in the"),
     (lambda k: k["axes"][3].update(direction=(1.0, 0.0, 0.0)), "do not span space"),
 ])
 def test_a_bad_chain_is_refused_with_its_reason(change: Any, message: str) -> None:

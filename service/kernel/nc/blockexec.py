@@ -39,6 +39,7 @@ from .blocks import (
     Motion,
     MotionKind,
     StopKind,
+    TrafoUse,
 )
 from .construct import make_block, make_motion, make_source
 from .coordinates import Placement
@@ -156,7 +157,8 @@ class BlockExecutor:
         self.items_done = 0  # items of the last block executed before it ended or failed
         index = {name: k for k, name in enumerate(axes)}
         # channel axis indices of X, Y, Z (the axes #CS transforms; #CS needs all three)
-        self.xyz = tuple(index.get(name, -1) for name in "XYZ")
+        self.xyz: tuple[int, int, int] = (index.get("X", -1), index.get("Y", -1),
+                                          index.get("Z", -1))
         # plane -> (p, q) channel axis indices, or None when the channel lacks an axis
         self.plane_axes: dict[Plane, tuple[int, int] | None] = {}
         self._arc_setup: dict[Plane, ArcSetup] = {}
@@ -187,8 +189,16 @@ class BlockExecutor:
         """What an absolute axis word adds per channel axis (zero offset + tool
         length), or None when nothing."""
         modal = self.modal
-        return program_shift_mm(modal.tooling, modal.zero_offset_group, modal.tool_offset,
+        # #TRAFO ON: the tool length acts along the tilted tool, in the kinematics
+        d = 0 if modal.settings.trafo else modal.tool_offset
+        return program_shift_mm(modal.tooling, modal.zero_offset_group, d,
                                 int(modal.plane), self.axes)
+
+    def trafo_use(self) -> TrafoUse:
+        """What a block decoded under ``#TRAFO ON`` carries: the tool length of D."""
+        modal = self.modal
+        d = modal.tool_offset
+        return TrafoUse(modal.tooling.tools.length_mm(d) if d else 0.0)
 
     def execute(self, stmt: NcBlock, env: Env, on_error: ItemFailed | None = None
                 ) -> tuple[Block | None, Flow, int]:
@@ -307,6 +317,8 @@ class BlockExecutor:
             None if tool is None else int(tool[0]), self.manual, None, None,
             self.modal.look_ahead_mark,
         )
+        if self.modal.settings.trafo:
+            block = replace(block, trafo=self.trafo_use())
         if homed:
             block = with_homing(block, homed)
         if h_codes:

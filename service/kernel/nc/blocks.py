@@ -179,6 +179,15 @@ class LookAheadMark:
 
 
 @dataclass(frozen=True, slots=True)
+class TrafoUse:
+    """``#TRAFO ON``: the block's X, Y, Z are the tool tip and its rotary axes the tool's
+    orientation; the channel's kinematics turns them into axis positions every cycle,
+    with this tool length along the tool."""
+
+    tool_length_mm: float = 0.0
+
+
+@dataclass(frozen=True, slots=True)
 class Block:
     """One decoded NC block: optional motion plus what happens at its end.
 
@@ -204,6 +213,8 @@ class Block:
     h_functions: tuple[int, ...] = ()  # H words: technology information to the PLC
     manual_mode: ManualModeRequest | None = None  # G200 / G201 / G202
     spindle_pos_deg: float | None = None  # S.POS: where an M19 of the block orients to
+    trafo: TrafoUse | None = None  # #TRAFO ON: the positions are tip and orientation
+    trafo_switch: bool = False  # #TRAFO ON/OFF: the positions change meaning at standstill
 
     @property
     def needs_stop(self) -> bool:
@@ -211,4 +222,5 @@ class Block:
         synchronises decoding and execution: flush and wait)."""
         return (self.dwell_s > 0.0 or self.stop != StopKind.NONE
                 or self.axis_exchange is not None or bool(self.homing_axes)
+                or self.trafo_switch
                 or (self.contour is not None and self.contour.kind == ContourKind.LOG_CLEAR))

@@ -96,6 +96,8 @@ def _fast_block(
     b.h_functions = ()
     b.manual_mode = None
     b.spindle_pos_deg = None
+    b.trafo = None
+    b.trafo_switch = False
     b.__class__ = Block
     return cast(Block, b)
 

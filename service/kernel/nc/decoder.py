@@ -331,9 +331,9 @@ class Decoder:
             frame.index = after
             return None
         if type(stmt) is Instruction:
-            run_instruction(stmt, self)
+            made = run_instruction(stmt, self)
             frame.index = after
-            return None
+            return made
         if self._modal.pattern is not None and type(stmt) is not Control:
             raise pattern_error(stmt.line, _first_pos(stmt.line))
         if type(stmt) is not NcBlock:

@@ -267,6 +267,8 @@ _BLOCK_FAST = '''\
                 block.h_functions = ()
                 block.manual_mode = None
                 block.spindle_pos_deg = None
+                block.trafo = None
+                block.trafo_switch = False
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\
@@ -301,11 +303,13 @@ _FLUSH_RECORDS = '''\
         if i > start_i:
             yield POINT_BATCH(program.src, start_i, i, start_pos, plane, records)'''
 
-# a machining coordinate system (#CS) or a pattern definition open: the general path
-_FAST_END = "i if modal.released_axes or modal.cs or modal.pattern is not None else end"
+# a machining coordinate system (#CS), a pattern definition open or #TRAFO ON: the
+# general path
+_FAST_END = ("i if modal.released_axes or modal.cs or modal.pattern is not None "
+             "or modal.settings.trafo else end")
 # check mode: compensation and single-stepping take the general path; batches are bounded
 _FAST_END_CHECK = ("i if modal.released_axes or modal.cs or modal.pattern is not None "
-                   "or decoder.check.line_by_line or comp != COMP_OFF "
+                   "or modal.settings.trafo or decoder.check.line_by_line or comp != COMP_OFF "
                    "else min(end, i + BATCH_LINES)")
 
 

@@ -1,13 +1,18 @@
 """Running the ``#`` instructions of ``instructions`` against the decoder's state.
 
-None of them moves an axis or produces a Block: they change the modal state
-(coordinate systems, patterns, settings) or send a text out (``#MSG``). ``#MSG SAVE``
+None of them moves an axis: they change the modal state (coordinate systems, patterns,
+settings) or send a text out (``#MSG``). ``#TRAFO ON/OFF`` on a channel with kinematics
+is the one that produces a Block: the positions change meaning, at standstill. ``#MSG SAVE``
 writes at decode time, as ISG's decoder does; a syntax check formats it (so a bad
 format is reported) but writes nothing.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
+
+from .blocks import Block, StopKind
+from .construct import make_block, make_source
 from .coordinates import CoordinateSystem, placement_of
 from .cycle_run import run_cycle
 from .errors import NcError, NcErrorId
@@ -24,8 +29,8 @@ DEFAULT_MSG_FILE = "msg_save.txt"  # #MSG SAVE before any #FILE NAME
 MAX_PATTERN_POSITIONS = 1000
 
 
-def run_instruction(stmt: Instruction, decoder: CallingDecoder) -> None:
-    """Execute ``stmt`` (raises NcError on a bad value)."""
+def run_instruction(stmt: Instruction, decoder: CallingDecoder) -> Block | None:
+    """Execute ``stmt`` (raises NcError on a bad value); the block it makes, if any."""
     modal = decoder.modal
     kind = stmt.kind
     if modal.pattern is not None and kind not in (InstructionKind.AT,
@@ -35,7 +40,10 @@ def run_instruction(stmt: Instruction, decoder: CallingDecoder) -> None:
                                   "#PATTERN BEGIN inside a pattern definition: close it with "
                                   "#PATTERN END first", stmt.pos)
         raise pattern_error(stmt.line, stmt.pos)
+    if kind == InstructionKind.TRAFO:
+        return _trafo(stmt, decoder)
     _RUN[kind](stmt, decoder)
+    return None
 
 
 def pattern_error(line: LogicalLine, pos: int) -> NcError:
@@ -226,15 +234,26 @@ def _tolerance(stmt: Instruction, decoder: CallingDecoder, key: str) -> float:
     return value
 
 
-def _trafo(stmt: Instruction, decoder: CallingDecoder) -> None:
-    kinematics = decoder.surroundings.kinematics_without_trafo
-    if stmt.on and kinematics is not None:
-        raise stmt.line.error(
-            NcErrorId.INSTRUCTION_NOT_SUPPORTED,
-            f"#TRAFO ON: this channel's kinematics (ID {kinematics}) is configured, but "
-            "the kinematic transformation is not built yet (issue 39): program the "
-            "machine axes", stmt.pos)
-    decoder.modal.settings.trafo = stmt.on
+def _trafo(stmt: Instruction, decoder: CallingDecoder) -> Block | None:
+    """``#TRAFO ON/OFF``. On a channel with kinematics the decoder's X, Y, Z become the
+    tool tip (ON) or the axes again (OFF): its position is turned over with the
+    kinematics, and the block returned makes the path turn over its own at standstill.
+    On a channel without, the transformation is the identity (a three-axis machine):
+    only the setting is shown."""
+    settings, modal = decoder.modal.settings, decoder.modal
+    chain = decoder.surroundings.kinematic_chain
+    if chain is None or stmt.on == settings.trafo:
+        settings.trafo = stmt.on
+        return None
+    use = decoder.executor.trafo_use()
+    convert = chain.to_program if stmt.on else chain.to_axes
+    modal.position_mm = convert(modal.position_mm, decoder.executor.xyz, use.tool_length_mm)
+    settings.trafo = stmt.on
+    line_no, column = stmt.line.locate(stmt.pos)
+    block = make_block(make_source(stmt.line.file, line_no, column, stmt.line.offset),
+                       stmt.number, None, 0.0, StopKind.NONE, (), None, None,
+                       decoder.manual, None, None, modal.look_ahead_mark)
+    return replace(block, trafo=use if stmt.on else None, trafo_switch=True)
 
 
 def _hsc(stmt: Instruction, decoder: CallingDecoder) -> None:
@@ -267,6 +286,6 @@ _RUN = {
     InstructionKind.PATTERN_END: _pattern_end, InstructionKind.PATTERN_DELETE: _pattern_delete,
     InstructionKind.AT: _at, InstructionKind.PATTERN_CALL: _pattern_call,
     InstructionKind.FILE_NAME: _file_name, InstructionKind.MSG: _msg,
-    InstructionKind.MSG_SAVE: _msg_save, InstructionKind.TRAFO: _trafo,
+    InstructionKind.MSG_SAVE: _msg_save,
     InstructionKind.HSC: _hsc, InstructionKind.SLOPE: _slope, InstructionKind.FILTER: _filter,
 }

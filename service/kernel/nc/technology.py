@@ -15,6 +15,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..path.kinematics import Kinematics
 
 HSCS_MODES = ("DESELECT", "ROUGH", "PREFINISH", "FINISH")  # SysHscSettings @P1 = 1..4
 
@@ -75,8 +79,7 @@ class Surroundings:
     show_message: Callable[[str], None] = _ignore
     hscs: Mapping[str, HscProgram] = field(default_factory=dict)
     kinematics: bool = False
-    # the channel has a five-axis kinematics configured (its ID), but the transformation
-    # that #TRAFO ON selects is not built yet: #TRAFO ON is refused rather than run
-    # without it (the tool tip would not be where the program says)
-    kinematics_without_trafo: int | None = None
+    # the channel's five-axis kinematics (#TRAFO ON turns tip and orientation into axis
+    # positions with it); None: a three-axis channel, #TRAFO is the identity
+    kinematic_chain: Kinematics | None = None
     idle_steps_max: int | None = None  # the endless-program guard; None: IDLE_STEPS_MAX

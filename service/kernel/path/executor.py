@@ -217,6 +217,19 @@ class PathExecutor:
         self._prep.reset(self._ipo.position_mm)
         self._closed = False
 
+    def relocate(self, position_mm: Sequence[float],
+                 sw_limits_mm: Sequence[tuple[float, float]] | None) -> None:
+        """At standstill with nothing buffered: the same place in other coordinates
+        (``#TRAFO ON/OFF``: the tool tip and the rotary axes, or the axes again), with
+        the software limits that hold in them (None: none)."""
+        if not self._ipo.idle:
+            raise RuntimeError("relocate needs the path at standstill with nothing buffered")
+        start = tuple(float(x) for x in position_mm)
+        if len(start) != len(self.dynamics):
+            raise ValueError("position_mm needs one value per axis")
+        self._prep = PathPreparation(self.dynamics, start, sw_limits_mm)
+        self._ipo.position_mm = start
+
     # -- state ------------------------------------------------------------------------
 
     @property

@@ -210,14 +210,31 @@ class Kinematics:
     def tip_to_axes(self, tip_mm: Vector, rotary_deg: dict[int, float],
                     tool_length_mm: float = 0.0) -> dict[int, float]:
         """RTCP: the translators' values that put the tool tip at ``tip_mm`` with the
-        rotators at ``rotary_deg``; returns every chain axis's value."""
-        values = {axis.axis_index: 0.0 for axis in self.translators}
-        values.update(rotary_deg)
-        base = self.forward(values, tool_length_mm).tip_mm
-        a, b, c = self._translator_columns(rotary_deg)
-        r = (tip_mm[0] - base[0], tip_mm[1] - base[1], tip_mm[2] - base[2])
+        rotators at ``rotary_deg``; returns every chain axis's value. (One pass each way
+        over the chain, each rotator's turn built once: this runs every cycle.)"""
+        turns = {a.axis_index: turn(a.direction, rotary_deg.get(a.axis_index, 0.0))
+                 for a in self.chain if a.kind == JointKind.ROTATOR}
+        o = self.zero_orientation
+        zx, zy, zz = self.zero_position_mm
+        p: Vector = (zx - tool_length_mm * o[0], zy - tool_length_mm * o[1],
+                     zz - tool_length_mm * o[2])
+        for axis in reversed(self.chain):  # the tip with every translator at 0
+            if axis.kind == JointKind.ROTATOR:
+                ox, oy, oz = axis.point_mm
+                x, y, z = apply(turns[axis.axis_index], (p[0] - ox, p[1] - oy, p[2] - oz))
+                p = (x + ox, y + oy, z + oz)
+        columns: list[Vector] = []
+        rot = IDENTITY
+        for axis in self.chain:  # each translator's direction as seen at the tip
+            if axis.kind == JointKind.ROTATOR:
+                rot = multiply(rot, turns[axis.axis_index])
+            else:
+                columns.append(apply(rot, axis.direction))
+        a, b, c = columns
+        r = (tip_mm[0] - p[0], tip_mm[1] - p[1], tip_mm[2] - p[2])
         det = _det(a, b, c)
         solved = (_det(r, b, c) / det, _det(a, r, c) / det, _det(a, b, r) / det)
+        values = dict(rotary_deg)
         for axis, q in zip(self.translators, solved, strict=True):
             values[axis.axis_index] = q + 0.0
         return values
@@ -274,3 +291,29 @@ class Kinematics:
             return near  # on the axis: any angle does; keep the axis where it is
         angle = _angle_deg(math.atan2(_dot(u, _cross(pp, qq)), _dot(pp, qq)))
         return angle + 360.0 * round((near - angle) / 360.0)
+
+    def to_program(self, axes_mm: Sequence[float], xyz: tuple[int, int, int],
+                   tool_length_mm: float) -> tuple[float, ...]:
+        """A channel's axis positions as ``#TRAFO ON`` programs them: the channel axes
+        ``xyz`` hold the tool tip relative to the tool's zero position (so that with the
+        rotary axes at 0 a tip is where a three-axis channel puts it), the rest stay."""
+        tip = self.forward(dict(enumerate(axes_mm)), tool_length_mm).tip_mm
+        out = list(axes_mm)
+        for k, value, zero in zip(xyz, tip, self.zero_position_mm, strict=True):
+            out[k] = value - zero + 0.0
+        return tuple(out)
+
+    def to_axes(self, program_mm: Sequence[float], xyz: tuple[int, int, int],
+                tool_length_mm: float) -> tuple[float, ...]:
+        """The inverse of ``to_program``: the axis positions for a programmed tip and
+        rotary positions (RTCP)."""
+        zx, zy, zz = self.zero_position_mm
+        tip = (program_mm[xyz[0]] + zx, program_mm[xyz[1]] + zy, program_mm[xyz[2]] + zz)
+        first, second = self.rotators
+        values = self.tip_to_axes(tip, {first.axis_index: program_mm[first.axis_index],
+                                        second.axis_index: program_mm[second.axis_index]},
+                                  tool_length_mm)
+        out = list(program_mm)
+        for k, value in values.items():
+            out[k] = value
+        return tuple(out)

@@ -113,10 +113,10 @@ def _run(context: CycleContext) -> str | None:
     mode = int(p[1])
     surroundings = context.decoder.surroundings
     if mode in (1, 2) and not surroundings.kinematics:
-        why = ("none is configured for this channel"
-               if surroundings.kinematics_without_trafo is None else
-               f"this channel's kinematics (ID {surroundings.kinematics_without_trafo}) is "
-               "configured, but its transformation is not built yet (issue 39)")
+        chain = surroundings.kinematic_chain
+        why = ("none is configured for this channel" if chain is None else
+               f"this channel's kinematics (ID {chain.kinematic_id}) is configured, but "
+               "turning the tool onto a plane is not built yet (issue 39)")
         raise context.error(
             NcErrorId.TRAFO_NOT_CONFIGURED,
             f"SysPosRotationToPlane.ecy @P1={mode} rotates the tool, which needs a kinematic "

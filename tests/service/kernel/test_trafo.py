@@ -1,0 +1,137 @@
+"""``#TRAFO ON`` on the five-axis machines: the program gives the tool tip and the
+rotary axes, the kinematics turns them into axis positions every cycle (RTCP)."""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+
+from cnc_objects.service.config import build_config
+from cnc_objects.service.kernel.channel_mode import ChannelState
+from cnc_objects.service.machine_config import FIVE_AXIS_AC, EmbeddedMachine
+from tests.support.kernel import KernelHarness, Run
+
+X, Y, Z, A, C = 0, 1, 2, 3, 4
+
+
+@pytest.fixture
+def ac() -> Iterator[KernelHarness]:
+    with KernelHarness(config=build_config(machine=EmbeddedMachine.FIVE_AXIS_AC)) as harness:
+        yield harness
+
+
+def _ran(run: Run) -> Run:
+    assert run.channel.state == ChannelState.READY, run.channel.errors.entries
+    return run
+
+
+def tip_of(axes: tuple[float, ...], tool_mm: float = 0.0) -> np.ndarray:
+    """Independent: the workpiece turned back by the table's C (about Z through the
+    table's centre) and A (about X, 100 mm below the table's face)."""
+    x, y, z, a, c = axes[:5]
+    nose = np.array([x, y, z - tool_mm])
+
+    def about(axis: str, deg: float, p: np.ndarray, centre: tuple[float, float, float]
+              ) -> np.ndarray:
+        t = math.radians(deg)
+        cs, sn = math.cos(t), math.sin(t)
+        m = {"x": np.array([[1, 0, 0], [0, cs, -sn], [0, sn, cs]]),
+             "z": np.array([[cs, -sn, 0], [sn, cs, 0], [0, 0, 1]])}[axis]
+        q = np.array(centre)
+        return np.asarray(m @ (p - q) + q, dtype=np.float64)
+    return about("z", -c, about("x", -a, nose, (0, 0, -100)), (0, 0, 0))
+
+
+def test_the_tip_follows_the_programmed_line_while_the_table_turns(ac: KernelHarness) -> None:
+    run = _ran(ac.run("G90 G01 X0 Y0 Z50 A0 C0 F3000\n#TRAFO ON\n"
+                      "G01 X20 Y0 Z50 C90 F600\n#TRAFO OFF\nM30\n", record=True))
+    # the last position: the tip at the workpiece's (20, 0, 50) with the table at C 90
+    assert run.positions_mm[:5] == pytest.approx((0.0, 20.0, 50.0, 0.0, 90.0), abs=1e-9)
+    turning = [s for s in run.samples if 0.0 < s.positions_mm[C] < 90.0]
+    assert len(turning) > 100
+    for sample in turning:
+        tip = tip_of(sample.positions_mm)
+        # on the line from (0, 0, 50) to (20, 0, 50), as far along it as C has turned
+        assert tip == pytest.approx((20.0 * sample.positions_mm[C] / 90.0, 0.0, 50.0),
+                                    abs=1e-9)
+    # the feed acts along the tip's path: 20 mm at 10 mm/s, plus reaching and leaving
+    # that speed at C's 600 degrees/s^2, C turning 4.5 degrees per mm of path
+    assert len(turning) * 0.001 == pytest.approx(20.0 / 10.0 + 10.0 / (600.0 / 4.5),
+                                                 abs=0.002)
+
+
+@pytest.fixture
+def ac_with_tool() -> Iterator[KernelHarness]:
+    data = copy.deepcopy(FIVE_AXIS_AC)
+    data["tools"] = [{"d": 7, "radius_mm": 5.0, "length_mm": 100.0}]
+    with KernelHarness(config=build_config(data, machine=EmbeddedMachine.THREE_AXIS)) as h:
+        yield h
+
+
+def test_the_tool_length_acts_along_the_tilted_tool(ac_with_tool: KernelHarness) -> None:
+    # the tip stays at the workpiece's (10, 0, 0) while the cradle tilts 30 degrees
+    run = _ran(ac_with_tool.run("G90 D7 G01 X10 Y0 Z0 A0 C0 F3000\n#TRAFO ON\n"
+                                "G01 A30 F600\n#TRAFO OFF\nM30\n", record=True))
+    tilting = [s for s in run.samples if 0.0 < s.positions_mm[A] < 30.0]
+    assert len(tilting) > 100
+    for sample in tilting:
+        assert tip_of(sample.positions_mm, 100.0) == pytest.approx((10.0, 0.0, 0.0),
+                                                                   abs=1e-9)
+    # at A 30 the tool points along the workpiece's (0, sin 30, cos 30): the nose is
+    # 100 mm up that line from the tip; hand: the machine point of the workpiece's
+    # (10, 0, 0) turned by A about the line (y 0, z -100): (10, -100 sin 30,
+    # -100 + 100 cos 30), and the nose 100 above it
+    s30, c30 = math.sin(math.radians(30)), math.cos(math.radians(30))
+    x, y, z = run.positions_mm[:3]
+    assert (x, y, z) == pytest.approx((10.0, -100.0 * s30, -100.0 + 100.0 * c30 + 100.0),
+                                      abs=1e-9)
+
+
+def test_an_axis_the_kinematics_would_drive_beyond_its_limit_stops_the_program(
+        ac: KernelHarness) -> None:
+    # the tip 999 mm above the table's face: tilting the cradle to A 90 (its line 100 mm
+    # below the face) takes the tip to Y -(999 + 100): beyond -1000 (once referenced,
+    # the software limits are monitored, P-AXIS-00705)
+    ac.home()
+    run = ac.run("G90 G01 X0 Y0 Z0 A0 C0 F60000\n#TRAFO ON\nG01 Z999 F60000\n"
+                 "A90 F60000\nM30\n")
+    assert run.channel.state == ChannelState.ERROR
+    [error] = run.channel.errors.entries
+    assert (error.id, error.line) == (50100, 4)
+    assert "axis Y would reach" in error.text
+    assert run.positions_mm[A] == pytest.approx(0.0)  # refused before it moved
+
+
+def test_a_manual_block_after_trafo_on_goes_on_in_the_tip_coordinates(
+        ac: KernelHarness) -> None:
+    _ran(ac.mdi("G90 G01 X0 Y0 Z50 A0 C90 F3000"))
+    _ran(ac.mdi("#TRAFO ON"))
+    run = _ran(ac.mdi("G01 X10 F600"))
+    # the tip at the workpiece's (10, 0, 50), the table at C 90: machine (0, 10, 50)
+    assert run.positions_mm[:5] == pytest.approx((0.0, 10.0, 50.0, 0.0, 90.0), abs=1e-9)
+    run = _ran(ac.mdi("#TRAFO OFF\nG91 G01 X5 F600"))
+    assert run.positions_mm[:3] == pytest.approx((5.0, 10.0, 50.0), abs=1e-9)
+
+
+def test_the_head_swivels_about_the_tip_on_the_bc_machine() -> None:
+    config = build_config(machine=EmbeddedMachine.FIVE_AXIS_BC)
+    chain = config.channels[0].kinematic_chain()
+    assert chain is not None
+    with KernelHarness(config=config) as bc:
+        run = _ran(bc.run("G90 G01 X0 Y0 Z20 B0 C0 F3000\n#TRAFO ON\n"
+                          "G01 B45 C30 F600\n#TRAFO OFF\nM30\n", record=True))
+    swivelling = [s for s in run.samples if 0.0 < s.positions_mm[3] < 45.0]
+    assert len(swivelling) > 50
+    for sample in swivelling:
+        values = dict(enumerate(sample.positions_mm))
+        assert chain.forward(values).tip_mm == pytest.approx((0.0, 0.0, 20.0), abs=1e-9)
+    # by hand at B 45 (C turns the table about the tip's line: X and Y stay): the head
+    # turns the nose (0, 0, 0) about the pivot (0, 0, 150) to (-150 sin 45, 0,
+    # 150 - 150 cos 45); X and Z shift it onto the tip (0, 20); cos 45 = sin 45
+    s45 = math.sin(math.radians(45))
+    x, _y, z = run.positions_mm[:3]
+    assert (x, z) == pytest.approx((150.0 * s45, 20.0 - 150.0 + 150.0 * s45), abs=1e-9)
