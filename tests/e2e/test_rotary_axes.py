@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from cnc_objects.clients import ChannelError, Client
+from cnc_objects.clients import Client
 from cnc_objects.testing import run_program
 from tests.support.service import RunningService, serving, serving_config
 
