@@ -148,7 +148,6 @@ class ChannelRunner:
             show_message=self._messages.append,
             hscs={mode.upper(): HscProgram(c.prog, c.tolerance / UM01_PER_MM)
                   for mode, c in config.hscs},
-            kinematics=False,  # SysPosRotationToPlane's tool-turning modes: not yet
             kinematic_chain=config.kinematic_chain(),
             idle_steps_max=services.idle_steps_max,
         )

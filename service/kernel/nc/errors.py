@@ -143,6 +143,9 @@ class NcErrorId(IntEnum):
     CYCLE_POINTS_COLLINEAR = 20517  # calculation cycle: the points lie on one line
     CYCLE_POINTS_COPLANAR = 20518  # SysCalcSphere: the points lie in one plane
     TRAFO_NOT_CONFIGURED = 20519  # a cycle mode rotates the tool: needs a kinematic trafo
+    # the kinematics cannot turn the tool to the direction asked for (ISG: "Kinematic
+    # transformation: Illegal argument for ACOS", tf5200_diagnosis/267444363.html)
+    TRAFO_POSE_UNREACHABLE = 292004
     CYCLE_PARAMETER_TWICE = 20520  # the same @P (or NAME, PATTERN_ID) twice in one call
     PATTERN_NOT_DEFINED = 20521  # PATTERN_ID / #PATTERN DELETE of an undefined pattern
     PATTERN_NESTED = 20522  # #PATTERN BEGIN inside a pattern definition

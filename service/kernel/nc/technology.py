@@ -69,8 +69,8 @@ class Surroundings:
     a cycle's result; never the program store): it queues the text and returns at once,
     or raises ``OutputLimitReached``; ``show_message(text)`` puts a ``#MSG`` into the
     channel's message list; ``hscs`` maps a mode of ``HSCS_MODES`` to its program and
-    tolerance; ``kinematics``: the channel has a kinematic transformation configured
-    (needed to rotate the tool); ``idle_steps_max``: steps of work without a block before
+    tolerance; ``kinematic_chain``: the channel's kinematics (``#TRAFO ON`` and the
+    cycles that turn the tool need it); ``idle_steps_max``: steps of work without a block before
     the endless-program guard ends the decoding (``work_guard``, ``[limits]
     decoder_idle_steps_max``). The defaults drop files and messages.
     """
@@ -78,7 +78,6 @@ class Surroundings:
     write_file: Callable[[str, str, bool], None] = _ignore
     show_message: Callable[[str], None] = _ignore
     hscs: Mapping[str, HscProgram] = field(default_factory=dict)
-    kinematics: bool = False
     # the channel's five-axis kinematics (#TRAFO ON turns tip and orientation into axis
     # positions with it); None: a three-axis channel, #TRAFO is the identity
     kinematic_chain: Kinematics | None = None

@@ -13,6 +13,7 @@ import pytest
 from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.channel_mode import ChannelState
 from cnc_objects.service.machine_config import FIVE_AXIS_AC, EmbeddedMachine
+from tests.service.kernel.nc.test_cs_and_patterns import EXAMPLE_1, EXAMPLE_2, PROCESSING
 from tests.support.kernel import KernelHarness, Run
 
 X, Y, Z, A, C = 0, 1, 2, 3, 4
@@ -135,3 +136,47 @@ def test_the_head_swivels_about_the_tip_on_the_bc_machine() -> None:
     s45 = math.sin(math.radians(45))
     x, _y, z = run.positions_mm[:3]
     assert (x, z) == pytest.approx((150.0 * s45, 20.0 - 150.0 + 150.0 * s45), abs=1e-9)
+
+
+def tool_direction_of(axes: tuple[float, ...]) -> np.ndarray:
+    """Independent: the tool (machine +Z) seen from the workpiece turned by C and A."""
+    a, c = math.radians(axes[A]), math.radians(axes[C])
+    rx = np.array([[1, 0, 0], [0, math.cos(-a), -math.sin(-a)], [0, math.sin(-a), math.cos(-a)]])
+    rz = np.array([[math.cos(-c), -math.sin(-c), 0], [math.sin(-c), math.cos(-c), 0], [0, 0, 1]])
+    return np.asarray(rz @ rx @ np.array([0.0, 0.0, 1.0]), dtype=np.float64)
+
+
+def _as_printed_then(example: str, after: str) -> str:
+    """The seed example up to its processing comment, then ``after`` (no #CS OFF)."""
+    return example[:example.index(PROCESSING) + len(PROCESSING)] + "\n" + after
+
+
+@pytest.mark.parametrize(("example", "normal"), [
+    # example 1: the plane through (100, 30, -25), (100, 70, -25), (115, 70, -50): its
+    # normal with a positive Z is (25, 0, 15) / |(25, 0, 15)|
+    (EXAMPLE_1, np.array([25.0, 0.0, 15.0]) / math.hypot(25.0, 15.0)),
+    # example 2: Rz(90) Ry(0) Rx(60) applied to Z: (sin 60, 0, cos 60)
+    (EXAMPLE_2, np.array([math.sin(math.radians(60)), 0.0, math.cos(math.radians(60))])),
+], ids=["points", "angles"])
+def test_the_seed_examples_turn_the_tool_onto_the_plane(
+        ac: KernelHarness, example: str, normal: np.ndarray) -> None:
+    text = ("G90 G00 X140 Y0 Z20 A0 C0\n"
+            + _as_printed_then(example, "G01 F1000 X0 Y0 Z0\nM30\n"))
+    run = _ran(ac.run(text, record=True))
+    final = run.positions_mm
+    # the tool stands perpendicular on the plane, its tip at the plane's origin
+    assert tool_direction_of(final) == pytest.approx(normal, abs=1e-9)
+    assert tip_of(final) == pytest.approx((140.0, 0.0, -80.0), abs=1e-9)
+    # before it turned, the tool retracted 50 mm along itself (vertical): from Z 20 to
+    # 70; while the rotary axes turned, the tip stayed there (RTCP)
+    turning = [s for s in run.samples if 0.0 < abs(s.positions_mm[A]) < abs(final[A])]
+    assert len(turning) > 10
+    for sample in turning:
+        assert tip_of(sample.positions_mm) == pytest.approx((140.0, 0.0, 70.0), abs=1e-9)
+
+
+def test_turning_the_tool_needs_trafo_on(ac: KernelHarness) -> None:
+    text = "G90 G00 X140 Y0 Z20\n" + EXAMPLE_2.replace("#TRAFO ON", "")
+    run = ac.run(text)
+    [error] = run.channel.errors.entries
+    assert error.id == 20519 and "program #TRAFO ON before the call" in error.text

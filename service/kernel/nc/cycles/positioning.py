@@ -36,6 +36,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from ...path.kinematics import KinematicsError
 from ..errors import NcErrorId
 from ..literals import nc_number
 from ..variables import Value
@@ -45,6 +46,7 @@ from .rotation import (
     RotationOrder,
     Vector,
     angles_from_rotation,
+    apply,
     rotation_from_angles,
     rotation_from_points,
 )
@@ -111,17 +113,15 @@ def _rotation(context: CycleContext) -> Matrix:
 def _run(context: CycleContext) -> str | None:
     p = context.params
     mode = int(p[1])
-    surroundings = context.decoder.surroundings
-    if mode in (1, 2) and not surroundings.kinematics:
-        chain = surroundings.kinematic_chain
+    chain = context.decoder.surroundings.kinematic_chain
+    if mode in (1, 2) and (chain is None or not context.modal.settings.trafo):
         why = ("none is configured for this channel" if chain is None else
-               f"this channel's kinematics (ID {chain.kinematic_id}) is configured, but "
-               "turning the tool onto a plane is not built yet (issue 39)")
+               "program #TRAFO ON before the call")
         raise context.error(
             NcErrorId.TRAFO_NOT_CONFIGURED,
-            f"SysPosRotationToPlane.ecy @P1={mode} rotates the tool, which needs a kinematic "
-            f"transformation; {why} (use @P1=3 to rotate only the machining coordinate "
-            "system)", 1)
+            f"SysPosRotationToPlane.ecy @P1={mode} rotates the tool, which needs the "
+            f"kinematic transformation active; {why} (use @P1=3 to rotate only the "
+            "machining coordinate system)", 1)
     rotation = _rotation(context)
     origin = tuple(float(p[n]) for n in (3, 4, 5))
     a, b, c = angles_from_rotation(rotation, RotationOrder.ZYX, True)
@@ -140,23 +140,59 @@ def _run(context: CycleContext) -> str | None:
     retract = float(p[2])
     if retract > 0.0:
         body.append(_retraction(context, retract))
+    if mode in (1, 2):  # the tool turns onto the plane's normal, its tip stays (RTCP)
+        body.append(_tool_onto(context, rotation))
     if mode in (1, 3):  # @P1=2 rotates only the tool: the MCS stays as it is
         body.append(cs_line)
     body.append("M17")
     return "\n".join(body) + "\n"
 
 
+def _tool_direction(context: CycleContext) -> Vector:
+    """The tool's direction in the decoder's coordinates: machine +Z without a
+    transformation, else what the rotary axes turn it to."""
+    chain = context.decoder.surroundings.kinematic_chain
+    if chain is None or not context.modal.settings.trafo:
+        return (0.0, 0.0, 1.0)
+    return chain.forward(dict(enumerate(context.modal.position_mm))).orientation
+
+
 def _retraction(context: CycleContext, distance_mm: float) -> str:
-    """G0 by ``distance_mm`` along machine +Z, written in the active coordinates."""
+    """G0 by ``distance_mm`` along the tool (machine +Z without a transformation),
+    written in the active coordinates."""
     decoder = context.decoder
     ix, iy, iz = decoder.executor.xyz
     position = context.modal.position_mm
-    target = (position[ix], position[iy], position[iz] + distance_mm)
+    dx, dy, dz = _tool_direction(context)
+    target = (position[ix] + distance_mm * dx, position[iy] + distance_mm * dy,
+              position[iz] + distance_mm * dz)
     placement = context.modal.cs_placement
     if placement is not None:
         target = placement.from_machine(target)
     x, y, z = (nc_number(v) for v in target)
     return f"G90 G00 X{x} Y{y} Z{z}"
+
+
+def _tool_onto(context: CycleContext, rotation: Matrix) -> str:
+    """G0 of the rotary axes that turns the tool onto the Z axis of ``rotation`` (in the
+    coordinates before the call), the solution nearer the rotary axes' positions; the
+    tip stays where it is (``#TRAFO ON``)."""
+    chain = context.decoder.surroundings.kinematic_chain
+    assert chain is not None  # _run checked
+    normal = (rotation[0][2], rotation[1][2], rotation[2][2])
+    placement = context.modal.cs_placement
+    if placement is not None:  # the plane is given in the active #CS: to the decoder's
+        normal = apply(placement.rotation, normal)
+    position = context.modal.position_mm
+    names = context.decoder.axes
+    near = {a.axis_index: position[a.axis_index] for a in chain.rotators}
+    try:
+        rotary = chain.orientation_to_rotary(normal, near)
+    except KinematicsError as fault:
+        raise context.error(NcErrorId.TRAFO_POSE_UNREACHABLE,
+                            f"SysPosRotationToPlane.ecy: {fault}", 1) from None
+    words = " ".join(f"{names[k]}{nc_number(v)}" for k, v in sorted(rotary.items()))
+    return f"G90 G00 {words}"
 
 
 ROTATION_TO_PLANE = BuiltinCycle("SysPosRotationToPlane.ecy", PARAMS, _run, _check)

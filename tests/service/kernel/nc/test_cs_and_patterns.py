@@ -8,7 +8,10 @@ import math
 import numpy as np
 import pytest
 
+from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.nc import MotionKind, NcError, NcErrorId, StopKind
+from cnc_objects.service.kernel.path.kinematics import Kinematics
+from cnc_objects.service.machine_config import EmbeddedMachine
 
 from .cycle_support import Channel, assert_at
 
@@ -314,11 +317,24 @@ def test_example_1_points_lie_in_a_plane_parallel_to_the_new_xy_plane() -> None:
     assert x_new[1] - x_new[0] == pytest.approx(40.0, abs=1e-9)  # X along point 1 -> 2
 
 
+def _ac_chain() -> Kinematics:
+    chain = build_config(machine=EmbeddedMachine.FIVE_AXIS_AC).channels[0].kinematic_chain()
+    assert chain is not None
+    return chain
+
+
 def test_example_1_runs_with_a_kinematic_transformation() -> None:
-    channel = Channel(kinematics=True)
-    d, blocks = channel.run("G00 X1 Y2 Z3\n" + EXAMPLE_1 + "M30\n")
+    chain = _ac_chain()
+    d, blocks = Channel(kinematics=chain).run("G00 X1 Y2 Z3 A0 C0\n" + EXAMPLE_1 + "M30\n")
     moves = [b for b in blocks if b.motion is not None]
-    assert moves[-1].motion.end_mm == pytest.approx((1.0, 2.0, 53.0), abs=1e-12)
+    # the retraction along the (vertical) tool, then the rotary axes turn the tool onto
+    # the plane's normal (25, 0, 15) / |.|, the tip staying (tip coordinates: #TRAFO ON)
+    assert moves[1].motion.end_mm == pytest.approx((1.0, 2.0, 53.0, 0.0, 0.0), abs=1e-12)
+    turned = moves[2].motion.end_mm
+    assert turned[:3] == pytest.approx((1.0, 2.0, 53.0), abs=1e-12)
+    normal = np.array([25.0, 0.0, 15.0]) / math.hypot(25.0, 15.0)
+    assert chain.forward({3: turned[3], 4: turned[4]}).orientation == pytest.approx(
+        tuple(normal), abs=1e-9)
     assert d.modal.cs == ()  # the example deselects the MCS with #CS OFF
     assert d.modal.settings.trafo is False
 
@@ -444,11 +460,15 @@ def test_no_result_file_without_p20() -> None:
 
 def test_mode_2_with_kinematics_rotates_no_mcs() -> None:
     # @P1=2: only the tool is rotated (was: the MCS was rotated too)
-    text = ("G00 X1 Y2 Z3\nL CYCLE [NAME=SysPosRotationToPlane.ecy @P1=2 @P2=5 @P3=10 @P15=30]\n"
+    text = ("G00 X1 Y2 Z3\n#TRAFO ON\n"
+            "L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=2 @P2=5 @P3=10 @P15=30]\n"
             "G01 F100 X0 Y0 Z0\nM30\n")
-    d, moves = Channel(kinematics=True).moves(text)
-    assert moves[1].motion.end_mm == (1.0, 2.0, 8.0)
-    assert moves[2].motion.end_mm == (0.0, 0.0, 0.0)
+    d, moves = Channel(kinematics=_ac_chain()).moves(text)
+    assert moves[1].motion.end_mm == pytest.approx((1.0, 2.0, 8.0, 0.0, 0.0), abs=1e-12)
+    # the tool tilts 30 degrees about X (towards -Y): the cradle A by -30, C stays (the
+    # other solution, A 30 with C 180, is farther from A 0 C 0)
+    assert moves[2].motion.end_mm[3:] == pytest.approx((-30.0, 0.0), abs=1e-9)
+    assert moves[3].motion.end_mm[:3] == pytest.approx((0.0, 0.0, 0.0), abs=1e-12)
     assert d.modal.cs == ()
     assert Channel().error(text).id == E.TRAFO_NOT_CONFIGURED
 
