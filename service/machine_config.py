@@ -669,8 +669,8 @@ _TRANSLATORS = [
     {"axis": "Y", "type": "translator", "direction": (0.0, 1.0, 0.0)},
     {"axis": "Z", "type": "translator", "direction": (0.0, 0.0, 1.0)},
 ]
-# 60 degrees/s, 600 degrees/s^2: a machine tool's rotary table / head of this size
-_ROTARY_DYNAMICS = {"vel_max_mm_s": 60.0, "acc_max_mm_s2": 600.0, "vel_jump_mm_s": 2.0}
+# 180 degrees/s (30 rpm), 1800 degrees/s^2: a machine tool's rotary table / head of this size
+_ROTARY_DYNAMICS = {"vel_max_mm_s": 180.0, "acc_max_mm_s2": 1800.0, "vel_jump_mm_s": 5.0}
 
 FIVE_AXIS_AC: dict[str, Any] = _five_axis(
     "cnc-objects-5ax-ac",

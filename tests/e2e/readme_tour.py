@@ -45,10 +45,30 @@ class TourStep:
     expected: tuple[str, ...]
 
 
+#: A section of the tour that runs on another machine than `make run`'s default: its
+#: own test (``machine_section``) plays it on that machine, the tour leaves it out.
+FIVE_AXIS_SECTION = "\n## Five axes"
+
+
 def tour_text(readme: Path) -> str:
-    """The README from the tour's first section up to "## What runs"."""
+    """The README from the tour's first section up to "## What runs", without the
+    sections of another machine."""
     text = readme.read_text()
-    return text[text.index("\n## 1. "):text.index("\n## What runs")]
+    tour = text[text.index("\n## 1. "):text.index("\n## What runs")]
+    start = tour.find(FIVE_AXIS_SECTION)
+    if start < 0:
+        return tour
+    end = tour.find("\n## ", start + 1)
+    return tour[:start] + (tour[end:] if end >= 0 else "")
+
+
+def machine_section(readme: Path, title: str = FIVE_AXIS_SECTION) -> list[TourStep]:
+    """The ``$ `` commands of the README section starting with ``title`` (a section
+    the tour leaves out, played on its own machine)."""
+    text = readme.read_text()
+    start = text.index(title)
+    end = text.find("\n## ", start + 1)
+    return _shell_steps(text[start:end], ())
 
 
 def _blocks(text: str, language: str) -> list[tuple[str, list[str]]]:
@@ -69,19 +89,24 @@ def _blocks(text: str, language: str) -> list[tuple[str, list[str]]]:
     return blocks
 
 
-def tour_steps(readme: Path) -> list[TourStep]:
-    """Every ``$ `` command of the tour's shell blocks that a test can run, in order."""
+def _shell_steps(text: str, not_run: tuple[str, ...]) -> list[TourStep]:
+    """Every ``$ `` command of the shell blocks of ``text`` with none of ``not_run``."""
     steps = []
-    for section, lines in _blocks(tour_text(readme), "sh"):
+    for section, lines in _blocks(text, "sh"):
         command, expected = None, []
         for line in [*lines, "$ "]:
             if line.startswith("$ "):
-                if command and not any(word in command for word in NOT_RUN):
+                if command and not any(word in command for word in not_run):
                     steps.append(TourStep(section, command, tuple(expected)))
                 command, expected = _COMMENT.sub("", line[2:]).strip(), []
             else:
                 expected.append(line)
     return steps
+
+
+def tour_steps(readme: Path) -> list[TourStep]:
+    """Every ``$ `` command of the tour's shell blocks that a test can run, in order."""
+    return _shell_steps(tour_text(readme), NOT_RUN)
 
 
 #: The MQTT step's commands the ordered tour plays itself (``tour_items``): a broker of

@@ -28,6 +28,7 @@ from tests.e2e.readme_tour import (
     README_WEB_PORT,
     PythonStep,
     _line_matches,
+    machine_section,
     output_matches,
     python_examples,
     tour_items,
@@ -106,6 +107,23 @@ def test_every_tour_command_prints_what_the_readme_shows(tmp_path: Path) -> None
         assert not failures, f"{len(failures)} command(s) print otherwise:\n\n" + \
             "\n\n".join(failures)
     assert (tmp_path / "part.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_five_axis_step_prints_what_the_readme_shows(tmp_path: Path) -> None:
+    """The README's five-axis section on the machine it names (`make run
+    MACHINE=five-axis-ac`: ``--machine five-axis-ac``), realtime as `make run`."""
+    (tmp_path / "docs").symlink_to(ROOT / "docs")
+    steps = machine_section(README)
+    assert [s.command.split()[:2] for s in steps] == [["cnc", "run"], ["cnc", "status"]]
+    with serving("--clock", "realtime", "--machine", "five-axis-ac", cwd=tmp_path) as service:
+        env = _env(service.endpoint)
+        for step in steps:
+            done = subprocess.run(["bash", "-c", step.command], cwd=tmp_path, env=env,
+                                  text=True, stdout=subprocess.PIPE,
+                                  stderr=subprocess.STDOUT, timeout=120)
+            assert output_matches(step.expected, done.stdout.splitlines()), (
+                f"$ {step.command}\nREADME shows:\n" + "\n".join(step.expected)
+                + f"\nprinted (exit {done.returncode}):\n{done.stdout}")
 
 
 def test_the_python_examples_print_what_the_readme_shows(tmp_path: Path) -> None:

@@ -60,8 +60,8 @@ def test_the_tip_follows_the_programmed_line_while_the_table_turns(ac: KernelHar
         assert tip == pytest.approx((20.0 * sample.positions_mm[C] / 90.0, 0.0, 50.0),
                                     abs=1e-9)
     # the feed acts along the tip's path: 20 mm at 10 mm/s, plus reaching and leaving
-    # that speed at C's 600 degrees/s^2, C turning 4.5 degrees per mm of path
-    assert len(turning) * 0.001 == pytest.approx(20.0 / 10.0 + 10.0 / (600.0 / 4.5),
+    # that speed at C's 1800 degrees/s^2, C turning 4.5 degrees per mm of path
+    assert len(turning) * 0.001 == pytest.approx(20.0 / 10.0 + 10.0 / (1800.0 / 4.5),
                                                  abs=0.002)
 
 
