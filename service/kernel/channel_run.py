@@ -449,7 +449,7 @@ class ChannelRunner:
         dynamics, sw_limits = self._axis_limits()
         self.manual.clear_program()  # a run starts where the axes stand
         position = tuple(a.position_mm for a in ch.axes)
-        kinematics = self._path_kinematics(sw_limits)
+        kinematics = self._path_kinematics(sw_limits, dynamics)
         trafo = None
         if fresh_modal or self._modal is None:
             self._modal = self.new_modal(position)
@@ -570,14 +570,15 @@ class ChannelRunner:
         return dynamics, tuple(monitored_limits_mm(p, self.manual.referenced(k))
                                for k, p in enumerate(params))
 
-    def _path_kinematics(self, sw_limits: tuple[tuple[float, float], ...]
-                         ) -> PathKinematics | None:
+    def _path_kinematics(self, sw_limits: tuple[tuple[float, float], ...],
+                         dynamics: tuple[AxisDynamics, ...]) -> PathKinematics | None:
         """The channel's kinematics for a run (None: a three-axis channel)."""
         chain = self._surroundings.kinematic_chain
         if chain is None:
             return None
         x, y, z = (self._axes.index(name) for name in "XYZ")
-        return PathKinematics(chain, (x, y, z), sw_limits, self._axes)
+        return PathKinematics(chain, (x, y, z), sw_limits, self._axes,
+                              tuple(d.vel_max_mm_s for d in dynamics))
 
     def _begin_check(self, job: Job, mode: int) -> None:
         """Start the syntax check (SYNCHK) or dry run (MACHINE_LOCK) of the program."""

@@ -452,12 +452,13 @@ class ProgramRun:
                         self._sync = item
                     return
                 if item.trafo is not None and self._kinematics is not None:
-                    beyond = self._kinematics.limit_error(item)
-                    if beyond is not None:
+                    prepared = self._kinematics.prepared(item)
+                    if isinstance(prepared, tuple):  # beyond a software limit
                         src = item.source
-                        self._stop_feeding(ErrorEntry(beyond[0], beyond[1], src.file,
+                        self._stop_feeding(ErrorEntry(prepared[0], prepared[1], src.file,
                                                       src.line, src.column))
                         return
+                    item = prepared
                 item = with_optional_stop(item, channel)  # M1 and its switch
                 if contour is not None:
                     contour.expect(item)

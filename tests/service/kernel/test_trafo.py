@@ -180,3 +180,18 @@ def test_turning_the_tool_needs_trafo_on(ac: KernelHarness) -> None:
     run = ac.run(text)
     [error] = run.channel.errors.entries
     assert error.id == 20519 and "program #TRAFO ON before the call" in error.text
+
+
+def test_no_axis_exceeds_its_velocity_when_the_table_turns_far_from_the_tip(
+        ac: KernelHarness) -> None:
+    # the tip 500 mm from the table's centre: turning C at its 180 degrees/s would drive
+    # X and Y at up to 500 * pi = 1571 mm/s; their limit is 500 mm/s, so the block's
+    # feed is capped at 500 / (500 * pi / 180) = 57.3 degrees/s
+    run = _ran(ac.run("G90 G01 X500 Y0 Z0 A0 C0 F60000\n#TRAFO ON\nG01 C90 F60000\n"
+                      "#TRAFO OFF\nM30\n", record=True))
+    turning = [s for s in run.samples if 0.0 < s.positions_mm[C] < 90.0]
+    speeds = [math.dist(a.positions_mm[:2], b.positions_mm[:2]) / 0.001
+              for a, b in zip(turning, turning[1:])]
+    assert max(speeds) == pytest.approx(500.0, rel=0.002)
+    assert len(turning) * 0.001 == pytest.approx(90.0 / (500.0 / (500.0 * math.pi / 180.0)),
+                                                 rel=0.02)
