@@ -15,6 +15,7 @@ from cnc_objects.clients.client import AsyncClient
 
 _CHANNEL = re.compile(r"ch(\d+)\.mc_active_state_r", re.IGNORECASE)
 _AXIS = re.compile(r"ch(\d+)\.ax(\d+)\.axis_name", re.IGNORECASE)
+ROTARY_AXIS_TYPE = 2  # ch<c>.ax<a>.axis_type of a rotary axis (ACHSTYP_ROTATOR)
 
 
 @dataclass(frozen=True, slots=True)
@@ -25,6 +26,12 @@ class AxisView:
     index: int
     name: str
     drive: int  # physical axis the axis links to (kopf.link_to); 0 = none
+    rotary: bool = False  # kenngr.achs_typ 2: positions in degrees
+
+    @property
+    def unit(self) -> str:
+        """The unit of the axis's positions: "mm", or "°" for a rotary axis."""
+        return "°" if self.rotary else "mm"
 
     @property
     def key(self) -> str:
@@ -94,11 +101,12 @@ async def discover(client: AsyncClient) -> Machine:
             if (m := _AXIS.fullmatch(info.name)) and int(m.group(1)) == channel
         )
         wanted = [f"ch{channel}.ax{a}.{leaf}" for a in found
-                  for leaf in ("axis_name", "requested_link_to_physical_axis")]
+                  for leaf in ("axis_name", "requested_link_to_physical_axis", "axis_type")]
         values = await client.read_many(wanted) if wanted else {}
         axes = tuple(
             AxisView(channel, a, values[names.ch(channel).ax(a).axis_name] or f"ax{a}",
-                     values[names.ch(channel).ax(a).requested_link_to_physical_axis])
+                     values[names.ch(channel).ax(a).requested_link_to_physical_axis],
+                     values[names.ch(channel).ax(a).axis_type] == ROTARY_AXIS_TYPE)
             for a in found
         )
         channels.append(ChannelView(channel, position, axes))

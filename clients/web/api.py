@@ -172,7 +172,8 @@ async def machine(request: web.Request) -> web.StreamResponse:
     return web.json_response({
         "channels": [
             {"id": c.id, "plc_index": c.plc_index,
-             "axes": [{"index": a.index, "name": a.name, "drive": a.drive} for a in c.axes]}
+             "axes": [{"index": a.index, "name": a.name, "drive": a.drive, "unit": a.unit}
+                      for a in c.axes]}
             for c in found.channels
         ],
         "modes": {str(k): v for k, v in MODES.items()},

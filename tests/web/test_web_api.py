@@ -16,8 +16,8 @@ from typing import Any
 import aiohttp
 
 from cnc_objects.clients.web.users import WebRole
-from cnc_objects.testing import ServiceProcess
-from cnc_objects.testing.web import WebProcess
+from cnc_objects.testing import ServiceProcess, serving
+from cnc_objects.testing.web import WebProcess, serving_web
 from tests.support.web_http import WAIT_S, browser_session, json_request
 
 from .conftest import PASSWORDS
@@ -285,3 +285,16 @@ async def test_an_alarm_is_listed_with_its_place_and_acknowledged_by_its_number(
                                    csrf, json={})
         assert status == 400 and body["error"].startswith("ADS 0x70c NOTFOUND: no alarm has")
         await json_request(http, "POST", web.url + "/api/channel/1/reset", csrf, json={})
+
+
+async def test_a_rotary_axis_is_shown_in_degrees(tmp_path: Path) -> None:
+    """Issue 39: the machine's axes carry their unit, degrees for a rotary axis."""
+    with serving("--machine", "five-axis-ac", cwd=tmp_path) as service, \
+            serving_web(service.endpoint, cwd=tmp_path) as five:
+        async with browser_session() as http:
+            await json_request(http, "GET", five.url + "/api/session")  # the session cookie
+            status, body = await json_request(http, "GET", five.url + "/api/machine")
+    assert status == 200
+    first = body["channels"][0]["axes"]
+    assert [(a["name"], a["unit"]) for a in first] == [
+        ("X", "mm"), ("Y", "mm"), ("Z", "mm"), ("A", "°"), ("C", "°")]

@@ -31,7 +31,7 @@ function renderMachine() {
     for (const ax of ch.axes) {
       const a = `${c}.ax${ax.index}`;
       cells(rowFor(axes, a), [
-        `${c} ${ax.name}`, mm(v(`${a}.command_position_acs`)), mm(v(`${a}.command_position_pcs`)),
+        `${c} ${ax.name}${ax.unit === "°" ? " (°)" : ""}`, mm(v(`${a}.command_position_acs`)), mm(v(`${a}.command_position_pcs`)),
         mm(v(`${a}.position_offset`)), named(facts.link_states, v(`${a}.link_state`)), ax.drive || "-",
         referenced(v(`${a}.homing_referenced_r`)),
       ]);
