@@ -182,6 +182,7 @@ async def test_browse_describes_objects(api: Any) -> None:
         "ch1.ax1.command_position_acs",
         "ch1.ax1.logical_axis_number",
         "ch1.ax1.axis_name",
+        "ch1.ax1.axis_type",
         "ch1.ax1.position_offset",
         "ch1.ax1.vel_max",
         "ch1.ax1.acc_max",
