@@ -11,6 +11,7 @@ tool, workpiece-side directions times -1); both must give the same tip and direc
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -82,20 +83,15 @@ def head_table_bc_model(x: float, y: float, z: float, b: float, c: float,
     return w, direction
 
 
-@given(lengths, lengths, lengths, angles, angles, tools)
-def test_table_table_ac_tip_and_direction_match_the_physical_model(
-        x: float, y: float, z: float, a: float, c: float, tool_mm: float) -> None:
-    pose = TABLE_AC.forward({X: x, Y: y, Z: z, A: a, C: c}, tool_mm)
-    tip, direction = table_ac_model(x, y, z, a, c, tool_mm)
-    assert np.allclose(pose.tip_mm, tip, atol=1e-9)
-    assert np.allclose(pose.orientation, direction, atol=1e-12)
-
-
-@given(lengths, lengths, lengths, angles, angles, tools)
-def test_head_table_bc_tip_and_direction_match_the_physical_model(
-        x: float, y: float, z: float, b: float, c: float, tool_mm: float) -> None:
-    pose = HEAD_TABLE_BC.forward({X: x, Y: y, Z: z, B: b, C: c}, tool_mm)
-    tip, direction = head_table_bc_model(x, y, z, b, c, tool_mm)
+@pytest.mark.parametrize(("kinematics", "first_rotator", "model"), [
+    (TABLE_AC, A, table_ac_model), (HEAD_TABLE_BC, B, head_table_bc_model),
+], ids=["AC", "BC"])
+@given(x=lengths, y=lengths, z=lengths, r=angles, c=angles, tool_mm=tools)
+def test_tip_and_direction_match_the_physical_model(
+        kinematics: Kinematics, first_rotator: int, model: Any, x: float, y: float,
+        z: float, r: float, c: float, tool_mm: float) -> None:
+    pose = kinematics.forward({X: x, Y: y, Z: z, first_rotator: r, C: c}, tool_mm)
+    tip, direction = model(x, y, z, r, c, tool_mm)
     assert np.allclose(pose.tip_mm, tip, atol=1e-9)
     assert np.allclose(pose.orientation, direction, atol=1e-12)
 
