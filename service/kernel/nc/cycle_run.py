@@ -25,8 +25,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..path.kinematics import KinematicsError
 from .call_stack import CallFrame, CallFrameKind
 from .check import ErrorReported, categorize
+from .cycles.rotation import RotationOrder, rotation_from_angles
 from .errors import NcError, NcErrorId
 from .evaluation import number
 from .literals import nc_number
@@ -36,6 +38,7 @@ from .running_decoder import CallingDecoder
 from .source import LogicalLine
 from .statements import Call, CycleArgs, NcBlock
 from .technology import OutputLimitReached
+from .tool_orientation import normal_of, rotary_of, turn_line
 from .variables import Scope, Value, VariableFault
 
 PATTERN_WRAPPER = "SysPosPatternWrapper.ecy"
@@ -200,20 +203,62 @@ def _run_pattern(decoder: CallingDecoder, cycle_call: CycleCall) -> None:
     if missing:
         raise line.error(NcErrorId.PATTERN_SYNTAX, "a call pattern needs the axes X, Y and Z",
                          args.pattern_id_pos)
-    text = pattern_wrapper(positions, retract)
+    turns = _tool_turns(positions, decoder, line, args.pattern_id_pos)
+    text = pattern_wrapper(positions, retract, turns)
     program = Program(text, PATTERN_WRAPPER, decoder.parser, 1, decoder.check)
     frame = CallFrame(program, program.main, program.main.start, CallFrameKind.FILE)
     frame.pattern_call = cycle_call
     decoder.push_cycle(frame, None)
 
 
-def pattern_wrapper(positions: tuple[PatternPosition, ...], retract_mm: float) -> str:
-    """The NC text that runs a cycle at every position (``#PATTERN CALL`` runs it)."""
+def _tool_turns(positions: tuple[PatternPosition, ...], decoder: CallingDecoder,
+                line: LogicalLine, pos: int) -> list[str] | None:
+    """For a pattern with tilted positions (``#AT`` about X or Y, a five-axis channel
+    under ``#TRAFO ON``): the rotary axes' line before each position, and the last
+    one that turns the tool back as it was; None for a pattern without."""
+    if not any(p.tilted for p in positions):
+        return None
+    chain, modal = decoder.surroundings.kinematic_chain, decoder.modal
+    if chain is None or not modal.settings.trafo:
+        raise line.error(NcErrorId.PATTERN_ROTATION_NOT_SUPPORTED,
+                         "a call pattern with #AT rotations about X or Y turns the tool: "
+                         "program #TRAFO ON before the call", pos)
+    start = rotary_of(chain, modal)
+    near, turns = start, []
+    for p in positions:
+        rotation = rotation_from_angles(p.a_deg, p.b_deg, p.c_deg, RotationOrder.ZYX, True)
+        try:
+            turn, near = turn_line(chain, decoder.axes, normal_of(rotation, modal), near)
+        except KinematicsError as fault:
+            raise line.error(NcErrorId.TRAFO_POSE_UNREACHABLE,
+                             f"#AT [{p.x_mm:g}, {p.y_mm:g}, {p.z_mm:g}, {p.a_deg:g}, "
+                             f"{p.b_deg:g}, {p.c_deg:g}]: {fault}", pos) from None
+        turns.append(turn)
+    words = " ".join(f"{decoder.axes[k]}{nc_number(v)}" for k, v in sorted(start.items()))
+    turns.append(f"G90 G00 {words}")
+    return turns
+
+
+def pattern_wrapper(positions: tuple[PatternPosition, ...], retract_mm: float,
+                    tool_turns: list[str] | None = None) -> str:
+    """The NC text that runs a cycle at every position (``#PATTERN CALL`` runs it);
+    ``tool_turns`` (``_tool_turns``) turn the tool onto each tilted position's Z axis
+    and back at the end; at a tilted position the tool then moves onto that Z axis (in
+    the new system), as the retraction plane puts it above an upright one."""
     r = nc_number(retract_mm)
     lines = [f"; call pattern: {len(positions)} positions, retraction plane Z{r}"]
-    for p in positions:
-        x, y, z, c = (nc_number(v) for v in (p.x_mm, p.y_mm, p.z_mm, p.c_deg))
-        lines += [f"G90 G00 Z{r}", f"G00 X{x} Y{y}", f"#CS ON [{x}, {y}, {z}, 0, 0, {c}]",
-                  "#PATTERN CALL", "#CS OFF"]
-    lines += [f"G90 G00 Z{r}", "M17"]
+    for k, p in enumerate(positions):
+        x, y, z, a, b, c = (nc_number(v) for v in (p.x_mm, p.y_mm, p.z_mm, p.a_deg,
+                                                    p.b_deg, p.c_deg))
+        lines += [f"G90 G00 Z{r}", f"G00 X{x} Y{y}"]
+        if tool_turns is not None:
+            lines.append(tool_turns[k])
+        lines.append(f"#CS ON [{x}, {y}, {z}, {a}, {b}, {c}]")
+        if p.tilted:  # onto the tilted Z axis above the position, as X Y above it
+            lines.append("G00 X0 Y0")
+        lines += ["#PATTERN CALL", "#CS OFF"]
+    lines.append(f"G90 G00 Z{r}")
+    if tool_turns is not None:
+        lines.append(tool_turns[-1])
+    lines.append("M17")
     return "\n".join(lines) + "\n"

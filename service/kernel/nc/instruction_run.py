@@ -156,18 +156,20 @@ def _at(stmt: Instruction, decoder: CallingDecoder) -> None:
                               "#AT outside a pattern definition (#PATTERN BEGIN ... END)",
                               stmt.pos)
     values = _numbers(stmt, decoder)
-    if len(values) == 6:
+    if len(values) == 6 and decoder.surroundings.kinematic_chain is None:
+        # the tool would have to turn with the tilted system: a five-axis channel only
         for k, letter in ((3, "a (about X)"), (4, "b (about Y)")):
             if values[k] != 0.0:
                 raise stmt.line.error(NcErrorId.PATTERN_ROTATION_NOT_SUPPORTED,
-                                      f"#AT rotation {letter} = {values[k]:g}: only a rotation "
-                                      "about Z (the 6th value) is permitted", stmt.value_pos[k])
+                                      f"#AT rotation {letter} = {values[k]:g}: on a channel "
+                                      "without kinematics only a rotation about Z (the 6th "
+                                      "value) is permitted", stmt.value_pos[k])
     if len(pattern.positions) >= MAX_PATTERN_POSITIONS:
         raise stmt.line.error(NcErrorId.PATTERN_SYNTAX,
                               f"a pattern holds at most {MAX_PATTERN_POSITIONS} positions",
                               stmt.pos)
-    c = values[5] if len(values) == 6 else 0.0
-    pattern.positions.append(PatternPosition(values[0], values[1], values[2], c))
+    a, b, c = values[3:6] if len(values) == 6 else (0.0, 0.0, 0.0)
+    pattern.positions.append(PatternPosition(values[0], values[1], values[2], c, a, b))
 
 
 def _pattern_call(stmt: Instruction, decoder: CallingDecoder) -> None:

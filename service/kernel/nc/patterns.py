@@ -22,12 +22,20 @@ from .source import LogicalLine
 
 @dataclass(frozen=True, slots=True)
 class PatternPosition:
-    """One ``#AT``: where the cycle runs and its rotation about Z."""
+    """One ``#AT``: where the cycle runs and its rotations (a about X, b about Y, c about
+    Z, as ``#CS ON`` takes them)."""
 
     x_mm: float
     y_mm: float
     z_mm: float
     c_deg: float = 0.0
+    a_deg: float = 0.0
+    b_deg: float = 0.0
+
+    @property
+    def tilted(self) -> bool:
+        """A rotation about X or Y: the tool must turn with it."""
+        return self.a_deg != 0.0 or self.b_deg != 0.0
 
 
 @dataclass(slots=True)

@@ -15,6 +15,7 @@ from cnc_objects.service.kernel.channel_mode import ChannelState
 from cnc_objects.service.machine_config import FIVE_AXIS_AC, EmbeddedMachine
 from tests.service.kernel.nc.test_cs_and_patterns import EXAMPLE_1, EXAMPLE_2, PROCESSING
 from tests.support.kernel import KernelHarness, Run
+from tests.support.service import ROOT
 
 X, Y, Z, A, C = 0, 1, 2, 3, 4
 
@@ -195,3 +196,39 @@ def test_no_axis_exceeds_its_velocity_when_the_table_turns_far_from_the_tip(
     assert max(speeds) == pytest.approx(500.0, rel=0.002)
     assert len(turning) * 0.001 == pytest.approx(90.0 / (500.0 / (500.0 * math.pi / 180.0)),
                                                  rel=0.02)
+
+
+DRILL = (ROOT / "docs" / "examples" / "cycles" / "drill.ecy").read_text()
+
+
+def test_a_call_pattern_tilts_the_tool_at_a_tilted_position(ac: KernelHarness) -> None:
+    # #AT about X by 30 degrees (a five-axis channel under #TRAFO ON): the tool turns
+    # onto the tilted Z, the cycle drills 2 mm along it and draws its 10 mm X line;
+    # the tool turns back to vertical after the pattern
+    ac.programs["drill.ecy"] = DRILL
+    text = ("G90 G00 X0 Y0 Z60 A0 C0\n#TRAFO ON\n#PATTERN BEGIN [ID=1]\n"
+            "#AT [50, 0, 0, 30, 0, 0]\n#PATTERN END\n"
+            "L CYCLE [NAME=drill.ecy @P1 = 2 PATTERN_ID = 1 PATTERN_RETRACT = 100]\nM30\n")
+    run = _ran(ac.run(text, record=True))
+    tilted = [s for s in run.samples if abs(s.positions_mm[A] + 30.0) < 1e-9]
+    assert tilted  # the cradle at -30: the tool along the workpiece's (0, -0.5, 0.866)
+    s30, c30 = math.sin(math.radians(30)), math.cos(math.radians(30))
+    # the tips in the tilted system: Rx(30) about the position (50, 0, 0)
+    turned = np.array([[1.0, 0.0, 0.0], [0.0, c30, -s30], [0.0, s30, c30]])
+    local = [turned.T @ (tip_of(s.positions_mm) - np.array([50.0, 0.0, 0.0])) for s in tilted]
+    on_axis = [p for p in local if abs(p[0]) < 1e-9 and abs(p[1]) < 1e-9]
+    assert min(p[2] for p in on_axis) == pytest.approx(-2.0, abs=0.02)  # drilled 2 mm
+    on_x_line = [p for p in local if abs(p[1]) < 1e-9 and abs(p[2] + 2.0) < 1e-9
+                 and 0.0 < p[0] < 10.0]
+    assert len(on_x_line) > 100  # the cycle's X line, at 1000 mm/min: 0.6 s
+    assert tool_direction_of(tilted[0].positions_mm) == pytest.approx((0.0, -s30, c30),
+                                                                       abs=1e-9)
+    assert run.positions_mm[A] == pytest.approx(0.0)  # turned back at the end
+
+
+def test_a_tilted_position_needs_trafo_on(ac: KernelHarness) -> None:
+    ac.programs["drill.ecy"] = DRILL
+    run = ac.run("#PATTERN BEGIN [ID=1]\n#AT [50, 0, 0, 30, 0, 0]\n#PATTERN END\n"
+                 "L CYCLE [NAME=drill.ecy @P1 = 2 PATTERN_ID = 1 PATTERN_RETRACT = 100]\nM30\n")
+    [error] = run.channel.errors.entries
+    assert error.id == 20526 and "program #TRAFO ON before the call" in error.text

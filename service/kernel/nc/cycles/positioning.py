@@ -39,6 +39,7 @@ from collections.abc import Mapping
 from ...path.kinematics import KinematicsError
 from ..errors import NcErrorId
 from ..literals import nc_number
+from ..tool_orientation import normal_of, rotary_of, turn_line
 from ..variables import Value
 from .rotation import (
     Matrix,
@@ -46,7 +47,6 @@ from .rotation import (
     RotationOrder,
     Vector,
     angles_from_rotation,
-    apply,
     rotation_from_angles,
     rotation_from_points,
 )
@@ -179,20 +179,13 @@ def _tool_onto(context: CycleContext, rotation: Matrix) -> str:
     tip stays where it is (``#TRAFO ON``)."""
     chain = context.decoder.surroundings.kinematic_chain
     assert chain is not None  # _run checked
-    normal = (rotation[0][2], rotation[1][2], rotation[2][2])
-    placement = context.modal.cs_placement
-    if placement is not None:  # the plane is given in the active #CS: to the decoder's
-        normal = apply(placement.rotation, normal)
-    position = context.modal.position_mm
-    names = context.decoder.axes
-    near = {a.axis_index: position[a.axis_index] for a in chain.rotators}
     try:
-        rotary = chain.orientation_to_rotary(normal, near)
+        line, _ = turn_line(chain, context.decoder.axes, normal_of(rotation, context.modal),
+                            rotary_of(chain, context.modal))
     except KinematicsError as fault:
         raise context.error(NcErrorId.TRAFO_POSE_UNREACHABLE,
                             f"SysPosRotationToPlane.ecy: {fault}", 1) from None
-    words = " ".join(f"{names[k]}{nc_number(v)}" for k, v in sorted(rotary.items()))
-    return f"G90 G00 {words}"
+    return line
 
 
 ROTATION_TO_PLANE = BuiltinCycle("SysPosRotationToPlane.ecy", PARAMS, _run, _check)
