@@ -518,8 +518,11 @@ class ChannelConfig(Strict):
                                  f"{link.axis}")
             chain.append(ChainAxis(index[link.axis], JointKind[link.type.upper()],
                                    link.direction, link.point_mm))
+        ranges = [(index[link.axis], self.axes[index[link.axis]].limits.sw_limit_min_mm,
+                   self.axes[index[link.axis]].limits.sw_limit_max_mm)
+                  for link in self.kinematics.axes if link.type == "rotator"]
         return Kinematics.from_chain(self.kinematics.id, self.kinematics.zero_orientation,
-                                     self.kinematics.zero_position_mm, chain)
+                                     self.kinematics.zero_position_mm, chain, ranges)
 
 
 class MachineConfig(Strict):

@@ -137,12 +137,17 @@ class Kinematics:
     zero_orientation: Vector  # unit
     zero_position_mm: Vector
     chain: tuple[ChainAxis, ...]
+    # the rotators' ranges (degrees, their software limits): a tool direction is turned
+    # to by values inside them
+    rotary_limits_deg: tuple[tuple[int, float, float], ...] = ()
 
     @classmethod
     def from_chain(cls, kinematic_id: int, zero_orientation: Sequence[float],
-                   zero_position_mm: Sequence[float], chain: Sequence[ChainAxis]) -> Kinematics:
+                   zero_position_mm: Sequence[float], chain: Sequence[ChainAxis],
+                   rotary_limits_deg: Sequence[tuple[int, float, float]] = ()) -> Kinematics:
         """Check and normalise a configured chain: three translators whose directions
-        span space, two rotators, each channel axis once."""
+        span space, two rotators, each channel axis once; ``rotary_limits_deg``: (axis
+        index, lowest, highest) of rotators with a range."""
         axes = tuple(ChainAxis(a.axis_index, JointKind(a.kind), _unit(a.direction),
                                _vector(a.point_mm, "a rotator's point"))
                      for a in chain)
@@ -157,7 +162,8 @@ class Kinematics:
             raise KinematicsError(f"kinematics {kinematic_id}: an axis is in the chain twice "
                                   f"(axis indices {indices})")
         made = cls(kinematic_id, _unit(zero_orientation),
-                   _vector(zero_position_mm, "the zero position"), axes)
+                   _vector(zero_position_mm, "the zero position"), axes,
+                   tuple(rotary_limits_deg))
         a, b, c = made._translator_columns({})
         if abs(_det(a, b, c)) < _SPAN_TOLERANCE:
             raise KinematicsError(f"kinematics {kinematic_id}: the translators' directions "
@@ -275,11 +281,31 @@ class Kinematics:
             t2 = self._angle_between(u2, z0, c, near_deg.get(second.axis_index, 0.0))
             t1 = self._angle_between(u1, c, d, near_deg.get(first.axis_index, 0.0))
             candidate = {first.axis_index: t1, second.axis_index: t2}
+            if not self._within_limits(candidate):
+                continue
             distance = sum(abs(v - near_deg.get(i, 0.0)) for i, v in candidate.items())
             if best is None or distance < best[0]:
                 best = (distance, candidate)
-        assert best is not None
+        if best is None:
+            raise KinematicsError(
+                f"kinematics {self.kinematic_id}: the tool direction ({d[0]:.6g}, "
+                f"{d[1]:.6g}, {d[2]:.6g}) needs the rotary axes beyond their limits")
         return best[1]
+
+    def _within_limits(self, values: dict[int, float]) -> bool:
+        """The rotators' ``values`` lie in their ranges (a range of a full turn or more
+        takes the value modulo 360 nearest to the one found)."""
+        for index, low, high in self.rotary_limits_deg:
+            value = values[index]
+            if low <= value <= high:
+                continue
+            if high - low >= 360.0:  # another turn of the same angle is inside
+                shifted = value + 360.0 * math.ceil((low - value) / 360.0)
+                if shifted <= high:
+                    values[index] = shifted
+                    continue
+            return False
+        return True
 
     @staticmethod
     def _angle_between(u: Vector, p: Vector, q: Vector, near: float) -> float:

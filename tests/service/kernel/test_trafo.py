@@ -232,3 +232,26 @@ def test_a_tilted_position_needs_trafo_on(ac: KernelHarness) -> None:
                  "L CYCLE [NAME=drill.ecy @P1 = 2 PATTERN_ID = 1 PATTERN_RETRACT = 100]\nM30\n")
     [error] = run.channel.errors.entries
     assert error.id == 20526 and "program #TRAFO ON before the call" in error.text
+
+
+def test_a_tilt_beyond_the_cradle_is_refused_before_anything_moves(ac: KernelHarness) -> None:
+    # 130 degrees about X: the cradle would need A -130 or +130, beyond its 120
+    text = ("G90 G00 X0 Y0 Z50 A0 C0\n#TRAFO ON\n"
+            "L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=2 @P15=130]\nM30\n")
+    run = ac.run(text)
+    [error] = run.channel.errors.entries
+    assert (error.id, error.line) == (292004, 3)
+    assert "beyond their limits" in error.text
+    assert run.positions_mm[A] == 0.0
+
+
+def test_of_two_solutions_the_one_inside_the_limits_is_taken() -> None:
+    # 100 degrees about X from A 0 C 0: the nearer solution is A -100, C 0; with the
+    # cradle's range -30..120 only A 100 with C 180 is inside
+    data = copy.deepcopy(FIVE_AXIS_AC)
+    data["channels"][0]["axes"][3]["limits"]["sw_limit_min_mm"] = -30.0
+    config = build_config(data, machine=EmbeddedMachine.THREE_AXIS)
+    with KernelHarness(config=config) as ac:
+        run = _ran(ac.run("G90 G00 X0 Y0 Z50 A0 C0\n#TRAFO ON\n"
+                          "L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=2 @P15=100]\nM30\n"))
+    assert (run.positions_mm[A], run.positions_mm[C]) == pytest.approx((100.0, 180.0))
