@@ -204,6 +204,9 @@ class Block:
     h_functions: tuple[int, ...] = ()  # H words: technology information to the PLC
     manual_mode: ManualModeRequest | None = None  # G200 / G201 / G202
     spindle_pos_deg: float | None = None  # S.POS: where an M19 of the block orients to
+    # G74 with a sequence (G74 Z1 X2): the homing steps after this one, each a block of
+    # the same source that starts when the one before has stopped (issue 39)
+    then: tuple[Block, ...] = ()
 
     @property
     def needs_stop(self) -> bool:

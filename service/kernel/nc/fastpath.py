@@ -222,6 +222,7 @@ def run(decoder):
             if block.contour is None or block.contour.kind not in LOOP_MARKERS:
                 progress = work
             yield block
+            yield from block.then  # the later steps of a G74 sequence
         if decoder.finished:
             return
         if work >= look_at:
@@ -267,6 +268,7 @@ _BLOCK_FAST = '''\
                 block.h_functions = ()
                 block.manual_mode = None
                 block.spindle_pos_deg = None
+                block.then = ()
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\
