@@ -76,15 +76,15 @@ OPERATOR_ROWS: tuple[ObjectTemplate, ...] = (
     ObjectTemplate("mc_all_axes_referenced_r", _CH, COM, COM_CH, 0x3707, BOOLEAN, R, "-",
               "TRUE when every axis of the channel is homed (project)"),
     ObjectTemplate("mc_referencing_required_r", _CH, COM, COM_CH, 0x3708, BOOLEAN, R, "-",
-              "TRUE while START of a program is refused because an axis is not homed "
-              "(programs_need_referenced_axes set) (project)"),
+              "TRUE while an axis of the channel that needs homing (P-AXIS-00277 "
+              "prog_move_requires_homing) is not homed: a program may not move it (project)"),
     ObjectTemplate("distance_to_go_pcs", _AXIS, COM, COM_CH, 0x04, SGN32, R, "0.1 um",
               "Distance to go of the axis: end point of the block in the interpolator - "
               "command position; 0 without a block (offset as TwinSharp)"),
     # --- settings that change behaviour (configuration; project) -------------------------
     ObjectTemplate("cnc_programs_need_referenced_axes_r", _PLATFORM, COM, COM_CH, 0x1040, BOOLEAN,
-              R, "-", "Configuration programs_need_referenced_axes: START needs every axis "
-              "homed (project)"),
+              R, "-", "Configuration programs_need_referenced_axes: the default of every axis' "
+              "P-AXIS-00277 prog_move_requires_homing (project)"),
     ObjectTemplate("cnc_tool_change_time_r", _PLATFORM, COM, COM_CH, 0x1041, REAL64, R, "s",
               "Configuration tool_change_time_s: the time M6 takes (project)"),
     ObjectTemplate("cnc_plc_acknowledges_r", _PLATFORM, COM, COM_CH, 0x1042,

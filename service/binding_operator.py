@@ -35,9 +35,15 @@ def _all_referenced(ch: Channel) -> bool:
 
 
 def _referencing_required(kernel: Kernel, obj: CncObject) -> Getter:
+    """TRUE while an axis of the channel that needs homing (P-AXIS-00277, its own or
+    the machine's default) is not referenced: a program may not move it yet."""
     ci = kernel.channel_index(obj.channel)
-    needed = kernel.config.programs_need_referenced_axes
-    return lambda: needed and not _all_referenced(kernel.snapshot.channels[ci])
+    config = kernel.config
+    default = config.programs_need_referenced_axes
+    needs = tuple(default if a.manual.prog_move_requires_homing is None
+                  else a.manual.prog_move_requires_homing for a in config.channels[ci].axes)
+    return lambda: any(need and not view.referenced for need, view in
+                       zip(needs, kernel.snapshot.channels[ci].manual, strict=False))
 
 
 def _distance_to_go(kernel: Kernel, obj: CncObject) -> Getter:

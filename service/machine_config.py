@@ -62,6 +62,10 @@ class ManualAxisConfig(Strict):
         "hb_display_r.hr_aufloesung; the HMI/PLC may change it")
     homing_vel_mm_s: float = Field(
         10.0, gt=0, description="speed of the homing run (G74 or homing_start_w, mm/s)")
+    prog_move_requires_homing: bool | None = Field(
+        None, description="P-AXIS-00277 kenngr.prog_move_requires_homing: a program block "
+        "that moves this axis before it is referenced is an error (error 50110, issue 39); "
+        "left out: the machine's programs_need_referenced_axes (default false, ISG's 0)")
     pos_refpkt_mm: float = Field(
         0.0, description="P-AXIS-00152 kenngr.pos_refpkt: the position the axis "
         "takes at the end of homing (mm)")
@@ -534,9 +538,9 @@ class MachineConfig(Strict):
     channels: tuple[ChannelConfig, ...] = Field(min_length=1, max_length=12)
     tools: tuple[ToolConfig, ...] = Field((), description="tool table (D number -> radius)")
     programs_need_referenced_axes: bool = Field(
-        False, description="START of a program (AUTOMATIC) is refused while an axis of "
-        "the channel is not referenced (homing, docs/manual.md); manual blocks (G74 in "
-        "MDI) still run")
+        False, description="the default of every axis' prog_move_requires_homing "
+        "(P-AXIS-00277): a program block that moves an unreferenced axis is an error "
+        "(docs/manual.md, issue 39); manual blocks (G74 in MDI) still run")
     tool_entries: int = Field(32, ge=1, le=9999,
                               description="rows wz[1..n] of each channel's tool list")
     tool_change_time_s: float = Field(0.0, ge=0.0, le=600.0,

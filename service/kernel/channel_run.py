@@ -151,7 +151,6 @@ class ChannelRunner:
             kinematic_chain=config.kinematic_chain(),
             idle_steps_max=services.idle_steps_max,
         )
-        self._programs_need_referenced_axes = machine.programs_need_referenced_axes
         self.manual = ManualMode(channel, machine, params, cycle_s, self._move, self.report)
 
     def _move(self, event: ChannelEvent) -> None:
@@ -216,11 +215,6 @@ class ChannelRunner:
             return None
         if ch.state != ChannelState.READY or ch.mode != ChannelMode.AUTOMATIC:
             return _not_ready(ch, "START needs AUTOMATIC/READY (select a program first) or HOLD")
-        if self._programs_need_referenced_axes and self.manual.unreferenced_axes():
-            names = ", ".join(self.manual.unreferenced_axes())
-            return _not_ready(ch, f"axes {names} are not referenced and the machine parameter "
-                              "programs_need_referenced_axes is set: home them first (G74 in "
-                              "MDI, or homing_start_w in MANUAL)")
         self._start_when_linked(Job(ch.program.program_name), keep_open=False, fresh_modal=True)
         return None
 
@@ -321,6 +315,10 @@ class ChannelRunner:
                     "P-CHAN-00306): configure it with kopf.clone_of",
                 )
         return None
+
+    def locked_axes(self) -> frozenset[int]:
+        """Axes a program block must not move: P-AXIS-00277 set, not referenced."""
+        return self.manual.locked_axes()
 
     def referenced(self, axes: tuple[int, ...]) -> None:
         """G74 homed the channel axes with these indices (a run reports it)."""

@@ -100,6 +100,8 @@ class ManualMode:
         self._axes: list[_Axis] = []
         # the manual offsets the path's output adds; None while all are 0 (no cost)
         self.offsets_mm: tuple[float, ...] | None = None
+        # P-AXIS-00277 of the axes that leave it out (issue 39)
+        self._requires_homing_default = machine.programs_need_referenced_axes
         for axis in channel.axes:
             configured = machine.axis(axis.logical_number)
             config = configured.manual if configured is not None else ManualAxisConfig()
@@ -136,6 +138,18 @@ class ManualMode:
         """For G74: axis index -> (reference position mm, homing speed mm/s)."""
         return {k: (a.config.pos_refpkt_mm, a.config.homing_vel_mm_s)
                 for k, a in enumerate(self._axes)}
+
+    def requires_homing(self, axis_index: int) -> bool:
+        """P-AXIS-00277 ``prog_move_requires_homing`` of the axis: a program may move it
+        only once it is referenced (the machine's default when the axis leaves it out)."""
+        own = self._axes[axis_index].config.prog_move_requires_homing
+        return self._requires_homing_default if own is None else own
+
+    def locked_axes(self) -> frozenset[int]:
+        """Indices of the axes a program must not move now: they need homing
+        (P-AXIS-00277) and are not referenced."""
+        return frozenset(k for k in range(len(self._axes))
+                         if self.requires_homing(k) and not self.referenced(k))
 
     def unreferenced_axes(self) -> list[str]:
         """Names of the channel's axes that are not referenced."""

@@ -97,6 +97,10 @@ class RunHost(Protocol):
     def referenced(self, axes: tuple[int, ...]) -> None:
         """G74 homed the channel axes with these indices."""
 
+    def locked_axes(self) -> frozenset[int]:
+        """Axes a program block must not move: they need homing (P-AXIS-00277) and
+        are not referenced."""
+
     @property
     def manual_offsets_mm(self) -> tuple[float, ...] | None:
         """The G200/G201 manual offsets to add to the path's output (None: all 0)."""
@@ -163,6 +167,9 @@ class ProgramRun:
         self._last_pushed: Block | None = None  # the block that entered the buffer last
         self._buffer_warned = False  # BUFFER_LIMITS_SPEED shown in this run
         self._pending_error: ErrorEntry | None = None  # takes effect where the path stops
+        # axes that need homing and are not referenced (P-AXIS-00277), less those a G74
+        # block fed in this run homes: the blocks after it find them referenced
+        self._locked = host.locked_axes()
         self._fed_all = False
         # manual blocks of a plain MDI run finished but not shown yet: they are counted
         # with the run's end, so that a client that waits on the count finds the channel
@@ -451,6 +458,11 @@ class ProgramRun:
                     if self._close(item):
                         self._sync = item
                     return
+                if self._locked and _moves_locked(item, self._locked):
+                    self._stop_feeding(_not_referenced(item, self._locked, channel))
+                    return
+                if item.homing_axes:
+                    self._locked = self._locked - frozenset(item.homing_axes)
                 if item.trafo is not None and self._kinematics is not None:
                     prepared = self._kinematics.prepared(item)
                     if isinstance(prepared, tuple):  # beyond a software limit
@@ -669,6 +681,29 @@ def _path_error(exc: PathError, block: Block | None) -> ErrorEntry:
         return ErrorEntry(int(exc.id), exc.message)
     src = named.source
     return ErrorEntry(int(exc.id), exc.message, src.file, src.line, src.column)
+
+
+def _moves_locked(block: Block, locked: frozenset[int]) -> bool:
+    """The block moves one of the ``locked`` axes (a G74 block moves its own axes to
+    home them: that is allowed)."""
+    motion = block.motion
+    if motion is None:
+        return False
+    homing = block.homing_axes
+    return any(motion.start_mm[k] != motion.end_mm[k] for k in locked if k not in homing)
+
+
+def _not_referenced(block: Block, locked: frozenset[int], channel: Channel) -> ErrorEntry:
+    """Error 50110 at ``block``: it would move an axis that must be homed first."""
+    motion = block.motion
+    assert motion is not None
+    names = ", ".join(channel.axes[k].name for k in sorted(locked)
+                      if motion.start_mm[k] != motion.end_mm[k])
+    src = block.source
+    return ErrorEntry(int(PathErrorId.AXIS_NOT_REFERENCED),
+                      f"axis {names} is not referenced and must be homed before a program "
+                      "moves it (P-AXIS-00277 prog_move_requires_homing): G74 first",
+                      src.file, src.line, src.column)
 
 
 def _waits_for_standstill(block: Block) -> bool:

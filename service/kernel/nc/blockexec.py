@@ -49,7 +49,7 @@ from .evaluation import Env
 from .exchange import moved_axes
 from .expressions import evaluate_number
 from .geometry import centre_from_offsets, centre_from_radius
-from .homing_block import homing_motion, with_homing
+from .homing_block import HomingStep, homing_steps, with_homing
 from .manual_block import manual_mode_request, with_manual_mode
 from .modal import G_CODES, PLANE_AXES, DistanceMode, GGroup, MCode, ModalState, Plane
 from .statements import Assign, AxisCommand, NcBlock, Word, WordKind
@@ -251,6 +251,7 @@ class BlockExecutor:
         self._modal_groups(groups)
         self._technology(words, err)
         homed: tuple[int, ...] = ()
+        steps: list[HomingStep] = []  # G74: its homing steps, in the order of their places
         manual_mode = None
         if GGroup.MANUAL_MODE in groups:  # G200/G201/G202: the axis words name the axes
             number, g_pos = groups[GGroup.MANUAL_MODE]
@@ -258,8 +259,9 @@ class BlockExecutor:
             axis_words = []
         if GGroup.HOMING in groups:  # G74: the axis words are places in the homing sequence
             dwell_s = 0.0
-            motion, homed = homing_motion(self.modal, axis_words, groups[GGroup.HOMING][1],
-                                          self.plane_axes.get(self.modal.plane) or (0, 1), err)
+            steps = homing_steps(self.modal, axis_words, groups[GGroup.HOMING][1],
+                                 self.plane_axes.get(self.modal.plane) or (0, 1), err)
+            motion, homed = steps[0]
             axis_words = []
         elif GGroup.DWELL in groups:  # G4: X or F is the time, F stays as it was
             dwell_s = self._dwell(groups, axis_words, offsets, words, err)
@@ -320,7 +322,7 @@ class BlockExecutor:
         if self.modal.settings.trafo:
             block = replace(block, trafo=self.trafo_use())
         if homed:
-            block = with_homing(block, homed)
+            block = with_homing(block, steps)
         if h_codes:
             block = replace(block, h_functions=tuple(h_codes))
         if WordKind.SPINDLE_POS in words:  # S.POS: the angle of the block's M19

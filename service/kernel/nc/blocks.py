@@ -215,6 +215,9 @@ class Block:
     spindle_pos_deg: float | None = None  # S.POS: where an M19 of the block orients to
     trafo: TrafoUse | None = None  # #TRAFO ON: the positions are tip and orientation
     trafo_switch: bool = False  # #TRAFO ON/OFF: the positions change meaning at standstill
+    # G74 with a sequence (G74 Z1 X2): the homing steps after this one, each a block of
+    # the same source that starts when the one before has stopped (issue 39)
+    then: tuple[Block, ...] = ()
 
     @property
     def needs_stop(self) -> bool:

@@ -98,6 +98,7 @@ def _fast_block(
     b.spindle_pos_deg = None
     b.trafo = None
     b.trafo_switch = False
+    b.then = ()
     b.__class__ = Block
     return cast(Block, b)
 

@@ -46,8 +46,9 @@ class NcErrorId(IntEnum):
     INVALID_TOOL_NUMBER = 20133  # T not a non-negative integer
     TOOL_NOT_IN_TABLE = 20134  # D number without an entry in the tool table
     INVALID_DWELL = 20135  # G4 without a time, negative time, or with axis motion
-    INVALID_HOMING = 20136  # G74 without axes, with a sequence number that is not
-    # a whole number >= 1, with motion words, or with several sequence numbers
+    INVALID_HOMING = 20136  # G74 without axes
+    HOMING_PLACE_OUT_OF_RANGE = 20816  # ISG: G74's value of an axis (its place in the
+    # homing sequence) out of range: 0, negative, not a whole number
     TOOL_CHANGE_WITHOUT_TOOL = 20137  # M6 before any T was programmed (project id)
     INVALID_H_CODE = 20138  # H negative or over 65535 (project id: ISG names no id)
     H_FUNCTION_TWICE = 20766  # ISG: the same H function twice in one block

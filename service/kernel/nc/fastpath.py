@@ -222,6 +222,7 @@ def run(decoder):
             if block.contour is None or block.contour.kind not in LOOP_MARKERS:
                 progress = work
             yield block
+            yield from block.then  # the later steps of a G74 sequence
         if decoder.finished:
             return
         if work >= look_at:
@@ -269,6 +270,7 @@ _BLOCK_FAST = '''\
                 block.spindle_pos_deg = None
                 block.trafo = None
                 block.trafo_switch = False
+                block.then = ()
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\

@@ -27,6 +27,8 @@ class PathErrorId(IntEnum):
     ARC_HELIX = 50012  # arc block moves an axis outside its plane (no helix)
     SW_LIMIT_MIN = 50100  # the motion leaves an axis' software limit downwards
     SW_LIMIT_MAX = 50101  # the motion leaves an axis' software limit upwards
+    AXIS_NOT_REFERENCED = 50110  # the block moves an axis that needs homing first
+    # (P-AXIS-00277 prog_move_requires_homing); project id: ISG's pages name none
     COMP_RADIUS_NEGATIVE = 50200  # tool radius for compensation is negative
     COMP_ARC_RADIUS = 50201  # arc radius <= tool radius on the inside of the arc
     COMP_NO_INTERSECTION = 50202  # offset elements at an inside corner do not intersect
