@@ -58,6 +58,7 @@ class NcErrorId(IntEnum):
     SPINDLE_COMMAND_UNKNOWN = 21035  # ISG: unknown command in the spindle sequence S[...]
     NEGATIVE_SPINDLE_REV = 20991  # ISG: negative spindle speed REV in S[...]
     SPINDLE_POS_TWICE = 20851  # ISG: the spindle position twice (POS or S.POS) in a block
+    UNKNOWN_SPINDLE_NAME = 20180  # ISG: S2[...]: a spindle name the channel does not have
     D_IN_SPINDLE_SYNTAX = 21243  # ISG: a D word inside the main spindle's S[...]
     MANUAL_MODE_TWICE = 20129  # ISG: more than one of G200/G201/G202 in one block
     MANUAL_MODE_WITHOUT_AXES = 20139  # G201 without an axis (project id)

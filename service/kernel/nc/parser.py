@@ -25,7 +25,7 @@ from .instructions import Instruction, parse_instruction
 from .lexer import IDENT, SIGNED_NUMBER, Cursor
 from .modal import G_CODES, GGroup
 from .source import LogicalLine
-from .spindle_syntax import parse_spindle_syntax, starts_spindle_syntax
+from .spindle_syntax import other_spindle_error, parse_spindle_syntax, starts_spindle_syntax
 from .statements import (
     Assign,
     AxisCommand,
@@ -312,6 +312,8 @@ class LineParser:
         elif c == "S" and starts_spindle_syntax(cur, pos):  # S[M3 REV1000 ...]
             parse_spindle_syntax(cur, block, letters, pos)
         elif "A" <= c <= "Z" or c == "_":
+            if c == "S":
+                other_spindle_error(cur, pos)  # S2[...]: ISG's 20180
             spec = table.get(c)
             if spec is None:
                 raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")

@@ -36,6 +36,7 @@ _NOT_MODELLED = frozenset({"CALLAX", "PUTAX", "GET_DYNAMIC_DATA", "GET_DYNAMIK_D
 _NOT_MODELLED_G = {74: "G74 (homing the spindle)", 167: "G167 (spindle override 100 %)",
                    130: "G130 (acceleration weighting)", 135: "G135 (feedforward)",
                    136: "G136 (feedforward weighting)", 137: "G137 (feedforward off)"}
+_OTHER_SPINDLE = re.compile(r"S([0-9]+)[ \t]*\[")  # S2[...]: another spindle's bracket
 _G_NUMBER = re.compile(r"[ \t]*=?[ \t]*([0-9]+)(?![0-9.])")
 
 
@@ -46,6 +47,14 @@ def starts_spindle_syntax(cur: Cursor, pos: int) -> bool:
     while k < cur.end and up[k] in " \t":
         k += 1
     return k < cur.end and up[k] == "[" and _KEYWORD.match(up, k + 1) is not None
+
+
+def other_spindle_error(cur: Cursor, pos: int) -> None:
+    """Raise ISG's 20180 for ``S<n>[...]`` at ``pos``: the channel has one spindle, S."""
+    m = _OTHER_SPINDLE.match(cur.up, pos)
+    if m is not None:
+        raise cur.error(NcErrorId.UNKNOWN_SPINDLE_NAME,
+                        f"unknown spindle name 'S{m.group(1)}': the channel's spindle is S", pos)
 
 
 def parse_spindle_syntax(cur: Cursor, block: NcBlock, letters: set[str], pos: int) -> None:

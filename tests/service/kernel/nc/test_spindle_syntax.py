@@ -50,6 +50,7 @@ def test_s_with_a_bracket_expression_is_still_the_speed() -> None:
     ("S[REV100 CALLAX]", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 10),
     ("S[REV100 FEED_LINK]", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 10),
     ("S[M19]", NcErrorId.M19_WITHOUT_SPEED, 3),
+    ("S100 M3 S2[M4 REV5000]", NcErrorId.UNKNOWN_SPINDLE_NAME, 9),  # one spindle: S
     ("M19 S.POS=90", NcErrorId.M19_WITHOUT_SPEED, 1),  # ISG: "a valid speed (> 0)"
     ("S0 M3 M19", NcErrorId.M19_WITHOUT_SPEED, 7),
 ])
