@@ -25,7 +25,7 @@ from .instructions import Instruction, parse_instruction
 from .lexer import IDENT, SIGNED_NUMBER, Cursor
 from .modal import G_CODES, GGroup
 from .source import LogicalLine
-from .spindle_syntax import other_spindle_error, parse_spindle_syntax, starts_spindle_syntax
+from .spindle_syntax import SPINDLE_BRACKET, spindle_bracket
 from .statements import (
     Assign,
     AxisCommand,
@@ -309,11 +309,10 @@ class LineParser:
             block.number = self._block_number(cur, block.number)
         elif c == "S" and _SPINDLE_POS.match(cur.up, pos):
             self._spindle_pos(cur, block, letters, pos)
-        elif c == "S" and starts_spindle_syntax(cur, pos):  # S[M3 REV1000 ...]
-            parse_spindle_syntax(cur, block, letters, pos)
+        elif c == "S" and SPINDLE_BRACKET.match(cur.up, pos) \
+                and spindle_bracket(cur, block, letters, pos):
+            return  # S[M3 REV1000 ...] (S2[...]: ISG's 20180); S[expr] is the speed
         elif "A" <= c <= "Z" or c == "_":
-            if c == "S":
-                other_spindle_error(cur, pos)  # S2[...]: ISG's 20180
             spec = table.get(c)
             if spec is None:
                 raise cur.error(NcErrorId.UNKNOWN_WORD, f"unknown word '{cur.word_text()}'")

@@ -36,25 +36,24 @@ _NOT_MODELLED = frozenset({"CALLAX", "PUTAX", "GET_DYNAMIC_DATA", "GET_DYNAMIK_D
 _NOT_MODELLED_G = {74: "G74 (homing the spindle)", 167: "G167 (spindle override 100 %)",
                    130: "G130 (acceleration weighting)", 135: "G135 (feedforward)",
                    136: "G136 (feedforward weighting)", 137: "G137 (feedforward off)"}
-_OTHER_SPINDLE = re.compile(r"S([0-9]+)[ \t]*\[")  # S2[...]: another spindle's bracket
+# S[ or S2[: a spindle's bracket (one cheap test for every S word of the general path)
+SPINDLE_BRACKET = re.compile(r"S([0-9]*)[ \t]*\[")
 _G_NUMBER = re.compile(r"[ \t]*=?[ \t]*([0-9]+)(?![0-9.])")
 
 
-def starts_spindle_syntax(cur: Cursor, pos: int) -> bool:
-    """``S`` at ``pos`` opens a spindle bracket: ``S [`` with a keyword after it."""
-    k = pos + 1
-    up = cur.up
-    while k < cur.end and up[k] in " \t":
-        k += 1
-    return k < cur.end and up[k] == "[" and _KEYWORD.match(up, k + 1) is not None
-
-
-def other_spindle_error(cur: Cursor, pos: int) -> None:
-    """Raise ISG's 20180 for ``S<n>[...]`` at ``pos``: the channel has one spindle, S."""
-    m = _OTHER_SPINDLE.match(cur.up, pos)
-    if m is not None:
+def spindle_bracket(cur: Cursor, block: NcBlock, letters: set[str], pos: int) -> bool:
+    """At ``S[`` or ``S<n>[`` (``SPINDLE_BRACKET`` matched at ``pos``): parse the spindle
+    bracket into ``block`` and return True; False when it is the speed's bracket
+    expression (``S[500 * 2]``). ``S2[...]`` is ISG's 20180: the channel has one spindle."""
+    m = SPINDLE_BRACKET.match(cur.up, pos)
+    assert m is not None  # checked by the caller
+    if m.group(1):
         raise cur.error(NcErrorId.UNKNOWN_SPINDLE_NAME,
                         f"unknown spindle name 'S{m.group(1)}': the channel's spindle is S", pos)
+    if _KEYWORD.match(cur.up, m.end()) is None:
+        return False
+    parse_spindle_syntax(cur, block, letters, pos)
+    return True
 
 
 def parse_spindle_syntax(cur: Cursor, block: NcBlock, letters: set[str], pos: int) -> None:
