@@ -518,6 +518,9 @@ class ChannelRunner:
         if feed_mm_min > 0.0:
             modal.feed_mm_min = feed_mm_min
         seed_modal(modal, self.tables, self.channel.tooling)
+        stored_rpm = self.plc.spindle.state.programmed_rpm  # S is stored across runs (ISG)
+        if stored_rpm > 0.0:
+            modal.spindle_speed_rpm = stored_rpm  # M19 needs a speed > 0 set
         return modal
 
     def _show_start(self, job: Job) -> None:

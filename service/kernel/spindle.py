@@ -94,8 +94,8 @@ class Spindle:
                 position_deg: float | None = None) -> None:
         """Apply the spindle M functions and S of one block (M19 > M3/M4/M5 > S);
         ``position_deg``: the block's S.POS, where an M19 orients to (default 0)."""
-        if SpindleM.ORIENT in m_functions:
-            self._orient_deg = 0.0 if position_deg is None else position_deg
+        if SpindleM.ORIENT in m_functions and position_deg is not None:
+            self._orient_deg = position_deg  # modal (ISG): the last POS, 0 at start-up
         st = self.state
         programmed = st.programmed_rpm if speed_rpm is None else float(speed_rpm)
         mode = st.mode

@@ -238,6 +238,20 @@ def test_m19_angle_shows_the_oriented_position(client: Client) -> None:
     assert seen[-1] == (SpindleMode.M19, True, 315.0)  # -45 degrees, in 0..360
 
 
+def test_spindle_bracket_syntax_orients_with_pos_modal(client: Client) -> None:
+    """ISG's spindle-specific syntax S[...] (issue 39): POS is modal, M19 repeats it."""
+    extra = ("ch1.mc_spindle_position_r", "ch1.mc_spindle_mode_r",
+             "ch1.mc_spindle_speed_reached_r")
+    rows = _run(client, "bracket.nc", "S[M3 REV1000]\nG01 X1 F6000\nS[M19 POS90]\n"
+                "S[M3]\nS[M19]\nM30\n", extra)
+    assert rows[-1].state == ChannelState.READY
+    seen = [(r.values["ch1.mc_spindle_mode_r"], r.values["ch1.mc_spindle_speed_reached_r"],
+             r.values["ch1.mc_spindle_position_r"]) for r in rows]
+    oriented = seen.index((SpindleMode.M19, True, 90.0))
+    assert (SpindleMode.M03, True, 90.0) in seen[oriented:]  # S[M3]: turning again
+    assert seen[-1] == (SpindleMode.M19, True, 90.0)  # S[M19]: back to the modal POS90
+
+
 def test_rapid_override_zero_stands_g0_and_feed_override_zero_does_not(
         client: Client) -> None:
     client.write("ch1.mc_command_feed_override_w", 0)

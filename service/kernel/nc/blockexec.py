@@ -65,6 +65,10 @@ class Flow(IntEnum):
     SUBPROGRAM_END = 2  # M17/M29: return to the caller
 
 
+M_ORIENT = 19  # spindle positioning: needs a speed > 0, may go with M3/M4
+M_STOP = 5
+_SPINDLE_DIRECTION = frozenset({3, 4, M_STOP})  # one of them a block
+
 # flow-control M functions -> (stop of the block, flow)
 _M_FLOW: dict[int, tuple[StopKind, Flow]] = {
     MCode.STOP: (StopKind.PROGRAMMED, Flow.NONE),
@@ -275,17 +279,21 @@ class BlockExecutor:
         flow = Flow.NONE
         flow_pos = -1
         m_functions: list[int] = []
-        spindle_m: int | None = None  # the block's spindle M function (one at most)
+        spindle_m: int | None = None  # the block's M3/M4/M5 (one at most; M19 may join)
         seen_m: set[int] = set()  # a set: a 1 MB line of distinct M words stays linear
         for number, pos, k in m_codes:
             twice = self._m_twice(number, seen_m, spindle_m, pos, err)
+            if twice is None and number == M_ORIENT and not self.modal.spindle_speed_rpm:
+                twice = err(NcErrorId.M19_WITHOUT_SPEED,
+                            "M19 needs a spindle speed > 0 (S or REV, in this block or "
+                            "before)", pos)
             if twice is not None:
                 if on_error is None:
                     raise twice
                 on_error(twice, k)  # this M is left out
                 continue
             seen_m.add(number)
-            if number in SPINDLE_M_FUNCTIONS:
+            if number in _SPINDLE_DIRECTION:
                 spindle_m = number
             if number == M_TOOL_CHANGE:
                 dwell_s += self._tool_change(pos, err)
@@ -372,14 +380,22 @@ class BlockExecutor:
     def _m_twice(number: int, before: set[int], spindle_m: int | None, pos: int,
                  err: ErrorAt) -> NcError | None:
         """The error of an M function the block has already (20765), or of a second
-        spindle M function (20155: ISG's spindle takes one of M3/M4/M5/M19 a block)."""
+        spindle M function (20155: ISG's spindle takes one of M3/M4/M5 a block; M19 may
+        go with M3 or M4, its direction, never with M5)."""
         if number in before:
             return err(NcErrorId.M_FUNCTION_TWICE, f"M{number} twice in one block", pos)
-        if number in SPINDLE_M_FUNCTIONS and spindle_m is not None:
-            return err(NcErrorId.SPINDLE_M_TWICE,
-                       f"M{number} after M{spindle_m} in one block: the spindle takes one "
-                       "of M3, M4, M5, M19 per block", pos)
-        return None
+        if number not in SPINDLE_M_FUNCTIONS:
+            return None
+        other = spindle_m if number != M_ORIENT else None
+        if number == M_ORIENT and spindle_m == M_STOP:
+            other = M_STOP
+        elif number == M_STOP and M_ORIENT in before:
+            other = M_ORIENT
+        if other is None:
+            return None
+        return err(NcErrorId.SPINDLE_M_TWICE,
+                   f"M{number} after M{other} in one block: the spindle takes one of M3, "
+                   "M4, M5 per block (M19 with M3 or M4, never with M5)", pos)
 
     def exchange(self, stmt: AxisCommand, env: Env) -> Block | None:
         """Run ``#AX RELEASE`` / ``#AX REQUEST``: the block that hands the axes over, or
@@ -509,6 +525,12 @@ class BlockExecutor:
                 raise err(NcErrorId.TOOL_NOT_IN_TABLE,
                           f"tool D{value:g} is not in the tool table", pos)
             modal.tool_offset = d
+        if WordKind.SPINDLE_REV in words:  # REV of S[...]: the S word
+            value, pos = words.pop(WordKind.SPINDLE_REV)
+            if value < 0:
+                raise err(NcErrorId.NEGATIVE_SPINDLE_REV,
+                          f"spindle speed REV{value:g} in S[...] is negative", pos)
+            words[WordKind.SPINDLE] = (value, pos)
         if WordKind.SPINDLE in words:
             value, pos = words[WordKind.SPINDLE]
             if value < 0:

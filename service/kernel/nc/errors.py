@@ -54,6 +54,13 @@ class NcErrorId(IntEnum):
     H_FUNCTION_TWICE = 20766  # ISG: the same H function twice in one block
     M_FUNCTION_TWICE = 20765  # ISG: the same M function twice in one block (M8 M8)
     SPINDLE_M_TWICE = 20155  # ISG: a second spindle M function (M3/M4/M5/M19) in a block
+    # (M19 may go with M3/M4, its direction; never with M5)
+    M19_WITHOUT_SPEED = 20156  # M19 with no spindle speed > 0 set (project id: ISG names none)
+    SPINDLE_COMMAND_UNKNOWN = 21035  # ISG: unknown command in the spindle sequence S[...]
+    NEGATIVE_SPINDLE_REV = 20991  # ISG: negative spindle speed REV in S[...]
+    SPINDLE_POS_TWICE = 20851  # ISG: the spindle position twice (POS or S.POS) in a block
+    UNKNOWN_SPINDLE_NAME = 20180  # ISG: S2[...]: a spindle name the channel does not have
+    D_IN_SPINDLE_SYNTAX = 21243  # ISG: a D word inside the main spindle's S[...]
     MANUAL_MODE_TWICE = 20129  # ISG: more than one of G200/G201/G202 in one block
     MANUAL_MODE_WITHOUT_AXES = 20139  # G201 without an axis (project id)
     UNKNOWN_TOOL = 21915  # ISG: unknown tool id (T of no valid wz[i] row)

@@ -25,6 +25,7 @@ from .instructions import Instruction, parse_instruction
 from .lexer import IDENT, SIGNED_NUMBER, Cursor
 from .modal import G_CODES, GGroup
 from .source import LogicalLine
+from .spindle_syntax import SPINDLE_BRACKET, spindle_bracket
 from .statements import (
     Assign,
     AxisCommand,
@@ -308,6 +309,9 @@ class LineParser:
             block.number = self._block_number(cur, block.number)
         elif c == "S" and _SPINDLE_POS.match(cur.up, pos):
             self._spindle_pos(cur, block, letters, pos)
+        elif c == "S" and SPINDLE_BRACKET.match(cur.up, pos) \
+                and spindle_bracket(cur, block, letters, pos):
+            return  # S[M3 REV1000 ...] (S2[...]: ISG's 20180); S[expr] is the speed
         elif "A" <= c <= "Z" or c == "_":
             spec = table.get(c)
             if spec is None:
@@ -351,7 +355,8 @@ class LineParser:
     def _spindle_pos(self, cur: Cursor, block: NcBlock, letters: set[str], pos: int) -> None:
         """``S.POS = <expr>``: the position (degrees) of an M19 in the same block."""
         if "S.POS" in letters:
-            raise cur.error(NcErrorId.WORD_REPEATED, "S.POS programmed twice in one block", pos)
+            raise cur.error(NcErrorId.SPINDLE_POS_TWICE, "the spindle position (POS, S.POS) "
+                            "programmed twice in one block", pos)
         m = _SPINDLE_POS.match(cur.up, pos)
         assert m is not None  # checked by the caller
         cur.pos = m.end()

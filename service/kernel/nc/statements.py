@@ -90,6 +90,7 @@ class WordKind(IntEnum):
     ZERO_OFFSET_INDEX = 12  # G159 = <i>: zero offset group np_grp[i]
     H = 13  # H: technology function to the PLC (ISG's H functions)
     SPINDLE_POS = 14  # S.POS = <degrees>: the position M19 orients the spindle to
+    SPINDLE_REV = 15  # REV<rpm> in S[...]: the speed (S), negative is ISG's 20991
 
 
 @final  # the decoder dispatches on type(stmt) is ...: no subclasses

@@ -101,7 +101,7 @@ def test_s_with_s_synch_mvs_svs_waits_for_the_new_speed() -> None:
 
 @pytest.mark.parametrize(("line", "error_id", "column"), [
     ("S1000 M3 M5", 20155, 10),  # ISG: a second spindle M function in the block
-    ("G01 X10 F600 M3 M19", 20155, 17),
+    ("G01 X10 F600 S100 M5 M19", 20155, 22),  # M19 goes with M3/M4, never with M5
     ("G01 X10 F600 M8 M8", 20765, 17),  # ISG: the same M function twice in a block
 ])
 def test_a_block_with_two_spindle_m_functions_or_one_m_twice_is_an_isg_error(
