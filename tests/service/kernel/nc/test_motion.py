@@ -110,7 +110,6 @@ def test_plane_indices_follow_the_channel_axis_order() -> None:
         ("G1 F100\nG2 X10\nM30", NcErrorId.MISSING_VALUE, 2, 1),
         ("G1 F100\nG2 X10 I5 R5\nM30", NcErrorId.ARC_CENTRE_AND_RADIUS, 2, 11),
         ("G1 F100\nG2 X10 K5\nM30", NcErrorId.ARC_OFFSET_OUT_OF_PLANE, 2, 8),
-        ("G1 F100\nG2 X10 Z1 I5\nM30", NcErrorId.HELIX_NOT_SUPPORTED, 2, 8),
         ("G1 F100 X1 I5\nM30", NcErrorId.ARC_WORDS_WITHOUT_ARC, 1, 12),
         ("G0 X1 R5\nM30", NcErrorId.ARC_WORDS_WITHOUT_ARC, 1, 7),
         ("G1 X1 X2 F100\nM30", NcErrorId.WORD_REPEATED, 1, 7),
