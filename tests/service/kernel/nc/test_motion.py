@@ -156,3 +156,28 @@ def test_modal_only_blocks_give_no_block() -> None:
     blocks = decode("G90\nF100\nG17 G40\nD1\nN10\nG1 X1\nM30")
     assert len(blocks) == 2
     assert blocks[0].source.line == 6
+
+
+@pytest.mark.parametrize(
+    ("program", "plane", "centre", "end"),
+    [
+        # issue 39, ISG "Simple helical interpolation": the axis perpendicular to the plane
+        # is the helix axis (G17: Z, G18: Y, G19: X); I/J/K and R give the plane's centre
+        ("G1 X10 F100\nG2 X0 Y-10 Z-5 I-10 J0\nM30", (0, 1), (0, 0), (0, -10, -5)),
+        ("G1 X10 F100\nG3 X0 Y10 Z2 R10\nM30", (0, 1), (0, 0), (0, 10, 2)),
+        ("G1 X10 F100\nG2 I-10 Z-1.5\nM30", (0, 1), (0, 0), (10, 0, -1.5)),  # one turn
+        ("G1 Z10 F100\nG18 G3 X10 Z0 Y4 K-10\nM30", (2, 0), (0, 0), (10, 4, 0)),
+        ("G1 Y10 F100\nG19 G2 Y0 Z10 X-3 J-10\nM30", (1, 2), (0, 0), (-3, 0, 10)),
+        ("G91 G1 X10 F100\nG3 X-10 Y10 Z-4 I-10\nM30", (0, 1), (0, 0), (0, 10, -4)),
+    ],
+)
+def test_helical_arcs(program, plane, centre, end) -> None:
+    for text in (program, slow(program)):
+        arc = motions(text)[-1]
+        assert arc.plane == plane
+        assert arc.center_mm == pytest.approx(tuple(map(float, centre)), abs=1e-12)
+        assert arc.end_mm == pytest.approx(tuple(map(float, end)), abs=1e-12)
+
+
+def test_helix_end_off_the_circle_is_the_plane_arcs_error() -> None:
+    assert error_of("G1 F100\nG2 X20 Z-3 I6\nM30").id == NcErrorId.ARC_RADIUS_DIFFERENCE
