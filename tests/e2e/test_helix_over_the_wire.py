@@ -71,3 +71,23 @@ def test_helix_end_off_the_circle_is_the_plane_arcs_error(c) -> None:
             c.wait_program(1, timeout_s=30)
         ids.append(c.read("ch1.mc_error_1_id_r"))
     assert ids[0] == ids[1] == 21758  # ARC_RADIUS_DIFFERENCE, as for the plane arc
+
+
+def test_the_dry_run_trace_cnc_web_draws_carries_the_helix_z(c) -> None:
+    # the tool path of cnc-web's program page is this trace (/api/.../trace): every
+    # sample of the helix block stands on the helix, Z with the angle
+    c.mdi("G0 X0 Y0 Z0")  # the rapid move to the helix start is 10 mm
+    c.wait_program(1, timeout_s=30)
+    c.upload("trace_helix.nc", HELIX.format(feed=600).encode())
+    run = c.trace_run("trace_helix.nc", 1, timeout_s=30)
+    c.reset(1)
+    assert run.ended == "READY"
+    xs, ys, zs = (run.positions_mm[a] for a in "XYZ")
+    on_helix = [(x, y, z) for x, y, z in zip(xs, ys, zs) if z < 0.0]
+    assert len(on_helix) > 100
+    for x, y, z in on_helix:
+        assert math.hypot(x, y) == pytest.approx(10.0, abs=1e-6)
+        phi = math.atan2(y, x) % (2.0 * math.pi)
+        phi = math.pi if z == pytest.approx(-6.0) else phi  # the end: -pi folds
+        assert z == pytest.approx(-6.0 * phi / math.pi, abs=1e-6)
+    assert run.path_mm[-1] == pytest.approx(10.0 + HELIX_MM, abs=1e-6)
