@@ -151,8 +151,11 @@ class Arc:
             sweep = TWO_PI
         else:
             sweep = (a1 - a0) % TWO_PI if ccw else (a0 - a1) % TWO_PI
-        arc = cls(plane, (cp, cq), r0, a0, sweep if ccw else -sweep, start_mm,
-                  r0 if full else r1, end_mm)
+        helix = any(e != s for i, (s, e) in enumerate(zip(start_mm, end_mm))
+                    if i != p and i != q)
+        arc = (Helix if helix else cls)(plane, (cp, cq), r0, a0, sweep if ccw else -sweep,
+                                        start_mm, r0 if full else r1,
+                                        end_mm if helix else None)
         arc.start_mm = tuple(float(x) for x in start_mm)
         arc.end_mm = tuple(float(x) for x in end_mm)  # on the circle up to rounding
         return arc
@@ -161,16 +164,7 @@ class Arc:
         out = self._base[:]
         out[self.plane[0]] = self.center[0] + radius * math.cos(angle)
         out[self.plane[1]] = self.center[1] + radius * math.sin(angle)
-        if self.rise:  # the helix axes at this angle's fraction of the sweep
-            frac = (angle - self.start_angle_rad) / self.sweep_rad if self.sweep_rad else 0.0
-            for i, b, d in self.rise:
-                out[i] = b + d * frac
         return tuple(out)
-
-    @property
-    def helical(self) -> bool:
-        """True when an axis outside the plane moves (a helix)."""
-        return bool(self.rise)
 
     @property
     def ccw(self) -> bool:
@@ -193,25 +187,14 @@ class Arc:
         out = self._base[:]
         out[self.plane[0]] = self.center[0] + radius * math.cos(angle)
         out[self.plane[1]] = self.center[1] + radius * math.sin(angle)
-        if self.rise:
-            frac = s_mm / self.length_mm
-            for i, b, d in self.rise:
-                out[i] = b + d * frac
         return tuple(out)
 
     def tangent_at_angle(self, angle: float) -> Point:
-        """Unit tangent (direction of motion) at ``angle``, over all axes; on a helix
-        the plane part is scaled by plane length / length and the rising axes add
-        their constant share change / length."""
+        """Unit tangent (direction of motion) at ``angle``, over all axes."""
         out = [0.0] * len(self._base)
         sign = 1.0 if self.sweep_rad > 0.0 else -1.0
-        scale = sign
-        if self.rise:
-            scale = sign * self.plane_length_mm / self.length_mm
-            for i, _b, d in self.rise:
-                out[i] = d / self.length_mm
-        out[self.plane[0]] = -scale * math.sin(angle)
-        out[self.plane[1]] = scale * math.cos(angle)
+        out[self.plane[0]] = -sign * math.sin(angle)
+        out[self.plane[1]] = sign * math.cos(angle)
         return tuple(out)
 
     @property
@@ -246,14 +229,58 @@ class Arc:
             if off <= span:
                 frac = off / span if span > 0.0 else 0.0
                 radius = self.radius_mm + (self.end_radius_mm - self.radius_mm) * frac
-                sign = 1.0 if self.sweep_rad > 0.0 else -1.0
-                # the unwrapped angle: a helix places its rising axes by it
-                points.append(self._point(self.start_angle_rad + sign * off, radius))
+                if self.rise:  # the unwrapped angle: a helix places its rising axes by it
+                    angle = self.start_angle_rad + (off if self.sweep_rad > 0.0 else -off)
+                points.append(self._point(angle, radius))
         return (tuple(map(min, *points)), tuple(map(max, *points)))
 
     def __repr__(self) -> str:
         return (f"Arc(plane={self.plane}, center={self.center}, r={self.radius_mm}, "
                 f"start={self.start_angle_rad:.6f}, sweep={self.sweep_rad:.6f})")
+
+
+class Helix(Arc):
+    """An arc whose axes outside the plane move linearly with the angle (issue 39).
+
+    A subclass, so that plane arcs keep their evaluation without a test per cycle: the
+    plane part is the arc's, the rising axes (``rise``) stand at start + change *
+    s / length; the tangent's plane part is scaled by plane length / length, the rising
+    axes add their constant share change / length.
+    """
+
+    __slots__ = ()
+
+    def _point(self, angle: float, radius: float) -> Point:
+        out = list(Arc._point(self, angle, radius))
+        frac = (angle - self.start_angle_rad) / self.sweep_rad if self.sweep_rad else 0.0
+        for i, b, d in self.rise:
+            out[i] = b + d * frac
+        return tuple(out)
+
+    def point_at(self, s_mm: float) -> Point:
+        """Position after ``s_mm`` along the helix."""
+        if s_mm >= self.length_mm:
+            return self.end_mm
+        if s_mm <= 0.0:
+            return self.start_mm
+        out = list(Arc.point_at(self, s_mm))
+        frac = s_mm / self.length_mm
+        for i, b, d in self.rise:
+            out[i] = b + d * frac
+        return tuple(out)
+
+    def tangent_at_angle(self, angle: float) -> Point:
+        """Unit tangent at ``angle``: the arc's, leaning by the rise."""
+        out = [0.0] * len(self._base)
+        scale = (1.0 if self.sweep_rad > 0.0 else -1.0) * self.plane_length_mm / self.length_mm
+        out[self.plane[0]] = -scale * math.sin(angle)
+        out[self.plane[1]] = scale * math.cos(angle)
+        for i, _b, d in self.rise:
+            out[i] = d / self.length_mm
+        return tuple(out)
+
+    def __repr__(self) -> str:
+        return f"Helix({Arc.__repr__(self)[4:-1]}, rise={self.rise})"
 
 
 Element = Line | Arc
