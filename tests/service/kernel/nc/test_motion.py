@@ -181,3 +181,11 @@ def test_helical_arcs(program, plane, centre, end) -> None:
 
 def test_helix_end_off_the_circle_is_the_plane_arcs_error() -> None:
     assert error_of("G1 F100\nG2 X20 Z-3 I6\nM30").id == NcErrorId.ARC_RADIUS_DIFFERENCE
+
+
+def test_helix_axis_alone_needs_a_centre_and_is_then_one_turn() -> None:
+    # only the helix axis programmed: without I/J/R the plane arc's missing-centre error,
+    # with a centre one full turn (end = start in the plane)
+    assert error_of("G1 X10 F100\nG2 Z-5\nM30").id == NcErrorId.MISSING_VALUE
+    arc = motions("G1 X10 F100\nG2 Z-5 I-10\nM30")[-1]
+    assert arc.end_mm == (10.0, 0.0, -5.0) and arc.center_mm == (0.0, 0.0)
