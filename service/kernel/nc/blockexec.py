@@ -654,11 +654,8 @@ class BlockExecutor:
                       f"axis {self.axes[p if p in released else q]} is not in the channel "
                       f"(released by #AX RELEASE): G{int(kind)} in G{int(modal.plane)} needs it",
                       motion_pos)
-        for axis, _value, pos, letter in axis_words:
-            if axis != p and axis != q and end[axis] != start[axis]:
-                raise err(NcErrorId.HELIX_NOT_SUPPORTED,
-                          f"{letter} is outside the G{int(modal.plane)} plane: "
-                          "helical arcs are not supported", pos)
+        # axes outside the plane (Z in G17, ...) move linearly with the angle: a helix
+        # (issue 39; ISG "Simple helical interpolation", docs/kernel.md)
         for axis, (_value, pos) in offsets.items():
             if axis != p and axis != q:
                 letter = _OFFSET_LETTER["XYZ".index(self.axes[axis])]
@@ -717,8 +714,8 @@ class BlockExecutor:
         p, q, n = _CS_PLANE[modal.plane]
         if cs_end[n] != cs_start[n]:
             raise err(NcErrorId.HELIX_NOT_SUPPORTED,
-                      f"{'XYZ'[n]} is outside the G{int(modal.plane)} plane: helical arcs are "
-                      "not supported", motion_pos)
+                      f"{'XYZ'[n]} is outside the G{int(modal.plane)} plane: helical arcs in a "
+                      "machining coordinate system (#CS) are not supported", motion_pos)
         column = tuple(row[n] for row in placement.rotation)  # the plane normal on the machine
         m = max(range(3), key=lambda k: abs(column[k]))
         if abs(abs(column[m]) - 1.0) > 1e-12:

@@ -80,7 +80,8 @@ class Motion:
 
     Arcs lie in the plane of axes ``plane`` = (p, q) (G17: X,Y; G18: Z,X; G19: Y,Z, as
     channel axis indices); ``center_mm`` is the centre in (p, q). Axes outside the plane
-    do not move in an arc block (no helix). A full circle has ``start_mm == end_mm``.
+    move linearly with the angle (a helix, issue 39). A full circle has ``start_mm`` and
+    ``end_mm`` equal in the plane.
     """
 
     kind: MotionKind

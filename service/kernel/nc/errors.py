@@ -73,7 +73,7 @@ class NcErrorId(IntEnum):
     # ---- geometry
     ARC_WORDS_WITHOUT_ARC = 20140  # I/J/K/R in a block that is not G2/G3
     ARC_OFFSET_OUT_OF_PLANE = 20141  # centre offset of an axis outside the plane (K in G17)
-    HELIX_NOT_SUPPORTED = 20142  # an axis outside the plane moves in an arc block
+    HELIX_NOT_SUPPORTED = 20142  # a helical arc under #CS (plane helices run, issue 39)
     ARC_RADIUS_ZERO = 20143  # centre on the start point
     ARC_RADIUS_TOO_SMALL = 20144  # R smaller than half the chord
     ARC_FULL_CIRCLE_WITH_R = 20145  # R with end point == start point (no unique circle)

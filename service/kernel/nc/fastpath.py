@@ -175,7 +175,7 @@ def run(decoder):
                         else:
                             break
                     if outside is not None and outside(end_pos) != outside(pos):
-                        break  # helix: the general path reports it
+                        break  # helix: the general path builds it
                     p, q = plane
                     r_start = HYPOT(cp, cq)
                     if r_start == 0.0:

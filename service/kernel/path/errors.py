@@ -24,7 +24,7 @@ class PathErrorId(IntEnum):
     DWELL_INVALID = 50006  # negative or infinite dwell time
     ARC_CENTER = 50010  # arc start (or end) coincides with its centre: radius 0
     ARC_END_RADIUS = 50011  # arc end point is not on the circle through the start
-    ARC_HELIX = 50012  # arc block moves an axis outside its plane (no helix)
+    ARC_HELIX = 50012  # unused since issue 39 (helical arcs run); the id stays reserved
     SW_LIMIT_MIN = 50100  # the motion leaves an axis' software limit downwards
     SW_LIMIT_MAX = 50101  # the motion leaves an axis' software limit upwards
     AXIS_NOT_REFERENCED = 50110  # the block moves an axis that needs homing first
@@ -37,6 +37,7 @@ class PathErrorId(IntEnum):
     COMP_NO_PLANE_MOTION = 50205  # compensated block without motion in the plane
     COMP_PLANE_CHANGE = 50206  # plane changed while compensation is active
     COMP_BOTTLENECK = 50207  # LA_ON, BBTRC: compensated elements of two blocks cross
+    COMP_HELIX = 50208  # G41/G42 on a helical arc (the offset helix is not built)
     BUFFER_FULL = 50300  # push() without a free slot in the look-ahead buffer
     BUFFER_LIMITS_SPEED = 50301  # warning: the end of the full buffer holds the speed down
 

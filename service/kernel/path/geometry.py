@@ -3,7 +3,10 @@
 An element is parametrised by its arc length ``s_mm`` in [0, length_mm]:
 ``point_at(s_mm)`` returns the position of every channel axis. Arcs are evaluated from
 the angle (centre + radius * (cos, sin)), never from chords, so every sample lies on
-the circle. Axes outside an arc's plane stay at their start value (no helix).
+the circle. Axes outside an arc's plane move linearly with the angle from their start to
+their end value: an arc whose end differs there is a helix (issue 39), and its length
+is the length along the helix, sqrt(plane arc length^2 + rise^2), as ISG's feed refers
+to the path of all main axes (#FGROUP default).
 
 Angles are measured in the plane (p, q) from the p axis towards the q axis; a positive
 sweep is counter-clockwise seen from the plane's positive normal (G3), negative is
@@ -100,22 +103,39 @@ class Arc:
     ``ARC_RADIUS_TOLERANCE_MM``) end exactly at its programmed end: the radius then
     changes linearly with the angle. For a consistent arc the two radii are equal and
     every point is exactly on the circle.
+
+    ``end_base_mm`` (default: ``base_mm``) gives the end values of the axes outside the
+    plane; where they differ the arc is a helix: those axes move linearly with the
+    angle (``rise`` holds (axis, start, change) per moving axis, empty for a plane arc).
     """
 
     __slots__ = ("plane", "center", "radius_mm", "end_radius_mm", "start_angle_rad",
-                 "sweep_rad", "length_mm", "start_mm", "end_mm", "_base", "_k", "_dr")
+                 "sweep_rad", "length_mm", "plane_length_mm", "rise", "start_mm", "end_mm",
+                 "_base", "_k", "_dr")
 
     def __init__(self, plane: tuple[int, int], center_pq: Sequence[float], radius_mm: float,
                  start_angle_rad: float, sweep_rad: float, base_mm: Sequence[float],
-                 end_radius_mm: float | None = None) -> None:
+                 end_radius_mm: float | None = None,
+                 end_base_mm: Sequence[float] | None = None) -> None:
         self.plane = (int(plane[0]), int(plane[1]))
         self.center = (float(center_pq[0]), float(center_pq[1]))
         self.radius_mm = float(radius_mm)
         self.end_radius_mm = self.radius_mm if end_radius_mm is None else float(end_radius_mm)
         self.start_angle_rad = float(start_angle_rad)
         self.sweep_rad = float(sweep_rad)
-        self.length_mm = 0.5 * (self.radius_mm + self.end_radius_mm) * abs(self.sweep_rad)
+        self.plane_length_mm = plane_length = (0.5 * (self.radius_mm + self.end_radius_mm)
+                                               * abs(self.sweep_rad))
         self._base = list(base_mm)
+        rise: tuple[tuple[int, float, float], ...] = ()
+        if end_base_mm is not None:
+            p, q = self.plane
+            rise = tuple((i, float(b), float(e) - float(b))
+                         for i, (b, e) in enumerate(zip(self._base, end_base_mm))
+                         if i != p and i != q and e != b)
+        self.rise = rise
+        self.length_mm = (math.sqrt(plane_length * plane_length
+                                    + sum(d * d for _, _, d in rise))
+                          if rise else plane_length)
         self._k = self.sweep_rad / self.length_mm if self.length_mm > 0.0 else 0.0  # rad per mm
         self._dr = ((self.end_radius_mm - self.radius_mm) / self.length_mm
                     if self.length_mm > 0.0 else 0.0)  # radius change per mm
@@ -149,8 +169,11 @@ class Arc:
             sweep = TWO_PI
         else:
             sweep = (a1 - a0) % TWO_PI if ccw else (a0 - a1) % TWO_PI
-        arc = cls(plane, (cp, cq), r0, a0, sweep if ccw else -sweep, start_mm,
-                  r0 if full else r1)
+        helix = any(e != s for i, (s, e) in enumerate(zip(start_mm, end_mm))
+                    if i != p and i != q)
+        arc = (Helix if helix else cls)(plane, (cp, cq), r0, a0, sweep if ccw else -sweep,
+                                        start_mm, r0 if full else r1,
+                                        end_mm if helix else None)
         arc.start_mm = tuple(float(x) for x in start_mm)
         arc.end_mm = tuple(float(x) for x in end_mm)  # on the circle up to rounding
         return arc
@@ -224,12 +247,58 @@ class Arc:
             if off <= span:
                 frac = off / span if span > 0.0 else 0.0
                 radius = self.radius_mm + (self.end_radius_mm - self.radius_mm) * frac
+                if self.rise:  # the unwrapped angle: a helix places its rising axes by it
+                    angle = self.start_angle_rad + (off if self.sweep_rad > 0.0 else -off)
                 points.append(self._point(angle, radius))
         return (tuple(map(min, *points)), tuple(map(max, *points)))
 
     def __repr__(self) -> str:
         return (f"Arc(plane={self.plane}, center={self.center}, r={self.radius_mm}, "
                 f"start={self.start_angle_rad:.6f}, sweep={self.sweep_rad:.6f})")
+
+
+class Helix(Arc):
+    """An arc whose axes outside the plane move linearly with the angle (issue 39).
+
+    A subclass, so that plane arcs keep their evaluation without a test per cycle: the
+    plane part is the arc's, the rising axes (``rise``) stand at start + change *
+    s / length; the tangent's plane part is scaled by plane length / length, the rising
+    axes add their constant share change / length.
+    """
+
+    __slots__ = ()
+
+    def _point(self, angle: float, radius: float) -> Point:
+        out = list(Arc._point(self, angle, radius))
+        frac = (angle - self.start_angle_rad) / self.sweep_rad if self.sweep_rad else 0.0
+        for i, b, d in self.rise:
+            out[i] = b + d * frac
+        return tuple(out)
+
+    def point_at(self, s_mm: float) -> Point:
+        """Position after ``s_mm`` along the helix."""
+        if s_mm >= self.length_mm:
+            return self.end_mm
+        if s_mm <= 0.0:
+            return self.start_mm
+        out = list(Arc.point_at(self, s_mm))
+        frac = s_mm / self.length_mm
+        for i, b, d in self.rise:
+            out[i] = b + d * frac
+        return tuple(out)
+
+    def tangent_at_angle(self, angle: float) -> Point:
+        """Unit tangent at ``angle``: the arc's, leaning by the rise."""
+        out = [0.0] * len(self._base)
+        scale = (1.0 if self.sweep_rad > 0.0 else -1.0) * self.plane_length_mm / self.length_mm
+        out[self.plane[0]] = -scale * math.sin(angle)
+        out[self.plane[1]] = scale * math.cos(angle)
+        for i, _b, d in self.rise:
+            out[i] = d / self.length_mm
+        return tuple(out)
+
+    def __repr__(self) -> str:
+        return f"Helix({Arc.__repr__(self)[4:-1]}, rise={self.rise})"
 
 
 Element = Line | Arc

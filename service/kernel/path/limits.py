@@ -52,6 +52,12 @@ def element_limits(element: Element, feed_mm_s: float,
     (tangential, and normal) <= min(A_p, A_q)/sqrt(2); speed <= min(V_p, V_q,
     sqrt(R * min(A_p, A_q)/sqrt(2))). For an arc whose radius changes a little from
     start to end (programmed end slightly off the circle) the smaller radius counts.
+
+    Helix (issue 39): the plane takes the share c = plane length / length of the path
+    speed and acceleration, so the plane limits above are divided by c (the helix's
+    curvature R/(R^2+h^2), h = rise per radian, gives the same normal acceleration
+    (v*c)^2/R); each rising axis i with constant share |u_i| = change_i / length adds
+    speed <= V_i/|u_i| and acceleration <= A_i/|u_i|, as on a line.
     """
     if isinstance(element, Arc):
         p, q = element.plane
@@ -59,6 +65,14 @@ def element_limits(element: Element, feed_mm_s: float,
         radius = min(element.radius_mm, element.end_radius_mm)
         axis_speed = min(dynamics[p].vel_max_mm_s, dynamics[q].vel_max_mm_s,
                          math.sqrt(radius * acc))
+        if element.rise and element.plane_length_mm > 0.0:
+            c = element.plane_length_mm / element.length_mm
+            axis_speed /= c
+            acc /= c
+            for i, _b, d in element.rise:
+                au = abs(d) / element.length_mm
+                axis_speed = min(axis_speed, dynamics[i].vel_max_mm_s / au)
+                acc = min(acc, dynamics[i].acc_max_mm_s2 / au)
     else:
         axis_speed = acc = math.inf
         for u, dyn in zip(element.direction, dynamics):

@@ -166,11 +166,15 @@ class PathPreparation:
         else:
             if motion.center_mm is None or not _finite(motion.center_mm):
                 raise PathError(PathErrorId.NOT_FINITE, "arc needs a finite centre")
-            if any(abs(end[i] - start[i]) > 1e-9 for i in range(n) if i != p and i != q):
-                raise PathError(PathErrorId.ARC_HELIX,
-                                "arc block moves an axis outside its plane")
             element = Arc.from_points(motion.start_mm, motion.end_mm, motion.center_mm,
                                       (p, q), motion.kind == MotionKind.ARC_CCW)
+            if (element.rise and motion.compensation != Compensation.OFF
+                    and motion.tool_radius_mm != 0.0):
+                # the offset helix (and its corners) are not built: refused, not run
+                # uncompensated (issue 39, docs/kernel.md "Helical interpolation")
+                raise PathError(PathErrorId.COMP_HELIX,
+                                "tool radius compensation (G41/G42) on a helical arc is not "
+                                "supported: deselect it (G40) for the helix")
         self.last_end_mm = end
         return element if element.length_mm > 0.0 else None
 

@@ -110,7 +110,6 @@ def test_plane_indices_follow_the_channel_axis_order() -> None:
         ("G1 F100\nG2 X10\nM30", NcErrorId.MISSING_VALUE, 2, 1),
         ("G1 F100\nG2 X10 I5 R5\nM30", NcErrorId.ARC_CENTRE_AND_RADIUS, 2, 11),
         ("G1 F100\nG2 X10 K5\nM30", NcErrorId.ARC_OFFSET_OUT_OF_PLANE, 2, 8),
-        ("G1 F100\nG2 X10 Z1 I5\nM30", NcErrorId.HELIX_NOT_SUPPORTED, 2, 8),
         ("G1 F100 X1 I5\nM30", NcErrorId.ARC_WORDS_WITHOUT_ARC, 1, 12),
         ("G0 X1 R5\nM30", NcErrorId.ARC_WORDS_WITHOUT_ARC, 1, 7),
         ("G1 X1 X2 F100\nM30", NcErrorId.WORD_REPEATED, 1, 7),
@@ -157,3 +156,36 @@ def test_modal_only_blocks_give_no_block() -> None:
     blocks = decode("G90\nF100\nG17 G40\nD1\nN10\nG1 X1\nM30")
     assert len(blocks) == 2
     assert blocks[0].source.line == 6
+
+
+@pytest.mark.parametrize(
+    ("program", "plane", "centre", "end"),
+    [
+        # issue 39, ISG "Simple helical interpolation": the axis perpendicular to the plane
+        # is the helix axis (G17: Z, G18: Y, G19: X); I/J/K and R give the plane's centre
+        ("G1 X10 F100\nG2 X0 Y-10 Z-5 I-10 J0\nM30", (0, 1), (0, 0), (0, -10, -5)),
+        ("G1 X10 F100\nG3 X0 Y10 Z2 R10\nM30", (0, 1), (0, 0), (0, 10, 2)),
+        ("G1 X10 F100\nG2 I-10 Z-1.5\nM30", (0, 1), (0, 0), (10, 0, -1.5)),  # one turn
+        ("G1 Z10 F100\nG18 G3 X10 Z0 Y4 K-10\nM30", (2, 0), (0, 0), (10, 4, 0)),
+        ("G1 Y10 F100\nG19 G2 Y0 Z10 X-3 J-10\nM30", (1, 2), (0, 0), (-3, 0, 10)),
+        ("G91 G1 X10 F100\nG3 X-10 Y10 Z-4 I-10\nM30", (0, 1), (0, 0), (0, 10, -4)),
+    ],
+)
+def test_helical_arcs(program, plane, centre, end) -> None:
+    for text in (program, slow(program)):
+        arc = motions(text)[-1]
+        assert arc.plane == plane
+        assert arc.center_mm == pytest.approx(tuple(map(float, centre)), abs=1e-12)
+        assert arc.end_mm == pytest.approx(tuple(map(float, end)), abs=1e-12)
+
+
+def test_helix_end_off_the_circle_is_the_plane_arcs_error() -> None:
+    assert error_of("G1 F100\nG2 X20 Z-3 I6\nM30").id == NcErrorId.ARC_RADIUS_DIFFERENCE
+
+
+def test_helix_axis_alone_needs_a_centre_and_is_then_one_turn() -> None:
+    # only the helix axis programmed: without I/J/R the plane arc's missing-centre error,
+    # with a centre one full turn (end = start in the plane)
+    assert error_of("G1 X10 F100\nG2 Z-5\nM30").id == NcErrorId.MISSING_VALUE
+    arc = motions("G1 X10 F100\nG2 Z-5 I-10\nM30")[-1]
+    assert arc.end_mm == (10.0, 0.0, -5.0) and arc.center_mm == (0.0, 0.0)

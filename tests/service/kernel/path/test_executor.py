@@ -425,7 +425,6 @@ def test_software_limit_checks_the_extreme_points_of_arcs() -> None:
     (line(ORIGIN, (5, 0)), PathErrorId.AXIS_COUNT),
     (line(ORIGIN, (5, 0, 0), 0.0), PathErrorId.FEED_INVALID),
     (line(ORIGIN, (math.nan, 0, 0)), PathErrorId.NOT_FINITE),
-    (arc(ORIGIN, (0, 0, 5), (5, 0), ccw=True), PathErrorId.ARC_HELIX),
     (arc(ORIGIN, (10, 0, 0), (5, 0), ccw=True, plane=(0, 0)), PathErrorId.PLANE_INVALID),
 ])
 def test_invalid_blocks(block, error) -> None:
