@@ -26,13 +26,13 @@ def machine() -> Iterator[ServiceProcess]:
 
 
 @pytest.fixture
-def c(machine):
+def c(machine: ServiceProcess) -> Iterator[Client]:
     with Client(machine.endpoint, timeout_s=10) as client:
         client.reset(1)
         yield client
 
 
-def test_helix_runs_to_its_end_with_the_helix_length(c) -> None:
+def test_helix_runs_to_its_end_with_the_helix_length(c: Client) -> None:
     c.upload("helix.nc", HELIX.format(feed=600).encode())
     s = run_program(c, "helix.nc", timeout_s=30)
     assert s.state == "READY"
@@ -43,7 +43,7 @@ def test_helix_runs_to_its_end_with_the_helix_length(c) -> None:
     assert values["ch1.program_time"] >= HELIX_MM / 10.0  # F600 = 10 mm/s
 
 
-def test_held_helix_stands_on_the_helix(c) -> None:
+def test_held_helix_stands_on_the_helix(c: Client) -> None:
     # F1: the helix takes half an hour of machining, the HOLD written after START
     # arrives within it (the event-speed clock would pass a short move first)
     c.mdi("G0 X10 Y0 Z0")
@@ -61,7 +61,7 @@ def test_held_helix_stands_on_the_helix(c) -> None:
     c.reset(1)
 
 
-def test_helix_end_off_the_circle_is_the_plane_arcs_error(c) -> None:
+def test_helix_end_off_the_circle_is_the_plane_arcs_error(c: Client) -> None:
     ids = []
     for name, z_word in (("plane_bad.nc", ""), ("helix_bad.nc", " Z-5")):
         c.reset(1)
@@ -73,7 +73,7 @@ def test_helix_end_off_the_circle_is_the_plane_arcs_error(c) -> None:
     assert ids[0] == ids[1] == 21758  # ARC_RADIUS_DIFFERENCE, as for the plane arc
 
 
-def test_the_dry_run_trace_cnc_web_draws_carries_the_helix_z(c) -> None:
+def test_the_dry_run_trace_cnc_web_draws_carries_the_helix_z(c: Client) -> None:
     # the tool path of cnc-web's program page is this trace (/api/.../trace): every
     # sample of the helix block stands on the helix, Z with the angle
     c.mdi("G0 X0 Y0 Z0")  # the rapid move to the helix start is 10 mm

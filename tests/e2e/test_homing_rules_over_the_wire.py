@@ -17,14 +17,14 @@ AXES = ["ch1.ax1.homing_referenced_r", "ch1.ax2.homing_referenced_r",
 
 
 @pytest.fixture(scope="module")
-def machine(tmp_path_factory) -> Iterator[ServiceProcess]:
+def machine(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceProcess]:
     with serving_config(tmp_path_factory.mktemp("homing"),
                         "programs_need_referenced_axes = true\n") as service:
         yield service
 
 
 def test_a_program_starts_and_stops_at_the_block_that_moves_an_unreferenced_axis(
-        machine) -> None:
+        machine: ServiceProcess) -> None:
     with Client(machine.endpoint, timeout_s=30.0) as c:
         c.reset(1)
         c.upload("move.nc", b"N10 G01 X1 F600\nM30\n")

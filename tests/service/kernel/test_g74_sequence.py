@@ -5,6 +5,7 @@ then X, then Y, axes with the same number together (ISG programming manual,
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -16,7 +17,7 @@ from tests.support.manual_machine import REF_MM, machine
 
 
 @pytest.fixture
-def k():
+def k() -> Iterator[KernelHarness]:
     with KernelHarness(config=machine()) as harness:
         yield harness
 
@@ -37,7 +38,7 @@ def _steps(k: KernelHarness) -> list[tuple[tuple[bool, ...], tuple[float, ...]]]
     return seen
 
 
-def test_g74_homes_the_axes_in_the_order_of_their_numbers(k) -> None:
+def test_g74_homes_the_axes_in_the_order_of_their_numbers(k: KernelHarness) -> None:
     k.mdi("G01 X-2 Y4 Z1 F600")
     seen = _steps(k)
     run = k.run("N10 G74 X2 Y3 Z1\nM30\n")
@@ -52,7 +53,7 @@ def test_g74_homes_the_axes_in_the_order_of_their_numbers(k) -> None:
     assert run.positions_mm == pytest.approx((REF_MM, 0.0, 0.0))
 
 
-def test_g74_axes_with_the_same_number_home_together(k) -> None:
+def test_g74_axes_with_the_same_number_home_together(k: KernelHarness) -> None:
     k.mdi("G01 X-2 Y4 Z1 F600")
     seen = _steps(k)
     run = k.run("N10 G74 Z1 X2 Y2\nN20 G01 X5 F600\nM30\n")
@@ -63,7 +64,7 @@ def test_g74_axes_with_the_same_number_home_together(k) -> None:
     assert run.positions_mm == pytest.approx((5.0, 0.0, 0.0))
 
 
-def test_g74_sequence_in_a_manual_block(k) -> None:
+def test_g74_sequence_in_a_manual_block(k: KernelHarness) -> None:
     run = k.mdi("G74 Y2 X1")
     assert run.channel.state == ChannelState.READY, run.channel.errors.entries
     assert [m.referenced for m in run.channel.manual] == [True, True, False]
@@ -77,7 +78,8 @@ def test_g74_sequence_in_a_manual_block(k) -> None:
     ("G74 X-1 Y1", 20816, 5, "whole number"),
     ("G74 X1.5", 20816, 5, "whole number"),
 ])
-def test_bad_g74_blocks_stop_with_isg_ids(k, text, error_id, column, words) -> None:
+def test_bad_g74_blocks_stop_with_isg_ids(k: KernelHarness, text: str, error_id: int,
+                                         column: int, words: str) -> None:
     k.command(ResetChannel(0, True))
     run = k.run(f"N10 G01 X1 F600\n{text}\nM30\n", name="bad.nc")
     assert run.channel.state == ChannelState.ERROR

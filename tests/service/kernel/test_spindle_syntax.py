@@ -7,6 +7,8 @@ do cycle for cycle what the plain block form does (same words, same PLC handshak
 
 from __future__ import annotations
 
+from typing import Any
+
 import pytest
 
 from cnc_objects.service.kernel.channel_mode import ChannelState
@@ -21,7 +23,7 @@ def _spindle(s: Snapshot) -> SpindleState:
     return s.channels[0].spindle
 
 
-def _cycles(text: str) -> list[tuple[object, ...]]:
+def _cycles(text: str) -> list[tuple[Any, ...]]:
     """Every cycle of ``text`` on a fresh kernel from START to READY: spindle state, X,
     path velocity, the PLC's units (type, number, kind, acknowledged)."""
     with KernelHarness() as h:

@@ -171,7 +171,8 @@ def test_modal_only_blocks_give_no_block() -> None:
         ("G91 G1 X10 F100\nG3 X-10 Y10 Z-4 I-10\nM30", (0, 1), (0, 0), (0, 10, -4)),
     ],
 )
-def test_helical_arcs(program, plane, centre, end) -> None:
+def test_helical_arcs(program: str, plane: tuple[int, int], centre: tuple[float, float],
+                      end: tuple[float, ...]) -> None:
     for text in (program, slow(program)):
         arc = motions(text)[-1]
         assert arc.plane == plane

@@ -8,6 +8,8 @@ stands at z0 + dz * phi / theta.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import Any
 
 import pytest
 
@@ -21,21 +23,23 @@ from .programs import DT, DYN, arc, check_axis_limits, line, run, trapezoid_time
 ORIGIN = (0.0, 0.0, 0.0)
 
 
-def executor(start=ORIGIN, dynamics=DYN) -> PathExecutor:
+def executor(start: tuple[float, ...] = ORIGIN,
+             dynamics: Any = DYN) -> PathExecutor:
     return PathExecutor(dynamics, start, cycle_s=DT)
 
 
-def finish_cycle(trace, block) -> int:
+def finish_cycle(trace: Any, block: Any) -> int:
     for k, res in enumerate(trace.results, start=1):
         if any(b is block for b in res.finished):
             return k
     raise AssertionError("block never finished")
 
 
-def travelled(point, centre, start_angle, ccw) -> float:
+def travelled(point: Sequence[float], centre: Sequence[float], start_angle: float,
+              ccw: bool) -> float:
     """Angle (rad, >= 0) from ``start_angle`` to ``point`` in the direction of motion."""
     angle = math.atan2(point[1] - centre[1], point[0] - centre[0])
-    return ((angle - start_angle) if ccw else (start_angle - angle)) % (2.0 * math.pi)
+    return float(((angle - start_angle) if ccw else (start_angle - angle)) % (2.0 * math.pi))
 
 
 def test_helix_geometry_by_hand() -> None:
