@@ -18,7 +18,11 @@ Runs of white space compare equal (tables piped through ``cnc`` are tab-separate
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import re
+import tempfile
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,6 +35,22 @@ NOT_RUN = ("cnc-hmi", "mosquitto", "cnc-mqtt", "docker")
 README_ENDPOINT = "tcp://127.0.0.1:5555"
 README_WEB_PORT = 8080  # cnc-web beside the service, as `make run` starts it
 README_AMS_NET_ID, README_ADS_HOST = "127.0.0.1.1.1", "127.0.0.1"  # what `make run` serves
+
+
+@contextlib.contextmanager
+def readme_web_port() -> Iterator[None]:
+    """Hold README_WEB_PORT for one test at a time: the tests that serve cnc-web where
+    `make run` puts it run in separate pytest-xdist workers, and two of them at once
+    would find the port taken (a file lock, as the workers are processes)."""
+    path = Path(tempfile.gettempdir()) / f"cnc-objects-web-{README_WEB_PORT}.lock"
+    with path.open("w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+
+
 _COMMENT = re.compile(r"\s+#\s.*$")
 _NUMBER = re.compile(r"-?\d+(?:\.\d+)?")
 _DURATION = re.compile(r"-?\d+\.\d+(?= s\b)")

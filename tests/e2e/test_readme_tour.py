@@ -31,6 +31,7 @@ from tests.e2e.readme_tour import (
     machine_section,
     output_matches,
     python_examples,
+    readme_web_port,
     tour_items,
     tour_steps,
 )
@@ -94,6 +95,7 @@ def test_the_matcher(expected: tuple[str, ...], actual: list[str], same: bool) -
 def test_every_tour_command_prints_what_the_readme_shows(tmp_path: Path) -> None:
     (tmp_path / "docs").symlink_to(ROOT / "docs")
     with serving("--clock", "realtime", cwd=tmp_path) as service, \
+            readme_web_port(), \
             serving_web(service.endpoint, port=README_WEB_PORT, cwd=tmp_path):  # as make run
         env = _env(service.endpoint)
         failures = []
@@ -184,6 +186,7 @@ async def test_the_whole_tour_in_order_leaks_no_state(tmp_path: Path) -> None:
     failures: list[str] = []
     bridge: subprocess.Popen[bytes] | None = None
     with serving("--clock", "realtime", cwd=tmp_path, ads=True) as service, \
+            readme_web_port(), \
             serving_web(service.endpoint, port=README_WEB_PORT, cwd=tmp_path):
         env = _env(service.endpoint)
         async with running_broker() as broker, contextlib.AsyncExitStack() as stack:
