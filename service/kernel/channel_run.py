@@ -149,6 +149,7 @@ class ChannelRunner:
                   for mode, c in config.hscs},
             kinematics=False,  # this kernel configures no kinematic transformation
             idle_steps_max=services.idle_steps_max,
+            m_function_known=config.techno.m_known,
         )
         self._programs_need_referenced_axes = machine.programs_need_referenced_axes
         self.manual = ManualMode(channel, machine, params, cycle_s, self._move, self.report)
