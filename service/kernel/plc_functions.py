@@ -186,6 +186,10 @@ class PlcFunctions:
         post = self._sns_post.pop(id(block), None)
         if post is not None:
             self._armed.append(post)
+        elif self._armed and any(b is block for b in self._armed):
+            # reached before the acknowledge: the path waits there (TECHNOLOGY), nothing
+            # is left to release (no stale id may outlive the block)
+            self._armed = [b for b in self._armed if b is not block]
         functions = self._functions(block)
         if functions:
             self._output(functions, now_s, block.spindle_pos_deg)
