@@ -253,6 +253,15 @@ class SyncKind(IntEnum):
     MNS_SNS = 0x8  # output after the motion, waited for at the block end
 
 
+NOT_VALID = "NOT_VALID"  # P-CHAN-00041's default: the M function is not defined
+
+# the M functions the embedded default machine defines (P-CHAN-00041 m_synch[i]): those
+# its README, tests and example programs use, each MVS_SVS as every unlisted M was before
+# issue 39 (spindle M3/M4/M5/M19 take their own keys, M0/M1/M2/M17/M29/M30 are internal)
+DEFAULT_M_SYNCH: dict[str, str] = {
+    str(m): "MVS_SVS" for m in (6, 7, 8, 9, 10, 11, 12, 13, 25, 40, 80)}
+
+
 def _sync_kind(value: str) -> str:
     if value not in SyncKind.__members__:
         raise ValueError(f"{value!r} is not a synchronisation kind; use one of "
@@ -292,9 +301,12 @@ class PlcFunctionsConfig(Strict):
     ``h_synch`` / ``h_prozess_zeit`` H numbers."""
 
     m_synch: dict[str, str] = Field(
-        default_factory=dict, description="P-CHAN-00041 m_synch[i]: kind of M<i>")
+        default_factory=lambda: dict(DEFAULT_M_SYNCH),
+        description="P-CHAN-00041 m_synch[i]: kind of M<i>; the default lists M6 M7 M8 "
+        "M9 M10 M11 M12 M13 M25 M40 M80 as MVS_SVS")
     m_synch_default: str = Field(
-        "MVS_SVS", description="kind of an M function m_synch does not list (ISG: NOT_VALID)")
+        NOT_VALID, description="kind of an M function m_synch does not list: NOT_VALID "
+        "(ISG's default: the M is an error, 20160), or a kind that such an M takes")
     h_synch: dict[str, str] = Field(
         default_factory=dict, description="P-CHAN-00027 h_synch[i]: kind of H<i>")
     h_synch_default: str = Field(
@@ -331,10 +343,20 @@ class PlcFunctionsConfig(Strict):
                 raise ValueError(f"time {time_us} us of function {key} is not in 0..3600000000")
         return value
 
-    @field_validator("m_synch_default", "h_synch_default", "t_synch")
+    @field_validator("h_synch_default", "t_synch")
     @classmethod
     def _kind(cls, value: str) -> str:
         return _sync_kind(value)
+
+    @field_validator("m_synch_default")
+    @classmethod
+    def _m_default(cls, value: str) -> str:
+        return value if value == NOT_VALID else _sync_kind(value)
+
+    def m_known(self, number: int) -> bool:
+        """M<number> has a kind: listed, a spindle function, or a default kind set."""
+        return (self.m_synch_default != NOT_VALID or str(number) in self.m_synch
+                or number in (3, 4, 5, 19))
 
     def kind(self, type_: int, number: int) -> SyncKind:
         """The kind of function ``number`` of type ``type_`` (1 M, 2 H, 3 S, 4 T)."""
@@ -349,7 +371,9 @@ class PlcFunctionsConfig(Strict):
                  19: spindle.m19_synch}.get(number)
         if named is not None:
             return SyncKind[named]
-        return SyncKind[self.m_synch.get(str(number), self.m_synch_default)]
+        kind = self.m_synch.get(str(number), self.m_synch_default)
+        # NOT_VALID: the decoder refuses such an M (20160); none reaches the PLC
+        return SyncKind.NO_SYNCH if kind == NOT_VALID else SyncKind[kind]
 
     def prozess_zeit_s(self, type_: int, number: int) -> float:
         """The function's time in s (the embedded PLC acknowledges after it)."""

@@ -150,6 +150,7 @@ class ChannelRunner:
                   for mode, c in config.hscs},
             kinematic_chain=config.kinematic_chain(),
             idle_steps_max=services.idle_steps_max,
+            m_function_known=config.techno.m_known,
         )
         self.manual = ManualMode(channel, machine, params, cycle_s, self._move, self.report)
 
@@ -637,8 +638,9 @@ class ChannelRunner:
         allows (0: the next cycle must be run as a cycle, ``cycle``)."""
         plc, ch = self.plc, self.channel
         if (not plc.spindle.reached
-                or any(u.pending and u.ack_due_s is not None for u in plc.unit.units)):
-            return 0  # a ramp or an acknowledge runs in time
+                or any(u.pending and u.ack_due_s is not None for u in plc.unit.units)
+                or plc.stops_due):
+            return 0  # a ramp or an acknowledge runs in time, an MVS_SNS stop goes
         if ch.state not in WORKING_STATES:
             return None
         run = self._run

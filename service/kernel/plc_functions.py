@@ -8,7 +8,8 @@ for its acknowledge:
 
 * MOS: output when the block's motion starts, never waited for;
 * MVS_SVS: output before the motion, which starts only after the acknowledge;
-* MVS_SNS: output before the motion, the path waits at the block end for the acknowledge;
+* MVS_SNS: output before the motion; the block end is planned as a stop only while the
+  acknowledge is outstanding (``stops_to_release``), a late one stops the path there;
 * MNS_SNS: output at the block end, the path waits there for the acknowledge.
 
 ``split`` turns a motion block with technology into up to three blocks the path runs in
@@ -109,6 +110,10 @@ class PlcFunctions:
         self.unit = PlcFunctionsUnit()
         self._extra: set[int] = set()  # ids of the pre/post blocks ``split`` made
         self._spindle_waits = False  # a spindle function waits for the spindle
+        # MVS_SNS: id of a pre block -> the post block whose stop its output arms; armed
+        # post blocks are stops only while an acknowledge is outstanding (issue 39)
+        self._sns_post: dict[int, Block] = {}
+        self._armed: list[Block] = []
 
     @property
     def unit(self) -> PlcFunctionsUnit:
@@ -154,7 +159,10 @@ class PlcFunctions:
         out.append(replace(block, m_functions=(), h_functions=(), spindle_speed_rpm=None,
                            tool=None))
         if after or any(k in _WAIT_AFTER for k in kinds):
-            out.append(self._part(block, after, True))
+            post = self._part(block, after, True)
+            out.append(post)
+            if before and not after:  # only MVS_SNS waits there: no stop once acknowledged
+                self._sns_post[id(out[0])] = post
         return out
 
     def _part(self, block: Block, functions: list[tuple[TechnoType, int]], wait: bool) -> Block:
@@ -175,6 +183,13 @@ class PlcFunctions:
         it was a pre or post block of ``split``."""
         extra = id(block) in self._extra
         self._extra.discard(id(block))
+        post = self._sns_post.pop(id(block), None)
+        if post is not None:
+            self._armed.append(post)
+        elif self._armed and any(b is block for b in self._armed):
+            # reached before the acknowledge: the path waits there (TECHNOLOGY), nothing
+            # is left to release (no stale id may outlive the block)
+            self._armed = [b for b in self._armed if b is not block]
         functions = self._functions(block)
         if functions:
             self._output(functions, now_s, block.spindle_pos_deg)
@@ -253,6 +268,20 @@ class PlcFunctions:
         self._spindle_waits = False
         return not any(u.pending for u in self.unit.units)
 
+    @property
+    def stops_due(self) -> bool:
+        """``stops_to_release`` has blocks for the next cycle (it must be stepped)."""
+        return bool(self._armed) and not (self.waits_for_spindle or self.waits_for_plc)
+
+    def stops_to_release(self) -> list[Block]:
+        """Post blocks of MVS_SNS functions already output whose acknowledge has come:
+        their block end is no stop any more (ISG: the path stops at the end of the
+        block only when the acknowledge is late)."""
+        if not self._armed or not self.all_acknowledged():
+            return []
+        armed, self._armed = self._armed, []
+        return armed
+
     def reset(self) -> None:
         """RESET or ERROR of the channel: pending functions are dropped (as
         acknowledged: nothing waits for them any more) and the spindle brakes to a stop
@@ -262,6 +291,8 @@ class PlcFunctions:
             tuple(replace(u, acknowledged=True) for u in self.unit.units),
             self.unit.output_count)
         self._extra.clear()
+        self._sns_post.clear()
+        self._armed.clear()
         self._spindle_waits = False
 
 

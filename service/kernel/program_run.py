@@ -245,6 +245,9 @@ class ProgramRun:
         if (plc is not None and executor.waiting == Waiting.TECHNOLOGY
                 and plc.all_acknowledged()):
             executor.release_technology()  # acknowledged in the last cycle: go on
+        if plc is not None:
+            for post in plc.stops_to_release():  # MVS_SNS acknowledged before its end
+                executor.release_stop(post)
         if self._sync is None:
             self._feed_blocks()
             if self._contour_changed:  # once per cycle, not per block

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import asyncio
 import time
+from pathlib import Path
 
 import pytest
 
@@ -27,6 +28,7 @@ from cnc_objects.testing.helpers import wait_for_async
 from tests.reliability import figures
 from tests.reliability.health import assert_well
 from tests.support.resources import cpu_s, rss_kib, thread_count
+from tests.support.service import serving_config
 
 NODE = "tests/reliability/test_long_lines.py"
 CLIENT_TIMEOUT_S = 30.0
@@ -40,6 +42,19 @@ WATCH_AFTER_RESET_S = 3.0  # RSS is watched this long after RESET (it once grew 
 CHECK_MAX_ERRORS = 1000  # the default of limits.check_max_errors
 ONE_MB_CPU_MAX_S = 5.0
 HEAD = "N1 G01 X1 F100 "
+# the default machine's channel with every M function taking MVS_SVS (m_synch_default)
+M_DEFAULT_MACHINE = """
+[[channels]]
+id = 1
+name = "main"
+axes = [
+    {name = "X", logical_number = 1, link_to = 1},
+    {name = "Y", logical_number = 2, link_to = 2},
+    {name = "Z", logical_number = 3, link_to = 3},
+]
+[channels.techno]
+m_synch_default = "MVS_SVS"
+"""
 
 
 def repeated_word_line(words: int) -> str:
@@ -178,12 +193,14 @@ async def test_a_one_megabyte_line_is_checked_in_seconds_with_bounded_errors() -
 
 
 @pytest.mark.parametrize("kind", ["distinct M words", "long expression", "long comment"])
-async def test_a_one_megabyte_valid_line_is_checked_and_run(kind: str) -> None:
+async def test_a_one_megabyte_valid_line_is_checked_and_run(kind: str, tmp_path: Path) -> None:
     """A 1 MB line of valid NC (many distinct words, one long expression, a long
     comment): no error, checked in < 5 s of CPU, and run to its end."""
     program = filled_line(kind, PROGRAM_MAX_BYTES - 10) + "M30\n"
     assert len(program) <= PROGRAM_MAX_BYTES
-    with serving() as service:
+    # M100 M101 ..: the channel's list does not define them (ISG: 20160, issue 39); the
+    # configured default kind makes them valid words, as they were before
+    with serving_config(tmp_path, M_DEFAULT_MACHINE) as service:
         pid = service.process.pid
         async with AsyncClient(service.endpoint, timeout_s=CLIENT_TIMEOUT_S) as c:
             await c.upload("valid.nc", program.encode())

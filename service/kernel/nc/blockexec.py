@@ -159,6 +159,9 @@ class BlockExecutor:
         self._np_index = 0  # the index of this block's G159 = <i>
         self.manual = manual
         self.items_done = 0  # items of the last block executed before it ended or failed
+        # P-CHAN-00041: M numbers with a synchronisation kind (the decoder sets it from
+        # its surroundings); None: every M is known
+        self.m_function_known: Callable[[int], bool] | None = None
         index = {name: k for k, name in enumerate(axes)}
         # channel axis indices of X, Y, Z (the axes #CS transforms; #CS needs all three)
         self.xyz: tuple[int, int, int] = (index.get("X", -1), index.get("Y", -1),
@@ -299,6 +302,15 @@ class BlockExecutor:
                 dwell_s += self._tool_change(pos, err)
             action = _M_FLOW.get(number)
             if action is None:
+                known = self.m_function_known
+                if known is not None and not known(number):
+                    unknown = err(NcErrorId.UNKNOWN_M_FUNCTION,
+                                  f"M{number} is not defined: the channel's m_synch "
+                                  "(P-CHAN-00041) does not list it", pos)
+                    if on_error is None:
+                        raise unknown
+                    on_error(unknown, k)  # this M is left out
+                    continue
                 m_functions.append(number)
                 continue
             if flow_pos >= 0:

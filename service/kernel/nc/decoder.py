@@ -144,6 +144,7 @@ class Decoder:
         self._skip_levels = skip_levels
         self.parser = LineParser(word_table(axes))
         self.executor = BlockExecutor(axes, tools, modal, manual, axis_numbers)
+        self.executor.m_function_known = self.surroundings.m_function_known
         self._main = Program(text, file, self.parser, skip_levels, check)
         self._files: dict[str, Program] = {}
         self.frames: list[CallFrame] = []

@@ -40,6 +40,7 @@ class NcErrorId(IntEnum):
     CONFLICTING_G_CODES = 20121  # two G functions of one group in a block (G0 G1)
     INVALID_M_CODE = 20122  # M not a non-negative integer
     CONFLICTING_M_CODES = 20123  # two program-flow M functions in a block (M0 M30)
+    UNKNOWN_M_FUNCTION = 20160  # ISG: an M function P-CHAN-00041 does not define
     INVALID_FEED = 20130  # F <= 0
     NO_FEED = 20008  # ISG "Feed rate in motion block is 0.": G1/G2/G3 without F or prog_start
     INVALID_SPINDLE_SPEED = 20132  # S < 0

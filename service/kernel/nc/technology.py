@@ -82,3 +82,6 @@ class Surroundings:
     # positions with it); None: a three-axis channel, #TRAFO is the identity
     kinematic_chain: Kinematics | None = None
     idle_steps_max: int | None = None  # the endless-program guard; None: IDLE_STEPS_MAX
+    # P-CHAN-00041: whether M<i> has a synchronisation kind (an M the channel's list
+    # lacks is ISG's unknown M function, 20160); None: every M is known
+    m_function_known: Callable[[int], bool] | None = None

@@ -140,7 +140,7 @@ class PathExecutor:
                 ipo.events.append((item, self._single_block))
                 continue
             tail.events.append(item)
-            if item.needs_stop:
+            if item.needs_stop and id(item) not in self._ipo.released_stops:
                 planner.mark_stop(tail)
             if self._single_block:
                 planner.mark_stop(tail, single=True)
@@ -198,6 +198,18 @@ class PathExecutor:
     def release_technology(self) -> None:
         """Continue after a stop for technology acknowledges (StopKind.TECHNOLOGY)."""
         self._ipo.release_technology()
+
+    def release_stop(self, block: Block) -> None:
+        """``block``'s TECHNOLOGY stop is no stop any more (MVS_SNS acknowledged in
+        time): the look-ahead plans through its end, the path does not wait there."""
+        ipo, planner = self._ipo, self._planner
+        ipo.released_stops.add(id(block))
+        for seg in planner:
+            if any(b is block for b in seg.events):
+                seg.stop = any(b.needs_stop and id(b) not in ipo.released_stops
+                               for b in seg.events)
+                planner.release(seg)
+                return
 
     @property
     def single_block(self) -> bool:

@@ -72,6 +72,8 @@ class Interpolator:
         self.dwell_left_s = 0.0
         self.dwell_single = False
         self.techno_single = False  # a single-block stop follows the technology wait
+        # ids of TECHNOLOGY blocks acknowledged before the path reached them (MVS_SNS)
+        self.released_stops: set[int] = set()
         self.hold = False
         self.override = 1.0
         self.unfinished = 0  # blocks handed over and not yet finished
@@ -134,6 +136,7 @@ class Interpolator:
         self.seg = None
         self.s_mm = self.v_mm_s = 0.0
         self.events.clear()
+        self.released_stops.clear()
         self.waiting = Waiting.NONE
         self.wait_block = None
         self.dwell_left_s = 0.0
@@ -325,7 +328,12 @@ class Interpolator:
         contour = block.contour
         if contour is not None and contour.kind == ContourKind.DISTANCE_CLEAR:
             self.distance_base_mm = -self.s_mm  # the path distance restarts here
-        if block.stop == StopKind.TECHNOLOGY:
+        if block.stop == StopKind.TECHNOLOGY and id(block) in self.released_stops:
+            self.released_stops.discard(id(block))  # acknowledged in time: no stop
+            if not single:
+                return False
+            self.waiting = Waiting.SINGLE_BLOCK
+        elif block.stop == StopKind.TECHNOLOGY:
             self.waiting = Waiting.TECHNOLOGY
             self.techno_single = single
         elif block.stop != StopKind.NONE:

@@ -162,6 +162,11 @@ class LookAhead:
         seg.planned = False
         self.backward(seg)
 
+    def release(self, seg: Segment) -> None:
+        """``seg.stop`` was cleared: its junction and the plan up to it again."""
+        self._junction(seg)
+        self.replan()
+
     def set_override(self, override: float) -> None:
         """New feed override: new caps everywhere, full backward pass."""
         self.override = override
