@@ -255,3 +255,38 @@ def test_of_two_solutions_the_one_inside_the_limits_is_taken() -> None:
         run = _ran(ac.run("G90 G00 X0 Y0 Z50 A0 C0\n#TRAFO ON\n"
                           "L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=2 @P15=100]\nM30\n"))
     assert (run.positions_mm[A], run.positions_mm[C]) == pytest.approx((100.0, 180.0))
+
+
+def test_a_simultaneous_part_a_half_circle_while_the_table_turns(ac: KernelHarness) -> None:
+    """Simultaneous five-axis: the tip runs a half circle of R10 about the workpiece's
+    origin (G02 under #TRAFO ON) while C turns 90 degrees with it, tracking."""
+    run = _ran(ac.run("G90 G01 X10 Y0 Z0 A0 C0 F3000\n#TRAFO ON\n"
+                      "G02 X-10 Y0 I-10 J0 C90 F600\n#TRAFO OFF\nM30\n", record=True))
+    moving = [s for s in run.samples if 0.0 < s.positions_mm[C] < 90.0]
+    assert len(moving) > 1000
+    for sample in moving:
+        x, y, z = tip_of(sample.positions_mm)
+        assert math.hypot(x, y) == pytest.approx(10.0, abs=1e-9) and z == pytest.approx(0.0)
+        swept = math.degrees(math.atan2(-y, x)) % 360.0  # clockwise from (10, 0)
+        assert sample.positions_mm[C] == pytest.approx(swept / 2.0, abs=1e-6)
+    assert run.positions_mm[:5] == pytest.approx((0.0, -10.0, 0.0, 0.0, 90.0), abs=1e-9)
+
+
+def test_a_three_plus_two_part_a_square_in_a_tilted_plane(ac: KernelHarness) -> None:
+    """3+2: the tool tilted onto a plane turned 30 degrees about X (origin (20, 0, 0)),
+    then a 20 mm square milled 1 mm deep in it; every corner checked against numpy."""
+    corners = [(0.0, 0.0), (20.0, 0.0), (20.0, 20.0), (0.0, 20.0), (0.0, 0.0)]
+    square = "\n".join(f"G01 X{x:g} Y{y:g} Z-1 F3000" for x, y in corners)
+    run = _ran(ac.run("G90 G00 X20 Y0 Z30 A0 C0\n#TRAFO ON\n"
+                      "L CYCLE [NAME=SysPosRotationToPlane.ecy @P1=1 @P2=10 @P3=20 @P4=0 "
+                      f"@P5=0 @P15=30]\n{square}\nM30\n", record=True))
+    s30, c30 = math.sin(math.radians(30)), math.cos(math.radians(30))
+    turned = np.array([[1.0, 0.0, 0.0], [0.0, c30, -s30], [0.0, s30, c30]])
+    expected = [np.array([20.0, 0.0, 0.0]) + turned @ np.array([x, y, -1.0])
+                for x, y in corners]
+    tips = [tip_of(s.positions_mm) for s in run.samples]
+    for corner in expected:
+        assert min(float(np.linalg.norm(t - corner)) for t in tips) < 0.06  # 3000 mm/min
+    final = run.positions_mm
+    assert tip_of(final) == pytest.approx(tuple(expected[-1]), abs=1e-9)
+    assert tool_direction_of(final) == pytest.approx((0.0, -s30, c30), abs=1e-9)
