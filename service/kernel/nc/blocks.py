@@ -204,6 +204,9 @@ class Block:
     h_functions: tuple[int, ...] = ()  # H words: technology information to the PLC
     manual_mode: ManualModeRequest | None = None  # G200 / G201 / G202
     spindle_pos_deg: float | None = None  # S.POS: where an M19 of the block orients to
+    # what the objects show from this block on (shift, zero offset group, T, D): set by
+    # the decoder feed on the first block after a change, None on all others (issue 39)
+    tooling: object | None = None
 
     @property
     def needs_stop(self) -> bool:

@@ -96,6 +96,7 @@ def _fast_block(
     b.h_functions = ()
     b.manual_mode = None
     b.spindle_pos_deg = None
+    b.tooling = None
     b.__class__ = Block
     return cast(Block, b)
 

@@ -267,6 +267,7 @@ _BLOCK_FAST = '''\
                 block.h_functions = ()
                 block.manual_mode = None
                 block.spindle_pos_deg = None
+                block.tooling = None
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\
