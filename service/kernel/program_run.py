@@ -51,6 +51,7 @@ from .plc_functions import PlcFunctions
 from .prod_time_trace import ProdTimeTrace, trace_file_name
 from .state import BLOCK_START_COLUMN, Channel, ContourLookaheadUnit, ErrorEntry
 from .tool_life import count_cutting
+from .tooling import show_block_tooling
 from .tooling_view import ChannelTooling
 from .wait_reason import WaitReason, manual_open, path_wait_reason
 
@@ -386,9 +387,7 @@ class ProgramRun:
             return
         self._tooling_shown = view
         assert isinstance(view, ChannelTooling)
-        ch = self.channel
-        shown = ch.tooling
-        ch.tooling = replace(view, tools=shown.tools, zero_offsets=shown.zero_offsets)
+        show_block_tooling(self.channel, view)
 
     def _stepped(self, step: StepResult) -> None:
         """After each interpolation cycle (a traced PROD_TIME run records it)."""

@@ -6,7 +6,6 @@ from __future__ import annotations
 from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.service.kernel.commands import StartProgram
 from cnc_objects.service.kernel.commands_tooling import SetZeroOffset
-
 from tests.support.kernel import KernelHarness
 
 
