@@ -9,7 +9,7 @@ expressions, no incremental coordinates).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import IntEnum
 
 
@@ -206,7 +206,8 @@ class Block:
     spindle_pos_deg: float | None = None  # S.POS: where an M19 of the block orients to
     # what the objects show from this block on (shift, zero offset group, T, D): set by
     # the decoder feed on the first block after a change, None on all others (issue 39)
-    tooling: object | None = None
+    # (not compared or hashed: a view of the tables, not part of what the block does)
+    tooling: object | None = field(default=None, compare=False)
 
     @property
     def needs_stop(self) -> bool:
