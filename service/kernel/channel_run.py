@@ -65,7 +65,7 @@ from .runner_services import RunnerServices
 from .spindle import Spindle
 from .state import Channel, DecoderFlag, ErrorEntry
 from .syntax_check import SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
-from .tooling import seed_modal, tables_from_config, tooling_of
+from .tooling import seed_modal, tables_from_config
 from .tooling_view import after_reset, initial_tooling
 from .wait_reason import WaitReason, channel_wait_reason
 
@@ -128,10 +128,6 @@ class ChannelRunner:
         self._internal_hold = False  # feedhold of a suspend_axis_output request
         self._waits_for_axes = False  # the last cycle's run (or start) waited for its axes
         self._modal: ModalState | None = None  # MDI: modal state carried between blocks
-        # what ``tooling_of`` was last computed from, and what it showed (objects by
-        # identity: the tables are replaced, never changed): the same inputs give the
-        # same view, so a run's block hand-over does not compute it again (issue 37)
-        self._tooling_inputs: tuple[object, ...] = ()
         self.time_s = 0.0  # kernel time of the cycle (PROD_TIME: the simulated time)
         # set by the kernel when a RESET of this channel is queued: a cycle waiting for
         # the decoder or the check (virtual clock) stops waiting; cleared by ``reset``
@@ -549,17 +545,6 @@ class ChannelRunner:
                 message_count=ch.program.message_count + len(new))
         if self._modal is not None and self._modal.settings != ch.program.machining:
             ch.program = replace(ch.program, machining=replace(self._modal.settings))
-        modal = self._modal
-        if modal is not None:
-            tables = modal.tooling
-            inputs = (tables.tools, tables.zero_offsets, modal.zero_offset_group,
-                      modal.tool_offset, modal.plane, modal.tool, modal.spindle_tool,
-                      ch.tooling)
-            last = self._tooling_inputs
-            if len(last) != len(inputs) or any(
-                    a is not b for a, b in zip(inputs, last, strict=True)):
-                ch.tooling = tooling_of(modal, ch.tooling, self._axes)
-                self._tooling_inputs = (*inputs[:-1], ch.tooling)
 
     def _axis_limits(self) -> tuple[tuple[AxisDynamics, ...], tuple[tuple[float, float], ...]]:
         """Dynamics and software limits of the channel's axes from the effective axis

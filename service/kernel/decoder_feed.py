@@ -17,7 +17,7 @@ import logging
 import queue
 import threading
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from .nc import Decoder, ModalState, NcError, NcErrorId
 from .nc.blocks import Block, Compensation, SourceRef, StopKind
@@ -26,6 +26,8 @@ from .nc.source import NcText
 from .nc.technology import Surroundings
 from .path.errors import PathError
 from .path.section_plan import SectionPlan
+from .tooling import tooling_of
+from .tooling_view import ChannelTooling
 from .workers import Workers
 
 log = logging.getLogger(__name__)
@@ -266,10 +268,30 @@ class DecoderFeed:
         )
         decoder.cancelled = self._cancel.is_set
         try:
-            yield from decoder.blocks()
+            yield from self._with_tooling(decoder)
         finally:
             decoder.close()  # a program read as a stream: its file is read no more
         self.modal = decoder.modal
+
+    def _with_tooling(self, decoder: Decoder) -> Iterator[Block]:
+        """The decoder's blocks; the first one after the tool, D, plane, zero offset or
+        a table changed carries the view the objects show while it runs (``tooling``):
+        the kernel shows the block being interpolated, not the decoder's look-ahead
+        state (issue 39). An identity check per block: nothing is built while nothing
+        changes."""
+        modal = decoder.modal
+        last: tuple[object, ...] = ()
+        shown: ChannelTooling | None = None
+        for block in decoder.blocks():
+            tables = modal.tooling
+            now = (tables.tools, tables.zero_offsets, modal.zero_offset_group,
+                   modal.tool_offset, modal.plane, modal.tool, modal.spindle_tool)
+            if len(now) != len(last) or any(
+                    a is not b and a != b for a, b in zip(now, last, strict=True)):
+                last = now
+                shown = tooling_of(modal, shown or ChannelTooling(), self._axes)
+                block = replace(block, tooling=shown)
+            yield block
 
     def _run(self) -> None:
         try:

@@ -53,6 +53,8 @@ from .plc_functions import PlcFunctions
 from .prod_time_trace import ProdTimeTrace, trace_file_name
 from .state import BLOCK_START_COLUMN, Channel, ContourLookaheadUnit, ErrorEntry
 from .tool_life import count_cutting
+from .tooling import show_block_tooling
+from .tooling_view import ChannelTooling
 from .wait_reason import WaitReason, manual_open, path_wait_reason
 
 _NOT_WAITING, _OVERRIDE_ZERO = int(WaitReason.NONE), int(WaitReason.OVERRIDE_ZERO)
@@ -176,6 +178,7 @@ class ProgramRun:
         # ready for the next manual block (the decoder's end may come cycles later)
         self._manual_done_at_end = 0
         self._technology_part: Block | None = None  # the last pre/post block finished
+        self._tooling_shown: object | None = None  # the Block.tooling shown last
         self.failure: ErrorEntry | None = None
         if contour is not None:
             executor.on_prepared = self._prepared
@@ -261,6 +264,7 @@ class ProgramRun:
             self._warn_buffer_limits()
         self._show_cycles(step, time_s, 1, output)
         self._stepped(step)
+        self._show_tooling(step)
         counted = manual_done = 0
         for block in step.finished:
             if plc is not None and plc.block_finished(block, time_s):
@@ -390,6 +394,23 @@ class ProgramRun:
         if self.channel.program.execution_mode_active & _SUPPRESS_TECHNO:
             return None
         return self._host.plc
+
+    def _show_tooling(self, step: StepResult) -> None:
+        """T, D, the zero offset and the PCS shift of the block being interpolated (the
+        last one carrying a view, ``Block.tooling``), with the live tables (issue 39).
+        A cycle without such a block costs two attribute looks."""
+        view = None
+        for block in step.finished:
+            if block.tooling is not None:
+                view = block.tooling
+        current = step.current
+        if current is not None and current.tooling is not None:
+            view = current.tooling
+        if view is None or view is self._tooling_shown:
+            return
+        self._tooling_shown = view
+        assert isinstance(view, ChannelTooling)
+        show_block_tooling(self.channel, view)
 
     def _stepped(self, step: StepResult) -> None:
         """After each interpolation cycle (a traced PROD_TIME run records it)."""

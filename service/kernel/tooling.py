@@ -77,3 +77,10 @@ def seed_modal(modal: ModalState, tables: ToolingTables, shown: ChannelTooling) 
 def show_tables(channel: Channel, tables: ToolingTables) -> None:
     channel.tooling = replace(channel.tooling, tools=tables.tools,
                               zero_offsets=tables.zero_offsets)
+
+
+def show_block_tooling(channel: Channel, view: ChannelTooling) -> None:
+    """Show the T, D, zero offset and PCS shift of the block being interpolated
+    (``view``, made by the decoder feed), with the live tables (issue 39)."""
+    shown = channel.tooling
+    channel.tooling = replace(view, tools=shown.tools, zero_offsets=shown.zero_offsets)

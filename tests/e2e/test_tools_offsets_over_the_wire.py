@@ -10,7 +10,7 @@ from collections.abc import Iterator
 import pytest
 
 from cnc_objects.clients import AdsError, ChannelError, Client
-from cnc_objects.testing import ServiceProcess, run_program
+from cnc_objects.testing import ServiceProcess, run_program, wait_for
 from tests.support.service import reset_client, serving_config
 
 INCR = 10_000  # 0.1 um per mm
@@ -189,3 +189,18 @@ def test_objects_beyond_the_tables_do_not_exist(c) -> None:
         with pytest.raises(AdsError) as info:
             c.read(name)
         assert info.value.code == 0x710 and name in str(info.value)
+
+
+def test_at_a_stop_the_objects_show_the_offset_of_the_block_that_ran(c) -> None:
+    """Issue 39: the decoder has decoded G53 beyond the M0 already; at the stop PCS Z is
+    the programmed 10 (machine 60 less G54's 50), the active offset G54's."""
+    c.write("ch1.ax3.np_grp[1].v", 50.0 * INCR)
+    assert run(c, "G53 G0 X0 Y0 Z0\nM30\n").state == "READY"
+    c.upload("stop.nc", b"G54 G0 X0 Y0 Z10\nM0\nG53\nG0 Z20\nG0 X1\nG0 X2\nM30\n")
+    c.run_program("stop.nc")
+    wait_for(c, "ch1.mc_waiting_for_start_r", True)
+    values = c.read_many(["ch1.mc_active_zero_offset_r", "ch1.ax3.command_position_acs",
+                          "ch1.ax3.command_position_pcs"])
+    assert values == {"ch1.mc_active_zero_offset_r": 1,
+                      "ch1.ax3.command_position_acs": 60 * INCR,
+                      "ch1.ax3.command_position_pcs": 10 * INCR}

@@ -9,7 +9,7 @@ expressions, no incremental coordinates).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import IntEnum
 
 
@@ -219,6 +219,10 @@ class Block:
     # G74 with a sequence (G74 Z1 X2): the homing steps after this one, each a block of
     # the same source that starts when the one before has stopped (issue 39)
     then: tuple[Block, ...] = ()
+    # what the objects show from this block on (shift, zero offset group, T, D): set by
+    # the decoder feed on the first block after a change, None on all others (issue 39)
+    # (not compared or hashed: a view of the tables, not part of what the block does)
+    tooling: object | None = field(default=None, compare=False)
 
     @property
     def needs_stop(self) -> bool:

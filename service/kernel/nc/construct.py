@@ -99,6 +99,7 @@ def _fast_block(
     b.trafo = None
     b.trafo_switch = False
     b.then = ()
+    b.tooling = None
     b.__class__ = Block
     return cast(Block, b)
 

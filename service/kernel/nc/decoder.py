@@ -210,8 +210,12 @@ class Decoder:
         return None
 
     def _provided(self, name: str) -> Variable | None:
-        """The V.G. variables the decoder provides: ``HSCS.<MODE>.TOLERANCE`` (mm) and
-        ``WZ_AKT.R`` (radius of the active tool, mm). Read only: a fresh copy each time."""
+        """The V.G. variables the decoder provides: ``HSCS.<MODE>.TOLERANCE`` (mm),
+        ``WZ_AKT.R`` (radius of the active tool, mm) and ``NP.V.<axis>`` / ``NP.V``
+        (the zero offset table, mm: ``NP[j].V.X``, ``NP[j].V[i]``). Read only: a fresh
+        copy each time."""
+        if name.startswith("NP.V"):
+            return self._zero_offsets(name)
         if name == "WZ_AKT.R":
             value = self.executor.tool_radius(self._modal.tool_offset) or 0.0
         else:
@@ -222,6 +226,24 @@ class Decoder:
             setting = self.surroundings.hscs.get(parts[1])
             value = setting.tolerance_mm if setting is not None else 0.0
         return Variable(f"V.G.{name}", VarType.REAL64, (), [float(value)])
+
+    def _zero_offsets(self, name: str) -> Variable | None:
+        """``NP.V.<axis>``: the offsets of one axis per group (index j = G159 j: 1 is
+        G54 .. 6 is G59, 0 is G53), or ``NP.V``: groups x axes; mm, from the live table
+        the objects show."""
+        table = self._modal.tooling.zero_offsets
+        axes = tuple(self.axes)
+        groups = table.groups
+        if name == "NP.V":
+            values: list[Value] = [table.offset_mm(g, k) for g in range(groups)
+                                   for k in range(len(axes))]
+            return Variable(f"V.G.{name}", VarType.REAL64, (groups, len(axes)), values)
+        axis = name[len("NP.V."):]
+        if axis not in axes:
+            return None
+        k = axes.index(axis)
+        return Variable(f"V.G.{name}", VarType.REAL64, (groups,),
+                        [table.offset_mm(g, k) for g in range(groups)])
 
     def cycle_parameter(self, number: int, line: LogicalLine, pos: int) -> Value:
         """``@P<number>`` in the innermost running cycle."""

@@ -84,6 +84,12 @@ class VarRef:
 
     def assign(self, env: Env, value: Value) -> None:
         """Store ``value`` (converted to the variable's type)."""
+        if self.scope == Scope.G and self.name.startswith("NP.V"):
+            raise self.line.error(
+                NcErrorId.INSTRUCTION_NOT_SUPPORTED,
+                f"writing V.G.NP[j]{self.name[2:]} is not supported: the zero offset table is "
+                "written by the operator (cnc offsets, objects); an NC program reads it",
+                self.pos)
         var, indices = self._resolve(env)
         try:
             var.set(value, indices)

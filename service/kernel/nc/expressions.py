@@ -51,6 +51,7 @@ _PARAM_REF = re.compile(r"@P([0-9]+)")
 # V.G. variables with members that the decoder provides (they are not declared)
 _MEMBER_NAMES = frozenset({"HSCS", "WZ_AKT"})
 _MEMBER = re.compile(r"(?:\.[A-Z_][A-Z0-9_]*)+")
+_NP_MEMBER = re.compile(r"\.V(?:\.[A-Z_][A-Z0-9_]*)?")  # .V.X or .V (then [i])
 MAX_DEPTH = 32  # nesting of brackets / unary operators; keeps Python's stack small
 
 _SCOPES = {"L": Scope.L, "P": Scope.P, "G": Scope.G, "CYC": Scope.CYC}
@@ -349,6 +350,18 @@ class ExpressionParser:
             member = cur.match(_MEMBER)  # V.G.HSCS.<MODE>.TOLERANCE, V.G.WZ_AKT.R
             if member is not None:
                 name += member.group()
+        if scope == Scope.G and name == "NP" and cur.peek() == ".":
+            # V.G.NP[j].V.<axis> / V.G.NP[j].V[i]: zero offset j of one axis (issue 39)
+            member = cur.match(_NP_MEMBER)
+            if member is not None:
+                name += member.group()
+                while cur.peek() == "[":
+                    open_pos = cur.pos
+                    cur.pos += 1
+                    self._enter()
+                    indices.append(self._or())
+                    self.depth -= 1
+                    self.expect("]", open_pos)
         if cur.peek() == ".":
             raise cur.error(
                 NcErrorId.INSTRUCTION_NOT_SUPPORTED,

@@ -271,6 +271,7 @@ _BLOCK_FAST = '''\
                 block.trafo = None
                 block.trafo_switch = False
                 block.then = ()
+                block.tooling = None
                 block.__class__ = BLOCK'''
 
 _BLOCK_PLAIN = '''\

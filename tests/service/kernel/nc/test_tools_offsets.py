@@ -90,3 +90,29 @@ def test_a_table_from_radii_accepts_every_tool() -> None:
     """Decoders given plain radii (syntax tools, tests) do not check T numbers."""
     blocks = decode("T23 M6\nM30")
     assert blocks[0].tool == 23
+
+
+# ---------------------------------------------- V.G.NP: the zero offsets from NC (issue 39)
+
+
+@pytest.mark.parametrize("as_text", [lambda t: t, slow], ids=["hot path", "general path"])
+def test_a_program_reads_the_zero_offset_table_per_axis_name_and_index(as_text) -> None:
+    """V.G.NP[j].V.<axis> and V.G.NP[j].V[i] (index i from 0): offset j (1 = G54) in mm."""
+    program = "G0 XV.G.NP[1].V.X YV.G.NP[2].V[1] Z[V.G.NP[1].V.Z + 1]\nM30"
+    modal = modal_with({1: (10.0, 20.0, 30.0), 2: (0.0, -7.5, 0.0)})
+    assert ends(as_text(program), modal=modal) == [(10.0, -7.5, 31.0)]
+
+
+@pytest.mark.parametrize(
+    ("program", "error_id", "column"),
+    [("G0 XV.G.NP[10].V.X", NcErrorId.ARRAY_INDEX_OUT_OF_RANGE, 5),
+     ("G0 XV.G.NP[1].V.Q", NcErrorId.UNDECLARED_VARIABLE, 5),
+     ("G0 XV.G.NP[1].V[3]", NcErrorId.ARRAY_INDEX_OUT_OF_RANGE, 5),
+     ("V.G.NP[1].V.X = 10", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1)],
+)
+def test_bad_zero_offset_variables(program, error_id, column) -> None:
+    """Out of range, an axis the channel lacks, and a write: ISG ids with their column."""
+    error = error_of(program + "\nM30", modal=modal_with({1: (10.0, 20.0, 30.0)}))
+    assert (error.id, error.line, error.column) == (error_id, 1, column)
+    if error_id == NcErrorId.INSTRUCTION_NOT_SUPPORTED:
+        assert "V.G.NP[j].V.X" in error.message
