@@ -24,7 +24,7 @@ def machine(tmp_path_factory) -> Iterator[ServiceProcess]:
 
 
 @pytest.fixture
-def c(machine) -> Iterator[Client]:
+def c(machine: ServiceProcess) -> Iterator[Client]:
     with reset_client(machine) as client:
         yield client
 
@@ -191,7 +191,7 @@ def test_objects_beyond_the_tables_do_not_exist(c) -> None:
         assert info.value.code == 0x710 and name in str(info.value)
 
 
-def test_at_a_stop_the_objects_show_the_offset_of_the_block_that_ran(c) -> None:
+def test_at_a_stop_the_objects_show_the_offset_of_the_block_that_ran(c: Client) -> None:
     """Issue 39: the decoder has decoded G53 beyond the M0 already; at the stop PCS Z is
     the programmed 10 (machine 60 less G54's 50), the active offset G54's."""
     c.write("ch1.ax3.np_grp[1].v", 50.0 * INCR)

@@ -3,6 +3,8 @@ plane's tool axis, #CS on top of the shift, the hot path and the general path al
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import pytest
 
 from cnc_objects.service.kernel.nc import ModalState, NcErrorId
@@ -75,7 +77,7 @@ def test_m6_takes_the_tool_and_waits_the_change_time() -> None:
      ("G159=-1", NcErrorId.ZERO_OFFSET_INDEX_FORMAT, 1),
      ("G159=2 G54", NcErrorId.ZERO_OFFSETS_TWICE, 8)],
 )
-def test_bad_words(program, error_id, column) -> None:
+def test_bad_words(program: str, error_id: int, column: int) -> None:
     error = error_of(program + "\nM30", modal=modal_with())
     assert (error.id, error.line, error.column) == (error_id, 1, column)
 
@@ -96,7 +98,8 @@ def test_a_table_from_radii_accepts_every_tool() -> None:
 
 
 @pytest.mark.parametrize("as_text", [lambda t: t, slow], ids=["hot path", "general path"])
-def test_a_program_reads_the_zero_offset_table_per_axis_name_and_index(as_text) -> None:
+def test_a_program_reads_the_zero_offset_table_per_axis_name_and_index(
+        as_text: Callable[[str], str]) -> None:
     """V.G.NP[j].V.<axis> and V.G.NP[j].V[i] (index i from 0): offset j (1 = G54) in mm."""
     program = "G0 XV.G.NP[1].V.X YV.G.NP[2].V[1] Z[V.G.NP[1].V.Z + 1]\nM30"
     modal = modal_with({1: (10.0, 20.0, 30.0), 2: (0.0, -7.5, 0.0)})
@@ -110,7 +113,7 @@ def test_a_program_reads_the_zero_offset_table_per_axis_name_and_index(as_text) 
      ("G0 XV.G.NP[1].V[3]", NcErrorId.ARRAY_INDEX_OUT_OF_RANGE, 5),
      ("V.G.NP[1].V.X = 10", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1)],
 )
-def test_bad_zero_offset_variables(program, error_id, column) -> None:
+def test_bad_zero_offset_variables(program: str, error_id: int, column: int) -> None:
     """Out of range, an axis the channel lacks, and a write: ISG ids with their column."""
     error = error_of(program + "\nM30", modal=modal_with({1: (10.0, 20.0, 30.0)}))
     assert (error.id, error.line, error.column) == (error_id, 1, column)
