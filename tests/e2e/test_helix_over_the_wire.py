@@ -14,6 +14,7 @@ import pytest
 
 from cnc_objects.clients import ChannelError, Client
 from cnc_objects.testing import ServiceProcess, run_program, serving, wait_for
+from tests.support.service import reset_client
 
 HELIX_MM = math.hypot(10.0 * math.pi, 6.0)
 HELIX = "N10 G0 X10 Y0 Z0\nN20 G17 G3 X-10 Y0 Z-6 I-10 J0 F{feed}\nN30 M30\n"
@@ -27,8 +28,7 @@ def machine() -> Iterator[ServiceProcess]:
 
 @pytest.fixture
 def c(machine: ServiceProcess) -> Iterator[Client]:
-    with Client(machine.endpoint, timeout_s=10) as client:
-        client.reset(1)
+    with reset_client(machine) as client:
         yield client
 
 

@@ -13,7 +13,7 @@ import pytest
 
 from cnc_objects.clients import Client
 from cnc_objects.testing import run_program
-from tests.support.service import RunningService, serving, serving_config
+from tests.support.service import RunningService, reset_client, serving, serving_config
 
 MACHINE = """
 [[physical_axes]]
@@ -59,8 +59,7 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> Iterator[RunningService
 
 @pytest.fixture
 def client(machine: RunningService) -> Iterator[Client]:
-    with Client(machine.endpoint, timeout_s=10) as c:
-        c.reset(1)
+    with reset_client(machine) as c:
         yield c
 
 

@@ -79,6 +79,17 @@ class ExpressionParser:
                 f"expression nested deeper than {MAX_DEPTH} levels",
             )
 
+    def _indices(self, into: list[Node]) -> None:
+        """Each ``[expr]`` at the cursor, appended to ``into`` (a variable's indices)."""
+        cur = self.cur
+        while cur.peek() == "[":
+            open_pos = cur.pos
+            cur.pos += 1
+            self._enter()
+            into.append(self._or())
+            self.depth -= 1
+            self.expect("]", open_pos)
+
     def _keyword(self, *words: str) -> str | None:
         """The keyword operator at the cursor (whole identifier only), consumed."""
         cur = self.cur
@@ -337,14 +348,8 @@ class ExpressionParser:
                 NcErrorId.VARIABLE_SCOPE_NOT_ALLOWED,
                 f"V.{m.group(1)}. variables are not supported yet", pos,
             )
-        indices = []
-        while cur.peek() == "[":
-            open_pos = cur.pos
-            cur.pos += 1
-            self._enter()
-            indices.append(self._or())
-            self.depth -= 1
-            self.expect("]", open_pos)
+        indices: list[Node] = []
+        self._indices(indices)
         name = m.group(2)
         if scope == Scope.G and name in _MEMBER_NAMES and cur.peek() == ".":
             member = cur.match(_MEMBER)  # V.G.HSCS.<MODE>.TOLERANCE, V.G.WZ_AKT.R
@@ -355,13 +360,7 @@ class ExpressionParser:
             member = cur.match(_NP_MEMBER)
             if member is not None:
                 name += member.group()
-                while cur.peek() == "[":
-                    open_pos = cur.pos
-                    cur.pos += 1
-                    self._enter()
-                    indices.append(self._or())
-                    self.depth -= 1
-                    self.expect("]", open_pos)
+                self._indices(indices)
         if cur.peek() == ".":
             raise cur.error(
                 NcErrorId.INSTRUCTION_NOT_SUPPORTED,
