@@ -3,8 +3,8 @@ X, Y, Z and the rotary axes), and every cycle's position is turned into axis pos
 by the channel's kinematics (``path.kinematics``) before it is output.
 
 The axes' limits hold for the axis positions, not for the tip. At points along each
-block (one per degree its rotary axes turn, at least 2, at most ``LIMIT_SAMPLES``): a
-block that would put an axis beyond its software limit is refused before the path
+block (its end, and one more per degree its rotary axes turn, at most
+``LIMIT_SAMPLES``): a block that would put an axis beyond its software limit is refused before the path
 takes it, with ISG's software limit error (50100/50101) naming the axis; and the block's
 feed is capped so that no axis exceeds its velocity (a linear axis far from a turning
 table's centre moves faster than the tip). Between those points an axis can pass its
@@ -49,14 +49,15 @@ class PathKinematics:
         far from a turning table's centre faster than the tip), or ISG's error (50100
         below, 50101 above the limit) and why it would put an axis beyond its software
         limit. Both are judged at points along the block: its end and one per degree
-        its rotary axes turn (at least 2, at most ``LIMIT_SAMPLES``)."""
+        its rotary axes turn (at most ``LIMIT_SAMPLES``); with the rotary axes fixed the
+        axes move linearly, and the end alone tells."""
         motion, trafo = block.motion, block.trafo
         if motion is None or trafo is None:
             return block
         start, end = motion.start_mm, motion.end_mm
         turn_deg = max(abs(end[a.axis_index] - start[a.axis_index])
                        for a in self.chain.rotators)
-        samples = min(LIMIT_SAMPLES, 2 + int(turn_deg))
+        samples = min(LIMIT_SAMPLES, 1 + int(turn_deg))
         monitored = self._monitored
         xyz = self.xyz
         before_p: Sequence[float] = start
