@@ -47,7 +47,7 @@ from .manual_mode import ManualMode
 from .nc import ModalState
 from .nc.blocks import LogArea, LookAheadMark, ManualModeRequest, TrafoUse
 from .nc.technology import HscProgram, MachiningSettings, Surroundings
-from .nc.tool_data import ToolingTables
+from .nc.tool_data import ToolingTables, ZeroOffsetWrite
 from .path.executor import AxisDynamics, PathExecutor
 from .path.section_plan import plan_section
 from .path_kinematics import PathKinematics
@@ -65,7 +65,7 @@ from .runner_services import RunnerServices
 from .spindle import Spindle
 from .state import Channel, DecoderFlag, ErrorEntry
 from .syntax_check import SYNCHK_WITHOUT_MACHINE_LOCK, CheckRun
-from .tooling import seed_modal, tables_from_config
+from .tooling import apply_nc_zero_offsets, seed_modal, tables_from_config
 from .tooling_view import after_reset, initial_tooling
 from .wait_reason import WaitReason, channel_wait_reason
 
@@ -330,6 +330,10 @@ class ChannelRunner:
     def manual_mode(self, request: ManualModeRequest) -> None:
         """The path reached a G200/G201/G202 block."""
         self.manual.program_request(request)
+
+    def zero_offsets_written(self, writes: tuple[ZeroOffsetWrite, ...]) -> None:
+        """The path reached the block after the program's ``V.G.NP`` writes."""
+        apply_nc_zero_offsets(self.channel, self.tables, writes)
 
     def _check_jog_of_path(self) -> bool:
         """True when the channel may work; otherwise it goes to ERROR naming the axis."""

@@ -9,9 +9,9 @@ from dataclasses import dataclass
 from cnc_objects.protocol.constants import TOOL_LIFE_MAX_S
 
 from .kernel_state import KernelState
-from .nc.tool_data import ToolField, ToolingTables
+from .nc.tool_data import TABLE_VALUE_MAX_01UM, ToolField, ToolingTables
 from .refusal import Refusal, RefusalReason
-from .tooling import TABLE_VALUE_MAX_01UM, show_tables
+from .tooling import show_tables
 
 
 def _value_refused(what: str, value_01um: float, low_01um: float) -> Refusal | None:
@@ -87,6 +87,9 @@ class SetZeroOffset:
             return refused
         tables.zero_offsets = tables.zero_offsets.with_offset(
             self.group, self.axis_index, len(channel.axes), value)
+        if tables.zero_offsets_kept is not None:  # a program wrote offsets: keep this one
+            tables.zero_offsets_kept = tables.zero_offsets_kept.with_offset(
+                self.group, self.axis_index, len(channel.axes), value)
         show_tables(channel, tables)
         return None
 

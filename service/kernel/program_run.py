@@ -43,6 +43,7 @@ from .nc.blocks import (
     TrafoUse,
 )
 from .nc.contour import LOOP_MARKERS
+from .nc.tool_data import ZeroOffsetWrite
 from .operator_switches import with_optional_stop
 from .path.errors import PathErrorId
 from .path.executor import PathError, PathExecutor
@@ -110,6 +111,9 @@ class RunHost(Protocol):
     def manual_mode(self, request: ManualModeRequest) -> None:
         """The path reached a G200/G201/G202 block."""
 
+    def zero_offsets_written(self, writes: tuple[ZeroOffsetWrite, ...]) -> None:
+        """The path reached the block after the program's ``V.G.NP`` writes."""
+
 
 class ChannelRun(Protocol):
     """What every kind of run offers the channel runner."""
@@ -143,6 +147,7 @@ class ProgramRun:
 
     _waits_for_decoder = False  # PROD_TIME: every take waits for the decoder
     _skips_cycles = True  # cruising cycles may be run in bulk (not PROD_TIME: traced)
+    _writes_tables = True  # the program's V.G.NP writes reach the live table (not PROD_TIME)
 
     def __init__(self, host: RunHost, channel: Channel, feed: DecoderFeed,
                  executor: PathExecutor, contour: ContourLog | None, *,
@@ -410,6 +415,8 @@ class ProgramRun:
             return
         self._tooling_shown = view
         assert isinstance(view, ChannelTooling)
+        if view.nc_zero_offsets and self._writes_tables:
+            self._host.zero_offsets_written(view.nc_zero_offsets)
         show_block_tooling(self.channel, view)
 
     def _stepped(self, step: StepResult) -> None:
@@ -606,6 +613,7 @@ class ProdTimeRun(ProgramRun):
 
     _waits_for_decoder = True
     _skips_cycles = False  # each GEO cycle simulates many cycles itself
+    _writes_tables = False  # a simulation: the tables stay as they are
 
     def __init__(self, host: RunHost, channel: Channel, feed: DecoderFeed,
                  executor: PathExecutor, contour: ContourLog | None, *,

@@ -20,14 +20,12 @@ from .nc.tool_data import (
     ToolingTables,
     ToolTable,
     ZeroOffsetTable,
+    ZeroOffsetWrite,
     program_shift_mm,
 )
+from .nc.zero_offset_writes import with_writes
 from .state import Channel
 from .tooling_view import ChannelTooling
-
-# |tool length|, radius and zero offsets the tables take (0.1 um): the largest position
-# the SGN32 position objects carry, 214748.3647 mm
-TABLE_VALUE_MAX_01UM = float(2**31 - 1)
 
 
 def tool_list_size(machine: MachineConfig) -> int:
@@ -56,7 +54,7 @@ def tooling_of(modal: ModalState, shown: ChannelTooling, axes: tuple[str, ...]
                              int(modal.plane), axes) or (0.0,) * len(axes)
     new = ChannelTooling(
         tables.tools, tables.zero_offsets, modal.tool or 0, modal.spindle_tool,
-        modal.tool_offset, modal.zero_offset_group, shift,
+        modal.tool_offset, modal.zero_offset_group, shift, tables.nc_zero_offsets,
     )
     return shown if new == shown else new
 
@@ -76,11 +74,26 @@ def seed_modal(modal: ModalState, tables: ToolingTables, shown: ChannelTooling) 
 
 def show_tables(channel: Channel, tables: ToolingTables) -> None:
     channel.tooling = replace(channel.tooling, tools=tables.tools,
-                              zero_offsets=tables.zero_offsets)
+                              zero_offsets=tables.zero_offsets,
+                              zero_offsets_kept=tables.zero_offsets_kept)
 
 
 def show_block_tooling(channel: Channel, view: ChannelTooling) -> None:
     """Show the T, D, zero offset and PCS shift of the block being interpolated
     (``view``, made by the decoder feed), with the live tables (issue 39)."""
     shown = channel.tooling
-    channel.tooling = replace(view, tools=shown.tools, zero_offsets=shown.zero_offsets)
+    channel.tooling = replace(view, tools=shown.tools, zero_offsets=shown.zero_offsets,
+                              nc_zero_offsets=(), zero_offsets_kept=shown.zero_offsets_kept)
+
+
+def apply_nc_zero_offsets(channel: Channel, tables: ToolingTables,
+                          writes: tuple[ZeroOffsetWrite, ...]) -> None:
+    """The program's ``V.G.NP`` writes into the live table and shown, on the cycle
+    thread when the block after them is interpolated (``nc.zero_offset_writes``); the
+    table as the operator wrote it stays what the operator data store keeps."""
+    table = with_writes(tables.zero_offsets, writes, len(channel.axes))
+    if table is not tables.zero_offsets:
+        if tables.zero_offsets_kept is None:
+            tables.zero_offsets_kept = tables.zero_offsets
+        tables.zero_offsets = table
+        show_tables(channel, tables)

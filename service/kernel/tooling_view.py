@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
-from .nc.tool_data import ToolingTables, ToolTable, ZeroOffsetTable
+from .nc.tool_data import ToolingTables, ToolTable, ZeroOffsetTable, ZeroOffsetWrite
 
 
 @dataclass(frozen=True, slots=True)
@@ -19,6 +19,17 @@ class ChannelTooling:
     d_active: int = 0  # D in effect (0: no compensation data)
     zero_offset_group: int = 0  # np_grp index in effect (0: G53)
     shift_mm: tuple[float, ...] = ()  # program shift per channel axis (PCS = ACS - shift)
+    # in a view the decoder feed made: the zero offsets the program wrote so far, for the
+    # kernel to apply when the block is interpolated; () in what the channel shows
+    nc_zero_offsets: tuple[ZeroOffsetWrite, ...] = ()
+    # the table without the programs' writes, when they changed it (None: zero_offsets)
+    zero_offsets_kept: ZeroOffsetTable | None = None
+
+    @property
+    def zero_offsets_to_keep(self) -> ZeroOffsetTable:
+        """The zero offsets the operator data store keeps: as the operator wrote them."""
+        kept = self.zero_offsets_kept
+        return self.zero_offsets if kept is None else kept
 
     @property
     def radius_01um(self) -> float:

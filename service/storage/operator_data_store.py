@@ -211,11 +211,11 @@ class OperatorDataStore:
         self._channels_seen = snapshot.channels
         shown = self._shown
         if shown is not None and all(
-            c.tooling.tools is t and c.tooling.zero_offsets is z
+            c.tooling.tools is t and c.tooling.zero_offsets_to_keep is z
             for c, (t, z) in zip(snapshot.channels, shown, strict=True)
         ):
             return
-        now = [(c.tooling.tools, c.tooling.zero_offsets) for c in snapshot.channels]
+        now = [(c.tooling.tools, c.tooling.zero_offsets_to_keep) for c in snapshot.channels]
         self._shown = now
         if shown is None:
             return  # the tables the service started with: in the file already (or configured)

@@ -67,3 +67,32 @@ def test_a_file_that_does_not_fit_the_machine_is_moved_aside(tmp_path: Path) -> 
         assert not path.exists() and len(list(directory.glob("*.corrupt-*"))) == 1
         [alarm] = alarms.view.active
         assert alarm.id == UNREADABLE_ID and words in alarm.text, alarm.text
+
+
+def test_a_programs_zero_offset_write_is_not_kept(tmp_path: Path) -> None:
+    """``V.G.NP[j]`` lasts until the list is read again (ISG: "explicit request or
+    start-up"): the store keeps the operator's values; an operator write after it is
+    kept, the program's value beside it is not."""
+    path = tmp_path / "operator-data.json"
+    with KernelHarness() as h:
+        store = OperatorDataStore(path, h.config)
+        hook = h.kernel.on_cycle_end
+        assert hook is not None
+
+        def both(s):  # the harness's hook and the store's, as the service chains them
+            hook(s)
+            store.observe(s)
+
+        h.kernel.on_cycle_end = both
+        store.start()
+        run = h.run("V.G.NP[1].V.X = 7\nG54 G01 X0 F6000\nM30\n")
+        assert run.channel.tooling.zero_offsets.offset_mm(1, 0) == 7.0
+        assert store.writes == 0 and not path.exists()
+        assert h.command(SetZeroOffset(0, 1, 1, 3.0 * INCR)) is None  # G54 Y, operator
+        run = h.run("G01 X0\nM30\n")  # a cycle after it
+        assert run.channel.tooling.zero_offsets.offset_mm(1, 1) == 3.0
+        assert run.channel.tooling.zero_offsets.offset_mm(1, 0) == 7.0  # still in effect
+        store.close()
+        assert store.writes >= 1
+    [g54] = [g for g in loads(path.read_text()).channel(1).zero_offsets or () if g.np_grp == 1]
+    assert (g54.offsets_mm["X"], g54.offsets_mm["Y"]) == (0.0, 3.0)

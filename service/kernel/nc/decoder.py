@@ -62,6 +62,7 @@ from .statements import (
 )
 from .technology import HSCS_MODES, Surroundings
 from .variables import Scope, Value, Variable, VarType
+from .zero_offset_writes import write_zero_offset
 
 log = logging.getLogger(__name__)
 
@@ -212,8 +213,8 @@ class Decoder:
     def _provided(self, name: str) -> Variable | None:
         """The V.G. variables the decoder provides: ``HSCS.<MODE>.TOLERANCE`` (mm),
         ``WZ_AKT.R`` (radius of the active tool, mm) and ``NP.V.<axis>`` / ``NP.V``
-        (the zero offset table, mm: ``NP[j].V.X``, ``NP[j].V[i]``). Read only: a fresh
-        copy each time."""
+        (the zero offset table, mm: ``NP[j].V.X``, ``NP[j].V[i]``). A fresh copy each
+        time: a write of ``NP`` goes to ``write_zero_offset``."""
         if name.startswith("NP.V"):
             return self._zero_offsets(name)
         if name == "WZ_AKT.R":
@@ -244,6 +245,13 @@ class Decoder:
         k = axes.index(axis)
         return Variable(f"V.G.{name}", VarType.REAL64, (groups,),
                         [table.offset_mm(g, k) for g in range(groups)])
+
+    def write_zero_offset(self, variable: Variable, indices: tuple[int, ...], value: Value,
+                          line: LogicalLine, pos: int) -> None:
+        """``V.G.NP[j].V.<axis> = value`` / ``V.G.NP[j].V[i] = value`` (mm): from here on
+        in this run's decoding, in the channel's table when the next block is
+        interpolated (``zero_offset_writes``)."""
+        write_zero_offset(self._modal, tuple(self.axes), variable, indices, value, line, pos)
 
     def cycle_parameter(self, number: int, line: LogicalLine, pos: int) -> Value:
         """``@P<number>`` in the innermost running cycle."""

@@ -155,6 +155,9 @@ class NcErrorId(IntEnum):
     # the kinematics cannot turn the tool to the direction asked for (ISG: "Kinematic
     # transformation: Illegal argument for ACOS", tf5200_diagnosis/267444363.html)
     TRAFO_POSE_UNREACHABLE = 292004
+    # V.G.NP[j] written while G5x selects group j (ISG: "Changing an active zero offset
+    # (G54-G59) not permitted", tf5200_diagnosis/1208284683.html)
+    ZERO_OFFSET_ACTIVE = 14421
     CYCLE_PARAMETER_TWICE = 20520  # the same @P (or NAME, PATTERN_ID) twice in one call
     PATTERN_NOT_DEFINED = 20521  # PATTERN_ID / #PATTERN DELETE of an undefined pattern
     PATTERN_NESTED = 20522  # #PATTERN BEGIN inside a pattern definition

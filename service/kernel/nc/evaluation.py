@@ -37,6 +37,10 @@ class Env(Protocol):
     def cycle_parameter(self, number: int, line: LogicalLine, pos: int) -> Value:
         """``@P<number>`` of the innermost running cycle (NcError at ``pos`` if none)."""
 
+    def write_zero_offset(self, variable: Variable, indices: tuple[int, ...], value: Value,
+                          line: LogicalLine, pos: int) -> None:
+        """``V.G.NP[j].V... = value``: write a zero offset (``nc.zero_offset_writes``)."""
+
 
 class Const:
     """A node whose value is known when parsed."""
@@ -84,13 +88,10 @@ class VarRef:
 
     def assign(self, env: Env, value: Value) -> None:
         """Store ``value`` (converted to the variable's type)."""
-        if self.scope == Scope.G and self.name.startswith("NP.V"):
-            raise self.line.error(
-                NcErrorId.INSTRUCTION_NOT_SUPPORTED,
-                f"writing V.G.NP[j]{self.name[2:]} is not supported: the zero offset table is "
-                "written by the operator (cnc offsets, objects); an NC program reads it",
-                self.pos)
         var, indices = self._resolve(env)
+        if self.scope == Scope.G and self.name.startswith("NP.V"):
+            env.write_zero_offset(var, indices, value, self.line, self.pos)
+            return
         try:
             var.set(value, indices)
         except Fault as f:

@@ -323,7 +323,12 @@ class LineParser:
                         NcErrorId.WORD_REPEATED, f"{c} programmed twice in one block"
                     )
             cur.pos += 1
-            value = self._value(cur, c, pos)
+            if kind == WordKind.AXIS and _skip(cur) < cur.end and cur.peek() == "=" \
+                    and cur.peek(1) != "=":
+                cur.pos += 1  # X=<expr>: ISG's axis word with '=' ("Axis commands")
+                value = self._expression_value(cur, c, pos)
+            else:
+                value = self._value(cur, c, pos)
             if kind == WordKind.G and value in _ASSIGNED_G and _skip(cur) < cur.end \
                     and cur.peek() == "=" and cur.peek(1) != "=":
                 cur.pos += 1  # G133 = <percent> / G134 = <percent> / G159 = <index>
@@ -416,14 +421,15 @@ class LineParser:
         if negative:
             inner = node
             node = lambda env: _negate(inner(env))
-        if isinstance(node, Const):
-            value = node.value
-            if isinstance(value, str):
-                raise cur.error(
-                    NcErrorId.TYPE_MISMATCH, f"{letter} needs a number, not a string", pos
-                )
-            return float(value)
-        return node
+        return _word_value(node, cur, letter, pos)
+
+    def _expression_value(self, cur: Cursor, letter: str, letter_pos: int) -> float | Node:
+        """The value of ``<axis>=<expression>``: a whole expression, brackets optional."""
+        if _skip(cur) >= cur.end:
+            raise cur.error(NcErrorId.MISSING_VALUE, f"value expected after '{letter}='",
+                            letter_pos)
+        pos = cur.pos
+        return _word_value(ExpressionParser(cur).parse(), cur, letter, pos)
 
     def _assign(self, cur: Cursor) -> Assign:
         pos = cur.pos
@@ -473,3 +479,15 @@ def _negate(value: Value) -> Value:
 __all__ = [
     "ItemErrorHandler", "LineParser", "RESERVED_LETTERS", "VarRef", "WordTable", "word_table",
 ]
+
+
+def _word_value(node: Node, cur: Cursor, letter: str, pos: int) -> float | Node:
+    """A word's value: a float when known at parse time (a string is TYPE_MISMATCH),
+    else the node to evaluate."""
+    if isinstance(node, Const):
+        value = node.value
+        if isinstance(value, str):
+            raise cur.error(NcErrorId.TYPE_MISMATCH, f"{letter} needs a number, not a string",
+                            pos)
+        return float(value)
+    return node

@@ -175,15 +175,32 @@ class ZeroOffsetTable:
         return ZeroOffsetTable(self.groups, offsets)
 
 
+# |tool length|, radius and zero offsets the tables take (0.1 um): the largest position
+# the SGN32 position objects carry, 214748.3647 mm
+TABLE_VALUE_MAX_01UM = float(2**31 - 1)
+
+# A zero offset an NC program wrote: (group, channel axis index, value in 0.1 um)
+ZeroOffsetWrite = tuple[int, int, float]
+
+
 @dataclass(slots=True)
 class ToolingTables:
     """The channel's live tables: the holder the decoder and the objects share. The
     objects' writes (on the cycle thread) replace a table; the decoder reads the
-    newest one at every block."""
+    newest one at every block.
+
+    A run whose program writes ``V.G.NP[j]`` decodes on a copy of its own from then on
+    (``nc_zero_offsets`` the writes, the last per group and axis): the kernel applies them
+    to the live holder when the next block is interpolated (``nc.zero_offset_writes``)."""
 
     tools: ToolTable = field(default_factory=lambda: ToolTable({}, 0, checks_tools=False))
     zero_offsets: ZeroOffsetTable = field(default_factory=ZeroOffsetTable)
     tool_change_time_s: float = 0.0  # M6: the path waits this long (tool change)
+    nc_zero_offsets: tuple[ZeroOffsetWrite, ...] = ()  # always () in the live holder
+    # live holder: the zero offsets as the operator wrote them, once a program's writes
+    # differ (None: the same): what the operator data store keeps, for ISG says an NC
+    # write lasts "until the next interpretation of the list (... start-up)"
+    zero_offsets_kept: ZeroOffsetTable | None = None
 
 
 def program_shift_mm(tables: ToolingTables, group: int, d: int, plane: int,

@@ -89,8 +89,9 @@ def test_nc_error_format_and_fields() -> None:
 def test_error_ids() -> None:
     values = [int(m) for m in NcErrorId]
     assert len(values) == len(set(values))
-    # the decoder's ids, and ISG's kinematic transformation ids (292xxx)
-    assert all(20000 <= v <= 22999 or 292000 <= v <= 292999 for v in values)
+    # the decoder's ids, ISG's kinematic transformation ids (292xxx) and ISG's id of a
+    # write of the zero offset in effect (14421)
+    assert all(20000 <= v <= 22999 or 292000 <= v <= 292999 or v == 14421 for v in values)
     assert 21309 not in values  # reserved for later use
     assert NcErrorId(22073) == NcErrorId.CONTOUR_CLEAR_IN_RT_LOOP  # ISG's id
 

@@ -111,11 +111,32 @@ def test_a_program_reads_the_zero_offset_table_per_axis_name_and_index(
     [("G0 XV.G.NP[10].V.X", NcErrorId.ARRAY_INDEX_OUT_OF_RANGE, 5),
      ("G0 XV.G.NP[1].V.Q", NcErrorId.UNDECLARED_VARIABLE, 5),
      ("G0 XV.G.NP[1].V[3]", NcErrorId.ARRAY_INDEX_OUT_OF_RANGE, 5),
-     ("V.G.NP[1].V.X = 10", NcErrorId.INSTRUCTION_NOT_SUPPORTED, 1)],
+     ("V.G.NP[10].V.X = 1", NcErrorId.ARRAY_INDEX_OUT_OF_RANGE, 1),
+     ("V.G.NP[0].V.X = 1", NcErrorId.ARRAY_INDEX_OUT_OF_RANGE, 1),
+     ("V.G.NP[1].V.X = \"A\"", NcErrorId.TYPE_MISMATCH, 1),
+     ("V.G.NP[1].V.X = 300000", NcErrorId.VALUE_OUT_OF_RANGE, 1),
+     ("G54\nV.G.NP[1].V[0] = 1", NcErrorId.ZERO_OFFSET_ACTIVE, 1)],
 )
 def test_bad_zero_offset_variables(program: str, error_id: int, column: int) -> None:
-    """Out of range, an axis the channel lacks, and a write: ISG ids with their column."""
+    """Out of range, an axis the channel lacks, a bad value, and a write of the group in
+    effect (ISG 14421): ISG ids with their line and column."""
     error = error_of(program + "\nM30", modal=modal_with({1: (10.0, 20.0, 30.0)}))
-    assert (error.id, error.line, error.column) == (error_id, 1, column)
-    if error_id == NcErrorId.INSTRUCTION_NOT_SUPPORTED:
-        assert "V.G.NP[j].V.X" in error.message
+    assert (error.id, error.line, error.column) == (error_id, program.count("\n") + 1, column)
+
+
+@pytest.mark.parametrize("as_text", [lambda t: t, slow], ids=["hot path", "general path"])
+def test_a_program_writes_a_zero_offset_for_the_blocks_after_it(
+        as_text: Callable[[str], str]) -> None:
+    """ISG's example (programming manual, G53/G54..G59): ``V.G.NP[1].V.X=10``, then G54
+    and ``G0 X=100`` moves to 110; the index form writes one axis by number; the
+    channel's own table is not touched by the decoder (the kernel applies the writes when
+    the path gets there)."""
+    program = ("V.G.NP[1].V.X = 10\nV.G.NP[1].V[1] = V.G.NP[1].V.X * 2\nG54\n"
+               "G0 X=100 Y0 Z0\nG55\nV.G.NP[1].V.Z = -5\nG54 G0 Z0\nM30")
+    modal = modal_with({1: (1.0, 2.0, 3.0)})
+    live = modal.tooling
+    before = live.zero_offsets
+    assert ends(as_text(program), modal=modal) == [(110.0, 20.0, 3.0), (110.0, 20.0, -5.0)]
+    assert live.zero_offsets is before and live.nc_zero_offsets == ()
+    assert modal.tooling.nc_zero_offsets == ((1, 0, 100_000.0), (1, 1, 200_000.0),
+                                             (1, 2, -50_000.0))

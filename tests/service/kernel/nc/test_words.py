@@ -6,7 +6,7 @@ import pytest
 
 from cnc_objects.service.kernel.nc import NcErrorId, SourceRef, StopKind
 
-from .support import decode, error_of, slow
+from .support import decode, ends, error_of, slow
 
 
 def test_block_numbers_and_labels() -> None:
@@ -142,3 +142,21 @@ def test_manual_flag() -> None:
     blocks = decode("G0 X1", manual=True)
     assert [b.manual for b in blocks] == [True]
     assert not decode("G0 X1\nM30")[0].manual
+
+
+@pytest.mark.parametrize("as_text", [lambda t: t, slow], ids=["hot path", "general path"])
+def test_an_axis_word_takes_an_expression_after_an_equals_sign(as_text) -> None:
+    """ISG ("Axis commands", tf5200_programming_manual/206043659.html): ``X=100`` and
+    ``X = <expr>`` as for multi-letter axis names; brackets optional after '='."""
+    program = "V.G.NP[1].V.X = 0\nG0 X=100 Y = 2*3 Z=-[1+2]\nG1 X=V.G.NP[1].V.X+1 F100\nM30"
+    assert ends(as_text(program)) == [(100.0, 6.0, -3.0), (1.0, 6.0, -3.0)]
+
+
+@pytest.mark.parametrize(("program", "err", "column"), [
+    ("G0 X=", NcErrorId.MISSING_VALUE, 4),
+    ("G0 X=\"A\"", NcErrorId.TYPE_MISMATCH, 6),
+    ("G0 X==1", NcErrorId.MISSING_VALUE, 4),
+])
+def test_bad_axis_words_with_an_equals_sign(program, err, column) -> None:
+    error = error_of(program + "\nM30")
+    assert (error.id, error.line, error.column) == (err, 1, column)
