@@ -30,6 +30,7 @@ from enum import IntEnum
 from cnc_objects.protocol.units import UM01_PER_MM
 from cnc_objects.protocol.values import SPINDLE_M_FUNCTIONS
 
+from ..path.kinematics import Kinematics
 from .blocks import (
     AxisExchange,
     AxisExchangeKind,
@@ -52,6 +53,7 @@ from .geometry import centre_from_offsets, centre_from_radius
 from .homing_block import HomingStep, homing_steps, with_homing
 from .manual_block import manual_mode_request, with_manual_mode
 from .modal import G_CODES, PLANE_AXES, DistanceMode, GGroup, MCode, ModalState, Plane
+from .orientation_vector import AxisWords, rotary_words
 from .statements import Assign, AxisCommand, NcBlock, Word, WordKind
 from .tool_data import ToolTable, program_shift_mm
 from .variables import VariableFault
@@ -110,7 +112,6 @@ M_TOOL_CHANGE = 6  # M6: change to the tool T selected
 
 
 Groups = dict[GGroup, tuple[int, int]]  # G group -> (G number, pos)
-AxisWords = list[tuple[int, float, int, str]]  # (channel axis, value, pos, letter)
 Offsets = dict[int, tuple[float, int]]  # channel axis of I/J/K -> (offset, pos)
 Words = dict[WordKind, tuple[float, int]]  # F S T D R ... -> (value, pos)
 #: (plane axes or None, plane of line motions, roles of I/J/K (0 = p, 1 = q, -1 =
@@ -162,6 +163,8 @@ class BlockExecutor:
         # P-CHAN-00041: M numbers with a synchronisation kind (the decoder sets it from
         # its surroundings); None: every M is known
         self.m_function_known: Callable[[int], bool] | None = None
+        # the channel's kinematics (``#ORI MODE [VECTOR_2DOF]`` under #TRAFO ON)
+        self.kinematic_chain: Kinematics | None = None
         index = {name: k for k, name in enumerate(axes)}
         # channel axis indices of X, Y, Z (the axes #CS transforms; #CS needs all three)
         self.xyz: tuple[int, int, int] = (index.get("X", -1), index.get("Y", -1),
@@ -277,6 +280,10 @@ class BlockExecutor:
             dwell_s = 0.0
             if WordKind.FEED in words:
                 self._feed(words[WordKind.FEED], err)
+            settings = self.modal.settings
+            if settings.ori_vector and settings.trafo and self.kinematic_chain is not None:
+                axis_words = rotary_words(self.kinematic_chain, axis_words, self.modal,
+                                          self.axes, self.program_shift(), err)
             motion = self._motion(groups, axis_words, offsets, words, err)
         stop = StopKind.NONE
         flow = Flow.NONE

@@ -143,9 +143,11 @@ class Decoder:
         self._loader = loader
         self._modal = modal
         self._skip_levels = skip_levels
-        self.parser = LineParser(word_table(axes))
+        chain = self.surroundings.kinematic_chain
+        self.parser = LineParser(word_table(axes, orientation=chain is not None))
         self.executor = BlockExecutor(axes, tools, modal, manual, axis_numbers)
         self.executor.m_function_known = self.surroundings.m_function_known
+        self.executor.kinematic_chain = chain
         self._main = Program(text, file, self.parser, skip_levels, check)
         self._files: dict[str, Program] = {}
         self.frames: list[CallFrame] = []

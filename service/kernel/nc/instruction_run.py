@@ -258,6 +258,13 @@ def _trafo(stmt: Instruction, decoder: CallingDecoder) -> Block | None:
     return replace(block, trafo=use if stmt.on else None, trafo_switch=True)
 
 
+def _ori_mode(stmt: Instruction, decoder: CallingDecoder) -> None:
+    """``#ORI MODE [VECTOR_2DOF]``: from now on (to M30), while ``#TRAFO ON``, A B C
+    are the components of the tool's direction (``blockexec``); ``[ANGLE]``: the
+    rotary axes' angles again (ISG's default)."""
+    decoder.modal.settings.ori_vector = stmt.name == "VECTOR_2DOF"
+
+
 def _hsc(stmt: Instruction, decoder: CallingDecoder) -> None:
     settings = decoder.modal.settings
     settings.hsc = stmt.on
@@ -290,4 +297,5 @@ _RUN = {
     InstructionKind.FILE_NAME: _file_name, InstructionKind.MSG: _msg,
     InstructionKind.MSG_SAVE: _msg_save,
     InstructionKind.HSC: _hsc, InstructionKind.SLOPE: _slope, InstructionKind.FILTER: _filter,
+    InstructionKind.ORI_MODE: _ori_mode,
 }

@@ -31,7 +31,8 @@ from .expressions import ExpressionParser, Node
 from .lexer import IDENT, Cursor
 from .source import LogicalLine
 
-WORDS = frozenset({"CS", "PATTERN", "AT", "FILE", "MSG", "TRAFO", "HSC", "SLOPE", "FILTER"})
+WORDS = frozenset({"CS", "PATTERN", "AT", "FILE", "MSG", "TRAFO", "HSC", "SLOPE", "FILTER",
+                   "ORI"})
 _KEY = re.compile(r"[A-Z_][A-Z0-9_]*")
 _CS_NAME = re.compile(r"\[[ \t]*([A-Z_][A-Z0-9_]*)[ \t]*\]")
 SLOPE_TYPES = ("STEP", "TRAPEZ", "HSC")
@@ -57,6 +58,7 @@ class InstructionKind(IntEnum):
     HSC = 31  # #HSC ON [..] / OFF
     SLOPE = 32  # #SLOPE [TYPE=..]
     FILTER = 33  # #FILTER ON [..] / OFF
+    ORI_MODE = 34  # #ORI MODE [VECTOR_2DOF] / [ANGLE] (``name``)
 
 
 @final  # the decoder dispatches on type(stmt) is Instruction: no subclasses
@@ -335,6 +337,39 @@ def _on_off(
     return parse
 
 
+# #ORI MODE [..]: the 5-axis modes; VECTOR_ABC / VECTOR_IJK are ISG's robot (6-axis) ones
+ORI_MODES = ("VECTOR_2DOF", "ANGLE")
+_ORI_MODES_6DOF = ("VECTOR_ABC", "VECTOR_IJK")
+
+
+def _ori(cur: Cursor, stmt: Instruction) -> None:
+    """``#ORI MODE [VECTOR_2DOF]`` / ``#ORI MODE [ANGLE]`` (ISG programming manual,
+    "Programming and configuration of 5-axis kinematics (#ORI MODE)")."""
+    stmt.kind = InstructionKind.ORI_MODE
+    _sub(cur, "ORI", ("MODE",))
+    cur.skip_ws()
+    open_pos = cur.pos
+    if cur.peek() != "[":
+        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX,
+                        f"'[{'|'.join(ORI_MODES)}]' expected after #ORI MODE")
+    cur.pos += 1
+    cur.skip_ws()
+    pos = cur.pos
+    m = cur.match(IDENT)
+    name = m.group() if m is not None else ""
+    if name in _ORI_MODES_6DOF:
+        raise cur.error(NcErrorId.INSTRUCTION_NOT_SUPPORTED,
+                        f"#ORI MODE [{name}] is for 6-axis (robot) kinematics; this channel's "
+                        "is a 5-axis one: VECTOR_2DOF or ANGLE", pos)
+    if name not in ORI_MODES:
+        cur.pos = pos
+        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX,
+                        f"#ORI MODE needs {' or '.join(ORI_MODES)}, found '{cur.word_text()}'",
+                        pos)
+    stmt.name = name
+    ExpressionParser(cur).expect("]", open_pos)
+
+
 def _slope(cur: Cursor, stmt: Instruction) -> None:
     stmt.kind = InstructionKind.SLOPE
     cur.skip_ws()
@@ -367,5 +402,5 @@ _PARSERS = {
     "TRAFO": _on_off("TRAFO", InstructionKind.TRAFO, None),
     "HSC": _on_off("HSC", InstructionKind.HSC, HSC_OPTIONS),
     "FILTER": _on_off("FILTER", InstructionKind.FILTER, FILTER_OPTIONS),
-    "SLOPE": _slope,
+    "SLOPE": _slope, "ORI": _ori,
 }

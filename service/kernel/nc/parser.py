@@ -77,8 +77,12 @@ _REPEATABLE = frozenset({WordKind.G, WordKind.M, WordKind.H})
 ItemErrorHandler = Callable[[NcError, int], "int | LogicalLine"]
 
 
-def word_table(axes: tuple[str, ...]) -> dict[str, tuple[WordKind, int]]:
-    """Address letter -> (meaning, axis index) for a channel with ``axes``."""
+def word_table(axes: tuple[str, ...], orientation: bool = False
+               ) -> dict[str, tuple[WordKind, int]]:
+    """Address letter -> (meaning, axis index) for a channel with ``axes``.
+    ``orientation`` (a channel with a kinematic chain): A, B and C are words even when
+    no axis has the name, for ``#ORI MODE [VECTOR_2DOF]`` (outside it such a word is
+    "not an axis of this channel", 21220, as before)."""
     index = {name: k for k, name in enumerate(axes)}
     table = {
         "F": (WordKind.FEED, -1), "S": (WordKind.SPINDLE, -1), "T": (WordKind.TOOL, -1),
@@ -89,6 +93,9 @@ def word_table(axes: tuple[str, ...]) -> dict[str, tuple[WordKind, int]]:
         "K": (WordKind.OFFSET, index.get("Z", -1)),
         "X": (WordKind.AXIS, -1),  # X is also the dwell time word of G4
     }
+    if orientation:
+        for letter in "ABC":
+            table[letter] = (WordKind.AXIS, -1)
     for name, k in index.items():
         table[name] = (WordKind.AXIS, k)
     return table

@@ -28,6 +28,7 @@ class MachiningSettings:
     """Modal high-speed and transformation settings of a program."""
 
     trafo: bool = False  # #TRAFO ON
+    ori_vector: bool = False  # #ORI MODE [VECTOR_2DOF]: under #TRAFO, A B C are a vector
     hsc: bool = False  # #HSC ON
     hsc_surface: bool = False  # #HSC ON [SURFACE]
     hsc_path_dev_mm: float = 0.0  # PATH_DEV (0: not programmed)

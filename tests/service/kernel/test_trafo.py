@@ -290,3 +290,51 @@ def test_a_three_plus_two_part_a_square_in_a_tilted_plane(ac: KernelHarness) -> 
     final = run.positions_mm
     assert tip_of(final) == pytest.approx(tuple(expected[-1]), abs=1e-9)
     assert tool_direction_of(final) == pytest.approx((0.0, -s30, c30), abs=1e-9)
+
+
+# ------------------------------------- point-vector programming: #ORI MODE [VECTOR_2DOF]
+
+
+@pytest.mark.parametrize("vector", [(0.0, -0.5, 0.8660254), (-0.5, 0.5, 0.7071),
+                                    (0.3, 0.0, 1.0), (0.0, 0.0, 2.0)])
+def test_a_b_c_are_the_tool_direction_in_vector_mode(ac: KernelHarness, vector) -> None:
+    """ISG's point-vector form (``X50 Y50 Z100 A-0.5 B0.5 C0.7071`` of the programming
+    manual, and others): the tool points along (A, B, C), not normalised, its tip at
+    X Y Z; checked with the independent numpy model of the machine."""
+    a, b, c = vector
+    run = _ran(ac.run("G90 G01 X0 Y0 Z100 A0 C0 F3000\n#ORI MODE [VECTOR_2DOF]\n#TRAFO ON\n"
+                      f"G01 X50 Y50 Z100 A{a} B{b} C{c} F3000\nG01 X40\n#TRAFO OFF\nM30\n"))
+    final = run.positions_mm
+    unit = np.array(vector) / np.linalg.norm(vector)
+    assert tool_direction_of(final) == pytest.approx(tuple(unit), abs=1e-7)
+    assert tip_of(final) == pytest.approx((40.0, 50.0, 100.0), abs=1e-7)
+    assert -120.0 <= final[A] <= 120.0
+
+
+def test_the_nearer_of_the_two_solutions_and_angle_mode_again(ac: KernelHarness) -> None:
+    """(0, 0.5, 0.866) is A 30 C 0 or A -30 C 180: from A -10 C 170 the second is
+    nearer; ``#ORI MODE [ANGLE]`` makes A an angle again."""
+    run = _ran(ac.run("G90 G01 X0 Y0 Z50 A-10 C170 F3000\n#ORI MODE [VECTOR_2DOF]\n"
+                      "#TRAFO ON\nG01 A0 B0.5 C0.8660254\n#TRAFO OFF\nM30\n"))
+    assert (run.positions_mm[A], run.positions_mm[C]) == pytest.approx((-30.0, 180.0))
+    run = _ran(ac.run("#ORI MODE [VECTOR_2DOF]\n#ORI MODE [ANGLE]\n#TRAFO ON\n"
+                      "G01 A-20 F3000\n#TRAFO OFF\nM30\n", "angle.nc"))
+    assert (run.positions_mm[A], run.positions_mm[C]) == pytest.approx((-20.0, 180.0))
+
+
+@pytest.mark.parametrize(("text", "error_id", "column"), [
+    # outside VECTOR_2DOF, or without #TRAFO ON, B is no axis of the A/C machine
+    ("#TRAFO ON\nG01 X0 A0 B1 C1 F100", 21220, 11),
+    ("#ORI MODE [VECTOR_2DOF]\nG01 X0 A0 B1 C1 F100", 21220, 11),
+    ("#ORI MODE [VECTOR_2DOF]\n#TRAFO ON\nG01 X0 A0 B0 C0 F100", 20113, 8),
+    # 130 degrees from the vertical: the cradle turns to 120 at most
+    ("#ORI MODE [VECTOR_2DOF]\n#TRAFO ON\nG01 A0 B-0.766 C-0.6428 F100", 292004, 5),
+    ("#ORI MODE [VECTOR_ABC]", 20500, 12),
+    ("#ORI MODE [POLAR]", 20530, 12),
+])
+def test_bad_orientation_vectors(ac: KernelHarness, text: str, error_id: int, column: int
+                                 ) -> None:
+    run = ac.run("G90 G00 X0 Y0 Z50 A0 C0\n" + text + "\nM30\n")
+    [error] = run.channel.errors.entries
+    assert (error.id, error.line, error.column) == (error_id, text.count("\n") + 2, column)
+    assert run.positions_mm[A] == 0.0
