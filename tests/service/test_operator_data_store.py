@@ -11,6 +11,7 @@ from cnc_objects.service.config import build_config
 from cnc_objects.service.kernel.alarms import AlarmLog
 from cnc_objects.service.kernel.commands_tooling import SetToolData, SetZeroOffset
 from cnc_objects.service.kernel.nc.tool_data import ToolField
+from cnc_objects.service.kernel.state import Snapshot
 from cnc_objects.service.storage.operator_data_store import UNREADABLE_ID, OperatorDataStore
 from tests.support.kernel import KernelHarness
 
@@ -79,7 +80,7 @@ def test_a_programs_zero_offset_write_is_not_kept(tmp_path: Path) -> None:
         hook = h.kernel.on_cycle_end
         assert hook is not None
 
-        def both(s):  # the harness's hook and the store's, as the service chains them
+        def both(s: Snapshot) -> None:  # the harness's hook and the store's, as the service chains them
             hook(s)
             store.observe(s)
 
@@ -94,5 +95,7 @@ def test_a_programs_zero_offset_write_is_not_kept(tmp_path: Path) -> None:
         assert run.channel.tooling.zero_offsets.offset_mm(1, 0) == 7.0  # still in effect
         store.close()
         assert store.writes >= 1
-    [g54] = [g for g in loads(path.read_text()).channel(1).zero_offsets or () if g.np_grp == 1]
+    entry = loads(path.read_text()).channel(1)
+    assert entry is not None and entry.zero_offsets is not None
+    [g54] = [g for g in entry.zero_offsets if g.np_grp == 1]
     assert (g54.offsets_mm["X"], g54.offsets_mm["Y"]) == (0.0, 3.0)

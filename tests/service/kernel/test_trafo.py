@@ -297,7 +297,8 @@ def test_a_three_plus_two_part_a_square_in_a_tilted_plane(ac: KernelHarness) -> 
 
 @pytest.mark.parametrize("vector", [(0.0, -0.5, 0.8660254), (-0.5, 0.5, 0.7071),
                                     (0.3, 0.0, 1.0), (0.0, 0.0, 2.0)])
-def test_a_b_c_are_the_tool_direction_in_vector_mode(ac: KernelHarness, vector) -> None:
+def test_a_b_c_are_the_tool_direction_in_vector_mode(
+        ac: KernelHarness, vector: tuple[float, float, float]) -> None:
     """ISG's point-vector form (``X50 Y50 Z100 A-0.5 B0.5 C0.7071`` of the programming
     manual, and others): the tool points along (A, B, C), not normalised, its tip at
     X Y Z; checked with the independent numpy model of the machine."""

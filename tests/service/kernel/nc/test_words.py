@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import pytest
 
 from cnc_objects.service.kernel.nc import NcErrorId, SourceRef, StopKind
@@ -145,7 +147,8 @@ def test_manual_flag() -> None:
 
 
 @pytest.mark.parametrize("as_text", [lambda t: t, slow], ids=["hot path", "general path"])
-def test_an_axis_word_takes_an_expression_after_an_equals_sign(as_text) -> None:
+def test_an_axis_word_takes_an_expression_after_an_equals_sign(
+        as_text: Callable[[str], str]) -> None:
     """ISG ("Axis commands", tf5200_programming_manual/206043659.html): ``X=100`` and
     ``X = <expr>`` as for multi-letter axis names; brackets optional after '='."""
     program = "V.G.NP[1].V.X = 0\nG0 X=100 Y = 2*3 Z=-[1+2]\nG1 X=V.G.NP[1].V.X+1 F100\nM30"
@@ -157,6 +160,6 @@ def test_an_axis_word_takes_an_expression_after_an_equals_sign(as_text) -> None:
     ("G0 X=\"A\"", NcErrorId.TYPE_MISMATCH, 6),
     ("G0 X==1", NcErrorId.MISSING_VALUE, 4),
 ])
-def test_bad_axis_words_with_an_equals_sign(program, err, column) -> None:
+def test_bad_axis_words_with_an_equals_sign(program: str, err: int, column: int) -> None:
     error = error_of(program + "\nM30")
     assert (error.id, error.line, error.column) == (err, 1, column)
