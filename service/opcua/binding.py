@@ -1,0 +1,310 @@
+"""OPC UA variables bound to CNC objects: read, subscribed and written through the
+``Backend``, as the ADS front end reads, subscribes and writes them.
+
+- Read: the variable's Value attribute has a read callback (asyncua's
+  ``set_attribute_value_callback``): each Read calls the objects' getters (the ones ADS
+  reads and the notification hub samples, ``Backend.direct_read``) on the event loop,
+  from the kernel's newest snapshot, and turns the raw values into the OPC UA value
+  (``sources.Source``).
+- Subscribe: a monitored item on a bound variable adds one on-change subscription per
+  source object to the ``NotificationHub``, at the item's sampling interval (asyncua
+  revises it to the subscription's publishing interval; never faster than the kernel
+  cycle: the hub's floor). Each sample goes to that monitored item alone; asyncua drops
+  a value equal to the last one. The item's removal (or its session's end) deletes them.
+  asyncua has no hook for "a monitored item was added": the variable's
+  ``datachange_callbacks`` dict, where asyncua registers the item, tells us.
+- Write: ``write`` checks the session's role (``roles.role_of``, the access policy
+  of every front end: ``role_to_write``), the variant type and the range, then writes
+  through ``Backend.decode_writes`` and ``apply_writes`` and answers when the kernel has
+  applied it: BadUserAccessDenied, BadTypeMismatch, BadOutOfRange (the kernel's own
+  refusal of a value included) and nothing changes.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from asyncua import Server, ua
+from asyncua.crypto.permission_rules import User
+
+from cnc_objects.objects import Entry
+from cnc_objects.protocol.constants import TransmissionMode
+from cnc_objects.protocol.errors import AdsReturnCode
+from cnc_objects.protocol.roles import role_to_write
+
+from ..backend import Backend
+from .roles import role_of
+from .sources import Source
+from .values import bad, eu_information, good, source_time
+
+log = logging.getLogger(__name__)
+
+_S = ua.StatusCodes
+_E = AdsReturnCode
+#: The ADS code of a refused write -> the OPC UA status that answers it.
+WRITE_STATUS: dict[int, int] = {
+    _E.DEVICE_INVALIDDATA: _S.BadOutOfRange,
+    _E.DEVICE_INVALIDPARM: _S.BadOutOfRange,
+    _E.DEVICE_INVALIDSIZE: _S.BadTypeMismatch,
+    _E.DEVICE_INVALIDACCESS: _S.BadNotWritable,
+    _E.DEVICE_NOTREADY: _S.BadInvalidState,
+    _E.DEVICE_INVALIDSTATE: _S.BadInvalidState,
+}
+_READ_ONLY = ua.AccessLevel.CurrentRead.mask
+_READ_WRITE = ua.AccessLevel.CurrentRead.mask | ua.AccessLevel.CurrentWrite.mask
+_VALUE = ua.AttributeIds.Value
+DataChangeCallback = Callable[..., Any]  # asyncua's async (handle, DataValue) -> None
+
+
+@dataclass(frozen=True, slots=True)
+class _Watch:
+    """The fields of an AddDeviceNotification the hub reads."""
+
+    port: int
+    group: int
+    offset: int
+    length: int
+    transmission_mode: int = TransmissionMode.SERVER_ON_CHANGE
+
+
+@dataclass
+class BoundVariable:
+    """A variable and the objects behind it."""
+
+    node_id: ua.NodeId
+    source: Source
+    entries: tuple[Entry, ...]
+    getters: tuple[Callable[[], Any], ...]
+    #: monitored items by asyncua's callback handle: (callback, hub handles)
+    items: dict[int, tuple[DataChangeCallback, list[int]]] = field(default_factory=dict)
+
+    def value(self) -> ua.DataValue:
+        """The current value, Good; BadInternalError when a getter fails."""
+        source = self.source
+        try:
+            return good(source.value(*(get() for get in self.getters)), source.variant)
+        except Exception:  # a getter fault must not take the service down
+            log.exception("reading OPC UA variable %s failed", self.node_id.to_string())
+            return bad(_S.BadInternalError)
+
+
+class _Watched(dict[int, DataChangeCallback]):
+    """asyncua's datachange callbacks of one attribute, telling us of items added and
+    removed (asyncua sets ``[handle] = callback`` and ``pop(handle)``)."""
+
+    def __init__(self, added: Callable[[int, DataChangeCallback], None],
+                 removed: Callable[[int], None]) -> None:
+        super().__init__()
+        self._added, self._removed = added, removed
+
+    def __setitem__(self, handle: int, callback: DataChangeCallback) -> None:
+        super().__setitem__(handle, callback)
+        self._added(handle, callback)
+
+    def pop(self, handle: int, *default: Any) -> Any:
+        found = handle in self
+        value = super().pop(handle, *default)
+        if found:
+            self._removed(handle)
+        return value
+
+
+class VariableBinder:
+    """Binds OPC UA variables of ``server`` to the objects of ``backend``."""
+
+    def __init__(self, server: Server, backend: Backend) -> None:
+        self.server = server
+        self.backend = backend
+        self.variables: dict[ua.NodeId, BoundVariable] = {}
+        self._aspace = server.iserver.aspace
+        self._tasks: set[asyncio.Task[None]] = set()
+
+    # ------------------------------------------------------------ binding
+
+    async def bind(self, node_id: ua.NodeId, source: Source) -> BoundVariable:
+        """Serve ``node_id``'s value from ``source``: its objects must exist
+        (``KeyError`` names the one that does not); its access level says whether it may
+        be written; its EngineeringUnits and EURange properties, where it has them, are
+        set from ``source``."""
+        space = self.backend.space
+        entries = []
+        for name in source.objects:
+            entry = space.by_name(name)
+            if entry is None or entry.read is None:
+                raise KeyError(f"OPC UA variable {node_id.to_string()}: no readable object {name}")
+            entries.append(entry)
+        getters = tuple(self._getter(e) for e in entries)
+        var = BoundVariable(node_id, source, tuple(entries), getters)
+        self.variables[node_id] = var
+        level = _READ_WRITE if source.write_object is not None else _READ_ONLY
+        for attr in (ua.AttributeIds.AccessLevel, ua.AttributeIds.UserAccessLevel):
+            await self._aspace.write_attribute_value(
+                node_id, attr, ua.DataValue(ua.Variant(level, ua.VariantType.Byte)))
+        await self._aspace.write_attribute_value(
+            node_id, ua.AttributeIds.ValueRank,
+            ua.DataValue(ua.Variant(1 if source.array else -1, ua.VariantType.Int32)))
+        self._aspace.set_attribute_value_callback(node_id, _VALUE, lambda n, a: var.value())
+        node = self._aspace[node_id]
+        node.attributes[_VALUE].datachange_callbacks = _Watched(
+            lambda handle, callback: self._item_added(var, handle, callback),
+            lambda handle: self._item_removed(var, handle))
+        await self._properties(node_id, source)
+        return var
+
+    def _getter(self, entry: Entry) -> Callable[[], Any]:
+        """The getter ADS reads and the hub samples (``Backend.direct_read``), else a
+        read through ``Backend.read_value`` decoded."""
+        obj = entry.obj
+        direct = self.backend.direct_read(obj.port, obj.group, obj.offset, obj.dtype.size)
+        if direct is not None:
+            return direct[0]
+        read, dtype = self.backend.read_value, obj.dtype
+
+        def through_backend() -> Any:
+            code, data = read(obj.port, obj.group, obj.offset, dtype.size)
+            if code:
+                raise RuntimeError(f"{obj.name}: ADS code {code:#x}: {data!r}")
+            return dtype.decode(data)
+
+        return through_backend
+
+    async def _properties(self, node_id: ua.NodeId, source: Source) -> None:
+        """EngineeringUnits and EURange of an AnalogItem (added when the instance lacks
+        them: both are optional or mandatory by type; we always give them)."""
+        if source.unit is None:
+            return
+        node = self.server.get_node(node_id)
+        idx = 0
+        units = await _child(node, "EngineeringUnits")
+        if units is None:
+            units = await node.add_property(idx, "EngineeringUnits", eu_information(source.unit))
+        else:
+            await units.write_value(eu_information(source.unit))
+        if source.limits is not None:
+            low, high = source.limits
+            eu_range = ua.Range(Low=low, High=high)
+            found = await _child(node, "EURange")
+            if found is None:
+                await node.add_property(idx, "EURange", eu_range)
+            else:
+                await found.write_value(eu_range)
+
+    # ------------------------------------------------------------ subscriptions
+
+    def _item_added(self, var: BoundVariable, handle: int, callback: DataChangeCallback) -> None:
+        """A monitored item on ``var``: one hub subscription per source object, sampled
+        at the item's revised sampling interval."""
+        interval_ms = _sampling_interval_ms(callback)
+        envelope = ("opcua", id(getattr(callback, "__self__", callback)), handle)
+        handles: list[int] = []
+        var.items[handle] = (callback, handles)
+        hub = self.backend.hub
+        for k, entry in enumerate(var.entries):
+            obj = entry.obj
+            code, answer = hub.add(
+                envelope, _Watch(obj.port, obj.group, obj.offset, obj.dtype.size),
+                int(interval_ms * 1e6), self._notifier(var, handle, k))
+            if code:
+                log.warning("OPC UA monitored item on %s: %s", var.node_id.to_string(), answer)
+                self._send(callback, handle, bad(_S.BadResourceUnavailable))
+                continue
+            handles.append(answer)  # type: ignore[arg-type]
+
+    def _item_removed(self, var: BoundVariable, handle: int) -> None:
+        held = var.items.pop(handle, None)
+        if held is None:
+            return
+        callback, handles = held
+        envelope = ("opcua", id(getattr(callback, "__self__", callback)), handle)
+        for hub_handle in handles:
+            self.backend.hub.delete(envelope, hub_handle)
+
+    def _notifier(self, var: BoundVariable, handle: int, k: int) -> Callable[..., bool]:
+        """The hub's ``notify`` for source object ``k`` of ``var``'s item ``handle``."""
+        single = len(var.entries) == 1
+        dtype = var.entries[k].obj.dtype
+        source = var.source
+
+        def notify(envelope: Any, port: int, samples: list[list[Any]]) -> bool:
+            held = var.items.get(handle)
+            if held is None:
+                return True
+            _, _, filetime, data = samples[-1]  # the newest of the batch
+            if single:
+                try:
+                    value = good(source.value(dtype.decode(data)), source.variant,
+                                 source_time(filetime))
+                except Exception:
+                    log.exception("OPC UA sample of %s failed", var.node_id.to_string())
+                    value = bad(_S.BadInternalError)
+            else:  # one of several objects changed: the value from all of them, now
+                value = var.value()
+            self._send(held[0], handle, value)
+            return True
+
+        return notify
+
+    def _send(self, callback: DataChangeCallback, handle: int, value: ua.DataValue) -> None:
+        task = asyncio.get_running_loop().create_task(callback(handle, value))
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+
+    # ------------------------------------------------------------ writes
+
+    async def write(self, node_id: ua.NodeId, value: ua.DataValue, user: User | None
+                    ) -> ua.StatusCode:
+        """Write ``value`` to a bound variable as the session of ``user`` may."""
+        var = self.variables.get(node_id)
+        if var is None or var.source.write_object is None or var.source.to_raw is None:
+            return ua.StatusCode(_S.BadNotWritable)
+        entry = self.backend.space.by_name(var.source.write_object)
+        if entry is None or entry.write is None:
+            return ua.StatusCode(_S.BadNotWritable)
+        obj = entry.obj
+        role = role_of(user)
+        if role is not None and not role.may(role_to_write(obj.port, obj.group)):
+            return ua.StatusCode(_S.BadUserAccessDenied)
+        variant = value.Value
+        if variant is None or variant.VariantType != var.source.variant:
+            return ua.StatusCode(_S.BadTypeMismatch)
+        try:
+            data = obj.dtype.encode(var.source.to_raw(variant.Value))
+        except (ValueError, OverflowError):
+            return ua.StatusCode(_S.BadOutOfRange)
+        except TypeError:
+            return ua.StatusCode(_S.BadTypeMismatch)
+        code, message, items = self.backend.decode_writes(obj.port, obj.group, obj.offset, data)
+        if code:
+            log.debug("OPC UA write to %s refused: %s", obj.name, message)
+            return ua.StatusCode(WRITE_STATUS.get(code, _S.BadInternalError))
+        done: asyncio.Future[list[tuple[int, str]]] = asyncio.get_running_loop().create_future()
+        self.backend.apply_writes(items, done.set_result, holder=("opcua", id(user)))
+        results = await done
+        for code, message in results:
+            if code:
+                log.debug("OPC UA write to %s refused: %s", obj.name, message)
+                return ua.StatusCode(WRITE_STATUS.get(code, _S.BadInternalError))
+        return ua.StatusCode(_S.Good)
+
+
+def _sampling_interval_ms(callback: DataChangeCallback) -> float:
+    """The sampling interval asyncua revised the item to: its subscription's publishing
+    interval (asyncua answers ``RevisedSamplingInterval`` with it); 0 when unknown (the
+    hub then samples every kernel cycle)."""
+    service = getattr(callback, "__self__", None)
+    try:
+        return float(service.isub.data.RevisedPublishingInterval)  # type: ignore[union-attr]
+    except AttributeError:
+        return 0.0
+
+
+async def _child(node: Any, name: str) -> Any:
+    """The child of ``node`` browsed as ``name`` (any namespace), None without one."""
+    for child in await node.get_children():
+        if (await child.read_browse_name()).Name == name:
+            return child
+    return None
