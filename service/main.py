@@ -276,9 +276,9 @@ async def serve(
                  ads.loopback_role.label)  # type: ignore[union-attr]
     if opcua_server is not None:
         log.info("OPC UA on %s (OPC 40502 CncInterface, %d channels; SecurityPolicy None; "
-                 "sessions' role %s; nodesets and instances built in %.2f s)",
+                 "sessions' role %s; built in %.2f s, %s)",
                  opcua_server.url, len(config.channels),
-                 opcua.loopback_role.label, opcua_server.start_s)  # type: ignore[union-attr]
+                 opcua.loopback_role.label, opcua_server.start_s, opcua_server.cache_note)  # type: ignore[union-attr]
     if curve is not None:
         log.info("CURVE on: server public key %s; allow-list %s (%s)",
                  curve.public_key.decode(), curve.allow_list.origin, curve.allow_list.census())

@@ -10,6 +10,8 @@ CNC (40502) needs only the base namespace.
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -32,8 +34,8 @@ CNC_URI = NODESETS[-1][0]
 MACHINE_TOOL_URI = NODESETS[-2][0]
 
 
-class _Counted(logging.Handler):
-    """Counts what asyncua's importer logs at ERROR and above instead of printing it."""
+class Counted(logging.Handler):
+    """Counts what asyncua logs at ERROR and above instead of printing it."""
 
     def __init__(self) -> None:
         super().__init__(logging.ERROR)
@@ -43,22 +45,30 @@ class _Counted(logging.Handler):
         self.count += 1
 
 
-async def load_nodesets(server: Server) -> int:
-    """Import every nodeset into ``server`` in dependency order; the nodes asyncua cannot
-    import are left out, not fatal (Machinery/Jobs' OptionSet structures,
-    docs/opcua.md "Departures"): their count is returned. asyncua's own log lines of
-    the import (a warning per structure it builds) are kept out of the service's log."""
+@contextmanager
+def asyncua_quiet() -> Iterator[Counted]:
+    """asyncua's log kept out of the service's while the block runs (a warning per
+    structure class it builds from a nodeset, an error per node it cannot import): the
+    errors are counted instead."""
     quiet = logging.getLogger("asyncua")
-    counted = _Counted()
+    counted = Counted()
     level, propagate = quiet.level, quiet.propagate
     quiet.setLevel(logging.ERROR)
     quiet.propagate = False
     quiet.addHandler(counted)
     try:
-        for _, name in NODESETS:
-            await server.import_xml(str(NODESET_DIR / name), strict_mode=False)
+        yield counted
     finally:
         quiet.removeHandler(counted)
         quiet.setLevel(level)
         quiet.propagate = propagate
+
+
+async def load_nodesets(server: Server) -> int:
+    """Import every nodeset into ``server`` in dependency order; the nodes asyncua cannot
+    import are left out, not fatal (Machinery/Jobs' OptionSet structures,
+    docs/opcua.md "Departures"): their count is returned."""
+    with asyncua_quiet() as counted:
+        for _, name in NODESETS:
+            await server.import_xml(str(NODESET_DIR / name), strict_mode=False)
     return counted.count

@@ -16,11 +16,12 @@ from asyncua import Server, ua
 from cnc_objects.protocol.roles import Role
 
 from ..backend import Backend
+from . import address_space_cache as cache
 from .attributes import BoundAttributes
 from .binding import VariableBinder
 from .cnc_interface import build_cnc_interface
 from .config import endpoint_url
-from .nodesets import load_nodesets
+from .nodesets import asyncua_quiet, load_nodesets
 from .roles import LoopbackUsers
 
 log = logging.getLogger(__name__)
@@ -50,6 +51,7 @@ class OpcUaServer:
         self.address: tuple[str, int] = ("", 0)
         self.nodes_left_out = 0  # nodeset nodes asyncua could not import
         self.start_s = 0.0  # how long ``start`` took (nodesets, instances, listening)
+        self.cache_note = ""  # where the imported address space came from
         self.binder: VariableBinder | None = None
         self._server: Server | None = None
 
@@ -65,13 +67,27 @@ class OpcUaServer:
         # asyncua logs every node it imports and instantiates at INFO: its warnings only
         asyncua_log = logging.getLogger("asyncua")
         asyncua_log.setLevel(max(asyncua_log.getEffectiveLevel(), logging.WARNING))
-        server = Server()
+        path = cache.cache_file()
+        kept = cache.load(path)
+        server = Server(iserver=cache.CachedInternalServer(kept[0] if kept else None))
         await server.init()
         server.set_endpoint(endpoint_url(host, port))
         server.set_server_name(f"{VENDOR} CNC")
         await server.set_application_uri(APPLICATION_URI)
         apply_security(server, self.loopback_role)
-        self.nodes_left_out = await load_nodesets(server)
+        namespaces = server.nodes.namespace_array
+        if kept is None:
+            self.nodes_left_out = await load_nodesets(server)
+            try:
+                cache.save(server.iserver.aspace._nodes, await namespaces.read_value(), path)
+                self.cache_note = f"nodesets imported, kept in {path}"
+            except OSError as exc:
+                self.cache_note = f"nodesets imported; cannot keep them in {path}: {exc}"
+        else:
+            await namespaces.write_value(kept[1])  # the server's set-up wrote its own
+            with asyncua_quiet():  # the structure classes of the nodesets, made again
+                await server.load_data_type_definitions()
+            self.cache_note = f"nodesets from {path}"
         binder = VariableBinder(server, self.backend)
         server.iserver.attribute_service = BoundAttributes(server.iserver.aspace, binder)
         await build_cnc_interface(server, binder, self.backend, VENDOR, self.version)
