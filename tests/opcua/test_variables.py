@@ -1,0 +1,108 @@
+"""Bound variables over asyncua's client: values that follow a running program through a
+subscription, writes under the session's role, and the status codes of bad writes."""
+
+from __future__ import annotations
+
+import asyncio
+from typing import Any
+
+import pytest
+from asyncua import Client, Node, ua
+
+from cnc_objects.clients import AsyncClient
+from cnc_objects.testing import ServiceProcess
+from tests.opcua.conftest import CNC_URI, cnc_node, opcua_url
+
+TIMEOUT_S = 60.0
+PROGRAM = "G90 G1 X50 F3000\nM30\n"  # 1 s of kernel time from X0 to X50
+_S = ua.StatusCodes
+
+
+class _Values:
+    """asyncua's subscription handler: every data change in a queue."""
+
+    def __init__(self) -> None:
+        self.queue: asyncio.Queue[Any] = asyncio.Queue()
+
+    def datachange_notification(self, node: Node, value: Any, data: Any) -> None:
+        self.queue.put_nowait(value)
+
+
+async def _override(client: Client) -> Node:
+    ns = await client.get_namespace_index(CNC_URI)
+    channel = await cnc_node(client, "CncInterface", "CncChannelList", "Channel1")
+    return await channel.get_child(f"{ns}:CmdOverride")
+
+
+async def _status_of_write(node: Node, variant: ua.Variant) -> int:
+    """The status code a Write of ``variant`` to ``node`` is answered with."""
+    write = ua.WriteValue(NodeId=node.nodeid, AttributeId=ua.AttributeIds.Value,
+                          Value=ua.DataValue(variant))
+    results = await node.session.write(ua.WriteParameters(NodesToWrite=[write]))
+    return int(results[0].value)
+
+
+async def test_act_pos_follows_a_running_program(opcua_service: ServiceProcess,
+                                                 ua_client: Client) -> None:
+    ns = await ua_client.get_namespace_index(CNC_URI)
+    act_pos = await cnc_node(ua_client, "CncInterface", "CncAxisList", "Ch1_X",
+                             "PosIndirect", "ActPos")
+    assert act_pos.nodeid.NamespaceIndex == ns
+    values = _Values()
+    subscription = await ua_client.create_subscription(20, values)
+    await subscription.subscribe_data_change(act_pos, queuesize=1000)
+    first = await asyncio.wait_for(values.queue.get(), TIMEOUT_S)
+    assert first == 0.0
+    async with AsyncClient(opcua_service.endpoint, timeout_s=TIMEOUT_S) as cnc:
+        await cnc.upload("opcua.nc", PROGRAM.encode())
+        await cnc.run_program("opcua.nc", 1)
+        seen = [first]
+        while seen[-1] != 50.0:
+            seen.append(await asyncio.wait_for(values.queue.get(), TIMEOUT_S))
+        await cnc.wait_program(1, TIMEOUT_S)
+    await subscription.delete()
+    assert seen == sorted(seen)  # the axis moves one way
+    assert len({v for v in seen if 0.0 < v < 50.0}) >= 3, seen  # and is seen on its way
+
+
+async def test_an_operator_writes_the_override(ua_client: Client) -> None:
+    override = await _override(ua_client)
+    assert await _status_of_write(override, ua.Variant(55.5, ua.VariantType.Double)) == _S.Good
+    assert await override.read_value() == 55.5  # the reply came once the kernel applied it
+    assert await _status_of_write(override, ua.Variant(100.0, ua.VariantType.Double)) == _S.Good
+
+
+@pytest.mark.parametrize("variant, status", [
+    (ua.Variant(50, ua.VariantType.Int32), _S.BadTypeMismatch),
+    (ua.Variant("50", ua.VariantType.String), _S.BadTypeMismatch),
+    (ua.Variant(-5.0, ua.VariantType.Double), _S.BadOutOfRange),
+    (ua.Variant(1000.0, ua.VariantType.Double), _S.BadOutOfRange),
+    (ua.Variant(float("nan"), ua.VariantType.Double), _S.BadOutOfRange),
+])
+async def test_a_bad_write_is_refused_and_changes_nothing(
+        ua_client: Client, variant: ua.Variant, status: int) -> None:
+    override = await _override(ua_client)
+    assert await _status_of_write(override, variant) == status
+    assert await override.read_value() == 100.0
+
+
+async def test_unknown_and_read_only_nodes(ua_client: Client) -> None:
+    ns = await ua_client.get_namespace_index(CNC_URI)
+    unknown = ua_client.get_node(ua.NodeId("no-such-node", ns))
+    value = await unknown.read_data_value(raise_on_bad_status=False)
+    assert value.StatusCode.value == _S.BadNodeIdUnknown
+    assert await _status_of_write(unknown, ua.Variant(1.0)) == _S.BadNodeIdUnknown
+    channel = await cnc_node(ua_client, "CncInterface", "CncChannelList", "Channel1")
+    act = await channel.get_child(f"{ns}:ActOverride")
+    assert await _status_of_write(act, ua.Variant(50.0)) == _S.BadNotWritable
+    vendor = await cnc_node(ua_client, "CncInterface", "VendorName")
+    assert await _status_of_write(vendor, ua.Variant("x")) == _S.BadNotWritable
+    assert await vendor.read_value() == "cnc-objects"
+
+
+async def test_a_monitor_may_not_write(monitor_service: ServiceProcess) -> None:
+    async with Client(opcua_url(monitor_service), timeout=30) as client:
+        override = await _override(client)
+        status = await _status_of_write(override, ua.Variant(50.0, ua.VariantType.Double))
+        assert status == _S.BadUserAccessDenied
+        assert await override.read_value() == 100.0
