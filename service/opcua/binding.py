@@ -81,15 +81,31 @@ class BoundVariable:
     getters: tuple[Callable[[], Any], ...]
     #: monitored items by asyncua's callback handle: (callback, hub handles)
     items: dict[int, tuple[DataChangeCallback, list[int]]] = field(default_factory=dict)
+    #: the raw values last read and their DataValue: a read of unchanged objects answers
+    #: it again (no new DataValue; its SourceTimestamp says when the value last changed)
+    _last_raw: Any = None
+    _last: ua.DataValue | None = None
 
     def value(self) -> ua.DataValue:
         """The current value, Good; BadInternalError when a getter fails."""
-        source = self.source
+        getters = self.getters
         try:
-            return good(source.value(*(get() for get in self.getters)), source.variant)
+            if len(getters) == 1:  # the common case: one object
+                raw = getters[0]()
+                if raw == self._last_raw and self._last is not None:
+                    return self._last
+                value = good(self.source.value(raw), self.source.variant)
+                self._last_raw, self._last = raw, value
+                return value
+            raw = tuple([get() for get in getters])
+            if raw == self._last_raw and self._last is not None:
+                return self._last
+            value = good(self.source.value(*raw), self.source.variant)
         except Exception:  # a getter fault must not take the service down
             log.exception("reading OPC UA variable %s failed", self.node_id.to_string())
             return bad(_S.BadInternalError)
+        self._last_raw, self._last = raw, value
+        return value
 
 
 class _Watched(dict[int, DataChangeCallback]):
