@@ -215,7 +215,7 @@ class VariableBinder:
         """A monitored item on ``var``: one hub subscription per source object, sampled
         at the item's revised sampling interval."""
         interval_ms = _sampling_interval_ms(callback)
-        envelope = ("opcua", id(getattr(callback, "__self__", callback)), handle)
+        envelope = _envelope(callback, handle)
         handles: list[int] = []
         var.items[handle] = (callback, handles)
         hub = self.backend.hub
@@ -235,7 +235,7 @@ class VariableBinder:
         if held is None:
             return
         callback, handles = held
-        envelope = ("opcua", id(getattr(callback, "__self__", callback)), handle)
+        envelope = _envelope(callback, handle)
         for hub_handle in handles:
             self.backend.hub.delete(envelope, hub_handle)
 
@@ -305,6 +305,12 @@ class VariableBinder:
                 log.debug("OPC UA write to %s refused: %s", obj.name, message)
                 return ua.StatusCode(WRITE_STATUS.get(code, _S.BadInternalError))
         return ua.StatusCode(_S.Good)
+
+
+def _envelope(callback: DataChangeCallback, handle: int) -> tuple[Any, ...]:
+    """The hub's envelope of a monitored item: its first part is the item's OPC UA
+    subscription (asyncua's monitored item service), the client the hub's limits count."""
+    return ("opcua", id(getattr(callback, "__self__", callback))), handle
 
 
 def _sampling_interval_ms(callback: DataChangeCallback) -> float:

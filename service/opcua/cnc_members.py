@@ -22,7 +22,7 @@ _B, _S = ua.VariantType.Boolean, ua.VariantType.String
 
 OVERRIDE_RANGE = (0.0, 150.0)  # % (the feed override's and spindle override's limits)
 FEED_RANGE = (0.0, 1e6)  # mm/min
-SPEED_RANGE = (0.0, 1e5)  # rpm
+SPEED_RANGE = (-1e5, 1e5)  # rpm, signed: negative turns CCW (M4)
 
 #: the twin's channel mode -> CncOperationMode (STANDBY has none: Manual, no motion)
 _OPERATION_MODE: dict[int, int] = {ChannelMode.STANDBY: 0, ChannelMode.MANUAL: 0, ChannelMode.MDI: 1,
@@ -61,7 +61,7 @@ def _m_functions(spindle_mode: int, coolant: int) -> list[int]:
 
 
 def channel_members(c: int, first_axis: str) -> dict[str, Source]:
-    """CncChannelType's mandatory members (OPC 40502 5.6) for channel ``c``."""
+    """CncChannelType's mandatory members (OPC 40502) for channel ``c``."""
     ch = f"ch{c}."
     return {
         "ActFeedrate": scaled(ch + "mc_active_feedrate_r", "um/s", FEED_RANGE),
@@ -88,14 +88,14 @@ def channel_members(c: int, first_axis: str) -> dict[str, Source]:
         "ActStatus": plain(ch + "mc_active_state_r", _I32, _channel_status),
         "BlockMode": plain(ch + "mc_active_single_block_r", _B, bool),
         "FeedHold": plain(ch + "mc_active_state_r", _B, lambda s: s == ChannelState.HOLD),
-        "DryRunFeed": fixed(0.0, _D, "the twin has no dry-run feed (OPC 40502 5.6)",
-                            unit="mm/min"),
+        "DryRunFeed": fixed(0.0, _D, "the twin has no dry-run feed (OPC 40502, "
+                            "CncChannelType)", unit="mm/min"),
         "ToolId": plain(ch + "mc_active_tool_r", _U32),
     }
 
 
 def position(act: str, cmd: str, rem: str | None, unit: str = "0.1 um") -> dict[str, Source]:
-    """CncPositionVariableType's members (OPC 40502 5.3): ActPos, CmdPos, RemDist."""
+    """CncPositionVariableType's members (OPC 40502): ActPos, CmdPos, RemDist."""
     members = {"ActPos": scaled(act, unit), "CmdPos": scaled(cmd, unit)}
     members["RemDist"] = (scaled(rem, unit) if rem is not None else
                           fixed(0.0, _D, "the twin keeps no remaining distance here", unit="mm"))
@@ -103,7 +103,7 @@ def position(act: str, cmd: str, rem: str | None, unit: str = "0.1 um") -> dict[
 
 
 def axis_members(axis: str) -> dict[str, Source]:
-    """CncAxisType's and CncDriveType's mandatory variables (OPC 40502 5.7, 5.5) for the
+    """CncAxisType's and CncDriveType's mandatory variables (OPC 40502) for the
     channel axis ``axis`` (``ch1.ax1.``)."""
     return {
         "ActStatus": plain(axis + "distance_to_go_pcs", _I32, lambda d: 0 if d == 0 else 1),
@@ -113,10 +113,10 @@ def axis_members(axis: str) -> dict[str, Source]:
                               lambda acs, pcs: (acs - pcs) / 10_000.0, _D),
         "IsInactive": fixed(False, _B, "every configured axis is active"),
         "IsVirtual": fixed(True, _B, "the twin's drives are simulated (ideal drives)"),
-        "ActLoad": fixed(0.0, _D, "the twin models no drive load (OPC 40502 5.5)", unit="%"),
-        "ActPower": fixed(0.0, _D, "the twin models no drive power (OPC 40502 5.5)"),
-        "ActTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502 5.5)"),
-        "CmdTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502 5.5)"),
+        "ActLoad": fixed(0.0, _D, "the twin models no drive load (OPC 40502, CncDriveType)", unit="%"),
+        "ActPower": fixed(0.0, _D, "the twin models no drive power (OPC 40502, CncDriveType)"),
+        "ActTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502, CncDriveType)"),
+        "CmdTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502, CncDriveType)"),
     }
 
 
@@ -138,7 +138,7 @@ def _spindle_status(mode: int, reached: bool, rev: int) -> int:
 
 
 def spindle_members(c: int) -> dict[str, Source]:
-    """CncSpindleType's and CncDriveType's mandatory variables (OPC 40502 5.8) for the
+    """CncSpindleType's and CncDriveType's mandatory variables (OPC 40502) for the
     spindle of channel ``c``."""
     ch = f"ch{c}."
     return {
@@ -155,10 +155,10 @@ def spindle_members(c: int) -> dict[str, Source]:
         "CmdGear": fixed(1, _U32, "the twin's spindle has one gear stage"),
         "IsInactive": fixed(False, _B, "the spindle is always configured active"),
         "IsVirtual": fixed(True, _B, "the twin's drives are simulated (ideal drives)"),
-        "ActLoad": fixed(0.0, _D, "the twin models no drive load (OPC 40502 5.5)", unit="%"),
-        "ActPower": fixed(0.0, _D, "the twin models no drive power (OPC 40502 5.5)"),
-        "ActTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502 5.5)"),
-        "CmdTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502 5.5)"),
+        "ActLoad": fixed(0.0, _D, "the twin models no drive load (OPC 40502, CncDriveType)", unit="%"),
+        "ActPower": fixed(0.0, _D, "the twin models no drive power (OPC 40502, CncDriveType)"),
+        "ActTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502, CncDriveType)"),
+        "CmdTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502, CncDriveType)"),
     }
 
 
