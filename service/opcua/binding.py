@@ -226,7 +226,7 @@ class VariableBinder:
                 int(interval_ms * 1e6), self._notifier(var, handle, k))
             if code:
                 log.warning("OPC UA monitored item on %s: %s", var.node_id.to_string(), answer)
-                self._send(callback, handle, bad(_S.BadResourceUnavailable))
+                self._send(callback, handle, [bad(_S.BadResourceUnavailable)])
                 continue
             handles.append(answer)  # type: ignore[arg-type]
 
@@ -249,23 +249,30 @@ class VariableBinder:
             held = var.items.get(handle)
             if held is None:
                 return True
-            _, _, filetime, data = samples[-1]  # the newest of the batch
-            if single:
-                try:
-                    value = good(source.value(dtype.decode(data)), source.variant,
-                                 source_time(filetime))
-                except Exception:
-                    log.exception("OPC UA sample of %s failed", var.node_id.to_string())
-                    value = bad(_S.BadInternalError)
+            values: list[ua.DataValue] = []
+            if single:  # every sample of the batch, in order (a batch spans passes)
+                for _, _, filetime, data in samples:
+                    try:
+                        values.append(good(source.value(dtype.decode(data)), source.variant,
+                                           source_time(filetime)))
+                    except Exception:
+                        log.exception("OPC UA sample of %s failed", var.node_id.to_string())
+                        values.append(bad(_S.BadInternalError))
             else:  # one of several objects changed: the value from all of them, now
-                value = var.value()
-            self._send(held[0], handle, value)
+                values.append(var.value())
+            self._send(held[0], handle, values)
             return True
 
         return notify
 
-    def _send(self, callback: DataChangeCallback, handle: int, value: ua.DataValue) -> None:
-        task = asyncio.get_running_loop().create_task(callback(handle, value))
+    def _send(self, callback: DataChangeCallback, handle: int, values: list[ua.DataValue]
+              ) -> None:
+        """Hand ``values`` to asyncua's monitored item, in order, in one task."""
+        async def deliver() -> None:
+            for value in values:
+                await callback(handle, value)
+
+        task = asyncio.get_running_loop().create_task(deliver())
         self._tasks.add(task)
         task.add_done_callback(self._tasks.discard)
 

@@ -91,7 +91,8 @@ class OpcUaServer:
         binder = VariableBinder(server, self.backend)
         server.iserver.attribute_service = BoundAttributes(server.iserver.aspace, binder)
         await build_cnc_interface(server, binder, self.backend, VENDOR, self.version)
-        await server.start()
+        with asyncua_quiet():  # its warnings of a server without signing policies
+            await server.start()  # (apply_security's choice) and its bind error's trace
         bound = server.bserver
         assert bound is not None  # start() made it
         self.address = (str(bound.hostname), int(bound.port or 0))

@@ -25,6 +25,17 @@ def opcua_url(service: ServiceProcess) -> str:
     return match.group(1)
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _address_space_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """The services of these tests keep their OPC UA address space cache in a directory
+    of the test session, not in the user's ~/.cache (the first start imports, the others
+    load it)."""
+    directory = tmp_path_factory.mktemp("opcua-cache")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("CNC_OPCUA_CACHE_DIR", str(directory))
+        yield directory
+
+
 @pytest.fixture(scope="module")
 def opcua_service() -> Iterator[ServiceProcess]:
     """A service with OPC UA for the tests of one module (the loopback role: admin)."""

@@ -42,27 +42,40 @@ async def _status_of_write(node: Node, variant: ua.Variant) -> int:
     return int(results[0].value)
 
 
-async def test_act_pos_follows_a_running_program(opcua_service: ServiceProcess,
-                                                 ua_client: Client) -> None:
-    ns = await ua_client.get_namespace_index(CNC_URI)
+async def _until(values: _Values, last: float) -> list[float]:
+    """The values of ``values`` up to and including ``last``."""
+    seen = [await asyncio.wait_for(values.queue.get(), TIMEOUT_S)]
+    while seen[-1] != last:
+        seen.append(await asyncio.wait_for(values.queue.get(), TIMEOUT_S))
+    return seen
+
+
+async def test_act_pos_follows_a_running_program_at_the_sampling_interval(
+        opcua_service: ServiceProcess, ua_client: Client) -> None:
+    """Sampled in kernel time at the subscription's interval: 20 ms gives about 50
+    values over the 1 s move, 250 ms about 4."""
     act_pos = await cnc_node(ua_client, "CncInterface", "CncAxisList", "Ch1_X",
                              "PosIndirect", "ActPos")
-    assert act_pos.nodeid.NamespaceIndex == ns
-    values = _Values()
-    subscription = await ua_client.create_subscription(20, values)
-    await subscription.subscribe_data_change(act_pos, queuesize=1000)
-    first = await asyncio.wait_for(values.queue.get(), TIMEOUT_S)
-    assert first == 0.0
+    fast, slow = _Values(), _Values()
+    subscriptions = [await ua_client.create_subscription(20, fast),
+                     await ua_client.create_subscription(250, slow)]
+    for subscription in subscriptions:
+        await subscription.subscribe_data_change(act_pos, queuesize=1000)
+    assert await _until(fast, 0.0) == [0.0]
+    assert await _until(slow, 0.0) == [0.0]
     async with AsyncClient(opcua_service.endpoint, timeout_s=TIMEOUT_S) as cnc:
         await cnc.upload("opcua.nc", PROGRAM.encode())
         await cnc.run_program("opcua.nc", 1)
-        seen = [first]
-        while seen[-1] != 50.0:
-            seen.append(await asyncio.wait_for(values.queue.get(), TIMEOUT_S))
+        fast_seen, slow_seen = await _until(fast, 50.0), await _until(slow, 50.0)
         await cnc.wait_program(1, TIMEOUT_S)
-    await subscription.delete()
-    assert seen == sorted(seen)  # the axis moves one way
-    assert len({v for v in seen if 0.0 < v < 50.0}) >= 3, seen  # and is seen on its way
+        await cnc.upload("back.nc", b"G90 G1 X0 F6000\nM30\n")  # for the next tests
+        await cnc.run_program("back.nc", 1)
+        await cnc.wait_program(1, TIMEOUT_S)
+    for subscription in subscriptions:
+        await subscription.delete()
+    assert fast_seen == sorted(fast_seen)  # the axis moves one way
+    assert 30 <= len(fast_seen) <= 70, fast_seen  # and is seen on its way
+    assert 2 <= len(slow_seen) <= 8, slow_seen
 
 
 async def test_an_operator_writes_the_override(ua_client: Client) -> None:
