@@ -1,10 +1,13 @@
-"""``cnc-service --opcua``: where it listens, off, an address in use, a bad URL."""
+"""``cnc-service --opcua``: where it listens, off, an address in use, a bad URL, malformed
+chunks."""
 
 from __future__ import annotations
 
+import asyncio
 import socket
 from pathlib import Path
 
+import pytest
 from asyncua import Client
 
 from cnc_objects.testing import ServiceProcess, serving
@@ -49,3 +52,24 @@ def test_a_bad_opcua_url_is_refused(tmp_path: Path) -> None:
                            str(tmp_path / "p"), "--opcua", url)
         assert done.returncode == 2, (url, done.stderr)
         assert says in done.stderr, (url, done.stderr)
+
+
+@pytest.mark.parametrize("garbage", [
+    b"\x00" * 64,  # no message type at all
+    b"HELF\xff\xff\xff\xff",  # a Hello that claims 4 GB
+    b"HELF\x20\x00\x00\x00" + b"\x01" * 24,  # a Hello whose fields are nonsense
+    b"MSGF\x10\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00",  # a message on no channel
+    b"OPNF\x08\x00\x00\x00",  # an OpenSecureChannel cut short
+])
+async def test_malformed_chunks_leave_the_service_serving(
+        opcua_service: ServiceProcess, garbage: bytes) -> None:
+    host, port = opcua_url(opcua_service).removeprefix("opc.tcp://").rsplit(":", 1)
+    reader, writer = await asyncio.open_connection(host, int(port))
+    writer.write(garbage)
+    await writer.drain()
+    writer.write_eof()
+    await asyncio.wait_for(reader.read(), 30)  # the server answers or closes; it goes on
+    writer.close()
+    async with Client(opcua_url(opcua_service), timeout=30) as client:
+        assert "http://opcfoundation.org/UA/CNC" in await client.get_namespace_array()
+    assert opcua_service.process.poll() is None
