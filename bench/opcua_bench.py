@@ -1,18 +1,27 @@
-"""OPC UA reads: asyncua's client reading 100 nodes per Read call, against asyncua's own
-server serving 100 static variables (a second process: the baseline), then against the
-real ``cnc-service`` (realtime clock, 1 ms cycle) reading 100 bound CncInterface
-variables. The ratio is taken within each run (baseline right before the service), its
-median printed. Target: >= 0.8 of the baseline (issue 40).
+"""``make bench`` OPC UA part (issue 40).
 
-    python -m bench.opcua_bench [RUNS]
+Reads: asyncua's client reading 100 nodes per Read call, against asyncua's own server
+serving 100 static variables (a second process: the baseline), then against the real
+``cnc-service`` (realtime clock, 1 ms cycle) reading 100 bound CncInterface variables.
+The ratio is taken within each run (baseline right before the service), its median
+printed. Target: >= 0.8 of the baseline.
+
+Start-up: from spawning ``cnc-service --clock virtual`` to its last start-up line, with
+``--opcua off``, with OPC UA and no address space cache (cold), and with the cache the
+cold start wrote (warm); medians. Target: < 3 s.
+
+    python -m bench.opcua_bench [RUNS]      (or python -m bench --part opcua)
 """
 
 from __future__ import annotations
 
 import asyncio
 import multiprocessing as mp
+import os
+import shutil
 import statistics
 import sys
+import tempfile
 import time
 
 from asyncua import Client, Server, ua
@@ -58,7 +67,8 @@ async def _reads_per_s(url: str, ids: list[str]) -> float:
 
 
 async def _bound_ids(url: str) -> list[str]:
-    """``NODES`` variables of the CncInterface bound to objects (channel and axis members)."""
+    """``NODES`` Double variables of the CncInterface bound to objects (channel, axis and
+    position members: the baseline's type, so that both encode the same values)."""
     async with Client(url, timeout=30) as client:
         ns = await client.get_namespace_index(CNC_URI)
         found: list[str] = []
@@ -67,12 +77,57 @@ async def _bound_ids(url: str) -> list[str]:
                                                            f"{ns}:{list_name}"])
             for instance in await parent.get_children():
                 for child in await instance.get_children(nodeclassmask=ua.NodeClass.Variable):
-                    if child.nodeid.NamespaceIndex == ns:
+                    if child.nodeid.NamespaceIndex != ns:
+                        continue
+                    if await child.read_data_type() == ua.NodeId(ua.ObjectIds.Double):
                         found.append(child.nodeid.to_string())
+                    else:  # a position: its ActPos, CmdPos, RemDist are Doubles
+                        found += [c.nodeid.to_string() for c in await child.get_children(
+                            nodeclassmask=ua.NodeClass.Variable)
+                            if c.nodeid.NamespaceIndex == ns
+                            and await c.read_data_type() == ua.NodeId(ua.ObjectIds.Double)]
+        assert len(found) >= NODES, len(found)
         return found[:NODES]
 
 
+def _start_s(*args: str) -> float:
+    began = time.perf_counter()
+    service = start_service(*args, timeout_s=180)
+    elapsed = time.perf_counter() - began
+    service.stop()
+    return elapsed
+
+
+def startup(runs: int = 3) -> None:
+    """The service's start-up time: OPC UA off, cold, warm (medians of ``runs``)."""
+    cache = tempfile.mkdtemp(prefix="opcua-bench-cache-")
+    before = os.environ.get("CNC_OPCUA_CACHE_DIR")
+    os.environ["CNC_OPCUA_CACHE_DIR"] = cache  # the services inherit it
+    off, cold, warm = [], [], []
+    try:
+        for _ in range(runs):
+            off.append(_start_s("--opcua", "off"))
+            shutil.rmtree(cache, ignore_errors=True)
+            cold.append(_start_s("--opcua", "opc.tcp://127.0.0.1:0"))
+            warm.append(_start_s("--opcua", "opc.tcp://127.0.0.1:0"))
+    finally:
+        shutil.rmtree(cache, ignore_errors=True)
+        if before is None:
+            os.environ.pop("CNC_OPCUA_CACHE_DIR", None)
+        else:
+            os.environ["CNC_OPCUA_CACHE_DIR"] = before
+    print(f"cnc-service start-up, {runs} runs (medians; target < 3 s):")
+    for name, figures in (("OPC UA off", off), ("OPC UA, cold", cold), ("OPC UA, warm", warm)):
+        print(f"  {name:22s} {statistics.median(figures):10.2f} s")
+
+
 def main(runs: int = 3) -> None:
+    reads(runs)
+    startup(runs)
+
+
+def reads(runs: int = 3) -> None:
+    """Read service figures against asyncua's static server."""
     ctx = mp.get_context("spawn")
     ready: mp.Queue = ctx.Queue()  # type: ignore[type-arg]
     static = ctx.Process(target=_serve_static, args=(ready,), daemon=True)
