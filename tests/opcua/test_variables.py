@@ -119,3 +119,27 @@ async def test_a_monitor_may_not_write(monitor_service: ServiceProcess) -> None:
         status = await _status_of_write(override, ua.Variant(50.0, ua.VariantType.Double))
         assert status == _S.BadUserAccessDenied
         assert await override.read_value() == 100.0
+
+
+async def _notifications_until(cnc: AsyncClient, count: int) -> int:
+    """``cnc_notifications_r`` once it is ``count`` (read again until then, or the timeout)."""
+    deadline = asyncio.get_running_loop().time() + TIMEOUT_S
+    while True:
+        held = int(await cnc.read("cnc_notifications_r"))
+        if held == count or asyncio.get_running_loop().time() > deadline:
+            return held
+
+
+async def test_a_closed_session_frees_its_hub_subscriptions(
+        opcua_service: ServiceProcess) -> None:
+    async with AsyncClient(opcua_service.endpoint, timeout_s=TIMEOUT_S) as cnc:
+        assert await _notifications_until(cnc, 0) == 0
+        async with Client(opcua_url(opcua_service), timeout=30) as client:
+            ns = await client.get_namespace_index(CNC_URI)
+            channel = await cnc_node(client, "CncInterface", "CncChannelList", "Channel1")
+            subscription = await client.create_subscription(50, _Values())
+            # one object each, and ActProgramStatus of two (state and waiting for start)
+            for name in ("ActOverride", "ActFeedrate", "ActProgramStatus"):
+                await subscription.subscribe_data_change(await channel.get_child(f"{ns}:{name}"))
+            assert await _notifications_until(cnc, 4) == 4
+        assert await _notifications_until(cnc, 0) == 0  # the session closed: all freed
