@@ -16,10 +16,13 @@ from asyncua import ua
 from cnc_objects.protocol.values import ChannelMode, ChannelState
 
 from .sources import Source, derived, fixed, plain, scaled
+from .values import engineering_factor
 
 _D, _U32, _I32 = ua.VariantType.Double, ua.VariantType.UInt32, ua.VariantType.Int32
 _B, _S = ua.VariantType.Boolean, ua.VariantType.String
 
+MM_PER_UM01 = engineering_factor("0.1 um")  # the objects' positions -> mm
+POSITION_RANGE = (-(2**31) * MM_PER_UM01, (2**31 - 1) * MM_PER_UM01)  # mm: SGN32 in 0.1 um
 OVERRIDE_RANGE = (0.0, 150.0)  # % (the feed override's and spindle override's limits)
 FEED_RANGE = (0.0, 1e6)  # mm/min
 SPEED_RANGE = (-1e5, 1e5)  # rpm, signed: negative turns CCW (M4)
@@ -60,6 +63,20 @@ def _m_functions(spindle_mode: int, coolant: int) -> list[int]:
     return [_SPINDLE_M.get(spindle_mode, 5), *_COOLANT_M.get(coolant, (9,))]
 
 
+#: CncDriveType's load, power and torque: the twin's drives are ideal, none is modelled;
+#: 0 with a range of 0 (OPC 40502, CncDriveType).
+DRIVE_UNMODELLED = {
+    "ActLoad": fixed(0.0, _D, "the twin models no drive load (OPC 40502, CncDriveType)",
+                     unit="%", limits=(0.0, 0.0)),
+    "ActPower": fixed(0.0, _D, "the twin models no drive power (OPC 40502, CncDriveType)",
+                      unit="W", limits=(0.0, 0.0)),
+    "ActTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502, CncDriveType)",
+                       unit="N.m", limits=(0.0, 0.0)),
+    "CmdTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502, CncDriveType)",
+                       unit="N.m", limits=(0.0, 0.0)),
+}
+
+
 def channel_members(c: int, first_axis: str) -> dict[str, Source]:
     """CncChannelType's mandatory members (OPC 40502) for channel ``c``."""
     ch = f"ch{c}."
@@ -89,7 +106,7 @@ def channel_members(c: int, first_axis: str) -> dict[str, Source]:
         "BlockMode": plain(ch + "mc_active_single_block_r", _B, bool),
         "FeedHold": plain(ch + "mc_active_state_r", _B, lambda s: s == ChannelState.HOLD),
         "DryRunFeed": fixed(0.0, _D, "the twin has no dry-run feed (OPC 40502, "
-                            "CncChannelType)", unit="mm/min"),
+                            "CncChannelType)", unit="mm/min", limits=FEED_RANGE),
         "ToolId": plain(ch + "mc_active_tool_r", _U32),
     }
 
@@ -110,13 +127,11 @@ def axis_members(axis: str) -> dict[str, Source]:
         "IsReferenced": plain(axis + "homing_referenced_r", _B, bool),
         "IsRotational": plain(axis + "axis_type", _B, lambda t: t == 2),
         "ZeroOffset": derived((axis + "command_position_acs", axis + "command_position_pcs"),
-                              lambda acs, pcs: (acs - pcs) / 10_000.0, _D),
+                              lambda acs, pcs: (acs - pcs) * MM_PER_UM01, _D,
+                              unit="mm", limits=POSITION_RANGE),
         "IsInactive": fixed(False, _B, "every configured axis is active"),
         "IsVirtual": fixed(True, _B, "the twin's drives are simulated (ideal drives)"),
-        "ActLoad": fixed(0.0, _D, "the twin models no drive load (OPC 40502, CncDriveType)", unit="%"),
-        "ActPower": fixed(0.0, _D, "the twin models no drive power (OPC 40502, CncDriveType)"),
-        "ActTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502, CncDriveType)"),
-        "CmdTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502, CncDriveType)"),
+        **DRIVE_UNMODELLED,
     }
 
 
@@ -155,10 +170,7 @@ def spindle_members(c: int) -> dict[str, Source]:
         "CmdGear": fixed(1, _U32, "the twin's spindle has one gear stage"),
         "IsInactive": fixed(False, _B, "the spindle is always configured active"),
         "IsVirtual": fixed(True, _B, "the twin's drives are simulated (ideal drives)"),
-        "ActLoad": fixed(0.0, _D, "the twin models no drive load (OPC 40502, CncDriveType)", unit="%"),
-        "ActPower": fixed(0.0, _D, "the twin models no drive power (OPC 40502, CncDriveType)"),
-        "ActTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502, CncDriveType)"),
-        "CmdTorque": fixed(0.0, _D, "the twin models no drive torque (OPC 40502, CncDriveType)"),
+        **DRIVE_UNMODELLED,
     }
 
 

@@ -64,12 +64,13 @@ def scaled(name: str, unit: str, limits: tuple[float, float] | None = None,
 
 
 def derived(names: tuple[str, ...], value: Callable[..., Any], variant: ua.VariantType,
-            array: bool = False) -> Source:
+            array: bool = False, unit: str | None = None,
+            limits: tuple[float, float] | None = None) -> Source:
     """A value computed from several objects (a status from mode and state)."""
-    return Source(names, value, variant, array=array)
+    return Source(names, value, variant, array=array, unit=unit, limits=limits)
 
 
 def fixed(value: Any, variant: ua.VariantType, why: str, unit: str | None = None,
-          array: bool = False) -> Source:
+          array: bool = False, limits: tuple[float, float] | None = None) -> Source:
     """A value the twin has no object for; ``why`` says so (docs/opcua.md)."""
-    return Source((), lambda: value, variant, array=array, unit=unit, why=why)
+    return Source((), lambda: value, variant, array=array, unit=unit, limits=limits, why=why)

@@ -40,6 +40,8 @@ UNECE_CODES: dict[str, tuple[str, str]] = {
     "rpm": ("RPM", "revolutions per minute"),
     "deg": ("DD", "degree [unit of angle]"),
     "s": ("SEC", "second [unit of time]"),
+    "W": ("WTT", "watt"),
+    "N.m": ("NU", "newton metre"),
 }
 UNECE_NAMESPACE = "http://www.opcfoundation.org/UA/units/un/cefact"
 

@@ -100,3 +100,22 @@ async def test_values_have_their_engineering_units(ua_client: Client) -> None:
     feed = await channel.get_child(f"{ns}:ActFeedrate")
     units = await (await feed.get_child("0:EngineeringUnits")).read_value()
     assert units.DisplayName.Text == "mm/min"
+
+
+async def test_every_analog_item_has_units_and_a_range(ua_client: Client) -> None:
+    interface = await cnc_node(ua_client, "CncInterface")
+    variables: list[Node] = []
+    await _walk(interface, "CncInterface", _Types(ua_client), [], variables)
+    analog = ua.NodeId(ua.ObjectIds.AnalogItemType)
+    checked, lacking = 0, []
+    for variable in variables:
+        if await variable.read_type_definition() != analog:
+            continue
+        checked += 1
+        path = (await variable.read_browse_name()).Name
+        units = await (await variable.get_child("0:EngineeringUnits")).read_value()
+        eu_range = await (await variable.get_child("0:EURange")).read_value()
+        if not isinstance(units, ua.EUInformation) or not isinstance(eu_range, ua.Range):
+            lacking.append(path)
+    assert checked > 50  # feeds, overrides, speeds, drive figures of every instance
+    assert lacking == [], sorted(set(lacking))
