@@ -344,8 +344,7 @@ async def _start_opcua(backend: Backend, opcua: OpcUaListen) -> OpcUaServer | No
     """The listening OPC UA front end, or None after saying in one line why it cannot be."""
     from .opcua.server import OpcUaServer  # asyncua only where OPC UA is served
 
-    version = backend.kernel.config.name
-    opcua_server = OpcUaServer(backend, opcua.loopback_role, version)
+    opcua_server = OpcUaServer(backend, opcua.loopback_role)
     try:
         await opcua_server.start(opcua.host, opcua.port)
     except OSError as exc:
@@ -359,7 +358,7 @@ async def _start_opcua(backend: Backend, opcua: OpcUaListen) -> OpcUaServer | No
 
 @app.command(
     epilog="Exit codes: 0 stopped by SIGINT or SIGTERM; 2 bad usage, bad configuration, "
-    "unusable program store, endpoint or ADS address in use."
+    "unusable program store, endpoint, ADS or OPC UA address in use."
 )
 def run(
     config_file: Path | None = typer.Option(

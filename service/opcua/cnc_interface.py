@@ -25,7 +25,8 @@ INTERFACE_NAME = "CncInterface"
 
 async def build_cnc_interface(server: Server, binder: VariableBinder, backend: Backend,
                               vendor: str, version: str) -> Node:
-    """Add the CncInterface with every channel, axis and spindle; returns its node."""
+    """Add the CncInterface with every channel, axis and spindle; returns its node.
+    ``version``: the kernel's (VendorRevision)."""
     ns = await server.get_namespace_index(CNC_URI)
     objects = server.nodes.objects
     interface = await _instance(objects, ns, INTERFACE_NAME, CNC_INTERFACE_TYPE)
@@ -42,14 +43,15 @@ async def build_cnc_interface(server: Server, binder: VariableBinder, backend: B
         c = channel.id
         node = await _instance(channel_list, ns, f"Channel{c}", CHANNEL_TYPE)
         await (await node.get_child(f"{ns}:Id")).write_value(ua.Variant(c, ua.VariantType.UInt32))
-        await bind_members(binder, node, ns, members.channel_members(c, f"ch{c}.ax1."))
-        await _positions(binder, node, ns, c, [a.name for a in channel.axes])
+        await bind_members(binder, node, ns, members.channel_members(c, bool(channel.axes)))
+        await _positions(binder, node, ns, c, [(a.name, a.axis_type == "rotary")
+                                                for a in channel.axes])
         for a, axis in enumerate(channel.axes, start=1):
             name = axis.name if unique else f"Ch{c}_{axis.name}"
             axis_node = await _instance(axis_list, ns, name, AXIS_TYPE)
-            prefix = f"ch{c}.ax{a}."
-            await bind_members(binder, axis_node, ns, members.axis_members(prefix))
-            for member, parts in members.axis_positions(prefix).items():
+            prefix, rotary = f"ch{c}.ax{a}.", axis.axis_type == "rotary"
+            await bind_members(binder, axis_node, ns, members.axis_members(prefix, rotary))
+            for member, parts in members.axis_positions(prefix, rotary).items():
                 await bind_position(binder, axis_node, ns, member, parts)
             await _act_channel(axis_node, ns, node)
             await node.add_reference(axis_node, ua.ObjectIds.Organizes)
@@ -102,24 +104,26 @@ async def bind_position(binder: VariableBinder, node: Node, ns: int, name: str,
         return struct(ActPos=fields[0], CmdPos=fields[1], RemDist=fields[2])
 
     variant = ua.VariantType.ExtensionObject if struct is not None else ua.VariantType.Double
-    await binder.bind(variable.nodeid, Source(objects, value, variant, unit="mm"))
+    await binder.bind(variable.nodeid, Source(objects, value, variant,
+                                              unit=parts["ActPos"].unit,
+                                              limits=members.POSITION_RANGE))
 
 
 async def _positions(binder: VariableBinder, channel: Node, ns: int, c: int,
-                     axis_names: list[str]) -> None:
+                     axes: list[tuple[str, bool]]) -> None:
     """PosTcpBcs<X..C> (machine coordinates) and PosTcpWcs<X..C> (workpiece coordinates)
-    of the channel: the channel's axis of that name; an axis the channel does not have
-    reads 0 (docs/opcua.md)."""
+    of the channel: the channel's axis of that name (``axes``: name, rotary); an axis
+    the channel does not have reads 0 (docs/opcua.md)."""
+    names = [name for name, _ in axes]
     for coordinate in "XYZABC":
-        a = axis_names.index(coordinate) + 1 if coordinate in axis_names else None
         for frame in ("Bcs", "Wcs"):
             name = f"PosTcp{frame}{coordinate}"
-            if a is None:
+            if coordinate not in names:
                 parts = members.fixed_position(f"channel {c} has no {coordinate} axis")
             else:
-                prefix = f"ch{c}.ax{a}."
-                parts = members.axis_positions(prefix)["PosDirect" if frame == "Bcs"
-                                                       else "PosIndirect"]
+                a = names.index(coordinate)
+                positions = members.axis_positions(f"ch{c}.ax{a + 1}.", axes[a][1])
+                parts = positions["PosDirect" if frame == "Bcs" else "PosIndirect"]
             await bind_position(binder, channel, ns, name, parts)
 
 

@@ -77,16 +77,18 @@ DRIVE_UNMODELLED = {
 }
 
 
-def channel_members(c: int, first_axis: str) -> dict[str, Source]:
+def channel_members(c: int, has_axes: bool = True) -> dict[str, Source]:
     """CncChannelType's mandatory members (OPC 40502) for channel ``c``."""
     ch = f"ch{c}."
+    jog = (scaled(ch + "ax1.manual_increment_w", "0.1 um", (0.0, 10.0)) if has_axes else
+           fixed(0.0, _D, "the channel has no axis", unit="mm", limits=(0.0, 10.0)))
     return {
         "ActFeedrate": scaled(ch + "mc_active_feedrate_r", "um/s", FEED_RANGE),
         "CmdFeedrate": scaled(ch + "mc_command_feedrate_r", "um/s", FEED_RANGE),
         "ActOverride": scaled(ch + "mc_active_feed_override_r", "0.1 %", OVERRIDE_RANGE),
         "CmdOverride": scaled(ch + "mc_command_feed_override_r", "0.1 %", OVERRIDE_RANGE,
                               write_object=ch + "mc_command_feed_override_w"),
-        "ActJogIncrement": scaled(first_axis + "manual_increment_w", "0.1 um", (0.0, 10.0)),
+        "ActJogIncrement": jog,
         "ActMainProgramName": plain(ch + "mc_active_program_name_r", _S),
         "ActMainProgramFile": plain(ch + "mc_active_program_name_r", _S),
         "ActProgramName": plain(ch + "mc_active_file_name_r", _S),
@@ -111,15 +113,19 @@ def channel_members(c: int, first_axis: str) -> dict[str, Source]:
     }
 
 
-def position(act: str, cmd: str, rem: str | None, unit: str = "0.1 um") -> dict[str, Source]:
-    """CncPositionVariableType's members (OPC 40502): ActPos, CmdPos, RemDist."""
-    members = {"ActPos": scaled(act, unit), "CmdPos": scaled(cmd, unit)}
-    members["RemDist"] = (scaled(rem, unit) if rem is not None else
-                          fixed(0.0, _D, "the twin keeps no remaining distance here", unit="mm"))
+def position(act: str, cmd: str, rem: str | None, unit: str = "0.1 um",
+             shown_as: str | None = None) -> dict[str, Source]:
+    """CncPositionVariableType's members (OPC 40502): ActPos, CmdPos, RemDist
+    (``shown_as``: ``deg`` for a rotary axis, whose objects hold 0.0001 deg)."""
+    members = {"ActPos": scaled(act, unit, shown_as=shown_as),
+               "CmdPos": scaled(cmd, unit, shown_as=shown_as)}
+    members["RemDist"] = (scaled(rem, unit, shown_as=shown_as) if rem is not None else
+                          fixed(0.0, _D, "the twin keeps no remaining distance here",
+                                unit=shown_as or "mm"))
     return members
 
 
-def axis_members(axis: str) -> dict[str, Source]:
+def axis_members(axis: str, rotary: bool = False) -> dict[str, Source]:
     """CncAxisType's and CncDriveType's mandatory variables (OPC 40502) for the
     channel axis ``axis`` (``ch1.ax1.``)."""
     return {
@@ -128,21 +134,23 @@ def axis_members(axis: str) -> dict[str, Source]:
         "IsRotational": plain(axis + "axis_type", _B, lambda t: t == 2),
         "ZeroOffset": derived((axis + "command_position_acs", axis + "command_position_pcs"),
                               lambda acs, pcs: (acs - pcs) * MM_PER_UM01, _D,
-                              unit="mm", limits=POSITION_RANGE),
+                              unit="deg" if rotary else "mm", limits=POSITION_RANGE),
         "IsInactive": fixed(False, _B, "every configured axis is active"),
         "IsVirtual": fixed(True, _B, "the twin's drives are simulated (ideal drives)"),
         **DRIVE_UNMODELLED,
     }
 
 
-def axis_positions(axis: str) -> dict[str, dict[str, Source]]:
+def axis_positions(axis: str, rotary: bool = False) -> dict[str, dict[str, Source]]:
     """PosDirect (machine coordinates, ACS) and PosIndirect (workpiece coordinates) of
-    ``axis``: the ideal drive follows its command, ActPos = CmdPos."""
+    ``axis``: the ideal drive follows its command, ActPos = CmdPos. A rotary axis's
+    positions are in degrees."""
+    deg = "deg" if rotary else None
     return {
         "PosDirect": position(axis + "command_position_acs", axis + "command_position_acs",
-                              axis + "distance_to_go_pcs"),
+                              axis + "distance_to_go_pcs", shown_as=deg),
         "PosIndirect": position(axis + "actual_position_pcs", axis + "command_position_pcs",
-                                axis + "distance_to_go_pcs"),
+                                axis + "distance_to_go_pcs", shown_as=deg),
     }
 
 

@@ -44,10 +44,9 @@ def apply_security(server: Server, loopback_role: Role) -> None:
 class OpcUaServer:
     """The OPC UA front end of one service."""
 
-    def __init__(self, backend: Backend, loopback_role: Role, version: str) -> None:
+    def __init__(self, backend: Backend, loopback_role: Role) -> None:
         self.backend = backend
         self.loopback_role = loopback_role
-        self.version = version
         self.address: tuple[str, int] = ("", 0)
         self.nodes_left_out = 0  # nodeset nodes asyncua could not import
         self.start_s = 0.0  # how long ``start`` took (nodesets, instances, listening)
@@ -90,7 +89,7 @@ class OpcUaServer:
             self.cache_note = f"nodesets from {path}"
         binder = VariableBinder(server, self.backend)
         server.iserver.attribute_service = BoundAttributes(server.iserver.aspace, binder)
-        await build_cnc_interface(server, binder, self.backend, VENDOR, self.version)
+        await build_cnc_interface(server, binder, self.backend, VENDOR, self._version())
         with asyncua_quiet():  # its warnings of a server without signing policies
             await server.start()  # (apply_security's choice) and its bind error's trace
         bound = server.bserver
@@ -99,6 +98,11 @@ class OpcUaServer:
         self.binder = binder
         self._server = server
         self.start_s = time.perf_counter() - began
+
+    def _version(self) -> str:
+        """The kernel's version, as the object ``cnc_version_r`` serves it."""
+        entry = self.backend.space.by_name("cnc_version_r")
+        return str(entry.read()) if entry is not None and entry.read is not None else ""
 
     async def close(self) -> None:
         """Close every session and stop listening."""

@@ -47,10 +47,11 @@ def plain(name: str, variant: ua.VariantType, convert: Callable[[Any], Any] = la
 
 
 def scaled(name: str, unit: str, limits: tuple[float, float] | None = None,
-           write_object: str | None = None) -> Source:
+           write_object: str | None = None, shown_as: str | None = None) -> Source:
     """One object's value in its engineering unit as a Double (``objects.units``: 0.1 um
     -> mm, um/s -> mm/min, 0.1 % -> %); written back (``write_object``) rounded to the
-    object's resolution."""
+    object's resolution. ``shown_as``: another name of that unit (a rotary axis's
+    positions are 0.0001 deg in the same objects: ``deg``)."""
     factor = engineering_factor(unit)
     to_raw = None
     if write_object is not None:
@@ -59,7 +60,8 @@ def scaled(name: str, unit: str, limits: tuple[float, float] | None = None,
                 raise ValueError(f"{value!r} is not a number")
             return round(value / factor)
     return Source((name,), lambda raw: float(raw) * factor, ua.VariantType.Double,
-                  unit=engineering_unit(unit), limits=limits, write_object=write_object,
+                  unit=shown_as or engineering_unit(unit), limits=limits,
+                  write_object=write_object,
                   to_raw=to_raw)
 
 

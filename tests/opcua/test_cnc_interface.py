@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from asyncua import Client, Node, ua
 
-from tests.opcua.conftest import cnc_node
+from cnc_objects.testing import serving
+from tests.opcua.conftest import OPCUA_ANY_PORT, OPCUA_START_S, cnc_node, opcua_url
 
 MANDATORY = ua.NodeId(ua.ObjectIds.ModellingRule_Mandatory)
 _FORWARD, _INVERSE = ua.BrowseDirection.Forward, ua.BrowseDirection.Inverse
@@ -119,3 +120,20 @@ async def test_every_analog_item_has_units_and_a_range(ua_client: Client) -> Non
             lacking.append(path)
     assert checked > 50  # feeds, overrides, speeds, drive figures of every instance
     assert lacking == [], sorted(set(lacking))
+
+
+async def test_a_rotary_axis_is_in_degrees() -> None:
+    with serving("--machine", "five-axis-ac", *OPCUA_ANY_PORT,
+                 timeout_s=OPCUA_START_S) as service:
+        async with Client(opcua_url(service), timeout=30) as client:
+            ns = await client.get_namespace_index("http://opcfoundation.org/UA/CNC")
+            channel = await cnc_node(client, "CncInterface", "CncChannelList", "Channel1")
+            units = {}
+            for name in ("PosTcpBcsA", "PosTcpWcsC", "PosTcpBcsX", "PosTcpBcsB"):
+                position = await channel.get_child(f"{ns}:{name}")
+                act = await position.get_child(f"{ns}:ActPos")
+                eu = await (await act.get_child("0:EngineeringUnits")).read_value()
+                units[name] = eu.DisplayName.Text
+    # the machine's A and C are rotary; it has no B: that position reads 0 mm
+    assert units == {"PosTcpBcsA": "deg", "PosTcpWcsC": "deg", "PosTcpBcsX": "mm",
+                     "PosTcpBcsB": "mm"}
