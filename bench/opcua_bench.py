@@ -6,6 +6,11 @@ serving 100 static variables (a second process: the baseline), then against the 
 The ratio is taken within each run (baseline right before the service), its median
 printed. Target: >= 0.8 of the baseline.
 
+Notifications: 1 000 monitored items at 100 ms on 10 variables that change faster than
+that (100 items each): on asyncua's server a task writes the 10 values every 10 ms; on
+the service X and Y move (a 10 s program) and the items watch their positions and
+distances to go. Data-change notifications received per second, ratio within each run.
+
 Start-up: from spawning ``cnc-service --clock virtual`` to its last start-up line, with
 ``--opcua off``, with OPC UA and no address space cache (cold), and with the cache the
 cold start wrote (warm); medians. Target: < 3 s.
@@ -90,6 +95,123 @@ async def _bound_ids(url: str) -> list[str]:
         return found[:NODES]
 
 
+ITEMS = 1000
+WATCHED = 10
+NOTIFY_S = 5.0  # seconds counted per measurement
+MOVE = "G90 G1 X400 Y400 F2400\nM30\n"  # 10 s: X and Y move the whole time
+
+
+def _serve_changing(ready: mp.Queue) -> None:  # type: ignore[type-arg]
+    """asyncua's server with ``WATCHED`` Doubles rewritten every 10 ms (second process)."""
+
+    async def main() -> None:
+        server = Server()
+        await server.init()
+        server.set_endpoint("opc.tcp://127.0.0.1:0")
+        server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+        folder = await server.nodes.objects.add_folder(2, "Changing")
+        nodes = [await folder.add_variable(2, f"v{k}", 0.0) for k in range(WATCHED)]
+        await server.start()
+        ready.put((server.bserver.port, [n.nodeid.to_string() for n in nodes]))  # type: ignore[union-attr]
+        value = 0.0
+        while True:
+            value += 1.0
+            for node in nodes:
+                await server.write_attribute_value(node.nodeid, ua.DataValue(value))
+            await asyncio.sleep(0.01)  # the baseline's own pace, not a synchronisation
+
+    asyncio.run(main())
+
+
+class _Count:
+    def __init__(self) -> None:
+        self.count = 0
+
+    def datachange_notification(self, node: object, value: object, data: object) -> None:
+        self.count += 1
+
+
+async def _notifications_per_s(url: str, ids: list[str], started: asyncio.Event | None = None
+                               ) -> float:
+    async with Client(url, timeout=60) as client:
+        counter = _Count()
+        subscription = await client.create_subscription(100, counter)
+        nodes = [client.get_node(ids[k % len(ids)]) for k in range(ITEMS)]
+        await subscription.subscribe_data_change(nodes, queuesize=1)
+        if started is not None:
+            started.set()
+        await asyncio.sleep(1.0)  # the first values out of the way (a measuring window)
+        before, began = counter.count, time.perf_counter()
+        await asyncio.sleep(NOTIFY_S)  # the measuring window
+        rate = (counter.count - before) / (time.perf_counter() - began)
+        await subscription.delete()
+    return rate
+
+
+async def _moving_ids(url: str) -> list[str]:
+    """Positions and distances to go of X and Y: 10 Doubles that change while they move."""
+    async with Client(url, timeout=30) as client:
+        ns = await client.get_namespace_index(CNC_URI)
+        found = []
+        for axis in ("Ch1_X", "Ch1_Y"):
+            for position in ("PosDirect", "PosIndirect"):
+                for member in ("ActPos", "CmdPos") + (("RemDist",) if position == "PosDirect"
+                                                      else ()):
+                    node = await client.nodes.objects.get_child(
+                        [f"{ns}:{n}" for n in ("CncInterface", "CncAxisList", axis, position,
+                                               member)])
+                    found.append(node.nodeid.to_string())
+        return found[:WATCHED]
+
+
+async def _service_notifications(url: str, endpoint: str, ids: list[str]) -> float:
+    from cnc_objects.clients import AsyncClient
+
+    async with AsyncClient(endpoint, timeout_s=60) as cnc:
+        await cnc.reset(1)
+        await cnc.upload("bench-move.nc", MOVE.encode())
+        await cnc.upload("bench-back.nc", b"G90 G0 X0 Y0\nM30\n")
+        started = asyncio.Event()
+        counting = asyncio.create_task(_notifications_per_s(url, ids, started))
+        await started.wait()
+        await cnc.run_program("bench-move.nc", 1)
+        rate = await counting
+        await cnc.wait_program(1, 60)
+        await cnc.run_program("bench-back.nc", 1)
+        await cnc.wait_program(1, 60)
+    return rate
+
+
+def notifications(runs: int = 3) -> None:
+    """Data-change notifications/s, 1 000 items at 100 ms, against asyncua's server."""
+    ctx = mp.get_context("spawn")
+    ready: mp.Queue = ctx.Queue()  # type: ignore[type-arg]
+    changing = ctx.Process(target=_serve_changing, args=(ready,), daemon=True)
+    changing.start()
+    port, base_ids = ready.get(timeout=120)
+    service = start_service("--clock", "realtime", "--opcua", "opc.tcp://127.0.0.1:0",
+                            timeout_s=180)
+    try:
+        url = next(line.split("OPC UA on ")[1].split()[0] for line in service.log
+                   if "OPC UA on " in line)
+        ids = asyncio.run(_moving_ids(url))
+        base, ours, ratios = [], [], []
+        for _ in range(runs):
+            b = asyncio.run(_notifications_per_s(f"opc.tcp://127.0.0.1:{port}", base_ids))
+            o = asyncio.run(_service_notifications(url, service.endpoint, ids))
+            base.append(b)
+            ours.append(o)
+            ratios.append(o / b)
+        print(f"OPC UA data changes, {ITEMS} items at 100 ms on {WATCHED} variables, "
+              f"{runs} runs (medians):")
+        print(f"  asyncua server (10 ms writes) {statistics.median(base):8.0f} notifications/s")
+        print(f"  cnc-service (X, Y moving)     {statistics.median(ours):8.0f} notifications/s")
+        print(f"  ratio                         {statistics.median(ratios):8.2f}  (target >= 0.8)")
+    finally:
+        service.stop()
+        changing.kill()
+
+
 def _start_s(*args: str) -> float:
     began = time.perf_counter()
     service = start_service(*args, timeout_s=180)
@@ -123,6 +245,7 @@ def startup(runs: int = 3) -> None:
 
 def main(runs: int = 3) -> None:
     reads(runs)
+    notifications(runs)
     startup(runs)
 
 
@@ -156,4 +279,6 @@ def reads(runs: int = 3) -> None:
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 3)
+    runs = int(sys.argv[1]) if len(sys.argv) > 1 else 3
+    {"reads": reads, "notifications": notifications, "startup": startup}.get(
+        sys.argv[2] if len(sys.argv) > 2 else "", main)(runs)
