@@ -11,6 +11,11 @@ that (100 items each): on asyncua's server a task writes the 10 values every 10 
 the service X and Y move (a 10 s program) and the items watch their positions and
 distances to go. Data-change notifications received per second, ratio within each run.
 
+Jitter: a realtime service of the bench machine runs a long program of short blocks; its
+cycle figures (cnc_cycle_jitter_p50/p99/max, overruns) are taken alone, then with 10
+OPC UA sessions each subscribed at 100 ms to every axis position and the channels' feeds
+and states (as the web bench's 10 sessions watch the machine page).
+
 Start-up: from spawning ``cnc-service --clock virtual`` to its last start-up line, with
 ``--opcua off``, with OPC UA and no address space cache (cold), and with the cache the
 cold start wrote (warm); medians. Target: < 3 s.
@@ -212,6 +217,90 @@ def notifications(runs: int = 3) -> None:
         changing.kill()
 
 
+SESSIONS = 10
+JITTER_S = 10.0
+
+
+async def _session_items(url: str) -> list[str]:
+    """What a dashboard watches: every position member of every axis, the channels'
+    feeds, overrides and states."""
+    async with Client(url, timeout=30) as client:
+        ns = await client.get_namespace_index(CNC_URI)
+        interface = await client.nodes.objects.get_child(f"{ns}:CncInterface")
+        found = []
+        axes = await (await interface.get_child(f"{ns}:CncAxisList")).get_children()
+        for axis in axes:
+            for position in ("PosDirect", "PosIndirect"):
+                node = await axis.get_child(f"{ns}:{position}")
+                found += [c.nodeid.to_string() for c in await node.get_children()
+                          if c.nodeid.NamespaceIndex == ns]
+        channels = await (await interface.get_child(f"{ns}:CncChannelList")).get_children()
+        for channel in channels:
+            for name in ("ActFeedrate", "CmdFeedrate", "ActOverride", "ActStatus",
+                         "ActProgramStatus", "ActProgramName", "ActProgramBlock"):
+                found.append((await channel.get_child(f"{ns}:{name}")).nodeid.to_string())
+        return found
+
+
+async def _with_sessions(url: str, endpoint: str, ids: list[str]) -> object:
+    from cnc_objects.clients import AsyncClient
+
+    from .web_bench import _cycles
+
+    async with AsyncClient(endpoint) as control:
+        clients = [Client(url, timeout=60) for _ in range(SESSIONS)]
+        for client in clients:
+            await client.connect()
+            subscription = await client.create_subscription(100, _Count())
+            await subscription.subscribe_data_change([client.get_node(i) for i in ids])
+        await asyncio.sleep(1.0)  # every session has its first values (a settling time)
+        figures = await _cycles(control, JITTER_S)
+        for client in clients:
+            await client.disconnect()
+    return figures
+
+
+def jitter(runs: int = 3) -> None:
+    """Cycle figures alone and with 10 OPC UA sessions subscribed (realtime clock)."""
+    from cnc_objects.clients import AsyncClient
+
+    from .common import BENCH_MACHINE
+    from .jitter_bench import program
+    from .web_bench import _cycles
+
+    async def alone(endpoint: str) -> object:
+        async with AsyncClient(endpoint) as control:
+            await control.upload("opcua-jitter.nc", program())
+            await control.run_program("opcua-jitter.nc")
+            await asyncio.sleep(1.0)  # the planner filled (a settling time)
+            return await _cycles(control, JITTER_S)
+
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        machine = f"{tmp}/bench.toml"
+        with open(machine, "w") as out:
+            out.write(BENCH_MACHINE)
+        for _ in range(runs):
+            service = start_service("--clock", "realtime", "--config", machine,
+                                    "--opcua", "opc.tcp://127.0.0.1:0", timeout_s=180)
+            try:
+                url = next(line.split("OPC UA on ")[1].split()[0] for line in service.log
+                           if "OPC UA on " in line)
+                ids = asyncio.run(_session_items(url))
+                quiet = asyncio.run(alone(service.endpoint))
+                loaded = asyncio.run(_with_sessions(url, service.endpoint, ids))
+                rows.append((quiet, loaded, len(ids)))
+            finally:
+                service.stop()
+    med = statistics.median
+    print(f"cycle figures, realtime 1 ms, {JITTER_S:g} s each, {runs} runs (medians): alone "
+          f"-> with {SESSIONS} OPC UA sessions of {rows[0][2]} items at 100 ms")
+    for field in ("p50_us", "p99_us", "max_us", "overruns"):
+        before = med(getattr(r[0], field) for r in rows)
+        after = med(getattr(r[1], field) for r in rows)
+        print(f"  {field:10s} {before:8g} -> {after:8g}")
+
+
 def _start_s(*args: str) -> float:
     began = time.perf_counter()
     service = start_service(*args, timeout_s=180)
@@ -246,6 +335,7 @@ def startup(runs: int = 3) -> None:
 def main(runs: int = 3) -> None:
     reads(runs)
     notifications(runs)
+    jitter(runs)
     startup(runs)
 
 
@@ -280,5 +370,6 @@ def reads(runs: int = 3) -> None:
 
 if __name__ == "__main__":
     runs = int(sys.argv[1]) if len(sys.argv) > 1 else 3
-    {"reads": reads, "notifications": notifications, "startup": startup}.get(
+    {"reads": reads, "notifications": notifications, "startup": startup,
+     "jitter": jitter}.get(
         sys.argv[2] if len(sys.argv) > 2 else "", main)(runs)
