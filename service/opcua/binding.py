@@ -72,6 +72,16 @@ class _Watch:
 
 
 @dataclass
+class Feed:
+    """One variable's samples at one interval: a hub subscription per source object,
+    shared by every monitored item of that interval (ten sessions that watch a variable
+    cost one sample per pass, not ten), and those items: asyncua's handle -> callback."""
+
+    hub_handles: list[int] = field(default_factory=list)
+    items: dict[int, DataChangeCallback] = field(default_factory=dict)
+
+
+@dataclass
 class BoundVariable:
     """A variable and the objects behind it."""
 
@@ -79,8 +89,10 @@ class BoundVariable:
     source: Source
     entries: tuple[Entry, ...]
     getters: tuple[Callable[[], Any], ...]
-    #: monitored items by asyncua's callback handle: (callback, hub handles)
-    items: dict[int, tuple[DataChangeCallback, list[int]]] = field(default_factory=dict)
+    #: the hub subscriptions by sampling interval (ns), each shared by the monitored
+    #: items of that interval; and the interval of each item by asyncua's handle
+    feeds: dict[int, Feed] = field(default_factory=dict)
+    items: dict[int, int] = field(default_factory=dict)
     #: the raw values last read and their DataValue: a read of unchanged objects answers
     #: it again (no new DataValue; its SourceTimestamp says when the value last changed)
     _last_raw: Any = None
@@ -212,42 +224,50 @@ class VariableBinder:
     # ------------------------------------------------------------ subscriptions
 
     def _item_added(self, var: BoundVariable, handle: int, callback: DataChangeCallback) -> None:
-        """A monitored item on ``var``: one hub subscription per source object, sampled
-        at the item's revised sampling interval."""
-        interval_ms = _sampling_interval_ms(callback)
-        envelope = _envelope(callback, handle)
-        handles: list[int] = []
-        var.items[handle] = (callback, handles)
+        """A monitored item on ``var``: it joins the feed of its revised sampling interval,
+        made on first use (one hub subscription per source object). asyncua reads the
+        item's first value itself."""
+        cycle_ns = int(_sampling_interval_ms(callback) * 1e6)
+        var.items[handle] = cycle_ns
+        feed = var.feeds.get(cycle_ns)
+        if feed is not None:
+            feed.items[handle] = callback
+            return
+        feed = var.feeds[cycle_ns] = Feed(items={handle: callback})
         hub = self.backend.hub
         for k, entry in enumerate(var.entries):
             obj = entry.obj
             code, answer = hub.add(
-                envelope, _Watch(obj.port, obj.group, obj.offset, obj.dtype.size),
-                int(interval_ms * 1e6), self._notifier(var, handle, k))
+                _envelope(var, cycle_ns), _Watch(obj.port, obj.group, obj.offset, obj.dtype.size),
+                cycle_ns, self._notifier(var, feed, k))
             if code:
                 log.warning("OPC UA monitored item on %s: %s", var.node_id.to_string(), answer)
                 self._send(callback, handle, [bad(_S.BadResourceUnavailable)])
                 continue
-            handles.append(answer)  # type: ignore[arg-type]
+            feed.hub_handles.append(answer)  # type: ignore[arg-type]
 
     def _item_removed(self, var: BoundVariable, handle: int) -> None:
-        held = var.items.pop(handle, None)
-        if held is None:
+        """The item leaves its feed; the last one out ends the feed's hub subscriptions."""
+        cycle_ns = var.items.pop(handle, None)
+        feed = var.feeds.get(cycle_ns) if cycle_ns is not None else None
+        if feed is None:
             return
-        callback, handles = held
-        envelope = _envelope(callback, handle)
-        for hub_handle in handles:
-            self.backend.hub.delete(envelope, hub_handle)
+        feed.items.pop(handle, None)
+        if feed.items:
+            return
+        del var.feeds[cycle_ns]  # type: ignore[arg-type]
+        for hub_handle in feed.hub_handles:
+            self.backend.hub.delete(_envelope(var, cycle_ns), hub_handle)  # type: ignore[arg-type]
 
-    def _notifier(self, var: BoundVariable, handle: int, k: int) -> Callable[..., bool]:
-        """The hub's ``notify`` for source object ``k`` of ``var``'s item ``handle``."""
+    def _notifier(self, var: BoundVariable, feed: Feed, k: int) -> Callable[..., bool]:
+        """The hub's ``notify`` for source object ``k`` of ``var`` in ``feed``: the
+        samples made DataValues once, handed to every item of the feed."""
         single = len(var.entries) == 1
         dtype = var.entries[k].obj.dtype
         source = var.source
 
         def notify(envelope: Any, port: int, samples: list[list[Any]]) -> bool:
-            held = var.items.get(handle)
-            if held is None:
+            if not feed.items:
                 return True
             values: list[ua.DataValue] = []
             if single:  # every sample of the batch, in order (a batch spans passes)
@@ -260,7 +280,8 @@ class VariableBinder:
                         values.append(bad(_S.BadInternalError))
             else:  # one of several objects changed: the value from all of them, now
                 values.append(var.value())
-            self._send(held[0], handle, values)
+            for handle, callback in list(feed.items.items()):
+                self._send(callback, handle, values)
             return True
 
         return notify
@@ -340,10 +361,10 @@ class VariableBinder:
         return ua.StatusCode(_S.Good)
 
 
-def _envelope(callback: DataChangeCallback, handle: int) -> tuple[Any, ...]:
-    """The hub's envelope of a monitored item: its first part is the item's OPC UA
-    subscription (asyncua's monitored item service), the client the hub's limits count."""
-    return ("opcua", id(getattr(callback, "__self__", callback))), handle
+def _envelope(var: BoundVariable, cycle_ns: int) -> tuple[Any, ...]:
+    """The hub's envelope of a feed: its first part, the client the hub's limits count,
+    is the variable (its feeds are at most one per interval and source object)."""
+    return ("opcua", id(var)), cycle_ns
 
 
 def _sampling_interval_ms(callback: DataChangeCallback) -> float:

@@ -143,3 +143,31 @@ async def test_a_closed_session_frees_its_hub_subscriptions(
                 await subscription.subscribe_data_change(await channel.get_child(f"{ns}:{name}"))
             assert await _notifications_until(cnc, 4) == 4
         assert await _notifications_until(cnc, 0) == 0  # the session closed: all freed
+
+
+async def test_sessions_watching_one_variable_share_its_samples(
+        opcua_service: ServiceProcess) -> None:
+    """One hub subscription per variable and interval, however many items watch it; it
+    ends with the last of them."""
+    url = opcua_url(opcua_service)
+    async with AsyncClient(opcua_service.endpoint, timeout_s=TIMEOUT_S) as cnc:
+        assert await _notifications_until(cnc, 0) == 0
+        async with Client(url, timeout=30) as first:
+            override = await _override(first)
+            values = _Values()
+            subscription = await first.create_subscription(50, values)
+            await subscription.subscribe_data_change(override)
+            async with Client(url, timeout=30) as second:
+                others = _Values()
+                shared = await second.create_subscription(50, others)
+                await shared.subscribe_data_change(await _override(second))
+                assert await asyncio.wait_for(others.queue.get(), TIMEOUT_S) == 100.0
+                assert await _notifications_until(cnc, 1) == 1  # shared
+                await cnc.write("ch1.mc_command_feed_override_w", 777)
+                assert await asyncio.wait_for(others.queue.get(), TIMEOUT_S) == 77.7
+            assert await _notifications_until(cnc, 1) == 1  # the first session still watches
+            assert await asyncio.wait_for(values.queue.get(), TIMEOUT_S) == 100.0
+            assert await asyncio.wait_for(values.queue.get(), TIMEOUT_S) == 77.7
+            await cnc.write("ch1.mc_command_feed_override_w", 1000)
+            assert await asyncio.wait_for(values.queue.get(), TIMEOUT_S) == 100.0
+        assert await _notifications_until(cnc, 0) == 0
