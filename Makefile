@@ -7,6 +7,9 @@ ENDPOINT ?= tcp://127.0.0.1:5555
 # disables ADS) and the data directory (programs/ and output/); empty: the service's default.
 ADS      ?=
 DATA_DIR ?=
+# make run OPCUA=off: where OPC UA clients connect (opc.tcp://HOST[:PORT], off disables
+# it); empty: the service's default, opc.tcp://127.0.0.1:4840 (docs/opcua.md).
+OPCUA    ?=
 # make run CONFIG=machine.toml: the machine configuration (TOML, laid over the default;
 # docs/configuration.md); empty: the embedded default machine.
 CONFIG   ?=
@@ -44,12 +47,12 @@ WEB_PORT ?= 8080
 
 run: $(VENV)/.installed $(VENV)/.native
 ifeq ($(WEB),0)
-	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) \
+	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) $(if $(OPCUA),--opcua $(OPCUA)) \
 		$(if $(DATA_DIR),--data-dir $(DATA_DIR)) $(if $(CONFIG),--config $(CONFIG)) $(if $(MACHINE),--machine $(MACHINE))
 else
 	$(BIN)/cnc-web --endpoint $(ENDPOINT) --port $(WEB_PORT) & web=$$!; \
 	trap 'kill $$web 2>/dev/null' EXIT INT TERM; \
-	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) \
+	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) $(if $(OPCUA),--opcua $(OPCUA)) \
 		$(if $(DATA_DIR),--data-dir $(DATA_DIR)) $(if $(CONFIG),--config $(CONFIG)) $(if $(MACHINE),--machine $(MACHINE))
 endif
 

@@ -223,7 +223,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--count", type=int, default=20000, help="reads per measurement")
     parser.add_argument("--part", choices=("all", "dispatch", "client", "ads", "kernel",
                                            "jitter", "virtual", "lookahead", "fairness", "cli",
-                                           "web", "idle", "short-blocks"),
+                                           "web", "idle", "short-blocks", "opcua"),
                         default="all",
                         help="dispatch: request dispatch (ZeroMQ); client: AsyncClient "
                         "batching against the raw echo, wall and CPU; ads: pyads over AMS/TCP; "
@@ -233,7 +233,8 @@ def main(argv: list[str] | None = None) -> int:
                         "notification limit is used up; cli: cnc's start to exit; web: "
                         "cnc-web's live values and their cost; idle: an idle service's CPU "
                         "and its kernel's idle cycle; short-blocks: the spiral and the CAM "
-                        "finishing program on the virtual clock (also in virtual)")
+                        "finishing program on the virtual clock (also in virtual); opcua: OPC "
+                        "UA reads against asyncua's static server, start-up cold and warm")
     parser.add_argument("--jitter-s", type=float, default=20.0,
                         help="seconds of load per jitter run (issue 22 asks 60)")
     parser.add_argument("--idle-s", type=float, default=15.0,
@@ -274,6 +275,11 @@ def main(argv: list[str] | None = None) -> int:
         from . import cli_bench
 
         cli_bench.main(args.runs)
+
+    if args.part in ("all", "opcua"):
+        from . import opcua_bench
+
+        opcua_bench.main(min(args.runs, 3))
 
     if args.part in ("all", "idle"):
         from . import idle_bench

@@ -21,6 +21,7 @@ from .frontend_config import AdsConfig, SecurityConfig
 from .kernel.realtime_priority import DEFAULT_RT_PRIORITY, RT_PRIORITY_MAX
 from .limits import LimitsConfig
 from .machine_config import EMBEDDED_MACHINES, EmbeddedMachine, MachineConfig, Strict
+from .opcua.config import OpcUaConfig
 from .param_list import ParamListError, read_axis_list, read_channel_list
 
 
@@ -74,6 +75,10 @@ class ServiceConfig(MachineConfig):
     )
     ads: AdsConfig = Field(
         default_factory=AdsConfig, description="the ADS front end ([ads] endpoint, net_id, routes)"
+    )
+    opcua: OpcUaConfig = Field(
+        default_factory=OpcUaConfig,
+        description="the OPC UA front end ([opcua] endpoint, loopback_role; docs/opcua.md)",
     )
     limits: LimitsConfig = Field(
         default_factory=LimitsConfig,

@@ -1,13 +1,16 @@
 """``cnc-service``: the composition root. Builds kernel, address space and servers, runs them.
 
     cnc-service [--config FILE] [--machine NAME] [--endpoint URL] [--ads HOST[:PORT]|off] [--ams-net-id ID]
+                [--opcua opc.tcp://HOST[:PORT]|off]
                 [--keys DIR] [--insecure]
                 [--clock realtime|virtual|virtual-step|step] [--speed X] [--cycle-ms MS]
                 [--samples latest|repeatable]
                 [--program-dir DIR | --data-dir DIR] [--output-dir DIR] [--log-level L]
 
 Two front ends over one dispatcher: ZeroMQ (``--endpoint``) and ADS over AMS/TCP
-(``--ads``, default 127.0.0.1:48898, for pyads and every other ADS client). Logs where
+(``--ads``, default 127.0.0.1:48898, for pyads and every other ADS client); a third, OPC
+UA (``--opcua``, default opc.tcp://127.0.0.1:4840, OPC 40502 CNC; docs/opcua.md), over
+the same backend (``OPC UA on opc.tcp://... (...)``). Logs where
 its program store is (``program store: /abs/path (why)``, see ``data_location``) and its
 output area (``output area: /abs/path (why)``: the files the kernel writes), where
 ADS listens (``ADS on 127.0.0.1:48898, AMS Net ID 127.0.0.1.1.1 ...``) and then the
@@ -36,7 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 import typer
 import zmq
@@ -62,6 +65,7 @@ from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
 from .limits import notification_limits, rate_limiter
 from .machine_config import EmbeddedMachine
 from .notifications import NotificationCounts
+from .opcua.config import parse_opcua_endpoint
 from .output_service import OutputService
 from .program_service import ProgramStoreService
 from .security import (
@@ -83,6 +87,9 @@ from .storage.operator_data_store import OperatorDataStore
 from .storage.output_area import OutputArea
 from .storage.output_writer import OutputLimits, OutputWriter
 from .storage.program_store import ProgramStore, StoreError
+
+if TYPE_CHECKING:
+    from .opcua.server import OpcUaServer
 
 log = logging.getLogger("cnc-service")
 
@@ -159,13 +166,23 @@ class AdsListen:
     open_to_all: bool = False  # --insecure without routes: peers need no route
 
 
+@dataclass(frozen=True)
+class OpcUaListen:
+    """Where the OPC UA front end listens and the role of its (loopback) sessions."""
+
+    host: str
+    port: int
+    loopback_role: Role = LOOPBACK_ROLE
+
+
 async def serve(
     config: ServiceConfig, endpoint: str, clock_kind: ClockKind, speed: float | None,
     store: ProgramStore, ads: AdsListen | None = None, curve: ServerCurve | None = None,
     outputs: OutputArea | None = None, operator_data: Path | None = None,
+    opcua: OpcUaListen | None = None,
 ) -> int:
-    """Run kernel and both front ends until SIGINT or SIGTERM (ADS when ``ads`` is given;
-    ZeroMQ with CURVE when ``curve`` is given). The files the kernel writes go to
+    """Run kernel and the front ends until SIGINT or SIGTERM (ADS when ``ads`` is given,
+    OPC UA when ``opcua`` is; ZeroMQ with CURVE when ``curve`` is given). The files the kernel writes go to
     ``outputs`` (default: ``<store>-output`` beside the store); the tool list and zero
     offsets are kept in ``operator_data`` (default: beside the store)."""
     loop = asyncio.get_running_loop()
@@ -230,6 +247,15 @@ async def serve(
             server.close()
             writer.close()
             return EXIT_USAGE
+    opcua_server = None
+    if opcua is not None:
+        opcua_server = await _start_opcua(backend, opcua)
+        if opcua_server is None:
+            if ads_server is not None:
+                ads_server.close()
+            server.close()
+            writer.close()
+            return EXIT_USAGE
     stop = asyncio.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
@@ -248,6 +274,11 @@ async def serve(
                  ", ".join(str(p) for p in sorted(ads_server.ports)), len(ads_server.routes),
                  "every peer's" if ads.open_to_all else "loopback",  # type: ignore[union-attr]
                  ads.loopback_role.label)  # type: ignore[union-attr]
+    if opcua_server is not None:
+        log.info("OPC UA on %s (OPC 40502 CncInterface, %d channels; SecurityPolicy None; "
+                 "sessions' role %s; built in %.2f s, %s)",
+                 opcua_server.url, len(config.channels),
+                 opcua.loopback_role.label, opcua_server.start_s, opcua_server.cache_note)  # type: ignore[union-attr]
     if curve is not None:
         log.info("CURVE on: server public key %s; allow-list %s (%s)",
                  curve.public_key.decode(), curve.allow_list.origin, curve.allow_list.census())
@@ -261,6 +292,8 @@ async def serve(
         await stop.wait()
     finally:
         log.info("stopping")
+        if opcua_server is not None:
+            await opcua_server.close()
         if ads_server is not None:
             ads_server.close()
         server.close()
@@ -307,9 +340,25 @@ async def _start_ads(
     return ads_server
 
 
+async def _start_opcua(backend: Backend, opcua: OpcUaListen) -> OpcUaServer | None:
+    """The listening OPC UA front end, or None after saying in one line why it cannot be."""
+    from .opcua.server import OpcUaServer  # asyncua only where OPC UA is served
+
+    opcua_server = OpcUaServer(backend, opcua.loopback_role)
+    try:
+        await opcua_server.start(opcua.host, opcua.port)
+    except OSError as exc:
+        reason = os.strerror(exc.errno) if exc.errno and exc.errno > 0 else exc.strerror or str(exc)
+        print(f"cnc-service: cannot listen for OPC UA on {opcua.host}:{opcua.port}: {reason}",
+              file=sys.stderr)
+        await opcua_server.close()
+        return None
+    return opcua_server
+
+
 @app.command(
     epilog="Exit codes: 0 stopped by SIGINT or SIGTERM; 2 bad usage, bad configuration, "
-    "unusable program store, endpoint or ADS address in use."
+    "unusable program store, endpoint, ADS or OPC UA address in use."
 )
 def run(
     config_file: Path | None = typer.Option(
@@ -373,6 +422,12 @@ def run(
         None, "--ams-net-id", metavar="NETID",
         help="AMS Net ID of the service (default: [ads] net_id, else the ADS address + .1.1).",
     ),
+    opcua: str | None = typer.Option(
+        None, "--opcua", metavar="URL",
+        help="Where OPC UA clients (UaExpert, umati dashboards) connect: opc.tcp://HOST[:PORT], "
+        "port 4840 when left out; off disables OPC UA (default: [opcua] endpoint of the "
+        "configuration, else opc.tcp://127.0.0.1:4840; loopback only, docs/opcua.md).",
+    ),
     keys: Path | None = typer.Option(
         None, "--keys", metavar="DIR",
         help="CURVE for ZeroMQ: DIR holds server.key_secret and the allow-list "
@@ -410,12 +465,14 @@ def run(
                "reaches it could write every object; give --keys DIR (docs/security.md), "
                "bind 127.0.0.1, or --insecure")
     listen = _ads_listen(config, ads, ams_net_id, curve is not None, insecure)
+    opcua_listen = _opcua_listen(config, opcua, curve is not None)
     store = _open_store(location, config)
     outputs = _open_outputs(output_dir, config, location)
     kept = operator_data_location(data_dir, config.data_dir, location)
     log.info("operator data file: %s (%s)", kept.path, kept.source)
     raise typer.Exit(asyncio.run(
-        serve(config, endpoint, clock, speed, store, listen, curve, outputs, kept.path)))
+        serve(config, endpoint, clock, speed, store, listen, curve, outputs, kept.path,
+              opcua_listen)))
 
 
 def _server_curve(config: ServiceConfig, keys: Path | None) -> ServerCurve | None:
@@ -468,6 +525,29 @@ def _ads_listen(
         loopback_role = Role.MONITOR if keys else LOOPBACK_ROLE
     return AdsListen(address[0], address[1], net_id or config.ads.net_id, loopback_role,
                      open_to_all=insecure and not local and not config.ads.routes)
+
+
+def _opcua_listen(config: ServiceConfig, opcua: str | None, keys: bool = False
+                  ) -> OpcUaListen | None:
+    """Where OPC UA listens: ``--opcua`` over the configuration's [opcua]. Only loopback
+    is served (SecurityPolicy None, as ADS without routes): another address is refused
+    until the front end has security. Sessions get ``[opcua] loopback_role``, by default
+    admin, monitor when the service runs with ``keys``."""
+    try:
+        address = parse_opcua_endpoint(opcua) if opcua is not None else config.opcua.address
+    except ValueError as exc:
+        _usage(f"bad --opcua: {exc}")
+    if address is None:
+        return None
+    if not host_is_loopback(address[0]):
+        _usage(f"OPC UA address {address[0]}:{address[1]} is not a loopback address: the "
+               "OPC UA front end serves SecurityPolicy None on loopback only; bind "
+               "127.0.0.1 (--opcua opc.tcp://127.0.0.1:4840) or --opcua off")
+    if config.opcua.loopback_role is not None:
+        role = Role.parse(config.opcua.loopback_role)
+    else:
+        role = Role.MONITOR if keys else LOOPBACK_ROLE
+    return OpcUaListen(address[0], address[1], role)
 
 
 def _machine_config(path: Path | None, cycle_ms: float | None,

@@ -184,13 +184,16 @@ class ServiceProcess:
 
 def service_command(*args: str) -> list[str]:
     """The command line ``start_service(*args)`` runs: ``cnc-service`` on a free loopback
-    port with the virtual clock and ADS off, unless ``args`` name another endpoint,
-    clock or ``--ads`` address (the last occurrence of an option wins)."""
+    port with the virtual clock, ADS and OPC UA off, unless ``args`` name another
+    endpoint, clock, ``--ads`` or ``--opcua`` address (the last occurrence of an option
+    wins)."""
     argv = [sys.executable, "-m", "cnc_objects.service.main", "--endpoint", "tcp://127.0.0.1:*"]
     if "--clock" not in args:
         argv += ["--clock", "virtual"]
     if "--ads" not in args:
         argv += ["--ads", "off"]
+    if "--opcua" not in args:  # services side by side never compete for port 4840
+        argv += ["--opcua", "off"]
     return [*argv, *args]
 
 

@@ -46,7 +46,7 @@ def test_make_run_config_starts_the_service_on_that_file(tmp_path: Path) -> None
     config.write_text('[plc]\nacknowledges = ["M6", "M8", "M9"]\n')
     endpoint = f"tcp://127.0.0.1:{_free_port()}"
     proc = subprocess.Popen(
-        ["make", "run", "WEB=0", f"CONFIG={config}", f"ENDPOINT={endpoint}", "ADS=off",
+        ["make", "run", "WEB=0", f"CONFIG={config}", f"ENDPOINT={endpoint}", "ADS=off", "OPCUA=off",
          f"DATA_DIR={tmp_path / 'data'}"],
         cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
         start_new_session=True)

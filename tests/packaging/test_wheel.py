@@ -70,3 +70,14 @@ def test_the_web_hmis_pages_and_command_are_in_the_wheel(wheel: Path) -> None:
     entry_points = configparser.ConfigParser()
     entry_points.read_string(text)
     assert entry_points["console_scripts"]["cnc-web"] == "cnc_objects.clients.web.cli:main"
+
+
+def test_the_opc_foundation_nodesets_and_their_license_are_in_the_wheel(wheel: Path) -> None:
+    """The OPC UA front end loads them at start: an install without them cannot serve."""
+    folder = ROOT / "service" / "opcua" / "nodesets"
+    expected = {f"cnc_objects/service/opcua/nodesets/{f.name}" for f in folder.iterdir()}
+    with zipfile.ZipFile(wheel) as archive:
+        names = set(archive.namelist())
+    assert "cnc_objects/service/opcua/nodesets/LICENSE" in expected
+    assert "cnc_objects/service/opcua/nodesets/Opc.Ua.CNC.NodeSet.xml" in expected
+    assert expected <= names

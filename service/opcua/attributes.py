@@ -1,0 +1,38 @@
+"""The Write service of the OPC UA front end: a client's write of a bound variable goes
+to the CNC objects (``binding.VariableBinder.write``); every other node is read-only to
+clients (BadNotWritable), whatever its AccessLevel in the nodesets says. The server's
+own writes (its internal session) take asyncua's path."""
+
+from __future__ import annotations
+
+from asyncua import ua
+from asyncua.crypto.permission_rules import User, UserRole
+from asyncua.server.address_space import AddressSpace, AttributeService
+
+from .binding import VariableBinder
+from .roles import role_of
+
+_SERVER_USER = User(role=UserRole.Admin)  # asyncua's default: the server's own writes
+
+
+class BoundAttributes(AttributeService):  # type: ignore[misc]  # asyncua is Any to mypy
+    """asyncua's attribute service with the writes of clients decided by ``binder``."""
+
+    def __init__(self, aspace: AddressSpace, binder: VariableBinder) -> None:
+        super().__init__(aspace)
+        self.binder = binder
+
+    async def write(self, params: ua.WriteParameters, user: User = _SERVER_USER
+                    ) -> list[ua.StatusCode]:
+        """One status per item; a client's items one after the other, in order."""
+        if role_of(user) is None:  # the server itself
+            return await super().write(params, user)  # type: ignore[no-any-return]
+        results = []
+        for item in params.NodesToWrite:
+            if item.AttributeId == ua.AttributeIds.Value and item.NodeId in self.binder.variables:
+                results.append(await self.binder.write(item.NodeId, item.Value, user))
+            elif item.NodeId not in self._aspace:
+                results.append(ua.StatusCode(ua.StatusCodes.BadNodeIdUnknown))
+            else:
+                results.append(ua.StatusCode(ua.StatusCodes.BadNotWritable))
+        return results

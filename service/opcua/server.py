@@ -1,0 +1,111 @@
+"""The OPC UA front end: an asyncua server on the service's event loop, over the
+``Backend`` that ZeroMQ and ADS serve (docs/opcua.md).
+
+At start it loads the OPC Foundation's nodesets (``nodesets``), builds the CncInterface
+(``cnc_interface``) bound to the objects (``binding``), applies security
+(``apply_security``) and listens. The kernel knows nothing of it.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+from asyncua import Server, ua
+
+from cnc_objects.protocol.roles import Role
+
+from ..backend import Backend
+from . import address_space_cache as cache
+from .attributes import BoundAttributes
+from .binding import VariableBinder
+from .cnc_interface import build_cnc_interface
+from .config import endpoint_url
+from .nodesets import asyncua_quiet, load_nodesets
+from .roles import LoopbackUsers
+
+log = logging.getLogger(__name__)
+
+APPLICATION_URI = "urn:cnc-objects:service"
+PRODUCT_URI = "https://github.com/cnc-objects"
+VENDOR = "cnc-objects"
+
+
+def apply_security(server: Server, loopback_role: Role) -> None:
+    """The one place where the server's security is decided: its endpoints' security
+    policies and its user manager (who a session is, ``roles``). For now: SecurityPolicy
+    None only (the service serves OPC UA on loopback only, as ADS without routes) and
+    every session the loopback role. Certificates, Basic256Sha256 and user tokens are
+    applied here by the security part (``security.py``)."""
+    server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+    server.iserver.set_user_manager(LoopbackUsers(loopback_role))
+
+
+class OpcUaServer:
+    """The OPC UA front end of one service."""
+
+    def __init__(self, backend: Backend, loopback_role: Role) -> None:
+        self.backend = backend
+        self.loopback_role = loopback_role
+        self.address: tuple[str, int] = ("", 0)
+        self.nodes_left_out = 0  # nodeset nodes asyncua could not import
+        self.start_s = 0.0  # how long ``start`` took (nodesets, instances, listening)
+        self.cache_note = ""  # where the imported address space came from
+        self.binder: VariableBinder | None = None
+        self._server: Server | None = None
+
+    @property
+    def url(self) -> str:
+        """``opc.tcp://host:port`` the server listens on."""
+        return endpoint_url(*self.address)
+
+    async def start(self, host: str, port: int) -> None:
+        """Build the address space and listen on ``host:port`` (0: any free port);
+        ``OSError`` when the address cannot be bound."""
+        began = time.perf_counter()
+        # asyncua logs every node it imports and instantiates at INFO: its warnings only
+        asyncua_log = logging.getLogger("asyncua")
+        asyncua_log.setLevel(max(asyncua_log.getEffectiveLevel(), logging.WARNING))
+        path = cache.cache_file()
+        kept = cache.load(path)
+        server = Server(iserver=cache.CachedInternalServer(kept[0] if kept else None))
+        await server.init()
+        server.set_endpoint(endpoint_url(host, port))
+        server.set_server_name(f"{VENDOR} CNC")
+        await server.set_application_uri(APPLICATION_URI)
+        apply_security(server, self.loopback_role)
+        namespaces = server.nodes.namespace_array
+        if kept is None:
+            self.nodes_left_out = await load_nodesets(server)
+            try:
+                cache.save(server.iserver.aspace._nodes, await namespaces.read_value(), path)
+                self.cache_note = f"nodesets imported, kept in {path}"
+            except OSError as exc:
+                self.cache_note = f"nodesets imported; cannot keep them in {path}: {exc}"
+        else:
+            await namespaces.write_value(kept[1])  # the server's set-up wrote its own
+            with asyncua_quiet():  # the structure classes of the nodesets, made again
+                await server.load_data_type_definitions()
+            self.cache_note = f"nodesets from {path}"
+        binder = VariableBinder(server, self.backend)
+        server.iserver.attribute_service = BoundAttributes(server.iserver.aspace, binder)
+        await build_cnc_interface(server, binder, self.backend, VENDOR, self._version())
+        with asyncua_quiet():  # its warnings of a server without signing policies
+            await server.start()  # (apply_security's choice) and its bind error's trace
+        bound = server.bserver
+        assert bound is not None  # start() made it
+        self.address = (str(bound.hostname), int(bound.port or 0))
+        self.binder = binder
+        self._server = server
+        self.start_s = time.perf_counter() - began
+
+    def _version(self) -> str:
+        """The kernel's version, as the object ``cnc_version_r`` serves it."""
+        entry = self.backend.space.by_name("cnc_version_r")
+        return str(entry.read()) if entry is not None and entry.read is not None else ""
+
+    async def close(self) -> None:
+        """Close every session and stop listening."""
+        if self._server is not None:
+            server, self._server = self._server, None
+            await server.stop()
