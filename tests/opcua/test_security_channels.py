@@ -30,42 +30,48 @@ from tests.support.opcua_security import (
 )
 
 
-@pytest.fixture
-def certificate_dir(tmp_path: Path) -> Path:
+# The certificates and the users file are made once per module: RSA keys and Argon2
+# hashes take a while, and no test changes them.
+@pytest.fixture(scope="module")
+def certificate_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The server's certificate, made by ``cnc opcua-cert``."""
-    directory = tmp_path / "opcua"
+    directory = tmp_path_factory.mktemp("server") / "opcua"
     made = cnc("opcua-cert", "--dir", str(directory), "--host", "localhost")
     assert made.returncode == 0, made.stderr
     return directory
 
 
-@pytest.fixture
-def trusted(tmp_path: Path, certificate_dir: Path) -> ClientIdentity:
+@pytest.fixture(scope="module")
+def trusted(tmp_path_factory: pytest.TempPathFactory, certificate_dir: Path) -> ClientIdentity:
     """A client whose certificate is in the server's trusted directory."""
-    identity = make_client_identity(tmp_path / "client", "trusted-client")
+    identity = make_client_identity(tmp_path_factory.mktemp("client"), "trusted-client")
     shutil.copy(identity.certificate, certificate_dir / TRUSTED_DIR)
     return identity
 
 
-@pytest.fixture
-def untrusted(tmp_path: Path) -> ClientIdentity:
+@pytest.fixture(scope="module")
+def untrusted(tmp_path_factory: pytest.TempPathFactory) -> ClientIdentity:
     """A client whose certificate the server has never seen."""
-    return make_client_identity(tmp_path / "stranger", "stranger")
+    return make_client_identity(tmp_path_factory.mktemp("stranger"), "stranger")
 
 
-def _settings(certificate_dir: Path | None, tmp_path: Path, **more: str) -> OpcUaSecurity:
-    return OpcUaSecurity(
-        certificate_dir=str(certificate_dir) if certificate_dir else None,
-        users_file=str(write_users_file(tmp_path / "web-users.json")), **more)
+@pytest.fixture(scope="module")
+def users_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_users_file(tmp_path_factory.mktemp("users") / "web-users.json")
+
+
+def _settings(certificate_dir: Path, users_file: Path, **more: str) -> OpcUaSecurity:
+    return OpcUaSecurity(certificate_dir=str(certificate_dir), users_file=str(users_file),
+                         **more)
 
 
 @pytest.mark.parametrize("mode", [ua.MessageSecurityMode.SignAndEncrypt,
                                   ua.MessageSecurityMode.Sign], ids=["sign-and-encrypt", "sign"])
 async def test_a_trusted_client_reads_on_basic256sha256(
-    tmp_path: Path, certificate_dir: Path, trusted: ClientIdentity,
+    certificate_dir: Path, users_file: Path, trusted: ClientIdentity,
     mode: ua.MessageSecurityMode,
 ) -> None:
-    async with secured_server(_settings(certificate_dir, tmp_path)) as server:
+    async with secured_server(_settings(certificate_dir, users_file)) as server:
         client = await secure_client(server.url, trusted, certificate_dir, mode, Role.OPERATOR)
         async with client:
             assert client.security_policy.Mode == mode
@@ -75,12 +81,14 @@ async def test_a_trusted_client_reads_on_basic256sha256(
 
 @pytest.mark.parametrize("others_trusted", [True, False], ids=["others-trusted", "none-trusted"])
 async def test_an_untrusted_client_certificate_is_refused(
-    tmp_path: Path, certificate_dir: Path, untrusted: ClientIdentity, others_trusted: bool,
-    request: pytest.FixtureRequest,
+    tmp_path: Path, certificate_dir: Path, users_file: Path, trusted: ClientIdentity,
+    untrusted: ClientIdentity, others_trusted: bool,
 ) -> None:
-    if others_trusted:
-        request.getfixturevalue("trusted")
-    async with secured_server(_settings(certificate_dir, tmp_path)) as server:
+    settings = _settings(certificate_dir, users_file)
+    if not others_trusted:  # [opcua] trusted_clients_dir: an empty one of its own
+        (tmp_path / "nobody").mkdir()
+        settings = _settings(certificate_dir, users_file, trusted_clients_dir=str(tmp_path / "nobody"))
+    async with secured_server(settings) as server:
         client = await secure_client(server.url, untrusted, certificate_dir, user=Role.ADMIN)
         with pytest.raises(UaStatusCodeError) as refused:
             await client.connect()
@@ -89,12 +97,12 @@ async def test_an_untrusted_client_certificate_is_refused(
 
 
 async def test_a_channel_of_an_untrusted_certificate_cannot_name_a_trusted_one(
-    tmp_path: Path, certificate_dir: Path, trusted: ClientIdentity, untrusted: ClientIdentity,
+    certificate_dir: Path, users_file: Path, trusted: ClientIdentity, untrusted: ClientIdentity,
 ) -> None:
     """asyncua validates the certificate a client names in CreateSession, not the one that
     secures its channel: a stranger who names a trusted client's (public) certificate is
     refused at ActivateSession, where the channel's own certificate is checked."""
-    async with secured_server(_settings(certificate_dir, tmp_path)) as server:
+    async with secured_server(_settings(certificate_dir, users_file)) as server:
         client = await secure_client(server.url, untrusted, certificate_dir, user=Role.ADMIN)
         await client.connect_socket()
         try:
@@ -119,14 +127,14 @@ async def test_a_channel_of_an_untrusted_certificate_cannot_name_a_trusted_one(
 
 
 async def test_security_policy_none_is_refused_off_loopback(
-    tmp_path: Path, certificate_dir: Path, trusted: ClientIdentity,
+    certificate_dir: Path, users_file: Path, trusted: ClientIdentity,
 ) -> None:
     server = Server()
     await server.init()
     with pytest.raises(OpcUaSecurityError, match="loopback only"):
         await apply_security(server, OpcUaSecurity(), "0.0.0.0")
     # with a certificate it serves the network, on the secured policies alone
-    async with secured_server(_settings(certificate_dir, tmp_path), host="0.0.0.0") as served:
+    async with secured_server(_settings(certificate_dir, users_file), host="0.0.0.0") as served:
         policies = {e.SecurityPolicyUri.rsplit("#", 1)[1]: e for e in
                     await Client(served.url, timeout=10).connect_and_get_server_endpoints()}
         # (GetEndpoints needs no session: asyncua answers it on any channel)
@@ -151,7 +159,7 @@ async def test_security_policy_none_is_refused_off_loopback(
     (True, "operator", Role.OPERATOR),  # [opcua] loopback_role
 ], ids=["open", "with-certificate", "configured"])
 async def test_loopback_serves_security_policy_none_and_anonymous_with_the_loopback_role(
-    tmp_path: Path, certificate_dir: Path, certificate: bool, loopback_role: str | None,
+    certificate_dir: Path, certificate: bool, loopback_role: str | None,
     expected: Role,
 ) -> None:
     settings = OpcUaSecurity(certificate_dir=str(certificate_dir) if certificate else None,
