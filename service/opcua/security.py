@@ -7,7 +7,9 @@ admin: ``protocol/roles.py``) of the session that sent a request. What it sets u
 - Secure channels. SecurityPolicy None is offered only when the server listens on a
   loopback host, as the ZeroMQ and ADS front ends serve only loopback without keys or
   routes. With ``[opcua] certificate_dir`` (``cnc opcua-cert`` makes it) Basic256Sha256
-  Sign and SignAndEncrypt are offered too; a server on any other host needs them.
+  Sign and SignAndEncrypt are offered too; a server on any other host needs them. asyncua
+  opens a None channel anyway (for GetEndpoints) and creates sessions on it: off
+  loopback the user manager activates none there.
 - Client certificates. Only a certificate in ``trusted_clients_dir`` (default
   ``certificate_dir/trusted``) gets a session: asyncua's ``CertificateValidator`` with
   its ``TrustStore`` checks the one a client names in CreateSession (time, application
@@ -117,11 +119,13 @@ class RoleUserManager(UserManager):
     identity token (called at ActivateSession; None: ``BadUserAccessDenied``)."""
 
     def __init__(self, passwords: RolePasswords | None, anonymous_role: Role | None,
-                 trust: TrustStore | None,
+                 trust: TrustStore | None, secured_only: bool = False,
                  clock: Callable[[], float] = time.monotonic) -> None:
+        """``secured_only``: no session on a SecurityPolicy None channel (off loopback)."""
         self._passwords = passwords
         self._anonymous_role = anonymous_role
         self._trust = trust
+        self._secured_only = secured_only
         self._clock = clock
         self._paused_until_s = 0.0
 
@@ -129,7 +133,14 @@ class RoleUserManager(UserManager):
                  password: str | None = None, certificate: Any = None) -> User | None:
         """The user of a session (asyncua's ``UserManager.get_user``); ``certificate`` is
         the DER certificate of the secure channel (None on SecurityPolicy None)."""
-        if certificate and not self._trusted(bytes(certificate)):  # None, b"": policy None
+        if not certificate:  # None, b"": a SecurityPolicy None channel
+            if self._secured_only:
+                # asyncua opens a None channel on any server (GetEndpoints needs one) and
+                # creates sessions on it; off loopback none is activated there
+                log.warning("OPC UA session refused: its channel has SecurityPolicy None, "
+                            "served on loopback only")
+                return None
+        elif not self._trusted(bytes(certificate)):
             return None
         if username is None:
             if self._anonymous_role is None:
@@ -214,7 +225,8 @@ async def apply_security(server: Server, settings: OpcUaSecurity, host: str) -> 
     tokens: list[type] = [ua.AnonymousIdentityToken] if anonymous_role is not None else []
     tokens += [ua.UserNameIdentityToken] if passwords is not None else []
     server.set_identity_tokens(tokens)
-    server.iserver.set_user_manager(RoleUserManager(passwords, anonymous_role, trust))
+    server.iserver.set_user_manager(
+        RoleUserManager(passwords, anonymous_role, trust, secured_only=not loopback))
     log.info("OPC UA security on %s: policies %s; anonymous %s; user names %s", host,
              ", ".join(p.name for p in policies),
              f"as {anonymous_role.label}" if anonymous_role else "refused",

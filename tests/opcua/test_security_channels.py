@@ -153,6 +153,38 @@ async def test_security_policy_none_is_refused_off_loopback(
         assert served.roles_read == [Role.MONITOR]
 
 
+async def test_a_security_policy_none_channel_gets_no_session_off_loopback(
+    certificate_dir: Path, users_file: Path,
+) -> None:
+    """asyncua opens a SecurityPolicy None channel on any server (GetEndpoints needs one)
+    and would create a session on it; off loopback no session is activated on it, not
+    even with a right password."""
+    async with secured_server(_settings(certificate_dir, users_file), host="0.0.0.0") as served:
+        client = Client(served.url, timeout=10)  # SecurityPolicy None, no certificate
+        await client.connect_socket()
+        try:
+            await client.send_hello()
+            await client.open_secure_channel()
+            params = ua.CreateSessionParameters()
+            params.ClientNonce = b"n" * 32
+            params.ClientDescription = ua.ApplicationDescription(
+                ApplicationUri="urn:test:plain", ApplicationType=ua.ApplicationType.Client)
+            params.EndpointUrl = served.url
+            params.SessionName = "plain channel"
+            params.RequestedSessionTimeout = 10_000
+            created = await client.uaclient.create_session(params)
+            client._server_nonce = created.ServerNonce
+            client._policy_ids = [ua.UserTokenPolicy(  # the password in clear: no policy
+                PolicyId="username", TokenType=ua.UserTokenType.UserName,
+                SecurityPolicyUri="http://opcfoundation.org/UA/SecurityPolicy#None")]
+            with pytest.raises(UaStatusCodeError) as refused:
+                await client.activate_session(Role.OPERATOR.label, PASSWORDS[Role.OPERATOR])
+            assert refused.value.code == StatusCodes.BadUserAccessDenied
+        finally:
+            client.disconnect_socket()
+        assert served.roles_read == []
+
+
 @pytest.mark.parametrize(("certificate", "loopback_role", "expected"), [
     (False, None, Role.ADMIN),  # a server without security: the ADS front end's loopback rule
     (True, None, Role.MONITOR),  # a server with a certificate gives anonymous the least
