@@ -29,7 +29,8 @@ from asyncua.server.server import Server
 from cnc_objects.protocol.role_passwords import RolePasswords, format_role_passwords
 from cnc_objects.protocol.roles import Role
 from cnc_objects.service.opcua import security
-from cnc_objects.service.opcua.security import OpcUaSecurity, apply_security
+from cnc_objects.service.opcua.security import apply_security
+from cnc_objects.service.opcua.security_config import OpcUaSecurity
 
 SECONDS = 4.0
 ATTACKERS = 4

@@ -45,15 +45,13 @@ from asyncua.server.internal_session import InternalSession
 from asyncua.server.server import Server
 from asyncua.server.user_managers import UserManager
 from cryptography import x509
-from pydantic import Field
 
 from cnc_objects.protocol.opcua_files import CERTIFICATE_FILE, PRIVATE_KEY_FILE, TRUSTED_DIR
 from cnc_objects.protocol.role_passwords import RolePasswords, parse_role_passwords
 from cnc_objects.protocol.roles import LOOPBACK_ROLE, Role
 
-from ..frontend_config import RoleName
-from ..machine_config import Strict
 from ..security import host_is_loopback
+from .security_config import OpcUaSecurity
 
 log = logging.getLogger(__name__)
 
@@ -66,28 +64,6 @@ CLIENT_CERTIFICATE_CHECKS = (CertificateValidatorOptions.TRUSTED_VALIDATION
                              | CertificateValidatorOptions.PEER_CLIENT)
 SECURED_POLICIES = (ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt,
                     ua.SecurityPolicyType.Basic256Sha256_Sign)
-
-
-class OpcUaSecurity(Strict):
-    """The security keys of ``[opcua]``. Relative paths are taken from the working
-    directory at start."""
-
-    certificate_dir: str | None = Field(
-        None, description="directory of the application certificate (cnc opcua-cert): "
-        "Basic256Sha256 Sign and SignAndEncrypt on; needed on a non-loopback host",
-    )
-    trusted_clients_dir: str | None = Field(
-        None, description="certificates (DER or PEM) of the clients that may connect "
-        "(default: certificate_dir/trusted)",
-    )
-    users_file: str | None = Field(
-        None, description="the web users file (cnc web-users set ROLE): user name = role, "
-        "its password; none: no user name tokens",
-    )
-    loopback_role: RoleName | None = Field(
-        None, description="role of anonymous sessions, allowed on a loopback host only "
-        "(default: admin; monitor when certificate_dir is given)",
-    )
 
 
 class OpcUaSecurityError(ValueError):

@@ -13,7 +13,8 @@ from cryptography.hazmat.primitives.asymmetric import rsa
 from cryptography.hazmat.primitives.serialization import load_pem_private_key
 from cryptography.x509.oid import ExtendedKeyUsageOID
 
-from cnc_objects.service.opcua.security import OpcUaSecurity, apply_security
+from cnc_objects.service.opcua.security import apply_security
+from cnc_objects.service.opcua.security_config import OpcUaSecurity
 from tests.support.cli import cnc
 
 URI = "urn:mill-7:cnc-objects"

@@ -17,7 +17,8 @@ from asyncua.ua.uaerrors import UaError, UaStatusCodeError
 
 from cnc_objects.protocol.opcua_files import TRUSTED_DIR
 from cnc_objects.protocol.roles import Role
-from cnc_objects.service.opcua.security import OpcUaSecurity, OpcUaSecurityError, apply_security
+from cnc_objects.service.opcua.security import OpcUaSecurityError, apply_security
+from cnc_objects.service.opcua.security_config import OpcUaSecurity
 from tests.support.cli import cnc
 from tests.support.opcua_security import (
     ANSWER,

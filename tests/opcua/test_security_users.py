@@ -13,19 +13,20 @@ from asyncua.crypto.permission_rules import User, UserRole
 from asyncua.server.server import Server
 from asyncua.ua.status_codes import StatusCodes
 from asyncua.ua.uaerrors import UaStatusCodeError
+from pydantic import ValidationError
 
 from cnc_objects.protocol.opcua_files import TRUSTED_DIR
 from cnc_objects.protocol.role_passwords import RolePasswords
 from cnc_objects.protocol.roles import Role
 from cnc_objects.service.opcua.security import (
     FAILED_CHECK_PAUSE_S,
-    OpcUaSecurity,
     OpcUaSecurityError,
     RoleUserManager,
     SessionUser,
     apply_security,
     role_of,
 )
+from cnc_objects.service.opcua.security_config import OpcUaSecurity
 from tests.support.cli import cnc, cnc_process
 from tests.support.opcua_security import (
     ANSWER,
@@ -157,3 +158,10 @@ def test_role_of_a_user_that_is_not_ours_is_the_least() -> None:
     assert role_of(None) is Role.MONITOR
     server = Server()  # the server's own (internal) session writes as the server: admin
     assert role_of(server.iserver.isession) is Role.ADMIN
+
+
+def test_the_opcua_keys_refuse_what_they_do_not_know() -> None:
+    with pytest.raises(ValidationError, match="loopback_role"):
+        OpcUaSecurity.model_validate({"loopback_role": "root"})
+    with pytest.raises(ValidationError, match="user_file"):
+        OpcUaSecurity.model_validate({"user_file": "web-users.json"})  # users_file misspelt

@@ -27,7 +27,8 @@ from cryptography.x509.oid import ExtendedKeyUsageOID
 from cnc_objects.clients.web.users import WebUsers, save_users
 from cnc_objects.protocol.opcua_files import CERTIFICATE_FILE
 from cnc_objects.protocol.roles import Role
-from cnc_objects.service.opcua.security import OpcUaSecurity, apply_security, role_of
+from cnc_objects.service.opcua.security import apply_security, role_of
+from cnc_objects.service.opcua.security_config import OpcUaSecurity
 
 ANSWER = 42  # the value of the one variable the server serves
 PASSWORDS = {Role.MONITOR: "m-secret", Role.OPERATOR: "o-secret", Role.ADMIN: "a-secret"}
