@@ -50,6 +50,7 @@ from cnc_objects.protocol.opcua_files import CERTIFICATE_FILE, PRIVATE_KEY_FILE,
 from cnc_objects.protocol.role_passwords import RolePasswords, parse_role_passwords
 from cnc_objects.protocol.roles import LOOPBACK_ROLE, Role
 
+from ..log_throttle import ThrottledWarning
 from ..security import host_is_loopback
 from .security_config import OpcUaSecurity
 
@@ -104,6 +105,11 @@ class RoleUserManager(UserManager):
         self._secured_only = secured_only
         self._clock = clock
         self._paused_until_s = 0.0
+        # a client can cause refusals at will: the first is logged, then one line a while
+        self._refusals = ThrottledWarning(log, "OPC UA session refused")
+
+    def _refuse(self, why: str) -> None:
+        self._refusals.note(why)
 
     def get_user(self, iserver: InternalServer, username: str | None = None,
                  password: str | None = None, certificate: Any = None) -> User | None:
@@ -113,15 +119,14 @@ class RoleUserManager(UserManager):
             if self._secured_only:
                 # asyncua opens a None channel on any server (GetEndpoints needs one) and
                 # creates sessions on it; off loopback none is activated there
-                log.warning("OPC UA session refused: its channel has SecurityPolicy None, "
-                            "served on loopback only")
+                self._refuse("its channel has SecurityPolicy None, served on "
+                             "loopback only")
                 return None
         elif not self._trusted(bytes(certificate)):
             return None
         if username is None:
             if self._anonymous_role is None:
-                log.warning("OPC UA anonymous session refused: anonymous is served on "
-                            "loopback only")
+                self._refuse("anonymous is served on loopback only")
                 return None
             return SessionUser(role=UserRole.User, name="anonymous",
                                cnc_role=self._anonymous_role)
@@ -139,16 +144,16 @@ class RoleUserManager(UserManager):
         except ValueError:
             role = None
         if passwords is None or role is None or role not in passwords.hashes:
-            log.warning("OPC UA user %r refused: the user name must be a role with a "
-                        "password (cnc web-users set ROLE)", username)
+            self._refuse(f"user {username[:64]!r}: the user name must be a role with a "
+                         "password (cnc web-users set ROLE)")
             return None
         if self._clock() < self._paused_until_s:
-            log.warning("OPC UA user %s refused unchecked: a wrong password came less than "
-                        "%.1f s ago", role.label, FAILED_CHECK_PAUSE_S)
+            self._refuse(f"user {role.label} unchecked: a wrong password came less "
+                         f"than {FAILED_CHECK_PAUSE_S:g} s ago")
             return None
         if not passwords.verify(role, password):
             self._paused_until_s = self._clock() + FAILED_CHECK_PAUSE_S
-            log.warning("OPC UA user %s refused: wrong password", role.label)
+            self._refuse(f"user {role.label}: wrong password")
             return None
         return role
 
@@ -156,11 +161,11 @@ class RoleUserManager(UserManager):
         try:
             certificate = x509.load_der_x509_certificate(der)
         except ValueError:
-            log.warning("OPC UA client refused: its channel certificate does not parse")
+            self._refuse("its channel certificate does not parse")
             return False
         if self._trust is None or not self._trust.validate(certificate):
-            log.warning("OPC UA client refused: its certificate %s is not trusted",
-                        certificate.subject.rfc4514_string())
+            self._refuse(f"its certificate {certificate.subject.rfc4514_string()} is not "
+                         "trusted")
             return False
         return True
 
