@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import ipaddress
 import os
+import re
 import socket
 from pathlib import Path
 
@@ -28,6 +29,9 @@ from cnc_objects.protocol.opcua_files import (
 )
 
 from .app import EXIT_USAGE, Settings, app, emit, say_error
+
+_LABEL = r"[A-Za-z0-9](?:[A-Za-z0-9-]{0,61}[A-Za-z0-9])?"
+_DNS_NAME = re.compile(rf"{_LABEL}(?:\.{_LABEL})*")  # RFC 1123 host names
 
 
 def _usage(text: str) -> typer.Exit:
@@ -66,6 +70,10 @@ def opcua_cert(
     names = hosts or [hostname, "localhost"]
     if ":" not in application_uri:
         raise _usage(f"--uri {application_uri!r}: an application URI has a scheme (urn:...)")
+    for name in names:
+        if not _is_address(name) and not _DNS_NAME.fullmatch(name):
+            raise _usage(f"--host {name!r}: give a DNS name (letters, digits, '-', '.') or an "
+                         "IP address")
     certificate_file = directory / CERTIFICATE_FILE
     key_file = directory / PRIVATE_KEY_FILE
     trusted = directory / TRUSTED_DIR
@@ -80,11 +88,8 @@ def opcua_cert(
     from cryptography.x509.oid import ExtendedKeyUsageOID
 
     alt_names: list[x509.GeneralName] = [x509.UniformResourceIdentifier(application_uri)]
-    for name in names:
-        try:
-            alt_names.append(x509.IPAddress(ipaddress.ip_address(name)))
-        except ValueError:
-            alt_names.append(x509.DNSName(name))
+    alt_names += [x509.IPAddress(ipaddress.ip_address(name)) if _is_address(name)
+                  else x509.DNSName(name) for name in names]
     key = cert_gen.generate_private_key()
     certificate = cert_gen.generate_self_signed_app_certificate(
         key, "cnc-objects", {}, alt_names,
@@ -107,6 +112,14 @@ def opcua_cert(
         f"clients that may connect: put their certificates into {trusted}/",
         f"serve it: [opcua] certificate_dir = \"{directory}\" (restart cnc-service)",
     ]))
+
+
+def _is_address(name: str) -> bool:
+    try:
+        ipaddress.ip_address(name)
+    except ValueError:
+        return False
+    return True
 
 
 def _write(path: Path, data: bytes, mode: int) -> None:

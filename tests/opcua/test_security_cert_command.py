@@ -7,6 +7,7 @@ import json
 import stat
 from pathlib import Path
 
+import pytest
 from asyncua.server.server import Server
 from cryptography import x509
 from cryptography.hazmat.primitives.asymmetric import rsa
@@ -89,8 +90,15 @@ def test_opcua_cert_keeps_a_certificate_unless_forced(tmp_path: Path) -> None:
     assert _mode(directory / "server-key.pem") == 0o600
 
 
-def test_opcua_cert_refuses_an_application_uri_without_a_scheme(tmp_path: Path) -> None:
-    refused = cnc("opcua-cert", "--dir", str(tmp_path / "opcua"), "--uri", "mill-7")
+@pytest.mark.parametrize(("option", "value", "problem"), [
+    ("--uri", "mill-7", "an application URI has a scheme"),
+    ("--host", "", "give a DNS name"),
+    ("--host", "bad name!", "give a DNS name"),
+])
+def test_opcua_cert_refuses_a_uri_or_host_a_certificate_cannot_carry(
+    tmp_path: Path, option: str, value: str, problem: str,
+) -> None:
+    refused = cnc("opcua-cert", "--dir", str(tmp_path / "opcua"), option, value)
     assert refused.returncode == 2
-    assert "an application URI has a scheme" in refused.stderr
+    assert problem in refused.stderr
     assert not (tmp_path / "opcua").exists()
