@@ -67,7 +67,8 @@ def opcua_cert(
     settings: Settings = ctx.find_root().obj
     hostname = socket.gethostname()
     application_uri = uri if uri is not None else f"urn:{hostname}:cnc-objects"
-    names = hosts or [hostname, "localhost"]
+    # this machine's name only where a certificate can carry it (not my_pc, say)
+    names = hosts or [n for n in (hostname, "localhost") if _DNS_NAME.fullmatch(n)]
     if ":" not in application_uri:
         raise _usage(f"--uri {application_uri!r}: an application URI has a scheme (urn:...)")
     for name in names:
