@@ -19,9 +19,9 @@ admin: ``protocol/roles.py``) of the session that sent a request. What it sets u
 - Users. A user name token names a role; its password is that role's in the web users
   file (``cnc web-users set ROLE``, ``protocol/role_passwords.py``). Anonymous sessions
   are allowed on a loopback host only, with ``[opcua] loopback_role`` (default admin,
-  monitor when the server has a certificate). A wrong password, an unknown role or an
-  anonymous session elsewhere: ``BadUserAccessDenied``, as asyncua answers a refused
-  user; a token type not offered: ``BadIdentityTokenRejected``.
+  monitor when the server has a certificate). A wrong password or a user name that is
+  not a role with a password: ``BadUserAccessDenied``, as asyncua answers a refused user;
+  a token type not offered (anonymous off loopback): ``BadIdentityTokenRejected``.
 
 Certificates, trust list and passwords are read at start: restart to apply a change.
 """
