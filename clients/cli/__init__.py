@@ -6,7 +6,7 @@ The package's ``__init__`` holds the global options and ``main``. The commands l
 modules ``objects`` (info, browse, read, write, watch), ``machine`` (program store, run,
 MDI, hold, resume, reset, status, lookahead, check), ``plot`` (plot), ``keys`` (keys new),
 ``tools`` (tool, offsets), ``tools_files`` (their export/import), ``step`` (step),
-``spindle``, ``manual`` (jog, home), ``alarms`` and ``web_users``; what they share is in
+``spindle``, ``manual`` (jog, home), ``alarms``, ``web_users`` and ``opcua_cert``; what they share is in
 ``app``. Importing them here registers them on the app, in this order.
 
 A service started with ``--keys`` needs this client's key (``--key FILE`` or
@@ -39,6 +39,7 @@ from . import (
     machine,  # noqa: F401  (programs, channel commands, check)
     manual,  # noqa: F401  (jog, home)
     objects,  # noqa: F401  (info, browse, read, write, watch)
+    opcua_cert,  # noqa: F401  (opcua-cert)
     plot,  # noqa: F401  (plot)
     spindle,  # noqa: F401  (spindle)
     step,  # noqa: F401  (step: the step clock)

@@ -20,9 +20,11 @@ from tests.support.cli import cnc
 # Heavy modules a command needs only where it uses them (plot: numpy, matplotlib; the
 # HMI: textual; service configuration: pydantic; fancy output: rich).
 # (argon2: the web users' password hashes, for `cnc web-users` only; issue 36.)
+# (asyncua, cryptography: the OPC UA certificate, for `cnc opcua-cert` only; issue 40.)
 NOT_FOR_HELP = ("numpy", "pydantic", "rich", "textual", "matplotlib", "msgpack", "zmq",
-                "asyncio", "argon2")
-NOT_FOR_READ = ("numpy", "pydantic", "rich", "textual", "matplotlib", "argon2")
+                "asyncio", "argon2", "asyncua", "cryptography")
+NOT_FOR_READ = ("numpy", "pydantic", "rich", "textual", "matplotlib", "argon2", "asyncua",
+                "cryptography")
 # A read runs on the blocking client: no event loop (asyncio, hence zmq.asyncio), no TLS
 # (ssl, which asyncio loads), no CURVE key files (zmq.auth) without keys (issue 36).
 NOT_FOR_BLOCKING_READ = ("asyncio", "ssl", "zmq.asyncio", "zmq.auth", "zmq.utils.monitor")
