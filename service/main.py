@@ -36,7 +36,7 @@ import os
 import signal
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
@@ -66,6 +66,7 @@ from .limits import notification_limits, rate_limiter
 from .machine_config import EmbeddedMachine
 from .notifications import NotificationCounts
 from .opcua.config import parse_opcua_endpoint
+from .opcua.security_config import OpcUaSecurity
 from .output_service import OutputService
 from .program_service import ProgramStoreService
 from .security import (
@@ -168,11 +169,11 @@ class AdsListen:
 
 @dataclass(frozen=True)
 class OpcUaListen:
-    """Where the OPC UA front end listens and the role of its (loopback) sessions."""
+    """Where the OPC UA front end listens and its security (``[opcua]``)."""
 
     host: str
     port: int
-    loopback_role: Role = LOOPBACK_ROLE
+    security: OpcUaSecurity = field(default_factory=OpcUaSecurity)
 
 
 async def serve(
@@ -275,10 +276,10 @@ async def serve(
                  "every peer's" if ads.open_to_all else "loopback",  # type: ignore[union-attr]
                  ads.loopback_role.label)  # type: ignore[union-attr]
     if opcua_server is not None:
-        log.info("OPC UA on %s (OPC 40502 CncInterface, %d channels; SecurityPolicy None; "
-                 "sessions' role %s; built in %.2f s, %s)",
-                 opcua_server.url, len(config.channels),
-                 opcua.loopback_role.label, opcua_server.start_s, opcua_server.cache_note)  # type: ignore[union-attr]
+        log.info("OPC UA on %s (OPC 40502 CncInterface, OPC 40501-1 MachineTool, %d channels; "
+                 "%s; built in %.2f s, %s)",
+                 opcua_server.url, len(config.channels), opcua_server.security_note,
+                 opcua_server.start_s, opcua_server.cache_note)
     if curve is not None:
         log.info("CURVE on: server public key %s; allow-list %s (%s)",
                  curve.public_key.decode(), curve.allow_list.origin, curve.allow_list.census())
@@ -342,11 +343,17 @@ async def _start_ads(
 
 async def _start_opcua(backend: Backend, opcua: OpcUaListen) -> OpcUaServer | None:
     """The listening OPC UA front end, or None after saying in one line why it cannot be."""
+    from .opcua.security import OpcUaSecurityError
     from .opcua.server import OpcUaServer  # asyncua only where OPC UA is served
 
-    opcua_server = OpcUaServer(backend, opcua.loopback_role)
+    opcua_server = OpcUaServer(backend, opcua.security)
     try:
         await opcua_server.start(opcua.host, opcua.port)
+    except OpcUaSecurityError as exc:
+        print(f"cnc-service: cannot serve OPC UA on {opcua.host}:{opcua.port}: {exc}",
+              file=sys.stderr)
+        await opcua_server.close()
+        return None
     except OSError as exc:
         reason = os.strerror(exc.errno) if exc.errno and exc.errno > 0 else exc.strerror or str(exc)
         print(f"cnc-service: cannot listen for OPC UA on {opcua.host}:{opcua.port}: {reason}",
@@ -529,25 +536,20 @@ def _ads_listen(
 
 def _opcua_listen(config: ServiceConfig, opcua: str | None, keys: bool = False
                   ) -> OpcUaListen | None:
-    """Where OPC UA listens: ``--opcua`` over the configuration's [opcua]. Only loopback
-    is served (SecurityPolicy None, as ADS without routes): another address is refused
-    until the front end has security. Sessions get ``[opcua] loopback_role``, by default
-    admin, monitor when the service runs with ``keys``."""
+    """Where OPC UA listens: ``--opcua`` over the configuration's [opcua], with its
+    security keys. Anonymous loopback sessions get ``[opcua] loopback_role``, by default
+    admin, monitor when the service runs with ``keys`` or the server has a certificate;
+    off loopback ``apply_security`` asks for a certificate and users (docs/opcua.md)."""
     try:
         address = parse_opcua_endpoint(opcua) if opcua is not None else config.opcua.address
     except ValueError as exc:
         _usage(f"bad --opcua: {exc}")
     if address is None:
         return None
-    if not host_is_loopback(address[0]):
-        _usage(f"OPC UA address {address[0]}:{address[1]} is not a loopback address: the "
-               "OPC UA front end serves SecurityPolicy None on loopback only; bind "
-               "127.0.0.1 (--opcua opc.tcp://127.0.0.1:4840) or --opcua off")
-    if config.opcua.loopback_role is not None:
-        role = Role.parse(config.opcua.loopback_role)
-    else:
-        role = Role.MONITOR if keys else LOOPBACK_ROLE
-    return OpcUaListen(address[0], address[1], role)
+    security: OpcUaSecurity = config.opcua
+    if security.loopback_role is None and keys:
+        security = security.model_copy(update={"loopback_role": Role.MONITOR.label})
+    return OpcUaListen(address[0], address[1], security)
 
 
 def _machine_config(path: Path | None, cycle_ms: float | None,

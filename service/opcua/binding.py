@@ -20,7 +20,6 @@ from __future__ import annotations
 import asyncio
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import Any
 
 from asyncua import Server, ua
@@ -31,10 +30,10 @@ from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.roles import role_to_write
 
 from ..backend import Backend
-from .feeds import Feed, Feeds
+from .feeds import BoundVariable, Feeds
 from .roles import role_of
 from .sources import Source
-from .values import bad, eu_information, good
+from .values import eu_information
 
 log = logging.getLogger(__name__)
 
@@ -52,45 +51,6 @@ WRITE_STATUS: dict[int, int] = {
 _READ_ONLY = ua.AccessLevel.CurrentRead.mask
 _READ_WRITE = ua.AccessLevel.CurrentRead.mask | ua.AccessLevel.CurrentWrite.mask
 _VALUE = ua.AttributeIds.Value
-
-
-@dataclass
-class BoundVariable:
-    """A variable and the objects behind it."""
-
-    node_id: ua.NodeId
-    source: Source
-    entries: tuple[Entry, ...]
-    getters: tuple[Callable[[], Any], ...]
-    #: the hub subscriptions by sampling interval (ns), each shared by the monitored
-    #: items of that interval; and the interval of each item by asyncua's handle
-    feeds: dict[int, Feed] = field(default_factory=dict)
-    items: dict[int, int] = field(default_factory=dict)
-    #: the raw values last read and their DataValue: a read of unchanged objects answers
-    #: it again (no new DataValue; its SourceTimestamp says when the value last changed)
-    _last_raw: Any = None
-    _last: ua.DataValue | None = None
-
-    def value(self) -> ua.DataValue:
-        """The current value, Good; BadInternalError when a getter fails."""
-        getters = self.getters
-        try:
-            if len(getters) == 1:  # the common case: one object
-                raw = getters[0]()
-                if raw == self._last_raw and self._last is not None:
-                    return self._last
-                value = good(self.source.value(raw), self.source.variant)
-                self._last_raw, self._last = raw, value
-                return value
-            raw = tuple([get() for get in getters])
-            if raw == self._last_raw and self._last is not None:
-                return self._last
-            value = good(self.source.value(*raw), self.source.variant)
-        except Exception:  # a getter fault must not take the service down
-            log.exception("reading OPC UA variable %s failed", self.node_id.to_string())
-            return bad(_S.BadInternalError)
-        self._last_raw, self._last = raw, value
-        return value
 
 
 class VariableBinder:

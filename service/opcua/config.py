@@ -7,8 +7,7 @@ from urllib.parse import urlsplit
 
 from pydantic import Field, field_validator
 
-from ..frontend_config import RoleName
-from ..machine_config import Strict
+from .security_config import OpcUaSecurity
 
 OPCUA_SCHEME = "opc.tcp"
 OPCUA_PORT = 4840  # IANA's port of OPC UA over TCP, the default of every client
@@ -47,16 +46,13 @@ def endpoint_url(host: str, port: int) -> str:
     return f"{OPCUA_SCHEME}://[{host}]:{port}" if bracket else f"{OPCUA_SCHEME}://{host}:{port}"
 
 
-class OpcUaConfig(Strict):
-    """The OPC UA front end: where it listens and the role of its sessions."""
+class OpcUaConfig(OpcUaSecurity):
+    """The OPC UA front end: where it listens, and its security (``OpcUaSecurity``:
+    certificate, trusted clients, users, the role of anonymous loopback sessions)."""
 
     endpoint: str = Field(
         DEFAULT_OPCUA_ENDPOINT,
         description="opc.tcp://HOST[:PORT] to listen on for OPC UA, or off",
-    )
-    loopback_role: RoleName | None = Field(
-        None, description="role of OPC UA sessions from loopback with SecurityPolicy None "
-        "(default: admin; monitor when the service runs with keys)",
     )
 
     @field_validator("endpoint")

@@ -6,6 +6,9 @@ sample goes to each item of the feed, in order; asyncua drops a value equal to t
 asyncua has no hook for "a monitored item was added": the variable's
 ``datachange_callbacks`` dict, where asyncua registers each item's callback, is replaced
 by ``WatchedCallbacks``, which tells ``Feeds`` when an item comes and goes.
+
+``BoundVariable`` (a variable, the objects behind it, its feeds) lives here, where its
+subscriptions are kept; ``binding`` makes them.
 """
 
 from __future__ import annotations
@@ -14,17 +17,16 @@ import asyncio
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from asyncua import ua
 
+from cnc_objects.objects import Entry
 from cnc_objects.protocol.constants import TransmissionMode
 
 from ..backend import Backend
+from .sources import Source
 from .values import bad, good, source_time
-
-if TYPE_CHECKING:
-    from .binding import BoundVariable
 
 log = logging.getLogger(__name__)
 
@@ -71,6 +73,45 @@ class WatchedCallbacks(dict[int, DataChangeCallback]):
         value = super().pop(handle, *default)
         if found:
             self._removed(handle)
+        return value
+
+
+@dataclass
+class BoundVariable:
+    """A variable and the objects behind it."""
+
+    node_id: ua.NodeId
+    source: Source
+    entries: tuple[Entry, ...]
+    getters: tuple[Callable[[], Any], ...]
+    #: the hub subscriptions by sampling interval (ns), each shared by the monitored
+    #: items of that interval; and the interval of each item by asyncua's handle
+    feeds: dict[int, Feed] = field(default_factory=dict)
+    items: dict[int, int] = field(default_factory=dict)
+    #: the raw values last read and their DataValue: a read of unchanged objects answers
+    #: it again (no new DataValue; its SourceTimestamp says when the value last changed)
+    _last_raw: Any = None
+    _last: ua.DataValue | None = None
+
+    def value(self) -> ua.DataValue:
+        """The current value, Good; BadInternalError when a getter fails."""
+        getters = self.getters
+        try:
+            if len(getters) == 1:  # the common case: one object
+                raw = getters[0]()
+                if raw == self._last_raw and self._last is not None:
+                    return self._last
+                value = good(self.source.value(raw), self.source.variant)
+                self._last_raw, self._last = raw, value
+                return value
+            raw = tuple([get() for get in getters])
+            if raw == self._last_raw and self._last is not None:
+                return self._last
+            value = good(self.source.value(*raw), self.source.variant)
+        except Exception:  # a getter fault must not take the service down
+            log.exception("reading OPC UA variable %s failed", self.node_id.to_string())
+            return bad(_S.BadInternalError)
+        self._last_raw, self._last = raw, value
         return value
 
 

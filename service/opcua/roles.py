@@ -1,19 +1,15 @@
 """Who an OPC UA session is: the role of our access policy (``protocol.roles``, the one
 policy of every front end) that its activated user carries.
 
-Every session a client activates gets a ``CncUser`` from the server's user manager; the
-service's own internal session keeps asyncua's plain ``User`` (``role_of`` is None:
-not a client). For now every client session is served on loopback with SecurityPolicy
-None (as ADS serves its loopback peers) and ``LoopbackUsers`` gives it the configured
-loopback role. The security part (user tokens, certificates: ``security.py``) installs a
-user manager of its own that maps tokens to ``CncUser`` objects of other roles;
-nothing else changes.
+Every session a client activates gets a ``CncUser`` from the server's user manager
+(``security.RoleUserManager``: anonymous on loopback as ``[opcua] loopback_role``, a user
+name token as the role it names); the service's own internal session keeps asyncua's
+plain ``User`` (``role_of`` is None: not a client).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 from asyncua.crypto.permission_rules import User, UserRole
 
@@ -40,16 +36,3 @@ def role_of(user: User | None) -> Role | None:
 def cnc_user(role: Role, name: str | None = None) -> CncUser:
     """The user of a session of ``role``."""
     return CncUser(role=ASYNCUA_ROLE[role], name=name, cnc_role=role)
-
-
-@dataclass(frozen=True)
-class LoopbackUsers:
-    """asyncua's user manager while only loopback is served with SecurityPolicy None:
-    every session, whatever its token, gets ``loopback``."""
-
-    loopback: Role
-
-    def get_user(self, iserver: Any, username: str | None = None,
-                 password: str | None = None, certificate: Any = None) -> User | None:
-        """The user of a session being activated (asyncua's UserManager protocol)."""
-        return cnc_user(self.loopback, username)

@@ -32,7 +32,6 @@ import logging
 import stat
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -52,6 +51,8 @@ from cnc_objects.protocol.roles import LOOPBACK_ROLE, Role
 
 from ..log_throttle import ThrottledWarning
 from ..security import host_is_loopback
+from .roles import CncUser, cnc_user
+from .roles import role_of as client_role_of
 from .security_config import OpcUaSecurity
 
 log = logging.getLogger(__name__)
@@ -71,27 +72,25 @@ class OpcUaSecurityError(ValueError):
     """The security settings cannot be served; the message says which file or key and why."""
 
 
-@dataclass
-class SessionUser(User):
-    """asyncua's user of a session, with the service's role. asyncua's own role is
-    ``UserRole.User`` for every one of ours: it may read, write, call and subscribe, never
-    add or delete nodes (``SimpleRoleRuleset``); what a write or call needs is ours to say."""
-
-    cnc_role: Role = Role.MONITOR
+#: asyncua's user of a session, with the service's role (``roles.CncUser``): asyncua's own
+#: role is ``UserRole.User`` for every one of ours (read, write, call, subscribe; never add
+#: or delete nodes, ``SimpleRoleRuleset``); what a write or call needs is ours to say.
+SessionUser = CncUser
 
 
 def role_of(who: InternalSession | User | None) -> Role:
     """The service's role of a session or of its user. The server's own session (asyncua's
     internal admin) is admin; a user this module did not make is monitor, the least."""
     user = who.user if isinstance(who, InternalSession) else who
-    if isinstance(user, SessionUser):
-        return user.cnc_role
+    role = client_role_of(user)
+    if role is not None:
+        return role
     if user is not None and user.role is UserRole.Admin:
         return Role.ADMIN  # asyncua's internal session: the server itself
     return Role.MONITOR
 
 
-class RoleUserManager(UserManager):
+class RoleUserManager(UserManager):  # type: ignore[misc]  # asyncua is Any to mypy (pyproject)
     """asyncua's user manager: the session's user from the channel's certificate and the
     identity token (called at ActivateSession; None: ``BadUserAccessDenied``)."""
 
@@ -128,13 +127,12 @@ class RoleUserManager(UserManager):
             if self._anonymous_role is None:
                 self._refuse("anonymous is served on loopback only")
                 return None
-            return SessionUser(role=UserRole.User, name="anonymous",
-                               cnc_role=self._anonymous_role)
+            return cnc_user(self._anonymous_role, "anonymous")
         role = self._checked_role(username, password or "")
         if role is None:
             return None
         log.info("OPC UA session of user %s (role %s)", username, role.label)
-        return SessionUser(role=UserRole.User, name=role.label, cnc_role=role)
+        return cnc_user(role, role.label)
 
     def _checked_role(self, username: str, password: str) -> Role | None:
         """The role ``username`` names when ``password`` is its password, else None."""
@@ -170,11 +168,11 @@ class RoleUserManager(UserManager):
         return True
 
 
-async def apply_security(server: Server, settings: OpcUaSecurity, host: str) -> None:
+async def apply_security(server: Server, settings: OpcUaSecurity, host: str) -> str:
     """Set ``server``'s security policies, certificate, trust list and user manager from
     ``settings`` for a server listening on ``host``. Call after ``server.init()`` (it sets
-    the application URI, the certificate's) and before ``server.start()``.
-    ``OpcUaSecurityError`` says what cannot be served."""
+    the application URI, the certificate's) and before ``server.start()``. Returns what is
+    served, in words for the start-up log; ``OpcUaSecurityError`` says what cannot be."""
     loopback = host_is_loopback(host)
     certificate_dir = _path(settings.certificate_dir)
     if certificate_dir is None and not loopback:
@@ -208,10 +206,9 @@ async def apply_security(server: Server, settings: OpcUaSecurity, host: str) -> 
     server.set_identity_tokens(tokens)
     server.iserver.set_user_manager(
         RoleUserManager(passwords, anonymous_role, trust, secured_only=not loopback))
-    log.info("OPC UA security on %s: policies %s; anonymous %s; user names %s", host,
-             ", ".join(p.name for p in policies),
-             f"as {anonymous_role.label}" if anonymous_role else "refused",
-             ", ".join(r.label for r in passwords.roles) if passwords else "none")
+    return (f"security policies {', '.join(p.name for p in policies)}; anonymous "
+            f"{'as ' + anonymous_role.label if anonymous_role else 'refused'}; user names "
+            f"{', '.join(r.label for r in passwords.roles) if passwords else 'none'}")
 
 
 def _path(text: str | None) -> Path | None:

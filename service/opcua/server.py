@@ -11,9 +11,7 @@ from __future__ import annotations
 import logging
 import time
 
-from asyncua import Server, ua
-
-from cnc_objects.protocol.roles import Role
+from asyncua import Server
 
 from ..backend import Backend
 from . import address_space_cache as cache
@@ -22,7 +20,8 @@ from .binding import VariableBinder
 from .cnc_interface import build_cnc_interface
 from .config import endpoint_url
 from .nodesets import asyncua_quiet, load_nodesets
-from .roles import LoopbackUsers
+from .security import apply_security
+from .security_config import OpcUaSecurity
 
 log = logging.getLogger(__name__)
 
@@ -31,22 +30,13 @@ PRODUCT_URI = "https://github.com/cnc-objects"
 VENDOR = "cnc-objects"
 
 
-def apply_security(server: Server, loopback_role: Role) -> None:
-    """The one place where the server's security is decided: its endpoints' security
-    policies and its user manager (who a session is, ``roles``). For now: SecurityPolicy
-    None only (the service serves OPC UA on loopback only, as ADS without routes) and
-    every session the loopback role. Certificates, Basic256Sha256 and user tokens are
-    applied here by the security part (``security.py``)."""
-    server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
-    server.iserver.set_user_manager(LoopbackUsers(loopback_role))
-
-
 class OpcUaServer:
     """The OPC UA front end of one service."""
 
-    def __init__(self, backend: Backend, loopback_role: Role) -> None:
+    def __init__(self, backend: Backend, security: OpcUaSecurity) -> None:
         self.backend = backend
-        self.loopback_role = loopback_role
+        self.security = security
+        self.security_note = ""  # what ``apply_security`` serves, for the start-up log
         self.address: tuple[str, int] = ("", 0)
         self.nodes_left_out = 0  # nodeset nodes asyncua could not import
         self.start_s = 0.0  # how long ``start`` took (nodesets, instances, listening)
@@ -73,7 +63,7 @@ class OpcUaServer:
         server.set_endpoint(endpoint_url(host, port))
         server.set_server_name(f"{VENDOR} CNC")
         await server.set_application_uri(APPLICATION_URI)
-        apply_security(server, self.loopback_role)
+        self.security_note = await apply_security(server, self.security, host)
         namespaces = server.nodes.namespace_array
         if kept is None:
             self.nodes_left_out = await load_nodesets(server)
