@@ -16,10 +16,12 @@ from asyncua import Server, ua
 from cnc_objects.protocol.roles import Role
 
 from ..backend import Backend
+from .alarm_events import build_alarm_events
 from .attributes import BoundAttributes
 from .binding import VariableBinder
 from .cnc_interface import build_cnc_interface
 from .config import endpoint_url
+from .machine_tool import build_machine_tool
 from .nodesets import load_nodesets
 from .roles import LoopbackUsers
 
@@ -75,6 +77,8 @@ class OpcUaServer:
         binder = VariableBinder(server, self.backend)
         server.iserver.attribute_service = BoundAttributes(server.iserver.aspace, binder)
         await build_cnc_interface(server, binder, self.backend, VENDOR, self.version)
+        machine = await build_machine_tool(server, binder, self.backend, VENDOR, PRODUCT_URI)
+        await build_alarm_events(server, self.backend, machine)
         await server.start()
         bound = server.bserver
         assert bound is not None  # start() made it
