@@ -93,18 +93,18 @@ class _Builder:
     def __init__(self, server: Server, binder: VariableBinder, ns: int) -> None:
         self.server, self.binder, self.ns = server, binder, ns
 
-    async def add_member(self, node: Node, name: str) -> Node:
+    async def add_member(self, node: Node, name: str, recursive: bool = True) -> Node:
         """Add ``node``'s optional member ``name`` as its type (or a supertype) declares
-        it."""
+        it (without its children unless ``recursive``)."""
         type_node = self.server.get_node(await node.read_type_definition())
         for declaring in await get_node_supertypes(type_node, includeitself=True):
-            found = await self.instantiate(node, declaring, name)
+            found = await self.instantiate(node, declaring, name, recursive=recursive)
             if found is not None:
                 return found
         raise KeyError(f"{name}: no member of {type_node.nodeid.to_string()}")
 
     async def instantiate(self, node: Node, declaring: Node, name: str,
-                          as_name: str | None = None) -> Node | None:
+                          as_name: str | None = None, recursive: bool = True) -> Node | None:
         """The member ``name`` that ``declaring`` declares, added to ``node`` (as
         ``as_name``): its type definition, data type and Mandatory children, by asyncua's
         own instantiation of a declaration (its public ``instantiate`` takes types
@@ -115,9 +115,10 @@ class _Builder:
                 bname = rdesc.BrowseName if as_name is None else ua.QualifiedName(as_name, self.ns)
                 added = await _instantiate_node(
                     node.session, self.server.get_node(rdesc.NodeId), node.nodeid, rdesc,
-                    ua.NodeId(NamespaceIndex=self.ns), bname, instantiate_optional=False)
+                    ua.NodeId(NamespaceIndex=self.ns), bname, recursive=recursive,
+                    instantiate_optional=False)
                 member = self.server.get_node(added[0])
-                for child in await member.get_children():
+                for child in await member.get_children() if recursive else ():
                     if (await child.read_browse_name()).Name.startswith("<"):
                         await self.server.delete_nodes([child], recursive=True)
                 return member
@@ -140,7 +141,8 @@ class _Builder:
         reason = sources.pop("ReasonForLocking")
         await self.bind(node, sources)
         await self.bind(await node.get_child(f"{self.ns}:Locked"), {"ReasonForLocking": reason})
-        life = await self.add_member(node, "ToolLife")
+        # its one child is the placeholder <ToolLifeEntry>: CuttingTime takes its place
+        life = await self.add_member(node, "ToolLife", recursive=False)
         declared = await self.server.get_node(ua.NodeId(TOOL_TYPE, self.ns)).get_child(
             f"{self.ns}:ToolLife")
         cutting = await self.instantiate(life, declared, "<ToolLifeEntry>", "CuttingTime")

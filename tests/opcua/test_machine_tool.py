@@ -97,7 +97,7 @@ async def conformance_gaps(client: Client, root: Node) -> list[str]:
     async def walk(node: Node, path: str) -> None:
         type_id = await node.read_type_definition()
         children = {(await c.read_browse_name()).Name: c for c in await node.get_children()}
-        if type_id is not None and type_id.NamespaceIndex != 0:
+        if type_id is not None and not type_id.is_null():
             for name, rule, member_type in await members(type_id):
                 if rule in _MANDATORY and name not in children:
                     gaps.append(f"{path}: {name}")
