@@ -230,7 +230,17 @@ class AlarmEvents:
                 await service.trigger_event(event)
         if row.state == AlarmState.CLEARED:
             self.conditions.pop(condition, None)
-            await self.server.delete_nodes([self.server.get_node(condition)])
+            self._forget(condition)
+
+    def _forget(self, condition: ua.NodeId) -> None:
+        """Delete the condition node of a cleared alarm. Only Messages refers to it:
+        that reference goes, then the node, without asyncua's search of every node for
+        references to it (a RESET may clear a hundred alarms at once)."""
+        aspace = self.server.iserver.aspace
+        parent = aspace[self.messages.nodeid]
+        parent.references[:] = [r for r in parent.references if r.NodeId != condition]
+        aspace.delete_nodes(ua.DeleteNodesParameters(NodesToDelete=[
+            ua.DeleteNodesItem(NodeId=condition, DeleteTargetReferences=False)]))
 
     async def _condition(self, row: AlarmRow) -> ua.NodeId:
         """The ConditionId of ``row``: a node under Messages while the alarm is active."""

@@ -182,3 +182,28 @@ async def test_a_monitors_acknowledge_is_refused_and_changes_nothing(monitored: 
         assert refused.value.code == ua.StatusCodes.BadUserAccessDenied
         assert await asyncio.to_thread(alarm_state, service, sequence) == AlarmState.ACTIVE
         await subscription.delete()
+
+
+async def test_reset_clears_the_condition_and_its_node_goes(machine: Running) -> None:
+    service, url = machine
+    async with connected(url) as client:
+        cnc_ns = await client.get_namespace_index(CNC_URI)
+        messages = await child(await machine_node(client), "Notification", "Messages")
+        subscription, events = await subscribe(client, client.nodes.server,
+                                               ua.NodeId(1006, cnc_ns))
+        sequence = await asyncio.to_thread(fail, service, "reset.nc")
+        name = f"Alarm{sequence}"
+        raised = await events.wait(lambda e: e.ConditionName == name)
+        assert name in [(await c.read_browse_name()).Name for c in await messages.get_children()]
+        with CncClient(service.endpoint, timeout_s=WAIT_S) as cnc:
+            cnc.reset(1)
+        cleared = await events.wait(lambda e: e.ConditionName == name and not e.Retain)
+        assert cleared.ActiveState.Text == "Inactive" and cleared.NodeId == raised.NodeId
+        assert name not in [(await c.read_browse_name()).Name
+                            for c in await messages.get_children()]
+        with pytest.raises(ua.UaStatusCodeError) as gone:
+            await client.get_node(raised.NodeId).call_method(
+                ACKNOWLEDGE, ua.Variant(raised.EventId, ua.VariantType.ByteString),
+                ua.LocalizedText("late"))
+        assert gone.value.code == ua.StatusCodes.BadNodeIdUnknown
+        await subscription.delete()
