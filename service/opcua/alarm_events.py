@@ -193,10 +193,18 @@ class AlarmEvents:
     # ------------------------------------------------------------ following the alarms
 
     def _changed(self, envelope: Any, port: int, samples: list[list[Any]]) -> bool:
-        task = asyncio.get_running_loop().create_task(self._update(emit=True))
+        task = asyncio.get_running_loop().create_task(self._update_logged())
         self._tasks.add(task)
         task.add_done_callback(self._tasks.discard)
         return True
+
+    async def _update_logged(self) -> None:
+        """``_update`` on a change: a fault is logged, the service goes on (the next
+        change reads the alarms again)."""
+        try:
+            await self._update(emit=True)
+        except Exception:
+            log.exception("OPC UA alarm events: reading the alarms failed")
 
     async def _update(self, emit: bool) -> None:
         """Read the alarms; an event for every alarm whose state moved."""
@@ -315,24 +323,28 @@ class AlarmEvents:
         return ua.StatusCode(_S.Good)
 
     async def refresh(self, parent: ua.NodeId, *args: ua.Variant) -> ua.StatusCode:
-        """ConditionRefresh(SubscriptionId[, MonitoredItemId]): RefreshStart, the active
-        alarms' newest events, RefreshEnd, to that subscription only."""
+        """ConditionRefresh(SubscriptionId) and ConditionRefresh2(SubscriptionId,
+        MonitoredItemId): RefreshStart, the active alarms' newest events, RefreshEnd, to
+        that subscription's (or that item's) event items only."""
         if not args or not isinstance(args[0].Value, int):
-            return ua.StatusCode(_S.BadArgumentsMissing)
+            return ua.StatusCode(_S.BadArgumentsMissing if not args else _S.BadInvalidArgument)
         subscription = self.server.iserver.subscription_service.subscriptions.get(
             args[0].Value)
         if subscription is None:
             return ua.StatusCode(_S.BadSubscriptionIdInvalid)
         items = subscription.monitored_item_srv
+        item = args[1].Value if len(args) > 1 else None
+        if item is not None and item not in items._monitored_items:
+            return ua.StatusCode(_S.BadMonitoredItemIdInvalid)
         start, end = self._refresh
         async with self._lock:
             for _, notifier in self._templates:
-                await items.trigger_event(_refresh_event(start, notifier))
+                await _send(items, _refresh_event(start, notifier), item)
             for sequence in sorted(self.latest):
                 for event in self.latest[sequence]:
-                    await items.trigger_event(event)
+                    await _send(items, event, item)
             for _, notifier in self._templates:
-                await items.trigger_event(_refresh_event(end, notifier))
+                await _send(items, _refresh_event(end, notifier), item)
         return ua.StatusCode(_S.Good)
 
     def close(self) -> None:
@@ -350,6 +362,16 @@ def _stamp(event: Any, when: datetime) -> None:
     local = ua.TimeZoneDataType()
     local.Offset = time.localtime(when.timestamp()).tm_gmtoff // 60
     event.LocalTime = local
+
+
+async def _send(items: Any, event: Any, item: int | None) -> None:
+    """``event`` to a subscription's event items on its notifier (``items``: asyncua's
+    MonitoredItemService), or to its item ``item`` alone when that one watches it
+    (asyncua's own ``trigger_event(event, mid)`` does not ask)."""
+    if item is None:
+        await items.trigger_event(event)
+    elif item in items._monitored_events.get(event.emitting_node, ()):
+        await items.trigger_event(event, item)
 
 
 def _refresh_event(template: Any, notifier: ua.NodeId) -> Any:

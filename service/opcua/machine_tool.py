@@ -46,7 +46,7 @@ async def build_machine_tool(server: Server, binder: VariableBinder, backend: Ba
     builder = _Builder(server, binder, ns)
 
     identity = await machine.get_child(f"{di}:Identification")
-    for name in ("Model", "SoftwareRevision"):
+    for name in ("Model", "SoftwareRevision", "ProductCode", "YearOfConstruction"):
         await builder.add_member(identity, name)
     await builder.bind(identity, members.identification(vendor, config.name, product_uri))
 

@@ -20,6 +20,7 @@ The twin's states as the MachineTool nodeset's enumerations (values as published
 from __future__ import annotations
 
 from collections.abc import Callable
+from datetime import UTC, datetime
 from typing import Any
 
 from asyncua import ua
@@ -78,7 +79,9 @@ def program_state(state: int, program: str) -> int:
 
 def identification(vendor: str, machine: str, product_uri: str) -> dict[str, Source]:
     """MachineToolIdentificationType's members (40501-1 8.2; Machinery 10.1): the service
-    is the machine; its identity does not change while it runs."""
+    is the machine; its identity does not change while it runs. Model, ProductCode,
+    SoftwareRevision and YearOfConstruction are optional in the model; the umati
+    dashboard shows them."""
     return {
         "Manufacturer": fixed(ua.LocalizedText(vendor), ua.VariantType.LocalizedText,
                               "the service's vendor name"),
@@ -89,6 +92,9 @@ def identification(vendor: str, machine: str, product_uri: str) -> dict[str, Sou
         "ProductInstanceUri": fixed(f"{product_uri}/{machine}", _S,
                                     "the product URI and the machine configuration's name"),
         "SoftwareRevision": plain("cnc_version_r", _S),
+        "ProductCode": fixed(f"{vendor}-twin", _S, "the service's product"),
+        "YearOfConstruction": fixed(datetime.now(UTC).year, _U16, "a twin is built when "
+                                    "its service starts: the year of the start"),
     }
 
 

@@ -207,3 +207,54 @@ async def test_reset_clears_the_condition_and_its_node_goes(machine: Running) ->
                 ua.LocalizedText("late"))
         assert gone.value.code == ua.StatusCodes.BadNodeIdUnknown
         await subscription.delete()
+
+
+async def status_of(call: Any) -> int:
+    """The status code a method call is refused with (0: it was not)."""
+    try:
+        await call
+    except ua.UaStatusCodeError as refused:
+        return int(refused.code)
+    return 0
+
+
+async def test_bad_method_arguments_get_their_status_and_change_nothing(
+        machine: Running) -> None:
+    service, url = machine
+    async with connected(url) as client:
+        cnc_ns = await client.get_namespace_index(CNC_URI)
+        subscription, events = await subscribe(client, client.nodes.server,
+                                               ua.NodeId(1006, cnc_ns))
+        sequence = await asyncio.to_thread(fail, service, "args.nc")
+        raised = await events.wait(lambda e: e.ConditionName == f"Alarm{sequence}")
+        condition = client.get_node(raised.NodeId)
+        event_id = ua.Variant(raised.EventId, ua.VariantType.ByteString)
+        comment = ua.LocalizedText("x")
+        assert await status_of(condition.call_method(ACKNOWLEDGE, event_id)) == (
+            ua.StatusCodes.BadArgumentsMissing)
+        assert await status_of(condition.call_method(
+            ACKNOWLEDGE, ua.Variant(b"no such event", ua.VariantType.ByteString), comment)) == (
+            ua.StatusCodes.BadEventIdUnknown)
+        assert await status_of(condition.call_method(ACKNOWLEDGE, "text", comment)) == (
+            ua.StatusCodes.BadInvalidArgument)
+        assert await status_of(client.nodes.server.call_method(ACKNOWLEDGE, event_id,
+                                                               comment)) == (
+            ua.StatusCodes.BadNodeIdUnknown)  # the Server object is no condition
+        condition_type = client.get_node(ua.NodeId(ua.ObjectIds.ConditionType))
+        assert await status_of(condition_type.call_method(
+            REFRESH, ua.Variant(987654, ua.VariantType.UInt32))) == (
+            ua.StatusCodes.BadSubscriptionIdInvalid)
+        assert await asyncio.to_thread(alarm_state, service, sequence) == AlarmState.ACTIVE
+
+        # ConditionRefresh2: the item asked for gets the events, another item none
+        other = await subscription.subscribe_events(client.nodes.server,
+                                                    ua.NodeId(1006, cnc_ns))
+        before = len(events.seen)
+        refresh2 = ua.NodeId(ua.ObjectIds.ConditionType_ConditionRefresh2)
+        assert await status_of(condition_type.call_method(
+            refresh2, ua.Variant(subscription.subscription_id, ua.VariantType.UInt32),
+            ua.Variant(other, ua.VariantType.UInt32))) == 0
+        again = await events.wait(lambda e: e.ConditionName == f"Alarm{sequence}", before)
+        assert again.EventId == raised.EventId
+        assert {e.server_handle for e in events.seen[before:]} == {other}
+        await subscription.delete()
