@@ -2,9 +2,9 @@
 Alarms & Conditions events: ``CncAlarmType`` (OPC 40502 6.10.2) from the Server object,
 ``AlertType`` (OPC 40501-1 9.1) from the MachineTool's Notification/Messages.
 
-- Each change of the alarms (``alarm_changes_r``, followed through the notification
-  hub) reads the alarm slots again; every alarm whose state moved gives one event per
-  notifier: raised (ActiveState True, AckedState False), acknowledged (AckedState True),
+- Each change of the alarms (``alarm_changes_r``, looked at every ``ALARM_POLL_S``
+  on the loop) reads the alarm slots again; every alarm whose state moved gives one
+  event per notifier: raised (ActiveState True, AckedState False), acknowledged (AckedState True),
   cleared (ActiveState False, Retain False: the condition ends).
 - Fields: AlarmIdentifier / ErrorCode the ISG error id, Severity the alarm's (500
   warning, 800 error, 1000 fatal), Message its text and place, Time when raised,
@@ -33,7 +33,6 @@ from asyncua import Node, Server, ua
 from asyncua.common.events import get_event_obj_from_type_node
 
 from cnc_objects.protocol.alarm_values import AlarmState
-from cnc_objects.protocol.constants import TransmissionMode
 from cnc_objects.protocol.roles import role_to_write
 
 from ..backend import Backend
@@ -50,6 +49,11 @@ _FIELDS = ("sequence", "id", "severity", "channel", "state", "time", "text", "fi
 _S = ua.StatusCodes
 _READ_TRIES = 10  # reads of the slots while the alarms keep changing
 _ACKNOWLEDGE_OBJECT = "alarm_acknowledge_w"
+#: how often (wall time) the loop looks at ``alarm_changes_r``. Not a subscription of the
+#: notification hub: its due cycles are cycles the event-speed virtual clock must publish
+#: (one each kernel cycle made a 120 s program take 3.4 s instead of 0.03 s), and with a
+#: longer period an idle kernel (after an ERROR) never reaches the next due cycle
+ALARM_POLL_S = 0.05
 
 
 @dataclass(frozen=True, slots=True)
@@ -74,17 +78,6 @@ class AlarmRow:
         return where + self.text
 
 
-@dataclass(frozen=True, slots=True)
-class _Watch:
-    """The fields of an AddDeviceNotification the hub reads."""
-
-    port: int
-    group: int
-    offset: int
-    length: int
-    transmission_mode: int = TransmissionMode.SERVER_ON_CHANGE
-
-
 class AlarmSlots:
     """Reads the alarm objects (active slots and history) through their getters."""
 
@@ -100,6 +93,10 @@ class AlarmSlots:
             self._history.append({f: _getter(backend, f"alarm_history[{k}].{f}")
                                   for f in _FIELDS})
             k += 1
+
+    def changes(self) -> int:
+        """``alarm_changes_r``: counts every raise, acknowledge and clear."""
+        return int(self._changes())
 
     def read(self) -> dict[int, AlarmRow]:
         """Every alarm listed (active, then the history), by sequence number; read again
@@ -147,7 +144,8 @@ class AlarmEvents:
         self._refresh: list[Any] = []  # RefreshStart, RefreshEnd templates
         self._lock = asyncio.Lock()
         self._tasks: set[asyncio.Task[None]] = set()
-        self._hub_handle: int | None = None
+        self._last_changes = 0
+        self._poll_handle: asyncio.TimerHandle | None = None
 
     async def start(self) -> None:
         """Event templates, the condition methods, the first reading, the subscription."""
@@ -180,23 +178,22 @@ class AlarmEvents:
                        ua.ObjectIds.ConditionType_ConditionRefresh2):
             isession.add_method_callback(ua.NodeId(method), self.refresh)
         await self._update(emit=False)
-        obj = self.backend.space.by_name("alarm_changes_r")
-        assert obj is not None  # the catalog has it
-        o = obj.obj
-        code, handle = self.backend.hub.add(
-            ("opcua-alarms", id(self), 0), _Watch(o.port, o.group, o.offset, o.dtype.size),
-            0, self._changed)
-        if code:
-            raise RuntimeError(f"alarm events: cannot follow alarm_changes_r: {handle}")
-        self._hub_handle = int(handle)
+        self._last_changes = self.slots.changes()
+        self._poll_handle = asyncio.get_running_loop().call_later(ALARM_POLL_S, self._poll)
 
     # ------------------------------------------------------------ following the alarms
 
-    def _changed(self, envelope: Any, port: int, samples: list[list[Any]]) -> bool:
+    def _poll(self) -> None:
+        """(loop, every ``ALARM_POLL_S``) Read the alarms again when their change
+        counter moved."""
+        self._poll_handle = asyncio.get_running_loop().call_later(ALARM_POLL_S, self._poll)
+        changes = self.slots.changes()
+        if changes == self._last_changes:
+            return
+        self._last_changes = changes
         task = asyncio.get_running_loop().create_task(self._update_logged())
         self._tasks.add(task)
         task.add_done_callback(self._tasks.discard)
-        return True
 
     async def _update_logged(self) -> None:
         """``_update`` on a change: a fault is logged, the service goes on (the next
@@ -244,11 +241,12 @@ class AlarmEvents:
         """Delete the condition node of a cleared alarm. Only Messages refers to it:
         that reference goes, then the node, without asyncua's search of every node for
         references to it (a RESET may clear a hundred alarms at once)."""
-        aspace = self.server.iserver.aspace
-        parent = aspace[self.messages.nodeid]
+        iserver = self.server.iserver
+        parent = iserver.aspace[self.messages.nodeid]
         parent.references[:] = [r for r in parent.references if r.NodeId != condition]
-        aspace.delete_nodes(ua.DeleteNodesParameters(NodesToDelete=[
-            ua.DeleteNodesItem(NodeId=condition, DeleteTargetReferences=False)]))
+        [status] = iserver.node_mgt_service.delete_nodes(ua.DeleteNodesParameters(
+            NodesToDelete=[ua.DeleteNodesItem(NodeId=condition, DeleteTargetReferences=False)]))
+        status.check()
 
     async def _condition(self, row: AlarmRow) -> ua.NodeId:
         """The ConditionId of ``row``: a node under Messages while the alarm is active."""
@@ -349,9 +347,9 @@ class AlarmEvents:
 
     def close(self) -> None:
         """Stop following the alarms."""
-        if self._hub_handle is not None:
-            self.backend.hub.delete(("opcua-alarms", id(self), 0), self._hub_handle)
-            self._hub_handle = None
+        if self._poll_handle is not None:
+            self._poll_handle.cancel()
+            self._poll_handle = None
 
 
 def _stamp(event: Any, when: datetime) -> None:

@@ -141,10 +141,11 @@ async def test_a_bad_programs_alarm_is_an_event_that_acknowledges_as_cnc_alarms_
 async def test_condition_refresh_sends_the_active_alarms_again(machine: Running) -> None:
     service, url = machine
     async with connected(url) as client:
-        sequence = await asyncio.to_thread(fail, service, "refresh.nc")
         cnc_ns = await client.get_namespace_index(CNC_URI)
         subscription, events = await subscribe(client, client.nodes.server,
                                                ua.NodeId(1006, cnc_ns))
+        sequence = await asyncio.to_thread(fail, service, "refresh.nc")
+        await events.wait(lambda e: e.ConditionName == f"Alarm{sequence}")  # raised
         events_before = len(events.seen)
         all_events = _Events()
         everything = await client.create_subscription(20, all_events)
@@ -205,7 +206,8 @@ async def test_reset_clears_the_condition_and_its_node_goes(machine: Running) ->
             await client.get_node(raised.NodeId).call_method(
                 ACKNOWLEDGE, ua.Variant(raised.EventId, ua.VariantType.ByteString),
                 ua.LocalizedText("late"))
-        assert gone.value.code == ua.StatusCodes.BadNodeIdUnknown
+        assert gone.value.code == ua.StatusCodes.BadNodeIdInvalid  # its node is gone
+        assert "alarm events" not in service.log_text  # nothing failed on the way
         await subscription.delete()
 
 
