@@ -24,7 +24,7 @@ MACHINERY_URI = "http://opcfoundation.org/UA/Machinery/"
 DI_URI = "http://opcfoundation.org/UA/DI/"
 START_TIMEOUT_S = 90.0  # the nodesets and instances take seconds on a busy machine
 WAIT_S = 30.0
-LONG = "G1 X100 F60\nM30\n"  # 100 s of kernel time at F60: runs while the test looks
+STOPS = "M3 S1000\nG1 X10 F600\nM0\nG1 X0\nM5\nM30\n"  # waits at M0 while the test looks
 Running = tuple[ServiceProcess, str]  # a service with OPC UA and its opc.tcp URL
 _MANDATORY = {ua.ObjectIds.ModellingRule_Mandatory}
 _PLACEHOLDER = {ua.ObjectIds.ModellingRule_MandatoryPlaceholder}
@@ -190,24 +190,34 @@ async def test_values_follow_a_running_program_and_the_overrides(machine: Runnin
         program = await child(node, "Production", "ActiveProgram")
         name = await child(program, "Name")
         state = await child(program, "State", "CurrentState")
+        operation_mode = await child(node, "Monitoring", "MachineTool", "OperationMode")
         channel = await child(node, "Monitoring", "Channel1")
-        channel_state, feed = await child(channel, "ChannelState"), await child(channel, "FeedOverride")
+        channel_state = await child(channel, "ChannelState")
+        channel_mode, feed = await child(channel, "ChannelMode"), await child(channel, "FeedOverride")
+        rotating = await child(node, "Monitoring", "Spindle1", "IsRotating")
         tool_name = await child(node, "Equipment", "Tools", "Ch1_T3", "Name")
+        watched = [name, state, operation_mode, channel_state, channel_mode, feed, rotating,
+                   tool_name]
         changes = _Changes()
         subscription = await client.create_subscription(20, changes)
-        await subscription.subscribe_data_change([name, state, channel_state, feed, tool_name])
+        await subscription.subscribe_data_change(watched)
         with CncClient(service.endpoint, timeout_s=WAIT_S) as cnc:
             cnc.reset(1)
-            cnc.upload("long.nc", LONG.encode())
-            cnc.run_program("long.nc", 1)
-            await changes.wait(name, lambda v: v == "long.nc")
+            cnc.upload("stops.nc", STOPS.encode())
+            cnc.run_program("stops.nc", 1)  # stays ACTIVE at its M0 until START
+            await changes.wait(name, lambda v: v == "stops.nc")
             await changes.wait(state, lambda v: v.Text == "Running")
             await changes.wait(channel_state, lambda v: v == 0)  # Active
+            await changes.wait(channel_mode, lambda v: v == 0)  # Automatic
+            await changes.wait(operation_mode, lambda v: v == 1)  # Automatic
+            await changes.wait(rotating, lambda v: v is True)  # M3 S1000
             cnc.write("ch1.mc_command_feed_override_w", 420)  # 42.0 %
             await changes.wait(feed, lambda v: abs(v - 42.0) < 1e-9)
             cnc.write("ch1.wz[3].name", "drill 6")
             await changes.wait(tool_name, lambda v: v == "drill 6")
-            cnc.reset(1)
-            await changes.wait(channel_state, lambda v: v == 2)  # Reset
+            cnc.start(1)  # on to M5 and M30
+            await changes.wait(state, lambda v: v.Text == "Ended")
+            await changes.wait(rotating, lambda v: v is False)
+            await changes.wait(channel_state, lambda v: v == 2)  # Reset (READY)
             cnc.write("ch1.mc_command_feed_override_w", 1000)
         await subscription.delete()
