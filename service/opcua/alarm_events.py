@@ -217,6 +217,10 @@ class AlarmEvents:
                 self.seen[sequence] = row.state
                 if emit or row.state != AlarmState.CLEARED:
                     await self._emit(row, trigger=emit)
+            # a cleared alarm that left the history is done with (the rest stay: an
+            # active one may be beyond the 16 active slots and the history for a while)
+            self.seen = {s: state for s, state in self.seen.items()
+                         if s in rows or state != AlarmState.CLEARED}
 
     async def _emit(self, row: AlarmRow, trigger: bool = True) -> None:
         condition = await self._condition(row)
@@ -264,8 +268,9 @@ class AlarmEvents:
         source, name = self.sources.get(row.channel, self.machine)
         active = row.state != AlarmState.CLEARED
         acked = row.state != AlarmState.ACTIVE
-        raised = datetime.fromtimestamp(row.wall_ns / 1e9, tz=UTC)
-        _stamp(event, raised)
+        # Time: when it happened (raised: when the kernel raised it; else now)
+        _stamp(event, datetime.fromtimestamp(row.wall_ns / 1e9, tz=UTC)
+               if row.state == AlarmState.ACTIVE else datetime.now(UTC))
         event.emitting_node = notifier
         event.SourceNode = source.nodeid
         event.SourceName = name
