@@ -1,6 +1,7 @@
 """The twin's alarms (``kernel.alarms``, read through the alarm objects) as OPC UA
-Alarms & Conditions events: ``CncAlarmType`` (OPC 40502 6.10.2) from the Server object,
-``AlertType`` (OPC 40501-1 9.1) from the MachineTool's Notification/Messages.
+Alarms & Conditions events: ``CncAlarmType`` (OPC 40502 6.10.2) from the Server object
+and the CncInterface, ``AlertType`` (OPC 40501-1 9.1) from the MachineTool's
+Notification/Messages.
 
 - Each change of the alarms (``alarm_changes_r``, looked at every ``ALARM_POLL_S``
   on the loop) reads the alarm slots again; every alarm whose state moved gives one
@@ -153,9 +154,14 @@ class AlarmEvents:
         cnc = await server.get_namespace_index(CNC_URI)
         mt = await server.get_namespace_index(MACHINE_TOOL_URI)
         server_node = ua.NodeId(ua.ObjectIds.Server)
-        for type_id, notifier, identifier in (
-                (ua.NodeId(CNC_ALARM_TYPE, cnc), server_node, "AlarmIdentifier"),
-                (ua.NodeId(ALERT_TYPE, mt), self.messages.nodeid, "ErrorCode")):
+        notifiers = [(ua.NodeId(CNC_ALARM_TYPE, cnc), server_node, "AlarmIdentifier"),
+                     (ua.NodeId(ALERT_TYPE, mt), self.messages.nodeid, "ErrorCode")]
+        interface = await _cnc_interface(server, cnc)
+        if interface is not None:  # CncInterfaceType GeneratesEvent CncAlarmType (40502)
+            await interface.set_event_notifier([ua.EventNotifier.SubscribeToEvents])
+            notifiers.append((ua.NodeId(CNC_ALARM_TYPE, cnc), interface.nodeid,
+                              "AlarmIdentifier"))
+        for type_id, notifier, identifier in notifiers:
             event = await get_event_obj_from_type_node(server.get_node(type_id))
             event.add_property("NodeId", None, ua.VariantType.NodeId)  # the ConditionId
             # a String (asyncua types a property the nodeset gives no value as Null)
@@ -382,6 +388,14 @@ def _refresh_event(template: Any, notifier: ua.NodeId) -> Any:
     _stamp(event, datetime.now(UTC))
     event.emitting_node = notifier
     return event
+
+
+async def _cnc_interface(server: Server, cnc: int) -> Node | None:
+    """Objects/CncInterface (``cnc_interface``), None when the server has none."""
+    for node in await server.nodes.objects.get_children():
+        if (await node.read_browse_name()) == ua.QualifiedName("CncInterface", cnc):
+            return node
+    return None
 
 
 async def build_alarm_events(server: Server, backend: Backend, machine: Node

@@ -113,6 +113,9 @@ async def test_a_bad_programs_alarm_is_an_event_that_acknowledges_as_cnc_alarms_
                                                ua.NodeId(1006, cnc_ns))  # CncAlarmType
         alerts_sub, alerts = await subscribe(client, messages, ua.NodeId(39, mt_ns),  # AlertType
                                              (ua.QualifiedName("ErrorCode", mt_ns),))
+        interface = await client.nodes.objects.get_child(f"{cnc_ns}:CncInterface")
+        interface_sub, interface_events = await subscribe(client, interface,
+                                                          ua.NodeId(1006, cnc_ns))
         sequence = await asyncio.to_thread(fail, service)
         raised = await events.wait(lambda e: e.ConditionName == f"Alarm{sequence}")
         assert (raised.AlarmIdentifier, raised.Severity, raised.SourceName) == (
@@ -121,6 +124,9 @@ async def test_a_bad_programs_alarm_is_an_event_that_acknowledges_as_cnc_alarms_
         assert raised.Retain is True
         alert = await alerts.wait(lambda e: e.ConditionName == f"Alarm{sequence}")
         assert (alert.ErrorCode, alert.Severity) == ("20008", 800)
+        from_interface = await interface_events.wait(
+            lambda e: e.ConditionName == f"Alarm{sequence}")
+        assert from_interface.AlarmIdentifier == "20008"
 
         seen = len(events.seen)
         condition = client.get_node(raised.NodeId)
@@ -136,6 +142,7 @@ async def test_a_bad_programs_alarm_is_an_event_that_acknowledges_as_cnc_alarms_
         assert again.value.code == ua.StatusCodes.BadConditionBranchAlreadyAcked
         await subscription.delete()
         await alerts_sub.delete()
+        await interface_sub.delete()
 
 
 async def test_condition_refresh_sends_the_active_alarms_again(machine: Running) -> None:
