@@ -92,16 +92,23 @@ class _Builder:
 
     def __init__(self, server: Server, binder: VariableBinder, ns: int) -> None:
         self.server, self.binder, self.ns = server, binder, ns
+        #: (type, member name) -> the declaring type: 64 tools ask the same questions
+        self._declaring: dict[tuple[ua.NodeId, str], Node] = {}
+        self._declarations: dict[ua.NodeId, list[ua.ReferenceDescription]] = {}
 
     async def add_member(self, node: Node, name: str, recursive: bool = True) -> Node:
         """Add ``node``'s optional member ``name`` as its type (or a supertype) declares
         it (without its children unless ``recursive``)."""
-        type_node = self.server.get_node(await node.read_type_definition())
-        for declaring in await get_node_supertypes(type_node, includeitself=True):
+        type_id = await node.read_type_definition()
+        known = self._declaring.get((type_id, name))
+        type_node = self.server.get_node(type_id)
+        for declaring in ([known] if known is not None else
+                          await get_node_supertypes(type_node, includeitself=True)):
             found = await self.instantiate(node, declaring, name, recursive=recursive)
             if found is not None:
+                self._declaring[(type_id, name)] = declaring
                 return found
-        raise KeyError(f"{name}: no member of {type_node.nodeid.to_string()}")
+        raise KeyError(f"{name}: no member of {type_id.to_string()}")
 
     async def instantiate(self, node: Node, declaring: Node, name: str,
                           as_name: str | None = None, recursive: bool = True) -> Node | None:
@@ -110,7 +117,9 @@ class _Builder:
         own instantiation of a declaration (its public ``instantiate`` takes types
         only); the placeholders among them (``<ToolLifeEntry>``) left out. None when
         ``declaring`` has no such member."""
-        for rdesc in await declaring.get_children_descriptions():
+        if declaring.nodeid not in self._declarations:
+            self._declarations[declaring.nodeid] = await declaring.get_children_descriptions()
+        for rdesc in self._declarations[declaring.nodeid]:
             if rdesc.BrowseName.Name == name:
                 bname = rdesc.BrowseName if as_name is None else ua.QualifiedName(as_name, self.ns)
                 added = await _instantiate_node(
