@@ -226,3 +226,15 @@ async def test_values_follow_a_running_program_and_the_overrides(machine: Runnin
             await changes.wait(channel_state, lambda v: v == 2)  # Reset (READY)
             cnc.write("ch1.mc_command_feed_override_w", 1000)
         await subscription.delete()
+
+
+async def test_the_machine_tool_variables_are_read_only(machine: Running) -> None:
+    """The overrides are written through the CncInterface (CmdOverride); a write of the
+    MachineTool's FeedOverride is refused and changes nothing."""
+    async with connected(machine[1]) as client:
+        feed = await child(await machine_node(client), "Monitoring", "Channel1", "FeedOverride")
+        before = await feed.read_value()
+        with pytest.raises(ua.UaStatusCodeError) as refused:
+            await feed.write_value(ua.DataValue(ua.Variant(12.0, ua.VariantType.Double)))
+        assert refused.value.code == ua.StatusCodes.BadNotWritable
+        assert await feed.read_value() == before
