@@ -33,6 +33,7 @@ from typing import Any
 from asyncua import Node, Server, ua
 from asyncua.common.events import get_event_obj_from_type_node
 
+from cnc_objects.objects.catalog_alarms import ACTIVE_SLOTS, active_element, history_element
 from cnc_objects.protocol.alarm_values import AlarmState
 from cnc_objects.protocol.roles import role_to_write
 
@@ -44,7 +45,6 @@ from .roles import role_of
 log = logging.getLogger(__name__)
 
 CNC_ALARM_TYPE, ALERT_TYPE = 1006, 39  # ns: CNC, MachineTool
-ACTIVE_SLOTS = 16  # alarm_active[1..16] (objects.catalog_alarms.ACTIVE_SLOTS)
 _FIELDS = ("sequence", "id", "severity", "channel", "state", "time", "text", "file",
            "line", "column")
 _S = ua.StatusCodes
@@ -86,12 +86,12 @@ class AlarmSlots:
         space = backend.space
         self._changes = _getter(backend, "alarm_changes_r")
         self._history_count = _getter(backend, "alarm_history_count_r")
-        self._active = [{f: _getter(backend, f"alarm_active[{k}].{f}") for f in _FIELDS}
+        self._active = [{f: _getter(backend, active_element(k, f)) for f in _FIELDS}
                         for k in range(1, ACTIVE_SLOTS + 1)]
         self._history = []
-        k = 1
-        while space.by_name(f"alarm_history[{k}].sequence") is not None:
-            self._history.append({f: _getter(backend, f"alarm_history[{k}].{f}")
+        k = 1  # as many history slots as the catalog has ([limits] alarm_history_max)
+        while space.by_name(history_element(k, "sequence")) is not None:
+            self._history.append({f: _getter(backend, history_element(k, f))
                                   for f in _FIELDS})
             k += 1
 
