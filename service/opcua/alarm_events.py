@@ -149,7 +149,8 @@ class AlarmEvents:
         self._poll_handle: asyncio.TimerHandle | None = None
 
     async def start(self) -> None:
-        """Event templates, the condition methods, the first reading, the subscription."""
+        """Event templates, the condition methods, the first reading, the look every
+        ``ALARM_POLL_S``."""
         server = self.server
         cnc = await server.get_namespace_index(CNC_URI)
         mt = await server.get_namespace_index(MACHINE_TOOL_URI)
