@@ -15,10 +15,12 @@ from asyncua import Server
 
 from ..backend import Backend
 from . import address_space_cache as cache
+from .alarm_events import build_alarm_events
 from .attributes import BoundAttributes
 from .binding import VariableBinder
 from .cnc_interface import build_cnc_interface
 from .config import endpoint_url
+from .machine_tool import build_machine_tool
 from .nodesets import asyncua_quiet, load_nodesets
 from .security import apply_security
 from .security_config import OpcUaSecurity
@@ -80,6 +82,8 @@ class OpcUaServer:
         binder = VariableBinder(server, self.backend)
         server.iserver.attribute_service = BoundAttributes(server.iserver.aspace, binder)
         await build_cnc_interface(server, binder, self.backend, VENDOR, self._version())
+        machine = await build_machine_tool(server, binder, self.backend, VENDOR, PRODUCT_URI)
+        await build_alarm_events(server, self.backend, machine)
         with asyncua_quiet():  # its warnings of a server without signing policies
             await server.start()  # (apply_security's choice) and its bind error's trace
         bound = server.bserver
