@@ -35,7 +35,7 @@ from .nodesets import NODESET_DIR, NODESETS
 
 log = logging.getLogger(__name__)
 
-CACHE_FORMAT = 1  # bump when what is pickled changes
+CACHE_FORMAT = 2  # bump when what is pickled changes (2: without the CNC example "test")
 CACHE_DIR_ENV = "CNC_OPCUA_CACHE_DIR"
 _GENERATED = "asyncua.common.structures104"  # where asyncua's import makes its classes
 

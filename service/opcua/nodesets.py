@@ -32,6 +32,11 @@ NODESETS: tuple[tuple[str, str], ...] = (
 )
 CNC_URI = NODESETS[-1][0]
 MACHINE_TOOL_URI = NODESETS[-2][0]
+#: The CNC nodeset (1.0.0, 2017) as published carries an example instance of
+#: CncInterfaceType named "test" under Objects (its ns=1;i=5008), with empty lists: not a
+#: part of the model, and a plant's client would show it beside the real CncInterface.
+#: It is removed after the import (docs/opcua.md "The nodesets").
+CNC_EXAMPLE_INSTANCE = 5008
 
 
 class Counted(logging.Handler):
@@ -71,4 +76,7 @@ async def load_nodesets(server: Server) -> int:
     with asyncua_quiet() as counted:
         for _, name in NODESETS:
             await server.import_xml(str(NODESET_DIR / name), strict_mode=False)
+        cnc = await server.get_namespace_index(CNC_URI)
+        await server.delete_nodes([server.get_node(f"ns={cnc};i={CNC_EXAMPLE_INSTANCE}")],
+                                  recursive=True)
     return counted.count
