@@ -21,6 +21,7 @@ from .attributes import BoundAttributes
 from .binding import VariableBinder
 from .cnc_interface import build_cnc_interface
 from .config import endpoint_url
+from .limits import OpcUaLimits, apply_limits
 from .nodesets import asyncua_quiet, load_nodesets
 from .roles import LoopbackUsers
 
@@ -44,9 +45,11 @@ def apply_security(server: Server, loopback_role: Role) -> None:
 class OpcUaServer:
     """The OPC UA front end of one service."""
 
-    def __init__(self, backend: Backend, loopback_role: Role) -> None:
+    def __init__(self, backend: Backend, loopback_role: Role,
+                 limits: OpcUaLimits | None = None) -> None:
         self.backend = backend
         self.loopback_role = loopback_role
+        self.limits = limits or OpcUaLimits()  # [limits] (limits.py)
         self.address: tuple[str, int] = ("", 0)
         self.nodes_left_out = 0  # nodeset nodes asyncua could not import
         self.start_s = 0.0  # how long ``start`` took (nodesets, instances, listening)
@@ -74,6 +77,7 @@ class OpcUaServer:
         server.set_server_name(f"{VENDOR} CNC")
         await server.set_application_uri(APPLICATION_URI)
         apply_security(server, self.loopback_role)
+        apply_limits(server, self.limits)
         namespaces = server.nodes.namespace_array
         if kept is None:
             self.nodes_left_out = await load_nodesets(server)
