@@ -45,6 +45,8 @@ from asyncua.server.internal_server import InternalServer
 from asyncua.server.internal_session import InternalSession, SessionState
 from asyncua.server.internal_subscription import InternalSubscription
 
+from . import chunk_guard
+
 log = logging.getLogger(__name__)
 
 _S = ua.StatusCodes
@@ -85,6 +87,7 @@ class OpcUaLimits:
 def apply_limits(server: Server, limits: OpcUaLimits) -> SessionGuard:
     """Set asyncua's own limits of ``server`` from ``limits`` and put the guard of the
     others in front of its services (before ``server.start()``)."""
+    chunk_guard.install()
     iserver = server.iserver
     iserver.max_connections = limits.connections
     iserver.max_pending_activation_seconds = limits.activation_timeout_s
