@@ -124,6 +124,9 @@ def startup(runs: int = 3) -> None:
 def main(runs: int = 3) -> None:
     reads(runs)
     startup(runs)
+    from . import opcua_subscription_bench  # notifications and the cycle with sessions
+
+    opcua_subscription_bench.main(runs)
 
 
 def reads(runs: int = 3) -> None:
