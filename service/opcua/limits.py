@@ -93,6 +93,9 @@ def apply_limits(server: Server, limits: OpcUaLimits) -> SessionGuard:
     iserver.max_pending_activation_seconds = limits.activation_timeout_s
     iserver.max_subscriptions = limits.subscriptions_total
     iserver.max_monitored_item_queue_size = limits.queue_size_max
+    # asyncua's own count of activated sessions (class-wide: one server per service)
+    # answers ActivateSession Bad_MaxConnectionsReached beyond it; ours refuses first
+    InternalSession.max_connections = limits.sessions
     chunk = server.limits.max_recv_buffer
     server.limits.max_message_size = limits.max_message_bytes
     server.limits.max_chunk_count = math.ceil(limits.max_message_bytes / chunk)
@@ -114,12 +117,14 @@ class SessionGuard:
         create_items = service.create_monitored_items
 
         def guarded_create_session(name: str, *args: Any, **kwargs: Any) -> InternalSession:
-            if kwargs.get("external") and self.open_sessions() >= limits.sessions:
+            # asyncua's signature: (name, user=..., external=False); clients' are external
+            external = bool(kwargs.get("external", args[1] if len(args) > 1 else False))
+            if external and self.open_sessions() >= limits.sessions:
                 log.warning("OPC UA session from %s refused: %d sessions open "
                             "([limits] opcua_sessions)", name, limits.sessions)
                 raise ServiceError(_S.BadTooManySessions)
             session = create_session(name, *args, **kwargs)
-            if kwargs.get("external"):
+            if external:
                 self._sessions.add(session)
             return session
 
@@ -160,8 +165,11 @@ class SessionGuard:
                         len(asked) - room, len(asked), limits.monitored_items_per_session,
                         limits.monitored_items_total)
             params.ItemsToCreate = asked[:room]
-            results: list[ua.MonitoredItemCreateResult] = (
-                await create_items(params) if room else [])
+            try:
+                results: list[ua.MonitoredItemCreateResult] = (
+                    await create_items(params) if room else [])
+            finally:  # the request as the client sent it, for asyncua's item callbacks
+                params.ItemsToCreate = asked
             for _ in asked[room:]:
                 refused = ua.MonitoredItemCreateResult()
                 refused.StatusCode = ua.StatusCode(_S.BadTooManyMonitoredItems)

@@ -125,6 +125,8 @@ async def _assert_served_on(reference: Reference) -> None:
         state = await client.get_node(ua.NodeId(ua.ObjectIds.Server_ServerStatus_State)).read_value()
     assert state == ua.ServerState.Running
     p50_s = statistics.median(read_latencies_s(service.endpoint, _READS))
+    print(f"ZeroMQ read p50: fresh service {reference.zmq_p50_s * 1e3:.3f} ms, "
+          f"now {p50_s * 1e3:.3f} ms")  # pytest -s shows them
     # a loaded machine moves medians of a fraction of a millisecond by some; a stuck loop
     # or a front end that is hurt moves them by tens of milliseconds
     assert p50_s < 5 * reference.zmq_p50_s + 0.002, (p50_s, reference.zmq_p50_s)
