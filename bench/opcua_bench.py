@@ -337,6 +337,9 @@ def main(runs: int = 3) -> None:
     notifications(runs)
     jitter(runs)
     startup(runs)
+    from . import opcua_subscription_bench  # notifications and the cycle with sessions
+
+    opcua_subscription_bench.main(runs)
 
 
 def reads(runs: int = 3) -> None:

@@ -37,6 +37,9 @@ limit and the figures measured):
   (``zmq_receive_bound_bytes``), held at most ``frame_timeout_s``.
 - ``jog_hold_timeout_s``: a pressed jog key not written TRUE again for this long is
   released; a key is released at once when its connection ends (``jog_holds``).
+- ``opcua_*``: what OPC UA sessions, subscriptions, monitored items and publishes may
+  hold (``opcua/limits.py``); ``connections_per_front_end`` and ``max_frame_bytes``
+  bound OPC UA connections and messages too.
 - ``idle_connection_s``: a full table closes the keyless connection idle longest (idle
   at least this long) for a newcomer; keyed connections keep their seats
   (``connection_limits``).
@@ -217,6 +220,47 @@ class LimitsConfig(BaseModel):
         32 << 20, ge=1 << 20, le=16 << 30,
         description="bytes of incomplete frames all ADS connections may hold together; "
         "the connection that would take it over is closed (logged)",
+    )
+
+    opcua_sessions: int = Field(
+        32, ge=1, le=10_000,
+        description="OPC UA sessions open at once (created or activated, all clients); "
+        "CreateSession beyond: Bad_TooManySessions",
+    )
+    opcua_activation_timeout_s: float = Field(
+        10.0, gt=0, le=3600,
+        description="seconds an OPC UA connection may stay without an activated session "
+        "(a half-open secure channel); then it is closed",
+    )
+    opcua_subscriptions_per_session: int = Field(
+        20, ge=1, le=10_000,
+        description="OPC UA subscriptions one session may hold; CreateSubscription beyond: "
+        "Bad_TooManySubscriptions",
+    )
+    opcua_subscriptions_total: int = Field(
+        200, ge=1, le=100_000,
+        description="OPC UA subscriptions of all sessions; CreateSubscription beyond: "
+        "Bad_TooManySubscriptions",
+    )
+    opcua_monitored_items_per_session: int = Field(
+        2000, ge=1, le=1_000_000,
+        description="OPC UA monitored items one session may hold; each item beyond: "
+        "Bad_TooManyMonitoredItems",
+    )
+    opcua_monitored_items_total: int = Field(
+        10_000, ge=1, le=10_000_000,
+        description="OPC UA monitored items of all sessions; each item beyond: "
+        "Bad_TooManyMonitoredItems",
+    )
+    opcua_queue_size_max: int = Field(
+        100, ge=1, le=100_000,
+        description="values one OPC UA monitored item may queue between publishes; a larger "
+        "requested QueueSize is revised down to it (the oldest value is dropped)",
+    )
+    opcua_notifications_per_publish: int = Field(
+        10_000, ge=1, le=1_000_000,
+        description="data changes in one OPC UA PublishResponse (or the subscription's "
+        "MaxNotificationsPerPublish when smaller); the rest go in the next ones",
     )
 
     @property

@@ -62,7 +62,7 @@ from .kernel.nc.source import NcText
 from .kernel.realtime_priority import DEFAULT_RT_PRIORITY, RT_PRIORITY_MAX, serve_below
 from .kernel.state import Snapshot
 from .kernel.step_clock import STEP_MAX_CYCLES, StepClock
-from .limits import notification_limits, rate_limiter
+from .limits import LimitsConfig, notification_limits, rate_limiter
 from .machine_config import EmbeddedMachine
 from .notifications import NotificationCounts
 from .opcua.config import parse_opcua_endpoint
@@ -250,7 +250,7 @@ async def serve(
             return EXIT_USAGE
     opcua_server = None
     if opcua is not None:
-        opcua_server = await _start_opcua(backend, opcua)
+        opcua_server = await _start_opcua(backend, opcua, config.limits)
         if opcua_server is None:
             if ads_server is not None:
                 ads_server.close()
@@ -341,12 +341,14 @@ async def _start_ads(
     return ads_server
 
 
-async def _start_opcua(backend: Backend, opcua: OpcUaListen) -> OpcUaServer | None:
+async def _start_opcua(backend: Backend, opcua: OpcUaListen, limits: LimitsConfig
+                       ) -> OpcUaServer | None:
     """The listening OPC UA front end, or None after saying in one line why it cannot be."""
+    from .opcua.limits import OpcUaLimits
     from .opcua.security import OpcUaSecurityError
     from .opcua.server import OpcUaServer  # asyncua only where OPC UA is served
 
-    opcua_server = OpcUaServer(backend, opcua.security)
+    opcua_server = OpcUaServer(backend, opcua.security, OpcUaLimits.from_config(limits))
     try:
         await opcua_server.start(opcua.host, opcua.port)
     except OpcUaSecurityError as exc:

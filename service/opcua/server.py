@@ -20,6 +20,7 @@ from .attributes import BoundAttributes
 from .binding import VariableBinder
 from .cnc_interface import build_cnc_interface
 from .config import endpoint_url
+from .limits import OpcUaLimits, apply_limits
 from .machine_tool import build_machine_tool
 from .nodesets import asyncua_quiet, load_nodesets
 from .security import apply_security
@@ -35,10 +36,12 @@ VENDOR = "cnc-objects"
 class OpcUaServer:
     """The OPC UA front end of one service."""
 
-    def __init__(self, backend: Backend, security: OpcUaSecurity) -> None:
+    def __init__(self, backend: Backend, security: OpcUaSecurity,
+                 limits: OpcUaLimits | None = None) -> None:
         self.backend = backend
         self.security = security
         self.security_note = ""  # what ``apply_security`` serves, for the start-up log
+        self.limits = limits or OpcUaLimits()  # [limits] (limits.py)
         self.address: tuple[str, int] = ("", 0)
         self.nodes_left_out = 0  # nodeset nodes asyncua could not import
         self.start_s = 0.0  # how long ``start`` took (nodesets, instances, listening)
@@ -84,6 +87,8 @@ class OpcUaServer:
         await build_cnc_interface(server, binder, self.backend, VENDOR, self._version())
         machine = await build_machine_tool(server, binder, self.backend, VENDOR, PRODUCT_URI)
         await build_alarm_events(server, self.backend, machine)
+        # last: its guard wraps the session factory the alarm events' methods installed
+        apply_limits(server, self.limits)
         with asyncua_quiet():  # its warnings of a server without signing policies
             await server.start()  # (apply_security's choice) and its bind error's trace
         bound = server.bserver
