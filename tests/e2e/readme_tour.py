@@ -35,6 +35,7 @@ NOT_RUN = ("cnc-hmi", "mosquitto", "cnc-mqtt", "docker")
 README_ENDPOINT = "tcp://127.0.0.1:5555"
 README_WEB_PORT = 8080  # cnc-web beside the service, as `make run` starts it
 README_AMS_NET_ID, README_ADS_HOST = "127.0.0.1.1.1", "127.0.0.1"  # what `make run` serves
+README_OPCUA_URL = "opc.tcp://127.0.0.1:4840"  # where `make run` serves OPC UA
 
 
 @contextlib.contextmanager
@@ -68,27 +69,37 @@ class TourStep:
 #: A section of the tour that runs on another machine than `make run`'s default: its
 #: own test (``machine_section``) plays it on that machine, the tour leaves it out.
 FIVE_AXIS_SECTION = "\n## Five axes"
+#: The OPC UA section: its own test plays it on a service serving OPC UA (the tour's
+#: services leave OPC UA off), the tour leaves it out.
+OPCUA_SECTION = "\n## OPC UA"
+OWN_SECTIONS = (FIVE_AXIS_SECTION, OPCUA_SECTION)
 
 
 def tour_text(readme: Path) -> str:
     """The README from the tour's first section up to "## What runs", without the
-    sections of another machine."""
+    sections played on their own (``OWN_SECTIONS``)."""
     text = readme.read_text()
     tour = text[text.index("\n## 1. "):text.index("\n## What runs")]
-    start = tour.find(FIVE_AXIS_SECTION)
-    if start < 0:
-        return tour
-    end = tour.find("\n## ", start + 1)
-    return tour[:start] + (tour[end:] if end >= 0 else "")
+    for title in OWN_SECTIONS:
+        start = tour.find(title)
+        if start >= 0:
+            end = tour.find("\n## ", start + 1)
+            tour = tour[:start] + (tour[end:] if end >= 0 else "")
+    return tour
+
+
+def section_text(readme: Path, title: str) -> str:
+    """The README section starting with ``title``, up to the next section."""
+    text = readme.read_text()
+    start = text.index(title)
+    end = text.find("\n## ", start + 1)
+    return text[start:end]
 
 
 def machine_section(readme: Path, title: str = FIVE_AXIS_SECTION) -> list[TourStep]:
     """The ``$ `` commands of the README section starting with ``title`` (a section
     the tour leaves out, played on its own machine)."""
-    text = readme.read_text()
-    start = text.index(title)
-    end = text.find("\n## ", start + 1)
-    return _shell_steps(text[start:end], ())
+    return _shell_steps(section_text(readme, title), ())
 
 
 def _blocks(text: str, language: str) -> list[tuple[str, list[str]]]:
@@ -177,9 +188,11 @@ def tour_items(readme: Path) -> list[TourStep | PythonStep]:
     return items
 
 
-def python_examples(readme: Path) -> list[tuple[str, tuple[str, ...]]]:
-    """Each Python example of the tour and the output shown in the ``text`` block after it."""
-    text = tour_text(readme)
+def python_examples(readme: Path, title: str | None = None
+                    ) -> list[tuple[str, tuple[str, ...]]]:
+    """Each Python example of the tour (of the section ``title`` when given) and the
+    output shown in the ``text`` block after it."""
+    text = tour_text(readme) if title is None else section_text(readme, title)
     examples = []
     for part in text.split("```python\n")[1:]:
         code, _, rest = part.partition("\n```\n")

@@ -22,9 +22,11 @@ import pytest
 from cnc_objects.testing import ServiceProcess, serving
 from cnc_objects.testing.web import serving_web
 from tests.e2e.readme_tour import (
+    OPCUA_SECTION,
     README_ADS_HOST,
     README_AMS_NET_ID,
     README_ENDPOINT,
+    README_OPCUA_URL,
     README_WEB_PORT,
     PythonStep,
     _line_matches,
@@ -35,6 +37,7 @@ from tests.e2e.readme_tour import (
     tour_items,
     tour_steps,
 )
+from tests.opcua.conftest import OPCUA_START_S
 from tests.support.broker import Watcher, running_broker
 from tests.support.service import ROOT
 
@@ -126,6 +129,27 @@ def test_the_five_axis_step_prints_what_the_readme_shows(tmp_path: Path) -> None
             assert output_matches(step.expected, done.stdout.splitlines()), (
                 f"$ {step.command}\nREADME shows:\n" + "\n".join(step.expected)
                 + f"\nprinted (exit {done.returncode}):\n{done.stdout}")
+
+
+def test_the_opcua_step_prints_what_the_readme_shows(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The README's OPC UA example as a script, against a fresh service serving OPC UA
+    (on a free port instead of 4840: the URL replaced, as the tour replaces addresses;
+    its address space cache in the test's directory, not the user's)."""
+    monkeypatch.setenv("CNC_OPCUA_CACHE_DIR", str(tmp_path / "opcua-cache"))
+    [(code, shown)] = python_examples(README, OPCUA_SECTION)
+    assert README_OPCUA_URL in code
+    with serving("--clock", "realtime", "--opcua", "opc.tcp://127.0.0.1:0", cwd=tmp_path,
+                 timeout_s=OPCUA_START_S) as service:
+        url = re.search(r"OPC UA on (opc\.tcp://\S+)",
+                        service.wait_for_log(r"OPC UA on opc\.tcp://\S+"))
+        assert url is not None
+        script = tmp_path / "opcua_example.py"
+        script.write_text(code.replace(README_OPCUA_URL, url.group(1)))
+        done = subprocess.run([sys.executable, str(script)], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+        assert output_matches(shown, done.stdout.splitlines()), done.stdout
 
 
 def test_the_python_examples_print_what_the_readme_shows(tmp_path: Path) -> None:
