@@ -17,7 +17,6 @@ connection:
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
@@ -26,6 +25,7 @@ from typing import Any
 import pytest
 
 from cnc_objects.testing import ServiceProcess, start_service
+from tests.support.node_packages import node_with
 
 NODE_DIR = Path(__file__).resolve().parents[1] / "ads_clients" / "node"
 CHECK_TIMEOUT_S = 120.0
@@ -43,15 +43,7 @@ def service(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceProcess
 @pytest.fixture(scope="session")
 def node() -> str:
     """Node.js with ads-client installed from the lock file (``npm ci`` when missing)."""
-    node_path, npm = shutil.which("node"), shutil.which("npm")
-    if node_path is None or npm is None:
-        pytest.skip("ads-client needs Node.js and npm: apt-get install nodejs npm")
-    if not (NODE_DIR / "node_modules" / "ads-client").is_dir():
-        installed = subprocess.run(
-            [npm, "ci", "--no-audit", "--no-fund"], cwd=NODE_DIR, capture_output=True,
-            text=True, timeout=600, check=False)
-        assert installed.returncode == 0, f"npm ci failed:\n{installed.stderr[-2000:]}"
-    return node_path
+    return node_with(NODE_DIR, "ads-client", "ads-client")
 
 
 def ads_client(node: str, service: ServiceProcess, check: str) -> Any:

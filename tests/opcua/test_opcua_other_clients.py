@@ -11,7 +11,6 @@ per process and prints what the client saw as JSON. ``npm ci`` installs it when 
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 from pathlib import Path
 from typing import Any
@@ -19,6 +18,7 @@ from typing import Any
 import pytest
 
 from cnc_objects.testing import ServiceProcess
+from tests.support.node_packages import node_with
 
 from .conftest import opcua_url
 
@@ -30,15 +30,7 @@ CHECK_TIMEOUT_S = 180.0
 def node() -> str:
     """Node.js with node-opcua-client installed from the lock file (``npm ci`` when
     missing)."""
-    node_path, npm = shutil.which("node"), shutil.which("npm")
-    if node_path is None or npm is None:
-        pytest.skip("node-opcua needs Node.js and npm: apt-get install nodejs npm")
-    if not (NODE_DIR / "node_modules" / "node-opcua-client").is_dir():
-        installed = subprocess.run(
-            [npm, "ci", "--no-audit", "--no-fund"], cwd=NODE_DIR, capture_output=True,
-            text=True, timeout=600, check=False)
-        assert installed.returncode == 0, f"npm ci failed:\n{installed.stderr[-2000:]}"
-    return node_path
+    return node_with(NODE_DIR, "node-opcua-client", "node-opcua")
 
 
 def node_opcua(node: str, service: ServiceProcess, check: str) -> Any:

@@ -116,15 +116,23 @@ def _sub(cur: Cursor, word: str, allowed: tuple[str, ...], optional: bool = Fals
                     f"#{word} needs {' or '.join(allowed)}, found {shown}", pos)
 
 
+def _open(cur: Cursor, expected: str, err_id: NcErrorId = NcErrorId.INSTRUCTION_SYNTAX
+          ) -> int:
+    """Past the '[' that opens an instruction's list (blanks before it skipped); its
+    position. ``err_id`` with ``expected`` (what should follow) when there is none."""
+    cur.skip_ws()
+    open_pos = cur.pos
+    if cur.peek() != "[":
+        raise cur.error(err_id, expected)
+    cur.pos += 1
+    return open_pos
+
+
 def _list(cur: Cursor, what: str, counts: tuple[int, ...],
           err_id: NcErrorId = NcErrorId.INSTRUCTION_SYNTAX,
           ) -> tuple[tuple[Node, ...], tuple[int, ...]]:
     """``[expr, expr, ...]`` with one of ``counts`` elements."""
-    cur.skip_ws()
-    open_pos = cur.pos
-    if cur.peek() != "[":
-        raise cur.error(err_id, f"'[' expected after {what}")
-    cur.pos += 1
+    open_pos = _open(cur, f"'[' expected after {what}", err_id)
     parser = ExpressionParser(cur)
     values: list[Node] = []
     positions: list[int] = []
@@ -185,11 +193,7 @@ def _options(cur: Cursor, what: str, known: dict[str, bool]) -> dict[str, tuple[
 
 def _id(cur: Cursor, what: str) -> tuple[Node, int]:
     """``[ID=<expr>]`` or ``[ID<expr>]``."""
-    cur.skip_ws()
-    open_pos = cur.pos
-    if cur.peek() != "[":
-        raise cur.error(NcErrorId.PATTERN_SYNTAX, f"'[ID=<number>]' expected after {what}")
-    cur.pos += 1
+    open_pos = _open(cur, f"'[ID=<number>]' expected after {what}", NcErrorId.PATTERN_SYNTAX)
     cur.skip_ws()
     if not cur.startswith("ID"):
         raise cur.error(NcErrorId.PATTERN_SYNTAX, f"ID expected in {what} [ID=<number>]")
@@ -262,12 +266,7 @@ def _at(cur: Cursor, stmt: Instruction) -> None:
 def _file(cur: Cursor, stmt: Instruction) -> None:
     stmt.kind = InstructionKind.FILE_NAME
     _sub(cur, "FILE", ("NAME",))
-    cur.skip_ws()
-    open_pos = cur.pos
-    if cur.peek() != "[":
-        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX,
-                        "'[MSG=\"<file>\"]' expected after #FILE NAME")
-    cur.pos += 1
+    open_pos = _open(cur, "'[MSG=\"<file>\"]' expected after #FILE NAME")
     cur.skip_ws()
     if not cur.startswith("MSG"):
         raise cur.error(NcErrorId.INSTRUCTION_SYNTAX, "MSG=\"<file>\" expected in #FILE NAME [..]")
@@ -300,11 +299,7 @@ def _msg(cur: Cursor, stmt: Instruction) -> None:
         if cur.startswith("EXCLUSIVE"):
             cur.pos += 9
             stmt.exclusive = True
-    cur.skip_ws()
-    open_pos = cur.pos
-    if cur.peek() != "[":
-        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX, "'[\"<text>\", ...]' expected after #MSG")
-    cur.pos += 1
+    open_pos = _open(cur, "'[\"<text>\", ...]' expected after #MSG")
     parser = ExpressionParser(cur)
     cur.skip_ws()
     stmt.text_pos = cur.pos
@@ -347,12 +342,7 @@ def _ori(cur: Cursor, stmt: Instruction) -> None:
     "Programming and configuration of 5-axis kinematics (#ORI MODE)")."""
     stmt.kind = InstructionKind.ORI_MODE
     _sub(cur, "ORI", ("MODE",))
-    cur.skip_ws()
-    open_pos = cur.pos
-    if cur.peek() != "[":
-        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX,
-                        f"'[{'|'.join(ORI_MODES)}]' expected after #ORI MODE")
-    cur.pos += 1
+    open_pos = _open(cur, f"'[{'|'.join(ORI_MODES)}]' expected after #ORI MODE")
     cur.skip_ws()
     pos = cur.pos
     m = cur.match(IDENT)
@@ -372,12 +362,7 @@ def _ori(cur: Cursor, stmt: Instruction) -> None:
 
 def _slope(cur: Cursor, stmt: Instruction) -> None:
     stmt.kind = InstructionKind.SLOPE
-    cur.skip_ws()
-    open_pos = cur.pos
-    if cur.peek() != "[":
-        raise cur.error(NcErrorId.INSTRUCTION_SYNTAX,
-                        f"'[TYPE=<{'|'.join(SLOPE_TYPES)}>]' expected after #SLOPE")
-    cur.pos += 1
+    open_pos = _open(cur, f"'[TYPE=<{'|'.join(SLOPE_TYPES)}>]' expected after #SLOPE")
     cur.skip_ws()
     if not cur.startswith("TYPE"):
         raise cur.error(NcErrorId.INSTRUCTION_SYNTAX, "TYPE= expected in #SLOPE [..]")
