@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import re
+import shutil
 from collections.abc import AsyncIterator, Iterator
 from pathlib import Path
 
 import pytest
 from asyncua import Client, Node
 
+from cnc_objects.protocol.opcua_files import TRUSTED_DIR
 from cnc_objects.testing import ServiceProcess, serving
+from tests.support.cli import cnc
+from tests.support.opcua_security import ClientIdentity, make_client_identity, write_users_file
 
 CNC_URI = "http://opcfoundation.org/UA/CNC"
 OPCUA_ANY_PORT = ("--opcua", "opc.tcp://127.0.0.1:0")
@@ -64,3 +68,34 @@ async def cnc_node(client: Client, *path: str) -> Node:
     """The node at ``path`` (browse names in the CNC namespace) under Objects."""
     ns = await client.get_namespace_index(CNC_URI)
     return await client.nodes.objects.get_child([f"{ns}:{name}" for name in path])
+
+
+# The security fixtures: made once per module (RSA keys and Argon2 hashes take a while,
+# and no test changes them).
+@pytest.fixture(scope="module")
+def certificate_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The server's certificate, made by ``cnc opcua-cert`` (its ``trusted/`` empty)."""
+    directory = tmp_path_factory.mktemp("server") / "opcua"
+    made = cnc("opcua-cert", "--dir", str(directory), "--host", "localhost")
+    assert made.returncode == 0, made.stderr
+    return directory
+
+
+@pytest.fixture(scope="module")
+def trusted(tmp_path_factory: pytest.TempPathFactory, certificate_dir: Path) -> ClientIdentity:
+    """A client whose certificate is in the server's trusted directory."""
+    identity = make_client_identity(tmp_path_factory.mktemp("client"), "trusted-client")
+    shutil.copy(identity.certificate, certificate_dir / TRUSTED_DIR)
+    return identity
+
+
+@pytest.fixture(scope="module")
+def untrusted(tmp_path_factory: pytest.TempPathFactory) -> ClientIdentity:
+    """A client whose certificate the server has never seen."""
+    return make_client_identity(tmp_path_factory.mktemp("stranger"), "stranger")
+
+
+@pytest.fixture(scope="module")
+def users_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A web users file with a password for each role (``PASSWORDS``)."""
+    return write_users_file(tmp_path_factory.mktemp("users") / "web-users.json")

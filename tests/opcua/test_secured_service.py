@@ -9,8 +9,6 @@ session; anonymous sessions on loopback are monitors once the server has a certi
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,12 +19,7 @@ from asyncua import Client, Node, ua
 from cnc_objects.clients import Client as CncClient
 from cnc_objects.protocol.roles import Role
 from cnc_objects.testing import ServiceProcess, serving
-from tests.support.opcua_security import (
-    ClientIdentity,
-    make_client_identity,
-    secure_client,
-    write_users_file,
-)
+from tests.support.opcua_security import ClientIdentity, secure_client
 
 from .conftest import OPCUA_ANY_PORT, OPCUA_START_S, cnc_node, opcua_url
 
@@ -44,23 +37,15 @@ class Secured:
 
 
 @pytest.fixture(scope="module")
-def secured(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Secured]:
-    work = tmp_path_factory.mktemp("opcua-secured")
-    certificate_dir = work / "pki"
-    made = subprocess.run(
-        [sys.executable, "-m", "cnc_objects.clients.cli", "opcua-cert", "--dir",
-         str(certificate_dir)], capture_output=True, text=True, timeout=120, check=False)
-    assert made.returncode == 0, made.stderr
-    trusted = make_client_identity(work / "client", "plant-mes")
-    stranger = make_client_identity(work / "stranger", "stranger")
-    (certificate_dir / "trusted" / "plant-mes.der").write_bytes(trusted.der)
-    users = write_users_file(work / "web-users.json")
-    config = work / "machine.toml"
+def secured(tmp_path_factory: pytest.TempPathFactory, certificate_dir: Path,
+            trusted: ClientIdentity, untrusted: ClientIdentity,
+            users_file: Path) -> Iterator[Secured]:
+    config = tmp_path_factory.mktemp("opcua-secured") / "machine.toml"
     config.write_text(f'[opcua]\ncertificate_dir = "{certificate_dir}"\n'
-                      f'users_file = "{users}"\n')
+                      f'users_file = "{users_file}"\n')
     with serving("--config", str(config), *OPCUA_ANY_PORT,
                  timeout_s=OPCUA_START_S) as service:
-        yield Secured(service, certificate_dir, trusted, stranger)
+        yield Secured(service, certificate_dir, trusted, untrusted)
 
 
 async def _override_node(client: Client) -> Node:

@@ -5,7 +5,6 @@ server configured by ``apply_security``, over real sockets."""
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import pytest
@@ -15,50 +14,16 @@ from asyncua.server.server import Server
 from asyncua.ua.status_codes import StatusCodes
 from asyncua.ua.uaerrors import UaError, UaStatusCodeError
 
-from cnc_objects.protocol.opcua_files import TRUSTED_DIR
 from cnc_objects.protocol.roles import Role
 from cnc_objects.service.opcua.security import OpcUaSecurityError, apply_security
 from cnc_objects.service.opcua.security_config import OpcUaSecurity
-from tests.support.cli import cnc
 from tests.support.opcua_security import (
     ANSWER,
     PASSWORDS,
     ClientIdentity,
-    make_client_identity,
     secure_client,
     secured_server,
-    write_users_file,
 )
-
-
-# The certificates and the users file are made once per module: RSA keys and Argon2
-# hashes take a while, and no test changes them.
-@pytest.fixture(scope="module")
-def certificate_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The server's certificate, made by ``cnc opcua-cert``."""
-    directory = tmp_path_factory.mktemp("server") / "opcua"
-    made = cnc("opcua-cert", "--dir", str(directory), "--host", "localhost")
-    assert made.returncode == 0, made.stderr
-    return directory
-
-
-@pytest.fixture(scope="module")
-def trusted(tmp_path_factory: pytest.TempPathFactory, certificate_dir: Path) -> ClientIdentity:
-    """A client whose certificate is in the server's trusted directory."""
-    identity = make_client_identity(tmp_path_factory.mktemp("client"), "trusted-client")
-    shutil.copy(identity.certificate, certificate_dir / TRUSTED_DIR)
-    return identity
-
-
-@pytest.fixture(scope="module")
-def untrusted(tmp_path_factory: pytest.TempPathFactory) -> ClientIdentity:
-    """A client whose certificate the server has never seen."""
-    return make_client_identity(tmp_path_factory.mktemp("stranger"), "stranger")
-
-
-@pytest.fixture(scope="module")
-def users_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return write_users_file(tmp_path_factory.mktemp("users") / "web-users.json")
 
 
 def _settings(certificate_dir: Path, users_file: Path, **more: str) -> OpcUaSecurity:

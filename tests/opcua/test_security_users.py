@@ -4,7 +4,6 @@ users file's (``cnc web-users set ROLE``); ``role_of`` gives the session's role
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import pytest
@@ -15,7 +14,6 @@ from asyncua.ua.status_codes import StatusCodes
 from asyncua.ua.uaerrors import UaStatusCodeError
 from pydantic import ValidationError
 
-from cnc_objects.protocol.opcua_files import TRUSTED_DIR
 from cnc_objects.protocol.role_passwords import RolePasswords
 from cnc_objects.protocol.roles import Role
 from cnc_objects.service.opcua.security import (
@@ -27,46 +25,27 @@ from cnc_objects.service.opcua.security import (
     role_of,
 )
 from cnc_objects.service.opcua.security_config import OpcUaSecurity
-from tests.support.cli import cnc, cnc_process
+from tests.support.cli import cnc_process
 from tests.support.opcua_security import (
     ANSWER,
     PASSWORDS,
     ClientIdentity,
-    make_client_identity,
     secure_client,
     secured_server,
-    write_users_file,
 )
 
 
-# Made once per module: RSA keys and Argon2 hashes take a while, and no test changes them.
 @pytest.fixture(scope="module")
-def certificate_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    directory = tmp_path_factory.mktemp("server") / "opcua"
-    assert cnc("opcua-cert", "--dir", str(directory)).returncode == 0
-    return directory
-
-
-@pytest.fixture(scope="module")
-def client_identity(tmp_path_factory: pytest.TempPathFactory,
-                    certificate_dir: Path) -> ClientIdentity:
-    identity = make_client_identity(tmp_path_factory.mktemp("client"), "hmi")
-    shutil.copy(identity.certificate, certificate_dir / TRUSTED_DIR)
-    return identity
-
-
-@pytest.fixture(scope="module")
-def settings(tmp_path_factory: pytest.TempPathFactory, certificate_dir: Path) -> OpcUaSecurity:
-    users_file = write_users_file(tmp_path_factory.mktemp("users") / "web-users.json")
+def settings(certificate_dir: Path, users_file: Path) -> OpcUaSecurity:
     return OpcUaSecurity(certificate_dir=str(certificate_dir), users_file=str(users_file))
 
 
 async def test_each_role_signs_in_with_its_password(
-    settings: OpcUaSecurity, certificate_dir: Path, client_identity: ClientIdentity,
+    settings: OpcUaSecurity, certificate_dir: Path, trusted: ClientIdentity,
 ) -> None:
     async with secured_server(settings) as server:
         for role in Role:
-            client = await secure_client(server.url, client_identity, certificate_dir, user=role)
+            client = await secure_client(server.url, trusted, certificate_dir, user=role)
             async with client:
                 assert await client.get_node(server.answer.nodeid).read_value() == ANSWER
         assert server.roles_read == list(Role)
@@ -78,11 +57,11 @@ async def test_each_role_signs_in_with_its_password(
     ("root", PASSWORDS[Role.ADMIN]),  # not a role
 ], ids=["wrong-password", "no-password", "unknown-user"])
 async def test_a_wrong_user_or_password_is_refused(
-    settings: OpcUaSecurity, certificate_dir: Path, client_identity: ClientIdentity,
+    settings: OpcUaSecurity, certificate_dir: Path, trusted: ClientIdentity,
     user: str, password: str,
 ) -> None:
     async with secured_server(settings) as server:
-        client = await secure_client(server.url, client_identity, certificate_dir)
+        client = await secure_client(server.url, trusted, certificate_dir)
         client.set_user(user)
         client.set_password(password)
         with pytest.raises(UaStatusCodeError) as refused:
@@ -92,11 +71,11 @@ async def test_a_wrong_user_or_password_is_refused(
 
 
 async def test_a_token_type_not_offered_is_rejected(
-    settings: OpcUaSecurity, certificate_dir: Path, client_identity: ClientIdentity,
+    settings: OpcUaSecurity, certificate_dir: Path, trusted: ClientIdentity,
 ) -> None:
     """Off loopback anonymous is not offered: asyncua rejects the token itself."""
     async with secured_server(settings, host="0.0.0.0") as server:
-        client = await secure_client(server.url, client_identity, certificate_dir)
+        client = await secure_client(server.url, trusted, certificate_dir)
         with pytest.raises(UaStatusCodeError) as refused:
             await client.connect()
         assert refused.value.code == StatusCodes.BadIdentityTokenRejected
