@@ -43,6 +43,7 @@ CALL_STATUS: dict[int, int] = {
     _E.DEVICE_INVALIDACCESS: _S.BadUserAccessDenied,
     _E.DEVICE_NOTREADY: _S.BadInvalidState,
     _E.DEVICE_INVALIDSTATE: _S.BadInvalidState,
+    _E.DEVICE_NOTFOUND: _S.BadNotFound,  # SelectProgram of a name not in the store
 }
 #: method -> (the channel object it writes, what it does)
 COMMANDS: dict[str, tuple[str, str]] = {

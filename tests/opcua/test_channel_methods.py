@@ -164,6 +164,8 @@ async def test_bad_arguments_are_refused(machine: Running) -> None:
                                  ) == ua.StatusCodes.BadInvalidArgument
         assert await call_status(node, "SelectProgram", ns, ua.Variant("x" * 10_000)
                                  ) == ua.StatusCodes.BadInvalidArgument
+        assert await call_status(node, "SelectProgram", ns, ua.Variant("missing.nc")
+                                 ) == ua.StatusCodes.BadNotFound
         assert await call_status(node, "SelectProgram", ns, ua.Variant("a"), ua.Variant("b")
                                  ) == ua.StatusCodes.BadTooManyArguments
         assert await call_status(node, "Start", ns, ua.Variant(True)
