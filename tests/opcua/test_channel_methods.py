@@ -27,6 +27,7 @@ OBJECTS_URI = "urn:cnc-objects:opcua"
 SHORT = "G1 X10 F6000\nG1 X0\nM30\n"  # ends at once on the virtual clock
 #: 100 minutes of virtual time at F1: long enough to hold, resume and reset in
 LONG = "G1 X100 F1\nM30\n"
+BAD = "G0 X1\nG1 X10\nM30\n"  # line 2: G1 without F, the channel ends in ERROR
 ACTIVE, INTERRUPTED, RESET = 0, 1, 2  # MachineTool ChannelState (CncChannelStatus)
 
 
@@ -151,6 +152,27 @@ async def test_start_without_a_ready_channel_is_bad_invalid_state(machine: Runni
                 assert cnc.read("ch1.mc_active_program_name_r") == "long.nc"
         finally:
             await node.call_method(f"{ns}:Reset")
+
+
+async def test_start_in_error_is_bad_invalid_state_until_reset(machine: Running) -> None:
+    service, url = machine
+    store(service, "bad.nc", BAD)
+    async with connected(url) as client:
+        node, ns = await channel_object(client)
+        monitoring = await child(await machine_node(client), "Monitoring", "Channel1")
+        channel_state = await child(monitoring, "ChannelState")
+        changes = _Changes()
+        subscription = await client.create_subscription(20, changes)
+        await subscription.subscribe_data_change([channel_state])
+        await node.call_method(f"{ns}:SelectProgram", ua.Variant("bad.nc"))
+        await node.call_method(f"{ns}:Start")
+        await changes.wait(channel_state, lambda v: v == INTERRUPTED)
+        assert kernel_state(service) == ChannelState.ERROR
+        assert await call_status(node, "Start", ns) == ua.StatusCodes.BadInvalidState
+        assert kernel_state(service) == ChannelState.ERROR  # refused: nothing changed
+        assert await call_status(node, "Reset", ns) == ua.StatusCodes.Good
+        assert kernel_state(service) != ChannelState.ERROR
+        await subscription.delete()
 
 
 async def test_bad_arguments_are_refused(machine: Running) -> None:
