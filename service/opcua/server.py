@@ -18,6 +18,7 @@ from . import address_space_cache as cache
 from .alarm_events import build_alarm_events
 from .attributes import BoundAttributes
 from .binding import VariableBinder
+from .channel_methods import build_channel_methods
 from .cnc_interface import build_cnc_interface
 from .config import endpoint_url
 from .limits import OpcUaLimits, apply_limits
@@ -87,6 +88,7 @@ class OpcUaServer:
         await build_cnc_interface(server, binder, self.backend, VENDOR, self._version())
         machine = await build_machine_tool(server, binder, self.backend, VENDOR, PRODUCT_URI)
         await build_alarm_events(server, self.backend, machine)
+        await build_channel_methods(server, self.backend, machine)
         # last: its guard wraps the session factory the alarm events' methods installed
         apply_limits(server, self.limits)
         with asyncua_quiet():  # its warnings of a server without signing policies
