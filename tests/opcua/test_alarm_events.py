@@ -19,13 +19,13 @@ from cnc_objects.clients import ChannelError
 from cnc_objects.clients import Client as CncClient
 from cnc_objects.protocol.alarm_values import AlarmState
 from cnc_objects.testing import ServiceProcess
-from tests.opcua.test_machine_tool import (
+from tests.support.opcua_machine import (
     WAIT_S,
     Running,
     child,
     connected,
     machine_node,
-    opcua_service,
+    serving_opcua,
 )
 
 CNC_URI = "http://opcfoundation.org/UA/CNC"
@@ -37,14 +37,14 @@ REFRESH = ua.NodeId(ua.ObjectIds.ConditionType_ConditionRefresh)
 
 @pytest.fixture(scope="module")
 def machine(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[ServiceProcess, str]]:
-    with opcua_service(tmp_path_factory.mktemp("alarm-events")) as running:
+    with serving_opcua(tmp_path_factory.mktemp("alarm-events")) as running:
         yield running
 
 
 @pytest.fixture(scope="module")
 def monitored(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[ServiceProcess, str]]:
     """A service whose OPC UA sessions are monitors."""
-    with opcua_service(tmp_path_factory.mktemp("alarm-events-monitor"),
+    with serving_opcua(tmp_path_factory.mktemp("alarm-events-monitor"),
                        '[opcua]\nloopback_role = "monitor"\n') as running:
         yield running
 

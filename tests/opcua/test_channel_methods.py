@@ -13,14 +13,14 @@ from asyncua import Client, Node, ua
 from cnc_objects.clients import Client as CncClient
 from cnc_objects.protocol.values import ChannelState
 from cnc_objects.testing import ServiceProcess
-from tests.opcua.test_machine_tool import (
+from tests.support.opcua_machine import (
     WAIT_S,
+    Changes,
     Running,
-    _Changes,
     child,
     connected,
     machine_node,
-    opcua_service,
+    serving_opcua,
 )
 
 OBJECTS_URI = "urn:cnc-objects:opcua"
@@ -33,14 +33,14 @@ ACTIVE, INTERRUPTED, RESET = 0, 1, 2  # MachineTool ChannelState (CncChannelStat
 
 @pytest.fixture(scope="module")
 def machine(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Running]:
-    with opcua_service(tmp_path_factory.mktemp("channel-methods")) as running:
+    with serving_opcua(tmp_path_factory.mktemp("channel-methods")) as running:
         yield running
 
 
 @pytest.fixture(scope="module")
 def monitored(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Running]:
     """A service whose OPC UA sessions are monitors."""
-    with opcua_service(tmp_path_factory.mktemp("channel-methods-monitor"),
+    with serving_opcua(tmp_path_factory.mktemp("channel-methods-monitor"),
                        '[opcua]\nloopback_role = "monitor"\n') as running:
         yield running
 
@@ -96,7 +96,7 @@ async def test_select_and_start_run_a_stored_program_to_its_end(machine: Running
         node, ns = await channel_object(client)
         program = await child(await machine_node(client), "Production", "ActiveProgram")
         name, state = await child(program, "Name"), await child(program, "State", "CurrentState")
-        changes = _Changes()
+        changes = Changes()
         subscription = await client.create_subscription(20, changes)
         await subscription.subscribe_data_change([name, state])
         await node.call_method(f"{ns}:SelectProgram", ua.Variant("short.nc"))
@@ -115,7 +115,7 @@ async def test_hold_stops_start_resumes_reset_ends(machine: Running) -> None:
         node, ns = await channel_object(client)
         monitoring = await child(await machine_node(client), "Monitoring", "Channel1")
         channel_state = await child(monitoring, "ChannelState")
-        changes = _Changes()
+        changes = Changes()
         subscription = await client.create_subscription(20, changes)
         await subscription.subscribe_data_change([channel_state])
         await changes.wait(channel_state, lambda v: v == RESET)
@@ -161,7 +161,7 @@ async def test_start_in_error_is_bad_invalid_state_until_reset(machine: Running)
         node, ns = await channel_object(client)
         monitoring = await child(await machine_node(client), "Monitoring", "Channel1")
         channel_state = await child(monitoring, "ChannelState")
-        changes = _Changes()
+        changes = Changes()
         subscription = await client.create_subscription(20, changes)
         await subscription.subscribe_data_change([channel_state])
         await node.call_method(f"{ns}:SelectProgram", ua.Variant("bad.nc"))

@@ -5,73 +5,35 @@ the kernel (docs/opcua.md, "MachineTool (OPC 40501-1)")."""
 
 from __future__ import annotations
 
-import asyncio
-import contextlib
-import re
-from collections.abc import AsyncIterator, Callable, Iterator
-from pathlib import Path
-from typing import Any
+from collections.abc import Iterator
 
 import pytest
 from asyncua import Client, Node, ua
 from asyncua.common.ua_utils import get_node_supertypes
 
 from cnc_objects.clients import Client as CncClient
-from cnc_objects.testing import ServiceProcess, serving
+from cnc_objects.testing import ServiceProcess
+from tests.support.opcua_machine import (
+    WAIT_S,
+    Changes,
+    Running,
+    child,
+    connected,
+    machine_node,
+    serving_opcua,
+)
 
 MT_URI = "http://opcfoundation.org/UA/MachineTool/"
-MACHINERY_URI = "http://opcfoundation.org/UA/Machinery/"
 DI_URI = "http://opcfoundation.org/UA/DI/"
-START_TIMEOUT_S = 90.0  # the nodesets and instances take seconds on a busy machine
-WAIT_S = 30.0
 STOPS = "M3 S1000\nG1 X10 F600\nM0\nG1 X0\nM5\nM30\n"  # waits at M0 while the test looks
-Running = tuple[ServiceProcess, str]  # a service with OPC UA and its opc.tcp URL
 _MANDATORY = {ua.ObjectIds.ModellingRule_Mandatory}
 _PLACEHOLDER = {ua.ObjectIds.ModellingRule_MandatoryPlaceholder}
 
 
-@contextlib.contextmanager
-def opcua_service(work: Path, toml: str = "") -> Iterator[tuple[ServiceProcess, str]]:
-    """A service with OPC UA on a free loopback port (``toml``: its configuration)."""
-    args = ["--opcua", "opc.tcp://127.0.0.1:0"]
-    if toml:
-        (work / "machine.toml").write_text(toml)
-        args += ["--config", str(work / "machine.toml")]
-    with serving(*args, program_dir=work / "programs", timeout_s=START_TIMEOUT_S) as service:
-        line = service.wait_for_log(r"OPC UA on opc\.tcp://")
-        found = re.search(r"OPC UA on (opc\.tcp://\S+) ", line)
-        assert found is not None, line
-        yield service, found.group(1)
-
-
-@contextlib.asynccontextmanager
-async def connected(url: str) -> AsyncIterator[Client]:
-    client = Client(url, timeout=WAIT_S)
-    async with client:
-        yield client
-
-
 @pytest.fixture(scope="module")
 def machine(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[ServiceProcess, str]]:
-    with opcua_service(tmp_path_factory.mktemp("machine-tool")) as running:
+    with serving_opcua(tmp_path_factory.mktemp("machine-tool")) as running:
         yield running
-
-
-async def machine_node(client: Client) -> Node:
-    """Objects/Machines/<the one machine>."""
-    machinery = await client.get_namespace_index(MACHINERY_URI)
-    machines = await client.nodes.objects.get_child(f"{machinery}:Machines")
-    [node] = await machines.get_children()
-    return node
-
-
-async def child(node: Node, *names: str) -> Node:
-    """The descendant of ``node`` browsed as ``names`` (any namespace)."""
-    for name in names:
-        found = {(await c.read_browse_name()).Name: c for c in await node.get_children()}
-        assert name in found, f"{name} not under {node}: {sorted(found)}"
-        node = found[name]
-    return node
 
 
 async def conformance_gaps(client: Client, root: Node) -> tuple[list[str], int]:
@@ -166,28 +128,6 @@ async def test_every_variable_reads_good_with_a_value(machine: Running) -> None:
         assert bad == []
 
 
-class _Changes:
-    """Data changes of subscribed variables, by node."""
-
-    def __init__(self) -> None:
-        self.values: dict[ua.NodeId, list[Any]] = {}
-        self.changed = asyncio.Condition()
-
-    async def datachange_notification(self, node: Node, value: Any, data: Any) -> None:
-        async with self.changed:
-            self.values.setdefault(node.nodeid, []).append(value)
-            self.changed.notify_all()
-
-    async def wait(self, node: Node, test: Callable[[Any], bool]) -> Any:
-        """The first value of ``node`` (seen or to come) that passes ``test``."""
-        async with asyncio.timeout(WAIT_S), self.changed:
-            while True:
-                for value in self.values.get(node.nodeid, []):
-                    if test(value):
-                        return value
-                await self.changed.wait()
-
-
 async def test_values_follow_a_running_program_and_the_overrides(machine: Running) -> None:
     service, url = machine
     async with connected(url) as client:
@@ -203,7 +143,7 @@ async def test_values_follow_a_running_program_and_the_overrides(machine: Runnin
         tool_name = await child(node, "Equipment", "Tools", "Ch1_T3", "Name")
         watched = [name, state, operation_mode, channel_state, channel_mode, feed, rotating,
                    tool_name]
-        changes = _Changes()
+        changes = Changes()
         subscription = await client.create_subscription(20, changes)
         await subscription.subscribe_data_change(watched)
         with CncClient(service.endpoint, timeout_s=WAIT_S) as cnc:
