@@ -81,7 +81,7 @@ def engineering_unit(unit: str) -> str | None:
 _DATA_VALUE_FIELDS = tuple(f.name for f in fields(ua.DataValue))
 
 
-class SharedDataValue(ua.DataValue):
+class SharedDataValue(ua.DataValue):  # type: ignore[misc]  # asyncua: Any to mypy
     """A DataValue that is never changed after it is made (each sample, each read makes a
     new one, its value a new object): ``copy.deepcopy`` gives it back as it is. asyncua
     deep-copies every value a monitored item is handed (``MonitoredItemValues``, to keep
