@@ -111,7 +111,7 @@ async def _notifications_per_s(url: str, ids: list[str], seconds: float) -> floa
     return rate
 
 
-async def _double_variables(url: str) -> list[str]:
+async def double_variables(url: str) -> list[str]:
     """Every Double variable of the CncInterface's channels and axes."""
     async with Client(url, timeout=60) as client:
         ns = await client.get_namespace_index(CNC_URI)
@@ -216,7 +216,7 @@ def _one_run(port: int, static_ids: list[str], seconds: float) -> SubscriptionRu
     base = asyncio.run(_notifications_per_s(f"opc.tcp://127.0.0.1:{port}", static_ids, seconds))
     with _opcua_bench_service() as (service, url):
         asyncio.run(_start_program(service.endpoint))
-        doubles = asyncio.run(_double_variables(url))
+        doubles = asyncio.run(double_variables(url))
         changing = asyncio.run(_changing(url, doubles))
         items = [changing[k % len(changing)] for k in range(ITEMS)]
         ours = asyncio.run(_notifications_per_s(url, items, seconds))
