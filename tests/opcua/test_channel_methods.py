@@ -53,6 +53,17 @@ async def channel_object(client: Client, channel: int = 1) -> tuple[Node, int]:
     return node, ns
 
 
+async def watched_channel_state(client: Client) -> tuple[Node, Changes]:
+    """MachineTool's Monitoring/Channel1/ChannelState, subscribed (20 ms): the node and
+    the changes seen."""
+    monitoring = await child(await machine_node(client), "Monitoring", "Channel1")
+    channel_state = await child(monitoring, "ChannelState")
+    changes = Changes()
+    subscription = await client.create_subscription(20, changes)
+    await subscription.subscribe_data_change([channel_state])
+    return channel_state, changes
+
+
 def store(service: ServiceProcess, name: str, text: str) -> None:
     """Reset channel 1 and put ``text`` in the program store as ``name`` (cnc upload)."""
     with CncClient(service.endpoint, timeout_s=WAIT_S) as cnc:
@@ -113,11 +124,7 @@ async def test_hold_stops_start_resumes_reset_ends(machine: Running) -> None:
     store(service, "long.nc", LONG)
     async with connected(url) as client:
         node, ns = await channel_object(client)
-        monitoring = await child(await machine_node(client), "Monitoring", "Channel1")
-        channel_state = await child(monitoring, "ChannelState")
-        changes = Changes()
-        subscription = await client.create_subscription(20, changes)
-        await subscription.subscribe_data_change([channel_state])
+        channel_state, changes = await watched_channel_state(client)
         await changes.wait(channel_state, lambda v: v == RESET)
         await node.call_method(f"{ns}:SelectProgram", ua.Variant("long.nc"))
         await node.call_method(f"{ns}:Start")
@@ -134,7 +141,6 @@ async def test_hold_stops_start_resumes_reset_ends(machine: Running) -> None:
         changes.values[channel_state.nodeid] = []
         await changes.wait(channel_state, lambda v: v == RESET)
         assert kernel_state(service) == ChannelState.READY
-        await subscription.delete()
 
 
 async def test_start_without_a_ready_channel_is_bad_invalid_state(machine: Running) -> None:
@@ -159,11 +165,7 @@ async def test_start_in_error_is_bad_invalid_state_until_reset(machine: Running)
     store(service, "bad.nc", BAD)
     async with connected(url) as client:
         node, ns = await channel_object(client)
-        monitoring = await child(await machine_node(client), "Monitoring", "Channel1")
-        channel_state = await child(monitoring, "ChannelState")
-        changes = Changes()
-        subscription = await client.create_subscription(20, changes)
-        await subscription.subscribe_data_change([channel_state])
+        channel_state, changes = await watched_channel_state(client)
         await node.call_method(f"{ns}:SelectProgram", ua.Variant("bad.nc"))
         await node.call_method(f"{ns}:Start")
         await changes.wait(channel_state, lambda v: v == INTERRUPTED)
@@ -172,7 +174,6 @@ async def test_start_in_error_is_bad_invalid_state_until_reset(machine: Running)
         assert kernel_state(service) == ChannelState.ERROR  # refused: nothing changed
         assert await call_status(node, "Reset", ns) == ua.StatusCodes.Good
         assert kernel_state(service) != ChannelState.ERROR
-        await subscription.delete()
 
 
 async def test_bad_arguments_are_refused(machine: Running) -> None:
