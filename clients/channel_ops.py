@@ -45,6 +45,7 @@ from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.file_listing import decode_listing
 from cnc_objects.protocol.program_lines import LinesRequest, decode_lines_reply, encode_lines_request
 from cnc_objects.protocol.values import (
+    ROTARY_AXIS_CODE,
     WORKING_STATES,
     ChannelMode,
     ChannelState,
@@ -147,6 +148,7 @@ class ChannelStatus:
     single_block: bool = False  # single block is on (mc_active_single_block_r)
     wait_reason: str = "NONE"  # why the channel stands (mc_wait_reason_r), by name
     wait_reason_text: str = ""  # the same as a sentence; empty when it does not stand
+    rotary_axes: tuple[str, ...] = ()  # axes whose positions are degrees, not mm
 
 
 @dataclass(frozen=True, slots=True)
@@ -525,7 +527,9 @@ class ChannelOps(ProgramOps):
             )
         ]
         axis_names = [o.name.replace("command_position_acs", "axis_name") for o in axes]
-        values = await self.read_many([*wanted, *axis_names, *(o.name for o in axes)])
+        axis_types = [o.name.replace("command_position_acs", "axis_type") for o in axes]
+        values = await self.read_many([*wanted, *axis_names, *axis_types,
+                                       *(o.name for o in axes)])
         v: list[Any] = [values[n] for n in wanted]
         positions = {
             # 0.1 um -> mm by the scale the service gives, rounded to 0.1 um: no float noise
@@ -541,6 +545,8 @@ class ChannelOps(ProgramOps):
             single_block=bool(v[10]),
             wait_reason=describe_wait_reason(v[11])[0],
             wait_reason_text=describe_wait_reason(v[11])[1],
+            rotary_axes=tuple(values[an] for an, at in zip(axis_names, axis_types, strict=True)
+                              if values[at] == ROTARY_AXIS_CODE),
         )
 
     async def contour_lookahead(

@@ -71,6 +71,12 @@ class ContourBlockType(IntEnum):
     POLYNOMIAL = 6  # polynomial contour element
 
 
+AXIS_TYPE_CODES: dict[str, int] = {"linear": 1, "rotary": 2}
+"""ISG's codes of kenngr.achs_typ (ACHSTYP_TRANSLATOR, ACHSTYP_ROTATOR): the machine
+configuration's ``axis_type`` and the object ``ch<c>.ax<a>.axis_type``."""
+ROTARY_AXIS_CODE = AXIS_TYPE_CODES["rotary"]
+
+
 class ExecutionMode(IntFlag):
     """Execution mode bits of a channel (``mc_command_execution_mode_w``); a value is
     their OR."""

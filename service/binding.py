@@ -20,7 +20,7 @@ from cnc_objects.objects.templates import CatalogSizes
 from cnc_objects.protocol.constants import CncPort
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.units import UM01_PER_MM
-from cnc_objects.protocol.values import ERRORS_LISTED, MESSAGES_LISTED
+from cnc_objects.protocol.values import AXIS_TYPE_CODES, ERRORS_LISTED, MESSAGES_LISTED
 from cnc_objects.protocol.wait_reasons import wait_reason_text
 
 from . import __version__, binding_alarms, binding_manual, binding_operator, binding_technology, binding_tools
@@ -52,7 +52,7 @@ from .kernel.kernel import Kernel, ResetCycleStats
 from .kernel.state import DecoderFlag
 from .kernel.step_clock import StepCycles
 from .kernel.tooling import tool_list_size
-from .machine_config import AXIS_TYPE_CODES, MachineConfig
+from .machine_config import MachineConfig
 from .notifications import NotificationCounts
 from .param_list import ParamListError, parse_axis_list
 

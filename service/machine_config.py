@@ -78,8 +78,6 @@ class PhysicalAxisConfig(Strict):
     name: str = Field(min_length=1, max_length=15)
 
 
-AXIS_TYPE_CODES: dict[str, int] = {"linear": 1, "rotary": 2}
-"""ISG's codes of kenngr.achs_typ (ACHSTYP_TRANSLATOR, ACHSTYP_ROTATOR)."""
 
 
 class AxisConfig(Strict):

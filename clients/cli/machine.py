@@ -377,6 +377,13 @@ def reset(
          f"channel {channel}: reset, standard execution from the next start")
 
 
+def _units(rotary_axes: tuple[str, ...]) -> str:
+    """The units of a channel's positions: mm, and degrees for its rotary axes."""
+    if not rotary_axes:
+        return "mm"
+    return f"mm; {', '.join(rotary_axes)} in degrees"
+
+
 @command()
 def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
     """Mode, state, execution mode, single block, wait reason, program, block and axis
@@ -400,7 +407,7 @@ def status(ctx: typer.Context, channel: int = ChannelOption) -> None:
         f"single block {'on' if s.single_block else 'off'}  {waits}",
         (f"block N{s.block_number if s.block_number >= 0 else '-'} {s.file or '-'}:{s.line}  "
          f"v={s.path_velocity_mm_s:.3f} mm/s  t={s.program_time_s:.3f} s"),
-        f"positions (mm): {positions}",
+        f"positions ({_units(s.rotary_axes)}): {positions}",
         *s.errors,
         *(["RESET clears the error (cnc reset)"] if s.state == "ERROR" else []),
     ]
