@@ -79,7 +79,9 @@ def test_a_write_touches_only_changed_writable_members(built) -> None:
     assert code == 0 and [(e.obj.name, v) for e, v in writes] == [("gpX[0].a.flag", True)]
     assert structs.decode_write(node, b"\x02\x00\x00\x00")[0] == AdsReturnCode.DEVICE_INVALIDDATA
     assert structs.decode_write(node, b"\x01")[0] == AdsReturnCode.DEVICE_INVALIDSIZE
-    assert structs.decode_write(structs.by_name("gpX[0].b"), bytes(32))[0] == (
+    # nothing writable in b: its own bytes come back (a round trip), a change is 0x704
+    assert structs.decode_write(structs.by_name("gpX[0].b"), bytes(32)) == (0, "", [])
+    assert structs.decode_write(structs.by_name("gpX[0].b"), b"\x01" + bytes(31))[0] == (
         AdsReturnCode.DEVICE_INVALIDACCESS)
 
 
