@@ -268,20 +268,16 @@ def test_the_type_upload_lays_every_struct_out_as_a_compiler_does(ads: RawAds) -
         if item.array:
             ((_, count),) = item.array
             assert types[item.type_name].size * count == item.size, item.name
+    info = answer(ads, READ, read(0xF00F, 0, 64))[1]
+    upload = parse_symbols(answer(ads, READ, read(0xF00B, 0, struct.unpack_from("<I", info, 4)[0]))[1])
+    for entry in upload:  # and each struct symbol is its type's size
+        if entry.data_type == BIGTYPE:
+            assert types[entry.type_name].size == entry.size, entry.name
     bahn_state = types["ST_gpCh_bahn_state"]
     assert [m.name for m in bahn_state.members][:2] == ["dist_prog_start", "coord_r"]
     spindle = types["ST_gpCh_spindle"]  # speed_reached_r (BOOL at 0x10), position_r at 0x18
     assert [(m.name, m.type_name, m.offset, m.size) for m in spindle.members][-2:] == [
         ("_pad_0x0011", "ARRAY [0..6] OF BYTE", 0x11, 7), ("position_r", "LREAL", 0x18, 8)]
-
-
-def test_every_struct_symbol_is_the_size_of_its_type(ads: RawAds) -> None:
-    info = answer(ads, READ, read(0xF00F, 0, 64))[1]
-    upload = parse_symbols(answer(ads, READ, read(0xF00B, 0, struct.unpack_from("<I", info, 4)[0]))[1])
-    types = _type_upload(ads)
-    for entry in upload:
-        if entry.data_type == BIGTYPE:
-            assert types[entry.type_name].size == entry.size, entry.name
 
 
 def handle_of(ads: RawAds, name: str) -> tuple[int, bytes]:
