@@ -81,7 +81,8 @@ def test_ads_client_whole_structs_and_arrays(node: str, service: ServiceProcess)
     assert seen["request"] == {"start_position": 3, "length": 7}
     assert set(seen["suspend"]) == {"command_w", "enable_w", "request_r", "state_r"}
     assert seen["axisNumbers"] == [1, 2, 3, 11, 12, 13]  # gpAx[i].head.log_ax_n_r
-    assert seen["blocks"] == 32 and seen["blockKeys"][:2] == ["block_type", "block_number"]
+    assert seen["blocks"] == 32 and seen["blockKeys"][:3] == [
+        "block_type", "_pad_0x0002", "block_number"]  # the padding the type lists (issue 41)
     assert seen["readOnly"]["code"] == INVALIDACCESS
 
 
