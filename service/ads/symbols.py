@@ -24,7 +24,8 @@ group  command   answer
 0xF009 ReadWrite name in, AdsSymbolEntry out
 0xF00B Read      every AdsSymbolEntry, back to back
 0xF00C Read      AdsSymbolUploadInfo, 8 bytes (count and size of 0xF00B)
-0xF00E Read      an AdsDatatypeEntry per type the symbols use (base types)
+0xF00E Read      an AdsDatatypeEntry per type the symbols use (base types, structs
+                 and arrays, the padding members' ARRAY [0..n-1] OF BYTE and BYTE)
 0xF00F Read      upload info, 64 bytes if the read length allows, else 24
 0xF011 ReadWrite type name in, AdsDatatypeEntry out (any elementary type, STRING(n))
 ====== ========= ==============================================================
