@@ -64,7 +64,9 @@ def name_key(name: str) -> str:
     stays in the key, which no symbol has (0x710, as for an unknown name)."""
     key = name.lower()
     if "^" in key:
-        key = _DEREFERENCE.sub(r"\1", key, count=1)
+        match = _DEREFERENCE.match(key)
+        if match is not None:  # one ^ after the root element: drop it
+            key = key[: match.end(1)] + key[match.end(1) + 1 :]
     return key
 
 
