@@ -50,12 +50,24 @@ class GroupHandler(Protocol):
 _INDEX = re.compile(r"\[\d+\]")
 
 
+#: A pointer dereference where ISG's HLI has its pointers: right after the element of a
+#: root array (``gpCh[0]^``, ``gpAx[3]^``, ``pMC[1]^``), at the end or before a member.
+_DEREFERENCE = re.compile(r"^([^.\[\]^]+\[\d+\])\^(?=\.|$)")
+
+
 def name_key(name: str) -> str:
     """The key a name is looked up by: case-insensitive, as TwinCAT's symbol names, and
-    without the ``^`` of pointer dereferences, since ISG's HLI documentation writes
+    without the ``^`` of a pointer dereference, since ISG's HLI documentation writes
     paths through the pointers (``gpCh[0]^.bahn_mc_control``) and the symbols are named
-    without them (``gpCh[0].bahn_mc_control``)."""
-    return name.lower().replace("^", "")
+    without them (``gpCh[0].bahn_mc_control``). TwinCAT takes ``^`` only after a
+    pointer, so only there: a ``^`` anywhere else (``gpCh^[0]``, ``gpCh[0].spindle^``)
+    stays in the key, which no symbol has (0x710, as for an unknown name)."""
+    key = name.lower()
+    if "^" in key:
+        match = _DEREFERENCE.match(key)
+        if match is not None:  # one ^ after the root element: drop it
+            key = key[: match.end(1)] + key[match.end(1) + 1 :]
+    return key
 
 
 def _glob(pattern: str) -> re.Pattern[str]:
@@ -135,7 +147,8 @@ class AddressSpace:
         return [e.obj for e in self._entries]
 
     def by_name(self, name: str) -> Entry | None:
-        """The entry named ``name`` (case-insensitive, ``^`` ignored), or None."""
+        """The entry named ``name`` (case-insensitive, ``^`` after a root element ignored:
+        ``name_key``), or None."""
         return self._by_name.get(name_key(name))
 
     def by_handle(self, handle: int) -> Entry | None:

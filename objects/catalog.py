@@ -485,7 +485,8 @@ CORE_TEMPLATES: tuple[ObjectTemplate, ...] = (
         "TRUE while the channel's axis output is suspended (its axes are given up)",
     ),
     ObjectTemplate(
-        "bahn_state.dist_prog_start", Scope.PLC_CHANNEL, PLC, PLC_GROUP, 0x110, REAL64, R,
+        # before coord_r (PLC_COORD_BASE): bahn_state's members lie together (issue 41)
+        "bahn_state.dist_prog_start", Scope.PLC_CHANNEL, PLC, PLC_GROUP, 0xE38, REAL64, R,
         "0.1 um", "Path distance covered since program start or #DISTANCE PROG START CLEAR, "
         "on the compensated path",
     ),

@@ -7,14 +7,21 @@ structs), ``gpCh[0]`` (a struct), ``gpCh[0].contour_lookahead`` (a struct), ...,
 ``gpCh[0].contour_lookahead.response.block`` (an array). Their layout is the leaves'
 own: a struct starts at its first member and ends with its last, an array element
 takes the stride between elements (so the array is contiguous, as in PLC memory), and
-the bytes between members are padding, read as zeros.
+the bytes between members are padding, read as zeros. Members never overlap and come
+in ascending offsets, as a compiler lays a struct out (a layout that would overlap is
+refused when the structs are built); ``struct_members`` names the padding as members of
+its own (``_pad_0x0004 : ARRAY [0..11] OF BYTE``, the offset in the struct), so that a
+reader that lays members out one after the other (pyads' ``structure_def``, a code
+generator over the type upload) finds every member where it is.
 
 The PLC memory area is read as a PLC reads it: from where a symbol starts, any number of
 bytes up to the area's end, the symbols in the range at their offsets and zeros between
 them; so a struct at its own address (its first member's offset) reads as a struct. A
-struct or array is written member by member (only the writable members whose bytes
-change; the others are left as they are), at its address or by handle; ``handle``
-numbers start at ``HANDLE_BASE``, apart from the address space's.
+struct or array is written member by member, at its address or by handle (the same
+rule both ways): the writable members whose bytes change are written; padding is
+ignored; the bytes of read-only members are ignored too when a member of the struct is
+writable, and must be the bytes it holds when none is (``decode_memory_write`` says
+why). ``handle`` numbers start at ``HANDLE_BASE``, apart from the address space's.
 
 Type names: ISG's where its HLI documentation names the type (reference/cnc-objects.md
 section 6: HLI_CONTOUR_LOOKAHEAD, MC_CONTROL_BOOL_UNIT, ...), else ``ST_`` and the path
@@ -38,6 +45,10 @@ from .address_space import AddressSpace, Entry, name_key
 _E = AdsReturnCode
 #: First handle of a struct or array symbol (the address space's handles are 1..N).
 HANDLE_BASE = 0x4000_0000
+#: Name of the padding member at ``offset`` in its struct (``struct_members``).
+PADDING_NAME = "_pad_0x{offset:04x}"
+#: Type of a padding member of ``size`` bytes.
+PADDING_TYPE = "ARRAY [0..{last}] OF BYTE"
 _PART = re.compile(r"^([^\[\]]+)\[(\d+)\]$")
 
 #: Type names of ISG's HLI (by path without indices, below the root array's element).
@@ -87,6 +98,48 @@ class Node:
         if self.elements:
             return [(f"[{k}]", node) for k, node in sorted(self.elements.items())]
         return sorted(self.members.items(), key=lambda item: (item[1].start, item[0]))
+
+
+@dataclass(frozen=True, slots=True)
+class Member:
+    """A member of a struct's type as ``struct_members`` lists it: ``offset`` in the
+    struct, ``size`` in bytes; ``node`` the member's symbol, None for padding."""
+
+    name: str
+    offset: int
+    size: int
+    node: Node | None
+
+    @property
+    def type_name(self) -> str:
+        """The member's TwinCAT type: the leaf's, the struct's or array's, or the padding's."""
+        if self.node is None:
+            return padding_type(self.size)
+        if self.node.entry is not None:
+            return twincat_type(self.node.entry.obj.dtype).name
+        return self.node.type_name
+
+
+def padding_type(size: int) -> str:
+    """The type of ``size`` bytes of padding (``ARRAY [0..11] OF BYTE``)."""
+    return PADDING_TYPE.format(last=size - 1)
+
+
+def struct_members(node: Node) -> tuple[Member, ...]:
+    """The members of the struct ``node`` in ascending offsets, with a padding member
+    for every gap (the trailing one up to the struct's size included): their sizes add
+    up to the struct's."""
+    members: list[Member] = []
+    at = 0
+    for name, child in node.children():
+        offset = child.start - node.start
+        if offset > at:
+            members.append(Member(PADDING_NAME.format(offset=at), at, offset - at, None))
+        members.append(Member(name, offset, child.size, child))
+        at = offset + child.size
+    if node.size > at:
+        members.append(Member(PADDING_NAME.format(offset=at), at, node.size - at, None))
+    return tuple(members)
 
 
 def _parts(name: str) -> Iterator[tuple[str, int | None]]:
@@ -169,6 +222,12 @@ class PlcStructs:
             return
         node.start = min(child.start for child in children)
         node.size = max(child.start + child.size for child in children) - node.start
+        ordered = [child for _, child in node.children()]  # by offset, now they are laid out
+        for before, after in zip(ordered, ordered[1:]):
+            if before.start + before.size > after.start:
+                raise ValueError(
+                    f"{before.name} (0x{before.start:x}, {before.size} bytes) overlaps "
+                    f"{after.name} (0x{after.start:x}): no PLC struct can hold both")
         node.type_name = HLI_TYPE_NAMES.get(
             node.type_path, "ST_" + node.type_path.replace("[]", "").replace(".", "_"))
 
@@ -184,7 +243,7 @@ class PlcStructs:
     # ------------------------------------------------------------------ lookup
 
     def by_name(self, name: str) -> Node | None:
-        """The struct or array named ``name`` (case-insensitive, ``^`` ignored)."""
+        """The struct or array named ``name`` (case-insensitive, ``^`` as ``name_key`` takes it)."""
         return self._by_name.get(name_key(name))
 
     def by_handle(self, handle: int) -> Node | None:
@@ -206,8 +265,6 @@ class PlcStructs:
     def decode_write(self, node: Node, data: bytes) -> tuple[int, str, list[tuple[Entry, Any]]]:
         """The member writes that a write of ``data`` to ``node`` makes (see
         ``decode_memory_write``); a write of another size than the node's is 0x705."""
-        if not node.writable:
-            return _E.DEVICE_INVALIDACCESS, f"{node.name} has no writable member", []
         if len(data) != node.size:
             return (_E.DEVICE_INVALIDSIZE,
                     f"{node.name} is {node.type_name}, {node.size} bytes; write sent {len(data)}",
@@ -252,14 +309,28 @@ class PlcStructs:
             image[lo - offset : hi - offset] = data[lo - start : hi - start]
         return 0, bytes(image)
 
+    def is_symbol_range(self, offset: int, length: int) -> bool:
+        """True when ``[offset, offset + length)`` is exactly a struct or array symbol."""
+        return (offset, length) in self._node_ranges
+
     def decode_memory_write(self, offset: int, data: bytes) -> tuple[int, str, list[tuple[Entry, Any]]]:
         """The member writes that writing ``data`` into the PLC memory area at ``offset``
         makes, where the range is exactly a struct or array symbol: each writable member
-        whose bytes differ from its value now. Read-only members and padding are left as
-        they are (a PLC would overwrite them); (code, message, []) for a range that is
-        not one symbol (a wrong size stays a clear 0x705, where a PLC would write into
-        the neighbours), holds nothing writable, or a value a member refuses: nothing is
-        written then."""
+        whose bytes differ from its value now; (code, message, []) and nothing written
+        for a range that is not one symbol (a wrong size stays a clear 0x705, where a
+        PLC would write into the neighbours) or a value a member refuses.
+
+        The other bytes, as TwinCAT's %M memory takes a struct byte for byte: padding
+        is ignored. The bytes of read-only members are ignored when the struct has a
+        writable member: a client writes such a struct to change its writable members,
+        with the bytes it read before (ads-client merges ``{"override_w": 500}`` into the
+        struct it reads, pyads ``write_structure_by_name`` sends a whole dict), and the
+        CNC changes its status members every cycle, so a rule that wanted them unchanged
+        would refuse such writes at random; the CNC owns them (in a TwinCAT PLC the CNC
+        overwrites them in its next cycle), so they never change kernel state. A struct
+        with no writable member takes its own bytes back (a round trip changes nothing)
+        and refuses other bytes 0x704 as a read-only symbol does: such a write could
+        change nothing, and the client is told so."""
         refused = self._range_refusal(offset, len(data))
         if refused:
             return (*refused, [])
@@ -271,26 +342,31 @@ class PlcStructs:
         if code or not isinstance(now, bytes):  # code 0 carries the bytes
             return code, str(now), []
         writes: list[tuple[Entry, Any]] = []
+        read_only_changed: Entry | None = None
         writable = False
         for entry, start in self._overlapping(offset, len(data)):
             size = entry.obj.dtype.size
             if start < offset or start + size > offset + len(data):
                 return (_E.DEVICE_INVALIDSIZE,
                         f"a write from 0x{offset:x} of {len(data)} bytes cuts {entry.obj.name}", [])
+            part = data[start - offset : start - offset + size]
+            unchanged = part == now[start - offset : start - offset + size]
             if entry.write is None:
+                if not unchanged and read_only_changed is None:
+                    read_only_changed = entry
                 continue
             writable = True
-            part = data[start - offset : start - offset + size]
-            if part == now[start - offset : start - offset + size]:
+            if unchanged:
                 continue
             code, target, value = AddressSpace.decode_entry_write(entry, part)
             if code:
                 return code, str(target), []
             writes.append((entry, value))
-        if not writable:
-            return _E.DEVICE_INVALIDACCESS, f"nothing from 0x{offset:x} on may be written", []
+        if not writable and read_only_changed is not None:
+            return (_E.DEVICE_INVALIDACCESS,
+                    f"nothing from 0x{offset:x} on may be written ({read_only_changed.obj.name} "
+                    "is read-only); only the bytes it holds are taken back", [])
         return 0, "", writes
-
 
 def _leaves(node: Node) -> Iterator[tuple[Entry, int]]:
     """(entry, absolute offset) of every leaf below ``node``."""

@@ -83,7 +83,9 @@ PLC_GROUP = 0x4020
 PLC_CHANNEL_BASE, PLC_CHANNEL_STRIDE = 0x10000, 0x1000
 PLC_AXIS_BASE, PLC_AXIS_STRIDE = 0x80000, 0x100
 # gpCh[i].bahn_state.coord_r[k] (per axis of the channel, k from 0), after the technology
-# units and the spindle (0xD00..0xE30): room for 28 axes before the next channel's area
+# units and the spindle (0xD00..0xE30) and bahn_state.dist_prog_start (0xE38), so that
+# bahn_state is one block, as a compiler lays it out: room for 28 axes before the next
+# channel's area
 PLC_COORD_BASE, PLC_COORD_STRIDE = 0xE40, 0x10
 
 def instantiate(

@@ -275,8 +275,12 @@ class Backend:
             code, message = symbols.write(group, offset, data)
             return (code, str(message), []) if code else (0, "", [])
         decoded = self.space.decode_write(port, group, offset, data)
-        if decoded[0] == _E.DEVICE_INVALIDSIZE and port == CncPort.PLC and group == PLC_GROUP:
-            return self.structs.decode_memory_write(offset, data)  # a struct at its address
+        if decoded[0] and port == CncPort.PLC and group == PLC_GROUP and (
+            decoded[0] == _E.DEVICE_INVALIDSIZE
+            or (decoded[0] == _E.DEVICE_INVALIDACCESS
+                and self.structs.is_symbol_range(offset, len(data)))
+        ):  # a struct at its address, whose first member may be read-only (issue 41)
+            return self.structs.decode_memory_write(offset, data)
         return _one(decoded)
 
     def connection_ended(self, holder: Hashable, how: str) -> None:

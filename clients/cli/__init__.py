@@ -6,7 +6,8 @@ The package's ``__init__`` holds the global options and ``main``. The commands l
 modules ``objects`` (info, browse, read, write, watch), ``machine`` (program store, run,
 MDI, hold, resume, reset, status, lookahead, check), ``plot`` (plot), ``keys`` (keys new),
 ``tools`` (tool, offsets), ``tools_files`` (their export/import), ``step`` (step),
-``spindle``, ``manual`` (jog, home), ``alarms``, ``web_users`` and ``opcua_cert``; what they share is in
+``spindle``, ``manual`` (jog, home), ``alarms``, ``ads`` (ads structure-def), ``web_users``
+and ``opcua_cert``; what they share is in
 ``app``. Importing them here registers them on the app, in this order.
 
 A service started with ``--keys`` needs this client's key (``--key FILE`` or
@@ -34,6 +35,7 @@ from ..endpoint import DEFAULT_ENDPOINT
 
 # Importing a command module registers its commands; help lists them in this order.
 from . import (
+    ads,  # noqa: F401  (ads structure-def)
     alarms,  # noqa: F401  (alarms, alarms ack)
     keys,  # noqa: F401  (keys new)
     machine,  # noqa: F401  (programs, channel commands, check)

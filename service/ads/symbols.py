@@ -24,7 +24,8 @@ group  command   answer
 0xF009 ReadWrite name in, AdsSymbolEntry out
 0xF00B Read      every AdsSymbolEntry, back to back
 0xF00C Read      AdsSymbolUploadInfo, 8 bytes (count and size of 0xF00B)
-0xF00E Read      an AdsDatatypeEntry per type the symbols use (base types)
+0xF00E Read      an AdsDatatypeEntry per type the symbols use (base types, structs
+                 and arrays, the padding members' ARRAY [0..n-1] OF BYTE and BYTE)
 0xF00F Read      upload info, 64 bytes if the read length allows, else 24
 0xF011 ReadWrite type name in, AdsDatatypeEntry out (any elementary type, STRING(n))
 ====== ========= ==============================================================
@@ -48,7 +49,13 @@ from collections.abc import Callable
 from cnc_objects.objects import AddressSpace
 from cnc_objects.objects.address_space import Entry, name_key
 from cnc_objects.objects.catalog import PLC_GROUP
-from cnc_objects.objects.plc_structs import Node, PlcStructs
+from cnc_objects.objects.plc_structs import (
+    Member,
+    Node,
+    PlcStructs,
+    padding_type,
+    struct_members,
+)
 from cnc_objects.protocol.ads_symbols import (
     AdsDataType,
     AdsDataTypeFlag,
@@ -108,15 +115,23 @@ def struct_symbol_entry(node: Node) -> SymbolEntry:
                        flags, node.name, node.type_name, "")
 
 
-def _member(name: str, node: Node, parent: Node) -> DataTypeEntry:
-    """A sub item of ``parent``'s type: ``node`` at its offset in ``parent``."""
-    offset = node.start - parent.start
-    if node.entry is not None:
+def _member(member: Member) -> DataTypeEntry:
+    """A sub item of a struct's type: a member at its offset, or padding."""
+    node = member.node
+    if node is not None and node.entry is not None:
         tc = twincat_type(node.entry.obj.dtype)
-        return DataTypeEntry(name, tc.size, tc.data_type, AdsDataTypeFlag.DATAITEM, tc.name,
-                             node.entry.obj.description, offset)
-    return DataTypeEntry(name, node.size, AdsDataType.BIGTYPE, AdsDataTypeFlag.DATAITEM,
-                         node.type_name, "", offset)
+        return DataTypeEntry(member.name, tc.size, tc.data_type, AdsDataTypeFlag.DATAITEM,
+                             tc.name, node.entry.obj.description, member.offset)
+    comment = "padding" if node is None else ""
+    return DataTypeEntry(member.name, member.size, AdsDataType.BIGTYPE, AdsDataTypeFlag.DATAITEM,
+                         member.type_name, comment, member.offset)
+
+
+def padding_datatype_entry(size: int) -> DataTypeEntry:
+    """The type of a padding member: ``ARRAY [0..size-1] OF BYTE``."""
+    name = padding_type(size)
+    return DataTypeEntry(name, size, AdsDataType.BIGTYPE, AdsDataTypeFlag.DATATYPE, "BYTE",
+                         hash_value=zlib.crc32(name.encode()), array=((0, size),))
 
 
 def struct_datatype_entry(node: Node) -> DataTypeEntry:
@@ -131,7 +146,7 @@ def struct_datatype_entry(node: Node) -> DataTypeEntry:
         return DataTypeEntry(node.type_name, node.size, AdsDataType.BIGTYPE,
                              AdsDataTypeFlag.DATATYPE, element_type, hash_value=hash_value,
                              array=((lower, count),))
-    members = tuple(_member(name, child, node) for name, child in node.children())
+    members = tuple(_member(member) for member in struct_members(node))
     return DataTypeEntry(node.type_name, node.size, AdsDataType.BIGTYPE, AdsDataTypeFlag.DATATYPE,
                          hash_value=hash_value, sub_items=members)
 
@@ -193,6 +208,13 @@ class SymbolService:
         for node in nodes:  # struct and array types, each once (instances share them)
             if node.type_name not in type_blobs:
                 type_blobs[node.type_name] = encode_datatype_entry(struct_datatype_entry(node))
+        paddings = {m.size for node in nodes if not node.is_array for m in struct_members(node)
+                    if m.node is None}
+        if paddings:  # the padding members' types, and their element type
+            byte = parse_twincat_type("BYTE")
+            type_blobs.setdefault(byte.name, encode_datatype_entry(datatype_entry(byte)))
+        for size in sorted(paddings):
+            type_blobs[padding_type(size)] = encode_datatype_entry(padding_datatype_entry(size))
         self._types_by_name = {_type_key(name): blob for name, blob in type_blobs.items()}
         self._datatype_upload = b"".join(type_blobs.values())
         info = UploadInfo(

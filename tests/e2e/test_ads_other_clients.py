@@ -81,8 +81,11 @@ def test_ads_client_whole_structs_and_arrays(node: str, service: ServiceProcess)
     assert seen["request"] == {"start_position": 3, "length": 7}
     assert set(seen["suspend"]) == {"command_w", "enable_w", "request_r", "state_r"}
     assert seen["axisNumbers"] == [1, 2, 3, 11, 12, 13]  # gpAx[i].head.log_ax_n_r
-    assert seen["blocks"] == 32 and seen["blockKeys"][:2] == ["block_type", "block_number"]
+    assert seen["blocks"] == 32 and seen["blockKeys"][:3] == [
+        "block_type", "_pad_0x0002", "block_number"]  # the padding the type lists (issue 41)
     assert seen["readOnly"]["code"] == INVALIDACCESS
+    assert seen["spindleWrite"] == {"code": 0}  # Node-RED's {"override_w": 500} (issue 41)
+    assert seen["spindle"] == {"mode_r": 1, "override_w": 500}
 
 
 def test_ads_client_notifications_of_a_member_and_its_struct(

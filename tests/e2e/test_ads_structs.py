@@ -9,8 +9,10 @@ Frames are built and parsed by hand here (``test_ads_raw``, ``test_ads_symbols_r
 
 from __future__ import annotations
 
+import re
 import struct
 from dataclasses import dataclass
+from pathlib import Path
 
 from tests.support.ads_answers import ANY, INVALIDSIZE, OK, answer
 from tests.support.ads_raw import (
@@ -121,6 +123,8 @@ def test_every_struct_type_places_its_members_where_a_read_finds_them(ads: RawAd
             continue
         for member in item.members:
             assert member.offset + member.size <= item.size, (entry.name, member.name)
+            if member.name.startswith("_pad_"):  # padding: no symbol of its own
+                continue
             assert whole[member.offset : member.offset + member.size] == value(
                 ads, f"{entry.name}.{member.name}"), (entry.name, member.name)
 
@@ -147,8 +151,8 @@ def test_write_a_whole_struct_then_read_its_members(ads: RawAds) -> None:
     assert ads.call(WRITE, write(entry.group, entry.offset, struct.pack("<d", 1.0))).result == OK
     assert value(ads, REQUEST + ".start_position") == struct.pack("<d", 1.0)
     assert ads.call(WRITE, write(entry.group, entry.offset, data[:12])).result == INVALIDSIZE
-    state = symbol(ads, STATE)
-    assert ads.call(WRITE, write(state.group, state.offset, bytes(state.size))).result == (
+    state = symbol(ads, STATE)  # nothing writable: other bytes than its own are refused
+    assert ads.call(WRITE, write(state.group, state.offset, b"\xff" * state.size)).result == (
         INVALIDACCESS)
 
 
@@ -205,7 +209,8 @@ def test_sum_read_and_sum_write_of_structs(ads: RawAds) -> None:
     assert body[8 + request.size :] == value(ads, STATE)
     data = struct.pack("<dd", 2.0, 3.0)
     writes = (struct.pack("<III", request.group, request.offset, 16)
-              + struct.pack("<III", state.group, state.offset, state.size) + data + bytes(state.size))
+              + struct.pack("<III", state.group, state.offset, state.size) + data
+              + b"\xff" * state.size)
     result, codes = answer(ads, READ_WRITE, read_write(0xF081, 2, 8, writes))
     assert result == OK and struct.unpack("<II", codes) == (OK, INVALIDACCESS)
     assert value(ads, REQUEST) == data
@@ -225,3 +230,89 @@ def test_the_plc_memory_area_reads_as_a_plc_reads_it(ads: RawAds) -> None:
     assert answer(ads, READ, read(0x4020, first.offset + 1, 4))[0] == 0x703
     gpch = symbol(ads, "gpCh")
     assert answer(ads, READ, read(0x4020, gpch.offset, gpch.size)) == (OK, value(ads, "gpCh"))
+
+
+def _type_upload(ads: RawAds) -> dict[str, Item]:
+    """Every entry of the data type upload (0xF00E), by name."""
+    info = answer(ads, READ, read(0xF00F, 0, 64))[1]
+    count, size = struct.unpack_from("<II", info, 8)
+    result, data = answer(ads, READ, read(0xF00E, 0, size))
+    assert result == OK
+    types: dict[str, Item] = {}
+    at = 0
+    while at < len(data):
+        item = parse_type(data, at)
+        types[item.name] = item
+        at += item.length
+    assert len(types) == count
+    return types
+
+
+def test_the_type_upload_lays_every_struct_out_as_a_compiler_does(ads: RawAds) -> None:
+    """Issue 41, item 3: a reader that lays members out one after the other (pyads'
+    structure_def, a code generator) finds each where it is: in every struct type the
+    members come in ascending offsets, each starts where the one before ends (gaps are
+    padding members of their own) and their sizes add up to the struct's; every member's
+    type is in the upload with the member's size; an array is count x element."""
+    types = _type_upload(ads)
+    structs = [t for t in types.values() if t.members]
+    assert {"HLI_CHANNEL", "ST_gpCh_bahn_state", "ST_gpCh_spindle"} <= {t.name for t in structs}
+    for item in structs:
+        at = 0
+        for member in item.members:
+            assert member.offset == at, (item.name, member.name, member.offset, at)
+            assert types[member.type_name].size == member.size, (item.name, member.name)
+            at += member.size
+        assert at == item.size, item.name
+    for item in types.values():
+        if item.array:
+            ((_, count),) = item.array
+            assert types[item.type_name].size * count == item.size, item.name
+    info = answer(ads, READ, read(0xF00F, 0, 64))[1]
+    upload = parse_symbols(answer(ads, READ, read(0xF00B, 0, struct.unpack_from("<I", info, 4)[0]))[1])
+    for entry in upload:  # and each struct symbol is its type's size
+        if entry.data_type == BIGTYPE:
+            assert types[entry.type_name].size == entry.size, entry.name
+    bahn_state = types["ST_gpCh_bahn_state"]
+    assert [m.name for m in bahn_state.members][:2] == ["dist_prog_start", "coord_r"]
+    spindle = types["ST_gpCh_spindle"]  # speed_reached_r (BOOL at 0x10), position_r at 0x18
+    assert [(m.name, m.type_name, m.offset, m.size) for m in spindle.members][-2:] == [
+        ("_pad_0x0011", "ARRAY [0..6] OF BYTE", 0x11, 7), ("position_r", "LREAL", 0x18, 8)]
+
+
+def handle_of(ads: RawAds, name: str) -> tuple[int, bytes]:
+    """(result, answer) of a handle by name (0xF003)."""
+    return answer(ads, READ_WRITE, read_write(0xF003, 0, 4, name.encode() + b"\0"))
+
+
+def test_a_dereference_is_taken_only_after_a_root_element(ads: RawAds) -> None:
+    """Issue 41, item 4: ``^`` follows a pointer in TwinCAT, and ISG's HLI has its
+    pointers in the root arrays' elements (``gpCh[0]^``, ``gpAx[0]^``); a ``^`` anywhere
+    else is an unknown name, 0x710, in every by-name service."""
+    assert handle_of(ads, f"{REQUEST}")[0] == OK
+    for name in ("gpCh[0]^.contour_lookahead.request", "gpCh[0]^", "GPCH[1]^.spindle",
+                 "gpAx[0]^.lr_state.position_offset_r"):
+        assert handle_of(ads, name)[0] == OK, name
+    for name in ("gpCh^[0].contour_lookahead.request", "gpCh[0].contour_lookahead^.request",
+                 "gpCh[0]^^.spindle", "gpCh[0].spindle.override_w^", "^gpCh[0].spindle",
+                 "gpCh^", "gpCh[0]^.spindle^"):
+        assert handle_of(ads, name)[0] == 0x710, name
+        assert answer(ads, READ_WRITE, read_write(0xF009, 0, ANY, name.encode() + b"\0"))[0] == (
+            0x710), name
+        assert answer(ads, READ_WRITE, read_write(0xF004, 0, ANY, name.encode() + b"\0"))[0] == (
+            0x710), name
+
+
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "ads.md"
+DOCS_COUNTS = re.compile(r"\((\d+)\s+of\s+the\s+default\s+machine's\s+(\d+)\s+symbols")
+
+
+def test_the_docs_count_the_symbols_the_service_uploads(ads: RawAds) -> None:
+    """Issue 41, item 5: docs/ads.md's numbers of struct/array symbols and of all
+    symbols are those of the upload of the default machine (this module's service)."""
+    info = answer(ads, READ, read(0xF00F, 0, 64))[1]
+    upload = parse_symbols(answer(ads, READ, read(0xF00B, 0, struct.unpack_from("<I", info, 4)[0]))[1])
+    found = DOCS_COUNTS.findall(DOCS.read_text())
+    assert found, "docs/ads.md no longer says '(N of the default machine's M symbols'"
+    structs = sum(1 for entry in upload if entry.data_type == BIGTYPE)
+    assert {(int(a), int(b)) for a, b in found} == {(structs, len(upload))}

@@ -10,6 +10,7 @@ comes from the other front end (ZeroMQ browse). pyads then does what its users d
 
 from __future__ import annotations
 
+import re
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -166,7 +167,12 @@ def test_upload_info_64_bytes_field_by_field(ads: RawAds, catalog: list[ObjectIn
     assert type_bytes == len(read_ok(ads, SYM_DT_UPLOAD, type_bytes))
     struct_types = {s.type_name for s in parse_symbols(read_ok(ads, SYM_UPLOAD, symbol_bytes))
                     if s.data_type == BIGTYPE}
-    assert types == len({twincat(info)[0] for info in catalog}) + len(struct_types)
+    # and the padding members' types, ARRAY [0..n-1] OF BYTE, with BYTE (issue 41)
+    paddings = set(re.findall(rb"ARRAY \[0\.\.\d+\] OF BYTE\x00", read_ok(
+        ads, SYM_DT_UPLOAD, type_bytes)))
+    assert paddings
+    assert types == len({twincat(info)[0] for info in catalog}) + len(struct_types) + len(
+        paddings) + 1
     assert (max_dynamic, used_dynamic, invalid_dynamic) == (0, 0, 0)
     assert code_page == 1252
     assert flags & 0x2  # includes base types
@@ -251,6 +257,7 @@ def test_data_type_upload_field_by_field(ads: RawAds, catalog: list[ObjectInfo])
         at += entry.entry_length
     assert at == len(data) and len(types) == count
     expected = {twincat(i)[0]: (twincat(i)[1], i.length) for i in catalog}
+    expected["BYTE"] = (17, 1)  # the element of the padding members' arrays (issue 41)
     base = [t for t in types if t.data_type != BIGTYPE]
     assert {t.name: (t.data_type, t.size) for t in base} == expected
     for t in base:

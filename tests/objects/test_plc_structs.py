@@ -9,7 +9,7 @@ import pytest
 
 from cnc_objects.objects.address_space import AddressSpace
 from cnc_objects.objects.model import Access, CncObject
-from cnc_objects.objects.plc_structs import HANDLE_BASE, PlcStructs
+from cnc_objects.objects.plc_structs import HANDLE_BASE, PlcStructs, struct_members
 from cnc_objects.protocol.datatypes import BOOLEAN, REAL64, UNS16, DataType
 from cnc_objects.protocol.errors import AdsReturnCode
 
@@ -79,7 +79,9 @@ def test_a_write_touches_only_changed_writable_members(built) -> None:
     assert code == 0 and [(e.obj.name, v) for e, v in writes] == [("gpX[0].a.flag", True)]
     assert structs.decode_write(node, b"\x02\x00\x00\x00")[0] == AdsReturnCode.DEVICE_INVALIDDATA
     assert structs.decode_write(node, b"\x01")[0] == AdsReturnCode.DEVICE_INVALIDSIZE
-    assert structs.decode_write(structs.by_name("gpX[0].b"), bytes(32))[0] == (
+    # nothing writable in b: its own bytes come back (a round trip), a change is 0x704
+    assert structs.decode_write(structs.by_name("gpX[0].b"), bytes(32)) == (0, "", [])
+    assert structs.decode_write(structs.by_name("gpX[0].b"), b"\x01" + bytes(31))[0] == (
         AdsReturnCode.DEVICE_INVALIDACCESS)
 
 
@@ -101,3 +103,25 @@ def test_the_memory_area_reads_any_range_from_a_symbol_and_writes_whole_symbols(
     code, _, writes = structs.decode_memory_write(0x100, b"\x01\x00\x02\x01")  # gpX[0].a
     assert code == 0 and [e.obj.name for e, _ in writes] == ["gpX[0].a.flag"]
     assert structs.decode_memory_write(0x100, b"\x01\x00")[0] == AdsReturnCode.DEVICE_INVALIDSIZE
+
+
+def test_members_that_would_overlap_are_refused() -> None:
+    """Issue 41, item 3: a struct whose member reaches into the next is no PLC struct
+    (``gpCh[i].bahn_state`` did, from 0x110 to its axes at 0xE40)."""
+    space = AddressSpace()
+    for name, offset in (("s[0].a.x", 0x10), ("s[0].b", 0x18), ("s[0].a.y", 0x40)):
+        space.add(leaf(name, offset, UNS16, Access.READ), lambda: 0)
+    with pytest.raises(ValueError, match=r"s\[0\]\.a .* overlaps s\[0\]\.b"):
+        PlcStructs(space)
+
+
+def test_struct_members_name_every_gap_and_add_up(built) -> None:
+    structs, _ = built
+    element = structs.by_name("gpX[0]")  # a at 0x100 (4 bytes), b at 0x110 (32), stride 0x100
+    members = [(m.name, m.offset, m.size, m.type_name) for m in struct_members(element)]
+    assert members == [
+        ("a", 0, 4, "ST_gpX_a"), ("_pad_0x0004", 4, 12, "ARRAY [0..11] OF BYTE"),
+        ("b", 0x10, 32, "ARRAY [0..1] OF ST_gpX_b"),
+        ("_pad_0x0030", 0x30, 0xD0, "ARRAY [0..207] OF BYTE")]
+    assert [m.name for m in struct_members(structs.by_name("gpX[0].a"))] == [
+        "flag", "_pad_0x0001", "count"]

@@ -61,11 +61,19 @@ const CHECKS = {
     const suspend = (await c.readValue('gpCh[0]^.bahn_mc_control.suspend_axis_output')).value;
     const axes = (await c.readValue('gpAx')).value;
     const blocks = (await c.readValue('gpCh[1].contour_lookahead.response.block')).value;
+    // nothing in state is writable: other bytes than its own are refused (autoFill: the
+    // padding members the type lists come from the struct as read)
     const readOnly = await refusal(c.writeValue('gpCh[0].contour_lookahead.state',
-      { max_dist_prog_start: 0, count_logged_blocks: 0, f_log_is_active: false }));
+      { max_dist_prog_start: 0, count_logged_blocks: 7, f_log_is_active: false }, true));
+    // Node-RED's write node: one member of a struct whose first member is read-only,
+    // the rest filled from the struct as read (issue 41: 0x704 before)
+    const spindleWrite = await refusal(c.writeValue('gpCh[0].spindle', { override_w: 500 }, true));
+    const spindle = (await c.readValue('gpCh[0].spindle')).value;
+    await c.writeValue('gpCh[0].spindle.override_w', 1000);
     return {
       request, suspend, axisNumbers: axes.map((a) => a.head.log_ax_n_r), blocks: blocks.length,
-      blockKeys: Object.keys(blocks[0]), readOnly,
+      blockKeys: Object.keys(blocks[0]), readOnly, spindleWrite,
+      spindle: { mode_r: spindle.mode_r, override_w: spindle.override_w },
     };
   },
   async notifications(c) {
