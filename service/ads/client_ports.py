@@ -15,7 +15,7 @@ from __future__ import annotations
 import heapq
 from collections.abc import Iterable
 
-FIRST_CLIENT_PORT = 32768  # TwinCAT's router numbers the ports of its clients from here
+FIRST_CLIENT_PORT = 32768  # the range the ports of TwinCAT's clients are in (32905, ...)
 LAST_CLIENT_PORT = 65535
 PORTS_PER_CONNECTION = 64
 
