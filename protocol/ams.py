@@ -3,7 +3,7 @@
 Every ADS message on TCP is one AMS/TCP frame; all integers are little-endian::
 
     AMS/TCP header (6 bytes)
-       0  reserved      u16   0 for an AMS command
+       0  reserved      u16   0 for an AMS command (else a router command, below)
        2  length        u32   bytes that follow: the AMS header and the data
     AMS header (32 bytes)
        6  target net id 6 x u8   AMS Net ID of the receiver (a.b.c.d.e.f)
@@ -16,6 +16,10 @@ Every ADS message on TCP is one AMS/TCP frame; all integers are little-endian::
       30  error code    u32      AMS error (0x6 port not found, ...); 0 otherwise
       34  invoke id     u32      chosen by the requester, echoed in the response
     data (data length bytes): the command's payload (see ``ads_commands``)
+
+A first u16 other than 0 is a command to the local AMS router (``AmsTcpCommand``: port
+connect, port close, get local Net ID): no AMS header follows, only the command's data
+(``length`` bytes); such a frame is a ``RouterFrame`` (``protocol.ams_router``).
 
 ``AmsStreamParser`` cuts frames out of a byte stream however TCP segments it (a frame
 split over several segments, several frames in one segment). It never raises on bad
@@ -109,6 +113,15 @@ class AmsFrame:
     data: bytes
 
 
+@dataclass(frozen=True, slots=True)
+class RouterFrame:
+    """One AMS/TCP frame for the router itself: its command (the AMS/TCP header's first
+    u16, not 0; ``AmsTcpCommand``) and the data after the 6-byte header (no AMS header)."""
+
+    command: int
+    data: bytes
+
+
 def encode_frame(
     target_net_id: bytes, target_port: int, source_net_id: bytes, source_port: int,
     command_id: int, state_flags: int, invoke_id: int, data: bytes = b"", error_code: int = 0,
@@ -137,7 +150,6 @@ class FrameProblem(IntEnum):
 
     TRUNCATED_HEADER = 1  # the AMS/TCP length leaves no room for the 32-byte AMS header
     LENGTH_MISMATCH = 2  # the AMS header's data length disagrees with the AMS/TCP length
-    NOT_AMS_COMMAND = 3  # AMS/TCP reserved field not 0: a router-internal frame
     TOO_LONG = 4  # longer than the maximum: the stream ends here
 
 
@@ -157,9 +169,12 @@ class SkippedFrame:
             FrameProblem.LENGTH_MISMATCH:
                 f"AMS/TCP length {self.length} does not match the AMS data length "
                 f"{self.header.data_length if self.header else '?'} + 32",
-            FrameProblem.NOT_AMS_COMMAND: "AMS/TCP reserved field is not 0",
             FrameProblem.TOO_LONG: f"AMS/TCP length {self.length} exceeds the maximum",
         }[self.problem]
+
+
+#: What ``AmsStreamParser.feed`` yields for each frame of the stream.
+StreamItem = AmsFrame | RouterFrame | SkippedFrame
 
 
 class AmsStreamParser:
@@ -180,9 +195,9 @@ class AmsStreamParser:
         """Bytes received that do not make a whole frame yet."""
         return len(self._pending)
 
-    def feed(self, data: bytes) -> list[AmsFrame | SkippedFrame]:
+    def feed(self, data: bytes) -> list[StreamItem]:
         """Take ``data`` (any amount); return the frames it completes, in order."""
-        out: list[AmsFrame | SkippedFrame] = []
+        out: list[StreamItem] = []
         if self.closed:
             return out
         if self._pending:
@@ -212,10 +227,10 @@ class AmsStreamParser:
         return out
 
 
-def _frame(data: bytes, start: int, length: int, reserved: int) -> AmsFrame | SkippedFrame:
+def _frame(data: bytes, start: int, length: int, reserved: int) -> StreamItem:
     """The frame of ``length`` bytes at ``start`` (after its AMS/TCP header)."""
-    if reserved != 0:
-        return SkippedFrame(FrameProblem.NOT_AMS_COMMAND, length)
+    if reserved != 0:  # a command to the router: its data only, no AMS header
+        return RouterFrame(reserved, data[start:start + length])
     if length < AMS_HEADER_BYTES:
         return SkippedFrame(FrameProblem.TRUNCATED_HEADER, length)
     header = AmsHeader(*AMS_HEADER.unpack_from(data, start))

@@ -144,6 +144,18 @@ class AmsStateFlag(IntEnum):
 #: TCP port of AMS/TCP (ADS routers listen here; AdsLib always dials it).
 AMS_TCP_PORT = 48898
 
+
+class AmsTcpCommand(IntEnum):
+    """The first u16 of the AMS/TCP header ("reserved" in the ADS specification): 0 for an
+    AMS command; otherwise a command to the local AMS router, as TwinCAT's router and
+    ads-client (``AMS_HEADER_FLAG``) number them. Answered in ``protocol.ams_router``."""
+
+    AMS_COMMAND = 0x0000  # an AMS header and ADS data follow
+    PORT_CLOSE = 0x0001  # data: the client's AMS port (u16) to release
+    PORT_CONNECT = 0x1000  # data: the AMS port wanted (u16, 0: any); reply: Net ID, port
+    ROUTER_NOTE = 0x1001  # router to client: the router's state (u32); never a request
+    GET_LOCAL_NET_ID = 0x1002  # data: ignored (4 bytes); reply: the router's AMS Net ID
+
 #: Largest AMS/TCP frame a connection may send by default (bytes after the 6-byte
 #: AMS/TCP header); a longer one closes that connection.
 AMS_MAX_FRAME_BYTES = 1 << 20

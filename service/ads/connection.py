@@ -12,8 +12,11 @@ An asyncio ``Protocol`` on the service's event loop. Frames are cut from the str
   a port nobody serves AMS error 0x6 (target port not found), both in the AMS header with
   no data, as a router answers;
 - an AMS header whose data length disagrees with the AMS/TCP length gets AMS error 0xE;
-  a frame too short for an AMS header, or not an AMS command, is skipped (logged): there
-  is no invoke id to answer;
+  a frame too short for an AMS header is skipped (logged): there is no invoke id to
+  answer;
+- a frame for the router itself (AMS/TCP command not 0) is answered as a TwinCAT router
+  answers its local clients (``_router_frame``): port connect, port close, get local Net
+  ID; any other is skipped (logged);
 - a frame longer than the maximum closes this connection only;
 - when the connection closes, the jog keys it pressed are released (``jog_holds``);
 - every ADS request goes to the dispatcher; payloads that do not decode get the ADS
@@ -51,11 +54,19 @@ from cnc_objects.protocol.ams import (
     AmsHeader,
     AmsStreamParser,
     FrameProblem,
+    RouterFrame,
     SkippedFrame,
+    StreamItem,
     encode_reply_frame,
     format_net_id,
 )
-from cnc_objects.protocol.constants import AdsCommand, AmsStateFlag
+from cnc_objects.protocol.ams_router import (
+    decode_port,
+    describe,
+    encode_local_net_id_reply,
+    encode_port_connect_reply,
+)
+from cnc_objects.protocol.constants import AdsCommand, AmsStateFlag, AmsTcpCommand
 from cnc_objects.protocol.errors import AdsReturnCode, ProtocolError
 from cnc_objects.protocol.roles import Role
 
@@ -64,6 +75,7 @@ from ..dispatch import Dispatcher
 from ..log_throttle import ThrottledWarning
 from ..notifications import NotificationHub
 from ..rate_limit import BYTES_PER_TOKEN, RateLimiter, extra_tokens
+from .client_ports import ClientPorts, PortRefused
 from .routes import Admission, RouteTable
 
 log = logging.getLogger(__name__)
@@ -87,6 +99,7 @@ class Listener(Protocol):
     connections: set[AmsConnection]  # the open connections, for closing them all
     rate: RateLimiter | None  # requests per connection; None: no limit
     limits: ConnectionLimits  # open connections and bytes of incomplete frames
+    client_ports: ClientPorts  # the AMS ports handed out by port registration
 
 
 class AmsConnection(asyncio.Protocol):
@@ -106,7 +119,7 @@ class AmsConnection(asyncio.Protocol):
         self._skipped = ThrottledWarning(log, "ADS frame skipped")
         self.paused = False  # the peer does not read: notifications are dropped
         self._rate = server.rate
-        self._held: deque[AmsFrame | SkippedFrame] | None = None  # waiting for the rate
+        self._held: deque[StreamItem] | None = None  # waiting for the rate
         self._held_timer: asyncio.TimerHandle | None = None
         self._limits = server.limits
         self._seat: Seat | None = None  # counted by the limits (released when lost)
@@ -149,7 +162,7 @@ class AmsConnection(asyncio.Protocol):
             return
         self._answer(items)
 
-    def _account(self, items: list[AmsFrame | SkippedFrame]) -> bool:
+    def _account(self, items: list[StreamItem]) -> bool:
         """Tell the limits what the incomplete frame now holds and time it; False when
         that closed the connection (over the receive budget)."""
         buffered = self._parser.buffered
@@ -182,7 +195,7 @@ class AmsConnection(asyncio.Protocol):
         self._limits.timed_out.note(f"{self.peer} ({self._buffered} bytes)")
         self.close()
 
-    def _answer(self, items: list[AmsFrame | SkippedFrame]) -> None:
+    def _answer(self, items: list[StreamItem]) -> None:
         """Answer ``items`` in order while the rate allows; hold the rest."""
         rate = self._rate
         now_s = perf_counter() if rate is not None else 0.0
@@ -194,10 +207,12 @@ class AmsConnection(asyncio.Protocol):
                 return
             if type(item) is AmsFrame:
                 self._frame(item)
+            elif type(item) is RouterFrame:
+                self._router_frame(item)
             else:
                 self._bad_frame(item)  # type: ignore[arg-type]
 
-    def _hold(self, items: list[AmsFrame | SkippedFrame], wait_s: float) -> None:
+    def _hold(self, items: list[StreamItem], wait_s: float) -> None:
         """Over the rate: keep ``items`` and stop reading until a token is due."""
         self._held = deque(items)
         if self._transport is not None:
@@ -229,6 +244,7 @@ class AmsConnection(asyncio.Protocol):
         if self._rate is not None:
             self._rate.forget(self)
         self._server.connections.discard(self)
+        self._server.client_ports.release_all(self)  # its registered AMS ports
         # its jog keys are released at once (the dead-man, ``jog_holds``)
         self._server.dispatcher.backend.connection_ended(self, f"from {self.peer} closed")
         hub = self._server.hub
@@ -318,6 +334,63 @@ class AmsConnection(asyncio.Protocol):
         log.debug("ADS %s: AMS error 0x%x for %s:%d", self.peer, code,
                   format_net_id(header.target_net_id), header.target_port)
         self.write(encode_reply_frame(header, b"", code))
+
+    def _router_frame(self, frame: RouterFrame) -> None:
+        """A command to the router (``protocol.ams_router``), answered as TwinCAT's router
+        answers the clients on its own machine: only peers of the loopback rule (TwinCAT's
+        router takes these on 127.0.0.1 only); a routed peer is closed."""
+        command = frame.command
+        if self._admission.roles is not None:
+            log.warning("ADS connection from %s closed: AMS/TCP command %s is answered to "
+                        "clients on this machine only; a remote client sends from its "
+                        "route's AMS Net ID", self.peer, describe(command))
+            self.close()
+            return
+        match command:
+            case AmsTcpCommand.PORT_CONNECT:
+                self._port_connect(frame.data)
+            case AmsTcpCommand.PORT_CLOSE:
+                self._port_close(frame.data)
+            case AmsTcpCommand.GET_LOCAL_NET_ID:
+                self.write(encode_local_net_id_reply(self._net_id))
+            case _:  # router notes go to clients, never come from them
+                self._skipped.note(f"AMS/TCP command {describe(command)} ({len(frame.data)} "
+                                   "bytes) is not answered: a router answers 0x1000 port "
+                                   "connect, 0x0001 port close and 0x1002 get local Net ID")
+
+    def _port_connect(self, data: bytes) -> None:
+        """Register an AMS port for this client; its AMS Net ID is the service's, as a
+        TwinCAT router gives its local clients its own. Refused: closed (logged), as
+        TwinCAT's router ends the connection of a client whose port is taken."""
+        wanted = decode_port(data)
+        if wanted is None:
+            self._skipped.note(f"AMS/TCP port connect with {len(data)} bytes of data, not "
+                               "2 (the port wanted, 0: any)")
+            return
+        try:
+            port = self._server.client_ports.register(self, wanted)
+        except PortRefused as exc:
+            log.warning("ADS connection from %s closed: port registration refused: %s",
+                        self.peer, exc)
+            self.close()
+            return
+        log.debug("ADS %s: registered AMS port %s:%d", self.peer,
+                  format_net_id(self._net_id), port)
+        self.write(encode_port_connect_reply(self._net_id, port))
+
+    def _port_close(self, data: bytes) -> None:
+        """Release a registered port; the connection closes with its last port, as
+        TwinCAT's router ends it (ads-client waits for that)."""
+        port = decode_port(data) if data else None
+        ports = self._server.client_ports
+        if port is None or not ports.release(self, port):
+            what = f"port {port}" if port is not None else f"{len(data)} bytes (not 2: a port)"
+            self._skipped.note(f"AMS/TCP port close of {what}: not a port this connection "
+                               "registered; nothing released")
+            return
+        log.debug("ADS %s: released AMS port %d", self.peer, port)
+        if not ports.held(self):
+            self.close()
 
     def _bad_frame(self, error: SkippedFrame) -> None:
         if error.problem is FrameProblem.TOO_LONG:

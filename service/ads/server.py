@@ -44,6 +44,7 @@ from ..connection_limits import ConnectionLimits
 from ..dispatch import Dispatcher
 from ..limits import LimitsConfig
 from ..rate_limit import RateLimiter
+from .client_ports import ClientPorts
 from .connection import AmsConnection
 from .routes import RouteTable
 
@@ -103,6 +104,8 @@ class AdsTcpServer:
         # open connections and bytes of incomplete frames ([limits])
         self.limits = ConnectionLimits("ADS", limits or LimitsConfig())
         self.ports = SERVED_PORTS
+        # AMS ports handed to clients that register one (a client without a Net ID)
+        self.client_ports = ClientPorts(reserved=SERVED_PORTS)
         self.dispatcher = Dispatcher(backend, self)
         self.connections: set[AmsConnection] = set()
         self.address: tuple[str, int] = ("", 0)

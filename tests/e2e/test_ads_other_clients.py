@@ -120,6 +120,17 @@ def test_ads_client_writes_to_read_only_are_0x704(node: str, service: ServicePro
     assert seen["leaf"]["code"] == INVALIDACCESS and seen["stillThere"] == 1000
 
 
+def test_ads_client_without_a_local_address_registers_a_port(
+    node: str, service: ServiceProcess,
+) -> None:
+    """ads-client 2 with no local AMS Net ID asks the router for a port (issue 41)."""
+    seen = ads_client(node, service, "registered")
+    assert seen["localAmsNetId"] == service.ams_net_id  # the router's own, as TwinCAT's
+    assert 32768 <= seen["localAdsPort"] <= 65535
+    assert seen["override"] == 1000
+    assert seen["disconnectMs"] < 5000  # the port close ends the connection, no timeout
+
+
 # --------------------------------------------------------------------------- py-ads-client
 
 

@@ -114,7 +114,7 @@ def test_a_data_length_that_does_not_match_gets_ams_error_0xe(ads: RawAds) -> No
 
 def test_a_truncated_header_is_skipped_and_the_connection_goes_on(ads: RawAds) -> None:
     ads.sock.sendall(struct.pack("<HI", 0, 20) + bytes(20))  # no room for an AMS header
-    ads.sock.sendall(struct.pack("<HI", 0x1000, 2) + b"\x01\x02")  # not an AMS command
+    ads.sock.sendall(struct.pack("<HI", 0x2345, 2) + b"\x01\x02")  # an unknown router command
     assert ads.call(READ_STATE).result == 0  # the next reply is this one's
 
 

@@ -20,11 +20,19 @@ from cnc_objects.protocol.ams import (
     AmsHeader,
     AmsStreamParser,
     FrameProblem,
+    RouterFrame,
     SkippedFrame,
+    StreamItem,
     encode_frame,
     encode_reply_frame,
     format_net_id,
     parse_net_id,
+)
+from cnc_objects.protocol.ams_router import (
+    decode_port,
+    describe,
+    encode_local_net_id_reply,
+    encode_port_connect_reply,
 )
 from cnc_objects.protocol.errors import ProtocolError
 from cnc_objects.protocol.frames import (
@@ -112,7 +120,7 @@ def test_reply_frame_swaps_addresses_and_keeps_the_invoke_id() -> None:
 # --------------------------------------------------------------------------- stream
 
 
-def frames_of(items: list[AmsFrame | SkippedFrame]) -> list[tuple[int, bytes]]:
+def frames_of(items: list[StreamItem]) -> list[tuple[int, bytes]]:
     """(invoke id, data) of the frames; fails on a SkippedFrame."""
     assert all(isinstance(i, AmsFrame) for i in items), items
     return [(i.header.invoke_id, i.data) for i in items]  # type: ignore[union-attr]
@@ -200,12 +208,24 @@ def test_a_data_length_that_does_not_match_is_reported_with_the_header() -> None
     assert frames_of(items[1:]) == [(10, b"")]
 
 
-def test_a_frame_that_is_not_an_ams_command_is_skipped() -> None:
+def test_a_frame_for_the_router_is_its_command_and_data() -> None:
     router_frame = struct.pack("<HI", 0x1000, 2) + b"\x01\x02"  # AMS/TCP port connect
     items = AmsStreamParser().feed(router_frame + request_frame(4, b"", invoke_id=3))
-    assert isinstance(items[0], SkippedFrame)
-    assert items[0].problem is FrameProblem.NOT_AMS_COMMAND
+    assert items[0] == RouterFrame(0x1000, b"\x01\x02")  # no AMS header
     assert frames_of(items[1:]) == [(3, b"")]
+    short = struct.pack("<HI", 0x1002, 0)  # no data at all
+    assert AmsStreamParser().feed(short) == [RouterFrame(0x1002, b"")]
+
+
+def test_router_replies_as_ads_client_and_ads_rs_read_them() -> None:
+    net_id = parse_net_id("127.0.0.1.1.1")
+    reply = encode_port_connect_reply(net_id, 32768)
+    # ads-rs checks the first 6 bytes literally: [0, 16, 8, 0, 0, 0]
+    assert reply == bytes([0, 16, 8, 0, 0, 0, 127, 0, 0, 1, 1, 1, 0, 0x80])
+    assert encode_local_net_id_reply(net_id) == struct.pack("<HI", 0x1002, 6) + net_id
+    assert [decode_port(d) for d in (b"\x00\x80", b"", b"\x01", b"\x00\x00\x00")] == [
+        32768, 0, None, None]
+    assert describe(0x1000) == "0x1000 (port connect)" and describe(0x2345) == "0x2345"
 
 
 # --------------------------------------------------------------------------- requests

@@ -151,16 +151,30 @@ const CHECKS = {
   },
 };
 
+// `registered`: no local AMS address given, so ads-client asks the router for one (AMS/TCP
+// port connect) as on a PC with TwinCAT; what it got, a read, and the port close on
+// disconnect (the router ends the connection then).
+const REGISTERED = {
+  async registered(c) {
+    const { localAmsNetId, localAdsPort } = c.connection;
+    const override = (await c.readValue('ch1.mc_command_feed_override_r')).value;
+    const started = Date.now();
+    await c.disconnect();
+    return { localAmsNetId, localAdsPort, override, disconnectMs: Date.now() - started };
+  },
+};
+
 async function main() {
+  const own = check in REGISTERED ? {}
+    : { localAmsNetId: '127.0.0.1.1.31', localAdsPort: 30000 + (process.pid % 30000) };
   const c = new Client({
     targetAmsNetId: netId, targetAdsPort: 851, routerAddress: host, routerTcpPort: Number(port),
-    localAmsNetId: '127.0.0.1.1.31', localAdsPort: 30000 + (process.pid % 30000),
-    timeoutDelay: 10000, autoReconnect: false, hideConsoleWarnings: true,
+    ...own, timeoutDelay: 10000, autoReconnect: false, hideConsoleWarnings: true,
   });
   let out;
   try {
     await c.connect();
-    out = { ok: true, result: await CHECKS[check](c) };
+    out = { ok: true, result: await (CHECKS[check] || REGISTERED[check])(c) };
   } catch (err) {
     out = { ok: false, code: adsCode(err), error: String(err && err.stack || err) };
   }
