@@ -185,9 +185,6 @@ async def serve(
     ``outputs`` (default: ``<store>-output`` beside the store); the tool list and zero
     offsets are kept in ``operator_data`` (default: beside the store)."""
     loop = asyncio.get_running_loop()
-    opcua_process = None
-    if opcua is not None:  # first: it imports asyncua while the kernel is built here
-        opcua_process = await _spawn_opcua(opcua, config.limits)
     # The cycle thread must get the GIL soon after it wakes, even while the server is busy.
     switch_s = min(0.005, config.cycle_ms / 1000.0 / 4)
     if clock_kind is ClockKind.REALTIME and config.rt_priority:
@@ -203,6 +200,10 @@ async def serve(
             # p99 510 us against 0.29 % and 440 us at a tenth (issue 37, docs/kernel.md).
             switch_s = config.cycle_ms / 1000.0 / SWITCH_CYCLE_FRACTION_FIFO
     sys.setswitchinterval(switch_s)
+    opcua_process = None
+    if opcua is not None:  # now: it imports asyncua while the kernel is built here; under
+        # the policy the service's threads have (the in-process front end had it too)
+        opcua_process = await _spawn_opcua(opcua, config.limits)
     log.info("GIL switch interval %g ms", switch_s * 1000.0)
     load, exists = _kernel_loader(store)
     limits = config.limits
