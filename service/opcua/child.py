@@ -95,7 +95,8 @@ async def serve(calls_fd: int, events_fd: int) -> int:
     stop = asyncio.Event()
     loop.add_signal_handler(signal.SIGTERM, stop.set)
     events.send((Link.READY, {"url": server.url, "security_note": server.security_note,
-                              "start_s": server.start_s, "cache_note": server.cache_note}))
+                              "start_s": server.start_s, "cache_note": server.cache_note,
+                              "port": server.address[1]}))
     ended = asyncio.ensure_future(events.closed.wait())
     stopped = asyncio.ensure_future(stop.wait())
     try:

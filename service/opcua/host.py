@@ -62,6 +62,7 @@ class Ready:
     security_note: str
     start_s: float
     cache_note: str
+    port: int  # where it listens (the one asked for, or the one given for 0)
     pid: int  # the process's
 
 
@@ -277,6 +278,7 @@ class OpcUaProcess:
         if self._process is None:
             await self.spawn()
         ready = await self._start_child(backend)
+        self._facts["port"] = ready.port  # a child started again listens where this one did
         self._supervisor = backend.loop.create_task(self._supervise(), name="opcua-supervisor")
         return ready
 
@@ -331,7 +333,8 @@ class OpcUaProcess:
             except (OpcUaRefused, OSError) as exc:
                 log.error("OPC UA is off: %s", exc)
                 return
-            log.info("OPC UA on %s again (built in %.2f s)", ready.url, ready.start_s)
+            log.info("OPC UA on %s again (built in %.2f s; process %d)", ready.url,
+                     ready.start_s, ready.pid)
 
     async def _stop_process(self) -> None:
         process = self._process
