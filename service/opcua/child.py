@@ -25,7 +25,7 @@ from .linked_backend import CallLink, LinkedBackend
 from .security import OpcUaSecurityError
 from .server import OpcUaServer
 
-log = logging.getLogger(__name__)
+log = logging.getLogger("cnc_objects.service.opcua.child")  # not __main__ (run with -m)
 
 
 class _Events(asyncio.Protocol):
@@ -104,7 +104,12 @@ async def serve(calls_fd: int, events_fd: int) -> int:
     finally:
         ended.cancel()
         stopped.cancel()
-        await server.close()
+    if not stop.is_set():  # the service is gone (killed): nothing left to serve from, and
+        # every getter would fail until asyncua had closed its sessions one by one
+        log.error("the service closed the OPC UA link: the OPC UA process ends")
+        logging.shutdown()
+        os._exit(1)
+    await server.close()
     return 0
 
 

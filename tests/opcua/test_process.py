@@ -6,12 +6,14 @@ from __future__ import annotations
 
 import os
 import re
+import select
 import signal
 from pathlib import Path
 
 from asyncua import Client
 
 from cnc_objects.testing import ServiceProcess, serving
+from cnc_objects.testing.process import start_service
 from tests.opcua.conftest import OPCUA_ANY_PORT, OPCUA_START_S, cnc_node
 
 _PROCESS = re.compile(r"OPC UA on (opc\.tcp://\S+).*process (\d+)\)")
@@ -89,3 +91,17 @@ async def test_a_child_that_dies_is_started_again_where_it_listened() -> None:
         assert "the OPC UA process ended (exit code -9): starting it again" in service.log_text
         assert await _channel_ids(again) == [1, 2]
         assert service.process.poll() is None
+
+
+def test_a_child_whose_service_is_killed_ends() -> None:
+    service = start_service(*OPCUA_ANY_PORT, timeout_s=OPCUA_START_S)
+    try:
+        _, pid = _served_by(service.wait_for_log("OPC UA on"))
+        ended = os.pidfd_open(pid)  # readable once the process has ended
+        try:
+            service.process.kill()  # no chance to stop its child
+            assert select.select([ended], [], [], 30.0)[0] == [ended], "the child goes on"
+        finally:
+            os.close(ended)
+    finally:
+        assert service.stop() == -signal.SIGKILL
