@@ -304,9 +304,13 @@ class OpcUaProcess:
             code = await self._process.wait()
             raise OpcUaRefused(f"the OPC UA process ended (exit code {code}) before it "
                                "served") from exc
-        except (OpcUaRefused, TimeoutError):
+        except OpcUaRefused:
             await self._stop_process()
             raise
+        except TimeoutError:
+            await self._stop_process()
+            raise OpcUaRefused(f"the OPC UA process did not serve within {START_TIMEOUT_S:g} s"
+                               ) from None
 
     async def _supervise(self) -> None:
         """Start a child again when it ends while serving (module docstring)."""
