@@ -197,7 +197,9 @@ class _Link:
         backend.apply_writes(decoded, applied, holder=holder)
 
     def lost(self) -> None:
-        """The child is gone: its subscriptions end."""
+        """The child is gone: its subscriptions end, its calls socket is closed."""
+        if self.calls is not None:
+            self.calls.close()
         subscriptions, self.subscriptions = self.subscriptions, {}
         for handle, envelope in subscriptions.items():
             self.backend.hub.delete(envelope, handle)
