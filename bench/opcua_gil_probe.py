@@ -8,7 +8,9 @@ The subscription bench's service (realtime clock, 1 ms cycle, a program running)
 for ``SECONDS`` (a sample only where a thread holds the GIL) into ``OUT`` (py-spy's raw
 format: one stack and its count a line), and the kernel's cycle figures over the same
 time are printed. The summary gives the samples by thread and the frames most often in
-them.
+them. Since OPC UA is served by a process of its own (docs/opcua.md), the service's GIL
+holds only the hub's sampling and the link's frames; asyncua's work is in the child
+(``py-spy record --pid`` of the pid the "OPC UA on" line names, to see it).
 """
 
 from __future__ import annotations

@@ -39,7 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
-from typing import TYPE_CHECKING, NoReturn
+from typing import NoReturn
 
 import typer
 import zmq
@@ -66,6 +66,7 @@ from .limits import LimitsConfig, notification_limits, rate_limiter
 from .machine_config import EmbeddedMachine
 from .notifications import NotificationCounts
 from .opcua.config import parse_opcua_endpoint
+from .opcua.host import OpcUaProcess, OpcUaRefused, Ready
 from .opcua.security_config import OpcUaSecurity
 from .output_service import OutputService
 from .program_service import ProgramStoreService
@@ -88,9 +89,6 @@ from .storage.operator_data_store import OperatorDataStore
 from .storage.output_area import OutputArea
 from .storage.output_writer import OutputLimits, OutputWriter
 from .storage.program_store import ProgramStore, StoreError
-
-if TYPE_CHECKING:
-    from .opcua.server import OpcUaServer
 
 log = logging.getLogger("cnc-service")
 
@@ -202,6 +200,10 @@ async def serve(
             # p99 510 us against 0.29 % and 440 us at a tenth (issue 37, docs/kernel.md).
             switch_s = config.cycle_ms / 1000.0 / SWITCH_CYCLE_FRACTION_FIFO
     sys.setswitchinterval(switch_s)
+    opcua_process = None
+    if opcua is not None:  # now: it imports asyncua while the kernel is built here; under
+        # the policy the service's threads have (the in-process front end had it too)
+        opcua_process = await _spawn_opcua(opcua, config.limits)
     log.info("GIL switch interval %g ms", switch_s * 1000.0)
     load, exists = _kernel_loader(store)
     limits = config.limits
@@ -240,18 +242,22 @@ async def serve(
     except zmq.ZMQError as exc:
         print(f"cnc-service: cannot listen on {endpoint}: {zmq.strerror(exc.errno or 0)}",
               file=sys.stderr)
+        if opcua_process is not None:
+            await opcua_process.close()
         return EXIT_USAGE
     ads_server = None
     if ads is not None:
         ads_server = await _start_ads(backend, config, ads)
         if ads_server is None:
+            if opcua_process is not None:
+                await opcua_process.close()
             server.close()
             writer.close()
             return EXIT_USAGE
-    opcua_server = None
-    if opcua is not None:
-        opcua_server = await _start_opcua(backend, opcua, config.limits)
-        if opcua_server is None:
+    opcua_ready = None
+    if opcua_process is not None:
+        opcua_ready = await _start_opcua(opcua_process, backend)
+        if opcua_ready is None:
             if ads_server is not None:
                 ads_server.close()
             server.close()
@@ -275,11 +281,11 @@ async def serve(
                  ", ".join(str(p) for p in sorted(ads_server.ports)), len(ads_server.routes),
                  "every peer's" if ads.open_to_all else "loopback",  # type: ignore[union-attr]
                  ads.loopback_role.label)  # type: ignore[union-attr]
-    if opcua_server is not None:
+    if opcua_ready is not None:
         log.info("OPC UA on %s (OPC 40502 CncInterface, OPC 40501-1 MachineTool, %d channels; "
-                 "%s; built in %.2f s, %s)",
-                 opcua_server.url, len(config.channels), opcua_server.security_note,
-                 opcua_server.start_s, opcua_server.cache_note)
+                 "%s; built in %.2f s, %s; process %d)",
+                 opcua_ready.url, len(config.channels), opcua_ready.security_note,
+                 opcua_ready.start_s, opcua_ready.cache_note, opcua_ready.pid)
     if curve is not None:
         log.info("CURVE on: server public key %s; allow-list %s (%s)",
                  curve.public_key.decode(), curve.allow_list.origin, curve.allow_list.census())
@@ -293,8 +299,8 @@ async def serve(
         await stop.wait()
     finally:
         log.info("stopping")
-        if opcua_server is not None:
-            await opcua_server.close()
+        if opcua_process is not None:
+            await opcua_process.close()
         if ads_server is not None:
             ads_server.close()
         server.close()
@@ -341,28 +347,22 @@ async def _start_ads(
     return ads_server
 
 
-async def _start_opcua(backend: Backend, opcua: OpcUaListen, limits: LimitsConfig
-                       ) -> OpcUaServer | None:
-    """The listening OPC UA front end, or None after saying in one line why it cannot be."""
-    from .opcua.limits import OpcUaLimits
-    from .opcua.security import OpcUaSecurityError
-    from .opcua.server import OpcUaServer  # asyncua only where OPC UA is served
+async def _spawn_opcua(opcua: OpcUaListen, limits: LimitsConfig) -> OpcUaProcess:
+    """The OPC UA process, spawned: it imports asyncua while the service builds its kernel
+    (docs/opcua.md "One process of its own")."""
+    process = OpcUaProcess(opcua.host, opcua.port, opcua.security, limits)
+    await process.spawn()
+    return process
 
-    opcua_server = OpcUaServer(backend, opcua.security, OpcUaLimits.from_config(limits))
+
+async def _start_opcua(process: OpcUaProcess, backend: Backend) -> Ready | None:
+    """The OPC UA process serving, or None after saying in one line why it cannot."""
     try:
-        await opcua_server.start(opcua.host, opcua.port)
-    except OpcUaSecurityError as exc:
-        print(f"cnc-service: cannot serve OPC UA on {opcua.host}:{opcua.port}: {exc}",
-              file=sys.stderr)
-        await opcua_server.close()
+        return await process.start(backend)
+    except OpcUaRefused as exc:
+        print(f"cnc-service: {exc}", file=sys.stderr)
+        await process.close()
         return None
-    except OSError as exc:
-        reason = os.strerror(exc.errno) if exc.errno and exc.errno > 0 else exc.strerror or str(exc)
-        print(f"cnc-service: cannot listen for OPC UA on {opcua.host}:{opcua.port}: {reason}",
-              file=sys.stderr)
-        await opcua_server.close()
-        return None
-    return opcua_server
 
 
 @app.command(

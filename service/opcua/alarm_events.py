@@ -37,8 +37,8 @@ from cnc_objects.objects.catalog_alarms import ACTIVE_SLOTS, active_element, his
 from cnc_objects.protocol.alarm_values import AlarmState
 from cnc_objects.protocol.roles import role_to_write
 
-from ..backend import Backend
 from . import alarm_events_caller as caller
+from .linked_backend import LinkedBackend
 from .nodesets import CNC_URI, MACHINE_TOOL_URI
 from .roles import role_of
 
@@ -82,8 +82,9 @@ class AlarmRow:
 class AlarmSlots:
     """Reads the alarm objects (active slots and history) through their getters."""
 
-    def __init__(self, backend: Backend) -> None:
+    def __init__(self, backend: LinkedBackend) -> None:
         space = backend.space
+        self._backend = backend
         self._changes = _getter(backend, "alarm_changes_r")
         self._history_count = _getter(backend, "alarm_history_count_r")
         self._active = [{f: _getter(backend, active_element(k, f)) for f in _FIELDS}
@@ -94,6 +95,12 @@ class AlarmSlots:
             self._history.append({f: _getter(backend, history_element(k, f))
                                   for f in _FIELDS})
             k += 1
+        names = ["alarm_history_count_r", *(active_element(k, f) for k in
+                 range(1, ACTIVE_SLOTS + 1) for f in _FIELDS),
+                 *(history_element(k, f) for k in range(1, len(self._history) + 1)
+                   for f in _FIELDS)]
+        #: the objects a reading of the slots reads, fetched in one round trip
+        self._slot_entries = [e for e in map(space.by_name, names) if e is not None]
 
     def changes(self) -> int:
         """``alarm_changes_r``: counts every raise, acknowledge and clear."""
@@ -105,23 +112,28 @@ class AlarmSlots:
         rows: dict[int, AlarmRow] = {}
         for _ in range(_READ_TRIES):
             before = self._changes()
-            rows = {}
-            for slot in [*self._history[:self._history_count()], *self._active]:
-                v = {f: get() for f, get in slot.items()}
-                if v["sequence"] and v["state"] in _STATES:
-                    rows[v["sequence"]] = AlarmRow(
-                        v["sequence"], v["id"], v["severity"], v["channel"],
-                        AlarmState(v["state"]), v["time"], v["text"], v["file"], v["line"],
-                        v["column"])
+            with self._backend.prefetched(self._slot_entries):  # one round trip
+                rows = self._rows()
             if self._changes() == before:
                 break
+        return rows
+
+    def _rows(self) -> dict[int, AlarmRow]:
+        rows: dict[int, AlarmRow] = {}
+        for slot in [*self._history[:self._history_count()], *self._active]:
+            v = {f: get() for f, get in slot.items()}
+            if v["sequence"] and v["state"] in _STATES:
+                rows[v["sequence"]] = AlarmRow(
+                    v["sequence"], v["id"], v["severity"], v["channel"],
+                    AlarmState(v["state"]), v["time"], v["text"], v["file"], v["line"],
+                    v["column"])
         return rows
 
 
 _STATES = frozenset(int(s) for s in AlarmState)
 
 
-def _getter(backend: Backend, name: str) -> Any:
+def _getter(backend: LinkedBackend, name: str) -> Any:
     entry = backend.space.by_name(name)
     if entry is None or entry.read is None:
         raise KeyError(f"no readable object {name}")
@@ -131,7 +143,7 @@ def _getter(backend: Backend, name: str) -> Any:
 class AlarmEvents:
     """The alarm events of one server (``build_alarm_events``)."""
 
-    def __init__(self, server: Server, backend: Backend, machine: tuple[Node, str],
+    def __init__(self, server: Server, backend: LinkedBackend, machine: tuple[Node, str],
                  messages: Node, sources: dict[int, tuple[Node, str]]) -> None:
         self.server, self.backend = server, backend
         self.machine, self.messages, self.sources = machine, messages, sources
@@ -399,7 +411,7 @@ async def _cnc_interface(server: Server, cnc: int) -> Node | None:
     return None
 
 
-async def build_alarm_events(server: Server, backend: Backend, machine: Node
+async def build_alarm_events(server: Server, backend: LinkedBackend, machine: Node
                              ) -> AlarmEvents:
     """The alarm events of ``server`` for the MachineTool ``machine`` (its
     Notification/Messages and Monitoring/Channel<c> nodes), started."""

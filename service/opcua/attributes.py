@@ -1,4 +1,5 @@
-"""The Write service of the OPC UA front end: a client's write of a bound variable goes
+"""The Read and Write services of the OPC UA front end. A Read fetches the objects of the
+bound variables it reads in one round trip to the service. A client's write of a bound variable goes
 to the CNC objects (``binding.VariableBinder.write``); every other node is read-only to
 clients (BadNotWritable), whatever its AccessLevel in the nodesets says. The server's
 own writes (its internal session) take asyncua's path."""
@@ -12,6 +13,7 @@ from asyncua.server.address_space import AddressSpace, AttributeService
 from .binding import VariableBinder
 from .roles import role_of
 
+_VALUE = ua.AttributeIds.Value
 _SERVER_USER = User(role=UserRole.Admin)  # asyncua's default: the server's own writes
 
 
@@ -21,6 +23,16 @@ class BoundAttributes(AttributeService):  # type: ignore[misc]  # asyncua is Any
     def __init__(self, aspace: AddressSpace, binder: VariableBinder) -> None:
         super().__init__(aspace)
         self.binder = binder
+
+    def read(self, params: ua.ReadParameters) -> list[ua.DataValue]:
+        """asyncua's Read, the objects of every bound Value it reads fetched from the
+        service first, all in one round trip (``LinkedBackend.prefetched``)."""
+        variables = self.binder.variables
+        entries = [entry for item in params.NodesToRead
+                   if item.AttributeId == _VALUE and item.NodeId in variables
+                   for entry in variables[item.NodeId].entries]
+        with self.binder.backend.prefetched(entries):
+            return super().read(params)  # type: ignore[no-any-return]
 
     async def write(self, params: ua.WriteParameters, user: User = _SERVER_USER
                     ) -> list[ua.StatusCode]:

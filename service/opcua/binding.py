@@ -29,8 +29,8 @@ from cnc_objects.objects import Entry
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.roles import role_to_write
 
-from ..backend import Backend
 from .feeds import BoundVariable, Feeds
+from .linked_backend import LinkedBackend
 from .roles import role_of
 from .sources import Source
 from .values import eu_information
@@ -56,7 +56,7 @@ _VALUE = ua.AttributeIds.Value
 class VariableBinder:
     """Binds OPC UA variables of ``server`` to the objects of ``backend``."""
 
-    def __init__(self, server: Server, backend: Backend) -> None:
+    def __init__(self, server: Server, backend: LinkedBackend) -> None:
         self.server = server
         self.backend = backend
         self.variables: dict[ua.NodeId, BoundVariable] = {}

@@ -25,8 +25,8 @@ from asyncua import Node, Server, ua
 from cnc_objects.protocol.errors import AdsReturnCode
 from cnc_objects.protocol.roles import role_to_write
 
-from ..backend import Backend
 from . import alarm_events_caller as caller
+from .linked_backend import LinkedBackend
 from .roles import role_of
 
 log = logging.getLogger(__name__)
@@ -67,7 +67,7 @@ Callback = Callable[..., Awaitable[ua.StatusCode]]
 class ChannelMethods:
     """The methods' callbacks over one ``Backend``."""
 
-    def __init__(self, backend: Backend) -> None:
+    def __init__(self, backend: LinkedBackend) -> None:
         self.backend = backend
 
     async def write(self, channel: int, name: str, value: Any) -> ua.StatusCode:
@@ -136,7 +136,7 @@ async def _method(parent: Node, ns: int, path: str, name: str, callback: Callbac
     return method
 
 
-async def build_channel_methods(server: Server, backend: Backend, machine: Node) -> Node:
+async def build_channel_methods(server: Server, backend: LinkedBackend, machine: Node) -> Node:
     """``CncObjects`` (namespace ``OBJECTS_URI``) under ``machine`` with the methods of
     every channel; returns its node."""
     ns = await server.register_namespace(OBJECTS_URI)

@@ -11,9 +11,9 @@ from typing import Any
 
 from asyncua import Node, Server, ua
 
-from ..backend import Backend
 from . import cnc_members as members
 from .binding import VariableBinder
+from .linked_backend import LinkedBackend
 from .nodesets import CNC_URI
 from .sources import Source
 
@@ -23,7 +23,7 @@ CHANNEL_TYPE, AXIS_TYPE, SPINDLE_TYPE = 1002, 1004, 1005
 INTERFACE_NAME = "CncInterface"
 
 
-async def build_cnc_interface(server: Server, binder: VariableBinder, backend: Backend,
+async def build_cnc_interface(server: Server, binder: VariableBinder, backend: LinkedBackend,
                               vendor: str, version: str) -> Node:
     """Add the CncInterface with every channel, axis and spindle; returns its node.
     ``version``: the kernel's (VendorRevision)."""

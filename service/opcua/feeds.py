@@ -24,7 +24,7 @@ from asyncua import ua
 from cnc_objects.objects import Entry
 from cnc_objects.protocol.constants import TransmissionMode
 
-from ..backend import Backend
+from .linked_backend import LinkedBackend
 from .sources import Source
 from .values import bad, good, source_time
 
@@ -118,7 +118,7 @@ class BoundVariable:
 class Feeds:
     """The feeds of every bound variable of one server, over ``backend``'s hub."""
 
-    def __init__(self, backend: Backend) -> None:
+    def __init__(self, backend: LinkedBackend) -> None:
         self.backend = backend
         self._tasks: set[asyncio.Task[None]] = set()
 

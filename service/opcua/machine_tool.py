@@ -17,9 +17,9 @@ from asyncua import Node, Server, ua
 from asyncua.common.instantiate_util import _instantiate_node
 from asyncua.common.ua_utils import get_node_supertypes
 
-from ..backend import Backend
 from . import machine_tool_members as members
 from .binding import VariableBinder
+from .linked_backend import LinkedBackend
 from .nodesets import MACHINE_TOOL_URI
 from .sources import Source
 from .values import eu_information
@@ -32,7 +32,7 @@ MACHINE_TOOL_TYPE, CHANNEL_MONITORING_TYPE, SPINDLE_MONITORING_TYPE = 13, 16, 22
 TOOL_TYPE, PROGRAM_STATE_MACHINE_TYPE = 50, 15
 
 
-async def build_machine_tool(server: Server, binder: VariableBinder, backend: Backend,
+async def build_machine_tool(server: Server, binder: VariableBinder, backend: LinkedBackend,
                              vendor: str, product_uri: str) -> Node:
     """Add the MachineTool instance of this service (named as its machine configuration)
     under Objects/Machines; returns its node."""

@@ -13,7 +13,6 @@ import time
 
 from asyncua import Server
 
-from ..backend import Backend
 from . import address_space_cache as cache
 from .alarm_events import build_alarm_events
 from .attributes import BoundAttributes
@@ -22,6 +21,7 @@ from .channel_methods import build_channel_methods
 from .cnc_interface import build_cnc_interface
 from .config import endpoint_url
 from .limits import OpcUaLimits, apply_limits
+from .linked_backend import LinkedBackend
 from .machine_tool import build_machine_tool
 from .nodesets import asyncua_quiet, load_nodesets
 from .security import apply_security
@@ -37,7 +37,7 @@ VENDOR = "cnc-objects"
 class OpcUaServer:
     """The OPC UA front end of one service."""
 
-    def __init__(self, backend: Backend, security: OpcUaSecurity,
+    def __init__(self, backend: LinkedBackend, security: OpcUaSecurity,
                  limits: OpcUaLimits | None = None) -> None:
         self.backend = backend
         self.security = security
