@@ -40,12 +40,19 @@ $(VENV)/.native: $(NATIVE_SOURCES) | $(VENV)/.installed
 	$(BIN)/python tools/build_native.py
 	touch $@
 
+# The OPC UA nodesets imported once, where the service keeps its address space cache
+# (service/opcua/prepare.py; docs/opcua.md "Start-up"): the service's first start is a
+# warm one. Without it (a cache that cannot be written) the first start imports them.
+$(VENV)/.opcua-cache: $(wildcard service/opcua/nodesets/*.xml) $(VENV)/.installed
+	-$(BIN)/python -m cnc_objects.service.opcua.prepare
+	touch $@
+
 # `make run` starts the web HMI cnc-web beside the service, on http://127.0.0.1:$(WEB_PORT)
 # (loopback only); WEB=0 leaves it out. It ends with the service (Ctrl-C).
 WEB      ?= 1
 WEB_PORT ?= 8080
 
-run: $(VENV)/.installed $(VENV)/.native
+run: $(VENV)/.installed $(VENV)/.native $(if $(filter off,$(OPCUA)),,$(VENV)/.opcua-cache)
 ifeq ($(WEB),0)
 	$(BIN)/cnc-service --endpoint $(ENDPOINT) $(if $(ADS),--ads $(ADS)) $(if $(OPCUA),--opcua $(OPCUA)) \
 		$(if $(DATA_DIR),--data-dir $(DATA_DIR)) $(if $(CONFIG),--config $(CONFIG)) $(if $(MACHINE),--machine $(MACHINE))

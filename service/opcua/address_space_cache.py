@@ -28,9 +28,15 @@ from pathlib import Path
 from typing import Any
 
 from asyncua import ua
-from asyncua.server.address_space import NodeData
+from asyncua.server.address_space import (
+    AttributeValue,
+    NodeData,
+    NodeManagementService,
+    ViewService,
+)
 from asyncua.server.internal_server import InternalServer
 
+from .fast_import import importing_services
 from .nodesets import NODESET_DIR, NODESETS
 
 log = logging.getLogger(__name__)
@@ -80,6 +86,23 @@ def _pickled(node: NodeData) -> bytes:
     return buffer.getvalue()
 
 
+def snapshot(nodes: MutableMapping[ua.NodeId, NodeData]) -> dict[ua.NodeId, NodeData]:
+    """The nodes as they are now, for ``save`` on another thread while the server goes
+    on: each node with its own attribute and reference containers (the server adds
+    references to the type nodes and writes values in place), the values themselves
+    shared (a write replaces a DataValue, never changes it). Callables are left out, as
+    ``save`` would leave them (there are none right after an import)."""
+    return {nodeid: _node_copy(node) for nodeid, node in nodes.items()}
+
+
+def _node_copy(node: NodeData) -> NodeData:
+    copy = NodeData(node.nodeid)
+    copy.attributes = {attribute: AttributeValue(kept.value)
+                       for attribute, kept in node.attributes.items()}
+    copy.references = list(node.references)
+    return copy
+
+
 def save(nodes: MutableMapping[ua.NodeId, NodeData], namespaces: list[str], path: Path
          ) -> None:
     """Write ``nodes`` and the server's ``namespaces`` (its NamespaceArray, which the
@@ -101,7 +124,7 @@ def load(path: Path) -> tuple[LazyNodes, list[str]] | None:
     try:
         with path.open("rb") as kept:
             form, namespaces, table = pickle.load(kept)
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):  # none kept (yet)
         return None
     except Exception as exc:  # a damaged cache is rebuilt, never fatal
         log.warning("OPC UA address space cache %s unusable (%s): importing again", path, exc)
@@ -157,6 +180,14 @@ class CachedInternalServer(InternalServer):  # type: ignore[misc]  # asyncua is 
     def __init__(self, nodes: LazyNodes | None) -> None:
         super().__init__()
         self.cached_nodes = nodes
+        # the import and the instances are built with indexes (fast_import)
+        self.node_mgt_service, self.view_service = importing_services(self.aspace)
+
+    def end_import(self) -> None:
+        """Back to asyncua's own node management and browsing (once the address space
+        is built)."""
+        self.node_mgt_service = NodeManagementService(self.aspace)
+        self.view_service = ViewService(self.aspace)
 
     async def load_standard_address_space(self, shelf_file: Path | None = None) -> None:
         """The cached nodes, else asyncua's standard address space."""

@@ -8,8 +8,11 @@ At start it loads the OPC Foundation's nodesets (``nodesets``), builds the CncIn
 
 from __future__ import annotations
 
+import asyncio
 import logging
 import time
+from pathlib import Path
+from typing import Any
 
 from asyncua import Server
 
@@ -49,6 +52,7 @@ class OpcUaServer:
         self.cache_note = ""  # where the imported address space came from
         self.binder: VariableBinder | None = None
         self._server: Server | None = None
+        self._saving: asyncio.Task[None] | None = None  # a cold start keeping its import
 
     @property
     def url(self) -> str:
@@ -73,13 +77,17 @@ class OpcUaServer:
         namespaces = server.nodes.namespace_array
         if kept is None:
             self.nodes_left_out = await load_nodesets(server)
-            try:
-                cache.save(server.iserver.aspace._nodes, await namespaces.read_value(), path)
-                self.cache_note = f"nodesets imported, kept in {path}"
-            except OSError as exc:
-                self.cache_note = f"nodesets imported; cannot keep them in {path}: {exc}"
+            # pickling the nodes takes about as long as importing them: a thread does it
+            # while the server serves (the snapshot is what the import made)
+            self._saving = asyncio.create_task(self._keep(
+                cache.snapshot(server.iserver.aspace._nodes), await namespaces.read_value(),
+                path))
+            self.cache_note = f"nodesets imported, keeping them in {path}"
         else:
-            await namespaces.write_value(kept[1])  # the server's set-up wrote its own
+            # the server's set-up wrote its own; the nodes' indexes are the kept ones,
+            # index 1 is this server's application URI (apply_security may set it)
+            await namespaces.write_value(
+                kept[1][:1] + [server.get_application_uri()] + kept[1][2:])
             with asyncua_quiet():  # the structure classes of the nodesets, made again
                 await server.load_data_type_definitions()
             self.cache_note = f"nodesets from {path}"
@@ -89,6 +97,7 @@ class OpcUaServer:
         machine = await build_machine_tool(server, binder, self.backend, VENDOR, PRODUCT_URI)
         await build_alarm_events(server, self.backend, machine)
         await build_channel_methods(server, self.backend, machine)
+        server.iserver.end_import()  # built: asyncua's own services from here on
         # last: its guard wraps the session factory the alarm events' methods installed
         apply_limits(server, self.limits)
         with asyncua_quiet():  # its warnings of a server without signing policies
@@ -105,8 +114,24 @@ class OpcUaServer:
         entry = self.backend.space.by_name("cnc_version_r")
         return str(entry.read()) if entry is not None and entry.read is not None else ""
 
+    async def _keep(self, nodes: dict[Any, Any], namespaces: list[str], path: Path) -> None:
+        """Write the imported address space to ``path`` on a thread; a failure costs only
+        the next start's time, and is logged."""
+        began = time.perf_counter()
+        try:
+            await asyncio.to_thread(cache.save, nodes, namespaces, path)
+        except OSError as exc:
+            log.warning("OPC UA: cannot keep the imported address space in %s: %s", path, exc)
+            return
+        log.info("OPC UA: imported address space kept in %s (%.1f s)", path,
+                 time.perf_counter() - began)
+
     async def close(self) -> None:
-        """Close every session and stop listening."""
+        """Close every session and stop listening; wait for the imported address space
+        to be kept (after a cold start)."""
+        if self._saving is not None:
+            saving, self._saving = self._saving, None
+            await saving
         if self._server is not None:
             server, self._server = self._server, None
             await server.stop()
