@@ -22,8 +22,8 @@ from typing import Any
 from asyncua import ua
 
 from cnc_objects.objects import Entry
-from cnc_objects.protocol.constants import TransmissionMode
 
+from .link_frames import HubWatch
 from .linked_backend import LinkedBackend
 from .sources import Source
 from .values import bad, good, source_time
@@ -32,17 +32,6 @@ log = logging.getLogger(__name__)
 
 _S = ua.StatusCodes
 DataChangeCallback = Callable[..., Any]  # asyncua's async (handle, DataValue) -> None
-
-
-@dataclass(frozen=True, slots=True)
-class _Watch:
-    """The fields of an AddDeviceNotification the hub reads."""
-
-    port: int
-    group: int
-    offset: int
-    length: int
-    transmission_mode: int = TransmissionMode.SERVER_ON_CHANGE
 
 
 @dataclass
@@ -142,7 +131,7 @@ class Feeds:
         for k, entry in enumerate(var.entries):
             obj = entry.obj
             code, answer = hub.add(
-                _envelope(var, cycle_ns), _Watch(obj.port, obj.group, obj.offset, obj.dtype.size),
+                _envelope(var, cycle_ns), HubWatch(obj.port, obj.group, obj.offset, obj.dtype.size),
                 cycle_ns, self._notifier(var, feed, k))
             if code:
                 log.warning("OPC UA monitored item on %s: %s", var.node_id.to_string(), answer)

@@ -33,11 +33,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from cnc_objects.protocol.constants import TransmissionMode
 from cnc_objects.protocol.errors import AdsReturnCode
 
 from ..backend import Backend
-from .link_frames import FrameBuffer, Link, ReadFailed, frame
+from .link_frames import FrameBuffer, HubWatch, Link, ReadFailed, frame
 
 log = logging.getLogger(__name__)
 
@@ -68,17 +67,6 @@ class Ready:
 
 class OpcUaRefused(Exception):
     """The child could not serve: the one line to print (exit code 2)."""
-
-
-@dataclass(frozen=True, slots=True)
-class _Watch:
-    """The fields of an AddDeviceNotification the hub reads."""
-
-    port: int
-    group: int
-    offset: int
-    length: int
-    transmission_mode: int = TransmissionMode.SERVER_ON_CHANGE
 
 
 class _Link:
@@ -119,6 +107,22 @@ class _Link:
 
     # ------------------------------------------------------------ calls
 
+    def attach_calls(self, transport: asyncio.Transport) -> None:
+        """The calls socket's transport (the child's blocking calls)."""
+        self.calls = transport
+
+    def attach_events(self, transport: asyncio.Transport) -> None:
+        """The events socket's transport (notifications and write answers go there)."""
+        self.events = transport
+
+    def answer_call(self, transport: asyncio.Transport, message: tuple[Any, ...]) -> None:
+        """A call of the child, answered on its socket."""
+        transport.write(frame(self.call(message)))
+
+    def take_event(self, _: asyncio.Transport, message: tuple[Any, ...]) -> None:
+        """An event of the child (its writes, its unsubscribes)."""
+        self.event(message)
+
     def call(self, message: tuple[Any, ...]) -> tuple[Any, ...]:
         """Answer a frame of the calls socket."""
         match message[0]:
@@ -126,7 +130,7 @@ class _Link:
                 return Link.READ, [self._read(h) for h in message[1]]
             case Link.SUBSCRIBE:
                 _, key, envelope, watch, cycle_ns = message
-                return (Link.SUBSCRIBE, *self._subscribe(key, envelope, _Watch(*watch), cycle_ns))
+                return (Link.SUBSCRIBE, *self._subscribe(key, envelope, HubWatch(*watch), cycle_ns))
         raise ValueError(f"unknown call {message[0]!r}")
 
     def _read(self, handle: int) -> Any:
@@ -141,7 +145,7 @@ class _Link:
         except Exception as exc:  # the child logs it as the in-process front end did
             return ReadFailed(f"{type(exc).__name__}: {exc}")
 
-    def _subscribe(self, key: int, envelope: Any, watch: _Watch, cycle_ns: int
+    def _subscribe(self, key: int, envelope: Any, watch: HubWatch, cycle_ns: int
                    ) -> tuple[int, int | str]:
         # the hub counts its limits per client: the child's variable, of this child
         ours = ((*envelope[0], self.generation), *envelope[1:])
@@ -208,41 +212,34 @@ class _Link:
         self.ended.set()
 
 
-class _Calls(asyncio.Protocol):
-    def __init__(self, link: _Link) -> None:
-        self.link, self.frames = link, FrameBuffer()
+class _LinkSocket(asyncio.Protocol):
+    """One socket of a child's link: its transport handed to ``attach``, its frames each
+    to ``handle`` (which may answer on the transport), its end to ``lost``; a frame that
+    fails closes the link (the child is ours: a bad frame is a broken child)."""
+
+    def __init__(self, what: str, attach: Callable[[asyncio.Transport], None],
+                 handle: Callable[[asyncio.Transport, tuple[Any, ...]], None],
+                 lost: Callable[[], None] = lambda: None) -> None:
+        self.what, self.attach, self.handle, self.lost = what, attach, handle, lost
+        self.frames = FrameBuffer()
+        self.transport: asyncio.Transport | None = None
 
     def connection_made(self, transport: asyncio.BaseTransport) -> None:
         assert isinstance(transport, asyncio.Transport)
-        self.link.calls = self.transport = transport
+        self.transport = transport
+        self.attach(transport)
 
     def data_received(self, data: bytes) -> None:
+        assert self.transport is not None
         try:
             for message in self.frames.feed(data):
-                self.transport.write(frame(self.link.call(message)))
+                self.handle(self.transport, message)
         except Exception:
-            log.exception("OPC UA process: a bad call; the link is closed")
-            self.transport.close()
-
-
-class _Events(asyncio.Protocol):
-    def __init__(self, link: _Link) -> None:
-        self.link, self.frames = link, FrameBuffer()
-
-    def connection_made(self, transport: asyncio.BaseTransport) -> None:
-        assert isinstance(transport, asyncio.Transport)
-        self.link.events = self.transport = transport
-
-    def data_received(self, data: bytes) -> None:
-        try:
-            for message in self.frames.feed(data):
-                self.link.event(message)
-        except Exception:
-            log.exception("OPC UA process: a bad event; the link is closed")
+            log.exception("OPC UA process: a bad %s; the link is closed", self.what)
             self.transport.close()
 
     def connection_lost(self, exc: Exception | None) -> None:
-        self.link.lost()
+        self.lost()
 
 
 class OpcUaProcess:
@@ -290,8 +287,11 @@ class OpcUaProcess:
         self._sockets = None
         link = _Link(backend, next(self._generation), self._process.pid)
         loop = backend.loop
-        await loop.connect_accepted_socket(lambda: _Calls(link), calls)
-        await loop.connect_accepted_socket(lambda: _Events(link), events)
+        await loop.connect_accepted_socket(
+            lambda: _LinkSocket("call", link.attach_calls, link.answer_call), calls)
+        await loop.connect_accepted_socket(
+            lambda: _LinkSocket("event", link.attach_events, link.take_event, link.lost),
+            events)
         self._link = link
         root = logging.getLogger()
         formatter = root.handlers[0].formatter if root.handlers else None

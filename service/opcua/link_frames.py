@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from enum import IntEnum
 from typing import Any
 
+from cnc_objects.protocol.constants import TransmissionMode
 from cnc_objects.protocol.datatypes import DataType, parse_type
 
 _LENGTH = struct.Struct("<I")
@@ -102,3 +103,15 @@ class FrameBuffer:
             start = end
         del buffer[:start]
         return messages
+
+
+@dataclass(frozen=True, slots=True)
+class HubWatch:
+    """The fields of an AddDeviceNotification the notification hub reads: what a feed
+    (child) subscribes and the host hands the service's hub."""
+
+    port: int
+    group: int
+    offset: int
+    length: int
+    transmission_mode: int = TransmissionMode.SERVER_ON_CHANGE

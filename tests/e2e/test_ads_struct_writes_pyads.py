@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import ctypes
 import struct
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import pyads
 import pytest
@@ -45,7 +45,7 @@ def raw(plc: pyads.Connection, entry: SymbolEntry) -> bytes:
                           return_ctypes=True))
 
 
-def test_every_struct_symbol_takes_its_own_bytes_back_at_its_address(plc) -> None:
+def test_every_struct_symbol_takes_its_own_bytes_back_at_its_address(plc: pyads.Connection) -> None:
     symbols = struct_symbols(plc)
     assert len(symbols) > 100 and SPINDLE in {s.name for s in symbols}
     refused = []
@@ -60,7 +60,7 @@ def test_every_struct_symbol_takes_its_own_bytes_back_at_its_address(plc) -> Non
     assert refused == []
 
 
-def test_every_struct_symbol_takes_its_own_bytes_back_by_handle(plc) -> None:
+def test_every_struct_symbol_takes_its_own_bytes_back_by_handle(plc: pyads.Connection) -> None:
     refused = []
     for entry in struct_symbols(plc):
         kind = ctypes.c_ubyte * entry.size
@@ -75,7 +75,8 @@ def test_every_struct_symbol_takes_its_own_bytes_back_by_handle(plc) -> None:
     assert refused == []
 
 
-def test_a_changed_read_only_member_changes_nothing_and_the_writable_one_is_written(plc) -> None:
+def test_a_changed_read_only_member_changes_nothing_and_the_writable_one_is_written(
+        plc: pyads.Connection) -> None:
     """Node-RED's write of ``{"override_w": 500}``: the struct read, one member changed,
     written back; a read-only member sent changed is ignored, kernel state unchanged."""
     entry = next(s for s in struct_symbols(plc) if s.name == SPINDLE)
@@ -93,14 +94,15 @@ def test_a_changed_read_only_member_changes_nothing_and_the_writable_one_is_writ
         plc.write_by_name(f"{SPINDLE}.override_w", override_w, pyads.PLCTYPE_UINT)
 
 
-def test_a_struct_with_nothing_writable_refuses_other_bytes(plc) -> None:
+def test_a_struct_with_nothing_writable_refuses_other_bytes(plc: pyads.Connection) -> None:
     entry = next(s for s in struct_symbols(plc) if s.name == "gpAx[0].lr_state")
     before = raw(plc, entry)
     changed = bytes([before[0] ^ 1]) + before[1:]
-    for write in (
+    writes: list[Callable[[], object]] = [
         lambda: plc.write(PLC_GROUP, entry.offset, list(changed), ctypes.c_ubyte * entry.size),
         lambda: plc.write_by_name(entry.name, list(changed), ctypes.c_ubyte * entry.size),
-    ):
+    ]
+    for write in writes:
         with pytest.raises(pyads.ADSError) as refused:
             write()
         assert refused.value.err_code == INVALIDACCESS
