@@ -197,11 +197,19 @@ def service_command(*args: str) -> list[str]:
     return [*argv, *args]
 
 
+#: The last byte of every loopback address ``free_loopback_ads_address`` gave.
+_ADS_HOSTS_GIVEN: set[int] = set()
+
+
 def free_loopback_ads_address() -> str:
     """``127.0.0.<n>:48898`` that nothing listens on right now (n in 2..254, chosen at
-    random, so that parallel test runs rarely pick the same)."""
+    random, so that parallel test runs rarely pick the same), and not given before in
+    this process while another is left: AdsLib, pyads' router, keeps its connection to an
+    address after a service there stopped, and a later service at the same address then
+    gets no answer through it (pyads: "timeout elapsed (1861)")."""
     candidates = list(range(2, 255))
     random.shuffle(candidates)
+    candidates.sort(key=lambda n: n in _ADS_HOSTS_GIVEN)  # the fresh ones first
     for n in candidates:
         host = f"127.0.0.{n}"
         with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
@@ -209,6 +217,7 @@ def free_loopback_ads_address() -> str:
                 probe.bind((host, AMS_TCP_PORT))
             except OSError:
                 continue
+        _ADS_HOSTS_GIVEN.add(n)
         return f"{host}:{AMS_TCP_PORT}"
     raise RuntimeError(f"no loopback address 127.0.0.2..254 has port {AMS_TCP_PORT} free")
 
